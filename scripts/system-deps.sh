@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Installs the Debian packages the test suite needs, only when they are missing.
+# Each entry: "<command that proves it is installed>:<apt package>".
+set -euo pipefail
+NEEDED=(
+)
+missing=()
+for entry in "${NEEDED[@]}"; do
+  probe=${entry%%:*}
+  pkg=${entry##*:}
+  command -v "$probe" >/dev/null 2>&1 || missing+=("$pkg")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+SUDO=""
+[ "$(id -u)" -ne 0 ] && SUDO="sudo"
+echo "installing system packages: ${missing[*]}" >&2
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null

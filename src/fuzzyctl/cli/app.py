@@ -1,0 +1,92 @@
+"""The typer application and the error boundary that keeps tracebacks away from users.
+
+Exit codes: 0 success, 1 the input has errors, 2 usage error, 3 internal error (a bug)."""
+
+from __future__ import annotations
+
+import sys
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from fuzzyctl import __version__
+from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
+
+app = typer.Typer(
+    name="fuzzyctl",
+    help="IEC 61131-7 fuzzy control: check, run, convert and generate code for FCL programs.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+err_console = Console(stderr=True, highlight=False, soft_wrap=True)
+
+EXIT_OK, EXIT_ERRORS, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
+
+
+def _version(value: bool) -> None:
+    if value:
+        typer.echo(f"fuzzyctl {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _root(
+    version: Annotated[
+        bool, typer.Option("--version", callback=_version, is_eager=True, help="Print the version.")
+    ] = False,
+) -> None:
+    """fuzzyctl: fuzzy control the way PLC engineers practise it."""
+
+
+def _register_commands() -> None:
+    """Import the command modules so that they attach themselves to ``app``."""
+    # Imported for their side effect; keep heavy imports inside the command functions.
+    from fuzzyctl.cli import commands  # noqa: F401
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the CLI; never lets a Python traceback reach the user."""
+    _register_commands()
+    command = typer.main.get_command(app)
+    try:
+        result = command.main(args=argv, prog_name="fuzzyctl", standalone_mode=False)
+    except typer.Exit as exc:
+        return int(exc.exit_code or 0)
+    except typer.Abort:
+        err_console.print("aborted")
+        return EXIT_ERRORS
+    except typer.TyperException as exc:  # usage errors: bad option, missing argument, ...
+        show = getattr(exc, "show", None)
+        if callable(show):
+            show(file=sys.stderr)
+        else:
+            err_console.print(f"error: {exc.format_message()}", markup=False)
+        return int(getattr(exc, "exit_code", EXIT_USAGE) or EXIT_USAGE)
+    except DiagnosticError as exc:
+        err_console.print(exc.render(), markup=False)
+        return EXIT_ERRORS
+    except FuzzyctlError as exc:
+        err_console.print(f"error: {exc}", markup=False)
+        return EXIT_ERRORS
+    except OSError as exc:
+        err_console.print(f"error: {exc.strerror or exc}: {exc.filename or ''}".rstrip(": "), markup=False)
+        return EXIT_ERRORS
+    except KeyboardInterrupt:
+        err_console.print("interrupted")
+        return 130
+    except Exception as exc:
+        err_console.print(
+            f"internal error: {type(exc).__name__}: {exc}\n"
+            "This is a bug in fuzzyctl; please report it with the command you ran.",
+            markup=False,
+        )
+        return EXIT_INTERNAL
+    # standalone_mode=False hands back the exit code of typer.Exit as the result.
+    return result if isinstance(result, int) else EXIT_OK
+
+
+def run() -> None:
+    sys.exit(main())

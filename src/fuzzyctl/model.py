@@ -1,0 +1,482 @@
+"""The immutable model of a fuzzy control program (IEC 61131-7 FCL and what our readers import).
+
+Every reader (FCL, FIS, FLL, FPL, XFUZ tables, JSON) produces these objects and every
+consumer (engine, code generators, PLC blocks, studio) reads them.  Objects are frozen
+dataclasses holding tuples, so a model can be shared between threads and compared with
+``==``.  Source positions (``span``) and comments never take part in equality: a program
+written back out and read again compares equal to the original.
+
+Conventions
+-----------
+* Names are kept exactly as written; FCL identifiers are case-sensitive in this model
+  (keywords are not).  Operator and method keywords are stored upper-case in their
+  canonical spelling (``"MIN"``, ``"COG"``), see the ``*_OPERATORS`` / ``*_METHODS`` sets.
+* A numeric parameter that may be given by a variable (membership points, singleton
+  positions, shape parameters, WITH weights) is a :data:`Param`: a ``float`` or a
+  :class:`Ref` to a variable (normally a VAR_INPUT, IEC 61131-7 5.2.2 and 5.2.4).
+* ``None`` means "not written in the source"; the engine documents the default it uses.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+from enum import StrEnum
+from typing import TypeAlias
+
+# --------------------------------------------------------------------------- positions
+
+
+@dataclass(frozen=True, slots=True)
+class Span:
+    """A source position, 1-based line and column, optionally with its end (exclusive)."""
+
+    line: int
+    column: int
+    end_line: int | None = None
+    end_column: int | None = None
+
+    def __str__(self) -> str:
+        return f"{self.line}:{self.column}"
+
+
+# --------------------------------------------------------------------------- parameters
+
+
+@dataclass(frozen=True)
+class Ref:
+    """A parameter given by the current value of a variable (e.g. ``(bp_warm1, 0.0)``)."""
+
+    name: str
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+Param: TypeAlias = float | Ref
+"""A number, or a reference to a variable whose value is read at each evaluation."""
+
+
+def is_constant(p: Param) -> bool:
+    """True when the parameter is a literal number."""
+    return not isinstance(p, Ref)
+
+
+# --------------------------------------------------------------------------- membership functions
+
+
+@dataclass(frozen=True)
+class Point:
+    """One ``(x, y)`` point of a piecewise-linear membership function (5.2.2)."""
+
+    x: Param
+    y: Param
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class PointsMF:
+    """IEC piecewise-linear membership function: linear between successive points and
+    constant beyond the first and the last point (5.2.2)."""
+
+    points: tuple[Point, ...]
+
+
+@dataclass(frozen=True)
+class SingletonMF:
+    """A singleton output term ``TERM closed := 0;`` (5.2.3); the value may be a variable."""
+
+    value: Param
+
+
+@dataclass(frozen=True)
+class SingletonsMF:
+    """jFuzzyLogic's generalised singletons ``SINGLETONS (x1, y1) (x2, y2) ...``: a discrete
+    fuzzy set with degree ``yi`` at ``xi`` and 0 elsewhere."""
+
+    points: tuple[Point, ...]
+
+
+@dataclass(frozen=True)
+class ShapeSpec:
+    """Description of a parametric shape kind: parameter names and their meaning."""
+
+    kind: str
+    params: tuple[str, ...]
+    summary: str
+    variadic: bool = False
+
+
+# Canonical parametric shapes.  Each reader maps its own spelling and parameter order onto
+# these (e.g. jFuzzyLogic ``GBELL a b mean`` and fuzzylite ``Bell center width slope`` both
+# become ``bell(center, width, slope)``); writers map back.  Formulas live in
+# ``fuzzyctl.engine.shapes`` and nowhere else.
+SHAPES: dict[str, ShapeSpec] = {
+    s.kind: s
+    for s in (
+        ShapeSpec("triangle", ("a", "b", "c"), "0 at a, 1 at b, 0 at c, linear between"),
+        ShapeSpec("trapezoid", ("a", "b", "c", "d"), "0 at a, 1 on [b, c], 0 at d"),
+        ShapeSpec("rectangle", ("start", "end"), "1 on [start, end], 0 elsewhere"),
+        ShapeSpec("gaussian", ("mean", "sigma"), "exp(-(x-mean)^2 / (2 sigma^2))"),
+        ShapeSpec(
+            "gaussian2",
+            ("mean1", "sigma1", "mean2", "sigma2"),
+            "left Gaussian below mean1, right Gaussian above mean2, 1 between (gauss2mf)",
+        ),
+        ShapeSpec("bell", ("center", "width", "slope"), "1 / (1 + |(x-center)/width|^(2 slope))"),
+        ShapeSpec("sigmoid", ("center", "slope"), "1 / (1 + exp(-slope (x-center)))"),
+        ShapeSpec(
+            "dsigmoid",
+            ("center1", "slope1", "center2", "slope2"),
+            "difference of two sigmoids (dsigmf / DSIGM / SigmoidDifference)",
+        ),
+        ShapeSpec(
+            "psigmoid",
+            ("center1", "slope1", "center2", "slope2"),
+            "product of two sigmoids (psigmf / SigmoidProduct)",
+        ),
+        ShapeSpec("cosine", ("center", "width"), "raised cosine of the given width around center"),
+        ShapeSpec("sshape", ("start", "end"), "smooth S-curve from 0 at start to 1 at end"),
+        ShapeSpec("zshape", ("start", "end"), "smooth Z-curve from 1 at start to 0 at end"),
+        ShapeSpec("pishape", ("a", "b", "c", "d"), "S-shape a..b times Z-shape c..d"),
+        ShapeSpec("ramp", ("start", "end"), "linear from 0 at start to 1 at end"),
+        ShapeSpec("spike", ("center", "width"), "exp(-|10 (x-center) / width|)"),
+        ShapeSpec("concave", ("inflection", "end"), "fuzzylite Concave"),
+        ShapeSpec("binary", ("start", "direction"), "1 on the side of start given by direction"),
+        ShapeSpec("constant", ("value",), "Takagi-Sugeno constant output"),
+        ShapeSpec(
+            "linear",
+            ("coefficients",),
+            "Takagi-Sugeno linear output: sum(c_i * input_i) + constant, inputs in declaration order",
+            variadic=True,
+        ),
+    )
+}
+
+
+@dataclass(frozen=True)
+class ShapeMF:
+    """A parametric membership function of a kind listed in :data:`SHAPES`.
+
+    ``height`` scales the shape (fuzzylite's optional last parameter)."""
+
+    kind: str
+    params: tuple[Param, ...]
+    height: Param = 1.0
+
+
+# ---- expressions of function terms (jFuzzyLogic FUNCTION, fuzzylite Function)
+
+
+@dataclass(frozen=True)
+class Num:
+    value: float
+
+
+@dataclass(frozen=True)
+class Name:
+    name: str
+
+
+@dataclass(frozen=True)
+class Unary:
+    op: str  # "-" or "+"
+    operand: Expr
+
+
+@dataclass(frozen=True)
+class Binary:
+    op: str  # "+", "-", "*", "/", "^", "%"
+    left: Expr
+    right: Expr
+
+
+@dataclass(frozen=True)
+class Call:
+    function: str  # lower-case: sin, cos, exp, log, sqrt, abs/fabs, ...
+    args: tuple[Expr, ...]
+
+
+Expr: TypeAlias = Num | Name | Unary | Binary | Call
+
+
+@dataclass(frozen=True)
+class FunctionMF:
+    """A term whose value is an arithmetic expression of input variables (open level)."""
+
+    expr: Expr
+    text: str = field(default="", compare=False)
+
+
+MembershipFunction: TypeAlias = PointsMF | SingletonMF | SingletonsMF | ShapeMF | FunctionMF
+
+
+@dataclass(frozen=True)
+class Term:
+    """A linguistic term ``TERM name := membership_function;``."""
+
+    name: str
+    mf: MembershipFunction
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+
+# --------------------------------------------------------------------------- variables and blocks
+
+
+class VarKind(StrEnum):
+    INPUT = "VAR_INPUT"
+    OUTPUT = "VAR_OUTPUT"
+    LOCAL = "VAR"
+
+
+@dataclass(frozen=True)
+class Range:
+    """``RANGE(low..high)``: limits the output terms (5.2.3) or, for inputs, the universe."""
+
+    low: float
+    high: float
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Variable:
+    """A declaration in VAR_INPUT / VAR_OUTPUT / VAR: ``name : TYPE [:= initial];``."""
+
+    name: str
+    kind: VarKind
+    data_type: str = "REAL"
+    initial: float | bool | str | None = None
+    range: Range | None = None
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class FuzzifyBlock:
+    """``FUZZIFY variable ... END_FUZZIFY`` (5.2.2)."""
+
+    variable: str
+    terms: tuple[Term, ...]
+    range: Range | None = None
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+    def term(self, name: str) -> Term | None:
+        return next((t for t in self.terms if t.name == name), None)
+
+
+@dataclass(frozen=True)
+class Default:
+    """``DEFAULT := value | NC``.  fuzzylite's ``DEFAULT := nan | NC`` sets both."""
+
+    value: float | None = None
+    no_change: bool = False
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+    def __post_init__(self) -> None:
+        # One NaN object, so that models holding NaN defaults still compare equal.
+        if self.value is not None and math.isnan(self.value):
+            object.__setattr__(self, "value", math.nan)
+
+
+@dataclass(frozen=True)
+class DefuzzifyBlock:
+    """``DEFUZZIFY variable ... END_DEFUZZIFY`` (5.2.3).
+
+    ``accu`` is fuzzylite's accumulation written inside DEFUZZIFY; the standard puts ACCU in
+    the rule block."""
+
+    variable: str
+    terms: tuple[Term, ...]
+    range: Range | None = None
+    method: str | None = None
+    default: Default | None = None
+    accu: str | None = None
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+    def term(self, name: str) -> Term | None:
+        return next((t for t in self.terms if t.name == name), None)
+
+
+# --------------------------------------------------------------------------- rules
+
+
+@dataclass(frozen=True)
+class Is:
+    """Subcondition ``variable IS [NOT] [hedges] term``."""
+
+    variable: str
+    term: str
+    negated: bool = False
+    hedges: tuple[str, ...] = ()
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Degree:
+    """A bare variable in a condition: its value is a membership degree in [0, 1]."""
+
+    variable: str
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Not:
+    operand: Condition
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class And:
+    """Conjunction of two or more operands, written without parentheses between them."""
+
+    operands: tuple[Condition, ...]
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Or:
+    operands: tuple[Condition, ...]
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+Condition: TypeAlias = Is | Degree | Not | And | Or
+
+
+@dataclass(frozen=True)
+class Conclusion:
+    """Subconclusion ``variable IS term [WITH weight]`` or a bare ``variable``
+    (``term is None``: the variable receives the condition degree)."""
+
+    variable: str
+    term: str | None = None
+    weight: Param | None = None
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class Rule:
+    """``RULE label: IF condition THEN conclusion;``.
+
+    ``condition`` is ``None`` for a rule with an empty IF part (Siemens 1.5: it acts with
+    degree 1).  A WITH weight belongs to the subconclusion it follows (5.2.4)."""
+
+    label: str
+    condition: Condition | None
+    conclusions: tuple[Conclusion, ...]
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class RuleBlock:
+    """``RULEBLOCK name ... END_RULEBLOCK`` (5.2.4).  Operators as written (canonical
+    upper-case spelling) or ``None`` when absent."""
+
+    name: str | None
+    rules: tuple[Rule, ...]
+    and_op: str | None = None
+    or_op: str | None = None
+    act: str | None = None
+    accu: str | None = None
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+
+@dataclass(frozen=True)
+class OptionsBlock:
+    """``OPTIONS ... END_OPTIONS`` (or ``OPTION ... END_OPTION``), text kept verbatim."""
+
+    text: str
+    keyword: str = "OPTIONS"
+    span: Span | None = field(default=None, compare=False, repr=False)
+
+
+# --------------------------------------------------------------------------- function block
+
+
+@dataclass(frozen=True)
+class FunctionBlock:
+    """An FCL function block: interface, fuzzification, defuzzification, rules, options."""
+
+    name: str | None
+    variables: tuple[Variable, ...] = ()
+    fuzzify: tuple[FuzzifyBlock, ...] = ()
+    defuzzify: tuple[DefuzzifyBlock, ...] = ()
+    rule_blocks: tuple[RuleBlock, ...] = ()
+    options: tuple[OptionsBlock, ...] = ()
+    span: Span | None = field(default=None, compare=False, repr=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+    def _of_kind(self, kind: VarKind) -> tuple[Variable, ...]:
+        return tuple(v for v in self.variables if v.kind is kind)
+
+    @property
+    def inputs(self) -> tuple[Variable, ...]:
+        return self._of_kind(VarKind.INPUT)
+
+    @property
+    def outputs(self) -> tuple[Variable, ...]:
+        return self._of_kind(VarKind.OUTPUT)
+
+    @property
+    def locals(self) -> tuple[Variable, ...]:
+        return self._of_kind(VarKind.LOCAL)
+
+    def variable(self, name: str) -> Variable | None:
+        return next((v for v in self.variables if v.name == name), None)
+
+    def fuzzify_block(self, variable: str) -> FuzzifyBlock | None:
+        return next((f for f in self.fuzzify if f.variable == variable), None)
+
+    def defuzzify_block(self, variable: str) -> DefuzzifyBlock | None:
+        return next((d for d in self.defuzzify if d.variable == variable), None)
+
+    def rules(self) -> Iterator[tuple[RuleBlock, Rule]]:
+        for block in self.rule_blocks:
+            for rule in block.rules:
+                yield block, rule
+
+
+@dataclass(frozen=True)
+class Document:
+    """A parsed file: one or more function blocks (IEC allows several per file)."""
+
+    blocks: tuple[FunctionBlock, ...]
+    path: str | None = field(default=None, compare=False)
+    comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+
+    @property
+    def main(self) -> FunctionBlock:
+        """The first function block."""
+        return self.blocks[0]
+
+    def block(self, name: str | None = None) -> FunctionBlock:
+        """The function block called ``name`` (the first one when ``name`` is None)."""
+        if name is None:
+            return self.main
+        for b in self.blocks:
+            if b.name == name:
+                return b
+        known = ", ".join(repr(b.name) for b in self.blocks)
+        raise KeyError(f"no function block {name!r} (this file has {known})")
+
+
+# --------------------------------------------------------------------------- keyword sets
+
+AND_OPERATORS = frozenset({"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER", "EINSTEIN"})
+OR_OPERATORS = frozenset({"MAX", "ASUM", "BSUM", "DMAX", "NIPMAX", "HAMACHER", "EINSTEIN"})
+# Table 3 pairs; the open-level norms pair with their usual duals.
+OPERATOR_PAIRS: dict[str, str] = {
+    "MIN": "MAX",
+    "PROD": "ASUM",
+    "BDIF": "BSUM",
+    "DMIN": "DMAX",
+    "NIPMIN": "NIPMAX",
+    "HAMACHER": "HAMACHER",
+    "EINSTEIN": "EINSTEIN",
+}
+ACT_METHODS = frozenset({"MIN", "PROD"})
+ACCU_METHODS = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR"})
+DEFUZZ_METHODS = frozenset({"COG", "COGS", "COA", "LM", "RM", "MOM", "COGF", "WTAVER", "WTSUM"})
