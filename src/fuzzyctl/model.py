@@ -127,14 +127,23 @@ SHAPES: dict[str, ShapeSpec] = {
         ShapeSpec(
             "dsigmoid",
             ("center1", "slope1", "center2", "slope2"),
-            "difference of two sigmoids (dsigmf / DSIGM / SigmoidDifference)",
+            "|s1 - s2| of two sigmoids (fuzzylite SigmoidDifference)",
+        ),
+        ShapeSpec(
+            "dsigmoid_pos",
+            ("center1", "slope1", "center2", "slope2"),
+            "max(s1 - s2, 0) of two sigmoids (jFuzzyLogic DSIGM)",
         ),
         ShapeSpec(
             "psigmoid",
             ("center1", "slope1", "center2", "slope2"),
             "product of two sigmoids (psigmf / SigmoidProduct)",
         ),
-        ShapeSpec("cosine", ("center", "width"), "raised cosine of the given width around center"),
+        ShapeSpec(
+            "cosine",
+            ("center", "width"),
+            "(1 + cos(2 pi (x-center)/width)) / 2 on [center-width/2, center+width/2], 0 outside",
+        ),
         ShapeSpec("sshape", ("start", "end"), "smooth S-curve from 0 at start to 1 at end"),
         ShapeSpec("zshape", ("start", "end"), "smooth Z-curve from 1 at start to 0 at end"),
         ShapeSpec("pishape", ("a", "b", "c", "d"), "S-shape a..b times Z-shape c..d"),
