@@ -55,22 +55,41 @@ EXPECTED_FPLTEST = FunctionBlock(
         Variable("Valve", VarKind.OUTPUT, "REAL", range=Range(-101.0, 101.0)),
     ),
     fuzzify=(
-        FuzzifyBlock("Temp", (Term("cold", pts((0, 1), (3, 1), (27, 0))),
-                              Term("hot", pts((3, 0), (27, 1), (30, 1))))),
-        FuzzifyBlock("Pressure", (Term("low", pts((50, 1), (55, 1), (95, 0))),
-                                  Term("high", pts((55, 0), (95, 1), (100, 1))))),
+        FuzzifyBlock(
+            "Temp", (Term("cold", pts((0, 1), (3, 1), (27, 0))), Term("hot", pts((3, 0), (27, 1), (30, 1))))
+        ),
+        FuzzifyBlock(
+            "Pressure",
+            (Term("low", pts((50, 1), (55, 1), (95, 0))), Term("high", pts((55, 0), (95, 1), (100, 1)))),
+        ),
     ),
     defuzzify=(
-        DefuzzifyBlock("Valve", (Term("drainage", SingletonMF(-100.0)), Term("closed", SingletonMF(0.0)),
-                                 Term("inlet", SingletonMF(100.0))),
-                       range=Range(-101.0, 101.0), method="COGS", default=Default(no_change=True)),
+        DefuzzifyBlock(
+            "Valve",
+            (
+                Term("drainage", SingletonMF(-100.0)),
+                Term("closed", SingletonMF(0.0)),
+                Term("inlet", SingletonMF(100.0)),
+            ),
+            range=Range(-101.0, 101.0),
+            method="COGS",
+            default=Default(no_change=True),
+        ),
     ),
-    rule_blocks=(RuleBlock("ProFuzzy", (
-        rule("Rule_01", "cold", "low", "inlet"),
-        rule("Rule_02", "cold", "high", "closed"),
-        rule("Rule_03", "hot", "low", "closed"),
-        rule("Rule_04", "hot", "high", "drainage"),
-    ), and_op="MIN", act="MIN", accu="MAX"),),
+    rule_blocks=(
+        RuleBlock(
+            "ProFuzzy",
+            (
+                rule("Rule_01", "cold", "low", "inlet"),
+                rule("Rule_02", "cold", "high", "closed"),
+                rule("Rule_03", "hot", "low", "closed"),
+                rule("Rule_04", "hot", "high", "drainage"),
+            ),
+            and_op="MIN",
+            act="MIN",
+            accu="MAX",
+        ),
+    ),
 )
 
 
@@ -141,7 +160,12 @@ def test_siemens_1_3_tolerated_elements_warn_as_the_manual_lists() -> None:
 @pytest.mark.parametrize(
     ("source", "message", "line", "column"),
     [
-        ("PROJECT p\nFUZZY r RULE a IF (x is lo) OR (x is hi) THEN y = s END END END", "OR is not permissible", 2, 29),
+        (
+            "PROJECT p\nFUZZY r RULE a IF (x is lo) OR (x is hi) THEN y = s END END END",
+            "OR is not permissible",
+            2,
+            29,
+        ),
         ("PROJECT p\nFUZZY r RULE a IF x is NOT lo THEN y = s END END END", "NOT is not permissible", 2, 24),
         ("PROJECT p\nPACKAGE q END END", "PACKAGE is not permissible", 2, 1),
         ("PROJECT p\nFUZZY a END\nFUZZY b END END", "only one set of rules", 3, 1),
@@ -171,8 +195,9 @@ def test_fpl_writer_round_trips_the_manual_example() -> None:
 
 def test_fpl_writer_refuses_what_the_subset_cannot_say() -> None:
     fb = EXPECTED_FPLTEST
-    weighted = RuleBlock("r", (Rule("1", Is("Temp", "cold"), (Conclusion("Valve", "inlet", weight=0.8),)),),
-                         and_op="PROD")
+    weighted = RuleBlock(
+        "r", (Rule("1", Is("Temp", "cold"), (Conclusion("Valve", "inlet", weight=0.8),)),), and_op="PROD"
+    )
     gauss = FuzzifyBlock("Temp", (Term("warm", ShapeMF("gaussian", (15.0, 3.0))),))
     bad = FunctionBlock(fb.name, fb.variables, (gauss,), fb.defuzzify, (weighted,))
     codes = sorted(d.code for d in check_fpl(bad) if d.is_error)
@@ -184,10 +209,22 @@ def test_fpl_writer_refuses_what_the_subset_cannot_say() -> None:
 def test_fpl_writer_turns_triangles_and_trapezoids_into_points() -> None:
     fb = FunctionBlock(
         "shapes",
-        variables=(Variable("x", VarKind.INPUT, range=Range(0, 10)), Variable("y", VarKind.OUTPUT, range=Range(0, 1))),
-        fuzzify=(FuzzifyBlock("x", (Term("t", ShapeMF("triangle", (1.0, 2.0, 3.0))),
-                                    Term("z", ShapeMF("trapezoid", (4.0, 5.0, 6.0, 7.0))))),),
-        defuzzify=(DefuzzifyBlock("y", (Term("one", SingletonMF(1.0)),), method="COGS", default=Default(0.0)),),
+        variables=(
+            Variable("x", VarKind.INPUT, range=Range(0, 10)),
+            Variable("y", VarKind.OUTPUT, range=Range(0, 1)),
+        ),
+        fuzzify=(
+            FuzzifyBlock(
+                "x",
+                (
+                    Term("t", ShapeMF("triangle", (1.0, 2.0, 3.0))),
+                    Term("z", ShapeMF("trapezoid", (4.0, 5.0, 6.0, 7.0))),
+                ),
+            ),
+        ),
+        defuzzify=(
+            DefuzzifyBlock("y", (Term("one", SingletonMF(1.0)),), method="COGS", default=Default(0.0)),
+        ),
         rule_blocks=(RuleBlock("r", (Rule("1", Is("x", "t"), (Conclusion("y", "one"),)),)),),
     )
     warnings = [d.code for d in check_fpl(fb)]

@@ -11,6 +11,7 @@ as skipped and resumes at the next release on the period grid.
 
 from __future__ import annotations
 
+import itertools
 import math
 import statistics
 import time
@@ -19,7 +20,15 @@ from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
-__all__ = ["Clock", "CycleContext", "CycleRecord", "CyclicTask", "RealTimeClock", "SimulatedClock", "TaskStats"]
+__all__ = [
+    "Clock",
+    "CycleContext",
+    "CycleRecord",
+    "CyclicTask",
+    "RealTimeClock",
+    "SimulatedClock",
+    "TaskStats",
+]
 
 
 class Clock(Protocol):
@@ -41,8 +50,9 @@ class SimulatedClock:
     ``latency`` adds a wake-up delay after each sleep: a constant, a sequence used
     cyclically, or a function of the wake-up count, to simulate jitter."""
 
-    def __init__(self, start: float = 0.0, *,
-                 latency: float | Sequence[float] | Callable[[int], float] = 0.0) -> None:
+    def __init__(
+        self, start: float = 0.0, *, latency: float | Sequence[float] | Callable[[int], float] = 0.0
+    ) -> None:
         self._t = float(start)
         self._wakeups = 0
         self._latency = latency
@@ -162,16 +172,23 @@ class TaskStats:
     def cycle_times(self) -> list[float]:
         """Start-to-start intervals of the kept records (the PLC's "cycle time")."""
         starts = [r.start for r in self.records]
-        return [b - a for a, b in zip(starts, starts[1:], strict=False)]
+        return [b - a for a, b in itertools.pairwise(starts)]
 
     def jitter_stdev(self) -> float:
         values = [r.jitter for r in self.records]
         return statistics.pstdev(values) if len(values) > 1 else 0.0
 
     def summary(self) -> dict[str, float | int]:
-        return {"period": self.period, "cycles": self.count, "overruns": self.overruns, "skipped": self.skipped,
-                "jitter_mean": self.jitter_mean, "jitter_max": self.jitter_max,
-                "duration_mean": self.duration_mean, "duration_max": self.duration_max}
+        return {
+            "period": self.period,
+            "cycles": self.count,
+            "overruns": self.overruns,
+            "skipped": self.skipped,
+            "jitter_mean": self.jitter_mean,
+            "jitter_max": self.jitter_max,
+            "duration_mean": self.duration_mean,
+            "duration_max": self.duration_max,
+        }
 
 
 Block = Callable[[CycleContext], object]
@@ -180,8 +197,9 @@ Block = Callable[[CycleContext], object]
 class CyclicTask:
     """Calls its blocks every ``period`` seconds, in the order they were added."""
 
-    def __init__(self, period: float, blocks: Iterable[Block] = (), *, clock: Clock | None = None,
-                 keep: int = 10_000) -> None:
+    def __init__(
+        self, period: float, blocks: Iterable[Block] = (), *, clock: Clock | None = None, keep: int = 10_000
+    ) -> None:
         if not period > 0 or not math.isfinite(period):
             raise ValueError(f"period must be a positive number of seconds, not {period!r}")
         self.period = float(period)
@@ -198,6 +216,13 @@ class CyclicTask:
         self.blocks.append(block)
         return block
 
+    @property
+    def next_release(self) -> float:
+        """When the next cycle is due (now, before the first one)."""
+        if self._origin is None:
+            return self.clock.now()
+        return self._origin + self._next_index * self.period
+
     def step(self) -> CycleRecord:
         """Wait for the next release, run every block once, record the cycle."""
         if self._origin is None:
@@ -212,24 +237,31 @@ class CyclicTask:
         # Releases that fell before the end of this cycle are lost (cyclic interrupt semantics).
         following = self._next_index + 1
         resume = max(following, math.ceil((end - self._origin) / self.period - 1e-9))
-        rec = CycleRecord(self._cycle, due, start, end, overrun=end > due + self.period, skipped=resume - following)
+        rec = CycleRecord(
+            self._cycle, due, start, end, overrun=end > due + self.period, skipped=resume - following
+        )
         self._next_index = resume
         self._cycle += 1
         self.stats.add(rec)
         return rec
 
-    def run(self, cycles: int | None = None, *, duration: float | None = None,
-            until: Callable[[], bool] | None = None) -> TaskStats:
-        """Run ``cycles`` cycles, or for ``duration`` seconds of clock time, or until
+    def run(
+        self,
+        cycles: int | None = None,
+        *,
+        duration: float | None = None,
+        until: Callable[[], bool] | None = None,
+    ) -> TaskStats:
+        """Run ``cycles`` cycles, or the cycles due within ``duration`` seconds, or until
         ``until()`` is true (checked after each cycle); at least one limit is required."""
         if cycles is None and duration is None and until is None:
             raise ValueError("give cycles, duration or until")
-        begin = self.clock.now()
+        begin = self.clock.now() if self._origin is None else self.next_release
         done = 0
         while True:
             if cycles is not None and done >= cycles:
                 break
-            if duration is not None and self.clock.now() - begin >= duration:
+            if duration is not None and self.next_release - begin >= duration - 1e-12:
                 break
             self.step()
             done += 1

@@ -1,1 +1,2 @@
 """Imports every command module so that each registers its commands on the app."""
+from fuzzyctl.cli import blocks  # noqa: F401  (fuzzyctl blocks ...)

@@ -83,10 +83,32 @@ _TOKEN = re.compile(
 )
 
 # Objects that own an END (skipping a tolerated object counts these to find its END).
-_OBJECTS = {"PROJECT", "PACKAGE", "VAR", "MEMBER", "FUZZY", "RULE", "CONNECT", "OPTIONS", "SOURCE", "FRAGMENT"}
+_OBJECTS = {
+    "PROJECT",
+    "PACKAGE",
+    "VAR",
+    "MEMBER",
+    "FUZZY",
+    "RULE",
+    "CONNECT",
+    "OPTIONS",
+    "SOURCE",
+    "FRAGMENT",
+}
 # Words that end the arguments of a tolerated attribute (MAP, INITIALLY, DEFAULT).
 _STRUCTURAL = _OBJECTS | {
-    "END", "TYPE", "MIN", "MAX", "POINTS", "IF", "THEN", "FROM", "TO", "MAP", "INITIALLY", "DEFAULT",
+    "END",
+    "TYPE",
+    "MIN",
+    "MAX",
+    "POINTS",
+    "IF",
+    "THEN",
+    "FROM",
+    "TO",
+    "MAP",
+    "INITIALLY",
+    "DEFAULT",
 }
 # The manual's texts for the tolerated elements (Siemens 1.3, "Tolerated FPL Elements").
 _TOLERATED_ATTRIBUTES = {
@@ -240,8 +262,12 @@ class _Parser:
         tok = self.tok
         if tok.kind == "code":
             self.advance()
-            self.note("#CODE..#END_CODE ignored: C source code is not used by Fuzzy Control",
-                      tok, Severity.NOTE, "fpl-tolerated")
+            self.note(
+                "#CODE..#END_CODE ignored: C source code is not used by Fuzzy Control",
+                tok,
+                Severity.NOTE,
+                "fpl-tolerated",
+            )
             return True
         word = tok.upper
         if word in _TOLERATED_ATTRIBUTES:
@@ -289,8 +315,9 @@ class _Parser:
                 break
             elif tok.kind == "eof":
                 # A missing final END loses nothing; say so and accept the file.
-                self.diags.append(warning("PROJECT is not closed by END", tok.span,
-                                          code="fpl-missing-end", file=self.file))
+                self.diags.append(
+                    warning("PROJECT is not closed by END", tok.span, code="fpl-missing-end", file=self.file)
+                )
                 break
             else:
                 self.fail(f"expected VAR, FUZZY, CONNECT or END, found {self.describe(tok)}")
@@ -311,9 +338,14 @@ class _Parser:
                 self.advance()
                 var.type_name = self.expect_word("a type name").text
                 if var.type_name.upper() != "FLOAT":
-                    self.diags.append(warning(
-                        f"TYPE {var.type_name} read as float: Fuzzy Control variables are always FLOAT",
-                        tok.span, code="fpl-type", file=self.file))
+                    self.diags.append(
+                        warning(
+                            f"TYPE {var.type_name} read as float: Fuzzy Control variables are always FLOAT",
+                            tok.span,
+                            code="fpl-type",
+                            file=self.file,
+                        )
+                    )
             elif word == "MIN":
                 self.advance()
                 var.low = self.number("MIN")
@@ -326,11 +358,18 @@ class _Parser:
                 self.advance()
                 break
             else:
-                self.fail(f"expected TYPE, MIN, MAX, MEMBER or END in VAR {var.name}, "
-                          f"found {self.describe(tok)}")
+                self.fail(
+                    f"expected TYPE, MIN, MAX, MEMBER or END in VAR {var.name}, found {self.describe(tok)}"
+                )
         if var.low is not None and var.high is not None and var.low >= var.high:
-            self.diags.append(error(f"VAR {var.name}: MIN {var.low:g} must be below MAX {var.high:g}",
-                                    var.span, code="fpl-range", file=self.file))
+            self.diags.append(
+                error(
+                    f"VAR {var.name}: MIN {var.low:g} must be below MAX {var.high:g}",
+                    var.span,
+                    code="fpl-range",
+                    file=self.file,
+                )
+            )
         self.vars.append(var)
 
     def parse_member(self) -> _Member:
@@ -350,23 +389,30 @@ class _Parser:
                     if t.kind == "number":
                         numbers.append((float(t.text), t))
                 if len(numbers) % 2:
-                    self.fail(f"MEMBER {member.name}: POINTS needs x,y pairs, found {len(numbers)} numbers",
-                              numbers[-1][1] if numbers else tok)
+                    self.fail(
+                        f"MEMBER {member.name}: POINTS needs x,y pairs, found {len(numbers)} numbers",
+                        numbers[-1][1] if numbers else tok,
+                    )
                 pts = [(numbers[k][0], numbers[k + 1][0]) for k in range(0, len(numbers), 2)]
                 for k, (x, y) in enumerate(pts):
                     ytok = numbers[2 * k + 1][1]
                     if not 0.0 <= y <= 1.0:
                         self.fail(f"MEMBER {member.name}: degree {y:g} is outside [0, 1]", ytok)
                     if k and x < pts[k - 1][0]:
-                        self.fail(f"MEMBER {member.name}: points must be in increasing x order "
-                                  f"({x:g} follows {pts[k - 1][0]:g})", numbers[2 * k][1])
+                        self.fail(
+                            f"MEMBER {member.name}: points must be in increasing x order "
+                            f"({x:g} follows {pts[k - 1][0]:g})",
+                            numbers[2 * k][1],
+                        )
                 member.points.extend(pts)
             elif tok.upper == "END":
                 self.advance()
                 break
             else:
-                self.fail(f"expected POINTS or END in MEMBER {member.name}, found {self.describe(tok)}",
-                          hint="equations are not permissible for membership functions (Siemens 1.3)")
+                self.fail(
+                    f"expected POINTS or END in MEMBER {member.name}, found {self.describe(tok)}",
+                    hint="equations are not permissible for membership functions (Siemens 1.3)",
+                )
         if not member.points:
             self.fail(f"MEMBER {member.name} has no POINTS", start)
         return member
@@ -467,8 +513,14 @@ class _Parser:
             self.advance()
             if self.at("FROM", "TO"):
                 # The manual's own example has "FROM FROM ProFuzzy": read it, say so.
-                self.diags.append(warning(f"repeated {self.tok.text} in CONNECT", self.tok.span,
-                                          code="fpl-repeated-keyword", file=self.file))
+                self.diags.append(
+                    warning(
+                        f"repeated {self.tok.text} in CONNECT",
+                        self.tok.span,
+                        code="fpl-repeated-keyword",
+                        file=self.file,
+                    )
+                )
                 continue
             if kw.upper in ends:
                 self.fail(f"CONNECT has two {kw.upper} parts", kw)
@@ -523,8 +575,14 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
         seen: set[str] = set()
         for m in var.members:
             if m.name in seen:
-                diags.append(error(f"MEMBER {m.name} is defined twice in VAR {var.name}", m.span,
-                                   code="fpl-duplicate", file=file))
+                diags.append(
+                    error(
+                        f"MEMBER {m.name} is defined twice in VAR {var.name}",
+                        m.span,
+                        code="fpl-duplicate",
+                        file=file,
+                    )
+                )
             seen.add(m.name)
     base = p.rulebases[0] if p.rulebases else None
     base_name = base.name if base else None
@@ -537,8 +595,14 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
             kinds[src] = VarKind.INPUT
         else:
             bad, span = (src, src_span) if src not in by_name and src != base_name else (dst, dst_span)
-            diags.append(error(f"CONNECT FROM {src} TO {dst}: {bad} is not a VAR or the rule base",
-                               span, code="fpl-connect", file=file))
+            diags.append(
+                error(
+                    f"CONNECT FROM {src} TO {dst}: {bad} is not a VAR or the rule base",
+                    span,
+                    code="fpl-connect",
+                    file=file,
+                )
+            )
     # Without CONNECT objects the rules tell inputs from outputs.
     for rule in base.rules if base else []:
         for c in rule.conclusions:
@@ -560,14 +624,18 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
         if kind is VarKind.OUTPUT:
             terms = tuple(Term(m.name, _output_mf(m.points, low, high), span=m.span) for m in var.members)
             all_singletons &= all(isinstance(t.mf, SingletonMF) for t in terms)
-            defuzzify.append(DefuzzifyBlock(var.name, terms, range=rng, default=Default(no_change=True),
-                                            span=var.span))
+            defuzzify.append(
+                DefuzzifyBlock(var.name, terms, range=rng, default=Default(no_change=True), span=var.span)
+            )
         elif var.members:
-            terms = tuple(Term(m.name, PointsMF(_input_points(m.points, low, high)), span=m.span)
-                          for m in var.members)
+            terms = tuple(
+                Term(m.name, PointsMF(_input_points(m.points, low, high)), span=m.span) for m in var.members
+            )
             fuzzify.append(FuzzifyBlock(var.name, terms, span=var.span))
     method = "COGS" if all_singletons else "COG"
-    defuzzify = [DefuzzifyBlock(d.variable, d.terms, d.range, method, d.default, span=d.span) for d in defuzzify]
+    defuzzify = [
+        DefuzzifyBlock(d.variable, d.terms, d.range, method, d.default, span=d.span) for d in defuzzify
+    ]
 
     for rule in base.rules if base else []:
         for cond in _leaves(rule.condition):
@@ -575,14 +643,21 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
         for c in rule.conclusions:
             _check_ref(by_name, kinds, c.variable, c.term, VarKind.OUTPUT, c.span, file, diags)
     if not outputs and base and base.rules:
-        diags.append(warning("no output variable: nothing is CONNECTed FROM the rule base",
-                             base.span, code="fpl-no-output", file=file))
+        diags.append(
+            warning(
+                "no output variable: nothing is CONNECTed FROM the rule base",
+                base.span,
+                code="fpl-no-output",
+                file=file,
+            )
+        )
     rule_blocks: tuple[RuleBlock, ...] = ()
     if base is not None:
         rules = tuple(Rule(r.label, r.condition, tuple(r.conclusions), span=r.span) for r in base.rules)
         rule_blocks = (RuleBlock(base.name, rules, and_op="MIN", act="MIN", accu="MAX", span=base.span),)
-    return FunctionBlock(p.project, tuple(variables), tuple(fuzzify), tuple(defuzzify), rule_blocks,
-                         comments=tuple(comments))
+    return FunctionBlock(
+        p.project, tuple(variables), tuple(fuzzify), tuple(defuzzify), rule_blocks, comments=tuple(comments)
+    )
 
 
 def _leaves(cond: Condition | None) -> Iterator[Is]:
@@ -598,14 +673,28 @@ def _condition_vars(cond: Condition | None) -> Iterator[str]:
         yield leaf.variable
 
 
-def _check_ref(by_name: dict[str, _Var], kinds: dict[str, VarKind], var: str, term: str | None,
-               want: VarKind, span: Span | None, file: str | None, diags: list[Diagnostic]) -> None:
+def _check_ref(
+    by_name: dict[str, _Var],
+    kinds: dict[str, VarKind],
+    var: str,
+    term: str | None,
+    want: VarKind,
+    span: Span | None,
+    file: str | None,
+    diags: list[Diagnostic],
+) -> None:
     role = "output" if want is VarKind.OUTPUT else "input"
     if var not in by_name:
         diags.append(error(f"{var} is not a VAR of this project", span, code="fpl-undeclared", file=file))
     elif kinds.get(var) is not want:
-        diags.append(error(f"{var} is used as an {role} but CONNECTed the other way", span,
-                           code="fpl-direction", file=file))
+        diags.append(
+            error(
+                f"{var} is used as an {role} but CONNECTed the other way",
+                span,
+                code="fpl-direction",
+                file=file,
+            )
+        )
     elif term is not None and term not in {m.name for m in by_name[var].members}:
         diags.append(error(f"{var} has no MEMBER {term}", span, code="fpl-undeclared-term", file=file))
 
@@ -684,13 +773,19 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
         diags.append(error(msg, span, code=code, hint=hint))
 
     if len(block.rule_blocks) > 1:
-        err("FPL for Fuzzy Control holds one set of rules; this program has "
-            f"{len(block.rule_blocks)} rule blocks", block.rule_blocks[1].span, "fpl-expr-ruleblocks")
+        err(
+            "FPL for Fuzzy Control holds one set of rules; this program has "
+            f"{len(block.rule_blocks)} rule blocks",
+            block.rule_blocks[1].span,
+            "fpl-expr-ruleblocks",
+        )
     if block.locals:
         err("FPL for Fuzzy Control has no intermediate variables", block.locals[0].span, "fpl-expr-local")
     for rb in block.rule_blocks:
         if rb.and_op not in (None, "MIN"):
-            err(f"AND : {rb.and_op} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op")
+            err(
+                f"AND : {rb.and_op} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op"
+            )
         if rb.accu not in (None, "MAX"):
             err(f"ACCU : {rb.accu} cannot be written in FPL (Fuzzy Control uses MAX)", rb.span, "fpl-expr-op")
         if rb.act not in (None, "MIN", "PROD") or (rb.act == "PROD" and not _all_singletons(block)):
@@ -701,29 +796,54 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
                 if c.term is None:
                     err(f"rule {rule.label}: a conclusion needs a term", c.span, "fpl-expr-rule")
                 if c.weight is not None and c.weight != 1.0:
-                    err(f"rule {rule.label}: WITH weights cannot be written in FPL", c.span,
-                        "fpl-expr-weight", hint="remove the WITH or scale the rule another way")
+                    err(
+                        f"rule {rule.label}: WITH weights cannot be written in FPL",
+                        c.span,
+                        "fpl-expr-weight",
+                        hint="remove the WITH or scale the rule another way",
+                    )
     for fz in block.fuzzify:
         for t in fz.terms:
             if _as_points(t.mf) is None:
-                err(f"{fz.variable}.{t.name}: only piecewise-linear terms with constant points can be "
-                    "written in FPL", t.span, "fpl-expr-term", hint="equations are not permissible (1.3)")
+                err(
+                    f"{fz.variable}.{t.name}: only piecewise-linear terms with constant points can be "
+                    "written in FPL",
+                    t.span,
+                    "fpl-expr-term",
+                    hint="equations are not permissible (1.3)",
+                )
     for dz in block.defuzzify:
         if dz.method not in (None, "COG", "COGS"):
-            err(f"METHOD : {dz.method} cannot be written in FPL (Fuzzy Control computes the centre of "
-                "gravity)", dz.span, "fpl-expr-method")
+            err(
+                f"METHOD : {dz.method} cannot be written in FPL (Fuzzy Control computes the centre of "
+                "gravity)",
+                dz.span,
+                "fpl-expr-method",
+            )
         if dz.default is not None and not dz.default.no_change:
-            diags.append(warning(f"{dz.variable}: DEFAULT := {dz.default.value} is not written: Fuzzy "
-                                 "Control keeps the last value when no rule fires", dz.span,
-                                 code="fpl-expr-default"))
+            diags.append(
+                warning(
+                    f"{dz.variable}: DEFAULT := {dz.default.value} is not written: Fuzzy "
+                    "Control keeps the last value when no rule fires",
+                    dz.span,
+                    code="fpl-expr-default",
+                )
+            )
         for t in dz.terms:
             if isinstance(t.mf, SingletonMF):
                 if not is_constant(t.mf.value):
-                    err(f"{dz.variable}.{t.name}: a singleton given by a variable cannot be written in FPL",
-                        t.span, "fpl-expr-term")
+                    err(
+                        f"{dz.variable}.{t.name}: a singleton given by a variable cannot be written in FPL",
+                        t.span,
+                        "fpl-expr-term",
+                    )
             elif _as_points(t.mf) is None:
-                err(f"{dz.variable}.{t.name}: only singletons and piecewise-linear terms can be "
-                    "written in FPL", t.span, "fpl-expr-term")
+                err(
+                    f"{dz.variable}.{t.name}: only singletons and piecewise-linear terms can be "
+                    "written in FPL",
+                    t.span,
+                    "fpl-expr-term",
+                )
     for v in block.variables:
         if v.kind is VarKind.OUTPUT and block.defuzzify_block(v.name) is None:
             err(f"output {v.name} has no DEFUZZIFY block", v.span, "fpl-expr-output")
@@ -743,9 +863,14 @@ def _check_condition(cond: Condition | None, rule: Rule, diags: list[Diagnostic]
     elif isinstance(cond, Is) and not cond.negated and not cond.hedges:
         return
     else:
-        diags.append(error(f"rule {rule.label}: only 'variable IS term' joined by AND can be written in FPL "
-                           "(no OR, NOT or hedges)", getattr(cond, "span", None) or rule.span,
-                           code="fpl-expr-rule"))
+        diags.append(
+            error(
+                f"rule {rule.label}: only 'variable IS term' joined by AND can be written in FPL "
+                "(no OR, NOT or hedges)",
+                getattr(cond, "span", None) or rule.span,
+                code="fpl-expr-rule",
+            )
+        )
 
 
 def _singleton_width(dz: DefuzzifyBlock, variable: Variable | None) -> float:
@@ -793,7 +918,7 @@ def write_fpl(block: FunctionBlock | Document) -> str:
             out += [f"MEMBER {name}", "POINTS " + " ".join(f"{_num(x)},{_num(y)}" for x, y in pts), "END"]
         out.append("END")
     base = fb.rule_blocks[0] if fb.rule_blocks else None
-    base_name = (base.name if base and base.name else "rules")
+    base_name = base.name if base and base.name else "rules"
     out.append(f"FUZZY {base_name}")
     for rb_rule in base.rules if base else ():
         out.append(f"RULE {rb_rule.label}")

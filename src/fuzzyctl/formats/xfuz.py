@@ -35,6 +35,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import math
 import re
 from collections.abc import Iterator
 from dataclasses import dataclass, replace
@@ -48,17 +49,18 @@ from fuzzyctl.formats.xfuz_tables import (
     OPEN_HIGH,
     OPEN_LOW,
     RG_SIZE,
+    KnowledgeBase,
+    SlotKind,
     StatusBit,
     XfuzConstants,
     XMembership,
     XRule,
     XVariable,
-    KnowledgeBase,
-    SlotKind,
     check_kb,
     decode_kb,
     encode_kb,
     encode_name,
+    esv_offsets,
     slot_kind,
     slot_label,
 )
@@ -75,6 +77,7 @@ from fuzzyctl.model import (
     MembershipFunction,
     Not,
     OptionsBlock,
+    Param,
     Point,
     PointsMF,
     Range,
@@ -101,12 +104,22 @@ __all__ = [
     "model_from_constants",
     "read_tables",
     "read_xfuz",
+    "slot_labels",
     "write_tables",
     "write_xfuz",
 ]
 
-_CONSTANT_KEYS = ("OP_CONJ", "OP_ET", "OP_IMPL", "OP_AGREG", "OP_DEFUZ", "OUT_PT", "CONTASK$", "T_OFB$",
-                  *(f"O{i}_DEF$" for i in range(1, 7)))
+_CONSTANT_KEYS = (
+    "OP_CONJ",
+    "OP_ET",
+    "OP_IMPL",
+    "OP_AGREG",
+    "OP_DEFUZ",
+    "OUT_PT",
+    "CONTASK$",
+    "T_OFB$",
+    *(f"O{i}_DEF$" for i in range(1, 7)),
+)
 _DEFAULTS = {"CONTASK$": 1, "T_OFB$": 200}
 
 
@@ -114,17 +127,36 @@ _DEFAULTS = {"CONTASK$": 1, "T_OFB$": 200}
 
 
 def _constants_from_mapping(values: dict[str, int], tables: dict[str, list[int]]) -> XfuzConstants:
-    get = lambda key: values.get(key, _DEFAULTS.get(key, 0))  # noqa: E731
+    def get(key: str) -> int:
+        return values.get(key, _DEFAULTS.get(key, 0))
+
+    # A table that is not given at all keeps the block's default (an empty base).
+    given = {name.lower(): tuple(words) for name, words in tables.items()}
     return XfuzConstants(
-        op_conj=get("OP_CONJ"), op_et=get("OP_ET"), op_impl=get("OP_IMPL"), op_agreg=get("OP_AGREG"),
-        op_defuz=get("OP_DEFUZ"), out_pt=bool(get("OUT_PT")), contask=bool(get("CONTASK$")),
-        t_ofb=get("T_OFB$"), o_def=tuple(get(f"O{i}_DEF$") for i in range(1, 7)),
-        esv=tuple(tables.get("ESV", ())), fa=tuple(tables.get("FA", ())), rg=tuple(tables.get("RG", ())))
+        op_conj=get("OP_CONJ"),
+        op_et=get("OP_ET"),
+        op_impl=get("OP_IMPL"),
+        op_agreg=get("OP_AGREG"),
+        op_defuz=get("OP_DEFUZ"),
+        out_pt=bool(get("OUT_PT")),
+        contask=bool(get("CONTASK$")),
+        t_ofb=get("T_OFB$"),
+        o_def=tuple(get(f"O{i}_DEF$") for i in range(1, 7)),
+        **given,
+    )
 
 
 def _constants_mapping(c: XfuzConstants) -> dict[str, int]:
-    values = {"OP_CONJ": c.op_conj, "OP_ET": c.op_et, "OP_IMPL": c.op_impl, "OP_AGREG": c.op_agreg,
-              "OP_DEFUZ": c.op_defuz, "OUT_PT": int(c.out_pt), "CONTASK$": int(c.contask), "T_OFB$": c.t_ofb}
+    values = {
+        "OP_CONJ": c.op_conj,
+        "OP_ET": c.op_et,
+        "OP_IMPL": c.op_impl,
+        "OP_AGREG": c.op_agreg,
+        "OP_DEFUZ": c.op_defuz,
+        "OUT_PT": int(c.out_pt),
+        "CONTASK$": int(c.contask),
+        "T_OFB$": c.t_ofb,
+    }
     values.update({f"O{i + 1}_DEF$": v for i, v in enumerate(c.o_def)})
     return values
 
@@ -137,33 +169,48 @@ def _read_json(text: str, path: str | None) -> XfuzConstants:
     try:
         data = json.loads(text)
     except json.JSONDecodeError as exc:
-        raise DiagnosticError([error(f"not valid JSON: {exc.msg}", Span(exc.lineno, exc.colno),
-                                     code="xfuz-json", file=path)], text) from None
+        raise DiagnosticError(
+            [error(f"not valid JSON: {exc.msg}", Span(exc.lineno, exc.colno), code="xfuz-json", file=path)],
+            text,
+        ) from None
     diags: list[Diagnostic] = []
     if not isinstance(data, dict):
-        raise DiagnosticError([error("expected a JSON object with ESV, FA and RG", code="xfuz-json", file=path)])
+        raise DiagnosticError(
+            [error("expected a JSON object with ESV, FA and RG", code="xfuz-json", file=path)]
+        )
     if data.get("format", FORMAT_TAG) != FORMAT_TAG:
-        diags.append(error(f"format is {data.get('format')!r}, expected {FORMAT_TAG!r}", code="xfuz-json",
-                           file=path))
+        diags.append(
+            error(f"format is {data.get('format')!r}, expected {FORMAT_TAG!r}", code="xfuz-json", file=path)
+        )
     consts = data.get("constants", {})
     if not isinstance(consts, dict):
         diags.append(error("constants must be an object", code="xfuz-json", file=path))
         consts = {}
     for key, value in consts.items():
         if key not in _CONSTANT_KEYS:
-            diags.append(error(f"unknown constant {key!r} (known: {', '.join(_CONSTANT_KEYS)})",
-                               code="xfuz-json", file=path))
+            diags.append(
+                error(
+                    f"unknown constant {key!r} (known: {', '.join(_CONSTANT_KEYS)})",
+                    code="xfuz-json",
+                    file=path,
+                )
+            )
         elif not _is_int(value):
-            diags.append(error(f"constant {key} must be an integer, got {value!r}", code="xfuz-json", file=path))
+            diags.append(
+                error(f"constant {key} must be an integer, got {value!r}", code="xfuz-json", file=path)
+            )
     tables: dict[str, list[int]] = {}
     for name, size in (("ESV", ESV_SIZE), ("FA", FA_SIZE), ("RG", RG_SIZE)):
-        words = data.get(name, [])
+        if name not in data:
+            continue
+        words = data[name]
         if not isinstance(words, list) or not all(_is_int(w) for w in words):
             diags.append(error(f"{name} must be an array of integers", code="xfuz-json", file=path))
             continue
         if len(words) > size:
-            diags.append(error(f"{name} has {len(words)} words; the table holds {size}", code="xfuz-json",
-                               file=path))
+            diags.append(
+                error(f"{name} has {len(words)} words; the table holds {size}", code="xfuz-json", file=path)
+            )
         tables[name] = words
     for key in data:
         if key not in ("format", "version", "constants", "ESV", "FA", "RG", "comment"):
@@ -171,8 +218,9 @@ def _read_json(text: str, path: str | None) -> XfuzConstants:
     return _finish(consts, tables, diags, text, path)
 
 
-def _finish(consts: dict[str, int], tables: dict[str, list[int]], diags: list[Diagnostic],
-            text: str, path: str | None) -> XfuzConstants:
+def _finish(
+    consts: dict[str, int], tables: dict[str, list[int]], diags: list[Diagnostic], text: str, path: str | None
+) -> XfuzConstants:
     if any(d.is_error for d in diags):
         raise DiagnosticError(diags, text)
     try:
@@ -191,8 +239,8 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
         if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
             continue
         cells = [c.strip() for c in row]
-        if lineno == 1 and cells[0].lower() == "table":
-            continue
+        if cells[0].lower() == "table" and len(cells) > 2 and cells[2].lower() == "value":
+            continue  # the header row
         span = Span(lineno, 1)
         if len(cells) < 3:
             diags.append(error("expected table,index,value[,note]", span, code="xfuz-csv", file=path))
@@ -205,8 +253,14 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
             continue
         key = (table, index.upper())
         if key in seen:
-            diags.append(error(f"{table} {index} is given twice (first on line {seen[key]})", span,
-                               code="xfuz-csv", file=path))
+            diags.append(
+                error(
+                    f"{table} {index} is given twice (first on line {seen[key]})",
+                    span,
+                    code="xfuz-csv",
+                    file=path,
+                )
+            )
             continue
         seen[key] = lineno
         if table == "CONST":
@@ -216,13 +270,20 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
                 consts[index.upper()] = number
         elif table in sizes:
             if not index.isdigit() or int(index) >= sizes[table]:
-                diags.append(error(f"{table} index {index!r} is not 0..{sizes[table] - 1}", span,
-                                   code="xfuz-csv", file=path))
+                diags.append(
+                    error(
+                        f"{table} index {index!r} is not 0..{sizes[table] - 1}",
+                        span,
+                        code="xfuz-csv",
+                        file=path,
+                    )
+                )
             else:
                 tables[table][int(index)] = number
         else:
-            diags.append(error(f"table {cells[0]!r} is not CONST, ESV, FA or RG", span, code="xfuz-csv",
-                               file=path))
+            diags.append(
+                error(f"table {cells[0]!r} is not CONST, ESV, FA or RG", span, code="xfuz-csv", file=path)
+            )
     return _finish(consts, tables, diags, text, path)
 
 
@@ -248,8 +309,9 @@ def _notes(c: XfuzConstants) -> dict[tuple[str, int], str]:
                 for k in range(4):
                     notes[("ESV", 46 + 4 * (slot - 14) + k)] = f"{label} Nom({2 * k + 1}-{2 * k + 2})"
     for n in range(64):
-        for k, what in enumerate(("Nom(1-2)", "Nom(3-4)", "Nom(5-6)", "Nom(7-8)", "Variable", "xA", "xB", "xC",
-                                  "xD")):
+        for k, what in enumerate(
+            ("Nom(1-2)", "Nom(3-4)", "Nom(5-6)", "Nom(7-8)", "Variable", "xA", "xB", "xC", "xD")
+        ):
             notes[("FA", 9 * n + k)] = f"FA{n} {what}"
     for r in range(64):
         for k, what in enumerate(("Pred1", "Pred2", "Pred3", "Pred4", "Concl1", "Concl2")):
@@ -265,8 +327,7 @@ def _used_ranges(c: XfuzConstants) -> Iterator[tuple[str, int]]:
     for name, words in (("ESV", c.esv), ("FA", c.fa), ("RG", c.rg)):
         keep.update((name, k) for k, w in enumerate(words) if w)
     for v in kb.variables:
-        lo = 2 * v.slot if v.slot < 8 else (16 + 3 * (v.slot - 8) if v.slot < 14 else 34 + 3 * (v.slot - 14))
-        keep.update(("ESV", lo + k) for k in range(2 if v.slot < 8 else 3))
+        keep.update(("ESV", k) for k in esv_offsets(v.slot) if k is not None)
     for mf in kb.memberships:
         keep.update(("FA", 9 * mf.number + k) for k in range(9))
     for rule in kb.rules:
@@ -278,11 +339,20 @@ def _used_ranges(c: XfuzConstants) -> Iterator[tuple[str, int]]:
 def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
     """Table file text in the ``json`` or ``csv`` layout."""
     if layout == "json":
-        body = {"format": FORMAT_TAG, "version": 1, "constants": _constants_mapping(constants),
-                "ESV": list(constants.esv), "FA": list(constants.fa), "RG": list(constants.rg)}
+        body = {
+            "format": FORMAT_TAG,
+            "version": 1,
+            "constants": _constants_mapping(constants),
+            "ESV": list(constants.esv),
+            "FA": list(constants.fa),
+            "RG": list(constants.rg),
+        }
         text = json.dumps(body, indent=1)
         # One table per line is easier to read and diff than one word per line.
-        return re.sub(r"\[\s+([-\d,\s]+?)\s+\]", lambda m: "[" + re.sub(r"\s+", " ", m.group(1)) + "]", text) + "\n"
+        return (
+            re.sub(r"\[\s+([-\d,\s]+?)\s+\]", lambda m: "[" + re.sub(r"\s+", " ", m.group(1)) + "]", text)
+            + "\n"
+        )
     if layout != "csv":
         raise ValueError(f"layout must be 'json' or 'csv', not {layout!r}")
     out = io.StringIO()
@@ -308,8 +378,9 @@ def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
         return SingletonMF(float(mf.singleton()))
     a, b, c, d = (float(x) for x in mf.points)
     left_open, right_open = mf.a == OPEN_LOW and mf.b == OPEN_LOW, mf.c == OPEN_HIGH and mf.d == OPEN_HIGH
+    pts: list[tuple[float, float]]
     if left_open and right_open:
-        pts = [(OPEN_LOW, 1.0), (OPEN_HIGH, 1.0)]
+        pts = [(float(OPEN_LOW), 1.0), (float(OPEN_HIGH), 1.0)]
     elif left_open:
         pts = [(c, 1.0), (d, 0.0)]
     elif right_open:
@@ -339,10 +410,14 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         # Rules pointing nowhere and functions of non-existent variables cannot be decoded;
         # everything else can, and is what the block itself would flag in STATUS.
         fatal = issue.bit == StatusBit.RULE_REFERENCE or (
-            issue.bit == StatusBit.MF_ORDER and "does not exist" in issue.message)
+            issue.bit == StatusBit.MF_ORDER and "does not exist" in issue.message
+        )
         text = f"{issue.location}: {issue.message} (XFUZ STATUS bit {issue.bit})".lstrip(": ")
-        diags.append(error(text, code=f"xfuz-status-{issue.bit}") if fatal
-                     else warning(text, code=f"xfuz-status-{issue.bit}"))
+        diags.append(
+            error(text, code=f"xfuz-status-{issue.bit}")
+            if fatal
+            else warning(text, code=f"xfuz-status-{issue.bit}")
+        )
     names: dict[int, str] = {}
     renamed: list[tuple[str, str]] = []
     for v in kb.variables:
@@ -352,14 +427,19 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
                 names[v.slot] = v.name
                 renamed.append((v.name, label))
             else:
-                diags.append(warning(f"{label}: name {v.name!r} is not an identifier; the variable is called "
-                                     f"{label}", code="xfuz-name"))
+                diags.append(
+                    warning(
+                        f"{label}: name {v.name!r} is not an identifier; the variable is called {label}",
+                        code="xfuz-name",
+                    )
+                )
                 names[v.slot] = label
         else:
             names[v.slot] = label
     # Variables in the order their functions appear in FA, then the ones without functions.
-    order = list(dict.fromkeys([m.slot for m in kb.memberships if 0 <= m.slot < 18]
-                               + [v.slot for v in kb.variables]))
+    order = list(
+        dict.fromkeys([m.slot for m in kb.memberships if 0 <= m.slot < 18] + [v.slot for v in kb.variables])
+    )
     term_names: dict[int, str] = {}
     terms: dict[int, list[Term]] = {slot: [] for slot in order}
     last_slot, regrouped = -1, False
@@ -370,24 +450,44 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         last_slot = mf.slot
         tname = mf.name if mf.name and _IDENT.match(mf.name) else f"FA{mf.number}"
         if tname != mf.name:
-            diags.append(warning(f"FA{mf.number}: name {mf.name!r} is not an identifier; the term is called "
-                                 f"{tname}", code="xfuz-name"))
+            diags.append(
+                warning(
+                    f"FA{mf.number}: name {mf.name!r} is not an identifier; the term is called {tname}",
+                    code="xfuz-name",
+                )
+            )
         if any(t.name == tname for t in terms[mf.slot]):
-            diags.append(warning(f"FA{mf.number}: {names[mf.slot]} already has a term {tname}; this one is "
-                                 f"called {tname}_{mf.number}", code="xfuz-name"))
+            diags.append(
+                warning(
+                    f"FA{mf.number}: {names[mf.slot]} already has a term {tname}; this one is "
+                    f"called {tname}_{mf.number}",
+                    code="xfuz-name",
+                )
+            )
             tname = f"{tname}_{mf.number}"
         term_names[mf.number] = tname
         singleton = c.out_pt and slot_kind(mf.slot) is SlotKind.OUTPUT
         if singleton and len(set(mf.points)) > 1:
-            diags.append(warning(f"FA{mf.number}: singleton mode keeps the point {mf.singleton()}; the other "
-                                 "abscissae are not kept", code="xfuz-singleton"))
+            diags.append(
+                warning(
+                    f"FA{mf.number}: singleton mode keeps the point {mf.singleton()}; the other "
+                    "abscissae are not kept",
+                    code="xfuz-singleton",
+                )
+            )
         terms[mf.slot].append(Term(tname, _mf_model(mf, singleton)))
     if regrouped:
-        diags.append(warning("the functions of a variable are not contiguous in FA; writing the tables back "
-                             "groups them and renumbers the rules' references", code="xfuz-order"))
+        diags.append(
+            warning(
+                "the functions of a variable are not contiguous in FA; writing the tables back "
+                "groups them and renumbers the rules' references",
+                code="xfuz-order",
+            )
+        )
 
-    as_predicate = {kb.memberships[n].slot for r in kb.rules for n, _ in r.predicates
-                    if 0 <= n < len(kb.memberships)}
+    as_predicate = {
+        kb.memberships[n].slot for r in kb.rules for n, _ in r.predicates if 0 <= n < len(kb.memberships)
+    }
     method = "COGS" if c.out_pt else ("MOM" if c.op_defuz == 1 else "COG")
     variables: list[Variable] = []
     fuzzify: list[FuzzifyBlock] = []
@@ -401,9 +501,8 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         vk = {SlotKind.INPUT: VarKind.INPUT, SlotKind.OUTPUT: VarKind.OUTPUT}.get(kind, VarKind.LOCAL)
         variables.append(Variable(vname, vk, "INT", range=rng))
         tt = tuple(terms[slot])
-        if kind is SlotKind.INPUT or slot in as_predicate:
-            if tt:
-                fuzzify.append(FuzzifyBlock(vname, tt))
+        if (kind is SlotKind.INPUT or slot in as_predicate) and tt:
+            fuzzify.append(FuzzifyBlock(vname, tt))
         if kind is not SlotKind.INPUT:
             discr.append((vname, v.discr))
             if tt:
@@ -413,26 +512,35 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
     for rule in kb.rules:
         conds: list[Condition] = []
         for number, negated in rule.predicates:
-            mf = kb.membership(number)
-            if mf is None or not 0 <= mf.slot < 18:
+            pred_mf = kb.membership(number)
+            if pred_mf is None or not 0 <= pred_mf.slot < 18:
                 continue
-            conds.append(Is(names[mf.slot], term_names[number], negated=negated))
-        concl = tuple(Conclusion(names[kb.memberships[n].slot], term_names[n]) for n in rule.conclusions
-                      if 0 <= n < len(kb.memberships) and n in term_names)
+            conds.append(Is(names[pred_mf.slot], term_names[number], negated=negated))
+        concl = tuple(
+            Conclusion(names[kb.memberships[n].slot], term_names[n])
+            for n in rule.conclusions
+            if 0 <= n < len(kb.memberships) and n in term_names
+        )
         cond: Condition | None = conds[0] if len(conds) == 1 else (And(tuple(conds)) if conds else None)
         rules.append(Rule(str(rule.number), cond, concl))
     ops = {0: "MIN", 1: "PROD"}
     block = FunctionBlock(
-        name, tuple(variables), tuple(fuzzify), tuple(defuzzify),
+        name,
+        tuple(variables),
+        tuple(fuzzify),
+        tuple(defuzzify),
         (RuleBlock("xfuz", tuple(rules), and_op=ops[c.op_et], act=ops[c.op_impl], accu="MAX"),),
-        (OptionsBlock(_options_text(c, renamed, discr)),))
+        (OptionsBlock(_options_text(c, renamed, discr)),),
+    )
     return block, diags
 
 
 def read_xfuz(text: str, *, path: str | None = None) -> Document:
     """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
     constants = read_tables(text, path=path)
-    stem = re.sub(r"(\.xfuz)?\.(json|csv)$|\.xfuz$", "", (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1])
+    stem = re.sub(
+        r"(\.xfuz)?\.(json|csv)$|\.xfuz$", "", (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1]
+    )
     block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
     diags = [replace(d, file=path) for d in diags]
     if any(d.is_error for d in diags):
@@ -472,23 +580,33 @@ def _read_options(block: FunctionBlock, diags: list[Diagnostic]) -> _Options:
                 elif key == "T_OFB$" and len(args) == 1:
                     opts.t_ofb = int(args[0])
                 else:
-                    diags.append(warning(f"OPTIONS line not understood: {line.strip()}", ob.span,
-                                         code="xfuz-options"))
+                    diags.append(
+                        warning(f"OPTIONS line not understood: {line.strip()}", ob.span, code="xfuz-options")
+                    )
             except ValueError:
-                diags.append(error(f"OPTIONS line has a bad number: {line.strip()}", ob.span, code="xfuz-options"))
+                diags.append(
+                    error(f"OPTIONS line has a bad number: {line.strip()}", ob.span, code="xfuz-options")
+                )
     return opts
 
 
-def _int_point(value: object, what: str, span: Span | None, diags: list[Diagnostic]) -> int:
-    if not is_constant(value) or float(value) != int(float(value)) or not OPEN_LOW <= float(value) <= OPEN_HIGH:  # type: ignore[arg-type]
-        diags.append(error(f"{what}: {value} is not a 16-bit integer (XFUZ works on integer words)", span,
-                           code="xfuz-expr-value"))
+def _int_point(value: Param, what: str, span: Span | None, diags: list[Diagnostic]) -> int:
+    number = float(value) if isinstance(value, int | float) else math.nan
+    if not (number == int(number) if math.isfinite(number) else False) or not OPEN_LOW <= number <= OPEN_HIGH:
+        diags.append(
+            error(
+                f"{what}: {value} is not a 16-bit integer (XFUZ works on integer words)",
+                span,
+                code="xfuz-expr-value",
+            )
+        )
         return 0
-    return int(float(value))  # type: ignore[arg-type]
+    return int(number)
 
 
-def _abcd(mf: MembershipFunction, what: str, span: Span | None,
-          diags: list[Diagnostic]) -> tuple[int, int, int, int] | None:
+def _abcd(
+    mf: MembershipFunction, what: str, span: Span | None, diags: list[Diagnostic]
+) -> tuple[int, int, int, int] | None:
     """A term as the four XFUZ abscissae (None and an error when it has another shape)."""
     if isinstance(mf, ShapeMF) and mf.kind in ("triangle", "trapezoid", "rectangle") and mf.height == 1.0:
         p = [_int_point(x, what, span, diags) for x in mf.params]
@@ -518,8 +636,14 @@ def _abcd(mf: MembershipFunction, what: str, span: Span | None,
             return (xs[0], xs[1], xs[2], xs[3])
         if ys in shapes:
             return shapes[ys]
-    diags.append(error(f"{what}: XFUZ terms are trapezoids, triangles or half trapezoids (and singletons "
-                       "with OUT_PT = 1)", span, code="xfuz-expr-term"))
+    diags.append(
+        error(
+            f"{what}: XFUZ terms are trapezoids, triangles or half trapezoids (and singletons "
+            "with OUT_PT = 1)",
+            span,
+            code="xfuz-expr-term",
+        )
+    )
     return None
 
 
@@ -532,23 +656,21 @@ def _leaves(cond: Condition | None, rule: Rule, diags: list[Diagnostic]) -> list
         return [(cond.operand, not cond.operand.negated)]
     if isinstance(cond, And):
         return [leaf for c in cond.operands for leaf in _leaves(c, rule, diags)]
-    diags.append(error(f"rule {rule.label}: XFUZ rules are ANDs of 'variable IS [NOT] term' (no OR, hedges "
-                       "or bare degrees)", getattr(cond, "span", None) or rule.span, code="xfuz-expr-rule",
-                       hint="split an OR into one rule per alternative"))
+    diags.append(
+        error(
+            f"rule {rule.label}: XFUZ rules are ANDs of 'variable IS [NOT] term' (no OR, hedges "
+            "or bare degrees)",
+            getattr(cond, "span", None) or rule.span,
+            code="xfuz-expr-rule",
+            hint="split an OR into one rule per alternative",
+        )
+    )
     return []
 
 
-def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants, list[Diagnostic]]:
-    """Encode a function block into XFUZ constants.  Returns the constants and the
-    diagnostics; when there are errors the constants are not meaningful."""
-    fb = block.main if isinstance(block, Document) else block
-    diags: list[Diagnostic] = []
-    opts = _read_options(fb, diags)
-
-    def err(msg: str, span: Span | None, code: str, hint: str | None = None) -> None:
-        diags.append(error(msg, span, code=code, hint=hint))
-
-    # Slots: an explicit XFUZ SLOT option, a name that is a slot label, else the next free one.
+def _assign_slots(fb: FunctionBlock, opts: _Options, diags: list[Diagnostic]) -> dict[str, int]:
+    """Slots: an explicit ``XFUZ SLOT`` option, a name that is a slot label, else the next
+    free slot of the variable's kind, in declaration order."""
     slots: dict[str, int] = {}
     taken: set[int] = set()
     pools = {VarKind.INPUT: range(0, 8), VarKind.OUTPUT: range(8, 14), VarKind.LOCAL: range(14, 18)}
@@ -568,15 +690,47 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
             continue
         free = [s for s in pools[v.kind] if s not in taken]
         if not free:
-            what = {VarKind.INPUT: "8 inputs", VarKind.OUTPUT: "6 outputs", VarKind.LOCAL: "4 intermediate variables"}
-            err(f"{v.name}: XFUZ has {what[v.kind]}", v.span, "xfuz-expr-count")
+            what = {
+                VarKind.INPUT: "8 inputs",
+                VarKind.OUTPUT: "6 outputs",
+                VarKind.LOCAL: "4 intermediate variables",
+            }
+            diags.append(error(f"{v.name}: XFUZ has {what[v.kind]}", v.span, code="xfuz-expr-count"))
             continue
         slots[v.name] = free[0]
         taken.add(free[0])
 
+    return slots
+
+
+def slot_labels(block: FunctionBlock | Document) -> dict[str, str]:
+    """Where each variable of ``block`` goes in the XFUZ block: name -> ``INP1``.. /
+    ``OUT1``.. / ``VAR1``.."""
+    fb = block.main if isinstance(block, Document) else block
+    diags: list[Diagnostic] = []
+    return {
+        name: slot_label(slot) for name, slot in _assign_slots(fb, _read_options(fb, diags), diags).items()
+    }
+
+
+def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants, list[Diagnostic]]:
+    """Encode a function block into XFUZ constants.  Returns the constants and the
+    diagnostics; when there are errors the constants are not meaningful."""
+    fb = block.main if isinstance(block, Document) else block
+    diags: list[Diagnostic] = []
+    opts = _read_options(fb, diags)
+
+    def err(msg: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        diags.append(error(msg, span, code=code, hint=hint))
+
+    slots = _assign_slots(fb, opts, diags)
+
     if len(fb.rule_blocks) > 1:
-        err("XFUZ has a single rule base; use one XFUZ instance per rule block", fb.rule_blocks[1].span,
-            "xfuz-expr-ruleblocks")
+        err(
+            "XFUZ has a single rule base; use one XFUZ instance per rule block",
+            fb.rule_blocks[1].span,
+            "xfuz-expr-ruleblocks",
+        )
     rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
     op = {None: 0, "MIN": 0, "PROD": 1}
     if rb.and_op not in op:
@@ -585,15 +739,21 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         err(f"ACT : {rb.act}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
     if rb.accu not in (None, "MAX"):
         err(f"ACCU : {rb.accu}: XFUZ aggregates with MAX", rb.span, "xfuz-expr-op")
-    methods = {d.method or "COG" for d in fb.defuzzify if d.terms and (fb.variable(d.variable) is None or
-                                                                      fb.variable(d.variable).kind is VarKind.OUTPUT)}  # type: ignore[union-attr]
+    local_names = {v.name for v in fb.locals}
+    methods = {d.method or "COG" for d in fb.defuzzify if d.terms and d.variable not in local_names}
     if len(methods) > 1:
-        err(f"XFUZ has one defuzzification method for all outputs; found {', '.join(sorted(methods))}", None,
-            "xfuz-expr-method")
+        err(
+            f"XFUZ has one defuzzification method for all outputs; found {', '.join(sorted(methods))}",
+            None,
+            "xfuz-expr-method",
+        )
     method = methods.pop() if len(methods) == 1 else "COG"
     if method not in ("COG", "COGS", "MOM"):
-        err(f"METHOD : {method}: XFUZ offers COG, MOM (mean of maxima) or singletons (COGS)", None,
-            "xfuz-expr-method")
+        err(
+            f"METHOD : {method}: XFUZ offers COG, MOM (mean of maxima) or singletons (COGS)",
+            None,
+            "xfuz-expr-method",
+        )
     out_pt = method == "COGS"
 
     variables: list[XVariable] = []
@@ -613,25 +773,39 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
             mf_terms = fz.terms if fz else ()
         else:
             if rng is None and (dz or fz):
-                err(f"{v.name}: XFUZ outputs and intermediate variables need a RANGE (BorneInf..BorneSup)",
-                    v.span, "xfuz-expr-range")
+                err(
+                    f"{v.name}: XFUZ outputs and intermediate variables need a RANGE (BorneInf..BorneSup)",
+                    v.span,
+                    "xfuz-expr-range",
+                )
             discr = opts.discr.get(v.name, max(3, min(DISCR_MAX, (high - low) // 2 + 1)))
             label = slot_label(slot)
             vname = v.name if kind is SlotKind.INTERMEDIATE and v.name.upper() != label else ""
             try:
                 encode_name(vname)
             except ValueError as exc:
-                diags.append(warning(f"{v.name}: {exc}; the name is not stored", v.span, code="xfuz-expr-name"))
+                diags.append(
+                    warning(f"{v.name}: {exc}; the name is not stored", v.span, code="xfuz-expr-name")
+                )
                 vname = ""
             variables.append(XVariable(slot, low, high, discr, vname))
             mf_terms = dz.terms if dz else (fz.terms if fz else ())
             if dz and fz and [t.name for t in dz.terms] != [t.name for t in fz.terms]:
-                err(f"{v.name}: FUZZIFY and DEFUZZIFY must have the same terms (XFUZ keeps one set per "
-                    "variable)", fz.span, "xfuz-expr-terms")
+                err(
+                    f"{v.name}: FUZZIFY and DEFUZZIFY must have the same terms (XFUZ keeps one set per "
+                    "variable)",
+                    fz.span,
+                    "xfuz-expr-terms",
+                )
             if kind is SlotKind.OUTPUT and dz is not None and dz.default is not None:
                 if dz.default.no_change or dz.default.value is None:
-                    diags.append(warning(f"{v.name}: DEFAULT := NC has no XFUZ equivalent; O{slot - 7}_DEF$ is 0",
-                                         dz.default.span, code="xfuz-expr-default"))
+                    diags.append(
+                        warning(
+                            f"{v.name}: DEFAULT := NC has no XFUZ equivalent; O{slot - 7}_DEF$ is 0",
+                            dz.default.span,
+                            code="xfuz-expr-default",
+                        )
+                    )
                 else:
                     o_def[slot - 8] = _int_point(dz.default.value, f"{v.name} DEFAULT", dz.span, diags)
         for t in mf_terms:
@@ -640,12 +814,15 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
     mf_list.sort(key=lambda item: slot_kind(item[0]) is not SlotKind.INPUT)
     memberships: list[XMembership] = []
     numbers: dict[tuple[str, str], int] = {}
-    for n, (slot, t, vname) in enumerate(mf_list):
+    for _n, (slot, t, vname) in enumerate(mf_list):
         what = f"{vname}.{t.name}"
         if isinstance(t.mf, SingletonMF):
             if not out_pt or slot_kind(slot) is not SlotKind.OUTPUT:
-                err(f"{what}: a singleton needs singleton mode (METHOD : COGS on every output, OUT_PT = 1)",
-                    t.span, "xfuz-expr-term")
+                err(
+                    f"{what}: a singleton needs singleton mode (METHOD : COGS on every output, OUT_PT = 1)",
+                    t.span,
+                    "xfuz-expr-term",
+                )
                 continue
             p = _int_point(t.mf.value, what, t.span, diags)
             abcd: tuple[int, int, int, int] | None = (p, p, p, p)
@@ -671,8 +848,11 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         for leaf, negated in _leaves(rule.condition, rule, diags):
             key = (leaf.variable, leaf.term)
             if key not in numbers:
-                err(f"rule {rule.label}: {leaf.variable} IS {leaf.term} is no XFUZ membership function",
-                    leaf.span or rule.span, "xfuz-expr-rule")
+                err(
+                    f"rule {rule.label}: {leaf.variable} IS {leaf.term} is no XFUZ membership function",
+                    leaf.span or rule.span,
+                    "xfuz-expr-rule",
+                )
                 continue
             preds.append((numbers[key], negated))
         if rule.condition is None:
@@ -680,16 +860,27 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         concl: list[int] = []
         for c in rule.conclusions:
             if c.weight is not None and c.weight != 1.0:
-                err(f"rule {rule.label}: XFUZ rules have no WITH weight", c.span or rule.span, "xfuz-expr-weight")
+                err(
+                    f"rule {rule.label}: XFUZ rules have no WITH weight",
+                    c.span or rule.span,
+                    "xfuz-expr-weight",
+                )
             key = (c.variable, c.term or "")
             if key not in numbers:
-                err(f"rule {rule.label}: {c.variable} IS {c.term} is no XFUZ membership function",
-                    c.span or rule.span, "xfuz-expr-rule")
+                err(
+                    f"rule {rule.label}: {c.variable} IS {c.term} is no XFUZ membership function",
+                    c.span or rule.span,
+                    "xfuz-expr-rule",
+                )
                 continue
             concl.append(numbers[key])
         if len(preds) > 4 or len(concl) > 2:
-            err(f"rule {rule.label}: XFUZ rules have at most 4 predicates and 2 conclusions "
-                f"(this one has {len(preds)} and {len(concl)})", rule.span, "xfuz-expr-rule")
+            err(
+                f"rule {rule.label}: XFUZ rules have at most 4 predicates and 2 conclusions "
+                f"(this one has {len(preds)} and {len(concl)})",
+                rule.span,
+                "xfuz-expr-rule",
+            )
             continue
         rules.append(XRule(len(rules), tuple(preds), tuple(concl)))
     for what, count, limit in (("membership functions", len(memberships), 64), ("rules", len(rules), 64)):
@@ -700,12 +891,25 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
     kb = KnowledgeBase(tuple(variables), tuple(memberships), tuple(rules))
     op_defuz = 1 if method == "MOM" else 0
     for issue in check_kb(kb, out_pt=out_pt, op_defuz=op_defuz):
-        diags.append(warning(f"the block would set STATUS bit {issue.bit}: {issue.message}",
-                             code=f"xfuz-status-{issue.bit}"))
+        diags.append(
+            warning(
+                f"the block would set STATUS bit {issue.bit}: {issue.message}",
+                code=f"xfuz-status-{issue.bit}",
+            )
+        )
     esv, fa, rg = encode_kb(kb)
-    constants = XfuzConstants(op_et=op.get(rb.and_op, 0), op_impl=op.get(rb.act, 0), op_defuz=op_defuz,
-                              out_pt=out_pt, contask=opts.contask, t_ofb=opts.t_ofb, o_def=tuple(o_def),
-                              esv=esv, fa=fa, rg=rg)
+    constants = XfuzConstants(
+        op_et=op.get(rb.and_op, 0),
+        op_impl=op.get(rb.act, 0),
+        op_defuz=op_defuz,
+        out_pt=out_pt,
+        contask=opts.contask,
+        t_ofb=opts.t_ofb,
+        o_def=tuple(o_def),
+        esv=esv,
+        fa=fa,
+        rg=rg,
+    )
     return constants, diags
 
 

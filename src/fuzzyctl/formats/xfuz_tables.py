@@ -45,6 +45,7 @@ __all__ = [
     "decode_name",
     "encode_kb",
     "encode_name",
+    "esv_offsets",
     "slot_kind",
     "slot_label",
 ]
@@ -147,12 +148,20 @@ def _check_words(name: str, words: Sequence[int], size: int) -> tuple[int, ...]:
     return tuple(out) + (0,) * (size - len(out))
 
 
+EMPTY_FA = (0, 0, 0, 0, UNUSED) + (0,) * (FA_SIZE - 5)
+"""FA holding no membership function (the block's default): 999 in FA0's variable word."""
+EMPTY_RG = (UNUSED,) * 4 + (0,) * (RG_SIZE - 4)
+"""RG holding no rule (the block's default): 999 in REG0's four predicates."""
+
+
 @dataclass(frozen=True)
 class XfuzConstants:
     """The internal constants of an XFUZ instance (2.3): structure operators, the
     initialisation constants ending in ``$`` and the knowledge base tables.
 
-    Shorter tables are padded with 0, as the manual's "values not given are left at 0"."""
+    By default the base is empty (2.3: "no membership function", "no rule"), which takes
+    the 999 terminators.  Shorter tables are padded with 0, as the manual's "values not
+    given are left at 0" (3.3-3)."""
 
     op_conj: int = 0
     op_et: int = 0
@@ -164,8 +173,8 @@ class XfuzConstants:
     t_ofb: int = 200
     o_def: tuple[int, ...] = (0,) * N_OUTPUTS
     esv: tuple[int, ...] = (0,) * ESV_SIZE
-    fa: tuple[int, ...] = (0,) * FA_SIZE
-    rg: tuple[int, ...] = (0,) * RG_SIZE
+    fa: tuple[int, ...] = EMPTY_FA
+    rg: tuple[int, ...] = EMPTY_RG
 
     def __post_init__(self) -> None:
         for name, value, allowed in (
@@ -285,7 +294,8 @@ class KnowledgeBase:
         return frozenset(i.bit for i in self.issues if i.bit in ERROR_BITS)
 
 
-def _esv_offsets(slot: int) -> tuple[int, int, int | None]:
+def esv_offsets(slot: int) -> tuple[int, int, int | None]:
+    """ESV indices of a slot's BorneInf, BorneSup and Discr (None for inputs)."""
     kind = slot_kind(slot)
     if kind is SlotKind.INPUT:
         return 2 * slot, 2 * slot + 1, None
@@ -302,25 +312,26 @@ def decode_kb(constants: XfuzConstants, *, span_rule: bool = True) -> KnowledgeB
     fa, rg, esv = constants.fa, constants.rg, constants.esv
     mfs: list[XMembership] = []
     for n in range(MAX_MF):
-        rec = fa[MF_WORDS * n: MF_WORDS * (n + 1)]
+        rec = fa[MF_WORDS * n : MF_WORDS * (n + 1)]
         if rec[4] == UNUSED:
             break
         mfs.append(XMembership(n, decode_name(rec[:4]), rec[4], rec[5], rec[6], rec[7], rec[8]))
     rules: list[XRule] = []
     for r in range(MAX_RULES):
-        rec = rg[RULE_WORDS * r: RULE_WORDS * (r + 1)]
+        rec = rg[RULE_WORDS * r : RULE_WORDS * (r + 1)]
         if all(w == UNUSED for w in rec[:4]):
             break
-        preds = tuple((w - NEGATION, True) if NEGATION <= w < UNUSED else (w, False)
-                      for w in rec[:4] if w != UNUSED)
+        preds = tuple(
+            (w - NEGATION, True) if NEGATION <= w < UNUSED else (w, False) for w in rec[:4] if w != UNUSED
+        )
         concl = tuple(w for w in rec[4:] if w != UNUSED)
         rules.append(XRule(r, preds, concl))
     variables: list[XVariable] = []
     used = {m.slot for m in mfs}
     for slot in range(18):
-        lo, hi, dz = _esv_offsets(slot)
+        lo, hi, dz = esv_offsets(slot)
         words = [esv[lo], esv[hi]] + ([esv[dz]] if dz is not None else [])
-        name = decode_name(esv[_name_offset(slot): _name_offset(slot) + NAME_WORDS]) if slot >= 14 else ""
+        name = decode_name(esv[_name_offset(slot) : _name_offset(slot) + NAME_WORDS]) if slot >= 14 else ""
         if slot in used or any(words) or name:
             variables.append(XVariable(slot, esv[lo], esv[hi], esv[dz] if dz is not None else 0, name))
     kb = KnowledgeBase(tuple(variables), tuple(mfs), tuple(rules))
@@ -328,8 +339,9 @@ def decode_kb(constants: XfuzConstants, *, span_rule: bool = True) -> KnowledgeB
     return KnowledgeBase(kb.variables, kb.memberships, kb.rules, tuple(issues))
 
 
-def check_kb(kb: KnowledgeBase, *, out_pt: bool = False, op_defuz: int = 0,
-             span_rule: bool = True) -> list[KbIssue]:
+def check_kb(
+    kb: KnowledgeBase, *, out_pt: bool = False, op_defuz: int = 0, span_rule: bool = True
+) -> list[KbIssue]:
     """The consistency checks of 2.8, each reported with the STATUS bit of 2.4.
 
     ``span_rule=False`` leaves out "BorneSup - BorneInf >= 2 (Discr - 1)", which the
@@ -345,28 +357,58 @@ def check_kb(kb: KnowledgeBase, *, out_pt: bool = False, op_defuz: int = 0,
     for mf in kb.memberships:
         at = MF_WORDS * mf.number
         if not 0 <= mf.slot < 18:
-            add(KbIssue(StatusBit.MF_ORDER, f"FA{mf.number} refers to variable {mf.slot}, which does not "
-                        "exist (0-7 inputs, 8-13 outputs, 14-17 intermediate, 999 ends the list)", "FA", at + 4))
+            add(
+                KbIssue(
+                    StatusBit.MF_ORDER,
+                    f"FA{mf.number} refers to variable {mf.slot}, which does not "
+                    "exist (0-7 inputs, 8-13 outputs, 14-17 intermediate, 999 ends the list)",
+                    "FA",
+                    at + 4,
+                )
+            )
             continue
         if slot_kind(mf.slot) is SlotKind.INPUT:
             if seen_non_input:
-                add(KbIssue(StatusBit.MF_ORDER, f"FA{mf.number} ({slot_label(mf.slot)}) comes after output or "
-                            "intermediate membership functions; input ones must come first", "FA", at + 4))
+                add(
+                    KbIssue(
+                        StatusBit.MF_ORDER,
+                        f"FA{mf.number} ({slot_label(mf.slot)}) comes after output or "
+                        "intermediate membership functions; input ones must come first",
+                        "FA",
+                        at + 4,
+                    )
+                )
         else:
             seen_non_input = True
         if not mf.a <= mf.b <= mf.c <= mf.d:
-            add(KbIssue(StatusBit.MF_POINTS, f"FA{mf.number}: points must satisfy xA <= xB <= xC <= xD, got "
-                        f"{mf.a}, {mf.b}, {mf.c}, {mf.d}", "FA", at + 5))
+            add(
+                KbIssue(
+                    StatusBit.MF_POINTS,
+                    f"FA{mf.number}: points must satisfy xA <= xB <= xC <= xD, got "
+                    f"{mf.a}, {mf.b}, {mf.c}, {mf.d}",
+                    "FA",
+                    at + 5,
+                )
+            )
 
     for v in kb.variables:
         if v.kind is SlotKind.INPUT or not any(m.slot == v.slot for m in kb.memberships):
             continue
-        lo, _, dz = _esv_offsets(v.slot)
+        lo, _, dz = esv_offsets(v.slot)
         if not DISCR_MIN <= v.discr <= DISCR_MAX:
-            add(KbIssue(StatusBit.DISCRETISATION, f"{v.label}: Discr = {v.discr} is outside 3..20", "ESV", dz))
+            add(
+                KbIssue(StatusBit.DISCRETISATION, f"{v.label}: Discr = {v.discr} is outside 3..20", "ESV", dz)
+            )
         elif v.high - v.low < 2 * (v.discr - 1) and (span_rule or v.high <= v.low):
-            add(KbIssue(StatusBit.DISCRETISATION, f"{v.label}: BorneSup - BorneInf = {v.high - v.low} is below "
-                        f"2 * (Discr - 1) = {2 * (v.discr - 1)}", "ESV", lo))
+            add(
+                KbIssue(
+                    StatusBit.DISCRETISATION,
+                    f"{v.label}: BorneSup - BorneInf = {v.high - v.low} is below "
+                    f"2 * (Discr - 1) = {2 * (v.discr - 1)}",
+                    "ESV",
+                    lo,
+                )
+            )
 
     second_outputs: set[int] = set()
     predicate_slots: dict[int, int] = {}
@@ -375,24 +417,45 @@ def check_kb(kb: KnowledgeBase, *, out_pt: bool = False, op_defuz: int = 0,
         at = RULE_WORDS * rule.number
         valid = True
         for k, (number, negated) in enumerate(rule.predicates):
-            mf = kb.membership(number)
-            if mf is None or number >= n_mf:
+            pred_mf = kb.membership(number)
+            if pred_mf is None or number >= n_mf:
                 code = number + NEGATION if negated else number
-                add(KbIssue(StatusBit.RULE_REFERENCE, f"REG{rule.number}: predicate {code} refers to no "
-                            f"membership function (there are {n_mf})", "RG", at + k))
+                add(
+                    KbIssue(
+                        StatusBit.RULE_REFERENCE,
+                        f"REG{rule.number}: predicate {code} refers to no "
+                        f"membership function (there are {n_mf})",
+                        "RG",
+                        at + k,
+                    )
+                )
                 valid = False
-            elif 0 <= mf.slot < 18:
-                predicate_slots.setdefault(mf.slot, at + k)
+            elif 0 <= pred_mf.slot < 18:
+                predicate_slots.setdefault(pred_mf.slot, at + k)
         for k, number in enumerate(rule.conclusions):
-            mf = kb.membership(number)
+            concl_mf = kb.membership(number)
             where = at + 4 + k
-            if mf is None:
-                add(KbIssue(StatusBit.RULE_REFERENCE, f"REG{rule.number}: conclusion {number} refers to no "
-                            f"membership function (there are {n_mf})", "RG", where))
+            if concl_mf is None:
+                add(
+                    KbIssue(
+                        StatusBit.RULE_REFERENCE,
+                        f"REG{rule.number}: conclusion {number} refers to no "
+                        f"membership function (there are {n_mf})",
+                        "RG",
+                        where,
+                    )
+                )
                 valid = False
-            elif 0 <= mf.slot < 18 and slot_kind(mf.slot) is SlotKind.INPUT:
-                add(KbIssue(StatusBit.RULE_REFERENCE, f"REG{rule.number}: conclusion FA{number} is an input "
-                            f"membership function ({slot_label(mf.slot)})", "RG", where))
+            elif 0 <= concl_mf.slot < 18 and slot_kind(concl_mf.slot) is SlotKind.INPUT:
+                add(
+                    KbIssue(
+                        StatusBit.RULE_REFERENCE,
+                        f"REG{rule.number}: conclusion FA{number} is an input "
+                        f"membership function ({slot_label(concl_mf.slot)})",
+                        "RG",
+                        where,
+                    )
+                )
                 valid = False
         if not valid or kb.rule_level(rule) == 1:
             continue
@@ -401,22 +464,46 @@ def check_kb(kb: KnowledgeBase, *, out_pt: bool = False, op_defuz: int = 0,
             if not 0 <= mf.slot < 18:
                 continue
             if slot_kind(mf.slot) is SlotKind.INTERMEDIATE:
-                add(KbIssue(StatusBit.SECOND_INFERENCE, f"REG{rule.number}: second-inference rule concludes on "
-                            f"intermediate variable {slot_label(mf.slot)}", "RG", at + 4 + k))
+                add(
+                    KbIssue(
+                        StatusBit.SECOND_INFERENCE,
+                        f"REG{rule.number}: second-inference rule concludes on "
+                        f"intermediate variable {slot_label(mf.slot)}",
+                        "RG",
+                        at + 4 + k,
+                    )
+                )
             else:
                 second_outputs.add(mf.slot)
     for slot in sorted(second_outputs & predicate_slots.keys()):
-        add(KbIssue(StatusBit.SECOND_INFERENCE, f"{slot_label(slot)} is computed by a second-inference rule "
-                    "and used as a rule predicate", "RG", predicate_slots[slot]))
+        add(
+            KbIssue(
+                StatusBit.SECOND_INFERENCE,
+                f"{slot_label(slot)} is computed by a second-inference rule and used as a rule predicate",
+                "RG",
+                predicate_slots[slot],
+            )
+        )
 
     if out_pt:
         second = [r for r in kb.rules if kb.rule_level(r) == 2]
         if second:
-            add(KbIssue(StatusBit.SINGLETON_MODE, f"REG{second[0].number}: second inference is impossible in "
-                        "singleton output mode (OUT_PT = 1)", "RG", RULE_WORDS * second[0].number))
+            add(
+                KbIssue(
+                    StatusBit.SINGLETON_MODE,
+                    f"REG{second[0].number}: second inference is impossible in "
+                    "singleton output mode (OUT_PT = 1)",
+                    "RG",
+                    RULE_WORDS * second[0].number,
+                )
+            )
         if op_defuz == 1:
-            add(KbIssue(StatusBit.SINGLETON_MODE, "mean of maxima (OP_DEFUZ = 1) is impossible in singleton "
-                        "output mode (OUT_PT = 1)"))
+            add(
+                KbIssue(
+                    StatusBit.SINGLETON_MODE,
+                    "mean of maxima (OP_DEFUZ = 1) is impossible in singleton output mode (OUT_PT = 1)",
+                )
+            )
     return issues
 
 
@@ -434,16 +521,16 @@ def encode_kb(kb: KnowledgeBase) -> tuple[tuple[int, ...], tuple[int, ...], tupl
         raise ValueError(f"{len(kb.rules)} rules; XFUZ holds {MAX_RULES}")
     esv = [0] * ESV_SIZE
     for v in kb.variables:
-        lo, hi, dz = _esv_offsets(v.slot)
+        lo, hi, dz = esv_offsets(v.slot)
         esv[lo], esv[hi] = v.low, v.high
         if dz is not None:
             esv[dz] = v.discr
         if v.name and v.kind is SlotKind.INTERMEDIATE:
             at = _name_offset(v.slot)
-            esv[at: at + NAME_WORDS] = encode_name(v.name)
+            esv[at : at + NAME_WORDS] = encode_name(v.name)
     fa = [0] * FA_SIZE
     for n, mf in enumerate(kb.memberships):
-        fa[MF_WORDS * n: MF_WORDS * (n + 1)] = (*encode_name(mf.name), mf.slot, mf.a, mf.b, mf.c, mf.d)
+        fa[MF_WORDS * n : MF_WORDS * (n + 1)] = (*encode_name(mf.name), mf.slot, mf.a, mf.b, mf.c, mf.d)
     if len(kb.memberships) < MAX_MF:
         fa[MF_WORDS * len(kb.memberships) + 4] = UNUSED
     rg = [0] * RG_SIZE
@@ -452,11 +539,12 @@ def encode_kb(kb: KnowledgeBase) -> tuple[tuple[int, ...], tuple[int, ...], tupl
             raise ValueError(f"rule {r}: XFUZ rules have at most 4 predicates and 2 conclusions")
         preds = [n + NEGATION if neg else n for n, neg in rule.predicates]
         concl = list(rule.conclusions)
-        rg[RULE_WORDS * r: RULE_WORDS * (r + 1)] = (
-            preds + [UNUSED] * (4 - len(preds)) + concl + [UNUSED] * (2 - len(concl)))
+        rg[RULE_WORDS * r : RULE_WORDS * (r + 1)] = (
+            preds + [UNUSED] * (4 - len(preds)) + concl + [UNUSED] * (2 - len(concl))
+        )
     if len(kb.rules) < MAX_RULES:
         at = RULE_WORDS * len(kb.rules)
-        rg[at: at + 4] = [UNUSED] * 4
+        rg[at : at + 4] = [UNUSED] * 4
     for table, words in (("ESV", esv), ("FA", fa), ("RG", rg)):
         _check_words(table, words, len(words))
     return tuple(esv), tuple(fa), tuple(rg)

@@ -7,5 +7,12 @@ from fuzzyctl.blocks.schneider.fb import XfuzFB, XfuzSnapshot
 from fuzzyctl.blocks.schneider.inference import InferenceResult, XfuzInference
 from fuzzyctl.formats.xfuz_tables import KnowledgeBase, StatusBit, XfuzConstants
 
-__all__ = ["InferenceResult", "KnowledgeBase", "StatusBit", "XfuzConstants", "XfuzFB", "XfuzInference",
-           "XfuzSnapshot"]
+__all__ = [
+    "InferenceResult",
+    "KnowledgeBase",
+    "StatusBit",
+    "XfuzConstants",
+    "XfuzFB",
+    "XfuzInference",
+    "XfuzSnapshot",
+]

@@ -54,8 +54,8 @@ def _array_key(name: str) -> tuple[str, int] | None:
     """``"INP3"`` -> ("INP", 2), ``"O2_CALC"`` -> ("O_CALC", 1), ``"I5_SIM"`` -> ("I_SIM", 4)."""
     upper = name.upper()
     for prefix in ("INP", "OUT"):
-        if upper.startswith(prefix) and upper[len(prefix):].isdigit():
-            return prefix, int(upper[len(prefix):]) - 1
+        if upper.startswith(prefix) and upper[len(prefix) :].isdigit():
+            return prefix, int(upper[len(prefix) :]) - 1
     if len(upper) >= 3 and upper[0] in "IO" and upper[1].isdigit() and upper[2] == "_":
         return f"{upper[0]}_{upper[3:]}", int(upper[1]) - 1
     return None
@@ -87,8 +87,9 @@ class XfuzFB:
     ``span_rule=False`` stops enforcing "BorneSup - BorneInf >= 2 (Discr - 1)" (STATUS bit
     9), which the manual's own example breaks; Discr must still be 3..20."""
 
-    def __init__(self, constants: XfuzConstants | None = None, *, task_period: float = 0.01,
-                 span_rule: bool = True) -> None:
+    def __init__(
+        self, constants: XfuzConstants | None = None, *, task_period: float = 0.01, span_rule: bool = True
+    ) -> None:
         if task_period <= 0:
             raise ValueError("task_period must be positive")
         self.constants = constants or XfuzConstants()
@@ -216,7 +217,9 @@ class XfuzFB:
         return self.snapshot()
 
     def _nominal(self, period: float) -> None:
-        inputs = [self.arrays["I_SIM"][i] if self.COMMAND >> i & 1 else self.arrays["INP"][i] for i in range(N_IN)]
+        inputs = [
+            self.arrays["I_SIM"][i] if self.COMMAND >> i & 1 else self.arrays["INP"][i] for i in range(N_IN)
+        ]
         cycles = self._round_period(period)
         start_edge = bool(self.START) and not self._prev["START"]
         self._prev["START"] = self.START
@@ -243,8 +246,9 @@ class XfuzFB:
 
     def _infer(self, inputs: list[int]) -> None:
         c = self.constants
-        result = self._inference.run(inputs, op_et=c.op_et, op_impl=c.op_impl, op_defuz=c.op_defuz,
-                                     out_pt=c.out_pt)
+        result = self._inference.run(
+            inputs, op_et=c.op_et, op_impl=c.op_impl, op_defuz=c.op_defuz, out_pt=c.out_pt
+        )
         self.last_result = result
         self.inferred = True
         info = 0
@@ -281,8 +285,14 @@ class XfuzFB:
             _word(name, getattr(self, name))
 
     def snapshot(self) -> XfuzSnapshot:
-        return XfuzSnapshot(tuple(self.arrays["OUT"]), tuple(self.arrays["O_CALC"]), self.STATUS, self.ERROR,
-                            self.inferred, tuple(self.DEGRE))
+        return XfuzSnapshot(
+            tuple(self.arrays["OUT"]),
+            tuple(self.arrays["O_CALC"]),
+            self.STATUS,
+            self.ERROR,
+            self.inferred,
+            tuple(self.DEGRE),
+        )
 
     @property
     def status_bits(self) -> tuple[int, ...]:
@@ -299,6 +309,6 @@ def _word(name: str, value: object) -> int:
 
 
 def _bit(name: str, value: object) -> int:
-    if value in (0, 1, True, False):
-        return int(value)  # type: ignore[call-overload]
+    if isinstance(value, int) and value in (0, 1):
+        return int(value)
     raise InputError(f"{name} = {value!r}: a bit is 0 or 1")

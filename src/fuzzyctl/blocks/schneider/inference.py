@@ -51,8 +51,11 @@ def trapezoid(x: FloatArray | float, mf: XMembership) -> FloatArray:
     with np.errstate(divide="ignore", invalid="ignore"):
         rise = np.where(b > a, (xs - a) / (b - a if b > a else 1.0), 0.0)
         fall = np.where(d > c, (d - xs) / (d - c if d > c else 1.0), 0.0)
-    mu = np.where((xs >= b) & (xs <= c), 1.0,
-                  np.where((xs > a) & (xs < b), rise, np.where((xs > c) & (xs < d), fall, 0.0)))
+    mu = np.where(
+        (xs >= b) & (xs <= c),
+        1.0,
+        np.where((xs > a) & (xs < b), rise, np.where((xs > c) & (xs < d), fall, 0.0)),
+    )
     return np.asarray(mu, dtype=np.float64)
 
 
@@ -105,19 +108,28 @@ class XfuzInference:
             if mf.slot in self.points:
                 self.sampled[mf.number] = trapezoid(self.points[mf.slot], mf)
         self.levels = tuple(kb.rule_level(r) for r in kb.rules)
-        self.outputs = sorted({m.slot for m in kb.memberships if 0 <= m.slot < 18
-                               and slot_kind(m.slot) is SlotKind.OUTPUT})
+        self.outputs = sorted(
+            {m.slot for m in kb.memberships if 0 <= m.slot < 18 and slot_kind(m.slot) is SlotKind.OUTPUT}
+        )
 
-    def run(self, inputs: Sequence[int], *, op_et: int = 0, op_impl: int = 0, op_defuz: int = 0,
-            out_pt: bool = False) -> InferenceResult:
+    def run(
+        self,
+        inputs: Sequence[int],
+        *,
+        op_et: int = 0,
+        op_impl: int = 0,
+        op_defuz: int = 0,
+        out_pt: bool = False,
+    ) -> InferenceResult:
         """Evaluate the rules for the 8 input words."""
         kb = self.kb
         conj: Callable[[Sequence[float]], float] = _prod_and if op_et == 1 else _min_and
         sets: dict[int, FloatArray] = {slot: np.zeros_like(xs) for slot, xs in self.points.items()}
         points_degree: dict[int, float] = {}  # singleton mode: aggregated degree of each output term
         degrees = [0.0] * len(kb.rules)
-        input_degree = {m.number: float(trapezoid(float(inputs[m.slot]), m))
-                        for m in kb.memberships if 0 <= m.slot < 8}
+        input_degree = {
+            m.number: float(trapezoid(float(inputs[m.slot]), m)) for m in kb.memberships if 0 <= m.slot < 8
+        }
 
         def predicate(number: int) -> float:
             if number in input_degree:
@@ -143,19 +155,31 @@ class XfuzInference:
                     if out_pt and slot_kind(mf.slot) is SlotKind.OUTPUT:
                         points_degree[number] = max(points_degree.get(number, 0.0), degree)
                     elif number in self.sampled:
-                        limited = degree * self.sampled[number] if op_impl == 1 else \
-                            np.minimum(degree, self.sampled[number])
+                        limited = (
+                            degree * self.sampled[number]
+                            if op_impl == 1
+                            else np.minimum(degree, self.sampled[number])
+                        )
                         np.maximum(sets[mf.slot], limited, out=sets[mf.slot])
         outputs: dict[int, float | None] = {}
         for slot in self.outputs:
             outputs[slot - 7] = self._defuzzify(slot, sets, points_degree, op_defuz, out_pt)
         return InferenceResult(outputs, tuple(degrees))
 
-    def _defuzzify(self, slot: int, sets: dict[int, FloatArray], points_degree: dict[int, float],
-                   op_defuz: int, out_pt: bool) -> float | None:
+    def _defuzzify(
+        self,
+        slot: int,
+        sets: dict[int, FloatArray],
+        points_degree: dict[int, float],
+        op_defuz: int,
+        out_pt: bool,
+    ) -> float | None:
         if out_pt:
-            weights = [(w, self.kb.memberships[n].singleton()) for n, w in points_degree.items()
-                       if self.kb.memberships[n].slot == slot]
+            weights = [
+                (w, self.kb.memberships[n].singleton())
+                for n, w in points_degree.items()
+                if self.kb.memberships[n].slot == slot
+            ]
             total = sum(w for w, _ in weights)
             return sum(w * x for w, x in weights) / total if total > 0 else None
         if slot not in sets:

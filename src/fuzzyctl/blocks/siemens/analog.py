@@ -86,8 +86,16 @@ def _raw_word(name: str, value: int) -> int:
     return value
 
 
-def fuzzy_ai(fuzzy_db: FuzzyDataBlock, ai_value: int, *, bipolar: bool = False, therm_el: bool = False,
-             factor: float = 1.0, offset: float = 0.0, input_nr: int = 1) -> AnalogResult:
+def fuzzy_ai(
+    fuzzy_db: FuzzyDataBlock,
+    ai_value: int,
+    *,
+    bipolar: bool = False,
+    therm_el: bool = False,
+    factor: float = 1.0,
+    offset: float = 0.0,
+    input_nr: int = 1,
+) -> AnalogResult:
     """FUZZY_AI: normalise the analog input word ``ai_value`` (the value read at AI_ADR)
     and write it to input ``input_nr`` of ``fuzzy_db``.  THERM_EL takes precedence over
     BIPOLAR (the manual lists THERM_EL = TRUE only with BIPOLAR = FALSE)."""
@@ -104,15 +112,23 @@ def fuzzy_ai(fuzzy_db: FuzzyDataBlock, ai_value: int, *, bipolar: bool = False, 
     else:
         x_min, x_max = fuzzy_db.input_limits(input_nr)
         if bipolar:
-            value = (x_min * (FULL_SCALE - xi) + x_max * (xi + FULL_SCALE)) / (2 * FULL_SCALE) * factor + offset
+            value = (x_min * (FULL_SCALE - xi) + x_max * (xi + FULL_SCALE)) / (
+                2 * FULL_SCALE
+            ) * factor + offset
         else:
             value = (x_min * (FULL_SCALE - xi) + x_max * xi) / FULL_SCALE * factor + offset
     fuzzy_db.write_input(input_nr, value)
     return AnalogResult(Info.OK, value)
 
 
-def fuzzy_ao(fuzzy_db: FuzzyDataBlock, *, bipolar: bool = False, factor: float = 1.0, offset: float = 0.0,
-             output_nr: int = 1) -> AnalogResult:
+def fuzzy_ao(
+    fuzzy_db: FuzzyDataBlock,
+    *,
+    bipolar: bool = False,
+    factor: float = 1.0,
+    offset: float = 0.0,
+    output_nr: int = 1,
+) -> AnalogResult:
     """FUZZY_AO: normalise output ``output_nr`` of ``fuzzy_db`` to the analog range; the
     result's ``word`` is what goes to AO_ADR.  An output whose MIN equals its MAX has no
     normalisation line and is reported as INFO 11 (no valid application for it)."""

@@ -86,8 +86,13 @@ class FuzzyFB:
     (operators, shapes, limits other than the I/O count); it then runs with the
     controller's own semantics, which a real S7 block would not."""
 
-    def __init__(self, application: FunctionBlock | Document | None = None, *, db_length: int = DB_FUZZY_LENGTH,
-                 check_profile: bool = True) -> None:
+    def __init__(
+        self,
+        application: FunctionBlock | Document | None = None,
+        *,
+        db_length: int = DB_FUZZY_LENGTH,
+        check_profile: bool = True,
+    ) -> None:
         self.INPUT1 = self.INPUT2 = self.INPUT3 = self.INPUT4 = 0.0
         self.INPUT5 = self.INPUT6 = self.INPUT7 = self.INPUT8 = 0.0
         self.OUTPUT1 = self.OUTPUT2 = self.OUTPUT3 = self.OUTPUT4 = 0.0
@@ -107,7 +112,9 @@ class FuzzyFB:
 
     # ----------------------------------------------------------------- configuration
 
-    def download(self, application: FunctionBlock | Document, *, check_profile: bool = True) -> list[Diagnostic]:
+    def download(
+        self, application: FunctionBlock | Document, *, check_profile: bool = True
+    ) -> list[Diagnostic]:
         """Load a controller as the configuration tool does (stop, transfer, START_STOP =
         W#16#FFFF).  Returns the profile's warnings; raises DiagnosticError when the
         controller does not fit the block."""
@@ -117,8 +124,14 @@ class FuzzyFB:
         self.START_STOP = 0
         diags = check_siemens(fb) if check_profile else []
         if len(fb.inputs) > N_INPUTS or len(fb.outputs) > N_OUTPUTS:
-            diags.append(error(f"{len(fb.inputs)} inputs and {len(fb.outputs)} outputs: the FUZZY block "
-                               f"connects {N_INPUTS} and {N_OUTPUTS}", fb.span, code="siemens-io-count"))
+            diags.append(
+                error(
+                    f"{len(fb.inputs)} inputs and {len(fb.outputs)} outputs: the FUZZY block "
+                    f"connects {N_INPUTS} and {N_OUTPUTS}",
+                    fb.span,
+                    code="siemens-io-count",
+                )
+            )
         if any(d.is_error for d in diags):
             raise DiagnosticError(diags)
         # The block keeps the last value when no rule fires: ask the engine for NaN then.
@@ -175,11 +188,15 @@ class FuzzyFB:
             for name, value in values.items():
                 if name in self._inputs:
                     self.write_input(self._inputs.index(name) + 1, value)
-                elif name.upper().startswith("INPUT") and name[5:].isdigit() and 1 <= int(name[5:]) <= N_INPUTS:
+                elif (
+                    name.upper().startswith("INPUT") and name[5:].isdigit() and 1 <= int(name[5:]) <= N_INPUTS
+                ):
                     self.write_input(int(name[5:]), value)
                 else:
-                    raise InputError(f"{name!r} is not an input of the block (inputs: "
-                                     f"{', '.join(self._inputs) or 'none'}; or INPUT1..INPUT8)")
+                    raise InputError(
+                        f"{name!r} is not an input of the block (inputs: "
+                        f"{', '.join(self._inputs) or 'none'}; or INPUT1..INPUT8)"
+                    )
         else:
             if len(values) > N_INPUTS:
                 raise InputError(f"{len(values)} values for {N_INPUTS} inputs")
