@@ -402,6 +402,8 @@ class Conclusion:
     term: str | None = None
     weight: Param | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
+    hedges: tuple[str, ...] = ()
+    """fuzzylite's hedges before the term (``then tip is very low``), outermost first."""
 
 
 @dataclass(frozen=True)
