@@ -175,7 +175,7 @@ class _Builder(Transformer[Token, Any]):
         return Ref(str(children[0]), _tok_span(children[0]))
 
     def point(self, children: list[Param]) -> Point:
-        return Point(children[0], children[1], _outer(children))
+        return Point(children[1], children[2], _outer(children))
 
     # ---------------------------------------------------------------- membership functions
     def points(self, children: list[Point]) -> PointsMF:
