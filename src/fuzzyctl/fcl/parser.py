@@ -23,6 +23,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl import keywords, shapes
+from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.model import (
     And,
@@ -237,8 +238,29 @@ class _Builder(Transformer[Token, Any]):
     def num(self, children: list[Token]) -> Num:
         return Num(_number(children[0]))
 
-    def name(self, children: list[Token]) -> Name:
+    def expr_name(self, children: list[Token]) -> Name:
         return Name(str(children[0]))
+
+    def name(self, children: list[Token]) -> Token:
+        if len(children) == 1:
+            return children[0]
+        first, last = children[0], children[-1]
+        text = " ".join(str(t) for t in children)
+        self.state.warn(
+            f"name of several words '{text}' (ridderware JFuzzy); FCL identifiers have no spaces",
+            _between(first, last),
+            "multiword-name",
+        )
+        return Token(
+            "ID",
+            text,
+            start_pos=first.start_pos,
+            line=first.line,
+            column=first.column,
+            end_line=last.end_line,
+            end_column=last.end_column,
+            end_pos=last.end_pos,
+        )
 
     def call(self, children: list[Any]) -> Call:
         return Call(str(children[0]).lower(), tuple(c for c in children[1:] if c is not None))
@@ -269,6 +291,9 @@ class _Builder(Transformer[Token, Any]):
     def _keyword_item(self, key: str, label: str, table: keywords.Synonyms, children: list[Any], tok: Token) -> _Item:
         spelling = str(tok)
         span = _outer(children) or _tok_span(tok)
+        if not _tokens(children, "SEMI"):
+            end = Span(tok.end_line or 0, tok.end_column or 0)
+            self.state.warn(f"missing ';' after {children[0].type} : {spelling}", end, "missing-semicolon")
         if spelling.upper() in keywords.NONE_SPELLINGS:
             return _Item(key, None, span)
         value = keywords.canonical(table, spelling)
@@ -467,7 +492,7 @@ class _Builder(Transformer[Token, Any]):
         for c in children:
             if isinstance(c, list):
                 variables.extend(c)
-        return FunctionBlock(
+        fb = FunctionBlock(
             name,
             tuple(variables),
             tuple(c for c in children if isinstance(c, FuzzifyBlock)),
@@ -476,6 +501,7 @@ class _Builder(Transformer[Token, Any]):
             tuple(c for c in children if isinstance(c, OptionsBlock)),
             _outer(children),
         )
+        return resolve_names(fb, lambda message, span, code: self.state.warn(message, span, code))
 
     def start(self, children: list[FunctionBlock]) -> Document:
         return Document(tuple(children), self.state.source.path)
