@@ -42,8 +42,12 @@ def check(
         result = _load(file)
     except DiagnosticError as exc:
         if as_json:
-            typer.echo(json.dumps({"file": str(file), "ok": False,
-                                   "diagnostics": [d.to_dict() for d in exc.diagnostics]}, indent=2))
+            typer.echo(
+                json.dumps(
+                    {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]},
+                    indent=2,
+                )
+            )
             raise typer.Exit(EXIT_ERRORS) from None
         raise
     doc = result.document
@@ -60,8 +64,10 @@ def check(
             report["features"] = [f.__dict__ | {"level": str(f.level)} for f in feats]
             if checklist:
                 report["checklist"] = {
-                    fb.name or "": {row.item: row.value for row in conformance.checklist(fb, bool(doc.comments)
-                                                                                          or _has_comments(fb))}
+                    fb.name or "": {
+                        row.item: row.value
+                        for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb))
+                    }
                     for fb in doc.blocks
                 }
         typer.echo(json.dumps(report, indent=2, default=str))
@@ -102,11 +108,12 @@ def check(
 
 
 def _has_comments(fb: object) -> bool:
+    from fuzzyctl.fcl.checks import term_blocks
     from fuzzyctl.model import FunctionBlock
 
     assert isinstance(fb, FunctionBlock)
     items: list[object] = [fb, *fb.variables, *fb.fuzzify, *fb.defuzzify, *fb.rule_blocks]
-    for block in (*fb.fuzzify, *fb.defuzzify):
+    for block in term_blocks(fb):
         items.extend(block.terms)
     for rb in fb.rule_blocks:
         items.extend(rb.rules)

@@ -21,6 +21,7 @@ from fuzzyctl.model import (
     Document,
     FunctionBlock,
     FunctionMF,
+    FuzzifyBlock,
     Is,
     Name,
     Not,
@@ -85,6 +86,11 @@ def run_checks(doc: Document, context: CheckContext | None = None) -> list[Diagn
 
 
 # --------------------------------------------------------------------------- helpers
+
+
+def term_blocks(fb: FunctionBlock) -> list[FuzzifyBlock | DefuzzifyBlock]:
+    """The FUZZIFY then DEFUZZIFY blocks of ``fb``."""
+    return [*fb.fuzzify, *fb.defuzzify]
 
 
 class _Reporter:
@@ -188,7 +194,9 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
     for f in fb.fuzzify:
         var = fb.variable(f.variable)
         if var is None:
-            r.error(f"FUZZIFY {f.variable}: no variable {f.variable} is declared", f.span, "undeclared-variable")
+            r.error(
+                f"FUZZIFY {f.variable}: no variable {f.variable} is declared", f.span, "undeclared-variable"
+            )
         elif var.kind is VarKind.OUTPUT:
             r.error(
                 f"FUZZIFY {f.variable}: {f.variable} is a VAR_OUTPUT; FUZZIFY takes a VAR_INPUT (5.2.2)",
@@ -210,7 +218,9 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
     for d in fb.defuzzify:
         var = fb.variable(d.variable)
         if var is None:
-            r.error(f"DEFUZZIFY {d.variable}: no variable {d.variable} is declared", d.span, "undeclared-variable")
+            r.error(
+                f"DEFUZZIFY {d.variable}: no variable {d.variable} is declared", d.span, "undeclared-variable"
+            )
         elif var.kind is VarKind.INPUT:
             r.error(
                 f"DEFUZZIFY {d.variable}: {d.variable} is a VAR_INPUT; DEFUZZIFY takes a VAR_OUTPUT (5.2.3)",
@@ -228,7 +238,11 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
     for term, p in _refs_in_terms(fb):
         var = fb.variable(p.name)
         if var is None:
-            r.error(f"TERM {term.name}: no variable {p.name} is declared", p.span or term.span, "undeclared-variable")
+            r.error(
+                f"TERM {term.name}: no variable {p.name} is declared",
+                p.span or term.span,
+                "undeclared-variable",
+            )
         elif var.kind is VarKind.OUTPUT:
             r.warning(
                 f"TERM {term.name}: parameter {p.name} is an output; variable points are VAR_INPUTs (5.2.2)",
@@ -242,7 +256,7 @@ def _assigned_bare(fb: FunctionBlock, name: str) -> bool:
 
 
 def _refs_in_terms(fb: FunctionBlock) -> Iterator[tuple[Term, Ref]]:
-    for block in (*fb.fuzzify, *fb.defuzzify):
+    for block in term_blocks(fb):
         for t in block.terms:
             for p in mf_params(t.mf):
                 if isinstance(p, Ref):
@@ -324,7 +338,9 @@ def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None
                 )
                 break
     if d.method == "COGF" and not any(isinstance(t.mf, FunctionMF) for t in d.terms):
-        r.warning(f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function")
+        r.warning(
+            f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function"
+        )
 
 
 def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
@@ -341,7 +357,7 @@ def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
 
 
 def _terms_of(fb: FunctionBlock, name: str) -> set[str] | None:
-    blocks = [b for b in (*fb.fuzzify, *fb.defuzzify) if b.variable == name]
+    blocks = [b for b in term_blocks(fb) if b.variable == name]
     if not blocks:
         return None
     return {t.name for b in blocks for t in b.terms}
@@ -357,17 +373,18 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
         )
     outputs = {c.variable for rule in rb.rules for c in rule.conclusions}
     if rb.accu is None:
-        without = sorted(
-            v for v in outputs if (d := fb.defuzzify_block(v)) is None or d.accu is None
-        )
+        without = sorted(v for v in outputs if (d := fb.defuzzify_block(v)) is None or d.accu is None)
         if without:
             r.warning(
-                f"RULEBLOCK {rb.name or ''} has no ACCU: using MAX, the Basic-level accumulation".replace("  ", " "),
+                f"RULEBLOCK {rb.name or ''} has no ACCU: using MAX, the Basic-level accumulation".replace(
+                    "  ", " "
+                ),
                 rb.span,
                 "missing-accu",
             )
     if rb.act is None and any(
-        (d := fb.defuzzify_block(v)) is not None and any(not is_singleton(t.mf) for t in d.terms) for v in outputs
+        (d := fb.defuzzify_block(v)) is not None and any(not is_singleton(t.mf) for t in d.terms)
+        for v in outputs
     ):
         r.note(
             f"RULEBLOCK {rb.name or ''} has no ACT: MIN activation is used".replace("  ", " "),
@@ -378,7 +395,8 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
     for rule in rb.rules:
         if rule.label in labels:
             r.warning(
-                f"RULE {rule.label} appears twice in this rule block (first on line {_line(labels[rule.label])})",
+                f"RULE {rule.label} appears twice in this rule block "
+                f"(first on line {_line(labels[rule.label])})",
                 rule.span,
                 "duplicate-rule",
             )
@@ -386,8 +404,11 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
         for sub in walk_condition(rule.condition):
             var = fb.variable(sub.variable)
             if var is None:
-                r.error(f"RULE {rule.label}: undeclared variable {sub.variable}", sub.span or rule.span,
-                        "undeclared-variable")
+                r.error(
+                    f"RULE {rule.label}: undeclared variable {sub.variable}",
+                    sub.span or rule.span,
+                    "undeclared-variable",
+                )
                 continue
             if isinstance(sub, Is):
                 terms = _terms_of(fb, sub.variable)
@@ -414,8 +435,11 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
         for c in rule.conclusions:
             var = fb.variable(c.variable)
             if var is None:
-                r.error(f"RULE {rule.label}: undeclared variable {c.variable}", c.span or rule.span,
-                        "undeclared-variable")
+                r.error(
+                    f"RULE {rule.label}: undeclared variable {c.variable}",
+                    c.span or rule.span,
+                    "undeclared-variable",
+                )
                 continue
             if var.kind is VarKind.INPUT:
                 r.error(
@@ -443,8 +467,11 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             if isinstance(w, Ref):
                 wvar = fb.variable(w.name)
                 if wvar is None:
-                    r.error(f"RULE {rule.label}: undeclared weight variable {w.name}", w.span or c.span,
-                            "undeclared-variable")
+                    r.error(
+                        f"RULE {rule.label}: undeclared weight variable {w.name}",
+                        w.span or c.span,
+                        "undeclared-variable",
+                    )
                 elif wvar.kind is not VarKind.INPUT:
                     r.warning(
                         f"RULE {rule.label}: weight {w.name} is not a VAR_INPUT (5.2.4)",
@@ -458,7 +485,9 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "weight-out-of-range",
                     )
             elif w is not None and math.isnan(w):
-                r.error(f"RULE {rule.label}: weight is not a number", c.span or rule.span, "weight-out-of-range")
+                r.error(
+                    f"RULE {rule.label}: weight is not a number", c.span or rule.span, "weight-out-of-range"
+                )
             elif w is not None and w < 0.0:
                 r.error(
                     f"RULE {rule.label}: weight {w:g} is negative; 5.2.4 allows 0.0 to 1.0",
@@ -492,7 +521,7 @@ def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
         state[i] = 1
         for j in sorted(edges[i]):
             if state.get(j) == 1:
-                return [*path[path.index(j):], j] if j in path else [i, j]
+                return [*path[path.index(j) :], j] if j in path else [i, j]
             if state.get(j) is None:
                 found = visit(j, [*path, j])
                 if found:
@@ -519,13 +548,16 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     """FUNCTION terms may only name declared variables."""
     r = _Reporter(ctx)
     for fb in doc.blocks:
-        for block in (*fb.fuzzify, *fb.defuzzify):
+        for block in term_blocks(fb):
             for t in block.terms:
                 if isinstance(t.mf, FunctionMF):
                     for name in sorted(_names(t.mf.expr)):
                         if fb.variable(name) is None and name not in ("x", "pi", "e"):
-                            r.error(f"TERM {t.name}: FUNCTION uses undeclared variable {name}", t.span,
-                                    "undeclared-variable")
+                            r.error(
+                                f"TERM {t.name}: FUNCTION uses undeclared variable {name}",
+                                t.span,
+                                "undeclared-variable",
+                            )
     yield from r.found
 
 
@@ -544,4 +576,3 @@ def _names(e: object) -> set[str]:
 register_provider("declarations", check_declarations)
 register_provider("rules", check_rules)
 register_provider("functions", check_functions)
-

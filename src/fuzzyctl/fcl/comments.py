@@ -11,6 +11,7 @@ from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any, Protocol
 
+from fuzzyctl.fcl.checks import term_blocks
 from fuzzyctl.model import Document, FunctionBlock, RuleBlock, Span
 
 
@@ -33,7 +34,7 @@ def _elements(doc: Document) -> list[tuple[int, int, int, int]]:
         add(fb, 0)
         for v in fb.variables:
             add(v, 1)
-        for block in (*fb.fuzzify, *fb.defuzzify):
+        for block in term_blocks(fb):
             add(block, 1)
             for t in block.terms:
                 add(t, 2)
@@ -70,7 +71,8 @@ def attach_comments(doc: Document, comments: Sequence[CommentLike]) -> Document:
         return replace(obj, comments=tuple(texts)) if texts else obj
 
     def rebuild_rb(rb: RuleBlock) -> RuleBlock:
-        return with_comments(replace(rb, rules=tuple(with_comments(r) for r in rb.rules)))
+        new: RuleBlock = with_comments(replace(rb, rules=tuple(with_comments(r) for r in rb.rules)))
+        return new
 
     def rebuild(fb: FunctionBlock) -> FunctionBlock:
         new = replace(
@@ -80,7 +82,8 @@ def attach_comments(doc: Document, comments: Sequence[CommentLike]) -> Document:
                 with_comments(replace(b, terms=tuple(with_comments(t) for t in b.terms))) for b in fb.fuzzify
             ),
             defuzzify=tuple(
-                with_comments(replace(b, terms=tuple(with_comments(t) for t in b.terms))) for b in fb.defuzzify
+                with_comments(replace(b, terms=tuple(with_comments(t) for t in b.terms)))
+                for b in fb.defuzzify
             ),
             rule_blocks=tuple(rebuild_rb(rb) for rb in fb.rule_blocks),
         )
@@ -89,4 +92,3 @@ def attach_comments(doc: Document, comments: Sequence[CommentLike]) -> Document:
 
     blocks = tuple(rebuild(fb) for fb in doc.blocks)
     return replace(doc, blocks=blocks, comments=tuple(loose))
-

@@ -179,8 +179,8 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
                         add(ext, "weighting factor", f"WITH {detail}")
         if fb.options:
             add(open_, "options", "OPTIONS ... END_OPTIONS")
-    for s in sorted(spellings):
-        add(open_, "membership function spelling", s)
+    for spelling in sorted(spellings):
+        add(open_, "membership function spelling", spelling)
     return sorted(found.values(), key=lambda f: (f.level, f.element, f.detail))
 
 

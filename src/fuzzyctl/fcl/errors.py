@@ -117,7 +117,7 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
         return error(message, span, code=code, file=path, hint=hint)
 
     if isinstance(exc, UnexpectedCharacters):
-        pos = exc.pos_in_stream
+        pos = exc.pos_in_stream or 0
         char = source_text[pos] if 0 <= pos < len(source_text) else ""
         span = Span(exc.line, exc.column)
         if source_text.startswith("(*", pos) or source_text.startswith("/*", pos):
@@ -150,19 +150,27 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
     statement = _statement(stack)
 
     # An empty TERM x := ;
-    if expected & _MF_START and "ASSIGN" not in expected and statement is not None and statement.type == "TERM":
-        if prev is not None and prev.type == "ASSIGN":
-            term_name = _term_name(stack)
-            return make(
-                f"TERM {term_name} has no membership function after ':='".replace("TERM  ", "TERM "),
-                _end_of(prev),
-                "give points (x, y) ..., a singleton value or a shape",
-                code="empty-term",
-            )
+    in_term = statement is not None and statement.type == "TERM"
+    if (
+        expected & _MF_START
+        and "ASSIGN" not in expected
+        and in_term
+        and prev is not None
+        and prev.type == "ASSIGN"
+    ):
+        term_name = _term_name(stack)
+        return make(
+            f"TERM {term_name} has no membership function after ':='".replace("TERM  ", "TERM "),
+            _end_of(prev),
+            "give points (x, y) ..., a singleton value or a shape",
+            code="empty-term",
+        )
 
     # A ';' missing at the end of a line (often swallowed by a // comment).
-    if ("SEMI" in expected or "SEMICOLON" in expected) and prev is not None and (tok.line or 0) > (
-        prev.end_line or prev.line or 0
+    if (
+        ("SEMI" in expected or "SEMICOLON" in expected)
+        and prev is not None
+        and (tok.line or 0) > (prev.end_line or prev.line or 0)
     ):
         where = _end_of(prev)
         line_text = lines[where.line - 1] if 0 < where.line <= len(lines) else ""
@@ -170,8 +178,13 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
         hint = None
         comment = re.search(r"//.*;|\(\*.*;.*\*\)|/\*.*;.*\*/", line_text)
         if comment:
-            hint = f"the ';' on line {where.line} is inside a comment, which starts at column {comment.start() + 1}"
-        return make(f"missing ';'{what} at the end of line {where.line}", where, hint, code="missing-semicolon")
+            hint = (
+                f"the ';' on line {where.line} is inside a comment, "
+                f"which starts at column {comment.start() + 1}"
+            )
+        return make(
+            f"missing ';'{what} at the end of line {where.line}", where, hint, code="missing-semicolon"
+        )
 
     # A block keyword or the END of an outer block while an inner block is open.
     if opener is not None:
@@ -185,10 +198,10 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
 
     # A point (x, y) not closed: (3, 0 (27, 1)
     if "RPAR" in expected and prev is not None and statement is not None and statement.type == "TERM":
-        start = _open_paren(stack)
-        where = f" opened at column {start.column}" if start is not None else ""
+        opening = _open_paren(stack)
+        opened = f" opened at column {opening.column}" if opening is not None else ""
         return make(
-            f"missing ')' to close the point{where}",
+            f"missing ')' to close the point{opened}",
             _end_of(prev) if tok.type == "LPAR" else _at(tok),
             code="unclosed-point",
         )
@@ -212,8 +225,7 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
 
     if tok.type == "ID" and str(tok).upper() in _OPERATOR_WORDS and expected & {"AND", "OR"}:
         return make(
-            f"unexpected {_shown(tok)} in a condition: {str(tok).upper()} is an algorithm, "
-            "not an operator",
+            f"unexpected {_shown(tok)} in a condition: {str(tok).upper()} is an algorithm, not an operator",
             _at(tok),
             "combine subconditions with AND, OR or NOT; choose the algorithm in the RULEBLOCK "
             f"(e.g. OR : {str(tok).upper()};)",

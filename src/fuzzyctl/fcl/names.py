@@ -16,8 +16,10 @@ from fuzzyctl.model import (
     And,
     Conclusion,
     Condition,
+    DefuzzifyBlock,
     Degree,
     FunctionBlock,
+    FuzzifyBlock,
     Is,
     Not,
     Or,
@@ -72,7 +74,8 @@ def resolve_names(fb: FunctionBlock, warn: Warn) -> FunctionBlock:
     fuzzify = tuple(replace(b, variable=r.variable(b.variable, b.span)) for b in fb.fuzzify)
     defuzzify = tuple(replace(b, variable=r.variable(b.variable, b.span)) for b in fb.defuzzify)
     terms: dict[str, set[str]] = {}
-    for b in (*fuzzify, *defuzzify):
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fuzzify, *defuzzify]
+    for b in blocks:
         terms.setdefault(b.variable, set()).update(t.name for t in b.terms)
 
     def condition(c: Condition) -> Condition:

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cache
 from importlib import resources
-from typing import Any
+from typing import Any, cast
 
 from lark import Lark, Token, Transformer
 from lark.exceptions import UnexpectedInput, VisitError
@@ -288,7 +288,9 @@ class _Builder(Transformer[Token, Any]):
             self.state.warn(f"RANGE({low:g}..{high:g}) is empty", span, "empty-range")
         return Range(low, high, span)
 
-    def _keyword_item(self, key: str, label: str, table: keywords.Synonyms, children: list[Any], tok: Token) -> _Item:
+    def _keyword_item(
+        self, key: str, label: str, table: keywords.Synonyms, children: list[Any], tok: Token
+    ) -> _Item:
         spelling = str(tok)
         span = _outer(children) or _tok_span(tok)
         if not _tokens(children, "SEMI"):
@@ -308,13 +310,19 @@ class _Builder(Transformer[Token, Any]):
         return _Item(key, value, span)
 
     def method_stmt(self, children: list[Token]) -> _Item:
-        return self._keyword_item("method", "defuzzification METHOD", keywords.METHOD_SYNONYMS, children, children[1])
+        return self._keyword_item(
+            "method", "defuzzification METHOD", keywords.METHOD_SYNONYMS, children, children[1]
+        )
 
     def accu_stmt(self, children: list[Token]) -> _Item:
-        return self._keyword_item("accu", "accumulation method (ACCU)", keywords.ACCU_SYNONYMS, children, children[1])
+        return self._keyword_item(
+            "accu", "accumulation method (ACCU)", keywords.ACCU_SYNONYMS, children, children[1]
+        )
 
     def act_stmt(self, children: list[Token]) -> _Item:
-        return self._keyword_item("act", "activation method (ACT)", keywords.ACT_SYNONYMS, children, children[1])
+        return self._keyword_item(
+            "act", "activation method (ACT)", keywords.ACT_SYNONYMS, children, children[1]
+        )
 
     def operator_stmt(self, children: list[Token]) -> _Item:
         if children[0].type == "AND":
@@ -331,7 +339,9 @@ class _Builder(Transformer[Token, Any]):
         default: Default = next(c for c in children if isinstance(c, Default))
         span = _outer(children)
         if _tokens(children, "EQUAL"):
-            self.state.warn("DEFAULT written with '=': the standard writes DEFAULT := value;", span, "default-equal")
+            self.state.warn(
+                "DEFAULT written with '=': the standard writes DEFAULT := value;", span, "default-equal"
+            )
         if not _tokens(children, "SEMI"):
             self.state.warn("missing ';' after DEFAULT", span, "missing-semicolon")
         return _Item("default", replace(default, span=span), span or Span(0, 0))
@@ -393,7 +403,9 @@ class _Builder(Transformer[Token, Any]):
 
     def var_decl(self, children: list[Any]) -> _Decls:
         ids = [c for c in children if isinstance(c, Token) and c.type == "ID"]
-        initial = next((c for c in children if isinstance(c, float | bool | str) and not isinstance(c, Token)), None)
+        initial = next(
+            (c for c in children if isinstance(c, float | bool | str) and not isinstance(c, Token)), None
+        )
         rng = next((c for c in children if isinstance(c, Range)), None)
         names = [(str(t), _tok_span(t)) for t in ids[:-1]]
         return _Decls(names, str(ids[-1]).upper(), initial, rng, _outer(children))
@@ -441,8 +453,7 @@ class _Builder(Transformer[Token, Any]):
     def paren_conclusion(self, children: list[Any]) -> Conclusion:
         made = self.conclusion(children)
         self.state.warn(
-            "parentheses around a subconclusion are not FCL (5.4.1); read as "
-            f"{made.variable} IS {made.term}",
+            f"parentheses around a subconclusion are not FCL (5.4.1); read as {made.variable} IS {made.term}",
             made.span,
             "paren-conclusion",
         )
@@ -563,14 +574,15 @@ def parse_source(source: Source) -> ParseResult:
 
     state = ParseState(source)
     lark = _parser()
-    builder: _Builder = lark.options.transformer
+    builder = lark.options.transformer
+    assert isinstance(builder, _Builder)
     text = source.text
     # One parser and one builder serve every parse; the lock keeps parses from mixing states.
     _LOCK.acquire()
     builder.state = state
     _ACTIVE.append(state)
     try:
-        document: Document | None = lark.parse(text)
+        document: Document | None = cast(Document, lark.parse(text))
     except UnexpectedInput as exc:
         recovered = _recover(lark, state, exc, source)
         if recovered is None:
@@ -607,7 +619,7 @@ def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, source: Source
     state.comments.clear()
     state.spellings.clear()
     try:
-        document: Document = lark.parse(source.text[:pos])
+        document = cast(Document, lark.parse(source.text[:pos]))
     except UnexpectedInput:
         return None
     state.warn(

@@ -169,9 +169,7 @@ def spelling_for(mf: ShapeMF) -> Spelling:
     if mf.kind == "gaussian2":
         # jFuzzyLogic rejects GAUSS2 with mean1 > mean2; fuzzylite's product form reads it.
         m1, m2 = mf.params[0], mf.params[2]
-        needs_fuzzylite = needs_fuzzylite or (
-            not isinstance(m1, Ref) and not isinstance(m2, Ref) and m1 > m2
-        )
+        needs_fuzzylite = needs_fuzzylite or (not isinstance(m1, Ref) and not isinstance(m2, Ref) and m1 > m2)
     if needs_fuzzylite and preferred.dialect != FL:
         return next(s for s in SPELLINGS if s.kind == mf.kind and s.dialect == FL)
     return preferred

@@ -47,5 +47,7 @@ def read_source(path: str | os.PathLike[str]) -> Source:
     try:
         data = p.read_bytes()
     except OSError as exc:
-        raise DiagnosticError([error(f"cannot read: {exc.strerror or exc}", file=name, code="unreadable")]) from exc
+        raise DiagnosticError(
+            [error(f"cannot read: {exc.strerror or exc}", file=name, code="unreadable")]
+        ) from exc
     return decode(data, name)

@@ -63,7 +63,9 @@ def _comment_lines(comments: Iterable[str], indent: str) -> list[str]:
         body = text
         if text.startswith("//"):
             body = text[2:].strip()
-        elif (text.startswith("/*") and text.endswith("*/")) or (text.startswith("(*") and text.endswith("*)")):
+        elif (text.startswith("/*") and text.endswith("*/")) or (
+            text.startswith("(*") and text.endswith("*)")
+        ):
             body = text[2:-2].strip()
         if "*)" in body or "(*" in body:
             out.append(indent + text if "\n" not in text else text)
