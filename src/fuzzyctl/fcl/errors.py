@@ -148,6 +148,10 @@ def syntax_diagnostic(exc: UnexpectedInput, state: Any) -> Diagnostic:
         prev = history[-1]
     opener = _open_block(stack)
     statement = _statement(stack)
+    start = tok.start_pos
+    if start is not None and (source_text.startswith("(*", start) or source_text.startswith("/*", start)):
+        closer = "*)" if source_text.startswith("(*", start) else "*/"
+        return make("comment is never closed", _at(tok), f"close it with {closer}", code="unclosed-comment")
 
     # An empty TERM x := ;
     in_term = statement is not None and statement.type == "TERM"
