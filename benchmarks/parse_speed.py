@@ -10,7 +10,13 @@ from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import read_source
 
 ROOT = Path(__file__).resolve().parent.parent
-FILE = ROOT.parent / "shared" / "corpus" / "fcl" / "khalidwalit__HIRS__WebContent__WEB-INF__Fuzzy__FuzzySmoke.fcl"
+FILE = (
+    ROOT.parent
+    / "shared"
+    / "corpus"
+    / "fcl"
+    / "khalidwalit__HIRS__WebContent__WEB-INF__Fuzzy__FuzzySmoke.fcl"
+)
 
 
 def main() -> int:

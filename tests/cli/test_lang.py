@@ -61,10 +61,15 @@ def test_usage_error_exit_2(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["check"]) == 2
 
 
-def test_fmt_prints_canonical_text_and_writes_in_place(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_fmt_prints_canonical_text_and_writes_in_place(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     assert main(["fmt", str(FIG7)]) == 0
     out = capsys.readouterr().out
-    assert "METHOD : CoGS;" in out and "RULE 2 : IF temp IS cold AND pressure IS high THEN valve IS closed WITH 0.8;" in out
+    assert (
+        "METHOD : CoGS;" in out
+        and "RULE 2 : IF temp IS cold AND pressure IS high THEN valve IS closed WITH 0.8;" in out
+    )
     copy = tmp_path / "f.fcl"
     copy.write_text(FIG7.read_text().lower().replace("fuzzy_fb", "fb"))
     assert main(["fmt", "--in-place", str(copy)]) == 0

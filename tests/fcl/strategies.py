@@ -28,10 +28,39 @@ from fuzzyctl.model import (
     VarKind,
 )
 
-KEYWORDS = {"and", "or", "not", "is", "if", "then", "with", "var", "term", "rule", "range", "nc", "nan", "inf",
-            "function", "method", "default", "accu", "act", "options", "option", "fuzzify", "defuzzify",
-            "ruleblock", "singletons", "end_var", "any", "infinity"}
-names = st.from_regex(r"[A-Za-z][A-Za-z0-9_]{0,8}", fullmatch=True).filter(lambda s: s.lower() not in KEYWORDS)
+KEYWORDS = {
+    "and",
+    "or",
+    "not",
+    "is",
+    "if",
+    "then",
+    "with",
+    "var",
+    "term",
+    "rule",
+    "range",
+    "nc",
+    "nan",
+    "inf",
+    "function",
+    "method",
+    "default",
+    "accu",
+    "act",
+    "options",
+    "option",
+    "fuzzify",
+    "defuzzify",
+    "ruleblock",
+    "singletons",
+    "end_var",
+    "any",
+    "infinity",
+}
+names = st.from_regex(r"[A-Za-z][A-Za-z0-9_]{0,8}", fullmatch=True).filter(
+    lambda s: s.lower() not in KEYWORDS
+)
 numbers = st.floats(-1e6, 1e6, allow_nan=False).map(lambda x: round(x, 3))
 degrees = st.sampled_from([0.0, 0.25, 0.5, 1.0])
 
@@ -44,9 +73,28 @@ def points_mf(draw: st.DrawFn) -> PointsMF:
 
 @st.composite
 def shape_mf(draw: st.DrawFn) -> ShapeMF:
-    kind = draw(st.sampled_from(["triangle", "trapezoid", "gaussian", "bell", "sigmoid", "cosine", "ramp",
-                                 "pishape", "dsigmoid", "psigmoid", "gaussian2", "spike", "concave"]))
-    n = {"triangle": 3, "trapezoid": 4, "pishape": 4, "dsigmoid": 4, "psigmoid": 4, "gaussian2": 4}.get(kind, 2)
+    kind = draw(
+        st.sampled_from(
+            [
+                "triangle",
+                "trapezoid",
+                "gaussian",
+                "bell",
+                "sigmoid",
+                "cosine",
+                "ramp",
+                "pishape",
+                "dsigmoid",
+                "psigmoid",
+                "gaussian2",
+                "spike",
+                "concave",
+            ]
+        )
+    )
+    n = {"triangle": 3, "trapezoid": 4, "pishape": 4, "dsigmoid": 4, "psigmoid": 4, "gaussian2": 4}.get(
+        kind, 2
+    )
     if kind == "bell":
         n = 3
     params = sorted(draw(st.lists(numbers, min_size=n, max_size=n)))
@@ -78,7 +126,9 @@ def function_blocks(draw: st.DrawFn) -> FunctionBlock:
     atoms: list[Is] = []
     for v in inputs:
         terms = draw(st.lists(names, min_size=1, max_size=3, unique=True))
-        fuzzify.append(FuzzifyBlock(v, tuple(Term(t, draw(st.one_of(points_mf(), shape_mf()))) for t in terms)))
+        fuzzify.append(
+            FuzzifyBlock(v, tuple(Term(t, draw(st.one_of(points_mf(), shape_mf()))) for t in terms))
+        )
         atoms.extend(Is(v, t) for t in terms)
     defuzzify = []
     heads: list[tuple[str, str]] = []
@@ -100,10 +150,17 @@ def function_blocks(draw: st.DrawFn) -> FunctionBlock:
         weight = draw(st.sampled_from([None, 0.5, 1.0]))
         conclusions = tuple(Conclusion(v, t, weight) for v, t in head)
         rules.append(Rule(str(i + 1), draw(conditions(atoms)), conclusions))
-    block = RuleBlock(draw(st.one_of(st.none(), names)), tuple(rules), "MIN", draw(st.sampled_from(["MAX", None])),
-                      draw(st.sampled_from(["MIN", "PROD", None])), "MAX")
-    return FunctionBlock(draw(st.one_of(st.none(), names)), tuple(variables), tuple(fuzzify), tuple(defuzzify),
-                         (block,))
+    block = RuleBlock(
+        draw(st.one_of(st.none(), names)),
+        tuple(rules),
+        "MIN",
+        draw(st.sampled_from(["MAX", None])),
+        draw(st.sampled_from(["MIN", "PROD", None])),
+        "MAX",
+    )
+    return FunctionBlock(
+        draw(st.one_of(st.none(), names)), tuple(variables), tuple(fuzzify), tuple(defuzzify), (block,)
+    )
 
 
 documents = st.lists(function_blocks(), min_size=1, max_size=2).map(lambda fbs: Document(tuple(fbs)))

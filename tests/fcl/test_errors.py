@@ -22,18 +22,34 @@ def first_error(text: str):  # type: ignore[no-untyped-def]
 @pytest.mark.parametrize(
     ("text", "line", "words"),
     [
-        ("FUNCTION_BLOCK f\nVAR_INPUT\nt : REAL;\nVAR_OUTPUT v : REAL; END_VAR\n" + TAIL, 4, "missing END_VAR"),
+        (
+            "FUNCTION_BLOCK f\nVAR_INPUT\nt : REAL;\nVAR_OUTPUT v : REAL; END_VAR\n" + TAIL,
+            4,
+            "missing END_VAR",
+        ),
         (HEAD + "FUZZIFY t\nTERM hot := (3, 0 (27, 1);\nEND_FUZZIFY\n" + TAIL, 5, "missing ')'"),
-        (HEAD + "FUZZIFY t\nTERM hot :=\nTERM cold := (3, 1) (27, 0);\nEND_FUZZIFY\n" + TAIL, 5, "no membership"),
-        (HEAD + "FUZZIFY t\nTERM hot := (3, 0) (27, 1) // ends here;\nTERM c := (1, 0) (2, 1);\nEND_FUZZIFY\n" + TAIL,
-         5, "missing ';'"),
+        (
+            HEAD + "FUZZIFY t\nTERM hot :=\nTERM cold := (3, 1) (27, 0);\nEND_FUZZIFY\n" + TAIL,
+            5,
+            "no membership",
+        ),
+        (
+            HEAD
+            + "FUZZIFY t\nTERM hot := (3, 0) (27, 1) // ends here;\nTERM c := (1, 0) (2, 1);\nEND_FUZZIFY\n"
+            + TAIL,
+            5,
+            "missing ';'",
+        ),
         (HEAD + FUZZ + DEFUZZ + RULES.replace("t IS cold", "t IS warm") + TAIL, 15, "no term warm"),
         (HEAD + FUZZ + DEFUZZ + RULES.replace("IF t", "IF q") + TAIL, 15, "undeclared variable q"),
         (HEAD + FUZZ + DEFUZZ.replace("CoGS", "CoA") + RULES + TAIL, 9, "CoA"),
         (HEAD + FUZZ.replace("(3, 1) (27, 0)", "(27, 1) (3, 0)") + DEFUZZ + RULES + TAIL, 5, "ascending"),
         (HEAD + FUZZ + DEFUZZ + RULES.replace("on;", "on WITH -0.5;") + TAIL, 15, "weight"),
-        (HEAD.replace("VAR_INPUT t", "VAR_INPUT q : REAL; END_VAR VAR_OUTPUT t") + FUZZ + DEFUZZ + TAIL, 4,
-         "VAR_OUTPUT"),
+        (
+            HEAD.replace("VAR_INPUT t", "VAR_INPUT q : REAL; END_VAR VAR_OUTPUT t") + FUZZ + DEFUZZ + TAIL,
+            4,
+            "VAR_OUTPUT",
+        ),
         (HEAD + "VAR_INPUT t : REAL; END_VAR\n" + TAIL, 4, "declared twice"),
         ("", 1, "no FUNCTION_BLOCK"),
         (HEAD + "FUZZIFY t (* never closed\n" + TAIL, 4, "comment"),
@@ -49,8 +65,13 @@ def test_diagnostic_points_at_the_defect(text: str, line: int, words: str) -> No
 
 
 def test_warnings_for_missing_accu_default_and_act() -> None:
-    text = HEAD + FUZZ + DEFUZZ.replace("DEFAULT := 0;\n", "").replace("on := 1", "on := (0, 0) (1, 1)") + \
-        "RULEBLOCK r\nAND : MIN;\nOR : ASUM;\nRULE 1 : IF t IS cold THEN v IS on;\nEND_RULEBLOCK\n" + TAIL
+    text = (
+        HEAD
+        + FUZZ
+        + DEFUZZ.replace("DEFAULT := 0;\n", "").replace("on := 1", "on := (0, 0) (1, 1)")
+        + "RULEBLOCK r\nAND : MIN;\nOR : ASUM;\nRULE 1 : IF t IS cold THEN v IS on;\nEND_RULEBLOCK\n"
+        + TAIL
+    )
     result = load_text(text)
     assert result.ok
     by_code = {d.code: d for d in result.diagnostics}
@@ -63,8 +84,10 @@ def test_warnings_for_missing_accu_default_and_act() -> None:
 def test_cycle_between_rule_blocks_through_locals() -> None:
     text = (
         "FUNCTION_BLOCK f\nVAR_INPUT t : REAL; END_VAR\nVAR a : REAL; b : REAL; END_VAR\n"
-        "VAR_OUTPUT v : REAL; END_VAR\n" + FUZZ + DEFUZZ +
-        "RULEBLOCK one ACCU : MAX; RULE 1 : IF b THEN a; END_RULEBLOCK\n"
+        "VAR_OUTPUT v : REAL; END_VAR\n"
+        + FUZZ
+        + DEFUZZ
+        + "RULEBLOCK one ACCU : MAX; RULE 1 : IF b THEN a; END_RULEBLOCK\n"
         "RULEBLOCK two ACCU : MAX; RULE 1 : IF a THEN b; END_RULEBLOCK\n" + TAIL
     )
     d = first_error(text)

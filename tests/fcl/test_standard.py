@@ -35,8 +35,9 @@ FIG3 = """FUNCTION_BLOCK Fuzzy_FB
 END_FUNCTION_BLOCK"""
 
 
-def _wrap(body: str, decls: str = "VAR_INPUT temp : REAL; pressure : REAL; END_VAR "
-          "VAR_OUTPUT valve : REAL; END_VAR") -> str:
+def _wrap(
+    body: str, decls: str = "VAR_INPUT temp : REAL; pressure : REAL; END_VAR VAR_OUTPUT valve : REAL; END_VAR"
+) -> str:
     return f"FUNCTION_BLOCK fb {decls}\n{body}\nEND_FUNCTION_BLOCK\n"
 
 
@@ -142,8 +143,13 @@ def test_siemens_example_is_basic_level() -> None:
 
 
 def test_weight_attaches_to_the_subconclusion_it_follows() -> None:
-    doc = parse_fcl(_wrap(WEIGHT_CONSTANT, "VAR_INPUT temp : REAL; pressure : REAL; END_VAR "
-                          "VAR_OUTPUT valve1 : REAL; valve2 : REAL; END_VAR"))
+    doc = parse_fcl(
+        _wrap(
+            WEIGHT_CONSTANT,
+            "VAR_INPUT temp : REAL; pressure : REAL; END_VAR "
+            "VAR_OUTPUT valve1 : REAL; valve2 : REAL; END_VAR",
+        )
+    )
     (rule,) = doc.main.rule_blocks[0].rules
     assert rule.conclusions == (Conclusion("valve1", "inlet", 0.5), Conclusion("valve2", "closed", None))
 
@@ -157,8 +163,7 @@ def test_variable_weight() -> None:
     _round_trip(_wrap(WEIGHT_VARIABLE, WEIGHT_VARIABLE_DECLS))
 
 
-RULES_DECLS = ("VAR_INPUT a : REAL; b : REAL; c : REAL; temp : REAL; END_VAR "
-               "VAR_OUTPUT v : REAL; END_VAR")
+RULES_DECLS = "VAR_INPUT a : REAL; b : REAL; c : REAL; temp : REAL; END_VAR VAR_OUTPUT v : REAL; END_VAR"
 RULES_TERMS = """FUZZIFY a TERM x := (0, 0) (1, 1); END_FUZZIFY
 FUZZIFY b TERM x := (0, 0) (1, 1); END_FUZZIFY
 FUZZIFY c TERM x := (0, 0) (1, 1); END_FUZZIFY
@@ -228,8 +233,10 @@ def test_lower_case_dialect_without_semicolons_and_fuzzylite_terms() -> None:
 
 
 def test_crlf_bom_latin1_comments_and_options(tmp_path) -> None:  # type: ignore[no-untyped-def]
-    text = ("\ufeff// header\r\nFUNCTION_BLOCK t (* iec *)\r\nVAR_INPUT temp\u00e9 : REAL; END_VAR\r\n"
-            "OPTIONS\r\n  vendor_param = 3; (* kept *)\r\nEND_OPTIONS\r\nEND_FUNCTION_BLOCK\r\n")
+    text = (
+        "\ufeff// header\r\nFUNCTION_BLOCK t (* iec *)\r\nVAR_INPUT temp\u00e9 : REAL; END_VAR\r\n"
+        "OPTIONS\r\n  vendor_param = 3; (* kept *)\r\nEND_OPTIONS\r\nEND_FUNCTION_BLOCK\r\n"
+    )
     path = tmp_path / "latin.fcl"
     path.write_bytes(text.encode("utf-8")[3:].replace("\u00e9".encode(), b"\xe9"))
     result = load_file(path)
