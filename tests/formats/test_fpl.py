@@ -3,6 +3,8 @@ subset's limits, writing back."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError, Severity
@@ -233,3 +235,19 @@ def test_fpl_writer_turns_triangles_and_trapezoids_into_points() -> None:
     assert back is not None
     assert back.term("t") == Term("t", pts((1, 0), (2, 1), (3, 0)))
     assert back.term("z") == Term("z", pts((4, 0), (5, 1), (6, 1), (7, 0)))
+
+
+def test_siemens_1_3_fpltest_reads_like_the_fcl_transcription() -> None:
+    # examples/siemens_fpltest.fcl was written by hand (FCL issue) from the same listing;
+    # the FPL carries MIN/MAX, which that FCL leaves out.
+    from fuzzyctl.fcl import parse_fcl
+
+    fcl = parse_fcl((EXAMPLES / "siemens_fpltest.fcl").read_text(encoding="utf-8")).main
+    fpl = read_fpl(fpltest_from_manual()).main
+    no_ranges = replace(
+        fpl,
+        variables=tuple(replace(v, range=None) for v in fpl.variables),
+        defuzzify=tuple(replace(d, range=None) for d in fpl.defuzzify),
+        rule_blocks=tuple(replace(rb, act=None) for rb in fpl.rule_blocks),
+    )
+    assert no_ranges == fcl

@@ -29,6 +29,7 @@ from fuzzyctl.model import (
     Conclusion,
     Default,
     DefuzzifyBlock,
+    Document,
     FunctionBlock,
     FuzzifyBlock,
     Is,
@@ -370,3 +371,14 @@ def test_xfuz_writer_encodes_a_singleton_program_and_reports_what_does_not_fit()
         write_xfuz(too_much)
     fractional = replace(fb, fuzzify=(FuzzifyBlock("level", (Term("low", pts((20.5, 1), (40, 0))),)),))
     assert any("16-bit integer" in d.message for d in constants_from_model(fractional)[1])
+
+
+def test_xfuz_3_3_tables_to_fcl_text_and_back_give_the_same_words() -> None:
+    from fuzzyctl.fcl import parse_fcl, write
+
+    block, _ = model_from_constants(manual_constants())
+    text = write(Document((block,)))
+    assert "RULE 0 : IF INP1 IS faible AND INP4 IS NOT élevée THEN Débit IS fort;" in text
+    again, diags = constants_from_model(parse_fcl(text))
+    assert not [d for d in diags if d.is_error]
+    assert again == manual_constants()
