@@ -169,7 +169,7 @@ def test_xfuz_3_3_program_re_encodes_to_the_same_words() -> None:
 
 
 def test_xfuz_3_3_example_files_hold_the_printed_tables() -> None:
-    for name in ("xfuz_3_3.xfuz.csv", "xfuz_3_3.xfuz.json"):
+    for name in ("xfuz_3_3.csv.xfuz", "xfuz_3_3.xfuz"):
         path = EXAMPLES / name
         assert read_tables(path.read_text(encoding="utf-8"), path=str(path)) == manual_constants(), name
 
@@ -199,7 +199,7 @@ def test_xfuz_csv_layout_is_sparse_and_errors_name_the_line() -> None:
 
 
 def test_xfuz_reader_gives_a_document_and_refuses_undecodable_tables() -> None:
-    path = EXAMPLES / "xfuz_3_3.xfuz.json"
+    path = EXAMPLES / "xfuz_3_3.xfuz"
     doc = read_xfuz(path.read_text(encoding="utf-8"), path=str(path))
     assert replace(doc.main, options=(), name="xfuz") == EXPECTED_3_3
     assert doc.main.name == "xfuz_3_3"

@@ -3,14 +3,16 @@ fuzzyctl model (hence FCL).
 
 Two file layouts hold the same content, the constants of the block and the three arrays:
 
-JSON (``.xfuz.json``)::
+A ``.xfuz`` file holds either; the reader tells them apart by the first character.
+
+JSON::
 
     {"format": "xfuz-tables", "version": 1,
      "constants": {"OP_CONJ": 0, "OP_ET": 0, "OP_IMPL": 0, "OP_AGREG": 0, "OP_DEFUZ": 0,
                    "OUT_PT": 0, "CONTASK$": 1, "T_OFB$": 200, "O1_DEF$": 0, ...},
      "ESV": [62 words], "FA": [576 words], "RG": [384 words]}
 
-CSV (``.xfuz.csv``), one word per row like the manual's "ligne N : value" listings::
+CSV, one word per row like the manual's "ligne N : value" listings::
 
     table,index,value,note
     CONST,OP_ET,0,
@@ -93,7 +95,7 @@ from fuzzyctl.model import (
 )
 
 NAME = "xfuz"
-EXTENSIONS = (".xfuz.json", ".xfuz.csv", ".xfuz")
+EXTENSIONS = (".xfuz",)
 FORMAT_TAG = "xfuz-tables"
 
 __all__ = [
@@ -288,9 +290,8 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
 
 
 def read_tables(text: str, *, path: str | None = None) -> XfuzConstants:
-    """Read a JSON or CSV table file (chosen by extension, else by content)."""
-    lower = (path or "").lower()
-    if lower.endswith(".json") or (not lower.endswith(".csv") and text.lstrip().startswith("{")):
+    """Read a table file: JSON when it starts with ``{``, else CSV."""
+    if text.lstrip().startswith("{"):
         return _read_json(text, path)
     return _read_csv(text, path)
 
@@ -538,9 +539,7 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
 def read_xfuz(text: str, *, path: str | None = None) -> Document:
     """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
     constants = read_tables(text, path=path)
-    stem = re.sub(
-        r"(\.xfuz)?\.(json|csv)$|\.xfuz$", "", (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1]
-    )
+    stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
     block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
     diags = [replace(d, file=path) for d in diags]
     if any(d.is_error for d in diags):
