@@ -8,7 +8,8 @@ from dataclasses import replace
 import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError, Severity
-from fuzzyctl.formats.fpl import check_fpl, parse_fpl, read_fpl, write_fpl
+from fuzzyctl.formats.fpl import parse_fpl, read_fpl
+from fuzzyctl.formats.fpl_write import check_fpl, write_fpl
 from fuzzyctl.model import (
     And,
     Conclusion,

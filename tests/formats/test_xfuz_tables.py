@@ -9,14 +9,7 @@ from dataclasses import replace
 import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats.xfuz import (
-    constants_from_model,
-    model_from_constants,
-    read_tables,
-    read_xfuz,
-    write_tables,
-    write_xfuz,
-)
+from fuzzyctl.formats.xfuz import model_from_constants, read_tables, read_xfuz, write_tables
 from fuzzyctl.formats.xfuz_tables import (
     StatusBit,
     XfuzConstants,
@@ -24,6 +17,7 @@ from fuzzyctl.formats.xfuz_tables import (
     decode_name,
     encode_name,
 )
+from fuzzyctl.formats.xfuz_write import constants_from_model, write_xfuz
 from fuzzyctl.model import (
     And,
     Conclusion,
