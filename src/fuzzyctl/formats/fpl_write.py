@@ -3,11 +3,14 @@ cannot express, and the lowering ``fuzzyctl convert --lossy`` uses."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
 from fuzzyctl.formats.fpl import leaves
 from fuzzyctl.model import (
     And,
     Condition,
+    Default,
     DefuzzifyBlock,
     Document,
     FunctionBlock,
@@ -24,7 +27,7 @@ from fuzzyctl.model import (
     is_constant,
 )
 
-__all__ = ["check_fpl", "write_fpl"]
+__all__ = ["check_fpl", "lower_fpl", "write_fpl"]
 
 
 def _num(x: float) -> str:
@@ -231,3 +234,84 @@ def write_fpl(block: FunctionBlock | Document) -> str:
         out += ["CONNECT", f"FROM {base_name}", f"TO {var.name}", "END"]
     out.append("END")
     return "\n".join(out) + "\n"
+
+
+def _loss(d: Diagnostic) -> tuple[str, str]:
+    where = f"line {d.span.line}" if d.span is not None else "program"
+    return where, d.message
+
+
+def _fpl_condition(cond: Condition | None) -> bool:
+    if cond is None:
+        return True
+    if isinstance(cond, Is):
+        return not cond.negated and not cond.hedges
+    return isinstance(cond, And) and all(_fpl_condition(c) for c in cond.operands)
+
+
+def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
+    """``document`` reduced to what FPL can say, and what was dropped as ``(element,
+    reason)`` pairs: further function blocks, rule blocks and intermediate variables,
+    weights, DEFAULT values (Fuzzy Control keeps the last value), other operators, rules
+    with OR/NOT/hedges and terms FPL cannot hold (with the rules that use them)."""
+    fb = document.main
+    losses = [(f"function block {b.name}", "an FPL file holds one project") for b in document.blocks[1:]]
+    diags = check_fpl(fb)
+    losses += [_loss(d) for d in diags if d.is_error or d.code == "fpl-expr-default"]
+    local_names = {v.name for v in fb.locals}
+    keep_terms: set[tuple[str, str]] = set()
+    fuzzify = []
+    for fz in fb.fuzzify:
+        if fz.variable in local_names:
+            continue
+        terms = tuple(t for t in fz.terms if _as_points(t.mf) is not None)
+        keep_terms.update((fz.variable, t.name) for t in terms)
+        fuzzify.append(replace(fz, terms=terms))
+    defuzzify = []
+    for dz in fb.defuzzify:
+        if dz.variable in local_names:
+            continue
+        terms = tuple(
+            t
+            for t in dz.terms
+            if (isinstance(t.mf, SingletonMF) and is_constant(t.mf.value)) or _as_points(t.mf) is not None
+        )
+        keep_terms.update((dz.variable, t.name) for t in terms)
+        singletons = all(isinstance(t.mf, SingletonMF) for t in terms)
+        defuzzify.append(
+            replace(
+                dz,
+                terms=terms,
+                method="COGS" if singletons else "COG",
+                default=Default(no_change=True),
+                accu=None,
+            )
+        )
+    rule_blocks = []
+    for rb in fb.rule_blocks[:1]:
+        rules = []
+        for rule in rb.rules:
+            used = [(c.variable, c.term) for c in leaves(rule.condition)]
+            used += [(c.variable, c.term or "") for c in rule.conclusions]
+            if _fpl_condition(rule.condition) and all(u in keep_terms for u in used):
+                rules.append(
+                    replace(rule, conclusions=tuple(replace(c, weight=None) for c in rule.conclusions))
+                )
+        rule_blocks.append(
+            replace(
+                rb,
+                rules=tuple(rules),
+                and_op="MIN",
+                or_op=None,
+                accu="MAX",
+                act=None if rb.act in (None, "MIN") else "MIN",
+            )
+        )
+    lowered = replace(
+        fb,
+        variables=tuple(v for v in fb.variables if v.name not in local_names),
+        fuzzify=tuple(fuzzify),
+        defuzzify=tuple(defuzzify),
+        rule_blocks=tuple(rule_blocks),
+    )
+    return Document((lowered,), path=document.path, comments=document.comments), losses

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
 from fuzzyctl.formats.xfuz_tables import (
@@ -34,8 +34,10 @@ from fuzzyctl.model import (
     Is,
     MembershipFunction,
     Not,
+    Or,
     Param,
     PointsMF,
+    Range,
     Rule,
     RuleBlock,
     ShapeMF,
@@ -46,7 +48,7 @@ from fuzzyctl.model import (
     is_constant,
 )
 
-__all__ = ["check_xfuz", "constants_from_model", "slot_labels", "write_xfuz"]
+__all__ = ["check_xfuz", "constants_from_model", "lower_xfuz", "slot_labels", "write_xfuz"]
 
 
 _SLOT_NAME = re.compile(r"^(INP|OUT|VAR)([1-8])$", re.IGNORECASE)
@@ -426,3 +428,198 @@ def write_xfuz(block: FunctionBlock | Document, *, layout: str = "json") -> str:
     from fuzzyctl.formats.xfuz import write_tables
 
     return write_tables(constants, layout=layout)
+
+
+# --------------------------------------------------------------------------- lowering
+
+Conjunct = list[tuple[Is, bool]]
+
+
+def _dnf(cond: Condition | None, or_is_max: bool) -> list[Conjunct] | None:
+    """``cond`` as an OR of ANDs of ``v IS [NOT] t``; None when that changes its value.
+
+    Splitting an OR into rules is exact when OR is MAX (rules aggregate by MAX), and AND
+    (MIN or product) distributes over MAX."""
+    if isinstance(cond, Is):
+        return None if cond.hedges else [[(cond, cond.negated)]]
+    if isinstance(cond, Not) and isinstance(cond.operand, Is) and not cond.operand.hedges:
+        return [[(cond.operand, not cond.operand.negated)]]
+    if isinstance(cond, And):
+        out: list[Conjunct] = [[]]
+        for operand in cond.operands:
+            part = _dnf(operand, or_is_max)
+            if part is None:
+                return None
+            out = [a + b for a in out for b in part]
+        return out
+    if isinstance(cond, Or) and or_is_max:
+        alternatives: list[Conjunct] = []
+        for operand in cond.operands:
+            part = _dnf(operand, or_is_max)
+            if part is None:
+                return None
+            alternatives += part
+        return alternatives
+    return None
+
+
+def _extent(terms: tuple[Term, ...]) -> Range | None:
+    xs = [float(x) for t in terms for x in _term_xs(t.mf)]
+    xs = [x for x in xs if math.isfinite(x)]
+    return Range(math.floor(min(xs)), math.ceil(max(xs))) if xs else None
+
+
+def _term_xs(mf: MembershipFunction) -> list[float]:
+    if isinstance(mf, PointsMF):
+        return [float(p.x) for p in mf.points if isinstance(p.x, int | float)]
+    if isinstance(mf, SingletonMF) and isinstance(mf.value, int | float):
+        return [float(mf.value)]
+    if isinstance(mf, ShapeMF):
+        return [float(p) for p in mf.params if isinstance(p, int | float)]
+    return []
+
+
+def _rounded(mf: MembershipFunction) -> MembershipFunction:
+    if isinstance(mf, PointsMF):
+        return PointsMF(
+            tuple(replace(p, x=float(round(p.x))) if isinstance(p.x, int | float) else p for p in mf.points)
+        )
+    if isinstance(mf, SingletonMF) and isinstance(mf.value, int | float):
+        return SingletonMF(float(round(mf.value)))
+    if isinstance(mf, ShapeMF):
+        return replace(
+            mf, params=tuple(float(round(p)) if isinstance(p, int | float) else p for p in mf.params)
+        )
+    return mf
+
+
+def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
+    """``document`` reduced to what the XFUZ tables hold, and what changes on the way as
+    ``(element, reason)`` pairs.  Exact rewrites are not losses: OR split into rules (OR is
+    MAX), more than 2 conclusions split into rules.  Losses: what is dropped (further rule
+    blocks, weights, rules with hedges, terms of other shapes and their rules, variables
+    and rules beyond the block's limits), what is rounded (non-integer points), operators
+    replaced, and the XFUZ semantics themselves when the program does not already state
+    them: defuzzification on Discr points (no ``XFUZ DISCR`` option) and 16-bit integer
+    inputs and outputs (REAL variables)."""
+    fb = document.main
+    losses: list[tuple[str, str]] = [
+        (f"function block {b.name}", "XFUZ holds one rule base") for b in document.blocks[1:]
+    ]
+    opts = _read_options(fb, [])
+    rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
+    losses += [(f"rule block {b.name}", "XFUZ holds one rule base") for b in fb.rule_blocks[1:]]
+    and_op = rb.and_op if rb.and_op in (None, "MIN", "PROD") else "MIN"
+    act = rb.act if rb.act in (None, "MIN", "PROD") else "MIN"
+    if and_op != rb.and_op or act != rb.act or rb.accu not in (None, "MAX"):
+        losses.append((f"rule block {rb.name}", "XFUZ offers AND MIN/PROD, ACT MIN/PROD and ACCU MAX only"))
+    or_is_max = rb.or_op == "MAX" or (rb.or_op is None and and_op in (None, "MIN"))
+    local_names = {v.name for v in fb.locals}
+    methods = {d.method or "COG" for d in fb.defuzzify if d.terms and d.variable not in local_names}
+    method = methods.pop() if len(methods) == 1 else "COG"
+    if method not in ("COG", "COGS", "MOM") or methods:
+        losses.append(
+            (
+                "defuzzification",
+                f"XFUZ has one method for all outputs, COG, MOM or singletons; "
+                f"{method if method in ('COG', 'COGS', 'MOM') else 'COG'} is used",
+            )
+        )
+        method = method if method in ("COG", "COGS", "MOM") else "COG"
+    singletons = method == "COGS"
+
+    keep: set[tuple[str, str]] = set()
+
+    def fit(owner: str, terms: tuple[Term, ...], output: bool) -> tuple[Term, ...]:
+        kept = []
+        for t in terms:
+            mf = t.mf
+            if isinstance(mf, SingletonMF) != (output and singletons):
+                losses.append(
+                    (
+                        f"term {t.name!r} of {owner!r}",
+                        "XFUZ output terms are all singletons (METHOD CoGS, OUT_PT = 1) or all trapezoids",
+                    )
+                )
+                continue
+            probe: list[Diagnostic] = []
+            rounded = _rounded(mf)
+            if not isinstance(mf, SingletonMF) and _abcd(rounded, t.name, None, probe) is None:
+                losses.append(
+                    (
+                        f"term {t.name!r} of {owner!r}",
+                        "XFUZ terms are trapezoids, triangles or half trapezoids with degrees 0 and 1",
+                    )
+                )
+                continue
+            if rounded != mf:
+                losses.append((f"term {t.name!r} of {owner!r}", "abscissae rounded to integers"))
+            kept.append(replace(t, mf=rounded))
+            keep.add((owner, t.name))
+        return tuple(kept)
+
+    fuzzify = tuple(replace(fz, terms=fit(fz.variable, fz.terms, False)) for fz in fb.fuzzify)
+    defuzzify = []
+    for dz in fb.defuzzify:
+        output = dz.variable not in local_names
+        terms = fit(dz.variable, dz.terms, output)
+        rng = (
+            dz.range
+            or (fb.variable(dz.variable).range if fb.variable(dz.variable) else None)
+            or _extent(terms)
+        )  # type: ignore[union-attr]
+        default = dz.default
+        if output and default is not None and (default.no_change or default.value is None):
+            losses.append((f"output {dz.variable!r}", "DEFAULT := NC: XFUZ outputs a default value (0)"))
+            default = None
+        if output and dz.variable not in opts.discr and not singletons:
+            losses.append((f"output {dz.variable!r}", "computed on Discr points (XFUZ 2.2-5), not exactly"))
+        defuzzify.append(
+            replace(
+                dz, terms=terms, range=rng, method=None if not output else method, default=default, accu=None
+            )
+        )
+    for v in fb.variables:
+        if v.kind is not VarKind.LOCAL and v.data_type.upper() not in ("INT", "WORD", "SINT", "DINT"):
+            losses.append((f"variable {v.name!r}", "XFUZ reads and writes 16-bit integers"))
+        if v.kind is VarKind.LOCAL and v.name not in opts.slots and v.name not in opts.discr:
+            losses.append(
+                (f"variable {v.name!r}", "chained as a fuzzy set (XFUZ 2.2-1), not as a crisp value")
+            )
+    rules: list[Rule] = []
+    for rule in rb.rules:
+        label = f"rule {rule.label!r}"
+        conjuncts = _dnf(rule.condition, or_is_max)
+        if conjuncts is None:
+            losses.append(
+                (label, "XFUZ rules are ANDs of 'v IS [NOT] t' (OR only as MAX, no hedges or degrees)")
+            )
+            continue
+        conclusions = [
+            replace(c, weight=None) for c in rule.conclusions if (c.variable, c.term or "") in keep
+        ]
+        if any(c.weight is not None and c.weight != 1.0 for c in rule.conclusions):
+            losses.append((label, "XFUZ rules have no weight"))
+        if len(conclusions) < len(rule.conclusions) or any(
+            (leaf.variable, leaf.term) not in keep for conj in conjuncts for leaf, _ in conj
+        ):
+            losses.append((label, "uses a term XFUZ cannot hold"))
+            continue
+        if any(len(conj) > 4 for conj in conjuncts):
+            losses.append((label, "more than 4 predicates"))
+            continue
+        for k, conj in enumerate(conjuncts):
+            preds = [replace(leaf, negated=negated) for leaf, negated in conj]
+            cond: Condition = preds[0] if len(preds) == 1 else And(tuple(preds))
+            exact = len(conjuncts) == 1 and len(conclusions) <= 2
+            for j in range(0, max(len(conclusions), 1), 2):
+                name = rule.label if exact else f"{rule.label}_{k + 1}_{j // 2 + 1}"
+                rules.append(Rule(name, cond, tuple(conclusions[j : j + 2])))
+    if len(rules) > 64:
+        losses.append((f"rules {rules[64].label}..", "XFUZ holds 64 rules"))
+        rules = rules[:64]
+    lowered_rb = replace(rb, rules=tuple(rules), and_op=and_op, act=act, or_op=None, accu="MAX")
+    lowered = replace(fb, fuzzify=fuzzify, defuzzify=tuple(defuzzify), rule_blocks=(lowered_rb,))
+    _, diags = constants_from_model(lowered)
+    losses += [(f"line {d.span.line}" if d.span else "program", d.message) for d in diags if d.is_error]
+    return Document((lowered,), path=document.path), losses
