@@ -446,6 +446,7 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
         if always and conn_value == 2.0:
             condition = None  # "x is any OR ..." is 1
         conclusions: list[Conclusion] = []
+        running: tuple[str, ...] = ()
         for var, code in zip(outputs, cons, strict=True):
             if code == 0:
                 continue
@@ -453,6 +454,19 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
                 raise rep.fail(f"negated consequent (-{abs(code):g}) for {var.name!r} is not supported", line,
                                code="fis-unsupported")
             index, hedges, _ = _hedges(code, dialect, rep, line)
+            if hedges and dialect == "fuzzylite":
+                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py)
+                hedges = running = (*hedges, *running)
+            elif hedges:
+                if not all(_is_ts_term(t.mf) for t in var.terms):
+                    raise rep.fail(f"a hedge on the Mamdani consequent of {var.name!r} is not supported", line,
+                                   code="fis-hedge")
+                # Octave raises a Sugeno rule's degree to 1/p for a consequent hedge of power p
+                power = 1.0
+                for h in hedges:
+                    power *= {"very": 2.0, "somewhat": 0.5}.get(h, 0.0) or float(h[4:])
+                hedges = (power_hedge(1.0 / power),) if 1.0 / power not in (2.0, 0.5) else (
+                    ("very",) if 1.0 / power == 2.0 else ("somewhat",))
             if not 1 <= index <= len(var.terms):
                 raise rep.fail(f"rule refers to MF{index} of output {var.name!r}, which has {len(var.terms)}", line,
                                code="fis-rule-index")
