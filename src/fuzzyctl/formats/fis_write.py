@@ -146,11 +146,26 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     for b in fb.rule_blocks:
         if b.rule_activation:
             losses.append(Loss(f"rule block {b.name!r}", f"FIS fires every rule ({b.rule_activation!r} dropped)"))
-    ops = {(b.and_op or "MIN", b.or_op or "MAX", b.act or "MIN") for b in enabled if b.rules}
-    if len(ops) > 1:
-        losses.append(Loss("rule blocks", "FIS has one AND/OR/implication for all rules; the blocks differ "
-                                          f"({', '.join('/'.join(o) for o in sorted(ops))}), the first one's are kept"))
-    first = next((b for b in enabled if b.rules), enabled[0] if enabled else RuleBlock(None, ()))
+    # Only operators that matter must agree: AND/OR where rules use them, the implication
+    # where a block concludes on a Mamdani output.
+    merged: dict[str, str] = {}
+    for b in enabled:
+        used = {
+            "AndMethod": (b.and_op or "MIN") if any(isinstance(r.condition, And) for r in b.rules) else None,
+            "OrMethod": (b.or_op or "MAX") if any(isinstance(r.condition, Or) for r in b.rules) else None,
+            "ImpMethod": (b.act or "MIN") if any(
+                not is_point_output(fb.defuzzify_block(c.variable) or DefuzzifyBlock(c.variable, ()))
+                for r in b.rules for c in r.conclusions) else None,
+        }
+        for key, value in used.items():
+            if value is None:
+                continue
+            if merged.setdefault(key, value) != value:
+                losses.append(Loss(f"rule block {b.name!r}", f"FIS has one {key} for all rules: "
+                                                             f"{merged[key]} is kept, {value} dropped"))
+    base = next((b for b in enabled if b.rules), enabled[0] if enabled else RuleBlock(None, ()))
+    first = replace(base, and_op=merged.get("AndMethod", base.and_op), or_op=merged.get("OrMethod", base.or_op),
+                    act=merged.get("ImpMethod", base.act))
     rules: list[Rule] = []
     outputs = {d.variable for d in fb.defuzzify}
     fuzzylite = _needs_fuzzylite(fb)

@@ -181,9 +181,9 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         rng = d.range or var.range
         out.append(f"  range: {fmt_number(rng.low)} {fmt_number(rng.high)}" if rng else "  range: -inf inf")
         out.append(f"  lock-range: {'true' if d.clamp else 'false'}")
-        accu = d.accu or accu_of_block.get(var.name)
         point = (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
-        out.append(f"  aggregation: {_ACCU_NAMES[accu] if accu and not point else ('Maximum' if not point else 'none')}")
+        accu = d.accu or (accu_of_block.get(var.name) if not point else None)
+        out.append(f"  aggregation: {_ACCU_NAMES[accu] if accu else ('none' if point else 'Maximum')}")
         method = d.method or "COG"
         name = _DEFUZZ_NAMES.get(method, "Centroid")
         out.append(f"  defuzzifier: {name} {resolution}" if method in INTEGRAL_METHODS else f"  defuzzifier: {name}")
