@@ -17,7 +17,13 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     existing path is parsed as FCL unless ``format`` says otherwise.  Raises
     :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
     input is not valid."""
-    raise FuzzyctlError("no reader is available yet")
+    from fuzzyctl import formats
+
+    if isinstance(path_or_text, Path) or (
+        isinstance(path_or_text, str) and "\n" not in path_or_text and Path(path_or_text).is_file()
+    ):
+        return formats.read_path(path_or_text, format).document
+    return formats.read_text(str(path_or_text), format or "fcl").document
 
 
 def compile(

@@ -1,1 +1,3 @@
 """Imports every command module so that each registers its commands on the app."""
+
+from fuzzyctl.cli import convert  # noqa: F401

@@ -350,6 +350,11 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: list[object], fuzzylite: b
 
     atoms = _ises(rule.condition)
     by_var = {a.variable: a for a in atoms}
+    if rule.condition is None and fuzzylite and inputs:
+        # fuzzylite reads "0.99" as "x is any" (a rule of don't-cares would not load there);
+        # MATLAB truncates it to 0, a don't-care: both give degree 1.
+        return f"{' '.join(['0.99'] + ['0'] * (len(inputs) - 1))}, " + _rule_text(
+            fb, replace(rule, condition=Is("", "")), inputs, fuzzylite).split(", ", 1)[1]
     ante = []
     for var in inputs:
         assert isinstance(var, Variable)
