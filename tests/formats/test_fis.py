@@ -96,9 +96,15 @@ def test_octave_hedges_and_fuzzylite_dialect() -> None:
     fb = doc("1.2 -2.3, 1 (1) : 1\n").document.main
     a, b = fb.rule_blocks[0].rules[0].condition.operands  # type: ignore[union-attr]
     assert a.hedges == ("very",) and b.hedges == ("pow:3",) and b.negated
-    text = "# generated with fuzzylite\n" + HEADER.format(type="mamdani", defuzz="centroid", nrules=1) + "1.3 0.99, 1 (1) : 1\n"
+    text = (
+        "# generated with fuzzylite\n"
+        + HEADER.format(type="mamdani", defuzz="centroid", nrules=1)
+        + "1.3 0.99, 1 (1) : 1\n"
+    )
     rule = fis.read(text).document.main.rule_blocks[0].rules[0]
-    assert rule.condition == Is("a", "lo", hedges=("extremely",))  # ".99" is fuzzylite's "any": dropped from AND
+    assert rule.condition == Is(
+        "a", "lo", hedges=("extremely",)
+    )  # ".99" is fuzzylite's "any": dropped from AND
     assert math.isnan(fis.read(text).document.main.defuzzify[0].default.value)  # type: ignore[union-attr]
 
 
@@ -119,7 +125,8 @@ def test_errors_name_line_and_problem() -> None:
 
 def test_sugeno_linear_needs_one_coefficient_per_input_and_a_constant() -> None:
     text = HEADER.replace("MF1='small':'trimf',[0 5 10]", "MF1='small':'linear',[1 2 3]").replace(
-        "MF2='big':'trapmf',[10 20 25 30]", "MF2='big':'constant',[7]")
+        "MF2='big':'trapmf',[10 20 25 30]", "MF2='big':'constant',[7]"
+    )
     fb = fis.read(text.format(type="sugeno", defuzz="wtaver", nrules=1) + "1 1, 1 (1) : 1\n").document.main
     out = fb.defuzzify[0]
     assert out.method == "WTAVER" and out.terms[0].mf == ShapeMF("linear", (1.0, 2.0, 3.0))

@@ -55,7 +55,11 @@ RuleBlock: rb
 """
 
 
-def read(agg: str = "aggregation", lock: str = "lock-previous", imp: str = "implication: Minimum\n  activation: General"):
+def read(
+    agg: str = "aggregation",
+    lock: str = "lock-previous",
+    imp: str = "implication: Minimum\n  activation: General",
+):
     return fll.read(SYSTEM.format(agg=agg, lock=lock, imp=imp), "demo.fll")
 
 
@@ -82,8 +86,12 @@ def test_duplicate_term_first_wins_and_warns() -> None:
 def test_rules_hedges_any_weights() -> None:
     fb = read().document.main
     r1, r2, r3 = fb.rule_blocks[0].rules
-    assert r1.condition == And((Is("a", "lo", negated=True, hedges=("very",)),
-                                Or((Is("b", "hi"), Is("b", "lo", hedges=("somewhat",))))))
+    assert r1.condition == And(
+        (
+            Is("a", "lo", negated=True, hedges=("very",)),
+            Or((Is("b", "hi"), Is("b", "lo", hedges=("somewhat",)))),
+        )
+    )
     assert r1.weight == 0.5
     assert r2.condition is None  # "a is any" always holds
     # fuzzylite hedges a running degree: z also receives y's "very"
@@ -96,15 +104,25 @@ def test_version5_spellings() -> None:
     fb = read(agg="accumulation", lock="lock-valid", imp="activation: AlgebraicProduct").document.main
     assert fb.rule_blocks[0].act == "PROD" and fb.rule_blocks[0].rule_activation is None
     y = fb.defuzzify[0]
-    assert y.accu == "MAX" and y.default is not None and y.default.no_change and math.isnan(y.default.value or 0)
+    assert (
+        y.accu == "MAX" and y.default is not None and y.default.no_change and math.isnan(y.default.value or 0)
+    )
 
 
 def test_errors_point_at_line() -> None:
     with pytest.raises(DiagnosticError) as err:
-        fll.read(SYSTEM.format(agg="aggregation", lock="lock-previous", imp="implication: Minimum").replace(
-            "then y is small", "then y is smal"))
+        fll.read(
+            SYSTEM.format(agg="aggregation", lock="lock-previous", imp="implication: Minimum").replace(
+                "then y is small", "then y is smal"
+            )
+        )
     d = next(x for x in err.value.diagnostics if x.is_error)
-    rule_line = SYSTEM.splitlines().index("  rule: if a is not very lo and (b is hi or b is somewhat lo) then y is small with 0.5") + 1
+    rule_line = (
+        SYSTEM.splitlines().index(
+            "  rule: if a is not very lo and (b is hi or b is somewhat lo) then y is small with 0.5"
+        )
+        + 1
+    )
     assert d.span is not None and d.span.line == rule_line and "no term 'smal'" in d.message
 
 

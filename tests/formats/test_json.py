@@ -23,10 +23,15 @@ def _same_everywhere(a: object, b: object) -> bool:
 
     if dataclasses.is_dataclass(a) and not isinstance(a, type):
         return type(a) is type(b) and all(
-            f.name == "path" or _same_everywhere(getattr(a, f.name), getattr(b, f.name)) for f in dataclasses.fields(a)
+            f.name == "path" or _same_everywhere(getattr(a, f.name), getattr(b, f.name))
+            for f in dataclasses.fields(a)
         )
     if isinstance(a, tuple):
-        return isinstance(b, tuple) and len(a) == len(b) and all(_same_everywhere(x, y) for x, y in zip(a, b, strict=True))
+        return (
+            isinstance(b, tuple)
+            and len(a) == len(b)
+            and all(_same_everywhere(x, y) for x, y in zip(a, b, strict=True))
+        )
     if isinstance(a, float) and isinstance(b, float) and a != a:
         return b != b
     return type(a) is type(b) and a == b
@@ -49,13 +54,21 @@ def test_any_model_round_trips_and_validates(document: Document) -> None:
 
 def test_layout_is_the_documented_one() -> None:
     data = fj.to_dict(Document((FunctionBlock("fb"),)))
-    assert data == {"format": "fuzzyctl-model", "version": 1,
-                    "blocks": [{"name": "fb", "variables": [], "fuzzify": [], "defuzzify": [], "rule_blocks": [],
-                                "options": []}]}
+    assert data == {
+        "format": "fuzzyctl-model",
+        "version": 1,
+        "blocks": [
+            {"name": "fb", "variables": [], "fuzzify": [], "defuzzify": [], "rule_blocks": [], "options": []}
+        ],
+    }
 
 
 def test_errors_name_the_json_path() -> None:
-    bad = {"format": "fuzzyctl-model", "version": 1, "blocks": [{"name": "x", "variables": [{"name": "v", "kind": "IN"}]}]}
+    bad = {
+        "format": "fuzzyctl-model",
+        "version": 1,
+        "blocks": [{"name": "x", "variables": [{"name": "v", "kind": "IN"}]}],
+    }
     with pytest.raises(DiagnosticError, match=r"\$\.blocks\[0\]\.variables\[0\]\.kind"):
         fj.read(json.dumps(bad))
     with pytest.raises(DiagnosticError) as err:

@@ -15,13 +15,19 @@ def convert(
     source: Annotated[Path, typer.Argument(help="File to read.", exists=True, dir_okay=False, readable=True)],
     target: Annotated[Path, typer.Argument(help="File to write (replaced atomically).", dir_okay=False)],
     from_format: Annotated[
-        str | None, typer.Option("--from", help="Format of SOURCE (fcl, fis, fll, fpl, xfuz, json); default: its extension.")
+        str | None,
+        typer.Option(
+            "--from", help="Format of SOURCE (fcl, fis, fll, fpl, xfuz, json); default: its extension."
+        ),
     ] = None,
     to_format: Annotated[
         str | None, typer.Option("--to", help="Format of TARGET; default: its extension.")
     ] = None,
     lossy: Annotated[
-        bool, typer.Option("--lossy", help="Write even when the target cannot express everything; list what was dropped.")
+        bool,
+        typer.Option(
+            "--lossy", help="Write even when the target cannot express everything; list what was dropped."
+        ),
     ] = False,
 ) -> None:
     """Convert a fuzzy system to another format.

@@ -141,7 +141,8 @@ def for_path(path: str | Path) -> Format:
         return get(suffix.lstrip("."))  # known but missing: let get() say so
     known = ", ".join(ext for f in available() for ext in f.extensions)
     raise FuzzyctlError(
-        f"cannot tell the format of {str(path)!r} from its extension (known: {known}); name it with --from/--to"
+        f"cannot tell the format of {str(path)!r} from its extension (known: {known}); "
+        "name it with --from/--to"
     )
 
 

@@ -121,7 +121,9 @@ class Reporter:
         span = self.span(line, column, width) if line else None
         self.items.append(warning(message, span, code=code, file=self.path))
 
-    def fail(self, message: str, line: int | None, *, code: str, column: int = 1, width: int = 0) -> DiagnosticError:
+    def fail(
+        self, message: str, line: int | None, *, code: str, column: int = 1, width: int = 0
+    ) -> DiagnosticError:
         """Record an error and return the exception to raise at once."""
         self.error(message, line, code=code, column=column, width=width)
         return self.exception()

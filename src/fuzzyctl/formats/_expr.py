@@ -60,7 +60,7 @@ def parse_expr(text: str) -> Expr:
         return tok
 
     def expect(op: str) -> None:
-        kind, value, pos = take()
+        _kind, value, pos = take()
         if value != op:
             raise ExprError(f"expected {op!r} but found {value!r}", pos)
 

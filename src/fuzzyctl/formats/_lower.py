@@ -18,8 +18,8 @@ from fuzzyctl.model import (
     Conclusion,
     Condition,
     Default,
-    Degree,
     DefuzzifyBlock,
+    Degree,
     Document,
     FunctionBlock,
     FunctionMF,
@@ -98,13 +98,21 @@ def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Lo
         out = fb.defuzzify_block(c.variable)
         points = out is not None and (out.method or "") in POINT_METHODS
         if w_conclusion != 1.0 and w_rule != 1.0 and not (points or act == "PROD"):
-            losses.append(Loss(rule_label(block, rule),
-                               "both a rule weight and a WITH weight under ACT MIN cannot be written as one weight"))
+            losses.append(
+                Loss(
+                    rule_label(block, rule),
+                    "both a rule weight and a WITH weight under ACT MIN cannot be written as one weight",
+                )
+            )
             return []
         if w_conclusion != 1.0 and not (points or act == "PROD"):
-            losses.append(Loss(rule_label(block, rule),
-                               f"WITH {w_conclusion:g} scales the activated term under ACT {act}; the target's rule "
-                               "weight scales the degree before activation"))
+            losses.append(
+                Loss(
+                    rule_label(block, rule),
+                    f"WITH {w_conclusion:g} scales the activated term under ACT {act}; the target's rule "
+                    "weight scales the degree before activation",
+                )
+            )
             return []
         groups.setdefault(w_rule * w_conclusion, []).append(replace(c, weight=None))
     out_rules: list[Rule] = []
@@ -113,11 +121,23 @@ def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Lo
         label = rule.label if len(groups) == 1 else f"{rule.label}_{i + 1}"
         if written is None:
             for j, c in enumerate(conclusions):
-                out_rules.append(replace(rule, label=f"{label}_{j + 1}", conclusions=(c,),
-                                         weight=None if weight == 1.0 else weight))
+                out_rules.append(
+                    replace(
+                        rule,
+                        label=f"{label}_{j + 1}",
+                        conclusions=(c,),
+                        weight=None if weight == 1.0 else weight,
+                    )
+                )
         else:
-            out_rules.append(replace(rule, label=label, conclusions=tuple(conclusions),
-                                     weight=None if weight == 1.0 else weight))
+            out_rules.append(
+                replace(
+                    rule,
+                    label=label,
+                    conclusions=tuple(conclusions),
+                    weight=None if weight == 1.0 else weight,
+                )
+            )
     return out_rules
 
 
@@ -125,13 +145,13 @@ def support(term: Term) -> tuple[float, float] | None:
     """Where a term is non-zero, for terms whose support is bounded."""
     mf = term.mf
     if isinstance(mf, PointsMF):
-        xs = [p.x for p in mf.points]
-        ys = [p.y for p in mf.points]
-        if any(isinstance(v, Ref) for v in xs + ys):
+        if any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points):
             return None
-        if float(ys[0]) != 0.0 or float(ys[-1]) != 0.0:
+        xs = [float(p.x) for p in mf.points]  # type: ignore[arg-type]
+        ys = [float(p.y) for p in mf.points]  # type: ignore[arg-type]
+        if ys[0] != 0.0 or ys[-1] != 0.0:
             return None
-        return float(min(xs)), float(max(xs))  # type: ignore[arg-type]
+        return min(xs), max(xs)
     if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
         return float(mf.value), float(mf.value)
     if isinstance(mf, ShapeMF) and not any(isinstance(p, Ref) for p in mf.params):
@@ -155,14 +175,20 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
     losses: list[Loss] = []
     fb = document.main
     for other in document.blocks[1:]:
-        losses.append(Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written"))
+        losses.append(
+            Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written")
+        )
     for opt in fb.options:
         losses.append(Loss(f"{opt.keyword} block", f"{target} has no vendor options; dropped"))
     for var in fb.locals:
         losses.append(Loss(f"local variable {var.name!r}", f"{target} has no intermediate variables"))
     for var in fb.inputs:
         if fb.fuzzify_block(var.name) is None:
-            used = any(isinstance(c, Degree) and c.variable == var.name for _, r in fb.rules() for c in _atoms(r.condition))
+            used = any(
+                isinstance(c, Degree) and c.variable == var.name
+                for _, r in fb.rules()
+                for c in _atoms(r.condition)
+            )
             if used:
                 continue  # reported with the rule
     for out in fb.outputs:
@@ -178,11 +204,15 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
             condition = simplify_not(rule.condition)
             label = rule_label(block, rule)
             if not negation_free(condition):
-                losses.append(Loss(label, "NOT of a compound condition, or a bare degree variable, cannot be written"))
+                losses.append(
+                    Loss(label, "NOT of a compound condition, or a bare degree variable, cannot be written")
+                )
                 continue
             bad = [c for c in rule.conclusions if c.term is None or c.variable in local_names]
             if bad:
-                losses.append(Loss(label, "a conclusion that is a bare variable or a local variable cannot be written"))
+                losses.append(
+                    Loss(label, "a conclusion that is a bare variable or a local variable cannot be written")
+                )
                 continue
             if any(a.variable in local_names for a in _atoms(condition) if isinstance(a, Is)):
                 losses.append(Loss(label, "a condition on a local variable cannot be written"))
@@ -216,12 +246,13 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
     """Rename variables and terms to identifiers (``LDL-Level`` -> ``LDL_Level``)."""
     taken_vars: set[str] = set()
     var_map = {v.name: identifier(v.name, taken_vars) for v in fb.variables}
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     if all(k == v for k, v in var_map.items()) and all(
-        identifier(t.name, set()) == t.name for blk in (*fb.fuzzify, *fb.defuzzify) for t in blk.terms
+        identifier(t.name, set()) == t.name for blk in blocks for t in blk.terms
     ):
         return fb, {}
     term_maps: dict[str, dict[str, str]] = {}
-    for blk in (*fb.fuzzify, *fb.defuzzify):
+    for blk in blocks:
         taken: set[str] = set()
         term_maps[blk.variable] = {t.name: identifier(t.name, taken) for t in blk.terms}
 
@@ -245,13 +276,39 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
     renamed = replace(
         fb,
         variables=tuple(replace(x, name=v(x.name)) for x in fb.variables),
-        fuzzify=tuple(replace(b, variable=v(b.variable), terms=tuple(replace(term, name=t(b.variable, term.name) or term.name)
-                                                                   for term in b.terms)) for b in fb.fuzzify),
-        defuzzify=tuple(replace(b, variable=v(b.variable), terms=tuple(replace(term, name=t(b.variable, term.name) or term.name)
-                                                                     for term in b.terms)) for b in fb.defuzzify),
-        rule_blocks=tuple(replace(b, rules=tuple(replace(r, condition=cond(r.condition), conclusions=tuple(
-            replace(c, variable=v(c.variable), term=t(c.variable, c.term)) for c in r.conclusions)) for r in b.rules))
-            for b in fb.rule_blocks),
+        fuzzify=tuple(
+            replace(
+                b,
+                variable=v(b.variable),
+                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
+            )
+            for b in fb.fuzzify
+        ),
+        defuzzify=tuple(
+            replace(
+                b,
+                variable=v(b.variable),
+                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
+            )
+            for b in fb.defuzzify
+        ),
+        rule_blocks=tuple(
+            replace(
+                b,
+                rules=tuple(
+                    replace(
+                        r,
+                        condition=cond(r.condition),
+                        conclusions=tuple(
+                            replace(c, variable=v(c.variable), term=t(c.variable, c.term))
+                            for c in r.conclusions
+                        ),
+                    )
+                    for r in b.rules
+                ),
+            )
+            for b in fb.rule_blocks
+        ),
     )
     return renamed, {k: x for k, x in var_map.items() if k != x}
 

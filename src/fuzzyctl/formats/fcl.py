@@ -39,8 +39,12 @@ def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule,
         out = fb.defuzzify_block(c.variable)
         points = out is not None and (out.method or "") in _POINT_METHODS
         if not (points or act == "PROD"):
-            losses.append(Loss(f"rule {rule.label!r}", f"a rule weight scales the degree before ACT {act}; FCL's WITH "
-                                                       "scales the activated term"))
+            losses.append(
+                Loss(
+                    f"rule {rule.label!r}",
+                    f"a rule weight scales the degree before ACT {act}; FCL's WITH scales the activated term",
+                )
+            )
             return replace(rule, weight=None)
         if c.weight is not None and not isinstance(c.weight, float | int):
             losses.append(Loss(f"rule {rule.label!r}", "a rule weight times a variable WITH weight"))
@@ -57,17 +61,26 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     for fb in document.blocks:
         for f in fb.fuzzify:
             if f.clamp:
-                losses.append(Loss(f"input {f.variable!r}", "FCL cannot clamp an input to its RANGE (fuzzylite lock-range)"))
+                losses.append(
+                    Loss(
+                        f"input {f.variable!r}",
+                        "FCL cannot clamp an input to its RANGE (fuzzylite lock-range)",
+                    )
+                )
         for d in fb.defuzzify:
             if d.clamp:
-                losses.append(Loss(f"output {d.variable!r}", "FCL cannot clamp an output (fuzzylite lock-range)"))
+                losses.append(
+                    Loss(f"output {d.variable!r}", "FCL cannot clamp an output (fuzzylite lock-range)")
+                )
         rule_blocks = []
         for block in fb.rule_blocks:
             if not block.enabled:
                 losses.append(Loss(f"rule block {block.name!r}", "FCL has no disabled rule blocks; dropped"))
                 continue
             if block.rule_activation:
-                losses.append(Loss(f"rule block {block.name!r}", f"FCL fires every rule ({block.rule_activation!r})"))
+                losses.append(
+                    Loss(f"rule block {block.name!r}", f"FCL fires every rule ({block.rule_activation!r})")
+                )
             rules = []
             for rule in block.rules:
                 rule = _rule_weight_to_conclusions(fb, block, rule, losses)

@@ -20,6 +20,7 @@ The writer lives in :mod:`fuzzyctl.formats.fis_write`.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -107,7 +108,9 @@ TS_KINDS = frozenset({"constant", "linear"})
 
 def _is_ts_term(mf: MembershipFunction) -> bool:
     """A Takagi-Sugeno output term: constant, linear, or a function of the variables."""
-    return (isinstance(mf, ShapeMF) and mf.kind in TS_KINDS) or (isinstance(mf, FunctionMF) and mf.argument is None)
+    return (isinstance(mf, ShapeMF) and mf.kind in TS_KINDS) or (
+        isinstance(mf, FunctionMF) and mf.argument is None
+    )
 
 
 @dataclass
@@ -192,7 +195,9 @@ def _numbers(text: str, rep: Reporter, line: int, what: str) -> list[float]:
             try:  # MATLAB evaluates entries such as -pi/4
                 out.append(eval_constant(parse_expr(part)))
             except (ValueError, ZeroDivisionError):
-                raise rep.fail(f"{what}: expected numbers, found {text.strip()!r}", line, code="fis-number") from None
+                raise rep.fail(
+                    f"{what}: expected numbers, found {text.strip()!r}", line, code="fis-number"
+                ) from None
     return out
 
 
@@ -204,7 +209,9 @@ def _range(value: str, rep: Reporter, line: int) -> Range:
     if len(numbers) != 2:
         raise rep.fail(f"Range needs 2 numbers, found {len(numbers)}", line, code="fis-range")
     if numbers[0] > numbers[1]:
-        raise rep.fail(f"Range [{numbers[0]:g} {numbers[1]:g}] has its minimum above its maximum", line, code="fis-range")
+        raise rep.fail(
+            f"Range [{numbers[0]:g} {numbers[1]:g}] has its minimum above its maximum", line, code="fis-range"
+        )
     return Range(numbers[0], numbers[1])
 
 
@@ -219,7 +226,13 @@ class _Var:
 
 
 def _membership(
-    kind: str, params_text: str, height_text: str | None, rep: Reporter, line: int, dialect: str, n_inputs: int,
+    kind: str,
+    params_text: str,
+    height_text: str | None,
+    rep: Reporter,
+    line: int,
+    dialect: str,
+    n_inputs: int,
     names: set[str],
 ) -> MembershipFunction:
     kind_lower = kind.strip().lower()
@@ -242,7 +255,8 @@ def _membership(
             params = [*params, 0.0]
         if len(params) != n_inputs + 1:
             raise rep.fail(
-                f"'linear' needs {n_inputs + 1} parameters (one per input and a constant), found {len(params)}",
+                f"'linear' needs {n_inputs + 1} parameters (one per input and a constant), "
+                f"found {len(params)}",
                 line,
                 code="fis-params",
             )
@@ -252,13 +266,17 @@ def _membership(
         if len(params) < 2:
             raise rep.fail("'discretemf' needs x y pairs", line, code="fis-params")
         xs, ys = params[0::2], params[1::2]
-        if any(b < a for a, b in zip(xs, xs[1:], strict=False)):
+        if any(b < a for a, b in itertools.pairwise(xs)):
             raise rep.fail("'discretemf' points must be in ascending x", line, code="fis-params")
         return PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     mapping = FIS_TYPES.get(kind_lower)
-    if mapping is None or (dialect == "matlab" and kind_lower not in MATLAB_TYPES and kind_lower not in FIS_TYPES):
+    if mapping is None or (
+        dialect == "matlab" and kind_lower not in MATLAB_TYPES and kind_lower not in FIS_TYPES
+    ):
         known = ", ".join(sorted([*FIS_TYPES, "constant", "linear", "discretemf", "function"]))
-        raise rep.fail(f"unknown membership function type {kind!r} (known: {known})", line, code="fis-mf-type")
+        raise rep.fail(
+            f"unknown membership function type {kind!r} (known: {known})", line, code="fis-mf-type"
+        )
     if len(params) < mapping.arity:
         raise rep.fail(
             f"{kind_lower} needs {mapping.arity} parameters, found {len(params)}", line, code="fis-params"
@@ -269,24 +287,39 @@ def _membership(
         if dialect == "fuzzylite" and len(extra) == 1:
             height = extra[0]
         elif dialect == "fuzzylite":
-            raise rep.fail(f"{kind_lower} takes {mapping.arity} parameters and a height, found {len(params)}", line,
-                           code="fis-params")
+            raise rep.fail(
+                f"{kind_lower} takes {mapping.arity} parameters and a height, found {len(params)}",
+                line,
+                code="fis-params",
+            )
         else:
-            rep.warning(f"{kind_lower}: extra parameters {' '.join(f'{v:g}' for v in extra)} ignored "
-                        f"(MATLAB reads {mapping.arity})", line, code="fis-extra-param")
+            rep.warning(
+                f"{kind_lower}: extra parameters {' '.join(f'{v:g}' for v in extra)} ignored "
+                f"(MATLAB reads {mapping.arity})",
+                line,
+                code="fis-extra-param",
+            )
     values = mapping.to_model(params[: mapping.arity])
     if kind_lower == "trimf" and not values[0] <= values[1] <= values[2]:
-        raise rep.fail(f"trimf parameters must satisfy a <= b <= c, found {params[:3]}", line, code="fis-params")
+        raise rep.fail(
+            f"trimf parameters must satisfy a <= b <= c, found {params[:3]}", line, code="fis-params"
+        )
     if kind_lower == "trapmf" and not values[0] <= values[1] <= values[2] <= values[3]:
-        raise rep.fail(f"trapmf parameters must satisfy a <= b <= c <= d, found {params[:4]}", line, code="fis-params")
-    if kind_lower in {"gaussmf", "gauss2mf"} and (values[1] == 0 or (kind_lower == "gauss2mf" and values[3] == 0)):
+        raise rep.fail(
+            f"trapmf parameters must satisfy a <= b <= c <= d, found {params[:4]}", line, code="fis-params"
+        )
+    if kind_lower in {"gaussmf", "gauss2mf"} and (
+        values[1] == 0 or (kind_lower == "gauss2mf" and values[3] == 0)
+    ):
         raise rep.fail(f"{kind_lower}: sigma must not be 0", line, code="fis-params")
     if kind_lower == "gbellmf" and values[1] == 0:
         raise rep.fail("gbellmf: width a must not be 0", line, code="fis-params")
     return ShapeMF(mapping.kind, values, height)
 
 
-def _variable(section: _Section, kind: str, rep: Reporter, dialect: str, n_inputs: int, names: set[str]) -> _Var:
+def _variable(
+    section: _Section, kind: str, rep: Reporter, dialect: str, n_inputs: int, names: set[str]
+) -> _Var:
     name_entry = section.get("Name")
     if name_entry is None:
         raise rep.fail(f"[{section.header}] has no Name", section.line, code="fis-missing-key")
@@ -301,39 +334,58 @@ def _variable(section: _Section, kind: str, rep: Reporter, dialect: str, n_input
     for position, (key, value, line) in enumerate(mf_entries, start=1):
         if int(key[2:]) != position:
             # MATLAB and fuzzylite both take the MF lines in file order, whatever their numbers.
-            rep.warning(f"{key} is membership function number {position} of {name!r} (taken in file order)", line,
-                        code="fis-mf-number")
+            rep.warning(
+                f"{key} is membership function number {position} of {name!r} (taken in file order)",
+                line,
+                code="fis-mf-number",
+            )
         m = _MF.match(value)
         if m is None:
             raise rep.fail(f"{key}: expected 'name':'type',[parameters]", line, code="fis-mf-syntax")
         term_name = m.group(1).strip()
         if not term_name:
             term_name = f"mf{position}"
-            rep.warning(f"{key} of {name!r} has an empty name; called {term_name!r}", line, code="fis-mf-name")
+            rep.warning(
+                f"{key} of {name!r} has an empty name; called {term_name!r}", line, code="fis-mf-name"
+            )
         mf = _membership(m.group(2), m.group(3), m.group(4), rep, line, dialect, n_inputs, names)
         if kind == "input" and isinstance(mf, ShapeMF) and mf.kind in TS_KINDS:
-            raise rep.fail(f"{key}: '{m.group(2)}' is a Sugeno output type, not an input membership function",
-                           line, code="fis-mf-type")
+            raise rep.fail(
+                f"{key}: '{m.group(2)}' is a Sugeno output type, not an input membership function",
+                line,
+                code="fis-mf-type",
+            )
         unique = unique_name(term_name, taken)
         if unique != term_name:
             # Rules refer to terms by position, so both stay reachable under distinct names.
-            rep.warning(f"duplicate term name {term_name!r} in {name!r}: {key} renamed {unique!r}", line,
-                        code="duplicate-term")
+            rep.warning(
+                f"duplicate term name {term_name!r} in {name!r}: {key} renamed {unique!r}",
+                line,
+                code="duplicate-term",
+            )
         var.terms.append(Term(unique, mf, rep.span(line)))
     declared = section.get("NumMFs")
     if declared is not None:
         try:
             count = int(parse_number(declared[0]))
         except ValueError:
-            raise rep.fail(f"NumMFs must be a number, found {declared[0]!r}", declared[1], code="fis-number") from None
+            raise rep.fail(
+                f"NumMFs must be a number, found {declared[0]!r}", declared[1], code="fis-number"
+            ) from None
         if count != len(var.terms):
-            rep.warning(f"NumMFs={count} but {len(var.terms)} membership functions are listed", declared[1],
-                        code="fis-count")
+            rep.warning(
+                f"NumMFs={count} but {len(var.terms)} membership functions are listed",
+                declared[1],
+                code="fis-count",
+            )
     for key in ("Enabled",):
         entry = section.get(key)
         if entry is not None and parse_number(entry[0]) != 1.0:
-            raise rep.fail(f"{name!r} is disabled (Enabled=0): disabled variables are not supported", entry[1],
-                           code="fis-unsupported")
+            raise rep.fail(
+                f"{name!r} is disabled (Enabled=0): disabled variables are not supported",
+                entry[1],
+                code="fis-unsupported",
+            )
     return var
 
 
@@ -351,7 +403,7 @@ def _hedges(code: float, dialect: str, rep: Reporter, line: int) -> tuple[int, t
     """Term index (1-based, 0 for "any"), hedges, negation of one rule entry."""
     negated = code < 0
     magnitude = abs(code)
-    index = int(math.floor(magnitude + 1e-9))
+    index = math.floor(magnitude + 1e-9)
     fraction = round((magnitude - index) * 100)
     if fraction == 0:
         return index, (), negated
@@ -360,8 +412,9 @@ def _hedges(code: float, dialect: str, rep: Reporter, line: int) -> tuple[int, t
             return 0, ("any",), negated
         hedges = FUZZYLITE_HEDGE_CODES.get(fraction)
         if hedges is None:
-            raise rep.fail(f"rule entry {code:g}: no fuzzylite hedge has code .{fraction:02d}", line,
-                           code="fis-hedge")
+            raise rep.fail(
+                f"rule entry {code:g}: no fuzzylite hedge has code .{fraction:02d}", line, code="fis-hedge"
+            )
         return index, hedges, negated
     # Octave: the two decimals times 10 give the power (.05 -> 0.5, .2 -> 2, .3 -> 3)
     power = fraction / 10.0
@@ -374,8 +427,15 @@ def _hedges(code: float, dialect: str, rep: Reporter, line: int) -> tuple[int, t
     return index, (power_hedge(power),), negated
 
 
-def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], rep: Reporter,
-           dialect: str, declared: int | None, system_line: int) -> list[Rule]:
+def _rules(
+    section: _Section | None,
+    inputs: list[_Var],
+    outputs: list[_Var],
+    rep: Reporter,
+    dialect: str,
+    declared: int | None,
+    system_line: int,
+) -> list[Rule]:
     rules: list[Rule] = []
     if section is None:
         return rules
@@ -389,8 +449,11 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
             # Version 1.0 writes "i1 i2 o1 w c" without punctuation.
             values = _numbers(text.replace("(", " ").replace(")", " ").replace(":", " "), rep, line, "rule")
             if len(values) != n_in + n_out + 2:
-                raise rep.fail(f"rule: expected '{' '.join(['i'] * n_in)}, {' '.join(['o'] * n_out)} (weight) : 1|2'",
-                               line, code="fis-rule-syntax")
+                raise rep.fail(
+                    f"rule: expected '{' '.join(['i'] * n_in)}, {' '.join(['o'] * n_out)} (weight) : 1|2'",
+                    line,
+                    code="fis-rule-syntax",
+                )
             ante, cons = values[:n_in], values[n_in : n_in + n_out]
             m = None
             weight_value, conn_value = values[-2], values[-1]
@@ -398,17 +461,28 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
             weight_list = _numbers(m.group("w"), rep, line, "rule weight")
             conn_list = _numbers(m.group("conn"), rep, line, "rule connection")
             if len(weight_list) != 1 or len(conn_list) != 1:
-                raise rep.fail("rule: weight and connection must be single numbers", line, code="fis-rule-syntax")
+                raise rep.fail(
+                    "rule: weight and connection must be single numbers", line, code="fis-rule-syntax"
+                )
             weight_value, conn_value = weight_list[0], conn_list[0]
         if len(ante) != n_in:
-            raise rep.fail(f"rule has {len(ante)} antecedent entries but the system has {n_in} inputs", line,
-                           code="fis-rule-arity")
+            raise rep.fail(
+                f"rule has {len(ante)} antecedent entries but the system has {n_in} inputs",
+                line,
+                code="fis-rule-arity",
+            )
         if len(cons) != n_out:
-            raise rep.fail(f"rule has {len(cons)} consequent entries but the system has {n_out} outputs", line,
-                           code="fis-rule-arity")
+            raise rep.fail(
+                f"rule has {len(cons)} consequent entries but the system has {n_out} outputs",
+                line,
+                code="fis-rule-arity",
+            )
         if conn_value not in (1.0, 2.0):
-            raise rep.fail(f"rule connection must be 1 (AND) or 2 (OR), found {conn_value:g}", line,
-                           code="fis-rule-syntax")
+            raise rep.fail(
+                f"rule connection must be 1 (AND) or 2 (OR), found {conn_value:g}",
+                line,
+                code="fis-rule-syntax",
+            )
         if not 0.0 <= weight_value <= 1.0:
             rep.warning(f"rule weight {weight_value:g} is outside [0, 1]", line, code="fis-weight")
         operands: list[Condition] = []
@@ -420,22 +494,33 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
             if hedges == ("any",):
                 # fuzzylite's "x is any" holds with degree 1
                 if negated:
-                    raise rep.fail("'not any' (never true) in a rule is not supported", line, code="fis-hedge")
+                    raise rep.fail(
+                        "'not any' (never true) in a rule is not supported", line, code="fis-hedge"
+                    )
                 always = True
                 continue
             if not 1 <= index <= len(var.terms):
-                raise rep.fail(f"rule refers to MF{index} of {var.name!r}, which has {len(var.terms)}", line,
-                               code="fis-rule-index")
+                raise rep.fail(
+                    f"rule refers to MF{index} of {var.name!r}, which has {len(var.terms)}",
+                    line,
+                    code="fis-rule-index",
+                )
             operands.append(Is(var.name, var.terms[index - 1].name, negated, hedges, rep.span(line)))
         condition: Condition | None
         if not operands:
             if conn_value == 2.0 and not always:
-                rep.warning("rule has no antecedent and connection OR: it never fires (MATLAB); dropped", line,
-                            code="fis-empty-rule")
+                rep.warning(
+                    "rule has no antecedent and connection OR: it never fires (MATLAB); dropped",
+                    line,
+                    code="fis-empty-rule",
+                )
                 continue
             if not always:
-                rep.warning("rule has no antecedent: it fires with degree 1 (MATLAB's AND of don't-cares)", line,
-                            code="fis-empty-rule")
+                rep.warning(
+                    "rule has no antecedent: it fires with degree 1 (MATLAB's AND of don't-cares)",
+                    line,
+                    code="fis-empty-rule",
+                )
             condition = None
         elif len(operands) == 1:
             condition = operands[0]
@@ -451,25 +536,37 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
             if code == 0:
                 continue
             if code < 0:
-                raise rep.fail(f"negated consequent (-{abs(code):g}) for {var.name!r} is not supported", line,
-                               code="fis-unsupported")
+                raise rep.fail(
+                    f"negated consequent (-{abs(code):g}) for {var.name!r} is not supported",
+                    line,
+                    code="fis-unsupported",
+                )
             index, hedges, _ = _hedges(code, dialect, rep, line)
             if hedges and dialect == "fuzzylite":
                 # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py)
                 hedges = running = (*hedges, *running)
             elif hedges:
                 if not all(_is_ts_term(t.mf) for t in var.terms):
-                    raise rep.fail(f"a hedge on the Mamdani consequent of {var.name!r} is not supported", line,
-                                   code="fis-hedge")
+                    raise rep.fail(
+                        f"a hedge on the Mamdani consequent of {var.name!r} is not supported",
+                        line,
+                        code="fis-hedge",
+                    )
                 # Octave raises a Sugeno rule's degree to 1/p for a consequent hedge of power p
                 power = 1.0
                 for h in hedges:
                     power *= {"very": 2.0, "somewhat": 0.5}.get(h, 0.0) or float(h[4:])
-                hedges = (power_hedge(1.0 / power),) if 1.0 / power not in (2.0, 0.5) else (
-                    ("very",) if 1.0 / power == 2.0 else ("somewhat",))
+                hedges = (
+                    (power_hedge(1.0 / power),)
+                    if 1.0 / power not in (2.0, 0.5)
+                    else (("very",) if 1.0 / power == 2.0 else ("somewhat",))
+                )
             if not 1 <= index <= len(var.terms):
-                raise rep.fail(f"rule refers to MF{index} of output {var.name!r}, which has {len(var.terms)}", line,
-                               code="fis-rule-index")
+                raise rep.fail(
+                    f"rule refers to MF{index} of output {var.name!r}, which has {len(var.terms)}",
+                    line,
+                    code="fis-rule-index",
+                )
             conclusions.append(Conclusion(var.name, var.terms[index - 1].name, None, rep.span(line), hedges))
         if not conclusions:
             rep.warning("rule concludes nothing (all consequents 0); dropped", line, code="fis-empty-rule")
@@ -477,8 +574,9 @@ def _rules(section: _Section | None, inputs: list[_Var], outputs: list[_Var], re
         weight = None if weight_value == 1.0 else weight_value
         rules.append(Rule(str(len(rules) + 1), condition, tuple(conclusions), rep.span(line), weight=weight))
     if declared is not None and declared != len(section.rules):
-        rep.warning(f"NumRules={declared} but [Rules] lists {len(section.rules)} rules", system_line,
-                    code="fis-count")
+        rep.warning(
+            f"NumRules={declared} but [Rules] lists {len(section.rules)} rules", system_line, code="fis-count"
+        )
     return rules
 
 
@@ -493,11 +591,16 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
     if not systems:
         raise rep.fail("no [System] section: this is not a FIS file", 1 if lines else None, code="fis-syntax")
     system = systems[0]
-    inputs_s = sorted((s for s in sections if s.header.lower().startswith("input")), key=lambda s: int(s.header[5:]))
-    outputs_s = sorted((s for s in sections if s.header.lower().startswith("output")), key=lambda s: int(s.header[6:]))
+    inputs_s = sorted(
+        (s for s in sections if s.header.lower().startswith("input")), key=lambda s: int(s.header[5:])
+    )
+    outputs_s = sorted(
+        (s for s in sections if s.header.lower().startswith("output")), key=lambda s: int(s.header[6:])
+    )
     rules_s = next((s for s in sections if s.header.lower() == "rules"), None)
-    fuzzylite_keys = any(s.get(k) for s in outputs_s + inputs_s for k in ("Default", "LockPrevious", "LockRange",
-                                                                           "Enabled"))
+    fuzzylite_keys = any(
+        s.get(k) for s in outputs_s + inputs_s for k in ("Default", "LockPrevious", "LockRange", "Enabled")
+    )
     dialect = dialect or ("fuzzylite" if mentions_fuzzylite or fuzzylite_keys else "matlab")
 
     def system_value(key: str) -> tuple[str, int] | None:
@@ -511,19 +614,27 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         try:
             return int(parse_number(entry[0]))
         except ValueError:
-            raise rep.fail(f"{key} must be a number, found {entry[0]!r}", entry[1], code="fis-number") from None
+            raise rep.fail(
+                f"{key} must be a number, found {entry[0]!r}", entry[1], code="fis-number"
+            ) from None
 
     for key, found in (("NumInputs", len(inputs_s)), ("NumOutputs", len(outputs_s))):
         declared = count(key)
         if declared is not None and declared != found:
             entry = system_value(key)
-            raise rep.fail(f"{key}={declared} but the file has {found} [{key[3:-1]}N] sections",
-                           entry[1] if entry else system.line, code="fis-count")
+            raise rep.fail(
+                f"{key}={declared} but the file has {found} [{key[3:-1]}N] sections",
+                entry[1] if entry else system.line,
+                code="fis-count",
+            )
     fis_type = (system_value("Type") or ("mamdani", system.line))[0].lower()
     if fis_type not in {"mamdani", "sugeno", "hybrid", "tsukamoto"}:
         entry = system_value("Type")
-        raise rep.fail(f"unknown FIS Type {fis_type!r} (mamdani, sugeno)", entry[1] if entry else system.line,
-                       code="fis-type")
+        raise rep.fail(
+            f"unknown FIS Type {fis_type!r} (mamdani, sugeno)",
+            entry[1] if entry else system.line,
+            code="fis-type",
+        )
 
     def method(key: str, table: dict[str, str], default: str | None) -> str | None:
         entry = system_value(key)
@@ -531,8 +642,12 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             return default
         name = entry[0].lower()
         if name not in table:
-            raise rep.fail(f"{key}={entry[0]!r} is not known (known: {', '.join(table)}); user-defined MATLAB "
-                           "functions cannot be imported", entry[1], code="fis-method")
+            raise rep.fail(
+                f"{key}={entry[0]!r} is not known (known: {', '.join(table)}); user-defined MATLAB "
+                "functions cannot be imported",
+                entry[1],
+                code="fis-method",
+            )
         return table[name]
 
     and_op = method("AndMethod", AND_METHODS, None)
@@ -552,7 +667,9 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
     seen: set[str] = set()
     for var in inputs + outputs:
         if var.name in seen:
-            raise rep.fail(f"two variables are called {var.name!r}", var.entries.line, code="duplicate-variable")
+            raise rep.fail(
+                f"two variables are called {var.name!r}", var.entries.line, code="duplicate-variable"
+            )
         seen.add(var.name)
 
     defuzzify: list[DefuzzifyBlock] = []
@@ -561,17 +678,27 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         ts = bool(var.terms) and all(_is_ts_term(t.mf) for t in var.terms)
         has_ts = any(_is_ts_term(t.mf) for t in var.terms)
         if has_ts and not ts:
-            raise rep.fail(f"output {var.name!r} mixes constant/linear terms with membership functions",
-                           var.entries.line, code="fis-mf-type")
+            raise rep.fail(
+                f"output {var.name!r} mixes constant/linear terms with membership functions",
+                var.entries.line,
+                code="fis-mf-type",
+            )
         if fis_type == "mamdani" and ts:
-            raise rep.fail(f"output {var.name!r} of a Mamdani system has constant/linear terms", var.entries.line,
-                           code="fis-mf-type")
+            raise rep.fail(
+                f"output {var.name!r} of a Mamdani system has constant/linear terms",
+                var.entries.line,
+                code="fis-mf-type",
+            )
         if fis_type == "sugeno" and not ts and var.terms:
             monotonic = all(isinstance(t.mf, ShapeMF) and t.mf.kind in MONOTONIC_KINDS for t in var.terms)
             if not (dialect == "fuzzylite" and monotonic):
-                raise rep.fail(f"output {var.name!r} of a Sugeno system must have constant or linear terms",
-                               var.entries.line, code="fis-mf-type")
+                raise rep.fail(
+                    f"output {var.name!r} of a Sugeno system must have constant or linear terms",
+                    var.entries.line,
+                    code="fis-mf-type",
+                )
         weighted = ts or fis_type in {"sugeno", "tsukamoto"}
+        out_method: str | None
         if weighted:
             out_method = defuzz if defuzz in {"WTAVER", "WTSUM"} else "WTAVER"
         else:
@@ -579,13 +706,24 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             out_method = defuzz if defuzz not in {"WTAVER", "WTSUM"} else "COG"
             if defuzz in {"WTAVER", "WTSUM"} and fis_type == "mamdani":
                 entry = system_value("DefuzzMethod")
-                raise rep.fail(f"DefuzzMethod {defuzz.lower()} needs a Sugeno system", entry[1] if entry else None,
-                               code="fis-method")
+                raise rep.fail(
+                    f"DefuzzMethod {defuzz.lower()} needs a Sugeno system",
+                    entry[1] if entry else None,
+                    code="fis-method",
+                )
         default = _default(var, rep, dialect)
-        defuzzify.append(DefuzzifyBlock(
-            var.name, tuple(var.terms), var.range, out_method, default, None, rep.span(var.entries.line),
-            clamp=_flag(var.entries, "LockRange", rep),
-        ))
+        defuzzify.append(
+            DefuzzifyBlock(
+                var.name,
+                tuple(var.terms),
+                var.range,
+                out_method,
+                default,
+                None,
+                rep.span(var.entries.line),
+                clamp=_flag(var.entries, "LockRange", rep),
+            )
+        )
     rules = _rules(rules_s, inputs, outputs, rep, dialect, count("NumRules"), system.line)
     rep.raise_if_errors()
     name_entry = system_value("Name")
@@ -596,12 +734,19 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             + [Variable(v.name, VarKind.OUTPUT, range=v.range) for v in outputs]
         ),
         fuzzify=tuple(
-            FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.entries.line), clamp=_flag(v.entries, "LockRange", rep))
+            FuzzifyBlock(
+                v.name,
+                tuple(v.terms),
+                v.range,
+                rep.span(v.entries.line),
+                clamp=_flag(v.entries, "LockRange", rep),
+            )
             for v in inputs
         ),
         defuzzify=tuple(defuzzify),
-        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act,
-                               accu if any_mamdani_output else None),) if rules_s is not None else (),
+        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, accu if any_mamdani_output else None),)
+        if rules_s is not None
+        else (),
         span=rep.span(system.line),
     )
     return Loaded(Document((fb,), path), rep.warnings)
@@ -614,7 +759,9 @@ def _default(var: _Var, rep: Reporter, dialect: str) -> Default:
         try:
             value = parse_number(entry[0])
         except ValueError:
-            raise rep.fail(f"Default must be a number, found {entry[0]!r}", entry[1], code="fis-number") from None
+            raise rep.fail(
+                f"Default must be a number, found {entry[0]!r}", entry[1], code="fis-number"
+            ) from None
         return Default(value, lock_previous)
     if dialect == "fuzzylite":
         return Default(math.nan, lock_previous)

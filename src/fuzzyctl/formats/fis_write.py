@@ -9,6 +9,7 @@ with a comment naming that dialect, which our reader and fuzzylite honour.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
 from fuzzyctl.formats import Loss
@@ -43,7 +44,10 @@ _AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
 _AGG["ASUM"] = "probor"
 _DEFUZZ = {v: k for k, v in DEFUZZ_METHODS.items() if k != "centroid_integral"}
 _DEFUZZ["COGS"] = "wtaver"
-DIALECT_COMMENT = "% FIS written by fuzzyctl in the fuzzylite dialect (Default/LockPrevious/LockRange keys, fuzzylite hedges and membership types)"
+DIALECT_COMMENT = (
+    "% FIS written by fuzzyctl in the fuzzylite dialect "
+    "(Default/LockPrevious/LockRange keys, fuzzylite hedges and membership types)"
+)
 _FUZZYLITE_HEDGE_CODE = {hedges: code for code, hedges in FUZZYLITE_HEDGE_CODES.items()}
 
 
@@ -59,16 +63,24 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
         if d.clamp or (default is not None and default.no_change):
             return True
         mid = (d.range.low + d.range.high) / 2 if d.range else None
-        if default is not None and default.value is not None and (mid is None or not _same(default.value, mid)):
+        if (
+            default is not None
+            and default.value is not None
+            and (mid is None or not _same(default.value, mid))
+        ):
             return True
-    for blk in (*fb.fuzzify, *fb.defuzzify):
+    all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in all_blocks:
         for t in blk.terms:
             mf = t.mf
             if isinstance(mf, FunctionMF):
                 return True
-            if isinstance(mf, ShapeMF) and mf.kind not in {"constant", "linear"}:
-                if FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0:  # type: ignore[arg-type]
-                    return True
+            if (
+                isinstance(mf, ShapeMF)
+                and mf.kind not in {"constant", "linear"}
+                and (FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0)  # type: ignore[arg-type]
+            ):
+                return True
             if isinstance(mf, PointsMF) and _points_as_matlab(mf) is None:
                 return True
     for _, rule in fb.rules():
@@ -117,14 +129,16 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     fb, losses, _ = prepare(document, "FIS")
     supported = set(FIS_OF_KIND) | {"constant", "linear"}
     # Inputs of a FIS cannot be clamped (fuzzylite's FIS importer rejects LockRange there).
-    fuzzify = []
+    fuzzify: list[FuzzifyBlock] = []
     for f in fb.fuzzify:
         if f.clamp:
-            losses.append(Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)"))
+            losses.append(
+                Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)")
+            )
             f = replace(f, clamp=False)
-        fuzzify.append(_with_range(f, losses))
+        fuzzify.append(_with_range(f, losses))  # type: ignore[arg-type]
     fb = replace(fb, fuzzify=tuple(fuzzify))
-    defuzzify = []
+    defuzzify: list[DefuzzifyBlock] = []
     for d in fb.defuzzify:
         kept = []
         for t in d.terms:
@@ -132,20 +146,36 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 if is_point_output(d):
                     kept.append(replace(t, mf=ShapeMF("constant", (t.mf.value,))))
                     continue
-                losses.append(Loss(f"term {t.name!r} of {d.variable!r}", "FIS has no singleton in a centroid output"))
+                losses.append(
+                    Loss(f"term {t.name!r} of {d.variable!r}", "FIS has no singleton in a centroid output")
+                )
                 continue
             if term_losses(d.variable, t, supported, "FIS", losses):
                 kept.append(t)
-        defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))
+        defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
-    fb = replace(fb, fuzzify=tuple(replace(f, terms=tuple(t for t in f.terms if term_losses(f.variable, t, supported - {
-        "constant", "linear"}, "FIS", losses))) for f in fb.fuzzify))
+    fb = replace(
+        fb,
+        fuzzify=tuple(
+            replace(
+                f,
+                terms=tuple(
+                    t
+                    for t in f.terms
+                    if term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                ),
+            )
+            for f in fb.fuzzify
+        ),
+    )
 
     # One rule block with one set of operators.
     enabled = [b for b in fb.rule_blocks if b.enabled]
     for b in fb.rule_blocks:
         if b.rule_activation:
-            losses.append(Loss(f"rule block {b.name!r}", f"FIS fires every rule ({b.rule_activation!r} dropped)"))
+            losses.append(
+                Loss(f"rule block {b.name!r}", f"FIS fires every rule ({b.rule_activation!r} dropped)")
+            )
     # Only operators that matter must agree: AND/OR where rules use them, the implication
     # where a block concludes on a Mamdani output.
     merged: dict[str, str] = {}
@@ -153,19 +183,31 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         used = {
             "AndMethod": (b.and_op or "MIN") if any(isinstance(r.condition, And) for r in b.rules) else None,
             "OrMethod": (b.or_op or "MAX") if any(isinstance(r.condition, Or) for r in b.rules) else None,
-            "ImpMethod": (b.act or "MIN") if any(
+            "ImpMethod": (b.act or "MIN")
+            if any(
                 not is_point_output(fb.defuzzify_block(c.variable) or DefuzzifyBlock(c.variable, ()))
-                for r in b.rules for c in r.conclusions) else None,
+                for r in b.rules
+                for c in r.conclusions
+            )
+            else None,
         }
         for key, value in used.items():
             if value is None:
                 continue
             if merged.setdefault(key, value) != value:
-                losses.append(Loss(f"rule block {b.name!r}", f"FIS has one {key} for all rules: "
-                                                             f"{merged[key]} is kept, {value} dropped"))
+                losses.append(
+                    Loss(
+                        f"rule block {b.name!r}",
+                        f"FIS has one {key} for all rules: {merged[key]} is kept, {value} dropped",
+                    )
+                )
     base = next((b for b in enabled if b.rules), enabled[0] if enabled else RuleBlock(None, ()))
-    first = replace(base, and_op=merged.get("AndMethod", base.and_op), or_op=merged.get("OrMethod", base.or_op),
-                    act=merged.get("ImpMethod", base.act))
+    first = replace(
+        base,
+        and_op=merged.get("AndMethod", base.and_op),
+        or_op=merged.get("OrMethod", base.or_op),
+        act=merged.get("ImpMethod", base.act),
+    )
     rules: list[Rule] = []
     outputs = {d.variable for d in fb.defuzzify}
     fuzzylite = _needs_fuzzylite(fb)
@@ -177,18 +219,27 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 continue
             rules.append(replace(rule, label=str(len(rules) + 1)))
     accu_values = {d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)} | (
-        {b.accu for b in enabled if b.accu} if any(not is_point_output(d) for d in fb.defuzzify) else set())
+        {b.accu for b in enabled if b.accu} if any(not is_point_output(d) for d in fb.defuzzify) else set()
+    )
     if len(accu_values) > 1:
-        losses.append(Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}"))
+        losses.append(
+            Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}")
+        )
     for d in fb.defuzzify:
         if d.method == "COGF" or (d.accu or "") == "NSUM":
-            losses.append(Loss(f"output {d.variable!r}", f"FIS has no {d.method if d.method == 'COGF' else 'NSUM'}"))
+            losses.append(
+                Loss(f"output {d.variable!r}", f"FIS has no {d.method if d.method == 'COGF' else 'NSUM'}")
+            )
     methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
     if len(methods) > 1:
-        losses.append(Loss("defuzzification", f"FIS has one DefuzzMethod; the outputs use {', '.join(sorted(methods))}"))
+        losses.append(
+            Loss("defuzzification", f"FIS has one DefuzzMethod; the outputs use {', '.join(sorted(methods))}")
+        )
     ts_methods = {("WTSUM" if d.method == "WTSUM" else "WTAVER") for d in fb.defuzzify if is_point_output(d)}
     if methods and ts_methods - {"WTAVER"}:
-        losses.append(Loss("defuzzification", "a FIS mixing Mamdani and Sugeno outputs has weighted averages only"))
+        losses.append(
+            Loss("defuzzification", "a FIS mixing Mamdani and Sugeno outputs has weighted averages only")
+        )
     block = replace(first, rules=tuple(rules), accu=(sorted(accu_values)[0] if accu_values else first.accu))
     fb = replace(fb, rule_blocks=(block,))
     return Document((fb,), document.path), losses
@@ -205,8 +256,11 @@ def _with_range(blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss]) -> Fuzzi
         return replace(blk, range=Range(low, high))
     if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
         losses.append(Loss(f"output {blk.variable!r}", "has no RANGE and unbounded terms; FIS needs a Range"))
-    return replace(blk, range=Range(-math.inf, math.inf)) if isinstance(blk, DefuzzifyBlock) else replace(
-        blk, range=Range(0.0, 1.0) if not blk.terms else Range(-math.inf, math.inf))
+    return (
+        replace(blk, range=Range(-math.inf, math.inf))
+        if isinstance(blk, DefuzzifyBlock)
+        else replace(blk, range=Range(0.0, 1.0) if not blk.terms else Range(-math.inf, math.inf))
+    )
 
 
 def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: bool) -> str | None:
@@ -214,7 +268,7 @@ def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: b
     if isinstance(c, And | Or):
         if not all(isinstance(o, Is) for o in c.operands):
             return "FIS joins a rule's conditions with one AND or OR, without nesting"
-        atoms = list(c.operands)
+        atoms = [o for o in c.operands if isinstance(o, Is)]
     elif c is None or isinstance(c, Is):
         atoms = [] if c is None else [c]
     else:
@@ -258,7 +312,7 @@ def _hedge_code(hedges: tuple[str, ...], fuzzylite: bool) -> int | None:
     if len(hedges) == 1:
         power = hedge_power(hedges[0])
         if power is not None and abs(power * 10 - round(power * 10)) < 1e-9 and 1 <= round(power * 10) <= 98:
-            return int(round(power * 10))
+            return round(power * 10)
     return None
 
 
@@ -296,8 +350,12 @@ def write(document: Document) -> str:
     fis_type = "sugeno" if point and all(point) else ("hybrid" if any(point) else "mamdani")
     mamdani_methods = [d.method or "COG" for d in fb.defuzzify if not is_point_output(d)]
     ts_methods = [d.method for d in fb.defuzzify if is_point_output(d)]
-    defuzz = _DEFUZZ[mamdani_methods[0]] if mamdani_methods else ("wtsum" if "WTSUM" in ts_methods else "wtaver")
-    accu = next((d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)), None) or block.accu or "MAX"
+    defuzz = (
+        _DEFUZZ[mamdani_methods[0]] if mamdani_methods else ("wtsum" if "WTSUM" in ts_methods else "wtaver")
+    )
+    accu = (
+        next((d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)), None) or block.accu or "MAX"
+    )
     out: list[str] = []
     if fuzzylite:
         out.append(DIALECT_COMMENT)
@@ -320,16 +378,29 @@ def write(document: Document) -> str:
         blk = fb.fuzzify_block(var.name)
         terms = blk.terms if blk else ()
         rng = (blk.range if blk else None) or var.range or Range(0.0, 1.0)
-        out += ["", f"[Input{i}]", f"Name='{var.name}'", f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]",
-                f"NumMFs={len(terms)}"]
+        out += [
+            "",
+            f"[Input{i}]",
+            f"Name='{var.name}'",
+            f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]",
+            f"NumMFs={len(terms)}",
+        ]
         out += [f"MF{k}={_mf_text(t)}" for k, t in enumerate(terms, start=1)]
     for i, d in enumerate(fb.defuzzify, start=1):
         rng = d.range or Range(0.0, 1.0)
-        out += ["", f"[Output{i}]", f"Name='{d.variable}'", f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]"]
+        out += [
+            "",
+            f"[Output{i}]",
+            f"Name='{d.variable}'",
+            f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]",
+        ]
         if fuzzylite:
             value = d.default.value if d.default and d.default.value is not None else 0.0
-            out += [f"Default={fmt_number(value)}", f"LockPrevious={int(bool(d.default and d.default.no_change))}",
-                    f"LockRange={int(d.clamp)}"]
+            out += [
+                f"Default={fmt_number(value)}",
+                f"LockPrevious={int(bool(d.default and d.default.no_change))}",
+                f"LockRange={int(d.clamp)}",
+            ]
         out.append(f"NumMFs={len(d.terms)}")
         out += [f"MF{k}={_mf_text(t)}" for k, t in enumerate(d.terms, start=1)]
     out += ["", "[Rules]"]
@@ -345,7 +416,7 @@ def _entry(index: int, negated: bool, hedges: tuple[str, ...], fuzzylite: bool) 
     return f"-{text}" if negated else text
 
 
-def _rule_text(fb: FunctionBlock, rule: Rule, inputs: list[object], fuzzylite: bool) -> str:
+def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylite: bool) -> str:
     from fuzzyctl.model import Variable
 
     atoms = _ises(rule.condition)
@@ -353,8 +424,10 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: list[object], fuzzylite: b
     if rule.condition is None and fuzzylite and inputs:
         # fuzzylite reads "0.99" as "x is any" (a rule of don't-cares would not load there);
         # MATLAB truncates it to 0, a don't-care: both give degree 1.
-        return f"{' '.join(['0.99'] + ['0'] * (len(inputs) - 1))}, " + _rule_text(
-            fb, replace(rule, condition=Is("", "")), inputs, fuzzylite).split(", ", 1)[1]
+        return (
+            f"{' '.join(['0.99'] + ['0'] * (len(inputs) - 1))}, "
+            + _rule_text(fb, replace(rule, condition=Is("", "")), inputs, fuzzylite).split(", ", 1)[1]
+        )
     ante = []
     for var in inputs:
         assert isinstance(var, Variable)

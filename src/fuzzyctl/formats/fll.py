@@ -22,6 +22,7 @@ The writer lives in :mod:`fuzzyctl.formats.fll_write`.
 
 from __future__ import annotations
 
+import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -138,7 +139,9 @@ def _numbers(words: list[str], rep: Reporter, line: int, what: str) -> list[floa
     try:
         return [parse_number(w) for w in words]
     except ValueError:
-        raise rep.fail(f"{what}: expected numbers, found {' '.join(words)!r}", line, code="fll-number") from None
+        raise rep.fail(
+            f"{what}: expected numbers, found {' '.join(words)!r}", line, code="fll-number"
+        ) from None
 
 
 def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, names: set[str]) -> Term:
@@ -167,7 +170,10 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
         if len(params) != n_inputs + 1:
             raise rep.fail(
                 f"Linear {name!r} needs {n_inputs} or {n_inputs + 1} coefficients (one per input variable "
-                f"and a constant), found {len(params)}", line, code="fll-term")
+                f"and a constant), found {len(params)}",
+                line,
+                code="fll-term",
+            )
         mf = ShapeMF("linear", tuple(params))
     elif cls == "Discrete":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
@@ -175,7 +181,7 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
         if len(params) < 2:
             raise rep.fail(f"Discrete {name!r} needs x y pairs", line, code="fll-term")
         xs, ys = params[0::2], params[1::2]
-        if any(b < a for a, b in zip(xs, xs[1:], strict=False)):
+        if any(b < a for a, b in itertools.pairwise(xs)):
             raise rep.fail(f"Discrete {name!r}: x values must ascend", line, code="fll-term")
         mf = PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     else:
@@ -185,14 +191,22 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
             raise rep.fail(f"unknown term class {cls!r} (known: {known})", line, code="fll-term")
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) not in (mapping.arity, mapping.arity + 1):
-            raise rep.fail(f"{cls} {name!r} takes {mapping.arity} parameters (and an optional height), "
-                           f"found {len(params)}", line, code="fll-term")
+            raise rep.fail(
+                f"{cls} {name!r} takes {mapping.arity} parameters (and an optional height), "
+                f"found {len(params)}",
+                line,
+                code="fll-term",
+            )
         height = params[mapping.arity] if len(params) > mapping.arity else 1.0
         mf = ShapeMF(mapping.kind, mapping.to_model(params), height)
     unique = unique_name(name, var.term_names)
     if unique != name:
-        rep.warning(f"duplicate term name {name!r} in {var.name!r}: rules use the first (as fuzzylite C++ does); "
-                    f"this one is renamed {unique!r}", line, code="duplicate-term")
+        rep.warning(
+            f"duplicate term name {name!r} in {var.name!r}: rules use the first (as fuzzylite C++ does); "
+            f"this one is renamed {unique!r}",
+            line,
+            code="duplicate-term",
+        )
     return Term(unique, mf, rep.span(line))
 
 
@@ -239,9 +253,14 @@ class _RuleParser:
                 raise self.fail(f"weight must be a number, found {word!r}") from None
         if self.peek() is not None:
             raise self.fail(f"unexpected {self.peek()!r} at the end")
-        value = None if condition is True else condition
-        return Rule(label, value, tuple(conclusions), self.rep.span(self.line),
-                    weight=None if weight is None or weight == 1.0 else weight)
+        value = None if isinstance(condition, bool) else condition
+        return Rule(
+            label,
+            value,
+            tuple(conclusions),
+            self.rep.span(self.line),
+            weight=None if weight is None or weight == 1.0 else weight,
+        )
 
     # Conditions are Condition objects, or True for "x is any" (always holds).
     def disjunction(self) -> Condition | bool:
@@ -353,16 +372,20 @@ def read(text: str, path: str | None = None) -> Loaded:
                 current.description = value
         elif current is None:
             if not saw_engine:
-                raise rep.fail(f"'{key}:' before any Engine, InputVariable, OutputVariable or RuleBlock", number,
-                               code="fll-syntax")
+                raise rep.fail(
+                    f"'{key}:' before any Engine, InputVariable, OutputVariable or RuleBlock",
+                    number,
+                    code="fll-syntax",
+                )
             raise rep.fail(f"'{key}:' does not belong to the Engine section", number, code="fll-syntax")
         elif isinstance(current, _Variable):
             _variable_key(current, key, value, rep, number, pending_terms)
         else:
             _block_key(current, key, value, rep, number)
     if not saw_engine and not variables:
-        raise rep.fail("no 'Engine:' and no variables: this is not an FLL file", 1 if lines else None,
-                       code="fll-syntax")
+        raise rep.fail(
+            "no 'Engine:' and no variables: this is not an FLL file", 1 if lines else None, code="fll-syntax"
+        )
     names = {v.name for v in variables}
     if len(names) != len(variables):
         seen: set[str] = set()
@@ -376,22 +399,52 @@ def read(text: str, path: str | None = None) -> Loaded:
     by_name = {v.name: v for v in variables}
     rule_blocks: list[RuleBlock] = []
     for block in blocks:
-        rules = [_RuleParser(text, number, rep, by_name).rule(str(i)) for i, (text, number) in
-                 enumerate(block.rules, start=1)]
-        rule_blocks.append(RuleBlock(block.name, tuple(rules), block.and_op, block.or_op, block.act, None,
-                                     rep.span(block.line), enabled=block.enabled,
-                                     rule_activation=block.rule_activation))
+        rules = [
+            _RuleParser(text, number, rep, by_name).rule(str(i))
+            for i, (text, number) in enumerate(block.rules, start=1)
+        ]
+        rule_blocks.append(
+            RuleBlock(
+                block.name,
+                tuple(rules),
+                block.and_op,
+                block.or_op,
+                block.act,
+                None,
+                rep.span(block.line),
+                enabled=block.enabled,
+                rule_activation=block.rule_activation,
+            )
+        )
     rep.raise_if_errors()
     inputs = [v for v in variables if v.kind is VarKind.INPUT]
     outputs = [v for v in variables if v.kind is VarKind.OUTPUT]
     fb = FunctionBlock(
         name=engine_name,
-        variables=tuple(Variable(v.name, v.kind, range=v.range, span=rep.span(v.line),
-                                 comments=(v.description,) if v.description else ()) for v in variables),
-        fuzzify=tuple(FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.line), clamp=v.clamp) for v in inputs),
+        variables=tuple(
+            Variable(
+                v.name,
+                v.kind,
+                range=v.range,
+                span=rep.span(v.line),
+                comments=(v.description,) if v.description else (),
+            )
+            for v in variables
+        ),
+        fuzzify=tuple(
+            FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.line), clamp=v.clamp) for v in inputs
+        ),
         defuzzify=tuple(
-            DefuzzifyBlock(v.name, tuple(v.terms), v.range, v.method, Default(v.default, v.lock_previous), v.accu,
-                           rep.span(v.line), clamp=v.clamp)
+            DefuzzifyBlock(
+                v.name,
+                tuple(v.terms),
+                v.range,
+                v.method,
+                Default(v.default, v.lock_previous),
+                v.accu,
+                rep.span(v.line),
+                clamp=v.clamp,
+            )
             for v in outputs
         ),
         rule_blocks=tuple(rule_blocks),
@@ -400,20 +453,32 @@ def read(text: str, path: str | None = None) -> Loaded:
     return Loaded(Document((fb,), path), rep.warnings)
 
 
-def _variable_key(var: _Variable, key: str, value: str, rep: Reporter, number: int,
-                  pending_terms: list[tuple[_Variable, str, int]]) -> None:
+def _variable_key(
+    var: _Variable,
+    key: str,
+    value: str,
+    rep: Reporter,
+    number: int,
+    pending_terms: list[tuple[_Variable, str, int]],
+) -> None:
     output = var.kind is VarKind.OUTPUT
     if key == "enabled":
         if not _bool(value, rep, number, key):
-            raise rep.fail(f"{var.name!r} is disabled: disabled variables are not supported", number,
-                           code="fll-unsupported")
+            raise rep.fail(
+                f"{var.name!r} is disabled: disabled variables are not supported",
+                number,
+                code="fll-unsupported",
+            )
     elif key == "range":
         numbers = _numbers(value.split(), rep, number, "range")
         if len(numbers) != 2:
             raise rep.fail(f"range needs 2 numbers, found {len(numbers)}", number, code="fll-value")
         if numbers[0] > numbers[1]:
-            raise rep.fail(f"range {numbers[0]:g} {numbers[1]:g} has its minimum above its maximum", number,
-                           code="fll-value")
+            raise rep.fail(
+                f"range {numbers[0]:g} {numbers[1]:g} has its minimum above its maximum",
+                number,
+                code="fll-value",
+            )
         var.range = Range(numbers[0], numbers[1], rep.span(number))
     elif key == "lock-range":
         var.clamp = _bool(value, rep, number, key)
@@ -421,16 +486,20 @@ def _variable_key(var: _Variable, key: str, value: str, rep: Reporter, number: i
         pending_terms.append((var, value, number))  # after all variables: Linear needs the input count
     elif output and key in {"aggregation", "accumulation"}:
         if value != "none" and value not in SNORMS_ACCU:
-            raise rep.fail(f"unknown {key} {value!r} (known: {', '.join(SNORMS_ACCU)}, none)", number,
-                           code="fll-value")
+            raise rep.fail(
+                f"unknown {key} {value!r} (known: {', '.join(SNORMS_ACCU)}, none)", number, code="fll-value"
+            )
         var.accu = SNORMS_ACCU.get(value)
     elif output and key == "defuzzifier":
         words = value.split()
         if not words or words[0] == "none":
             var.method = None
         elif words[0] not in DEFUZZIFIERS:
-            raise rep.fail(f"unknown defuzzifier {words[0]!r} (known: {', '.join(DEFUZZIFIERS)})", number,
-                           code="fll-value")
+            raise rep.fail(
+                f"unknown defuzzifier {words[0]!r} (known: {', '.join(DEFUZZIFIERS)})",
+                number,
+                code="fll-value",
+            )
         else:
             var.method = DEFUZZIFIERS[words[0]]
     elif output and key == "default":
@@ -438,8 +507,11 @@ def _variable_key(var: _Variable, key: str, value: str, rep: Reporter, number: i
     elif output and key in {"lock-previous", "lock-valid"}:
         var.lock_previous = _bool(value, rep, number, key)
     else:
-        raise rep.fail(f"unknown key '{key}:' in {'OutputVariable' if output else 'InputVariable'} {var.name!r}",
-                       number, code="fll-syntax")
+        raise rep.fail(
+            f"unknown key '{key}:' in {'OutputVariable' if output else 'InputVariable'} {var.name!r}",
+            number,
+            code="fll-syntax",
+        )
 
 
 def _block_key(block: _Block, key: str, value: str, rep: Reporter, number: int) -> None:

@@ -19,6 +19,7 @@ from fuzzyctl.model import (
     Document,
     FunctionBlock,
     FunctionMF,
+    FuzzifyBlock,
     Is,
     Or,
     PointsMF,
@@ -43,7 +44,8 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as FLL can state it, and what had to be dropped."""
     fb, losses, _ = prepare(document, "FLL")
     supported = set(FLL_OF_KIND) | {"constant", "linear"}
-    for blk in (*fb.fuzzify, *fb.defuzzify):
+    all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in all_blocks:
         kept = tuple(t for t in blk.terms if _term_ok(blk.variable, t, supported, losses, blk))
         if len(kept) != len(blk.terms):
             fb = _replace_block(fb, replace(blk, terms=kept))
@@ -51,7 +53,9 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     for block in fb.rule_blocks:
         rules = []
         for rule in block.rules:
-            hedges = [h for a in _ises(rule.condition) for h in a.hedges] + [h for c in rule.conclusions for h in c.hedges]
+            hedges = [h for a in _ises(rule.condition) for h in a.hedges] + [
+                h for c in rule.conclusions for h in c.hedges
+            ]
             unknown = sorted({h for h in hedges if h not in FLL_HEDGES})
             if unknown:
                 losses.append(Loss(rule_label(block, rule), f"FLL has no hedge {', '.join(unknown)}"))
@@ -65,27 +69,42 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         if d.method in {"COGF"}:
             losses.append(Loss(f"output {d.variable!r}", f"FLL has no defuzzification method {d.method}"))
         if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
-            losses.append(Loss(f"output {d.variable!r}", "FLL has no IEC NSUM accumulation (fuzzylite's "
-                                                          "NormalizedSum normalises pairwise)"))
+            losses.append(
+                Loss(
+                    f"output {d.variable!r}",
+                    "FLL has no IEC NSUM accumulation (fuzzylite's NormalizedSum normalises pairwise)",
+                )
+            )
     return Document((replace(fb, rule_blocks=tuple(blocks)),), document.path), losses
 
 
-def _replace_block(fb: FunctionBlock, blk: object) -> FunctionBlock:
+def _replace_block(fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock) -> FunctionBlock:
     if isinstance(blk, DefuzzifyBlock):
         return replace(fb, defuzzify=tuple(blk if d.variable == blk.variable else d for d in fb.defuzzify))
-    return replace(fb, fuzzify=tuple(blk if f.variable == blk.variable else f for f in fb.fuzzify))  # type: ignore[attr-defined]
+    return replace(fb, fuzzify=tuple(blk if f.variable == blk.variable else f for f in fb.fuzzify))
 
 
 def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], blk: object) -> bool:
-    if isinstance(term.mf, SingletonMF) and not (isinstance(blk, DefuzzifyBlock) and blk.method in
-                                                 {"COGS", "WTAVER", "WTSUM"}):
-        losses.append(Loss(f"term {term.name!r} of {owner!r}",
-                           "FLL has singletons only as Constant terms of a weighted-average output"))
-        return False
-    if isinstance(term.mf, ShapeMF) and term.mf.kind in {"constant", "linear"} and not (
+    if isinstance(term.mf, SingletonMF) and not (
         isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"}
     ):
-        losses.append(Loss(f"term {term.name!r} of {owner!r}", "Constant/Linear terms belong to weighted-average outputs"))
+        losses.append(
+            Loss(
+                f"term {term.name!r} of {owner!r}",
+                "FLL has singletons only as Constant terms of a weighted-average output",
+            )
+        )
+        return False
+    if (
+        isinstance(term.mf, ShapeMF)
+        and term.mf.kind in {"constant", "linear"}
+        and not (isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"})
+    ):
+        losses.append(
+            Loss(
+                f"term {term.name!r} of {owner!r}", "Constant/Linear terms belong to weighted-average outputs"
+            )
+        )
         return False
     return term_losses(owner, term, supported, "FLL", losses)
 
@@ -131,8 +150,10 @@ def term_text(term: Term) -> str:
         values = FLL_TYPES[cls].from_model(tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
         return f"{term.name} {cls} {_params(values, float(mf.height))}"  # type: ignore[arg-type]
     if isinstance(mf, PointsMF):
-        return f"{term.name} Discrete " + " ".join(f"{fmt_number(float(p.x))} {fmt_number(float(p.y))}"  # type: ignore[arg-type]
-                                                   for p in mf.points)
+        return f"{term.name} Discrete " + " ".join(
+            f"{fmt_number(float(p.x))} {fmt_number(float(p.y))}"  # type: ignore[arg-type]
+            for p in mf.points
+        )
     if isinstance(mf, SingletonMF):
         return f"{term.name} Constant {fmt_number(float(mf.value))}"  # type: ignore[arg-type]
     if isinstance(mf, FunctionMF):
@@ -170,8 +191,12 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         out.append(f"  lock-range: {'true' if blk and blk.clamp else 'false'}")
         for term in blk.terms if blk else ():
             out.append(f"  term: {term_text(term)}")
-    accu_of_block = {c.variable: b.accu for b in fb.rule_blocks for _, r in [(b, r) for r in b.rules]
-                     for c in r.conclusions}
+    accu_of_block = {
+        c.variable: b.accu
+        for b in fb.rule_blocks
+        for _, r in [(b, r) for r in b.rules]
+        for c in r.conclusions
+    }
     for var in fb.outputs:
         d = fb.defuzzify_block(var.name)
         if d is None:
@@ -186,7 +211,9 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         out.append(f"  aggregation: {_ACCU_NAMES[accu] if accu else ('none' if point else 'Maximum')}")
         method = d.method or "COG"
         name = _DEFUZZ_NAMES.get(method, "Centroid")
-        out.append(f"  defuzzifier: {name} {resolution}" if method in INTEGRAL_METHODS else f"  defuzzifier: {name}")
+        out.append(
+            f"  defuzzifier: {name} {resolution}" if method in INTEGRAL_METHODS else f"  defuzzifier: {name}"
+        )
         default = d.default
         value = default.value if default and default.value is not None else 0.0
         out.append(f"  default: {fmt_number(value) if not math.isnan(value) else 'nan'}")
@@ -201,9 +228,16 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         uses_and = any(_has(r.condition, And) for r in block.rules)
         uses_or = any(_has(r.condition, Or) for r in block.rules)
         mamdani = any(not _is_point(fb, c.variable) for r in block.rules for c in r.conclusions)
-        out.append(f"  conjunction: {_TNORM_NAMES[block.and_op] if block.and_op else ('Minimum' if uses_and else 'none')}")
-        out.append(f"  disjunction: {_OR_NAMES[block.or_op] if block.or_op else ('Maximum' if uses_or else 'none')}")
-        out.append(f"  implication: {_TNORM_NAMES[block.act] if block.act else ('Minimum' if mamdani else 'none')}")
+        out.append(
+            "  conjunction: "
+            + (_TNORM_NAMES[block.and_op] if block.and_op else ("Minimum" if uses_and else "none"))
+        )
+        out.append(
+            f"  disjunction: {_OR_NAMES[block.or_op] if block.or_op else ('Maximum' if uses_or else 'none')}"
+        )
+        out.append(
+            f"  implication: {_TNORM_NAMES[block.act] if block.act else ('Minimum' if mamdani else 'none')}"
+        )
         out.append(f"  activation: {block.rule_activation or 'General'}")
         for rule in block.rules:
             out.append(f"  rule: {rule_text(fb, rule)}")
@@ -233,7 +267,9 @@ def rule_text(fb: FunctionBlock, rule: object) -> str:
     else:
         antecedent = condition_text(rule.condition)
     written = uncumulate([c.hedges for c in rule.conclusions]) or [c.hedges for c in rule.conclusions]
-    parts = [" ".join([c.variable, "is", *h, c.term or ""]) for c, h in zip(rule.conclusions, written, strict=True)]
+    parts = [
+        " ".join([c.variable, "is", *h, c.term or ""]) for c, h in zip(rule.conclusions, written, strict=True)
+    ]
     text = f"if {antecedent} then {' and '.join(parts)}"
     if rule.weight is not None:
         text += f" with {fmt_number(float(rule.weight))}"  # type: ignore[arg-type]

@@ -237,13 +237,15 @@ def read(text: str, path: str | None = None) -> Loaded:
         data = _json.loads(text)
     except _json.JSONDecodeError as exc:
         line, column = _line_of(text, exc.pos)
-        raise DiagnosticError([error(f"invalid JSON: {exc.msg}", m.Span(line, column), code="json-syntax",
-                                     file=path)], text) from None
+        raise DiagnosticError(
+            [error(f"invalid JSON: {exc.msg}", m.Span(line, column), code="json-syntax", file=path)], text
+        ) from None
     try:
         document = from_dict(data)
     except JsonModelError as exc:
-        raise DiagnosticError([error(f"not a fuzzyctl model: {exc}", None, code="json-model", file=path)],
-                              text) from None
+        raise DiagnosticError(
+            [error(f"not a fuzzyctl model: {exc}", None, code="json-model", file=path)], text
+        ) from None
     return Loaded(dataclasses.replace(document, path=path))
 
 
