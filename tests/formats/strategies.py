@@ -57,6 +57,12 @@ rules = st.builds(
     comments,
     st.none() | params,
 )
+item_spans = st.lists(
+    st.tuples(
+        st.sampled_from(["act", "accu", "method"]), st.builds(m.Span, st.integers(1, 9), st.integers(1, 9))
+    ),
+    max_size=2,
+).map(tuple)
 ops = st.none() | st.sampled_from(["MIN", "PROD", "MAX", "EINSTEIN"])
 rule_blocks = st.builds(
     m.RuleBlock,

@@ -3,8 +3,7 @@
 The FCL reader and writer belong to :mod:`fuzzyctl.fcl`; this module only adapts their
 public functions to the registry and says what FCL cannot express of a model that came from
 another format (a MATLAB/fuzzylite rule weight under ACT MIN, fuzzylite's lock-range, ...).
-Until :mod:`fuzzyctl.fcl` provides ``parse`` and ``write``, the format is listed but not
-available.
+It uses ``fuzzyctl.fcl.load_text`` (parse and check) and ``fuzzyctl.fcl.write``.
 """
 
 from __future__ import annotations
@@ -24,7 +23,7 @@ def _fcl_api() -> Any | None:
     if importlib.util.find_spec("fuzzyctl.fcl") is None:
         return None
     module = importlib.import_module("fuzzyctl.fcl")
-    if not (hasattr(module, "parse") and hasattr(module, "write")):
+    if not (hasattr(module, "load_text") and hasattr(module, "write")):
         return None
     return module
 
@@ -98,11 +97,10 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
 def _read(text: str, path: str | None) -> Loaded:
     api = _fcl_api()
     assert api is not None
-    result = api.parse(text, path=path)
-    if isinstance(result, Document):
-        return Loaded(result)
-    document, diagnostics = result
-    return Loaded(document, tuple(d for d in diagnostics if not d.is_error))
+    result = api.load_text(text, path)
+    document = result.raise_for_errors()
+    assert isinstance(document, Document)
+    return Loaded(document, tuple(d for d in result.diagnostics if not d.is_error))
 
 
 def _write(document: Document) -> str:

@@ -47,7 +47,7 @@ TAGS: dict[type, str] = {
     m.Or: "or",
 }
 CLASSES: dict[str, type] = {tag: cls for cls, tag in TAGS.items()}
-_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments"})
+_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments", "item_spans"})
 
 
 def _number(value: float) -> float | str:
@@ -155,8 +155,12 @@ def decode(value: Any, tp: Any, where: str = "$") -> Any:
     if origin is tuple:
         if not isinstance(value, list):
             raise JsonModelError(where, "expected a list")
-        item = typing.get_args(tp)[0]
-        return tuple(decode(v, item, f"{where}[{i}]") for i, v in enumerate(value))
+        args = typing.get_args(tp)
+        if len(args) == 2 and args[1] is Ellipsis:
+            return tuple(decode(v, args[0], f"{where}[{i}]") for i, v in enumerate(value))
+        if len(value) != len(args):
+            raise JsonModelError(where, f"expected {len(args)} items, found {len(value)}")
+        return tuple(decode(v, a, f"{where}[{i}]") for i, (v, a) in enumerate(zip(value, args, strict=True)))
     if tp is float:
         return _decode_float(value, where)
     if tp is int:
