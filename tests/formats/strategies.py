@@ -76,6 +76,7 @@ rule_blocks = st.builds(
     comments,
     st.booleans(),
     st.none() | st.just("Highest 2"),
+    item_spans,
 )
 initials = st.none() | st.booleans() | numbers | st.text(max_size=4)
 variables = st.builds(
@@ -103,6 +104,7 @@ defuzzify = st.builds(
     spans,
     comments,
     st.booleans(),
+    item_spans,
 )
 options = st.builds(m.OptionsBlock, st.text(max_size=10), st.sampled_from(["OPTIONS", "OPTION"]), spans)
 blocks = st.builds(
