@@ -17,6 +17,7 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     existing path is parsed as FCL unless ``format`` says otherwise.  Raises
     :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
     input is not valid."""
+    from fuzzyctl import formats
     from fuzzyctl.diagnostics import DiagnosticError, error
     from fuzzyctl.fcl import load_file, load_text
 
@@ -24,11 +25,11 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        if fmt != "fcl":
-            raise FuzzyctlError(f"no reader for format {fmt!r} yet (FCL only)")
-        return load_file(path).raise_for_errors()
+        if fmt == "fcl":
+            return load_file(path).raise_for_errors()
+        return formats.read_path(path, fmt).document
     if fmt not in (None, "fcl"):
-        raise FuzzyctlError(f"no reader for format {fmt!r} yet (FCL only)")
+        return formats.read_text(str(path_or_text), fmt).document
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])

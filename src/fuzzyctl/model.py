@@ -185,6 +185,18 @@ SHAPES: dict[str, ShapeSpec] = {
             "1 for x >= start when direction > start, 1 for x <= start when direction < start, "
             "0 elsewhere (fuzzylite Binary)",
         ),
+        ShapeSpec(
+            "arc",
+            ("start", "end"),
+            "quarter ellipse: 0 before start, sqrt(r^2 - (x-end)^2) / |r| with r = end - start "
+            "between start and end, 1 beyond end (pyfuzzylite Arc; falls when end < start)",
+        ),
+        ShapeSpec(
+            "semiellipse",
+            ("start", "end"),
+            "sqrt(r^2 - (x-c)^2) / r on [start, end] with c, r its centre and half-width, "
+            "0 outside (pyfuzzylite SemiEllipse)",
+        ),
         ShapeSpec("constant", ("value",), "Takagi-Sugeno constant output"),
         ShapeSpec(
             "linear",
@@ -248,6 +260,10 @@ class FunctionMF:
 
     expr: Expr
     text: str = field(default="", compare=False)
+    argument: str | None = None
+    """The name that stands for the point at which the term is evaluated (fuzzylite's
+    ``x`` in ``Function lt(x, 0.3) * ...``).  ``None``: every name is a variable and the
+    expression gives the term's value directly (jFuzzyLogic FUNCTION, Takagi-Sugeno)."""
 
 
 MembershipFunction: TypeAlias = PointsMF | SingletonMF | SingletonsMF | ShapeMF | FunctionMF
@@ -303,6 +319,8 @@ class FuzzifyBlock:
     range: Range | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    clamp: bool = False
+    """Limit the input value to ``range`` before fuzzification (fuzzylite ``lock-range``)."""
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
@@ -337,6 +355,8 @@ class DefuzzifyBlock:
     accu: str | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    clamp: bool = False
+    """Limit the defuzzified value to ``range`` (fuzzylite ``lock-range``)."""
     item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
     """Where the single-valued items were written: ``("method", span)``, ``("accu", ...)``."""
 
@@ -403,7 +423,9 @@ class Conclusion:
     weight: Param | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     hedges: tuple[str, ...] = ()
-    """fuzzylite's hedges before the term (``then tip is very low``), outermost first."""
+    """Hedges written before the term (fuzzylite ``then y is very t``), outermost first.
+    They modify the degree this conclusion is activated with, as :attr:`Is.hedges` modify
+    a membership degree; see :data:`HEDGES`."""
 
 
 @dataclass(frozen=True)
@@ -418,6 +440,10 @@ class Rule:
     conclusions: tuple[Conclusion, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    weight: Param | None = None
+    """Rule weight of MATLAB FIS and fuzzylite (``(0.5)``, ``with 0.5``): it multiplies the
+    condition degree *before* activation, ``act(w * a, mu)``.  Unlike a WITH weight of a
+    subconclusion (IEC 61131-7: ``w * act(a, mu)``) it differs from it under ACT MIN."""
 
 
 @dataclass(frozen=True)
@@ -433,6 +459,12 @@ class RuleBlock:
     accu: str | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    enabled: bool = True
+    """A disabled rule block (fuzzylite ``enabled: false``) fires none of its rules."""
+    rule_activation: str | None = None
+    """fuzzylite's rule activation method when it is not ``General`` (``"First 2"``,
+    ``"Highest 1"``, ``"Threshold >= 0.5"``, ...): which rules of the block fire.  ``None``:
+    every rule fires (IEC 61131-7)."""
     item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
     """Where the operator items were written: ``("and_op", span)``, ``("or_op", ...)``,
     ``("act", ...)``, ``("accu", ...)``."""
@@ -542,3 +574,15 @@ ACT_METHODS = frozenset({"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER", "E
 # HSUM -> HAMACHER, DSUM -> DMAX, NMAX -> NIPMAX).  The synonym table is fuzzyctl.fcl.keywords.
 ACCU_METHODS = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR", "DMAX", "NIPMAX", "HAMACHER", "EINSTEIN"})
 DEFUZZ_METHODS = frozenset({"COG", "COGS", "COA", "LM", "RM", "MOM", "COGF", "WTAVER", "WTSUM"})
+
+# Hedges (``x IS very t``, ``then y is very t``): name -> what it does to a degree d.
+# fuzzylite's ``any`` (degree 1 whatever the term) is resolved by the readers, never stored.
+HEDGES: dict[str, str] = {
+    "very": "d^2",
+    "somewhat": "sqrt(d)",
+    "extremely": "2 d^2 if d <= 0.5 else 1 - 2 (1-d)^2 (fuzzylite Extremely)",
+    "seldom": "sqrt(d/2) if d <= 0.5 else 1 - sqrt((1-d)/2) (fuzzylite Seldom)",
+}
+POWER_HEDGE_PREFIX = "pow:"
+"""A hedge ``"pow:p"`` raises the degree to the power p (Octave FIS hedge codes: ``2.3`` is
+term 2 with ``d^3``)."""

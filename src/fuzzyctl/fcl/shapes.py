@@ -85,6 +85,9 @@ SPELLINGS: tuple[Spelling, ...] = (
     Spelling("Spike", "spike", (0, 1), FL, height=True),
     Spelling("Concave", "concave", (0, 1), FL, height=True),
     Spelling("Binary", "binary", (0, 1), FL, height=True),
+    # pyfuzzylite 8 terms (its FCL export writes the class name like the others)
+    Spelling("Arc", "arc", (0, 1), FL, height=True),
+    Spelling("SemiEllipse", "semiellipse", (0, 1), FL, height=True),
     Spelling("Constant", "constant", (0,), FL),
     Spelling("Linear", "linear", (), FL, variadic=True),
     # scalablurry
