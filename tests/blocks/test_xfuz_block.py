@@ -84,6 +84,14 @@ def test_xfuz_3_3_as_printed_with_the_span_rule_relaxed() -> None:
     assert expected == pytest.approx(7.5014, abs=1e-4)
     assert fb.last_result is not None and fb.last_result.outputs[3] == pytest.approx(expected)
     assert fb["OUT3"] == 8 and fb.STATUS == 0
+    # Second case on the same 20 points: max(petite, min(9/29, grande)) -> 3.578 -> 4.
+    auto(fb, 20, 10)
+    petite = [1.0 if x <= 3 else 0.0 if x >= 7 else (7 - x) / 4 for x in xs]
+    f = [max(p, min(9 / 29, g)) for p, g in zip(petite, grande, strict=True)]
+    expected = sum(x * v for x, v in zip(xs, f, strict=True)) / sum(f)
+    assert expected == pytest.approx(3.5777, abs=1e-4)
+    assert fb.last_result is not None and fb.last_result.outputs[3] == pytest.approx(expected)
+    assert fb["OUT3"] == 4
 
 
 def test_xfuz_2_2_3_product_for_and_and_implication() -> None:

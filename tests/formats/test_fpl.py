@@ -53,17 +53,21 @@ def rule(label: str, t: str, p: str, v: str) -> Rule:
 EXPECTED_FPLTEST = FunctionBlock(
     "FPLTEST",
     variables=(
-        Variable("Temp", VarKind.INPUT, "REAL", range=Range(0.0, 30.0)),
-        Variable("Pressure", VarKind.INPUT, "REAL", range=Range(50.0, 100.0)),
-        Variable("Valve", VarKind.OUTPUT, "REAL", range=Range(-101.0, 101.0)),
+        Variable("Temp", VarKind.INPUT, "REAL"),
+        Variable("Pressure", VarKind.INPUT, "REAL"),
+        Variable("Valve", VarKind.OUTPUT, "REAL"),
     ),
     fuzzify=(
+        # MIN/MAX: the range of the FUZZIFY block; no clamp needed, all points are inside.
         FuzzifyBlock(
-            "Temp", (Term("cold", pts((0, 1), (3, 1), (27, 0))), Term("hot", pts((3, 0), (27, 1), (30, 1))))
+            "Temp",
+            (Term("cold", pts((0, 1), (3, 1), (27, 0))), Term("hot", pts((3, 0), (27, 1), (30, 1)))),
+            range=Range(0, 30),
         ),
         FuzzifyBlock(
             "Pressure",
             (Term("low", pts((50, 1), (55, 1), (95, 0))), Term("high", pts((55, 0), (95, 1), (100, 1)))),
+            range=Range(50, 100),
         ),
     ),
     defuzzify=(
@@ -134,6 +138,9 @@ def test_siemens_1_3_vertical_edges_inside_the_range_get_their_foot() -> None:
     assert fz.term("mid") == Term("mid", pts((10, 0), (10, 1), (20, 1), (20, 0)))
     assert fz.term("edge") == Term("edge", pts((0, 1), (5, 1), (8, 0)))
     assert fz.term("right") == Term("right", pts((22, 0), (25, 1), (25, 0)))
+    assert not fz.clamp
+    wide = read_fpl("PROJECT p VAR x TYPE float MIN 0 MAX 30 MEMBER m POINTS -5,0 10,1 40,0 END END END")
+    assert wide.main.fuzzify[0].clamp  # points outside [MIN, MAX]: the clamp of 1.5 matters
 
 
 def test_siemens_1_3_tolerated_elements_warn_as_the_manual_lists() -> None:
@@ -247,7 +254,7 @@ def test_siemens_1_3_fpltest_reads_like_the_fcl_transcription() -> None:
     fpl = read_fpl(fpltest_from_manual()).main
     no_ranges = replace(
         fpl,
-        variables=tuple(replace(v, range=None) for v in fpl.variables),
+        fuzzify=tuple(replace(f, range=None) for f in fpl.fuzzify),
         defuzzify=tuple(replace(d, range=None) for d in fpl.defuzzify),
         rule_blocks=tuple(replace(rb, act=None) for rb in fpl.rule_blocks),
     )

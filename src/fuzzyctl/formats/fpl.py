@@ -18,6 +18,10 @@ with an FCL program outside it.  An output term whose points all have degree 1 (
 
 The rule base reads as IEC AND MIN, ACT MIN, ACCU MAX, METHOD COGS (COG when an output has
 area terms) and ``DEFAULT := NC``: Fuzzy Control keeps the last output when no rule fires.
+MIN/MAX of an input become the range of its FUZZIFY block, of an output the range of its
+DEFUZZIFY block.  The block limits its inputs to [MIN, MAX] (1.5); that changes nothing when
+every point of the input's terms lies in [MIN, MAX] (points lists are constant beyond their
+ends), else the FUZZIFY block gets ``clamp``.
 """
 
 from __future__ import annotations
@@ -25,10 +29,11 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import NoReturn
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
+from fuzzyctl.formats import Format, Loaded, Loss
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -57,6 +62,7 @@ EXTENSIONS = (".fpl",)
 
 __all__ = [
     "EXTENSIONS",
+    "FORMAT",
     "NAME",
     "FplResult",
     "leaves",
@@ -617,7 +623,11 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
         rng = Range(var.low, var.high) if var.low is not None and var.high is not None else None
         low = var.low if var.low is not None else -math.inf
         high = var.high if var.high is not None else math.inf
-        variables.append(Variable(var.name, kind, "REAL", range=rng, span=var.span))
+        # MIN/MAX go where FCL puts a range: on the DEFUZZIFY block of an output, on the
+        # FUZZIFY block of an input - with clamp, as the block limits its inputs (1.5) -
+        # and on the declaration of a monitoring input, which has no terms.
+        monitoring = kind is VarKind.INPUT and not var.members
+        variables.append(Variable(var.name, kind, "REAL", range=rng if monitoring else None, span=var.span))
         if kind is VarKind.OUTPUT:
             terms = tuple(Term(m.name, _output_mf(m.points, low, high), span=m.span) for m in var.members)
             all_singletons &= all(isinstance(t.mf, SingletonMF) for t in terms)
@@ -628,11 +638,12 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
             terms = tuple(
                 Term(m.name, PointsMF(_input_points(m.points, low, high)), span=m.span) for m in var.members
             )
-            fuzzify.append(FuzzifyBlock(var.name, terms, span=var.span))
+            # Clamping only changes something when a term has points outside [MIN, MAX]:
+            # IEC points lists are constant beyond their ends.
+            outside = any(not low <= x <= high for m in var.members for x, _ in m.points)
+            fuzzify.append(FuzzifyBlock(var.name, terms, range=rng, span=var.span, clamp=outside))
     method = "COGS" if all_singletons else "COG"
-    defuzzify = [
-        DefuzzifyBlock(d.variable, d.terms, d.range, method, d.default, span=d.span) for d in defuzzify
-    ]
+    defuzzify = [replace(d, method=method) for d in defuzzify]
 
     for rule in base.rules if base else []:
         for cond in leaves(rule.condition):
@@ -724,3 +735,36 @@ def read_fpl(text: str, *, path: str | None = None) -> Document:
     if result.document is None:
         raise DiagnosticError(result.diagnostics, text)
     return result.document
+
+
+# --------------------------------------------------------------------------- registry
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    result = parse_fpl(text, path=path)
+    if result.document is None:
+        raise DiagnosticError(result.diagnostics, text)
+    return Loaded(result.document, result.diagnostics)
+
+
+def _write(document: Document) -> str:
+    from fuzzyctl.formats.fpl_write import write_fpl
+
+    return write_fpl(document)
+
+
+def _lower(document: Document) -> tuple[Document, list[Loss]]:
+    from fuzzyctl.formats.fpl_write import lower_fpl
+
+    lowered, losses = lower_fpl(document)
+    return lowered, [Loss(element, reason) for element, reason in losses]
+
+
+FORMAT = Format(
+    NAME,
+    EXTENSIONS,
+    "FPL of Siemens S7 Fuzzy Control (Togai InfraLogic subset, Siemens manual 1.3)",
+    read=_read,
+    write=_write,
+    lower=_lower,
+)

@@ -89,9 +89,19 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
             err(f"ACCU : {rb.accu} cannot be written in FPL (Fuzzy Control uses MAX)", rb.span, "fpl-expr-op")
         if rb.act not in (None, "MIN", "PROD") or (rb.act == "PROD" and not _all_singletons(block)):
             err(f"ACT : {rb.act} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op")
+        if not rb.enabled or rb.rule_activation is not None:
+            err(
+                f"rule block {rb.name}: FPL has no disabled rule blocks or rule activation methods",
+                rb.span,
+                "fpl-expr-ruleblocks",
+            )
         for rule in rb.rules:
             _check_condition(rule.condition, rule, diags)
+            if rule.weight is not None and rule.weight != 1.0:
+                err(f"rule {rule.label}: rule weights cannot be written in FPL", rule.span, "fpl-expr-weight")
             for c in rule.conclusions:
+                if c.hedges:
+                    err(f"rule {rule.label}: hedges cannot be written in FPL", c.span, "fpl-expr-rule")
                 if c.term is None:
                     err(f"rule {rule.label}: a conclusion needs a term", c.span, "fpl-expr-rule")
                 if c.weight is not None and c.weight != 1.0:
@@ -293,18 +303,20 @@ def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
         for rule in rb.rules:
             used = [(c.variable, c.term) for c in leaves(rule.condition)]
             used += [(c.variable, c.term or "") for c in rule.conclusions]
-            if _fpl_condition(rule.condition) and all(u in keep_terms for u in used):
-                rules.append(
-                    replace(rule, conclusions=tuple(replace(c, weight=None) for c in rule.conclusions))
-                )
+            plain = _fpl_condition(rule.condition) and not any(c.hedges for c in rule.conclusions)
+            if plain and all(u in keep_terms for u in used):
+                conclusions = tuple(replace(c, weight=None) for c in rule.conclusions)
+                rules.append(replace(rule, conclusions=conclusions, weight=None))
         rule_blocks.append(
             replace(
                 rb,
-                rules=tuple(rules),
+                rules=tuple(rules) if rb.enabled else (),
                 and_op="MIN",
                 or_op=None,
                 accu="MAX",
                 act=None if rb.act in (None, "MIN") else "MIN",
+                enabled=True,
+                rule_activation=None,
             )
         )
     lowered = replace(

@@ -43,6 +43,7 @@ from dataclasses import replace
 from typing import Any
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
+from fuzzyctl.formats import Format, Loaded, Loss
 from fuzzyctl.formats.xfuz_tables import (
     ESV_SIZE,
     FA_SIZE,
@@ -88,6 +89,7 @@ FORMAT_TAG = "xfuz-tables"
 
 __all__ = [
     "EXTENSIONS",
+    "FORMAT",
     "NAME",
     "model_from_constants",
     "read_tables",
@@ -520,12 +522,47 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
     return block, diags
 
 
-def read_xfuz(text: str, *, path: str | None = None) -> Document:
-    """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
+def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
     constants = read_tables(text, path=path)
     stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
     block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
     diags = [replace(d, file=path) for d in diags]
     if any(d.is_error for d in diags):
         raise DiagnosticError(diags, text)
-    return Document((block,), path=path)
+    return Document((block,), path=path), diags
+
+
+def read_xfuz(text: str, *, path: str | None = None) -> Document:
+    """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
+    return _decode(text, path)[0]
+
+
+# --------------------------------------------------------------------------- registry
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    document, diags = _decode(text, path)
+    return Loaded(document, tuple(diags))
+
+
+def _write(document: Document) -> str:
+    from fuzzyctl.formats.xfuz_write import write_xfuz
+
+    return write_xfuz(document)
+
+
+def _lower(document: Document) -> tuple[Document, list[Loss]]:
+    from fuzzyctl.formats.xfuz_write import lower_xfuz
+
+    lowered, losses = lower_xfuz(document)
+    return lowered, [Loss(element, reason) for element, reason in losses]
+
+
+FORMAT = Format(
+    NAME,
+    EXTENSIONS,
+    "Schneider XFUZ knowledge-base tables ESV/FA/RG and constants (JSON or CSV layout)",
+    read=_read,
+    write=_write,
+    lower=_lower,
+)

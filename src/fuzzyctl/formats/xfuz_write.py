@@ -226,6 +226,12 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
 
     slots = _assign_slots(fb, opts, diags)
 
+    if fb.rule_blocks and (not fb.rule_blocks[0].enabled or fb.rule_blocks[0].rule_activation is not None):
+        err(
+            "XFUZ has no disabled rule blocks or rule activation methods",
+            fb.rule_blocks[0].span,
+            "xfuz-expr-ruleblocks",
+        )
     if len(fb.rule_blocks) > 1:
         err(
             "XFUZ has a single rule base; use one XFUZ instance per rule block",
@@ -359,7 +365,15 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         if rule.condition is None:
             err(f"rule {rule.label}: XFUZ rules need at least one predicate", rule.span, "xfuz-expr-rule")
         concl: list[int] = []
+        if rule.weight is not None and rule.weight != 1.0:
+            err(f"rule {rule.label}: XFUZ rules have no weight", rule.span, "xfuz-expr-weight")
         for c in rule.conclusions:
+            if c.hedges:
+                err(
+                    f"rule {rule.label}: XFUZ conclusions have no hedges",
+                    c.span or rule.span,
+                    "xfuz-expr-rule",
+                )
             if c.weight is not None and c.weight != 1.0:
                 err(
                     f"rule {rule.label}: XFUZ rules have no WITH weight",
@@ -563,11 +577,8 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     for dz in fb.defuzzify:
         output = dz.variable not in local_names
         terms = fit(dz.variable, dz.terms, output)
-        rng = (
-            dz.range
-            or (fb.variable(dz.variable).range if fb.variable(dz.variable) else None)
-            or _extent(terms)
-        )  # type: ignore[union-attr]
+        declared = fb.variable(dz.variable)
+        rng = dz.range or (declared.range if declared is not None else None) or _extent(terms)
         default = dz.default
         if output and default is not None and (default.no_change or default.value is None):
             losses.append((f"output {dz.variable!r}", "DEFAULT := NC: XFUZ outputs a default value (0)"))
@@ -598,7 +609,12 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
         conclusions = [
             replace(c, weight=None) for c in rule.conclusions if (c.variable, c.term or "") in keep
         ]
-        if any(c.weight is not None and c.weight != 1.0 for c in rule.conclusions):
+        if any(c.hedges for c in rule.conclusions):
+            losses.append((label, "XFUZ conclusions have no hedges"))
+            continue
+        if (rule.weight is not None and rule.weight != 1.0) or any(
+            c.weight is not None and c.weight != 1.0 for c in rule.conclusions
+        ):
             losses.append((label, "XFUZ rules have no weight"))
         if len(conclusions) < len(rule.conclusions) or any(
             (leaf.variable, leaf.term) not in keep for conj in conjuncts for leaf, _ in conj
@@ -618,7 +634,21 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     if len(rules) > 64:
         losses.append((f"rules {rules[64].label}..", "XFUZ holds 64 rules"))
         rules = rules[:64]
-    lowered_rb = replace(rb, rules=tuple(rules), and_op=and_op, act=act, or_op=None, accu="MAX")
+    if not rb.enabled or rb.rule_activation is not None:
+        losses.append(
+            (f"rule block {rb.name}", "XFUZ has no disabled rule blocks or rule activation methods")
+        )
+        rules = rules if rb.enabled else []
+    lowered_rb = replace(
+        rb,
+        rules=tuple(rules),
+        and_op=and_op,
+        act=act,
+        or_op=None,
+        accu="MAX",
+        enabled=True,
+        rule_activation=None,
+    )
     lowered = replace(fb, fuzzify=fuzzify, defuzzify=tuple(defuzzify), rule_blocks=(lowered_rb,))
     _, diags = constants_from_model(lowered)
     losses += [(f"line {d.span.line}" if d.span else "program", d.message) for d in diags if d.is_error]

@@ -215,6 +215,8 @@ def check_siemens(model: FunctionBlock | Document) -> list[Diagnostic]:
             err(f"AND : {rb.and_op}; the block uses MIN", rb.span, "operator")
         if rb.accu not in (None, "MAX"):
             err(f"ACCU : {rb.accu}; the block accumulates with MAX", rb.span, "operator")
+        if not rb.enabled or rb.rule_activation is not None:
+            err(f"rule block {rb.name}: the FUZZY block always fires every rule", rb.span, "rule-activation")
         if rb.act not in (None, "MIN", "PROD"):
             err(f"ACT : {rb.act}; the block uses MIN", rb.span, "operator")
         for rule in rb.rules:
@@ -259,6 +261,14 @@ def check_siemens(model: FunctionBlock | Document) -> list[Diagnostic]:
                         k.span or where,
                         "weight",
                     )
+                if k.hedges:
+                    err(f"rule {rule.label}: no hedges in the FUZZY block", k.span or where, "rule-operator")
+            if rule.weight is not None and rule.weight != 1.0:
+                err(
+                    f"rule {rule.label}: weight {rule.weight}: the FUZZY block has no rule weights",
+                    where,
+                    "weight",
+                )
     return diags
 
 
