@@ -127,3 +127,41 @@ def test_blocks_xfuz_rejects_unknown_columns(tmp_path: Path, capsys: pytest.Capt
     path = samples(tmp_path, "INP1\n40000\n")
     code, _, err = run(["blocks", "xfuz", str(EXAMPLES / "xfuz_3_3.xfuz"), str(path)], capsys)
     assert code == 1 and "16-bit" in err and "INP1" in err
+
+
+def test_blocks_siemens_runs_one_row_per_cycle(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    path = samples(tmp_path, "Temp,Pressure,START_STOP\n9,65,\n20,60,0\n30,100,\n,,16#FFFF\n-5,200,\n")
+    code, out, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(path)], capsys)
+    assert code == 0, err
+    got = rows(out)
+    # 40 (hand computation in tests/blocks/test_siemens_fb.py); START_STOP 0: INFO 01 and the
+    # value kept; back on at (30, 100): drainage -100; (-5, 200) is clamped to (0, 100): cold
+    # 1, high 1 -> closed 0.
+    assert [(r["Valve"], r["INFO"], r["ENO"]) for r in got] == [
+        ("40.0", "00", "1"),
+        ("40.0", "01", "0"),
+        ("40.0", "01", "0"),
+        ("-100.0", "00", "1"),
+        ("0.0", "00", "1"),
+    ]
+    code, out, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(path), "--json"], capsys)
+    assert code == 0 and json.loads(out)[0] == {"cycle": 0, "Valve": 40.0, "INFO": "00", "ENO": 1}
+
+
+def test_blocks_siemens_and_check_report_what_does_not_fit(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    path = samples(tmp_path, "temp,pressure\n9,65\n")
+    code, _, err = run(["blocks", "siemens", str(EXAMPLES / "figure7.fcl"), str(path)], capsys)
+    assert code == 1 and "figure7.fcl:36" in err and "no rule weights" in err
+    code, out, _ = run(
+        ["blocks", "siemens", str(EXAMPLES / "figure7.fcl"), str(path), "--no-profile"], capsys
+    )
+    assert code == 0 and rows(out)[0]["valve"] == "40.0"
+    code, _, err = run(["blocks", "check", str(EXAMPLES / "figure7.fcl")], capsys)
+    assert code == 1 and "siemens-weight" not in err and "WITH 0.8" in err
+    code, out, _ = run(["blocks", "check", str(EXAMPLES / "fpltest.fpl"), "--json"], capsys)
+    assert code == 0 and [d["code"] for d in json.loads(out)] == ["siemens-long-name"]
+    bad = samples(tmp_path, "Temp,Flow\n1,2\n")
+    code, _, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(bad)], capsys)
+    assert code == 1 and "unknown column 'Flow'" in err

@@ -8,13 +8,14 @@ from __future__ import annotations
 import csv
 import io
 import json
+from dataclasses import replace
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
 from fuzzyctl.cli.app import app, err_console
-from fuzzyctl.diagnostics import DiagnosticError, InputError
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, InputError
 
 blocks_app = typer.Typer(
     name="blocks",
@@ -149,9 +150,12 @@ def siemens(
     is 00)."""
     from fuzzyctl.blocks.siemens import FuzzyFB
 
-    fb = FuzzyFB(_load(application), check_profile=not no_profile)
-    for d in fb.diagnostics:
-        err_console.print(d.render(), markup=False)
+    try:
+        fb = FuzzyFB(_load(application), check_profile=not no_profile)
+    except DiagnosticError as exc:
+        raise _located(exc.diagnostics, application) from None
+    for d in _located(fb.diagnostics, application).diagnostics:
+        err_console.print(d.render(_source(application)), markup=False)
     header, rows = _read_samples(samples)
     allowed = set(fb.input_names) | {f"INPUT{i}" for i in range(1, 9)} | {"START_STOP"}
     unknown = [h for h in header if h not in allowed]
@@ -306,23 +310,28 @@ def check(
     Exit status 1 when it does not fit (errors), 0 otherwise (warnings are printed)."""
     from fuzzyctl.blocks.siemens import check_siemens
 
-    diags = check_siemens(_load(application))
-    diags = [d if d.file else _with_file(d, str(application)) for d in diags]
+    diags = _located(check_siemens(_load(application)), application).diagnostics
     if as_json:
         typer.echo(json.dumps([d.to_dict() for d in diags], indent=1))
     else:
         for d in diags:
-            err_console.print(d.render(), markup=False)
+            err_console.print(d.render(_source(application)), markup=False)
         if not diags:
             typer.echo(f"{application}: fits the Siemens FUZZY block")
     if any(d.is_error for d in diags):
         raise typer.Exit(1)
 
 
-def _with_file(d: Any, file: str) -> Any:
-    from dataclasses import replace
+def _source(path: Path) -> str | None:
+    try:
+        return path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError):
+        return None
 
-    return replace(d, file=file)
+
+def _located(diags: list[Diagnostic], path: Path) -> DiagnosticError:
+    """The diagnostics with the file they are about (the checks work on models)."""
+    return DiagnosticError([d if d.file else replace(d, file=str(path)) for d in diags], _source(path))
 
 
 __all__ = ["blocks_app", "check", "siemens", "xfuz"]

@@ -118,7 +118,7 @@ class FuzzyFB:
         """Load a controller as the configuration tool does (stop, transfer, START_STOP =
         W#16#FFFF).  Returns the profile's warnings; raises DiagnosticError when the
         controller does not fit the block."""
-        from fuzzyctl.engine import compile as compile_controller
+        from fuzzyctl.engine import compile_block as compile_controller
 
         fb = application.main if isinstance(application, Document) else application
         self.START_STOP = 0
