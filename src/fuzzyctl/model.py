@@ -362,6 +362,9 @@ class Conclusion:
     term: str | None = None
     weight: Param | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
+    hedges: tuple[str, ...] = ()
+    """Hedges written before the term (fuzzylite ``then y is very high``); they modify the
+    rule's degree for this subconclusion, innermost first."""
 
 
 @dataclass(frozen=True)
