@@ -700,6 +700,7 @@ def _output(ctx: _Ctx, var: m.Variable, oi: int, rules: list[RulePlan], output_n
     exact = kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
     grid = None
     if exact and all(t.constant for t in tps):
-        grid = build_grid([t.pwl for t in tps if t.pwl is not None], low, high)
+        used = {c.term for c in contributions if c.term is not None}
+        grid = build_grid([t.pwl for t in tps if t.pwl is not None], low, high, used)
     return OutputPlan(var.name, "mamdani", meth, acc, tps, tuple(contributions), default, no_change, low, high,
                       exact, grid)

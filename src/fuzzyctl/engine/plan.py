@@ -237,6 +237,17 @@ class GridPlan:
     right: tuple[tuple[float, ...], ...]
     point: tuple[tuple[float, ...], ...]
     active: tuple[tuple[int, ...], ...]
+    #: intervals where at least two concluded terms are nonzero (accumulation must be done
+    #: pointwise there); every other interval belongs to one term alone:
+    shared: tuple[int, ...] = ()
+    solo: tuple[tuple[int, ...], ...] = ()  # per term: the intervals it has to itself
+    #: per term, the area and first moment of min(h, term) over its solo intervals as
+    #: polynomials in h: bands ``(h_low, h_high, (a0, a1, a2), (m0, m1, m2, m3))``
+    #: (area = a0 + a1 h + a2 h^2, moment = m0 + ... + m3 h^3 for h_low <= h <= h_high)
+    min_bands: tuple[tuple[tuple[float, float, tuple[float, ...], tuple[float, ...]], ...], ...] = ()
+    #: per term, (area, moment) of the whole term over its solo intervals (PROD activation
+    #: scales both by h)
+    full: tuple[tuple[float, float], ...] = ()
 
 
 @dataclass(frozen=True)

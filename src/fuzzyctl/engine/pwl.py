@@ -22,6 +22,9 @@ import numpy as np
 
 from fuzzyctl.engine.plan import GridPlan
 
+#: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
+MAX_TOL = 1e-12
+
 Piece = tuple[float, float, float, float, tuple[tuple[float, float], ...] | None]
 #: One activated set on one grid interval: (L, R, a, w, is_min) - the term goes linearly from
 #: L to R; the set is w*min(a, term) (is_min) or w*a*term.
@@ -249,20 +252,22 @@ def maxima(pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> tu
     lm, rm = math.inf, -math.inf
     plateau_len = plateau_mom = 0.0
     isolated: set[float] = set()
+    # crossing points are computed, not given: accept values within MAX_TOL of the supremum
+    thr = sup * (1.0 - MAX_TOL)
     for x0, x1, v0, v1, _f in pieces:
-        if v0 == sup:
+        if v0 >= thr:
             lm = min(lm, x0)
             rm = max(rm, x0)
             isolated.add(x0)
-        if v1 == sup:
+        if v1 >= thr:
             lm = min(lm, x1)
             rm = max(rm, x1)
             isolated.add(x1)
-        if v0 == sup and v1 == sup and x1 > x0:
+        if v0 >= thr and v1 >= thr and x1 > x0:
             plateau_len += x1 - x0
             plateau_mom += (x1 - x0) * 0.5 * (x0 + x1)
     for x, v in points:
-        if v == sup:
+        if v >= thr:
             lm = min(lm, x)
             rm = max(rm, x)
             isolated.add(x)
