@@ -384,7 +384,9 @@ class BatchEvaluator:
         if op.method == "COA":
             return _coa(x0, x1, v0, v1)
         pts = _point_values(grid, groups, accu, n)
-        return _maxima(op.method, x0, x1, v0, v1, np.asarray(grid.xs), pts)
+        value, _fired = _maxima(op.method, x0, x1, v0, v1, np.asarray(grid.xs), pts)
+        fired = (0.5 * (x1 - x0) * (v0 + v1)).sum(axis=1) > 0.0
+        return np.where(fired, value, np.nan), fired
 
 
 def _apply_default(op: OutputPlan, value: Arr, fired: Arr, state: list[float | None], oi: int) -> Arr:
@@ -454,8 +456,10 @@ def _interval(x0: float, x1: float, lines: list[tuple[float, float, Arr, W, bool
     kinks: list[Arr | None] = []
     for L, R, a, _w, mn in lines:
         if mn and L != R:
-            tk = (a - L) / (R - L)
-            inside = (tk > 0.0) & (tk < 1.0)
+            # a kink where the term strictly crosses the degree (as in pwl.interval_pieces;
+            # rounding may put it on an end of the interval)
+            tk = np.clip((a - L) / (R - L), 0.0, 1.0)
+            inside = (L - a) * (R - a) < 0.0
             kinks.append(np.where(inside, tk, np.nan))  # NaN never equals a candidate
             cands.append(np.where(inside, tk, 0.0))
         else:
@@ -500,10 +504,10 @@ def _interval(x0: float, x1: float, lines: list[tuple[float, float, Arr, W, bool
         if accu == "BSUM":
             return np.asarray(np.minimum(1.0, s))
         if accu == "PROBOR":
-            q = np.ones_like(s)
+            acc = np.zeros_like(s)
             for v in vs:
-                q = q * (1.0 - v)
-            return np.asarray(1.0 - q)
+                acc = acc + v - acc * v
+            return np.asarray(acc)
         return np.asarray(s)
 
     vs = values(T)
@@ -598,6 +602,9 @@ def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> tuple[Arr, Arr]:
         with np.errstate(all="ignore"):
             if reverse:  # measure from the right end: mirror the piece
                 p0, p1 = p1, p0
+            scale = np.maximum(np.abs(p0), np.abs(p1))  # scale-free formula; avoid underflow
+            scale = np.where(scale > 0.0, scale, 1.0)
+            p0, p1, r = p0 / scale, p1 / scale, r / scale
             k = np.where(d > 0.0, (p1 - p0) / d, 0.0)
             den = p0 + np.sqrt(np.maximum(p0 * p0 + 2.0 * k * r, 0.0))
             s = np.where(den > 0.0, 2.0 * r / den, 0.0)

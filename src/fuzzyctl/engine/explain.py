@@ -111,10 +111,7 @@ def polyline(pieces: list[pwl.Piece], samples_per_poly: int = 16) -> list[tuple[
         if factors is not None:
             for i in range(1, samples_per_poly):
                 s = i / samples_per_poly
-                q = 1.0
-                for c0, c1 in factors:
-                    q *= 1.0 - (c0 + (c1 - c0) * s)
-                add(x0 + s * (x1 - x0), 1.0 - q)
+                add(x0 + s * (x1 - x0), pwl._poly_value(factors, s))
         add(x1, v1)
     return pts
 

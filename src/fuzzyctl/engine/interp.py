@@ -378,6 +378,8 @@ class Interpreter:
             rec.fired = True
             rec.value = float(np.sum(KM)) / area if op.method == "COG" else quadrature.bisector(f, A, B, K)
             return rec
+        if not area > 0.0:
+            return rec
         sup, lm, rm, mom = quadrature.maxima(f, A, B)
         if sup > 0.0:
             rec.fired = True

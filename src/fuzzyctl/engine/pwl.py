@@ -110,11 +110,8 @@ def _combine(xa: float, xb: float, p0: list[float], p1: list[float], accu: str, 
         else:
             out.append((xa, xb, min(1.0, s0), min(1.0, s1), None))
     elif accu == "PROBOR":
-        q0 = q1 = 1.0
-        for k in range(n):
-            q0 *= 1.0 - p0[k]
-            q1 *= 1.0 - p1[k]
-        out.append((xa, xb, 1.0 - q0, 1.0 - q1, tuple(zip(p0, p1, strict=True))))
+        factors = tuple(zip(p0, p1, strict=True))
+        out.append((xa, xb, _poly_value(factors, 0.0), _poly_value(factors, 1.0), factors))
     else:  # pragma: no cover - lowering sends other accumulations to quadrature
         raise ValueError(f"accumulation {accu} is not piecewise linear")
 
@@ -154,10 +151,12 @@ def point_values(grid: GridPlan, contribs: Sequence[tuple[int, float, float, boo
 
 
 def _poly_value(factors: tuple[tuple[float, float], ...], s: float) -> float:
-    q = 1.0
+    # folded as a + b - a*b (not 1 - prod(1 - c)) so that tiny degrees are not lost
+    acc = 0.0
     for c0, c1 in factors:
-        q *= 1.0 - (c0 + (c1 - c0) * s)
-    return 1.0 - q
+        c = c0 + (c1 - c0) * s
+        acc = acc + c - acc * c
+    return acc
 
 
 def piece_area_moment(p: Piece) -> tuple[float, float]:
@@ -200,6 +199,9 @@ def _solve_in_piece(p: Piece, r: float) -> float:
     x0, x1, v0, v1, factors = p
     dx = x1 - x0
     if factors is None:
+        scale = max(abs(v0), abs(v1))  # the formula is scale-free; scaling avoids underflow
+        if scale > 0.0:
+            v0, v1, r = v0 / scale, v1 / scale, r / scale
         k = (v1 - v0) / dx if dx > 0.0 else 0.0
         disc = v0 * v0 + 2.0 * k * r
         den = v0 + math.sqrt(max(disc, 0.0))
@@ -277,14 +279,14 @@ def maxima(pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> tu
 
 def defuzzify_pieces(method: str, pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> float | None:
     """The defuzzified value, or None when the set is empty (no rule fired)."""
-    if method in ("COG", "COA"):
-        area, moment = area_moment(pieces)
-        if not area > 0.0:
-            return None
-        if method == "COG":
-            return moment / area
+    # "fired" means the set has area: a set that is 0 almost everywhere (a lone vertical edge
+    # at the end of the range) has no centre and no meaningful maximum either
+    area, moment = area_moment(pieces)
+    if not area > 0.0:
+        return None
+    if method == "COG":
+        return moment / area
+    if method == "COA":
         return bisector([p for p in pieces if p[1] > p[0]], area)
     sup, lm, rm, mom = maxima(pieces, points)
-    if not sup > 0.0:
-        return None
     return {"LM": lm, "RM": rm, "MOM": mom}[method]

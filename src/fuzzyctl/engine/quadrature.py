@@ -117,54 +117,72 @@ def bisector(f: Integrand, A: FloatArray, B: FloatArray, K: FloatArray) -> float
 
 
 def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, float, float]:
-    """``(height, LM, RM, MoM)`` of a smooth accumulated set, from the nodes of the accepted
-    intervals refined by golden-section (peak) and bisection (edges of the maximising set)."""
+    """``(height, LM, RM, MoM)`` of a smooth accumulated set.
+
+    Plateaus (clipping makes the set *exactly* constant) are runs of nodes with exactly the
+    largest value, their edges found by bisection; smooth peaks are local maxima of the nodes
+    refined by golden-section search.  The maximising set is the plateaus when the largest
+    value is reached on one (MoM: their centroid), else the peaks within 1e-12 of the
+    height (MoM: their mean)."""
     half = 0.5 * (B - A)
     x = np.concatenate([(0.5 * (A + B))[:, None] + half[:, None] * NODES[None, :], A[:, None], B[:, None]], axis=1)
     xs = np.unique(x.ravel())
     ys = f(xs)
-    i = int(np.argmax(ys))
-    sup = float(ys[i])
-    if not sup > 0.0:
-        return sup, math.nan, math.nan, math.nan
-    # refine a smooth peak between its neighbours
-    lo, hi = float(xs[max(i - 1, 0)]), float(xs[min(i + 1, len(xs) - 1)])
+    n = len(xs)
+    top = float(np.max(ys))
+    if not top > 0.0:
+        return top, math.nan, math.nan, math.nan
+    # smooth peaks between nodes
+    peaks: list[tuple[float, float]] = []
+    for i in np.flatnonzero(ys >= top * (1.0 - 1e-6)):
+        i = int(i)
+        if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
+            continue
+        peaks.append(_golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i])))
+    sup = max([top, *(v for _x, v in peaks)])
+    # plateaus: runs of at least two nodes exactly at the top value
+    runs: list[tuple[float, float]] = []
+    if top >= sup * (1.0 - 1e-12):
+        j = 0
+        while j < n:
+            if ys[j] != top:
+                j += 1
+                continue
+            k = j
+            while k + 1 < n and ys[k + 1] == top:
+                k += 1
+            if k > j:
+                left = _edge(f, float(xs[j - 1]), float(xs[j]), top) if j > 0 else float(xs[j])
+                right = _edge(f, float(xs[k + 1]), float(xs[k]), top) if k + 1 < n else float(xs[k])
+                runs.append((left, right))
+            j = k + 1
+    points = sorted({px for px, pv in peaks if pv >= sup * (1.0 - 1e-12)})
+    if runs:
+        lm = min(runs[0][0], *points) if points else runs[0][0]
+        rm = max(runs[-1][1], *points) if points else runs[-1][1]
+        length = sum(r - l_ for l_, r in runs)
+        mom = sum((r - l_) * 0.5 * (l_ + r) for l_, r in runs) / length if length > 0 else 0.5 * (lm + rm)
+        return sup, lm, rm, mom
+    if not points:  # pragma: no cover - the top node itself is always a candidate peak
+        i = int(np.argmax(ys))
+        points = [float(xs[i])]
+    return sup, points[0], points[-1], math.fsum(points) / len(points)
+
+
+def _golden(f: Integrand, lo: float, hi: float, x0: float, y0: float) -> tuple[float, float]:
     g = (math.sqrt(5.0) - 1.0) / 2.0
     for _ in range(80):
+        if hi - lo <= 1e-15 * max(1.0, abs(lo), abs(hi)):
+            break
         c, d = hi - g * (hi - lo), lo + g * (hi - lo)
         fc, fd = f(np.array([c, d]))
         if fc >= fd:
             hi = d
         else:
             lo = c
-    peak = 0.5 * (lo + hi)
-    sup = max(sup, float(f(np.array([peak]))[0]))
-    thr = sup - 1e-12 * max(sup, 1.0)
-    xs = np.unique(np.concatenate([xs, [peak]]))
-    ys = f(xs)
-    above = ys >= thr
-    # runs of consecutive nodes above the threshold; refine each run's edges by bisection
-    runs: list[tuple[float, float]] = []
-    j = 0
-    n = len(xs)
-    while j < n:
-        if not above[j]:
-            j += 1
-            continue
-        k = j
-        while k + 1 < n and above[k + 1]:
-            k += 1
-        left = _edge(f, float(xs[j - 1]), float(xs[j]), thr) if j > 0 else float(xs[j])
-        right = _edge(f, float(xs[k + 1]), float(xs[k]), thr) if k + 1 < n else float(xs[k])
-        runs.append((left, right))
-        j = k + 1
-    lm, rm = runs[0][0], runs[-1][1]
-    length = sum(r - l_ for l_, r in runs)
-    if length > 1e-9 * (float(B[-1]) - float(A[0])):
-        mom = sum((r - l_) * 0.5 * (l_ + r) for l_, r in runs) / length
-    else:
-        mom = sum(0.5 * (l_ + r) for l_, r in runs) / len(runs)
-    return sup, lm, rm, mom
+    xm = 0.5 * (lo + hi)
+    ym = float(f(np.array([xm]))[0])
+    return (xm, ym) if ym > y0 else (x0, y0)
 
 
 def _edge(f: Integrand, outside: float, inside: float, thr: float) -> float:
