@@ -382,8 +382,9 @@ def _gen_ts(g: _Gen, plan: Plan, op: OutputPlan, contribs: list[tuple[int | None
             wt = h if w == "1.0" else f"{w} * {h}"
             x = g.tmp()
             g.emit(f"{x} = {wt}")
+            zt = z(t)
             g.emit(f"if {x} > 0.0:")
-            g.emit(f"num += {x} * {z(t)}; den += {x}", 2)
+            g.emit(f"num += {x} * {zt}; den += {x}", 2)
     else:
         by_term: dict[int, str] = {}
         for t, h, w, _act in contribs:
@@ -397,8 +398,9 @@ def _gen_ts(g: _Gen, plan: Plan, op: OutputPlan, contribs: list[tuple[int | None
                 g.emit(f"{x} = {wt}")
                 g.emit(f"{by_term[t]} = {_accu_src(op.accu, by_term[t], x)}")
         for t, m in by_term.items():
+            zt = z(t)
             g.emit(f"if {m} > 0.0:")
-            g.emit(f"num += {m} * {z(t)}; den += {m}", 2)
+            g.emit(f"num += {m} * {zt}; den += {m}", 2)
     g.emit(f"{fired} = den > 0.0")
     if op.method == "WTAVER":
         g.emit(f"{val} = num / den if {fired} else _NAN")
