@@ -3,6 +3,7 @@
 # Each entry: "<command that proves it is installed>:<apt package>".
 set -euo pipefail
 NEEDED=(
+  fuzzylite:fuzzylite  # fuzzylite 6.0 command: outside oracle for our FIS/FLL exports
 )
 missing=()
 for entry in "${NEEDED[@]}"; do

@@ -20,7 +20,31 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     existing path is parsed as FCL unless ``format`` says otherwise.  Raises
     :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
     input is not valid."""
-    raise FuzzyctlError("no reader is available yet")
+    from fuzzyctl import formats
+    from fuzzyctl.diagnostics import DiagnosticError, error
+    from fuzzyctl.fcl import load_file, load_text
+
+    fmt = (format or "").lower() or None
+    if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
+        path = Path(path_or_text)
+        fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
+        if fmt == "fcl":
+            return load_file(path).raise_for_errors()
+        return formats.read_path(path, fmt).document
+    if fmt not in (None, "fcl"):
+        return formats.read_text(str(path_or_text), fmt).document
+    text = str(path_or_text)
+    if not text.strip():
+        raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
+    return load_text(text).raise_for_errors()
+
+
+def _looks_like_path(value: str) -> bool:
+    """Text holding a newline, ';' or ':=' is source; anything else is taken as a path (a
+    missing file is then reported as such, not parsed as FCL)."""
+    if "\n" in value or ";" in value or ":=" in value:
+        return False
+    return "FUNCTION_BLOCK" not in value.upper() or Path(value).exists()
 
 
 def compile(

@@ -120,7 +120,9 @@ SHAPES: dict[str, ShapeSpec] = {
         ShapeSpec(
             "gaussian2",
             ("mean1", "sigma1", "mean2", "sigma2"),
-            "left Gaussian below mean1, right Gaussian above mean2, 1 between (gauss2mf)",
+            "g1(x) * g2(x) where g1 = exp(-(x-mean1)^2 / (2 sigma1^2)) for x < mean1 else 1 and "
+            "g2 = exp(-(x-mean2)^2 / (2 sigma2^2)) for x > mean2 else 1; so 1 between the means "
+            "when mean1 <= mean2 (MATLAB gauss2mf, fuzzylite GaussianProduct, jFuzzyLogic GAUSS2)",
         ),
         ShapeSpec("bell", ("center", "width", "slope"), "1 / (1 + |(x-center)/width|^(2 slope))"),
         ShapeSpec("sigmoid", ("center", "slope"), "1 / (1 + exp(-slope (x-center)))"),
@@ -144,13 +146,57 @@ SHAPES: dict[str, ShapeSpec] = {
             ("center", "width"),
             "(1 + cos(2 pi (x-center)/width)) / 2 on [center-width/2, center+width/2], 0 outside",
         ),
-        ShapeSpec("sshape", ("start", "end"), "smooth S-curve from 0 at start to 1 at end"),
-        ShapeSpec("zshape", ("start", "end"), "smooth Z-curve from 1 at start to 0 at end"),
+        ShapeSpec(
+            "cosine_half",
+            ("center", "half_width"),
+            "(1 + cos(pi (x-center)/half_width)) / 2 on [center-half_width, center+half_width], "
+            "0 outside: jFuzzyLogic COSINE net_max offset when net_max is a variable (with a "
+            "literal net_max the reader gives cosine(offset, 2 net_max))",
+        ),
+        ShapeSpec(
+            "sshape",
+            ("start", "end"),
+            "0 for x <= start; 2 ((x-start)/(end-start))^2 up to (start+end)/2; "
+            "1 - 2 ((x-end)/(end-start))^2 up to end; 1 for x >= end (smf, fuzzylite SShape)",
+        ),
+        ShapeSpec(
+            "zshape",
+            ("start", "end"),
+            "1 - sshape(start, end): 1 for x <= start, 0 for x >= end (zmf, fuzzylite ZShape)",
+        ),
         ShapeSpec("pishape", ("a", "b", "c", "d"), "S-shape a..b times Z-shape c..d"),
-        ShapeSpec("ramp", ("start", "end"), "linear from 0 at start to 1 at end"),
+        ShapeSpec(
+            "ramp",
+            ("start", "end"),
+            "linear from 0 at start to 1 at end, clamped to [0, 1] outside (rising when "
+            "start < end, falling when start > end; 0 everywhere when start == end)",
+        ),
         ShapeSpec("spike", ("center", "width"), "exp(-|10 (x-center) / width|)"),
-        ShapeSpec("concave", ("inflection", "end"), "fuzzylite Concave"),
-        ShapeSpec("binary", ("start", "direction"), "1 on the side of start given by direction"),
+        ShapeSpec(
+            "concave",
+            ("inflection", "end"),
+            "inflection <= end: (end-inflection) / (2 end - inflection - x) for x < end, else 1; "
+            "inflection > end: (inflection-end) / (inflection - 2 end + x) for x > end, else 1 "
+            "(fuzzylite Concave)",
+        ),
+        ShapeSpec(
+            "binary",
+            ("start", "direction"),
+            "1 for x >= start when direction > start, 1 for x <= start when direction < start, "
+            "0 elsewhere (fuzzylite Binary)",
+        ),
+        ShapeSpec(
+            "arc",
+            ("start", "end"),
+            "quarter ellipse: 0 before start, sqrt(r^2 - (x-end)^2) / |r| with r = end - start "
+            "between start and end, 1 beyond end (pyfuzzylite Arc; falls when end < start)",
+        ),
+        ShapeSpec(
+            "semiellipse",
+            ("start", "end"),
+            "sqrt(r^2 - (x-c)^2) / r on [start, end] with c, r its centre and half-width, "
+            "0 outside (pyfuzzylite SemiEllipse)",
+        ),
         ShapeSpec("constant", ("value",), "Takagi-Sugeno constant output"),
         ShapeSpec(
             "linear",
@@ -214,6 +260,10 @@ class FunctionMF:
 
     expr: Expr
     text: str = field(default="", compare=False)
+    argument: str | None = None
+    """The name that stands for the point at which the term is evaluated (fuzzylite's
+    ``x`` in ``Function lt(x, 0.3) * ...``).  ``None``: every name is a variable and the
+    expression gives the term's value directly (jFuzzyLogic FUNCTION, Takagi-Sugeno)."""
 
 
 MembershipFunction: TypeAlias = PointsMF | SingletonMF | SingletonsMF | ShapeMF | FunctionMF
@@ -269,6 +319,8 @@ class FuzzifyBlock:
     range: Range | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    clamp: bool = False
+    """Limit the input value to ``range`` before fuzzification (fuzzylite ``lock-range``)."""
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
@@ -303,9 +355,17 @@ class DefuzzifyBlock:
     accu: str | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    clamp: bool = False
+    """Limit the defuzzified value to ``range`` (fuzzylite ``lock-range``)."""
+    item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
+    """Where the single-valued items were written: ``("method", span)``, ``("accu", ...)``."""
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
+
+    def item_span(self, item: str) -> Span | None:
+        """The source position of ``item`` (``"method"``, ``"accu"``), else the block's."""
+        return next((s for k, s in self.item_spans if k == item), self.span)
 
 
 # --------------------------------------------------------------------------- rules
@@ -363,8 +423,9 @@ class Conclusion:
     weight: Param | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     hedges: tuple[str, ...] = ()
-    """Hedges written before the term (fuzzylite ``then y is very high``); they modify the
-    rule's degree for this subconclusion, innermost first."""
+    """Hedges written before the term (fuzzylite ``then y is very t``), outermost first.
+    They modify the degree this conclusion is activated with, as :attr:`Is.hedges` modify
+    a membership degree; see :data:`HEDGES`."""
 
 
 @dataclass(frozen=True)
@@ -379,6 +440,10 @@ class Rule:
     conclusions: tuple[Conclusion, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    weight: Param | None = None
+    """Rule weight of MATLAB FIS and fuzzylite (``(0.5)``, ``with 0.5``): it multiplies the
+    condition degree *before* activation, ``act(w * a, mu)``.  Unlike a WITH weight of a
+    subconclusion (IEC 61131-7: ``w * act(a, mu)``) it differs from it under ACT MIN."""
 
 
 @dataclass(frozen=True)
@@ -394,6 +459,19 @@ class RuleBlock:
     accu: str | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    enabled: bool = True
+    """A disabled rule block (fuzzylite ``enabled: false``) fires none of its rules."""
+    rule_activation: str | None = None
+    """fuzzylite's rule activation method when it is not ``General`` (``"First 2"``,
+    ``"Highest 1"``, ``"Threshold >= 0.5"``, ...): which rules of the block fire.  ``None``:
+    every rule fires (IEC 61131-7)."""
+    item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
+    """Where the operator items were written: ``("and_op", span)``, ``("or_op", ...)``,
+    ``("act", ...)``, ``("accu", ...)``."""
+
+    def item_span(self, item: str) -> Span | None:
+        """The source position of ``item`` (``"and_op"``, ``"act"``, ...), else the block's."""
+        return next((s for k, s in self.item_spans if k == item), self.span)
 
 
 @dataclass(frozen=True)
@@ -489,6 +567,22 @@ OPERATOR_PAIRS: dict[str, str] = {
     "HAMACHER": "HAMACHER",
     "EINSTEIN": "EINSTEIN",
 }
-ACT_METHODS = frozenset({"MIN", "PROD"})
-ACCU_METHODS = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR"})
+# Activation with any t-norm (fuzzylite exports e.g. ``ACT : EPROD``, stored as EINSTEIN).
+ACT_METHODS = frozenset({"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER", "EINSTEIN"})
+# Accumulation: Table 5 (MAX, BSUM, NSUM), jFuzzyLogic's SUM (unbounded) and PROBOR (a + b - ab,
+# also written ASUM by fuzzylite), and the s-norms fuzzylite exports (ESUM -> EINSTEIN,
+# HSUM -> HAMACHER, DSUM -> DMAX, NMAX -> NIPMAX).  The synonym table is fuzzyctl.fcl.keywords.
+ACCU_METHODS = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR", "DMAX", "NIPMAX", "HAMACHER", "EINSTEIN"})
 DEFUZZ_METHODS = frozenset({"COG", "COGS", "COA", "LM", "RM", "MOM", "COGF", "WTAVER", "WTSUM"})
+
+# Hedges (``x IS very t``, ``then y is very t``): name -> what it does to a degree d.
+# fuzzylite's ``any`` (degree 1 whatever the term) is resolved by the readers, never stored.
+HEDGES: dict[str, str] = {
+    "very": "d^2",
+    "somewhat": "sqrt(d)",
+    "extremely": "2 d^2 if d <= 0.5 else 1 - 2 (1-d)^2 (fuzzylite Extremely)",
+    "seldom": "sqrt(d/2) if d <= 0.5 else 1 - sqrt((1-d)/2) (fuzzylite Seldom)",
+}
+POWER_HEDGE_PREFIX = "pow:"
+"""A hedge ``"pow:p"`` raises the degree to the power p (Octave FIS hedge codes: ``2.3`` is
+term 2 with ``d^3``)."""

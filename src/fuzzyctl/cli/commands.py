@@ -1,1 +1,6 @@
 """Imports every command module so that each registers its commands on the app."""
+
+from fuzzyctl.cli import (
+    convert,  # noqa: F401
+    lang,  # noqa: F401  (check, fmt)
+)

@@ -1,0 +1,47 @@
+"""``fuzzyctl convert IN OUT``: move a fuzzy system between FCL, FIS, FLL, FPL, XFUZ, JSON."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from fuzzyctl.cli.app import app, err_console
+
+
+@app.command()
+def convert(
+    source: Annotated[Path, typer.Argument(help="File to read.", exists=True, dir_okay=False, readable=True)],
+    target: Annotated[Path, typer.Argument(help="File to write (replaced atomically).", dir_okay=False)],
+    from_format: Annotated[
+        str | None,
+        typer.Option(
+            "--from", help="Format of SOURCE (fcl, fis, fll, fpl, xfuz, json); default: its extension."
+        ),
+    ] = None,
+    to_format: Annotated[
+        str | None, typer.Option("--to", help="Format of TARGET; default: its extension.")
+    ] = None,
+    lossy: Annotated[
+        bool,
+        typer.Option(
+            "--lossy", help="Write even when the target cannot express everything; list what was dropped."
+        ),
+    ] = False,
+) -> None:
+    """Convert a fuzzy system to another format.
+
+    A conversion that would change what the system computes fails and lists, one line each,
+    what the target format cannot express; --lossy writes it anyway without those elements."""
+    from fuzzyctl import formats
+
+    loaded = formats.read_path(source, from_format)
+    for diagnostic in loaded.diagnostics:
+        err_console.print(diagnostic.render(), markup=False)
+    fmt = formats.get(to_format) if to_format else formats.for_path(target)
+    text, losses = formats.convert(loaded.document, fmt.name, lossy=lossy)
+    formats.write_atomic(target, text)
+    for loss in losses:
+        err_console.print(f"dropped: {loss}", markup=False)
+    typer.echo(f"wrote {target} ({fmt.name}{', lossy' if losses else ''})")

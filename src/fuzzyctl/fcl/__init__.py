@@ -1,0 +1,78 @@
+"""IEC 61131-7 Fuzzy Control Language: parser, checks, writer and conformance report.
+
+>>> from fuzzyctl.fcl import load_text
+>>> result = load_text("FUNCTION_BLOCK f VAR_INPUT t : REAL; END_VAR END_FUNCTION_BLOCK")
+>>> result.document.main.inputs[0].name
+'t'
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, has_errors
+from fuzzyctl.fcl.checks import CheckContext, register_provider, run_checks
+from fuzzyctl.fcl.parser import parse_source
+from fuzzyctl.fcl.source import Source, decode, read_source
+from fuzzyctl.fcl.writer import write
+from fuzzyctl.model import Document
+
+
+@dataclass
+class LoadResult:
+    """A loaded document (``None`` when the file has errors) with every diagnostic."""
+
+    document: Document | None
+    diagnostics: list[Diagnostic]
+    source: Source
+    spellings: frozenset[str] = frozenset()
+
+    @property
+    def ok(self) -> bool:
+        return self.document is not None and not has_errors(self.diagnostics)
+
+    def raise_for_errors(self) -> Document:
+        """The document, or :class:`DiagnosticError` carrying every diagnostic."""
+        if self.document is None or has_errors(self.diagnostics):
+            raise DiagnosticError(self.diagnostics, self.source.text)
+        return self.document
+
+
+def check_source(source: Source) -> LoadResult:
+    """Parse and check decoded text; never raises for bad input."""
+    parsed = parse_source(source)
+    diagnostics = list(parsed.diagnostics)
+    if parsed.document is not None and not has_errors(diagnostics):
+        diagnostics.extend(run_checks(parsed.document, CheckContext(source.path)))
+    return LoadResult(parsed.document, diagnostics, source, parsed.spellings)
+
+
+def load_text(text: str, path: str | None = None) -> LoadResult:
+    """Parse and check FCL source text."""
+    return check_source(Source(text.removeprefix("\ufeff"), path))
+
+
+def load_file(path: str | os.PathLike[str]) -> LoadResult:
+    """Read, parse and check an FCL file (missing file, directory, binary data and
+    undecodable text raise :class:`DiagnosticError`)."""
+    return check_source(read_source(path))
+
+
+def parse_fcl(text: str, path: str | None = None) -> Document:
+    """The document for ``text``; raises :class:`DiagnosticError` on any error."""
+    return load_text(text, path).raise_for_errors()
+
+
+__all__ = [
+    "CheckContext",
+    "LoadResult",
+    "check_source",
+    "decode",
+    "load_file",
+    "load_text",
+    "parse_fcl",
+    "register_provider",
+    "run_checks",
+    "write",
+]

@@ -1,0 +1,578 @@
+"""Semantic checks of a parsed FCL document.
+
+Checks are *providers*: functions ``(document, context) -> diagnostics``.  The built-in
+ones below cover IEC 61131-7 clause 5; other packages add theirs with
+:func:`register_provider` (the inference engine reports the features it does not evaluate
+that way) and :func:`run_checks` runs them all.  A provider never raises for bad input: it
+reports."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass, field
+
+from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
+from fuzzyctl.model import (
+    OPERATOR_PAIRS,
+    Condition,
+    DefuzzifyBlock,
+    Degree,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Is,
+    Name,
+    Not,
+    Param,
+    PointsMF,
+    Ref,
+    RuleBlock,
+    ShapeMF,
+    SingletonMF,
+    SingletonsMF,
+    Span,
+    Term,
+    VarKind,
+)
+
+
+@dataclass
+class CheckContext:
+    """What a provider may need besides the document: the file name for diagnostics."""
+
+    file: str | None = None
+    options: dict[str, object] = field(default_factory=dict)
+
+
+Provider = Callable[[Document, CheckContext], Iterable[Diagnostic]]
+
+_PROVIDERS: dict[str, Provider] = {}
+
+
+def register_provider(name: str, provider: Provider) -> None:
+    """Add (or replace) a named check provider; ``run_checks`` calls it for every file."""
+    _PROVIDERS[name] = provider
+
+
+def providers() -> dict[str, Provider]:
+    return dict(_PROVIDERS)
+
+
+# Modules that register providers when imported; missing ones are skipped (the engine
+# lands in another branch).
+PLUGIN_MODULES = ("fuzzyctl.engine.support",)
+
+
+def load_plugins() -> None:
+    import importlib
+
+    for name in PLUGIN_MODULES:
+        try:
+            importlib.import_module(name)
+        except ModuleNotFoundError as exc:
+            if exc.name is None or not name.startswith(exc.name):
+                raise
+
+
+def run_checks(doc: Document, context: CheckContext | None = None) -> list[Diagnostic]:
+    """Every provider's diagnostics, sorted by position."""
+    ctx = context or CheckContext(doc.path)
+    out: list[Diagnostic] = []
+    for provider in _PROVIDERS.values():
+        out.extend(provider(doc, ctx))
+    return sorted(out, key=lambda d: (d.span.line if d.span else 0, d.span.column if d.span else 0))
+
+
+# --------------------------------------------------------------------------- helpers
+
+
+def term_blocks(fb: FunctionBlock) -> list[FuzzifyBlock | DefuzzifyBlock]:
+    """The FUZZIFY then DEFUZZIFY blocks of ``fb``."""
+    return [*fb.fuzzify, *fb.defuzzify]
+
+
+class _Reporter:
+    def __init__(self, ctx: CheckContext) -> None:
+        self.ctx = ctx
+        self.found: list[Diagnostic] = []
+
+    def error(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        self.found.append(error(message, span, code=code, file=self.ctx.file, hint=hint))
+
+    def warning(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        self.found.append(warning(message, span, code=code, file=self.ctx.file, hint=hint))
+
+    def note(self, message: str, span: Span | None, code: str) -> None:
+        self.found.append(Diagnostic(Severity.NOTE, message, span, self.ctx.file, code))
+
+
+def walk_condition(c: Condition | None) -> Iterator[Is | Degree]:
+    """The subconditions of a condition, left to right."""
+    if c is None:
+        return
+    if isinstance(c, Is | Degree):
+        yield c
+    elif isinstance(c, Not):
+        yield from walk_condition(c.operand)
+    else:
+        for operand in c.operands:
+            yield from walk_condition(operand)
+
+
+def uses_operator(c: Condition | None, kind: type) -> bool:
+    if c is None or isinstance(c, Is | Degree):
+        return False
+    if isinstance(c, kind):
+        return True
+    if isinstance(c, Not):
+        return uses_operator(c.operand, kind)
+    return any(uses_operator(o, kind) for o in c.operands)
+
+
+def mf_params(mf: object) -> list[Param]:
+    if isinstance(mf, PointsMF | SingletonsMF):
+        return [v for p in mf.points for v in (p.x, p.y)]
+    if isinstance(mf, SingletonMF):
+        return [mf.value]
+    if isinstance(mf, ShapeMF):
+        return [*mf.params, mf.height]
+    return []
+
+
+def is_singleton(mf: object) -> bool:
+    return isinstance(mf, SingletonMF | SingletonsMF) or (isinstance(mf, ShapeMF) and mf.kind == "constant")
+
+
+# Shapes whose membership does not fall to 0 on at least one side.
+_UNBOUNDED_KINDS = {"sigmoid", "ramp", "sshape", "zshape", "binary", "concave", "linear", "constant"}
+_AREA_METHODS = {None, "COG", "COA", "LM", "RM", "MOM", "COGF"}
+
+
+def unbounded(mf: object) -> bool:
+    """True when the membership stays above 0 towards -inf or +inf (so an area-based
+    defuzzification needs a RANGE)."""
+    if isinstance(mf, PointsMF) and mf.points:
+        first, last = mf.points[0].y, mf.points[-1].y
+        return (not isinstance(first, Ref) and first != 0) or (not isinstance(last, Ref) and last != 0)
+    if isinstance(mf, ShapeMF):
+        return mf.kind in _UNBOUNDED_KINDS
+    return False
+
+
+# --------------------------------------------------------------------------- built-in checks
+
+
+def check_declarations(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+    r = _Reporter(ctx)
+    names: dict[str | None, Span | None] = {}
+    for fb in doc.blocks:
+        if fb.name in names and len(doc.blocks) > 1:
+            r.error(f"function block {fb.name!r} defined twice", fb.span, "duplicate-block")
+        names[fb.name] = fb.span
+        seen: dict[str, Span | None] = {}
+        for v in fb.variables:
+            if v.name in seen:
+                r.error(
+                    f"variable {v.name} declared twice (first on line {_line(seen[v.name])})",
+                    v.span,
+                    "duplicate-variable",
+                )
+            else:
+                seen[v.name] = v.span
+        _check_blocks(fb, r)
+    yield from r.found
+
+
+def _line(span: Span | None) -> str:
+    return str(span.line) if span else "?"
+
+
+def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
+    fuzzified: dict[str, Span | None] = {}
+    for f in fb.fuzzify:
+        var = fb.variable(f.variable)
+        if var is None:
+            r.error(
+                f"FUZZIFY {f.variable}: no variable {f.variable} is declared", f.span, "undeclared-variable"
+            )
+        elif var.kind is VarKind.OUTPUT:
+            r.error(
+                f"FUZZIFY {f.variable}: {f.variable} is a VAR_OUTPUT; FUZZIFY takes a VAR_INPUT (5.2.2)",
+                f.span,
+                "fuzzify-non-input",
+            )
+        elif var.kind is VarKind.LOCAL:
+            r.warning(
+                f"FUZZIFY {f.variable}: {f.variable} is a local VAR; the standard fuzzifies VAR_INPUT "
+                "variables (5.2.2)",
+                f.span,
+                "fuzzify-local",
+            )
+        if f.variable in fuzzified:
+            r.error(f"second FUZZIFY block for {f.variable}", f.span, "duplicate-block")
+        fuzzified[f.variable] = f.span
+        _check_terms(f.terms, f.variable, r)
+    defuzzified: dict[str, Span | None] = {}
+    for d in fb.defuzzify:
+        var = fb.variable(d.variable)
+        if var is None:
+            r.error(
+                f"DEFUZZIFY {d.variable}: no variable {d.variable} is declared", d.span, "undeclared-variable"
+            )
+        elif var.kind is VarKind.INPUT:
+            r.error(
+                f"DEFUZZIFY {d.variable}: {d.variable} is a VAR_INPUT; DEFUZZIFY takes a VAR_OUTPUT (5.2.3)",
+                d.span,
+                "defuzzify-non-output",
+            )
+        if d.variable in defuzzified:
+            r.error(f"second DEFUZZIFY block for {d.variable}", d.span, "duplicate-block")
+        defuzzified[d.variable] = d.span
+        _check_terms(d.terms, d.variable, r)
+        _check_defuzzify(fb, d, r)
+    for v in fb.variables:
+        if v.kind is VarKind.OUTPUT and v.name not in defuzzified and not _assigned_bare(fb, v.name):
+            r.warning(f"output {v.name} has no DEFUZZIFY block", v.span, "output-without-defuzzify")
+    for term, p in _refs_in_terms(fb):
+        var = fb.variable(p.name)
+        if var is None:
+            r.error(
+                f"TERM {term.name}: no variable {p.name} is declared",
+                p.span or term.span,
+                "undeclared-variable",
+            )
+        elif var.kind is VarKind.OUTPUT:
+            r.warning(
+                f"TERM {term.name}: parameter {p.name} is an output; variable points are VAR_INPUTs (5.2.2)",
+                p.span or term.span,
+                "parameter-not-input",
+            )
+
+
+def _assigned_bare(fb: FunctionBlock, name: str) -> bool:
+    return any(c.variable == name and c.term is None for _, rule in fb.rules() for c in rule.conclusions)
+
+
+def _refs_in_terms(fb: FunctionBlock) -> Iterator[tuple[Term, Ref]]:
+    for block in term_blocks(fb):
+        for t in block.terms:
+            for p in mf_params(t.mf):
+                if isinstance(p, Ref):
+                    yield t, p
+
+
+def _check_terms(terms: tuple[Term, ...], variable: str, r: _Reporter) -> None:
+    seen: dict[str, Span | None] = {}
+    for t in terms:
+        if t.name in seen:
+            r.warning(
+                f"term {t.name} of {variable} defined twice (first on line {_line(seen[t.name])}); "
+                "the first definition is used",
+                t.span,
+                "duplicate-term",
+            )
+        else:
+            seen[t.name] = t.span
+        mf = t.mf
+        if isinstance(mf, PointsMF | SingletonsMF):
+            xs = [p.x for p in mf.points]
+            for i in range(1, len(xs)):
+                a, b = xs[i - 1], xs[i]
+                if not isinstance(a, Ref) and not isinstance(b, Ref) and b < a:
+                    r.error(
+                        f"TERM {t.name}: points not in ascending order ({_num(a)} then {_num(b)})",
+                        mf.points[i].span or t.span,
+                        "points-not-ascending",
+                        hint="5.2.2: the points shall be given in ascending order of the variable value",
+                    )
+                    break
+            for p in mf.points:
+                if not isinstance(p.y, Ref) and not (0.0 <= p.y <= 1.0):
+                    r.error(
+                        f"TERM {t.name}: membership degree {_num(p.y)} is outside [0, 1]",
+                        p.span or t.span,
+                        "degree-out-of-range",
+                    )
+        if isinstance(mf, PointsMF) and not mf.points:
+            r.error(f"TERM {t.name} has no points", t.span, "empty-term")
+
+
+def _num(x: float) -> str:
+    return f"{x:g}"
+
+
+def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None:
+    method_span = d.item_span("method")
+    if d.method == "COA" and any(is_singleton(t.mf) for t in d.terms):
+        r.error(
+            f"DEFUZZIFY {d.variable}: CoA cannot be used with singleton terms (Table 1, note 3)",
+            method_span,
+            "coa-singletons",
+            hint="use CoGS for singletons",
+        )
+    if d.method is None:
+        r.warning(
+            f"DEFUZZIFY {d.variable} has no METHOD: CoG is used (for singletons it equals CoGS)",
+            d.span,
+            "missing-method",
+        )
+    if d.default is None:
+        r.warning(
+            f"DEFUZZIFY {d.variable} has no DEFAULT: NC is used, the output keeps its last value, "
+            "0 before the first firing",
+            d.span,
+            "missing-default",
+        )
+    if d.range is None and d.method in _AREA_METHODS:
+        for t in d.terms:
+            if unbounded(t.mf):
+                r.warning(
+                    f"DEFUZZIFY {d.variable}: term {t.name} does not fall to 0 at one end and there is "
+                    f"no RANGE, so {d.method or 'CoG'} depends on the universe each tool assumes (the "
+                    "standard: the range of the data type; jFuzzyLogic: the span of the terms)",
+                    t.span,
+                    "unbounded-output",
+                    hint=f"add RANGE(min..max); to DEFUZZIFY {d.variable}",
+                )
+                break
+    if d.method == "COGF" and not any(isinstance(t.mf, FunctionMF) for t in d.terms):
+        r.warning(
+            f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function"
+        )
+
+
+def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+    r = _Reporter(ctx)
+    for fb in doc.blocks:
+        names: dict[str | None, Span | None] = {}
+        for rb in fb.rule_blocks:
+            if rb.name is not None and rb.name in names:
+                r.error(f"rule block {rb.name} defined twice", rb.span, "duplicate-block")
+            names[rb.name] = rb.span
+            _check_rule_block(fb, rb, r)
+        _check_cycles(fb, r)
+    yield from r.found
+
+
+def _terms_of(fb: FunctionBlock, name: str) -> set[str] | None:
+    blocks = [b for b in term_blocks(fb) if b.variable == name]
+    if not blocks:
+        return None
+    return {t.name for b in blocks for t in b.terms}
+
+
+def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
+    if rb.and_op and rb.or_op and OPERATOR_PAIRS.get(rb.and_op) != rb.or_op:
+        r.warning(
+            f"AND : {rb.and_op} and OR : {rb.or_op} are not a pair of Table 3 "
+            f"(AND {rb.and_op} goes with OR {OPERATOR_PAIRS.get(rb.and_op, '?')})",
+            rb.item_span("or_op"),
+            "operator-pair",
+        )
+    outputs = {c.variable for rule in rb.rules for c in rule.conclusions}
+    if rb.accu is None:
+        without = sorted(v for v in outputs if (d := fb.defuzzify_block(v)) is None or d.accu is None)
+        if without:
+            r.warning(
+                f"RULEBLOCK {rb.name or ''} has no ACCU: using MAX, the Basic-level accumulation".replace(
+                    "  ", " "
+                ),
+                rb.span,
+                "missing-accu",
+            )
+    if rb.act is None and any(
+        (d := fb.defuzzify_block(v)) is not None and any(not is_singleton(t.mf) for t in d.terms)
+        for v in outputs
+    ):
+        r.note(
+            f"RULEBLOCK {rb.name or ''} has no ACT: MIN activation is used".replace("  ", " "),
+            rb.span,
+            "missing-act",
+        )
+    labels: dict[str, Span | None] = {}
+    for rule in rb.rules:
+        if rule.label in labels:
+            r.warning(
+                f"RULE {rule.label} appears twice in this rule block "
+                f"(first on line {_line(labels[rule.label])})",
+                rule.span,
+                "duplicate-rule",
+            )
+        labels[rule.label] = rule.span
+        for sub in walk_condition(rule.condition):
+            var = fb.variable(sub.variable)
+            if var is None:
+                r.error(
+                    f"RULE {rule.label}: undeclared variable {sub.variable}",
+                    sub.span or rule.span,
+                    "undeclared-variable",
+                )
+                continue
+            if isinstance(sub, Is):
+                terms = _terms_of(fb, sub.variable)
+                if terms is None:
+                    r.error(
+                        f"RULE {rule.label}: {sub.variable} has no FUZZIFY or DEFUZZIFY block defining "
+                        f"term {sub.term}",
+                        sub.span or rule.span,
+                        "undeclared-term",
+                    )
+                elif sub.term not in terms and sub.term.lower() == "any" and not sub.hedges:
+                    r.note(
+                        f"RULE {rule.label}: {sub.variable} IS any is fuzzylite's hedge 'any' (always true)",
+                        sub.span or rule.span,
+                        "fuzzylite-any",
+                    )
+                elif sub.term not in terms:
+                    r.error(
+                        f"RULE {rule.label}: {sub.variable} has no term {sub.term}",
+                        sub.span or rule.span,
+                        "undeclared-term",
+                        hint="its terms: " + ", ".join(sorted(terms)),
+                    )
+        for c in rule.conclusions:
+            var = fb.variable(c.variable)
+            if var is None:
+                r.error(
+                    f"RULE {rule.label}: undeclared variable {c.variable}",
+                    c.span or rule.span,
+                    "undeclared-variable",
+                )
+                continue
+            if var.kind is VarKind.INPUT:
+                r.error(
+                    f"RULE {rule.label}: {c.variable} is a VAR_INPUT and cannot be a conclusion",
+                    c.span or rule.span,
+                    "conclusion-on-input",
+                )
+            if c.term is not None:
+                d = fb.defuzzify_block(c.variable)
+                terms = _terms_of(fb, c.variable)
+                if d is None and terms is None:
+                    r.error(
+                        f"RULE {rule.label}: {c.variable} has no DEFUZZIFY block defining term {c.term}",
+                        c.span or rule.span,
+                        "undeclared-term",
+                    )
+                elif terms is not None and c.term not in terms:
+                    r.error(
+                        f"RULE {rule.label}: {c.variable} has no term {c.term}",
+                        c.span or rule.span,
+                        "undeclared-term",
+                        hint="its terms: " + ", ".join(sorted(terms)),
+                    )
+            w = c.weight
+            if isinstance(w, Ref):
+                wvar = fb.variable(w.name)
+                if wvar is None:
+                    r.error(
+                        f"RULE {rule.label}: undeclared weight variable {w.name}",
+                        w.span or c.span,
+                        "undeclared-variable",
+                    )
+                elif wvar.kind is not VarKind.INPUT:
+                    r.warning(
+                        f"RULE {rule.label}: weight {w.name} is not a VAR_INPUT (5.2.4)",
+                        w.span or c.span,
+                        "weight-not-input",
+                    )
+                elif isinstance(wvar.initial, float) and not 0.0 <= wvar.initial <= 1.0:
+                    r.error(
+                        f"RULE {rule.label}: weight {w.name} starts at {wvar.initial:g}, outside [0, 1]",
+                        wvar.span,
+                        "weight-out-of-range",
+                    )
+            elif w is not None and math.isnan(w):
+                r.error(
+                    f"RULE {rule.label}: weight is not a number", c.span or rule.span, "weight-out-of-range"
+                )
+            elif w is not None and w < 0.0:
+                r.error(
+                    f"RULE {rule.label}: weight {w:g} is negative; 5.2.4 allows 0.0 to 1.0",
+                    c.span or rule.span,
+                    "weight-out-of-range",
+                )
+            elif w is not None and w > 1.0:
+                # jFuzzyLogic multiplies by any weight; files written for it use weights > 1.
+                r.warning(
+                    f"RULE {rule.label}: weight {w:g} is above 1; 5.2.4 allows 0.0 to 1.0 "
+                    "(used as written, as jFuzzyLogic does)",
+                    c.span or rule.span,
+                    "weight-out-of-range",
+                )
+
+
+def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
+    """Rule blocks feed each other through local variables; a cycle has no evaluation order."""
+    locals_ = {v.name for v in fb.locals}
+    if not locals_ or len(fb.rule_blocks) < 2:
+        return
+    writes: dict[int, set[str]] = {}
+    reads: dict[int, set[str]] = {}
+    for i, rb in enumerate(fb.rule_blocks):
+        writes[i] = {c.variable for rule in rb.rules for c in rule.conclusions} & locals_
+        reads[i] = {s.variable for rule in rb.rules for s in walk_condition(rule.condition)} & locals_
+    edges = {i: {j for j in writes if j != i and writes[i] & reads[j]} for i in writes}
+    state: dict[int, int] = {}
+
+    def visit(i: int, path: list[int]) -> list[int] | None:
+        state[i] = 1
+        for j in sorted(edges[i]):
+            if state.get(j) == 1:
+                return [*path[path.index(j) :], j] if j in path else [i, j]
+            if state.get(j) is None:
+                found = visit(j, [*path, j])
+                if found:
+                    return found
+        state[i] = 2
+        return None
+
+    for i in edges:
+        if state.get(i) is None:
+            cycle = visit(i, [i])
+            if cycle:
+                names = " -> ".join(fb.rule_blocks[k].name or f"#{k + 1}" for k in cycle)
+                via = sorted(set().union(*(writes[k] for k in cycle)))
+                r.error(
+                    f"rule blocks depend on each other in a cycle ({names}) through local "
+                    f"variable(s) {', '.join(via)}",
+                    fb.rule_blocks[cycle[0]].span,
+                    "rule-block-cycle",
+                )
+                return
+
+
+def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+    """FUNCTION terms may only name declared variables."""
+    r = _Reporter(ctx)
+    for fb in doc.blocks:
+        for block in term_blocks(fb):
+            for t in block.terms:
+                if isinstance(t.mf, FunctionMF):
+                    for name in sorted(_names(t.mf.expr)):
+                        if fb.variable(name) is None and name not in ("x", "pi", "e"):
+                            r.error(
+                                f"TERM {t.name}: FUNCTION uses undeclared variable {name}",
+                                t.span,
+                                "undeclared-variable",
+                            )
+    yield from r.found
+
+
+def _names(e: object) -> set[str]:
+    if isinstance(e, Name):
+        return {e.name}
+    out: set[str] = set()
+    for attr in ("operand", "left", "right"):
+        if hasattr(e, attr):
+            out |= _names(getattr(e, attr))
+    for a in getattr(e, "args", ()):
+        out |= _names(a)
+    return out
+
+
+register_provider("declarations", check_declarations)
+register_provider("rules", check_rules)
+register_provider("functions", check_functions)

@@ -1,0 +1,641 @@
+"""FCL text to :class:`fuzzyctl.model.Document`.
+
+The grammar is ``fcl.lark`` (LALR(1), contextual lexer); a parse-time transformer builds the
+immutable model directly, so no intermediate tree is kept (the 290 KB corpus file parses in
+a fraction of a second).  Problems that the grammar accepts but the model cannot take (an
+unknown METHOD keyword, a shape with the wrong number of parameters) become diagnostics;
+syntax errors are translated into human messages by :mod:`fuzzyctl.fcl.errors`.
+"""
+
+from __future__ import annotations
+
+import math
+import textwrap
+import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from functools import cache
+from importlib import resources
+from typing import Any, cast
+
+from lark import Lark, Token, Transformer
+from lark.exceptions import UnexpectedInput, VisitError
+
+from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
+from fuzzyctl.fcl import keywords, shapes
+from fuzzyctl.fcl.names import resolve_names
+from fuzzyctl.fcl.source import Source
+from fuzzyctl.model import (
+    And,
+    Binary,
+    Call,
+    Conclusion,
+    Condition,
+    Default,
+    DefuzzifyBlock,
+    Degree,
+    Document,
+    Expr,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Is,
+    MembershipFunction,
+    Name,
+    Not,
+    Num,
+    OptionsBlock,
+    Or,
+    Param,
+    Point,
+    PointsMF,
+    Range,
+    Ref,
+    Rule,
+    RuleBlock,
+    SingletonMF,
+    SingletonsMF,
+    Span,
+    Term,
+    Unary,
+    Variable,
+    VarKind,
+)
+
+_MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
+
+
+def _between(first: Any, last: Any) -> Span | None:
+    """The span from the start of ``first`` to the end of ``last`` (tokens or model
+    objects with a span); ``None`` when a position is unknown."""
+    a = _start(first)
+    b = _end(last)
+    if a is None:
+        return None
+    if b is None:
+        return a
+    return Span(a.line, a.column, b.end_line, b.end_column)
+
+
+def _start(obj: Any) -> Span | None:
+    if isinstance(obj, Token):
+        return _tok_span(obj)
+    span = getattr(obj, "span", None)
+    return span if isinstance(span, Span) else None
+
+
+def _end(obj: Any) -> Span | None:
+    return _start(obj)
+
+
+def _outer(children: Sequence[Any]) -> Span | None:
+    located = [c for c in children if _start(c) is not None]
+    return _between(located[0], located[-1]) if located else None
+
+
+def _tok_span(tok: Token) -> Span:
+    return Span(tok.line or 0, tok.column or 0, tok.end_line, tok.end_column)
+
+
+def _number(tok: Token) -> float:
+    return float(str(tok).translate(_MINUS_SIGNS))
+
+
+def _tokens(children: Sequence[Any], *types: str) -> list[Token]:
+    return [c for c in children if isinstance(c, Token) and c.type in types]
+
+
+@dataclass
+class _Item:
+    """A single-valued statement inside a block (METHOD, ACCU, AND, ...)."""
+
+    key: str
+    value: Any
+    span: Span
+
+
+@dataclass
+class _Decls:
+    names: list[tuple[str, Span]]
+    data_type: str
+    initial: float | bool | str | None
+    range: Range | None
+    span: Span | None
+
+
+@dataclass
+class _Function:
+    """A FUNCTION term before its source text is known (the TERM's ';' ends it)."""
+
+    expr: Expr
+    start: int
+
+
+@dataclass
+class _Comment:
+    text: str
+    line: int
+    column: int
+    end_line: int
+
+
+@dataclass
+class ParseState:
+    """What the transformer learns while building the model."""
+
+    source: Source
+    diagnostics: list[Diagnostic] = field(default_factory=list)
+    comments: list[_Comment] = field(default_factory=list)
+    prev_token: Token | None = None
+    last_token: Token | None = None
+    # How each shape was spelled, for the conformance report (kind -> spellings).
+    spellings: set[str] = field(default_factory=set)
+
+    def error(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        self.diagnostics.append(error(message, span, code=code, file=self.source.path, hint=hint))
+
+    def warn(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        self.diagnostics.append(warning(message, span, code=code, file=self.source.path, hint=hint))
+
+    def note(self, message: str, span: Span | None, code: str) -> None:
+        self.diagnostics.append(Diagnostic(Severity.NOTE, message, span, self.source.path, code))
+
+
+class _Builder(Transformer[Token, Any]):
+    """Builds model objects while LALR reduces (see ``Lark(transformer=...)``)."""
+
+    def __init__(self, state: ParseState) -> None:
+        super().__init__(visit_tokens=False)
+        self.state = state
+
+    # ---------------------------------------------------------------- parameters
+    def number(self, children: list[Token]) -> float:
+        return _number(children[0])
+
+    def ref(self, children: list[Token]) -> Ref:
+        return Ref(str(children[0]), _tok_span(children[0]))
+
+    def point(self, children: list[Param]) -> Point:
+        return Point(children[1], children[2], _outer(children))
+
+    # ---------------------------------------------------------------- membership functions
+    def points(self, children: list[Point]) -> PointsMF:
+        return PointsMF(tuple(children))
+
+    def singleton(self, children: list[Param]) -> SingletonMF:
+        return SingletonMF(children[0])
+
+    def shape(self, children: list[Any]) -> MembershipFunction:
+        name_tok: Token = children[0]
+        args: list[Param] = children[1:]
+        name = str(name_tok)
+        if name.upper() == "DISCRETE":
+            # fuzzylite's Discrete x1 y1 x2 y2 ... is the IEC point list.
+            if len(args) % 2 or not args:
+                self.state.error(
+                    f"Discrete takes pairs of values x y, got {len(args)} values",
+                    _tok_span(name_tok),
+                    "shape-arity",
+                )
+                return PointsMF(())
+            self.state.spellings.add("Discrete")
+            return PointsMF(tuple(Point(args[i], args[i + 1]) for i in range(0, len(args), 2)))
+        spelling = shapes.lookup(name)
+        if spelling is None:
+            self.state.error(
+                f"unknown membership function '{name}'",
+                _tok_span(name_tok),
+                "unknown-shape",
+                hint="known shapes: " + ", ".join(s.written for s in shapes.SPELLINGS),
+            )
+            return PointsMF(())
+        self.state.spellings.add(spelling.written)
+        try:
+            return shapes.build(spelling, args)
+        except shapes.ShapeError as exc:
+            self.state.error(str(exc), _outer(children), "shape-arity")
+            return PointsMF(())
+
+    def singletons(self, children: list[Any]) -> MembershipFunction:
+        name_tok: Token = children[0]
+        if str(name_tok).upper() != "SINGLETONS":
+            self.state.error(
+                f"unknown membership function '{name_tok}' followed by points",
+                _tok_span(name_tok),
+                "unknown-shape",
+                hint="a list of points is written without a name: TERM t := (0, 0) (1, 1);"
+                " jFuzzyLogic's discrete singletons are SINGLETONS (x, y) ...",
+            )
+            return PointsMF(())
+        self.state.spellings.add("SINGLETONS")
+        return SingletonsMF(tuple(children[1:]))
+
+    def function(self, children: list[Any]) -> _Function:
+        self.state.spellings.add("FUNCTION")
+        return _Function(children[1], children[0].end_pos or 0)
+
+    # ---- expressions
+    def num(self, children: list[Token]) -> Num:
+        return Num(_number(children[0]))
+
+    def expr_name(self, children: list[Token]) -> Name:
+        return Name(str(children[0]))
+
+    def name(self, children: list[Token]) -> Token:
+        if len(children) == 1:
+            return children[0]
+        first, last = children[0], children[-1]
+        text = " ".join(str(t) for t in children)
+        self.state.warn(
+            f"name of several words '{text}' (ridderware JFuzzy); FCL identifiers have no spaces",
+            _between(first, last),
+            "multiword-name",
+        )
+        return Token(
+            "ID",
+            text,
+            start_pos=first.start_pos,
+            line=first.line,
+            column=first.column,
+            end_line=last.end_line,
+            end_column=last.end_column,
+            end_pos=last.end_pos,
+        )
+
+    def call(self, children: list[Any]) -> Call:
+        return Call(str(children[0]).lower(), tuple(c for c in children[1:] if c is not None))
+
+    def binary(self, children: list[Any]) -> Binary:
+        return Binary(str(children[1]), children[0], children[2])
+
+    def unary(self, children: list[Any]) -> Unary:
+        return Unary(str(children[0]), children[1])
+
+    # ---------------------------------------------------------------- terms and blocks
+    def term(self, children: list[Any]) -> Term:
+        name, mf, semi = children[1], children[2], children[3]
+        if isinstance(mf, _Function):
+            text = self.state.source.text[mf.start : semi.start_pos]
+            mf = FunctionMF(mf.expr, " ".join(text.split()))
+        return Term(str(name), mf, _outer(children))
+
+    def range_stmt(self, children: list[Any]) -> Range:
+        low, high = (_number(t) for t in _tokens(children, "NUMBER"))
+        span = _outer(children)
+        if low > high:
+            self.state.error(f"RANGE({low:g}..{high:g}): the minimum is above the maximum", span, "bad-range")
+        elif low == high:
+            self.state.warn(f"RANGE({low:g}..{high:g}) is empty", span, "empty-range")
+        return Range(low, high, span)
+
+    def _keyword_item(
+        self, key: str, label: str, table: keywords.Synonyms, children: list[Any], tok: Token
+    ) -> _Item:
+        spelling = str(tok)
+        span = _outer(children) or _tok_span(tok)
+        if not _tokens(children, "SEMI"):
+            end = Span(tok.end_line or 0, tok.end_column or 0)
+            self.state.warn(f"missing ';' after {children[0].type} : {spelling}", end, "missing-semicolon")
+        if spelling.upper() in keywords.NONE_SPELLINGS:
+            return _Item(key, None, span)
+        value = keywords.canonical(table, spelling)
+        if value is None:
+            known = sorted({canon for canon, _ in table.values()})
+            self.state.error(
+                f"unknown {label} '{spelling}'",
+                _tok_span(tok),
+                "unknown-keyword",
+                hint="accepted: " + ", ".join(sorted(table)) + " (stored as " + ", ".join(known) + ")",
+            )
+        return _Item(key, value, span)
+
+    def method_stmt(self, children: list[Token]) -> _Item:
+        return self._keyword_item(
+            "method", "defuzzification METHOD", keywords.METHOD_SYNONYMS, children, children[1]
+        )
+
+    def accu_stmt(self, children: list[Token]) -> _Item:
+        return self._keyword_item(
+            "accu", "accumulation method (ACCU)", keywords.ACCU_SYNONYMS, children, children[1]
+        )
+
+    def act_stmt(self, children: list[Token]) -> _Item:
+        return self._keyword_item(
+            "act", "activation method (ACT)", keywords.ACT_SYNONYMS, children, children[1]
+        )
+
+    def operator_stmt(self, children: list[Token]) -> _Item:
+        if children[0].type == "AND":
+            return self._keyword_item("and_op", "AND operator", keywords.AND_SYNONYMS, children, children[1])
+        return self._keyword_item("or_op", "OR operator", keywords.OR_SYNONYMS, children, children[1])
+
+    def default_value(self, children: list[Token]) -> Default:
+        numbers = _tokens(children, "NUMBER")
+        no_change = bool(_tokens(children, "NC"))
+        value = _number(numbers[0]) if numbers else None
+        return Default(value, no_change, _outer(children))
+
+    def default_stmt(self, children: list[Any]) -> _Item:
+        default: Default = next(c for c in children if isinstance(c, Default))
+        span = _outer(children)
+        if _tokens(children, "EQUAL"):
+            self.state.warn(
+                "DEFAULT written with '=': the standard writes DEFAULT := value;", span, "default-equal"
+            )
+        if not _tokens(children, "SEMI"):
+            self.state.warn("missing ';' after DEFAULT", span, "missing-semicolon")
+        return _Item("default", replace(default, span=span), span or Span(0, 0))
+
+    def _items(self, children: list[Any], block: str, span: Span | None) -> dict[str, _Item]:
+        items: dict[str, _Item] = {}
+        for c in children:
+            if isinstance(c, _Item):
+                if c.key in items:
+                    self.state.error(
+                        f"{c.key.upper().replace('_OP', '')} given twice in this {block}",
+                        c.span,
+                        "duplicate-item",
+                    )
+                    continue
+                items[c.key] = c
+        return items
+
+    def fuzzify_block(self, children: list[Any]) -> FuzzifyBlock:
+        name: Token = children[1]
+        span = _outer(children)
+        terms = tuple(c for c in children if isinstance(c, Term))
+        ranges = [c for c in children if isinstance(c, Range)]
+        if len(ranges) > 1:
+            self.state.error("RANGE given twice in this FUZZIFY block", ranges[1].span, "duplicate-item")
+        return FuzzifyBlock(str(name), terms, ranges[0] if ranges else None, span)
+
+    def defuzzify_block(self, children: list[Any]) -> DefuzzifyBlock:
+        name: Token = children[1]
+        span = _outer(children)
+        terms = tuple(c for c in children if isinstance(c, Term))
+        ranges = [c for c in children if isinstance(c, Range)]
+        if len(ranges) > 1:
+            self.state.error("RANGE given twice in this DEFUZZIFY block", ranges[1].span, "duplicate-item")
+        items = self._items(children, "DEFUZZIFY block", span)
+        method = items.get("method")
+        default = items.get("default")
+        accu = items.get("accu")
+        return DefuzzifyBlock(
+            str(name),
+            terms,
+            ranges[0] if ranges else None,
+            method.value if method else None,
+            default.value if default else None,
+            accu.value if accu else None,
+            span,
+            item_spans=tuple((k, v.span) for k, v in items.items()),
+        )
+
+    # ---------------------------------------------------------------- declarations
+    def initial(self, children: list[Token]) -> float | bool | str:
+        tok = children[0]
+        if tok.type == "NUMBER":
+            return _number(tok)
+        text = str(tok)
+        if text.upper() in ("TRUE", "FALSE"):
+            return text.upper() == "TRUE"
+        return text
+
+    def var_decl(self, children: list[Any]) -> _Decls:
+        ids = [c for c in children if isinstance(c, Token) and c.type == "ID"]
+        initial = next(
+            (c for c in children if isinstance(c, float | bool | str) and not isinstance(c, Token)), None
+        )
+        rng = next((c for c in children if isinstance(c, Range)), None)
+        names = [(str(t), _tok_span(t)) for t in ids[:-1]]
+        return _Decls(names, str(ids[-1]).upper(), initial, rng, _outer(children))
+
+    def var_block(self, children: list[Any]) -> list[Variable]:
+        kind = VarKind(str(children[0].type))
+        out: list[Variable] = []
+        for decls in children:
+            if not isinstance(decls, _Decls):
+                continue
+            for name, span in decls.names:
+                where = span if len(decls.names) > 1 else decls.span
+                out.append(Variable(name, kind, decls.data_type, decls.initial, decls.range, where))
+        return out
+
+    # ---------------------------------------------------------------- rules
+    def is_condition(self, children: list[Token]) -> Is:
+        ids = _tokens(children, "ID")
+        negated = bool(_tokens(children, "NOT"))
+        return Is(str(ids[0]), str(ids[-1]), negated, tuple(str(t) for t in ids[1:-1]), _outer(children))
+
+    def degree_condition(self, children: list[Token]) -> Degree:
+        return Degree(str(children[0]), _outer(children))
+
+    def negation(self, children: list[Any]) -> Not:
+        return Not(children[1], _outer(children))
+
+    def group(self, children: list[Any]) -> Condition:
+        inner: Condition = children[0]
+        return inner
+
+    def and_condition(self, children: list[Any]) -> And:
+        return And(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
+
+    def or_condition(self, children: list[Any]) -> Or:
+        return Or(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
+
+    def conclusion(self, children: list[Any]) -> Conclusion:
+        ids = _tokens(children, "ID")
+        weight = next((c for c in children if not isinstance(c, Token)), None)
+        term = str(ids[-1]) if len(ids) > 1 else None
+        hedges = tuple(str(t) for t in ids[1:-1])
+        return Conclusion(str(ids[0]), term, weight, _outer(children), hedges)
+
+    def paren_conclusion(self, children: list[Any]) -> Conclusion:
+        made = self.conclusion(children)
+        self.state.warn(
+            f"parentheses around a subconclusion are not FCL (5.4.1); read as {made.variable} IS {made.term}",
+            made.span,
+            "paren-conclusion",
+        )
+        return made
+
+    def conclusions(self, children: list[Any]) -> tuple[Conclusion, ...]:
+        return tuple(c for c in children if isinstance(c, Conclusion))
+
+    def rule(self, children: list[Any]) -> Rule:
+        label: Token = children[1]
+        condition = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
+        conclusions = next(c for c in children if isinstance(c, tuple))
+        return Rule(str(label), condition, conclusions, _outer(children))
+
+    def rule_block(self, children: list[Any]) -> RuleBlock:
+        name = next((str(c) for c in children if isinstance(c, Token) and c.type == "ID"), None)
+        span = _outer(children)
+        items = self._items(children, "RULEBLOCK", span)
+
+        def value(key: str) -> str | None:
+            item = items.get(key)
+            return item.value if item else None
+
+        return RuleBlock(
+            name,
+            tuple(c for c in children if isinstance(c, Rule)),
+            value("and_op"),
+            value("or_op"),
+            value("act"),
+            value("accu"),
+            span,
+            item_spans=tuple((k, v.span) for k, v in items.items()),
+        )
+
+    def options_block(self, children: list[Token]) -> OptionsBlock:
+        body = _tokens(children, "OPTIONS_BODY")
+        text = textwrap.dedent(str(body[0])).strip() if body else ""
+        return OptionsBlock(text, str(children[0].type), _outer(children))
+
+    # ---------------------------------------------------------------- function blocks
+    def fb_name(self, children: list[Token]) -> str:
+        return str(children[0])
+
+    def function_block(self, children: list[Any]) -> FunctionBlock:
+        name = next((c for c in children if isinstance(c, str) and not isinstance(c, Token)), None)
+        variables: list[Variable] = []
+        for c in children:
+            if isinstance(c, list):
+                variables.extend(c)
+        fb = FunctionBlock(
+            name,
+            tuple(variables),
+            tuple(c for c in children if isinstance(c, FuzzifyBlock)),
+            tuple(c for c in children if isinstance(c, DefuzzifyBlock)),
+            tuple(c for c in children if isinstance(c, RuleBlock)),
+            tuple(c for c in children if isinstance(c, OptionsBlock)),
+            _outer(children),
+        )
+        return resolve_names(fb, lambda message, span, code: self.state.warn(message, span, code))
+
+    def start(self, children: list[FunctionBlock]) -> Document:
+        return Document(tuple(children), self.state.source.path)
+
+
+@cache
+def _grammar() -> str:
+    return resources.files("fuzzyctl.fcl").joinpath("fcl.lark").read_text(encoding="utf-8")
+
+
+_COMMENT_TYPES = ("COMMENT_IEC", "COMMENT_C", "COMMENT_LINE")
+_ACTIVE: list[ParseState] = []
+_LOCK = threading.RLock()
+
+
+def _on_comment(tok: Token) -> Token:
+    if _ACTIVE:
+        _ACTIVE[-1].comments.append(_Comment(str(tok), tok.line or 0, tok.column or 0, tok.end_line or 0))
+    return tok
+
+
+def _on_token(tok: Token) -> Token:
+    if _ACTIVE:
+        state = _ACTIVE[-1]
+        state.prev_token, state.last_token = state.last_token, tok
+    return tok
+
+
+@cache
+def _parser() -> Lark:
+    # The transformer is swapped per parse (see parse_source); lark builds its tables once.
+    base = Lark(_grammar(), parser="lalr", lexer="contextual")
+    callbacks = {name: _on_comment for name in _COMMENT_TYPES}
+    callbacks.update({t.name: _on_token for t in base.terminals if t.name not in (*_COMMENT_TYPES, "WS")})
+    return Lark(
+        _grammar(),
+        parser="lalr",
+        lexer="contextual",
+        maybe_placeholders=True,
+        lexer_callbacks=callbacks,
+        transformer=_Builder(ParseState(Source(""))),
+        cache=False,
+    )
+
+
+@dataclass
+class ParseResult:
+    """The document (``None`` after a syntax error) and every diagnostic found."""
+
+    document: Document | None
+    diagnostics: list[Diagnostic]
+    source: Source
+    spellings: frozenset[str] = frozenset()
+
+
+def parse_source(source: Source) -> ParseResult:
+    """Parse decoded FCL text; never raises for bad input."""
+    from fuzzyctl.fcl.errors import syntax_diagnostic
+
+    state = ParseState(source)
+    lark = _parser()
+    builder = lark.options.transformer
+    assert isinstance(builder, _Builder)
+    text = source.text
+    # One parser and one builder serve every parse; the lock keeps parses from mixing states.
+    _LOCK.acquire()
+    builder.state = state
+    _ACTIVE.append(state)
+    try:
+        document: Document | None = cast(Document, lark.parse(text))
+    except UnexpectedInput as exc:
+        recovered = _recover(lark, state, exc, source)
+        if recovered is None:
+            state.diagnostics.insert(0, syntax_diagnostic(exc, state))
+            document = None
+        else:
+            document = recovered
+    except VisitError as exc:  # pragma: no cover - a bug in the builder
+        raise exc.orig_exc from exc
+    finally:
+        _ACTIVE.pop()
+        _LOCK.release()
+    if document is not None and not document.blocks:
+        state.error("no FUNCTION_BLOCK in this file", Span(1, 1), "no-function-block")
+        document = None
+    if document is not None:
+        from fuzzyctl.fcl.comments import attach_comments
+
+        document = attach_comments(document, state.comments)
+    return ParseResult(document, state.diagnostics, source, frozenset(state.spellings))
+
+
+def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, source: Source) -> Document | None:
+    """Text after the last END_FUNCTION_BLOCK is ignored with a warning (jFuzzyLogic's
+    ANTLR grammar stops there too); any other syntax error is not recovered."""
+    from lark.exceptions import UnexpectedToken
+
+    if not isinstance(exc, UnexpectedToken) or exc.expected - {"FUNCTION_BLOCK", "$END"}:
+        return None
+    pos = exc.token.start_pos
+    if pos is None or "END_FUNCTION_BLOCK" not in source.text[:pos].upper():
+        return None
+    state.diagnostics.clear()
+    state.comments.clear()
+    state.spellings.clear()
+    try:
+        document = cast(Document, lark.parse(source.text[:pos]))
+    except UnexpectedInput:
+        return None
+    state.warn(
+        "text after END_FUNCTION_BLOCK is ignored",
+        Span(exc.token.line or 0, exc.token.column or 0),
+        "trailing-text",
+    )
+    return document
+
+
+def number_text(value: float) -> str:
+    """A float written the way FCL files write numbers (``3``, ``0.5``, ``nan``, ``-inf``)."""
+    if math.isnan(value):
+        return "nan"
+    if math.isinf(value):
+        return "inf" if value > 0 else "-inf"
+    if value == int(value) and abs(value) < 1e15:
+        return str(int(value))
+    return repr(value)

@@ -1,0 +1,231 @@
+"""Interchange formats: one registry of readers, writers and expressibility checks.
+
+Every file format fuzzyctl reads or writes is a :class:`Format` in :data:`REGISTRY`:
+``fcl`` (IEC 61131-7, from :mod:`fuzzyctl.fcl`), ``fis`` (MATLAB / Octave / fuzzylite),
+``fll`` (fuzzylite language), ``json`` (our own lossless form) and, when their modules are
+present, ``fpl`` and ``xfuz`` (PLC tools).  :func:`fuzzyctl.api.load` and ``fuzzyctl
+convert`` go through this registry and nothing else.
+
+A format module exposes ``FORMAT: Format``.  ``lower(doc)`` turns a model into what the
+format can say, returning the list of :class:`Loss` it had to accept; a conversion is
+lossless exactly when that list is empty.  Meaning-preserving rewrites (renaming a
+``LDL-Level`` to ``LDL_Level`` for FCL, a point list that is a triangle to ``trimf``) are
+not losses.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+import os
+import tempfile
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
+from fuzzyctl.model import Document
+
+
+@dataclass(frozen=True)
+class Loss:
+    """Something of the model that a target format cannot express.
+
+    ``element`` names where it is (``rule 3 of block 'No1'``, ``term 'cold' of 'temp'``),
+    ``reason`` says what the target lacks."""
+
+    element: str
+    reason: str
+
+    def __str__(self) -> str:
+        return f"{self.element}: {self.reason}"
+
+
+@dataclass(frozen=True)
+class Loaded:
+    """What a reader returns: the model and the warnings met on the way."""
+
+    document: Document
+    diagnostics: tuple[Diagnostic, ...] = ()
+
+
+Reader = Callable[[str, "str | None"], Loaded]
+"""``read(text, path) -> Loaded``; raises :class:`DiagnosticError` on invalid input."""
+Writer = Callable[[Document], str]
+"""``write(document) -> text``; expects a document :attr:`Format.lower` accepted."""
+Lowerer = Callable[[Document], "tuple[Document, list[Loss]]"]
+
+
+def _nothing_lost(document: Document) -> tuple[Document, list[Loss]]:
+    return document, []
+
+
+@dataclass(frozen=True)
+class Format:
+    """A file format: name, file extensions, reader, writer and expressibility check."""
+
+    name: str
+    extensions: tuple[str, ...]
+    description: str
+    read: Reader | None = None
+    write: Writer | None = None
+    lower: Lowerer = field(default=_nothing_lost)
+
+    def losses(self, document: Document) -> list[Loss]:
+        """What this format cannot express of ``document`` (empty: a lossless write)."""
+        return self.lower(document)[1]
+
+
+REGISTRY: dict[str, Format] = {}
+"""Registered formats by name.  Use :func:`get` and :func:`available`, which load the
+built-in ones on first use."""
+
+# Module that provides each built-in format, imported lazily (heavy parsers stay unloaded
+# until a file of that kind is used).  Optional ones may be absent from an installation.
+_BUILTIN: dict[str, str] = {
+    "fcl": "fuzzyctl.formats.fcl",
+    "fis": "fuzzyctl.formats.fis",
+    "fll": "fuzzyctl.formats.fll",
+    "json": "fuzzyctl.formats.json",
+    "fpl": "fuzzyctl.formats.fpl",
+    "xfuz": "fuzzyctl.formats.xfuz",
+}
+KNOWN_NAMES: tuple[str, ...] = tuple(_BUILTIN)
+
+
+def register(fmt: Format) -> None:
+    """Add (or replace) a format in the registry."""
+    REGISTRY[fmt.name] = fmt
+
+
+def _load_builtin(name: str) -> Format | None:
+    if name in REGISTRY:
+        return REGISTRY[name]
+    module_name = _BUILTIN.get(name)
+    if module_name is None or importlib.util.find_spec(module_name) is None:
+        return None
+    module = importlib.import_module(module_name)
+    fmt = getattr(module, "FORMAT", None)
+    if not isinstance(fmt, Format) or (fmt.read is None and fmt.write is None):
+        return None  # a module that exists but provides no usable format yet
+    register(fmt)
+    return fmt
+
+
+def available() -> list[Format]:
+    """Every format that can be used here, built-in ones first."""
+    for name in _BUILTIN:
+        _load_builtin(name)
+    return list(REGISTRY.values())
+
+
+def get(name: str) -> Format:
+    """The format called ``name``; a clear error when it is unknown or not available."""
+    key = name.lower().lstrip(".")
+    fmt = _load_builtin(key)
+    if fmt is not None:
+        return fmt
+    usable = ", ".join(f.name for f in available())
+    if key in _BUILTIN:
+        raise FuzzyctlError(f"format {key!r} is not available in this installation (available: {usable})")
+    raise FuzzyctlError(f"unknown format {name!r} (available: {usable})")
+
+
+def for_path(path: str | Path) -> Format:
+    """The format a file name's extension says (``.fis`` -> fis)."""
+    suffix = Path(path).suffix.lower()
+    for fmt in available():
+        if suffix in fmt.extensions:
+            return fmt
+    if suffix.lstrip(".") in _BUILTIN:
+        return get(suffix.lstrip("."))  # known but missing: let get() say so
+    known = ", ".join(ext for f in available() for ext in f.extensions)
+    raise FuzzyctlError(
+        f"cannot tell the format of {str(path)!r} from its extension (known: {known}); "
+        "name it with --from/--to"
+    )
+
+
+def decode(data: bytes) -> str:
+    """Source bytes as text: UTF-8 (with or without BOM), else Latin-1, which never fails
+    (the corpus has both)."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
+
+def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
+    """Parse ``text`` as ``format``."""
+    fmt = get(format)
+    if fmt.read is None:
+        raise FuzzyctlError(f"format {fmt.name!r} can be written but not read")
+    return fmt.read(text, path)
+
+
+def read_path(path: str | Path, format: str | None = None) -> Loaded:
+    """Read a file, choosing the format by ``format`` or by the file's extension."""
+    fmt = get(format) if format else for_path(path)
+    data = Path(path).read_bytes()
+    return read_text(decode(data), fmt.name, path=str(path))
+
+
+def convert(document: Document, format: str, *, lossy: bool = False) -> tuple[str, list[Loss]]:
+    """Write ``document`` as ``format``.
+
+    Raises :class:`FuzzyctlError` listing every loss unless ``lossy``; with ``lossy`` the
+    text is written without what the format cannot express and the losses are returned."""
+    fmt = get(format)
+    if fmt.write is None:
+        raise FuzzyctlError(f"format {fmt.name!r} can be read but not written")
+    lowered, losses = fmt.lower(document)
+    if losses and not lossy:
+        raise LossError(fmt.name, losses)
+    return fmt.write(lowered), losses
+
+
+class LossError(FuzzyctlError):
+    """A conversion would lose meaning; ``losses`` says what, one item per element."""
+
+    def __init__(self, format: str, losses: Sequence[Loss]) -> None:
+        self.format = format
+        self.losses = list(losses)
+        lines = "\n".join(f"  - {loss}" for loss in self.losses)
+        super().__init__(
+            f"{format} cannot express {len(self.losses)} element(s) of this model "
+            f"(use --lossy to convert anyway):\n{lines}"
+        )
+
+
+def write_atomic(path: str | Path, text: str) -> None:
+    """Write a file so that readers see the old content or the new one, never a part."""
+    target = Path(path)
+    directory = target.parent if str(target.parent) else Path(".")
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as out:
+            out.write(text)
+        os.replace(tmp, target)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+__all__ = [
+    "KNOWN_NAMES",
+    "REGISTRY",
+    "DiagnosticError",
+    "Format",
+    "Loaded",
+    "Loss",
+    "LossError",
+    "available",
+    "convert",
+    "decode",
+    "for_path",
+    "get",
+    "read_path",
+    "read_text",
+    "register",
+    "write_atomic",
+]

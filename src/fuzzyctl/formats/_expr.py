@@ -1,0 +1,196 @@
+"""Arithmetic expressions of fuzzylite ``Function`` terms, to and from the model's Expr.
+
+Grammar (fuzzylite's infix notation): numbers, names, calls ``f(a, b)``, unary ``-``/``+``,
+binary ``+ - * / %`` and ``^`` (right-associative, binds tighter than unary minus:
+``-x^2`` is ``-(x^2)``), parentheses.  Comparisons are functions (``lt``, ``gt``, ``eq``...).
+"""
+
+from __future__ import annotations
+
+import re
+
+from fuzzyctl.formats._common import fmt_number
+from fuzzyctl.model import Binary, Call, Expr, Name, Num, Unary
+
+_TOKEN = re.compile(
+    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z0-9_.]*)|(?P<op>[-+*/%^(),]))"
+)
+_BINARY_POWER = {"+": 10, "-": 10, "*": 20, "/": 20, "%": 20, "^": 40}
+_UNARY_POWER = 30
+
+
+class ExprError(ValueError):
+    """An expression that does not parse; ``position`` is the 0-based offset."""
+
+    def __init__(self, message: str, position: int) -> None:
+        super().__init__(message)
+        self.position = position
+
+
+def _tokens(text: str) -> list[tuple[str, str, int]]:
+    out: list[tuple[str, str, int]] = []
+    pos = 0
+    while pos < len(text):
+        if text[pos:].strip() == "":
+            break
+        m = _TOKEN.match(text, pos)
+        if m is None or m.end() == pos:
+            start = pos + len(text[pos:]) - len(text[pos:].lstrip())
+            raise ExprError(f"unexpected character {text[start]!r} in expression", start)
+        kind = m.lastgroup or "op"
+        out.append((kind, m.group(kind), m.start(kind)))
+        pos = m.end()
+    return out
+
+
+def parse_expr(text: str) -> Expr:
+    """Parse an infix expression; raises :class:`ExprError`."""
+    tokens = _tokens(text)
+    index = 0
+
+    def peek() -> tuple[str, str, int] | None:
+        return tokens[index] if index < len(tokens) else None
+
+    def take() -> tuple[str, str, int]:
+        nonlocal index
+        tok = peek()
+        if tok is None:
+            raise ExprError("expression ends too early", len(text))
+        index += 1
+        return tok
+
+    def expect(op: str) -> None:
+        _kind, value, pos = take()
+        if value != op:
+            raise ExprError(f"expected {op!r} but found {value!r}", pos)
+
+    def primary() -> Expr:
+        kind, value, pos = take()
+        if kind == "num":
+            return Num(float(value))
+        if kind == "name":
+            nxt = peek()
+            if nxt is not None and nxt[1] == "(":
+                take()
+                args: list[Expr] = []
+                if (peek() or ("", "", 0))[1] != ")":
+                    args.append(expression(0))
+                    while (peek() or ("", "", 0))[1] == ",":
+                        take()
+                        args.append(expression(0))
+                expect(")")
+                return Call(value.lower(), tuple(args))
+            return Name(value)
+        if value == "(":
+            inner = expression(0)
+            expect(")")
+            return inner
+        if value in {"-", "+"}:
+            return Unary(value, expression(_UNARY_POWER))
+        raise ExprError(f"unexpected {value!r} in expression", pos)
+
+    def expression(min_power: int) -> Expr:
+        left = primary()
+        while True:
+            tok = peek()
+            if tok is None or tok[0] != "op" or tok[1] not in _BINARY_POWER:
+                return left
+            power = _BINARY_POWER[tok[1]]
+            if power < min_power or (power == min_power and tok[1] != "^"):
+                return left
+            take()
+            right = expression(power if tok[1] == "^" else power + 1)
+            left = Binary(tok[1], left, right)
+
+    result = expression(0)
+    leftover = peek()
+    if leftover is not None:
+        raise ExprError(f"unexpected {leftover[1]!r} after the expression", leftover[2])
+    return result
+
+
+def names_in(expr: Expr) -> set[str]:
+    """Every name the expression reads."""
+    if isinstance(expr, Name):
+        return {expr.name}
+    if isinstance(expr, Unary):
+        return names_in(expr.operand)
+    if isinstance(expr, Binary):
+        return names_in(expr.left) | names_in(expr.right)
+    if isinstance(expr, Call):
+        out: set[str] = set()
+        for a in expr.args:
+            out |= names_in(a)
+        return out
+    return set()
+
+
+def _power(expr: Expr) -> int:
+    if isinstance(expr, Binary):
+        return _BINARY_POWER[expr.op]
+    if isinstance(expr, Unary):
+        return _UNARY_POWER
+    return 100
+
+
+def format_expr(expr: Expr) -> str:
+    """Infix text that :func:`parse_expr` reads back to an equal expression."""
+    if isinstance(expr, Num):
+        text = fmt_number(expr.value)
+        return f"({text})" if text.startswith("-") else text
+    if isinstance(expr, Name):
+        return expr.name
+    if isinstance(expr, Call):
+        return f"{expr.function}({', '.join(format_expr(a) for a in expr.args)})"
+    if isinstance(expr, Unary):
+        inner = format_expr(expr.operand)
+        if _power(expr.operand) <= _UNARY_POWER and not isinstance(expr.operand, Binary | Unary):
+            return f"{expr.op}{inner}"
+        if isinstance(expr.operand, Binary) and expr.operand.op == "^":
+            return f"{expr.op}{inner}"
+        return f"{expr.op}({inner})"
+    power = _BINARY_POWER[expr.op]
+    left, right = format_expr(expr.left), format_expr(expr.right)
+    if expr.op == "^":
+        # right-associative: parenthesise a left operand of equal or lower power
+        if _power(expr.left) <= power:
+            left = f"({left})"
+        if _power(expr.right) < power:
+            right = f"({right})"
+    else:
+        if _power(expr.left) < power:
+            left = f"({left})"
+        if _power(expr.right) <= power:
+            right = f"({right})"
+    return f"{left} {expr.op} {right}"
+
+
+_CONSTANTS = {"pi": 3.141592653589793, "e": 2.718281828459045, "inf": float("inf"), "nan": float("nan")}
+
+
+def eval_constant(expr: Expr) -> float:
+    """The value of an expression made of numbers and the constants ``pi``, ``e``, ``Inf``,
+    ``NaN`` (MATLAB evaluates a FIS ``Range=[-pi/4 pi/4]``); raises ValueError otherwise."""
+    if isinstance(expr, Num):
+        return expr.value
+    if isinstance(expr, Name):
+        if expr.name.lower() in _CONSTANTS:
+            return _CONSTANTS[expr.name.lower()]
+        raise ValueError(f"unknown name {expr.name!r}")
+    if isinstance(expr, Unary):
+        value = eval_constant(expr.operand)
+        return -value if expr.op == "-" else value
+    if isinstance(expr, Binary):
+        a, b = eval_constant(expr.left), eval_constant(expr.right)
+        if expr.op == "+":
+            return a + b
+        if expr.op == "-":
+            return a - b
+        if expr.op == "*":
+            return a * b
+        if expr.op == "/":
+            return a / b
+        if expr.op == "^":
+            return float(a**b)
+        return a % b
+    raise ValueError("functions are not allowed in a number")

@@ -1,0 +1,366 @@
+"""What FIS and FLL share when a model is written: one function block, rule weights in the
+fuzzylite/MATLAB sense, renamed identifiers, and the list of what cannot be said.
+
+A model written to FIS or FLL first goes through :func:`prepare`, which returns an
+equivalent :class:`FunctionBlock` (same evaluation results) using only what both formats
+share, plus the :class:`Loss` list for what it had to drop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from fuzzyctl.formats import Loss
+from fuzzyctl.formats._common import identifier
+from fuzzyctl.model import (
+    And,
+    Conclusion,
+    Condition,
+    Default,
+    DefuzzifyBlock,
+    Degree,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Is,
+    Not,
+    Or,
+    PointsMF,
+    Ref,
+    Rule,
+    RuleBlock,
+    ShapeMF,
+    SingletonMF,
+    SingletonsMF,
+    Term,
+    VarKind,
+)
+
+# Defuzzification methods whose output terms act as points (a weighted average of term
+# values): activation MIN and PROD give the same result there, so an IEC WITH weight
+# equals a MATLAB/fuzzylite rule weight.
+POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
+DEFAULT_WHEN_ABSENT = 0.0
+"""What our engine outputs when no rule fired and no DEFAULT is written (IEC 61131-7
+leaves it open; fuzzyctl uses 0, see docs/formats.md)."""
+
+
+def rule_label(block: RuleBlock, rule: Rule) -> str:
+    return f"rule {rule.label!r}" + (f" of block {block.name!r}" if block.name else "")
+
+
+def negation_free(condition: Condition | None) -> bool:
+    """True when NOT appears only as ``x IS NOT t``."""
+    if condition is None or isinstance(condition, Is):
+        return True
+    if isinstance(condition, Degree | Not):
+        return False
+    return all(negation_free(c) for c in condition.operands)
+
+
+def simplify_not(condition: Condition | None) -> Condition | None:
+    """``NOT (x IS t)`` -> ``x IS NOT t`` (equal by definition: 1 - mu)."""
+    if isinstance(condition, Not) and isinstance(condition.operand, Is) and not condition.operand.negated:
+        return replace(condition.operand, negated=True)
+    if isinstance(condition, And):
+        return And(tuple(simplify_not(c) or c for c in condition.operands), condition.span)
+    if isinstance(condition, Or):
+        return Or(tuple(simplify_not(c) or c for c in condition.operands), condition.span)
+    return condition
+
+
+def uncumulate(hedges: list[tuple[str, ...]]) -> list[tuple[str, ...]] | None:
+    """Written hedges per conclusion such that fuzzylite's running degree gives the model's
+    effective ``hedges``; None when no such list exists (the rule must then be split)."""
+    written: list[tuple[str, ...]] = []
+    previous: tuple[str, ...] = ()
+    for effective in hedges:
+        if len(effective) < len(previous) or effective[len(effective) - len(previous) :] != previous:
+            return None
+        written.append(effective[: len(effective) - len(previous)])
+        previous = effective
+    return written
+
+
+def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss]) -> list[Rule]:
+    """Rules equivalent to ``rule`` whose weight is a single rule weight (MATLAB/fuzzylite)
+    and whose conclusion hedges can be written; splits per conclusion when needed."""
+    act = block.act or "MIN"
+    groups: dict[float, list[Conclusion]] = {}
+    for c in rule.conclusions:
+        if isinstance(c.weight, Ref) or isinstance(rule.weight, Ref):
+            losses.append(Loss(rule_label(block, rule), "a weight given by a variable cannot be written"))
+            return []
+        w_conclusion = 1.0 if c.weight is None else float(c.weight)
+        w_rule = 1.0 if rule.weight is None else float(rule.weight)
+        out = fb.defuzzify_block(c.variable)
+        points = out is not None and (out.method or "") in POINT_METHODS
+        if w_conclusion != 1.0 and w_rule != 1.0 and not (points or act == "PROD"):
+            losses.append(
+                Loss(
+                    rule_label(block, rule),
+                    "both a rule weight and a WITH weight under ACT MIN cannot be written as one weight",
+                )
+            )
+            return []
+        if w_conclusion != 1.0 and not (points or act == "PROD"):
+            losses.append(
+                Loss(
+                    rule_label(block, rule),
+                    f"WITH {w_conclusion:g} scales the activated term under ACT {act}; the target's rule "
+                    "weight scales the degree before activation",
+                )
+            )
+            return []
+        groups.setdefault(w_rule * w_conclusion, []).append(replace(c, weight=None))
+    out_rules: list[Rule] = []
+    for i, (weight, conclusions) in enumerate(groups.items()):
+        written = uncumulate([c.hedges for c in conclusions])
+        label = rule.label if len(groups) == 1 else f"{rule.label}_{i + 1}"
+        if written is None:
+            for j, c in enumerate(conclusions):
+                out_rules.append(
+                    replace(
+                        rule,
+                        label=f"{label}_{j + 1}",
+                        conclusions=(c,),
+                        weight=None if weight == 1.0 else weight,
+                    )
+                )
+        else:
+            out_rules.append(
+                replace(
+                    rule,
+                    label=label,
+                    conclusions=tuple(conclusions),
+                    weight=None if weight == 1.0 else weight,
+                )
+            )
+    return out_rules
+
+
+def support(term: Term) -> tuple[float, float] | None:
+    """Where a term is non-zero, for terms whose support is bounded."""
+    mf = term.mf
+    if isinstance(mf, PointsMF):
+        if any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points):
+            return None
+        xs = [float(p.x) for p in mf.points]  # type: ignore[arg-type]
+        ys = [float(p.y) for p in mf.points]  # type: ignore[arg-type]
+        if ys[0] != 0.0 or ys[-1] != 0.0:
+            return None
+        return min(xs), max(xs)
+    if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
+        return float(mf.value), float(mf.value)
+    if isinstance(mf, ShapeMF) and not any(isinstance(p, Ref) for p in mf.params):
+        p = [float(v) for v in mf.params]  # type: ignore[arg-type]
+        if mf.kind == "triangle":
+            return min(p), max(p)
+        if mf.kind == "trapezoid":
+            return min(p), max(p)
+        if mf.kind in {"rectangle", "semiellipse"}:
+            return min(p), max(p)
+        if mf.kind == "cosine":
+            return p[0] - abs(p[1]) / 2, p[0] + abs(p[1]) / 2
+        if mf.kind == "constant":
+            return p[0], p[0]
+    return None
+
+
+def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
+    """The main function block rewritten for FIS/FLL, the losses, and the renaming applied
+    (old name -> new name, variables and terms share one map per variable)."""
+    losses: list[Loss] = []
+    fb = document.main
+    for other in document.blocks[1:]:
+        losses.append(
+            Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written")
+        )
+    for opt in fb.options:
+        losses.append(Loss(f"{opt.keyword} block", f"{target} has no vendor options; dropped"))
+    for var in fb.locals:
+        losses.append(Loss(f"local variable {var.name!r}", f"{target} has no intermediate variables"))
+    for var in fb.inputs:
+        if fb.fuzzify_block(var.name) is None:
+            used = any(
+                isinstance(c, Degree) and c.variable == var.name
+                for _, r in fb.rules()
+                for c in _atoms(r.condition)
+            )
+            if used:
+                continue  # reported with the rule
+    for out in fb.outputs:
+        if fb.defuzzify_block(out.name) is None:
+            losses.append(Loss(f"output {out.name!r}", "has no DEFUZZIFY block"))
+
+    # Rules: resolve NOT, weights and hedges into what FIS and FLL say.
+    new_blocks: list[RuleBlock] = []
+    local_names = {v.name for v in fb.locals}
+    for block in fb.rule_blocks:
+        rules: list[Rule] = []
+        for rule in block.rules:
+            condition = simplify_not(rule.condition)
+            label = rule_label(block, rule)
+            if not negation_free(condition):
+                losses.append(
+                    Loss(label, "NOT of a compound condition, or a bare degree variable, cannot be written")
+                )
+                continue
+            bad = [c for c in rule.conclusions if c.term is None or c.variable in local_names]
+            if bad:
+                losses.append(
+                    Loss(label, "a conclusion that is a bare variable or a local variable cannot be written")
+                )
+                continue
+            if any(a.variable in local_names for a in _atoms(condition) if isinstance(a, Is)):
+                losses.append(Loss(label, "a condition on a local variable cannot be written"))
+                continue
+            rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses))
+        new_blocks.append(replace(block, rules=tuple(rules)))
+
+    # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
+    defuzzify = []
+    for d in fb.defuzzify:
+        default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT)
+        if default.value is None:
+            default = Default(DEFAULT_WHEN_ABSENT, default.no_change)
+        defuzzify.append(replace(d, default=default))
+    fb = replace(fb, rule_blocks=tuple(new_blocks), defuzzify=tuple(defuzzify))
+    fb, renames = rename(fb)
+    return fb, losses, renames
+
+
+def _atoms(condition: Condition | None) -> list[Condition]:
+    if condition is None:
+        return []
+    if isinstance(condition, And | Or):
+        return [a for c in condition.operands for a in _atoms(c)]
+    if isinstance(condition, Not):
+        return _atoms(condition.operand)
+    return [condition]
+
+
+def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
+    """Rename variables and terms to identifiers (``LDL-Level`` -> ``LDL_Level``)."""
+    taken_vars: set[str] = set()
+    var_map = {v.name: identifier(v.name, taken_vars) for v in fb.variables}
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    if all(k == v for k, v in var_map.items()) and all(
+        identifier(t.name, set()) == t.name for blk in blocks for t in blk.terms
+    ):
+        return fb, {}
+    term_maps: dict[str, dict[str, str]] = {}
+    for blk in blocks:
+        taken: set[str] = set()
+        term_maps[blk.variable] = {t.name: identifier(t.name, taken) for t in blk.terms}
+
+    def v(name: str) -> str:
+        return var_map.get(name, name)
+
+    def t(var: str, name: str | None) -> str | None:
+        return None if name is None else term_maps.get(var, {}).get(name, name)
+
+    def cond(c: Condition | None) -> Condition | None:
+        if c is None:
+            return None
+        if isinstance(c, Is):
+            return replace(c, variable=v(c.variable), term=t(c.variable, c.term) or c.term)
+        if isinstance(c, Degree):
+            return replace(c, variable=v(c.variable))
+        if isinstance(c, Not):
+            return replace(c, operand=cond(c.operand) or c.operand)
+        return replace(c, operands=tuple(cond(o) or o for o in c.operands))
+
+    renamed = replace(
+        fb,
+        variables=tuple(replace(x, name=v(x.name)) for x in fb.variables),
+        fuzzify=tuple(
+            replace(
+                b,
+                variable=v(b.variable),
+                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
+            )
+            for b in fb.fuzzify
+        ),
+        defuzzify=tuple(
+            replace(
+                b,
+                variable=v(b.variable),
+                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
+            )
+            for b in fb.defuzzify
+        ),
+        rule_blocks=tuple(
+            replace(
+                b,
+                rules=tuple(
+                    replace(
+                        r,
+                        condition=cond(r.condition),
+                        conclusions=tuple(
+                            replace(c, variable=v(c.variable), term=t(c.variable, c.term))
+                            for c in r.conclusions
+                        ),
+                    )
+                    for r in b.rules
+                ),
+            )
+            for b in fb.rule_blocks
+        ),
+    )
+    return renamed, {k: x for k, x in var_map.items() if k != x}
+
+
+def term_losses(owner: str, term: Term, supported: set[str], target: str, losses: list[Loss]) -> bool:
+    """Report a term the target cannot express; True when it is fine."""
+    mf = term.mf
+    where = f"term {term.name!r} of {owner!r}"
+    if isinstance(mf, ShapeMF):
+        if any(isinstance(p, Ref) for p in mf.params) or isinstance(mf.height, Ref):
+            losses.append(Loss(where, "parameters given by variables cannot be written"))
+            return False
+        if mf.kind not in supported:
+            losses.append(Loss(where, f"{target} has no {mf.kind} membership function"))
+            return False
+        return True
+    if isinstance(mf, PointsMF):
+        if any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points):
+            losses.append(Loss(where, "points given by variables cannot be written"))
+            return False
+        return True
+    if isinstance(mf, SingletonsMF):
+        losses.append(Loss(where, f"{target} has no discrete singleton sets (jFuzzyLogic SINGLETONS)"))
+        return False
+    if isinstance(mf, FunctionMF):
+        return True
+    if isinstance(mf.value, Ref):
+        losses.append(Loss(where, "a singleton given by a variable cannot be written"))
+        return False
+    return True
+
+
+def is_point_output(block: DefuzzifyBlock) -> bool:
+    """A Takagi-Sugeno style output: weighted average or sum of term values."""
+    return (block.method or "") in POINT_METHODS
+
+
+def finite(x: float) -> bool:
+    return not (math.isnan(x) or math.isinf(x))
+
+
+__all__ = [
+    "DEFAULT_WHEN_ABSENT",
+    "POINT_METHODS",
+    "FuzzifyBlock",
+    "VarKind",
+    "finite",
+    "is_point_output",
+    "prepare",
+    "rule_label",
+    "split_rules",
+    "support",
+    "term_losses",
+    "uncumulate",
+]

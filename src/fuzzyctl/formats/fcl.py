@@ -1,0 +1,122 @@
+"""FCL (IEC 61131-7) in the format registry.
+
+The FCL reader and writer belong to :mod:`fuzzyctl.fcl`; this module only adapts their
+public functions to the registry and says what FCL cannot express of a model that came from
+another format (a MATLAB/fuzzylite rule weight under ACT MIN, fuzzylite's lock-range, ...).
+It uses ``fuzzyctl.fcl.load_text`` (parse and check) and ``fuzzyctl.fcl.write``.
+"""
+
+from __future__ import annotations
+
+import importlib
+import importlib.util
+from dataclasses import replace
+from typing import Any
+
+from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.model import Document, FunctionBlock, Rule, RuleBlock
+
+_POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
+
+
+def _fcl_api() -> Any | None:
+    if importlib.util.find_spec("fuzzyctl.fcl") is None:
+        return None
+    module = importlib.import_module("fuzzyctl.fcl")
+    if not (hasattr(module, "load_text") and hasattr(module, "write")):
+        return None
+    return module
+
+
+def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss]) -> Rule:
+    """A MATLAB/fuzzylite rule weight as IEC WITH weights, where that is the same thing."""
+    if rule.weight is None:
+        return rule
+    act = block.act or "MIN"
+    conclusions = []
+    for c in rule.conclusions:
+        out = fb.defuzzify_block(c.variable)
+        points = out is not None and (out.method or "") in _POINT_METHODS
+        if not (points or act == "PROD"):
+            losses.append(
+                Loss(
+                    f"rule {rule.label!r}",
+                    f"a rule weight scales the degree before ACT {act}; FCL's WITH scales the activated term",
+                )
+            )
+            return replace(rule, weight=None)
+        if c.weight is not None and not isinstance(c.weight, float | int):
+            losses.append(Loss(f"rule {rule.label!r}", "a rule weight times a variable WITH weight"))
+            return replace(rule, weight=None)
+        w = float(rule.weight) * (1.0 if c.weight is None else float(c.weight))  # type: ignore[arg-type]
+        conclusions.append(replace(c, weight=w))
+    return replace(rule, weight=None, conclusions=tuple(conclusions))
+
+
+def lower(document: Document) -> tuple[Document, list[Loss]]:
+    """Rewrite what FCL says differently, report what it cannot say at all."""
+    losses: list[Loss] = []
+    blocks = []
+    for fb in document.blocks:
+        for f in fb.fuzzify:
+            if f.clamp:
+                losses.append(
+                    Loss(
+                        f"input {f.variable!r}",
+                        "FCL cannot clamp an input to its RANGE (fuzzylite lock-range)",
+                    )
+                )
+        for d in fb.defuzzify:
+            if d.clamp:
+                losses.append(
+                    Loss(f"output {d.variable!r}", "FCL cannot clamp an output (fuzzylite lock-range)")
+                )
+        rule_blocks = []
+        for block in fb.rule_blocks:
+            if not block.enabled:
+                losses.append(Loss(f"rule block {block.name!r}", "FCL has no disabled rule blocks; dropped"))
+                continue
+            if block.rule_activation:
+                losses.append(
+                    Loss(f"rule block {block.name!r}", f"FCL fires every rule ({block.rule_activation!r})")
+                )
+            rules = []
+            for rule in block.rules:
+                rule = _rule_weight_to_conclusions(fb, block, rule, losses)
+                if any(c.hedges for c in rule.conclusions):
+                    losses.append(Loss(f"rule {rule.label!r}", "FCL has no hedges on conclusions"))
+                    rule = replace(rule, conclusions=tuple(replace(c, hedges=()) for c in rule.conclusions))
+                rules.append(rule)
+            rule_blocks.append(replace(block, rules=tuple(rules), enabled=True, rule_activation=None))
+        fuzzify = tuple(replace(f, clamp=False) for f in fb.fuzzify)
+        defuzzify = tuple(replace(d, clamp=False) for d in fb.defuzzify)
+        blocks.append(replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify))
+    return replace(document, blocks=tuple(blocks)), losses
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    api = _fcl_api()
+    assert api is not None
+    result = api.load_text(text, path)
+    document = result.raise_for_errors()
+    assert isinstance(document, Document)
+    return Loaded(document, tuple(d for d in result.diagnostics if not d.is_error))
+
+
+def _write(document: Document) -> str:
+    api = _fcl_api()
+    assert api is not None
+    text = api.write(document)
+    assert isinstance(text, str)
+    return text
+
+
+_available = _fcl_api() is not None
+FORMAT = Format(
+    name="fcl",
+    extensions=(".fcl",),
+    description="IEC 61131-7 Fuzzy Control Language",
+    read=_read if _available else None,
+    write=_write if _available else None,
+    lower=lower,
+)

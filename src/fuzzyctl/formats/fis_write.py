@@ -1,0 +1,456 @@
+"""Writing MATLAB FIS from the model.
+
+The output is a MATLAB FIS (Version 2.0) that MATLAB, Octave and fuzzylite read.  When the
+model needs what only fuzzylite's FIS dialect says (an explicit ``Default``, ``LockPrevious``,
+an output ``LockRange``, fuzzylite hedges or membership types, heights), the file starts
+with a comment naming that dialect, which our reader and fuzzylite honour.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
+
+from fuzzyctl.formats import Loss
+from fuzzyctl.formats._common import fmt_number, hedge_power
+from fuzzyctl.formats._expr import format_expr
+from fuzzyctl.formats._lower import is_point_output, prepare, rule_label, support, term_losses, uncumulate
+from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES
+from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
+from fuzzyctl.model import (
+    And,
+    Condition,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Is,
+    Or,
+    Point,
+    PointsMF,
+    Range,
+    Rule,
+    RuleBlock,
+    ShapeMF,
+    SingletonMF,
+    Term,
+)
+
+_AND = {v: k for k, v in AND_METHODS.items()}
+_OR = {v: k for k, v in OR_METHODS.items()}
+_AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
+_AGG["ASUM"] = "probor"
+_DEFUZZ = {v: k for k, v in DEFUZZ_METHODS.items() if k != "centroid_integral"}
+_DEFUZZ["COGS"] = "wtaver"
+DIALECT_COMMENT = (
+    "% FIS written by fuzzyctl in the fuzzylite dialect "
+    "(Default/LockPrevious/LockRange keys, fuzzylite hedges and membership types)"
+)
+_FUZZYLITE_HEDGE_CODE = {hedges: code for code, hedges in FUZZYLITE_HEDGE_CODES.items()}
+
+
+@dataclass
+class _Plan:
+    fb: FunctionBlock
+    fuzzylite: bool
+
+
+def _needs_fuzzylite(fb: FunctionBlock) -> bool:
+    for d in fb.defuzzify:
+        default = d.default
+        if d.clamp or (default is not None and default.no_change):
+            return True
+        mid = (d.range.low + d.range.high) / 2 if d.range else None
+        if (
+            default is not None
+            and default.value is not None
+            and (mid is None or not _same(default.value, mid))
+        ):
+            return True
+    all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in all_blocks:
+        for t in blk.terms:
+            mf = t.mf
+            if isinstance(mf, FunctionMF):
+                return True
+            if (
+                isinstance(mf, ShapeMF)
+                and mf.kind not in {"constant", "linear"}
+                and (FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0)  # type: ignore[arg-type]
+            ):
+                return True
+            if isinstance(mf, PointsMF) and _points_as_matlab(mf) is None:
+                return True
+    for _, rule in fb.rules():
+        hedges = [a.hedges for a in _ises(rule.condition)] + [c.hedges for c in rule.conclusions]
+        if any(h in {("extremely",), ("seldom",)} for h in hedges) or any(c.hedges for c in rule.conclusions):
+            return True
+    return False
+
+
+def _same(a: float, b: float) -> bool:
+    return (math.isnan(a) and math.isnan(b)) or a == b
+
+
+def _points_as_matlab(mf: PointsMF) -> tuple[str, list[float]] | None:
+    """A point list that is exactly a trimf or trapmf (shoulders via +-Inf)."""
+    pts = [(float(p.x), float(p.y)) for p in mf.points]  # type: ignore[arg-type]
+    ys = [y for _, y in pts]
+    xs = [x for x, _ in pts]
+    if ys == [0.0, 1.0, 0.0]:
+        return "trimf", xs
+    if ys == [0.0, 1.0, 1.0, 0.0]:
+        return "trapmf", xs
+    if ys == [1.0, 0.0]:
+        return "trapmf", [-math.inf, -math.inf, xs[0], xs[1]]
+    if ys == [0.0, 1.0]:
+        return "trapmf", [xs[0], xs[1], math.inf, math.inf]
+    if ys == [1.0, 1.0, 0.0]:
+        return "trapmf", [-math.inf, -math.inf, xs[1], xs[2]]
+    if ys == [0.0, 1.0, 1.0]:
+        return "trapmf", [xs[0], xs[1], math.inf, math.inf]
+    return None
+
+
+def _ises(condition: Condition | None) -> list[Is]:
+    if condition is None:
+        return []
+    if isinstance(condition, Is):
+        return [condition]
+    if isinstance(condition, And | Or):
+        return [a for c in condition.operands for a in _ises(c)]
+    return []
+
+
+def lower(document: Document) -> tuple[Document, list[Loss]]:
+    """The model as a FIS can state it, and what had to be dropped."""
+    fb, losses, _ = prepare(document, "FIS")
+    supported = set(FIS_OF_KIND) | {"constant", "linear"}
+    # Inputs of a FIS cannot be clamped (fuzzylite's FIS importer rejects LockRange there).
+    fuzzify: list[FuzzifyBlock] = []
+    for f in fb.fuzzify:
+        if f.clamp:
+            losses.append(
+                Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)")
+            )
+            f = replace(f, clamp=False)
+        fuzzify.append(_with_range(f, losses))  # type: ignore[arg-type]
+    fb = replace(fb, fuzzify=tuple(fuzzify))
+    defuzzify: list[DefuzzifyBlock] = []
+    for d in fb.defuzzify:
+        kept = []
+        for t in d.terms:
+            if isinstance(t.mf, SingletonMF):
+                if is_point_output(d):
+                    kept.append(replace(t, mf=ShapeMF("constant", (t.mf.value,))))
+                    continue
+                losses.append(
+                    Loss(f"term {t.name!r} of {d.variable!r}", "FIS has no singleton in a centroid output")
+                )
+                continue
+            if term_losses(d.variable, t, supported, "FIS", losses):
+                kept.append(t)
+        defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))  # type: ignore[arg-type]
+    fb = replace(fb, defuzzify=tuple(defuzzify))
+    fb = replace(
+        fb,
+        fuzzify=tuple(
+            replace(
+                f,
+                terms=tuple(
+                    t
+                    for t in f.terms
+                    if term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                ),
+            )
+            for f in fb.fuzzify
+        ),
+    )
+
+    # One rule block with one set of operators.
+    enabled = [b for b in fb.rule_blocks if b.enabled]
+    for b in fb.rule_blocks:
+        if b.rule_activation:
+            losses.append(
+                Loss(f"rule block {b.name!r}", f"FIS fires every rule ({b.rule_activation!r} dropped)")
+            )
+    # Only operators that matter must agree: AND/OR where rules use them, the implication
+    # where a block concludes on a Mamdani output.
+    merged: dict[str, str] = {}
+    for b in enabled:
+        used = {
+            "AndMethod": (b.and_op or "MIN") if any(isinstance(r.condition, And) for r in b.rules) else None,
+            "OrMethod": (b.or_op or "MAX") if any(isinstance(r.condition, Or) for r in b.rules) else None,
+            "ImpMethod": (b.act or "MIN")
+            if any(
+                not is_point_output(fb.defuzzify_block(c.variable) or DefuzzifyBlock(c.variable, ()))
+                for r in b.rules
+                for c in r.conclusions
+            )
+            else None,
+        }
+        for key, value in used.items():
+            if value is None:
+                continue
+            if merged.setdefault(key, value) != value:
+                losses.append(
+                    Loss(
+                        f"rule block {b.name!r}",
+                        f"FIS has one {key} for all rules: {merged[key]} is kept, {value} dropped",
+                    )
+                )
+    base = next((b for b in enabled if b.rules), enabled[0] if enabled else RuleBlock(None, ()))
+    first = replace(
+        base,
+        and_op=merged.get("AndMethod", base.and_op),
+        or_op=merged.get("OrMethod", base.or_op),
+        act=merged.get("ImpMethod", base.act),
+    )
+    rules: list[Rule] = []
+    outputs = {d.variable for d in fb.defuzzify}
+    fuzzylite = _needs_fuzzylite(fb)
+    for b in enabled:
+        for rule in b.rules:
+            reason = _rule_problem(fb, rule, outputs, fuzzylite)
+            if reason:
+                losses.append(Loss(rule_label(b, rule), reason))
+                continue
+            rules.append(replace(rule, label=str(len(rules) + 1)))
+    accu_values = {d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)} | (
+        {b.accu for b in enabled if b.accu} if any(not is_point_output(d) for d in fb.defuzzify) else set()
+    )
+    if len(accu_values) > 1:
+        losses.append(
+            Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}")
+        )
+    for d in fb.defuzzify:
+        if d.method == "COGF" or (d.accu or "") == "NSUM":
+            losses.append(
+                Loss(f"output {d.variable!r}", f"FIS has no {d.method if d.method == 'COGF' else 'NSUM'}")
+            )
+    methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
+    if len(methods) > 1:
+        losses.append(
+            Loss("defuzzification", f"FIS has one DefuzzMethod; the outputs use {', '.join(sorted(methods))}")
+        )
+    ts_methods = {("WTSUM" if d.method == "WTSUM" else "WTAVER") for d in fb.defuzzify if is_point_output(d)}
+    if methods and ts_methods - {"WTAVER"}:
+        losses.append(
+            Loss("defuzzification", "a FIS mixing Mamdani and Sugeno outputs has weighted averages only")
+        )
+    block = replace(first, rules=tuple(rules), accu=(sorted(accu_values)[0] if accu_values else first.accu))
+    fb = replace(fb, rule_blocks=(block,))
+    return Document((fb,), document.path), losses
+
+
+def _with_range(blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss]) -> FuzzifyBlock | DefuzzifyBlock:
+    """A FIS variable needs a Range: take RANGE, else the span of bounded terms."""
+    if blk.range is not None:
+        return blk
+    spans = [support(t) for t in blk.terms]
+    if blk.terms and all(s is not None for s in spans):
+        low = min(s[0] for s in spans if s)
+        high = max(s[1] for s in spans if s)
+        return replace(blk, range=Range(low, high))
+    if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
+        losses.append(Loss(f"output {blk.variable!r}", "has no RANGE and unbounded terms; FIS needs a Range"))
+    return (
+        replace(blk, range=Range(-math.inf, math.inf))
+        if isinstance(blk, DefuzzifyBlock)
+        else replace(blk, range=Range(0.0, 1.0) if not blk.terms else Range(-math.inf, math.inf))
+    )
+
+
+def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: bool) -> str | None:
+    c = rule.condition
+    if isinstance(c, And | Or):
+        if not all(isinstance(o, Is) for o in c.operands):
+            return "FIS joins a rule's conditions with one AND or OR, without nesting"
+        atoms = [o for o in c.operands if isinstance(o, Is)]
+    elif c is None or isinstance(c, Is):
+        atoms = [] if c is None else [c]
+    else:
+        return "this condition has no FIS form"
+    names = [a.variable for a in atoms if isinstance(a, Is)]
+    if len(set(names)) != len(names):
+        return "FIS can test each input once per rule"
+    if any(n in outputs for n in names):
+        return "FIS cannot test an output variable in a condition (chained rules)"
+    if any(n not in {f.variable for f in fb.fuzzify} for n in names):
+        return "the condition tests a variable without terms"
+    concl = [x.variable for x in rule.conclusions]
+    if len(set(concl)) != len(concl):
+        return "FIS can conclude once per output in a rule"
+    for a in atoms:
+        if isinstance(a, Is) and _hedge_code(a.hedges, fuzzylite) is None:
+            return f"FIS has no code for the hedges {' '.join(a.hedges)}"
+    written = uncumulate([x.hedges for x in rule.conclusions])
+    if written is None or any(_hedge_code(h, fuzzylite) is None for h in written):
+        return "FIS has no code for these conclusion hedges"
+    for x in rule.conclusions:
+        blk = fb.defuzzify_block(x.variable)
+        if blk is None or blk.term(x.term or "") is None:
+            return "refers to a term that could not be written"
+    for a in atoms:
+        fblk = fb.fuzzify_block(a.variable)
+        if fblk is None or fblk.term(a.term) is None:
+            return "refers to a term that could not be written"
+    return None
+
+
+def _hedge_code(hedges: tuple[str, ...], fuzzylite: bool) -> int | None:
+    """Hundredths added to a term index for these hedges (0: none), in the given dialect."""
+    if not hedges:
+        return 0
+    if hedges in _FUZZYLITE_HEDGE_CODE:
+        code = _FUZZYLITE_HEDGE_CODE[hedges]
+        return code if fuzzylite or hedges not in {("extremely",), ("seldom",)} else None
+    if fuzzylite:
+        return None
+    if len(hedges) == 1:
+        power = hedge_power(hedges[0])
+        if power is not None and abs(power * 10 - round(power * 10)) < 1e-9 and 1 <= round(power * 10) <= 98:
+            return round(power * 10)
+    return None
+
+
+def _mf_text(term: Term) -> str:
+    mf = term.mf
+    name = term.name.replace("'", "")
+    if isinstance(mf, ShapeMF):
+        if mf.kind in {"constant", "linear"}:
+            kind = mf.kind
+            values = [float(p) for p in mf.params]  # type: ignore[arg-type]
+        else:
+            kind = FIS_OF_KIND[mf.kind]
+            values = FIS_TYPES[kind].from_model(tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
+            if float(mf.height) != 1.0:  # type: ignore[arg-type]
+                values.append(float(mf.height))  # type: ignore[arg-type]
+        return f"'{name}':'{kind}',[{' '.join(fmt_number(v) for v in values)}]"
+    if isinstance(mf, PointsMF):
+        as_matlab = _points_as_matlab(mf)
+        if as_matlab is not None:
+            kind, xs = as_matlab
+            return f"'{name}':'{kind}',[{' '.join(fmt_number(v) for v in xs)}]"
+        flat = [v for p in mf.points for v in (float(p.x), float(p.y))]  # type: ignore[arg-type]
+        return f"'{name}':'discretemf',[{' '.join(fmt_number(v) for v in flat)}]"
+    if isinstance(mf, FunctionMF):
+        return f"'{name}':'function',[{format_expr(mf.expr)}]"
+    raise TypeError(f"term {term.name!r} has no FIS form")
+
+
+def write(document: Document) -> str:
+    """FIS text of a document that :func:`lower` returned."""
+    fb = document.main
+    fuzzylite = _needs_fuzzylite(fb)
+    block = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock(None, ())
+    point = [is_point_output(d) for d in fb.defuzzify]
+    fis_type = "sugeno" if point and all(point) else ("hybrid" if any(point) else "mamdani")
+    mamdani_methods = [d.method or "COG" for d in fb.defuzzify if not is_point_output(d)]
+    ts_methods = [d.method for d in fb.defuzzify if is_point_output(d)]
+    defuzz = (
+        _DEFUZZ[mamdani_methods[0]] if mamdani_methods else ("wtsum" if "WTSUM" in ts_methods else "wtaver")
+    )
+    accu = (
+        next((d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)), None) or block.accu or "MAX"
+    )
+    out: list[str] = []
+    if fuzzylite:
+        out.append(DIALECT_COMMENT)
+    out += [
+        "[System]",
+        f"Name='{(fb.name or '').replace(chr(39), '')}'",
+        f"Type='{fis_type}'",
+        "Version=2.0",
+        f"NumInputs={len(fb.inputs)}",
+        f"NumOutputs={len(fb.defuzzify)}",
+        f"NumRules={len(block.rules)}",
+        f"AndMethod='{_AND[block.and_op or 'MIN']}'",
+        f"OrMethod='{_OR[block.or_op or 'MAX']}'",
+        f"ImpMethod='{_AND[block.act or 'MIN']}'",
+        f"AggMethod='{_AGG.get(accu, 'max')}'",
+        f"DefuzzMethod='{defuzz}'",
+    ]
+    inputs = list(fb.inputs)
+    for i, var in enumerate(inputs, start=1):
+        blk = fb.fuzzify_block(var.name)
+        terms = blk.terms if blk else ()
+        rng = (blk.range if blk else None) or var.range or Range(0.0, 1.0)
+        out += [
+            "",
+            f"[Input{i}]",
+            f"Name='{var.name}'",
+            f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]",
+            f"NumMFs={len(terms)}",
+        ]
+        out += [f"MF{k}={_mf_text(t)}" for k, t in enumerate(terms, start=1)]
+    for i, d in enumerate(fb.defuzzify, start=1):
+        rng = d.range or Range(0.0, 1.0)
+        out += [
+            "",
+            f"[Output{i}]",
+            f"Name='{d.variable}'",
+            f"Range=[{fmt_number(rng.low)} {fmt_number(rng.high)}]",
+        ]
+        if fuzzylite:
+            value = d.default.value if d.default and d.default.value is not None else 0.0
+            out += [
+                f"Default={fmt_number(value)}",
+                f"LockPrevious={int(bool(d.default and d.default.no_change))}",
+                f"LockRange={int(d.clamp)}",
+            ]
+        out.append(f"NumMFs={len(d.terms)}")
+        out += [f"MF{k}={_mf_text(t)}" for k, t in enumerate(d.terms, start=1)]
+    out += ["", "[Rules]"]
+    for rule in block.rules:
+        out.append(_rule_text(fb, rule, inputs, fuzzylite))
+    return "\n".join(out) + "\n"
+
+
+def _entry(index: int, negated: bool, hedges: tuple[str, ...], fuzzylite: bool) -> str:
+    code = _hedge_code(hedges, fuzzylite) or 0
+    value = index + code / 100.0
+    text = f"{index}" if code == 0 else f"{value:.2f}"
+    return f"-{text}" if negated else text
+
+
+def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylite: bool) -> str:
+    from fuzzyctl.model import Variable
+
+    atoms = _ises(rule.condition)
+    by_var = {a.variable: a for a in atoms}
+    if rule.condition is None and fuzzylite and inputs:
+        # fuzzylite reads "0.99" as "x is any" (a rule of don't-cares would not load there);
+        # MATLAB truncates it to 0, a don't-care: both give degree 1.
+        return (
+            f"{' '.join(['0.99'] + ['0'] * (len(inputs) - 1))}, "
+            + _rule_text(fb, replace(rule, condition=Is("", "")), inputs, fuzzylite).split(", ", 1)[1]
+        )
+    ante = []
+    for var in inputs:
+        assert isinstance(var, Variable)
+        a = by_var.get(var.name)
+        blk = fb.fuzzify_block(var.name)
+        if a is None or blk is None:
+            ante.append("0")
+            continue
+        index = [t.name for t in blk.terms].index(a.term) + 1
+        ante.append(_entry(index, a.negated, a.hedges, fuzzylite))
+    written = uncumulate([c.hedges for c in rule.conclusions]) or [c.hedges for c in rule.conclusions]
+    hedges_of = {c.variable: h for c, h in zip(rule.conclusions, written, strict=True)}
+    cons = []
+    for d in fb.defuzzify:
+        c = next((x for x in rule.conclusions if x.variable == d.variable), None)
+        if c is None:
+            cons.append("0")
+            continue
+        index = [t.name for t in d.terms].index(c.term or "") + 1
+        cons.append(_entry(index, False, hedges_of[d.variable], fuzzylite))
+    weight = 1.0 if rule.weight is None else float(rule.weight)  # type: ignore[arg-type]
+    connection = 2 if isinstance(rule.condition, Or) else 1
+    return f"{' '.join(ante)}, {' '.join(cons)} ({fmt_number(weight)}) : {connection}"
+
+
+__all__ = ["Point", "lower", "write"]

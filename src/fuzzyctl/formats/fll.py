@@ -1,0 +1,571 @@
+"""fuzzylite language (FLL) files: fuzzylite 5 and 6 (C++) and pyfuzzylite 8.
+
+Semantics follow fuzzylite's C++ sources, which the ``.fld`` datasets were made with:
+
+* ``lock-range`` clamps an input before fuzzification and an output after defuzzification;
+  ``lock-previous`` keeps the last valid output (``DEFAULT := nan | NC`` in the model).
+* A rule weight (``with 0.5``) multiplies the antecedent degree before implication
+  (model :attr:`Rule.weight`).
+* Hedges in a consequent modify the activation degree; fuzzylite applies them to a running
+  degree, so a conclusion also receives the hedges of the conclusions before it in the same
+  rule.  The reader stores that effective list on each :class:`Conclusion`, the writer
+  undoes it, so the model states what fuzzylite computes.
+* ``x is any`` holds with degree 1: an ``and`` drops it, an ``or`` becomes true, and a rule
+  whose whole antecedent is ``any`` gets no condition.
+* Duplicate term names: rules refer to the first (fuzzylite C++); later ones are renamed
+  ``name_2``, ... with a warning (pyfuzzylite would take the last).
+* Version 5 spellings: ``accumulation:`` for ``aggregation:``, ``activation: <TNorm>`` for
+  ``implication:``, ``lock-valid`` for ``lock-previous``.
+
+The writer lives in :mod:`fuzzyctl.formats.fll_write`.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+import re
+from dataclasses import dataclass, field
+
+from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats._common import Reporter, parse_number, unique_name
+from fuzzyctl.formats._expr import ExprError, names_in, parse_expr
+from fuzzyctl.formats._terms import FLL_TYPES
+from fuzzyctl.model import (
+    And,
+    Conclusion,
+    Condition,
+    Default,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Is,
+    MembershipFunction,
+    Or,
+    Point,
+    PointsMF,
+    Range,
+    Rule,
+    RuleBlock,
+    ShapeMF,
+    Term,
+    Variable,
+    VarKind,
+)
+
+TNORMS = {
+    "Minimum": "MIN",
+    "AlgebraicProduct": "PROD",
+    "BoundedDifference": "BDIF",
+    "DrasticProduct": "DMIN",
+    "EinsteinProduct": "EINSTEIN",
+    "HamacherProduct": "HAMACHER",
+    "NilpotentMinimum": "NIPMIN",
+}
+SNORMS_OR = {
+    "Maximum": "MAX",
+    "AlgebraicSum": "ASUM",
+    "BoundedSum": "BSUM",
+    "DrasticSum": "DMAX",
+    "EinsteinSum": "EINSTEIN",
+    "HamacherSum": "HAMACHER",
+    "NilpotentMaximum": "NIPMAX",
+}
+SNORMS_ACCU = {
+    "Maximum": "MAX",
+    "AlgebraicSum": "PROBOR",
+    "BoundedSum": "BSUM",
+    "DrasticSum": "DMAX",
+    "EinsteinSum": "EINSTEIN",
+    "HamacherSum": "HAMACHER",
+    "NilpotentMaximum": "NIPMAX",
+    "UnboundedSum": "SUM",
+}
+DEFUZZIFIERS = {
+    "Centroid": "COG",
+    "Bisector": "COA",
+    "SmallestOfMaximum": "LM",
+    "LargestOfMaximum": "RM",
+    "MeanOfMaximum": "MOM",
+    "WeightedAverage": "WTAVER",
+    "WeightedSum": "WTSUM",
+}
+HEDGE_WORDS = frozenset({"not", "very", "somewhat", "extremely", "seldom", "any"})
+KEYWORDS = frozenset({"if", "then", "and", "or", "is", "with"})
+
+_LINE = re.compile(r"^(?P<indent>\s*)(?P<key>[A-Za-z][A-Za-z-]*)\s*:\s?(?P<value>.*)$")
+
+
+@dataclass
+class _Variable:
+    kind: VarKind
+    name: str
+    line: int
+    range: Range | None = None
+    clamp: bool = False
+    terms: list[Term] = field(default_factory=list)
+    term_names: set[str] = field(default_factory=set)
+    accu: str | None = None
+    method: str | None = None
+    default: float = math.nan
+    lock_previous: bool = False
+    description: str | None = None
+
+
+@dataclass
+class _Block:
+    name: str | None
+    line: int
+    enabled: bool = True
+    and_op: str | None = None
+    or_op: str | None = None
+    act: str | None = None
+    rule_activation: str | None = None
+    rules: list[tuple[str, int]] = field(default_factory=list)
+
+
+def _bool(value: str, rep: Reporter, line: int, key: str) -> bool:
+    lowered = value.strip().lower()
+    if lowered in {"true", "1"}:
+        return True
+    if lowered in {"false", "0"}:
+        return False
+    raise rep.fail(f"{key} must be true or false, found {value.strip()!r}", line, code="fll-value")
+
+
+def _numbers(words: list[str], rep: Reporter, line: int, what: str) -> list[float]:
+    try:
+        return [parse_number(w) for w in words]
+    except ValueError:
+        raise rep.fail(
+            f"{what}: expected numbers, found {' '.join(words)!r}", line, code="fll-number"
+        ) from None
+
+
+def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, names: set[str]) -> Term:
+    words = value.split()
+    if len(words) < 2:
+        raise rep.fail("term: expected 'name Class parameters'", line, code="fll-term")
+    name, cls = words[0], words[1]
+    rest = value.split(None, 2)[2] if len(words) > 2 else ""
+    mf: MembershipFunction
+    if cls == "Function":
+        try:
+            expr = parse_expr(rest)
+        except ExprError as exc:
+            raise rep.fail(f"Function {name!r}: {exc}", line, code="fll-function") from None
+        argument = "x" if "x" in names_in(expr) and "x" not in names else None
+        mf = FunctionMF(expr, rest.strip(), argument)
+    elif cls == "Constant":
+        params = _numbers(words[2:], rep, line, f"term {name!r}")
+        if len(params) != 1:
+            raise rep.fail(f"Constant {name!r} takes one value, found {len(params)}", line, code="fll-term")
+        mf = ShapeMF("constant", (params[0],))
+    elif cls == "Linear":
+        params = _numbers(words[2:], rep, line, f"term {name!r}")
+        if len(params) == n_inputs:
+            params.append(0.0)
+        if len(params) != n_inputs + 1:
+            raise rep.fail(
+                f"Linear {name!r} needs {n_inputs} or {n_inputs + 1} coefficients (one per input variable "
+                f"and a constant), found {len(params)}",
+                line,
+                code="fll-term",
+            )
+        mf = ShapeMF("linear", tuple(params))
+    elif cls == "Discrete":
+        params = _numbers(words[2:], rep, line, f"term {name!r}")
+        height = params.pop() if len(params) % 2 == 1 else 1.0
+        if len(params) < 2:
+            raise rep.fail(f"Discrete {name!r} needs x y pairs", line, code="fll-term")
+        xs, ys = params[0::2], params[1::2]
+        if any(b < a for a, b in itertools.pairwise(xs)):
+            raise rep.fail(f"Discrete {name!r}: x values must ascend", line, code="fll-term")
+        mf = PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
+    else:
+        mapping = FLL_TYPES.get(cls)
+        if mapping is None:
+            known = ", ".join(sorted([*FLL_TYPES, "Constant", "Linear", "Discrete", "Function"]))
+            raise rep.fail(f"unknown term class {cls!r} (known: {known})", line, code="fll-term")
+        params = _numbers(words[2:], rep, line, f"term {name!r}")
+        if len(params) not in (mapping.arity, mapping.arity + 1):
+            raise rep.fail(
+                f"{cls} {name!r} takes {mapping.arity} parameters (and an optional height), "
+                f"found {len(params)}",
+                line,
+                code="fll-term",
+            )
+        height = params[mapping.arity] if len(params) > mapping.arity else 1.0
+        mf = ShapeMF(mapping.kind, mapping.to_model(params), height)
+    unique = unique_name(name, var.term_names)
+    if unique != name:
+        rep.warning(
+            f"duplicate term name {name!r} in {var.name!r}: rules use the first (as fuzzylite C++ does); "
+            f"this one is renamed {unique!r}",
+            line,
+            code="duplicate-term",
+        )
+    return Term(unique, mf, rep.span(line))
+
+
+class _RuleParser:
+    """Recursive descent over one rule's words (``and`` binds tighter than ``or``)."""
+
+    def __init__(self, text: str, line: int, rep: Reporter, variables: dict[str, _Variable]) -> None:
+        self.words = re.findall(r"\(|\)|[^\s()]+", text)
+        self.pos = 0
+        self.line = line
+        self.rep = rep
+        self.variables = variables
+
+    def fail(self, message: str) -> Exception:
+        return self.rep.fail(f"rule: {message}", self.line, code="fll-rule")
+
+    def peek(self) -> str | None:
+        return self.words[self.pos] if self.pos < len(self.words) else None
+
+    def take(self, what: str) -> str:
+        word = self.peek()
+        if word is None:
+            raise self.fail(f"expected {what} but the rule ends")
+        self.pos += 1
+        return word
+
+    def expect(self, word: str) -> None:
+        found = self.take(repr(word))
+        if found != word:
+            raise self.fail(f"expected {word!r} but found {found!r}")
+
+    def rule(self, label: str) -> Rule:
+        self.expect("if")
+        condition = self.disjunction()
+        self.expect("then")
+        conclusions = self.consequent()
+        weight: float | None = None
+        if self.peek() == "with":
+            self.take("with")
+            word = self.take("a weight")
+            try:
+                weight = parse_number(word)
+            except ValueError:
+                raise self.fail(f"weight must be a number, found {word!r}") from None
+        if self.peek() is not None:
+            raise self.fail(f"unexpected {self.peek()!r} at the end")
+        value = None if isinstance(condition, bool) else condition
+        return Rule(
+            label,
+            value,
+            tuple(conclusions),
+            self.rep.span(self.line),
+            weight=None if weight is None or weight == 1.0 else weight,
+        )
+
+    # Conditions are Condition objects, or True for "x is any" (always holds).
+    def disjunction(self) -> Condition | bool:
+        operands = [self.conjunction()]
+        while self.peek() == "or":
+            self.take("or")
+            operands.append(self.conjunction())
+        if any(o is True for o in operands):
+            return True
+        items = tuple(o for o in operands if not isinstance(o, bool))
+        return items[0] if len(items) == 1 else Or(items, self.rep.span(self.line))
+
+    def conjunction(self) -> Condition | bool:
+        operands = [self.atom()]
+        while self.peek() == "and":
+            self.take("and")
+            operands.append(self.atom())
+        items = tuple(o for o in operands if not isinstance(o, bool))
+        if not items:
+            return True
+        return items[0] if len(items) == 1 else And(items, self.rep.span(self.line))
+
+    def atom(self) -> Condition | bool:
+        if self.peek() == "(":
+            self.take("(")
+            inner = self.disjunction()
+            self.expect(")")
+            return inner
+        name = self.take("a variable")
+        var = self.variables.get(name)
+        if var is None:
+            raise self.fail(f"unknown variable {name!r}")
+        self.expect("is")
+        hedges: list[str] = []
+        while self.peek() in HEDGE_WORDS:
+            hedges.append(self.take("a hedge"))
+            if hedges[-1] == "any":
+                break
+        if hedges and hedges[-1] == "any":
+            if "not" in hedges:
+                raise self.fail("'not any' never holds and is not supported")
+            return True
+        term = self.take("a term")
+        if term not in var.term_names:
+            raise self.fail(f"{name!r} has no term {term!r}")
+        negated = bool(hedges) and hedges[0] == "not"
+        rest = tuple(hedges[1:] if negated else hedges)
+        if "not" in rest:
+            raise self.fail("'not' after another hedge is not supported (write it first)")
+        return Is(name, term, negated, rest, self.rep.span(self.line))
+
+    def consequent(self) -> list[Conclusion]:
+        out: list[Conclusion] = []
+        running: tuple[str, ...] = ()
+        while True:
+            name = self.take("an output variable")
+            var = self.variables.get(name)
+            if var is None or var.kind is not VarKind.OUTPUT:
+                raise self.fail(f"{name!r} is not an output variable")
+            self.expect("is")
+            own: list[str] = []
+            while self.peek() in HEDGE_WORDS - {"any", "not"}:
+                own.append(self.take("a hedge"))
+            if self.peek() in {"any", "not"}:
+                raise self.fail(f"hedge {self.peek()!r} is not supported in a conclusion")
+            term = self.take("a term")
+            if term not in var.term_names:
+                raise self.fail(f"{name!r} has no term {term!r}")
+            # fuzzylite hedges a running degree: earlier conclusions' hedges apply too.
+            running = (*own, *running)
+            out.append(Conclusion(name, term, None, self.rep.span(self.line), running))
+            if self.peek() != "and":
+                return out
+            self.take("and")
+
+
+def read(text: str, path: str | None = None) -> Loaded:
+    """Parse an FLL file into a one-block :class:`Document`."""
+    lines = text.splitlines()
+    rep = Reporter(path, lines)
+    engine_name: str | None = None
+    engine_line = 1
+    saw_engine = False
+    variables: list[_Variable] = []
+    blocks: list[_Block] = []
+    current: _Variable | _Block | None = None
+    pending_terms: list[tuple[_Variable, str, int]] = []
+    for number, raw in enumerate(lines, start=1):
+        line = raw.split("#", 1)[0].rstrip()
+        if not line.strip():
+            continue
+        m = _LINE.match(line)
+        if m is None:
+            raise rep.fail("expected 'key: value'", number, code="fll-syntax")
+        key, value = m.group("key"), m.group("value").strip()
+        if key == "Engine":
+            engine_name, engine_line, saw_engine, current = (value or None), number, True, None
+        elif key in {"InputVariable", "OutputVariable"}:
+            if not value:
+                raise rep.fail(f"{key} needs a name", number, code="fll-syntax")
+            kind = VarKind.INPUT if key == "InputVariable" else VarKind.OUTPUT
+            current = _Variable(kind, value.split()[0], number)
+            variables.append(current)
+        elif key == "RuleBlock":
+            current = _Block(value or None, number)
+            blocks.append(current)
+        elif key == "description":
+            if isinstance(current, _Variable):
+                current.description = value
+        elif current is None:
+            if not saw_engine:
+                raise rep.fail(
+                    f"'{key}:' before any Engine, InputVariable, OutputVariable or RuleBlock",
+                    number,
+                    code="fll-syntax",
+                )
+            raise rep.fail(f"'{key}:' does not belong to the Engine section", number, code="fll-syntax")
+        elif isinstance(current, _Variable):
+            _variable_key(current, key, value, rep, number, pending_terms)
+        else:
+            _block_key(current, key, value, rep, number)
+    if not saw_engine and not variables:
+        raise rep.fail(
+            "no 'Engine:' and no variables: this is not an FLL file", 1 if lines else None, code="fll-syntax"
+        )
+    names = {v.name for v in variables}
+    if len(names) != len(variables):
+        seen: set[str] = set()
+        for v in variables:
+            if v.name in seen:
+                raise rep.fail(f"two variables are called {v.name!r}", v.line, code="duplicate-variable")
+            seen.add(v.name)
+    n_inputs = sum(1 for v in variables if v.kind is VarKind.INPUT)
+    for var, value, number in pending_terms:
+        var.terms.append(_term(value, rep, number, var, n_inputs, names))
+    by_name = {v.name: v for v in variables}
+    rule_blocks: list[RuleBlock] = []
+    for block in blocks:
+        rules = [
+            _RuleParser(text, number, rep, by_name).rule(str(i))
+            for i, (text, number) in enumerate(block.rules, start=1)
+        ]
+        rule_blocks.append(
+            RuleBlock(
+                block.name,
+                tuple(rules),
+                block.and_op,
+                block.or_op,
+                block.act,
+                None,
+                rep.span(block.line),
+                enabled=block.enabled,
+                rule_activation=block.rule_activation,
+            )
+        )
+    rep.raise_if_errors()
+    inputs = [v for v in variables if v.kind is VarKind.INPUT]
+    outputs = [v for v in variables if v.kind is VarKind.OUTPUT]
+    fb = FunctionBlock(
+        name=engine_name,
+        variables=tuple(
+            Variable(
+                v.name,
+                v.kind,
+                range=v.range,
+                span=rep.span(v.line),
+                comments=(v.description,) if v.description else (),
+            )
+            for v in variables
+        ),
+        fuzzify=tuple(
+            FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.line), clamp=v.clamp) for v in inputs
+        ),
+        defuzzify=tuple(
+            DefuzzifyBlock(
+                v.name,
+                tuple(v.terms),
+                v.range,
+                v.method,
+                Default(v.default, v.lock_previous),
+                v.accu,
+                rep.span(v.line),
+                clamp=v.clamp,
+            )
+            for v in outputs
+        ),
+        rule_blocks=tuple(rule_blocks),
+        span=rep.span(engine_line),
+    )
+    return Loaded(Document((fb,), path), rep.warnings)
+
+
+def _variable_key(
+    var: _Variable,
+    key: str,
+    value: str,
+    rep: Reporter,
+    number: int,
+    pending_terms: list[tuple[_Variable, str, int]],
+) -> None:
+    output = var.kind is VarKind.OUTPUT
+    if key == "enabled":
+        if not _bool(value, rep, number, key):
+            raise rep.fail(
+                f"{var.name!r} is disabled: disabled variables are not supported",
+                number,
+                code="fll-unsupported",
+            )
+    elif key == "range":
+        numbers = _numbers(value.split(), rep, number, "range")
+        if len(numbers) != 2:
+            raise rep.fail(f"range needs 2 numbers, found {len(numbers)}", number, code="fll-value")
+        if numbers[0] > numbers[1]:
+            raise rep.fail(
+                f"range {numbers[0]:g} {numbers[1]:g} has its minimum above its maximum",
+                number,
+                code="fll-value",
+            )
+        var.range = Range(numbers[0], numbers[1], rep.span(number))
+    elif key == "lock-range":
+        var.clamp = _bool(value, rep, number, key)
+    elif key == "term":
+        pending_terms.append((var, value, number))  # after all variables: Linear needs the input count
+    elif output and key in {"aggregation", "accumulation"}:
+        if value != "none" and value not in SNORMS_ACCU:
+            raise rep.fail(
+                f"unknown {key} {value!r} (known: {', '.join(SNORMS_ACCU)}, none)", number, code="fll-value"
+            )
+        var.accu = SNORMS_ACCU.get(value)
+    elif output and key == "defuzzifier":
+        words = value.split()
+        if not words or words[0] == "none":
+            var.method = None
+        elif words[0] not in DEFUZZIFIERS:
+            raise rep.fail(
+                f"unknown defuzzifier {words[0]!r} (known: {', '.join(DEFUZZIFIERS)})",
+                number,
+                code="fll-value",
+            )
+        else:
+            var.method = DEFUZZIFIERS[words[0]]
+    elif output and key == "default":
+        var.default = _numbers([value], rep, number, "default")[0]
+    elif output and key in {"lock-previous", "lock-valid"}:
+        var.lock_previous = _bool(value, rep, number, key)
+    else:
+        raise rep.fail(
+            f"unknown key '{key}:' in {'OutputVariable' if output else 'InputVariable'} {var.name!r}",
+            number,
+            code="fll-syntax",
+        )
+
+
+def _block_key(block: _Block, key: str, value: str, rep: Reporter, number: int) -> None:
+    if key == "enabled":
+        block.enabled = _bool(value, rep, number, key)
+    elif key == "conjunction":
+        block.and_op = _norm(value, TNORMS, rep, number, key)
+    elif key == "disjunction":
+        block.or_op = _norm(value, SNORMS_OR, rep, number, key)
+    elif key == "implication":
+        block.act = _norm(value, TNORMS, rep, number, key)
+    elif key == "activation":
+        words = value.split()
+        if words and words[0] in TNORMS:  # fuzzylite 5: "activation" was the implication
+            block.act = TNORMS[words[0]]
+        elif not words or words[0] in {"General", "none"}:
+            block.rule_activation = None
+        else:
+            block.rule_activation = value
+    elif key == "rule":
+        block.rules.append((value, number))
+    else:
+        raise rep.fail(f"unknown key '{key}:' in RuleBlock", number, code="fll-syntax")
+
+
+def _norm(value: str, table: dict[str, str], rep: Reporter, number: int, key: str) -> str | None:
+    if value in {"", "none"}:
+        return None
+    if value not in table:
+        raise rep.fail(f"unknown {key} {value!r} (known: {', '.join(table)}, none)", number, code="fll-value")
+    return table[value]
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    return read(text, path)
+
+
+def _write(document: Document) -> str:
+    from fuzzyctl.formats.fll_write import write
+
+    return write(document)
+
+
+def _lower(document: Document) -> tuple[Document, list[Loss]]:
+    from fuzzyctl.formats.fll_write import lower
+
+    return lower(document)
+
+
+FORMAT = Format(
+    name="fll",
+    extensions=(".fll",),
+    description="fuzzylite language (fuzzylite 5/6, pyfuzzylite 8)",
+    read=_read,
+    write=_write,
+    lower=_lower,
+)

@@ -1,0 +1,14 @@
+"""The examples in docs/formats.md run and print what the page says."""
+
+from __future__ import annotations
+
+import doctest
+
+from tests.conftest import ROOT
+
+
+def test_formats_doc_examples() -> None:
+    result = doctest.testfile(
+        str(ROOT / "docs" / "formats.md"), module_relative=False, optionflags=doctest.ELLIPSIS
+    )
+    assert result.attempted >= 2 and result.failed == 0
