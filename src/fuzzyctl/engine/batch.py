@@ -253,9 +253,12 @@ class BatchEvaluator:
             outs: Sequence[Arr], n: int) -> tuple[Arr, Arr]:
         zs: dict[int, Arr] = {}
 
-        def z_of(t: int) -> Arr:
+        def z_of(t: int, wt: Arr) -> Arr:
+            term = op.terms[t]
+            if term.kind in shapes.TSUKAMOTO_KINDS:
+                return np.asarray(shapes.tsukamoto_np(term.kind, [self._pv(p, vals) for p in term.params],
+                                                      self._pv(term.height, vals), wt), dtype=np.float64)
             if t not in zs:
-                term = op.terms[t]
                 if term.kind in ("singleton", "constant"):
                     z = np.full(n, 1.0) * self._pv(term.params[0], vals)
                 elif term.kind == "linear":
@@ -283,7 +286,7 @@ class BatchEvaluator:
         num = np.zeros(n)
         den = np.zeros(n)
         for t, wt in items:
-            z = z_of(t)
+            z = z_of(t, wt)
             num = num + np.where(wt > 0.0, wt * z, 0.0)
             den = den + wt
         fired = den > 0.0

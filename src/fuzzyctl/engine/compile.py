@@ -21,7 +21,7 @@ COMPAT_PROFILES: dict[str, Options] = {
     # pyfuzzylite 8: like fuzzylite but no firing threshold and per-conclusion hedges
     "pyfuzzylite": Options(weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"),
     # jFuzzyLogic 3.3: WITH scales the condition degree
-    "jfuzzylogic": Options(weight_before_activation=True),
+    "jfuzzylogic": Options(weight_before_activation=True, weight_whole_rule=True),
 }
 
 

@@ -280,12 +280,13 @@ class Interpreter:
 
     def _ts(self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float],
             outs: Sequence[float]) -> OutputRecord:
-        zs: dict[int, float] = {}
+        zs: dict[tuple[int, float], float] = {}
 
-        def z_of(t: int) -> float:
-            if t not in zs:
-                zs[t] = ts_value(op.terms[t], values, outs, self.pv)
-            return zs[t]
+        def z_of(t: int, wt: float) -> float:
+            key = (t, wt if op.terms[t].kind in shapes.TSUKAMOTO_KINDS else 0.0)
+            if key not in zs:
+                zs[key] = ts_value(op.terms[t], values, outs, self.pv, wt)
+            return zs[key]
 
         rec = OutputRecord(math.nan, False)
         if op.accu is None:
@@ -296,9 +297,9 @@ class Interpreter:
                 if t is not None:
                     acc[t] = accumulate(op.accu, acc.get(t, 0.0), w * a)
             items = sorted(acc.items())
-        num = [wt * z_of(t) for t, wt in items]
+        num = [wt * z_of(t, wt) for t, wt in items]
         den = [wt for _t, wt in items]
-        rec.weights = [(op.terms[t].name, wt, z_of(t)) for t, wt in items]
+        rec.weights = [(op.terms[t].name, wt, z_of(t, wt)) for t, wt in items]
         total = math.fsum(den)
         if not total > 0.0:
             return rec
@@ -393,8 +394,10 @@ def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:
     return 1.0 - d if negated else d
 
 
-def ts_value(term: TermPlan, values: Sequence[float], outs: Sequence[float], pv: Any) -> float:
-    """z of a Takagi-Sugeno term."""
+def ts_value(term: TermPlan, values: Sequence[float], outs: Sequence[float], pv: Any, weight: float = 1.0) -> float:
+    """z of a Takagi-Sugeno term (of a Tsukamoto term: where it reaches ``weight``)."""
+    if term.kind in shapes.TSUKAMOTO_KINDS:
+        return shapes.tsukamoto(term.kind, [pv(p, values) for p in term.params], pv(term.height, values), weight)
     if term.kind in ("singleton", "constant"):
         return float(pv(term.params[0], values))
     if term.kind == "linear":

@@ -8,6 +8,7 @@ error.  Whatever the FCL parser accepts either lowers or yields an error diagnos
 
 from __future__ import annotations
 
+import dataclasses
 import heapq
 import math
 from collections.abc import Iterable
@@ -368,7 +369,12 @@ def _lower(ctx: _Ctx) -> Plan | None:  # noqa: C901 - one pass over the block, i
                 else CTrue()
             )
             concls: list[ConclusionPlan] = []
-            for c in rule.conclusions:
+            conclusions = rule.conclusions
+            if ctx.options.weight_whole_rule:
+                w_rule = next((c.weight for c in conclusions if c.weight is not None), None)
+                if w_rule is not None:
+                    conclusions = tuple(dataclasses.replace(c, weight=w_rule) for c in conclusions)
+            for c in conclusions:
                 cp = _conclusion(ctx, c, rule.label, output_names, chained_index, term_source, inputs)
                 if cp is not None:
                     concls.append(cp)
@@ -452,6 +458,8 @@ def _cond(ctx: _Ctx, c: m.Condition, and_op: str, or_op: str, fuzzy_index: dict[
         if c.variable in chained_index:
             names = chained_terms[c.variable]
             deps.add(c.variable)
+            if c.term.lower() == "any" and c.term not in names:
+                hs = (*hs, "any")
             if "any" in hs:
                 return CChained(chained_index[c.variable], 0, hs, c.negated)
             if c.term not in names:
@@ -462,6 +470,8 @@ def _cond(ctx: _Ctx, c: m.Condition, and_op: str, or_op: str, fuzzy_index: dict[
             fz = ctx.fb.fuzzify_block(c.variable)
             assert fz is not None
             names = [t.name for t in _dedup(fz.terms)]
+            if c.term.lower() == "any" and c.term not in names:  # fuzzylite "x is any"
+                hs = (*hs, "any")
             if "any" in hs:
                 return CTerm(fuzzy_index[c.variable], 0, hs, c.negated)
             if c.term not in names:
@@ -637,6 +647,11 @@ def _output(ctx: _Ctx, var: m.Variable, oi: int, rules: list[RulePlan], output_n
         return None
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
+    if method in ("COGS", "WTAVER", "WTSUM") and kinds <= shapes.TSUKAMOTO_KINDS:
+        # Tsukamoto: a weighted average of where each monotonic term reaches its degree
+        ts_accu = accu if accu is not None else ctx.options.ts_default_accu
+        return OutputPlan(var.name, "ts", "WTSUM" if method == "WTSUM" else "WTAVER", ts_accu, tps,
+                          tuple(contributions), default, no_change)
     if ts_terms or (singletonish and method in ("WTAVER", "WTSUM")):
         if not kinds <= shapes.TS_KINDS | {"singleton"}:
             ctx.err(f"DEFUZZIFY {var.name}: Takagi-Sugeno terms (constant, linear, function) cannot be mixed with "

@@ -302,6 +302,7 @@ class Options:
     ts_default_accu: str | None = None  # accumulation of Takagi-Sugeno outputs without ACCU
     singleton_default_accu: str | None = None  # COGS outputs without ACCU (None: MAX)
     hedges_carry_over: bool = False  # fuzzylite 6: a conclusion's hedges modify the next ones
+    weight_whole_rule: bool = False  # jFuzzyLogic: a WITH anywhere in a rule weights every conclusion
     quad_rtol: float = 1e-10
 
 

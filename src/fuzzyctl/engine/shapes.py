@@ -28,6 +28,8 @@ Points = tuple[tuple[float, float], ...]
 PWL_KINDS = frozenset({"points", "triangle", "trapezoid", "rectangle", "ramp", "binary"})
 #: Takagi-Sugeno output terms: a value, not a fuzzy set.
 TS_KINDS = frozenset({"constant", "linear", "function"})
+#: Monotonic shapes a weighted average can invert (Tsukamoto outputs, fuzzylite).
+TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave"})
 #: Smooth parametric shapes (integrated by adaptive quadrature on outputs).
 SMOOTH_KINDS = frozenset(
     {
@@ -477,3 +479,53 @@ def hedge_np(name: str, x: Any) -> Any:
     if name == "any":
         return np.ones_like(x)
     raise ValueError(f"unknown hedge {name!r}")
+
+
+# --------------------------------------------------------------------------- Tsukamoto
+
+
+def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> float:
+    """The x at which a monotonic term reaches degree ``y`` (Tsukamoto inference)."""
+    h = float(height)
+    p = list(params)
+    try:
+        if kind == "ramp":
+            s, e = p
+            return s + (e - s) * y / h
+        if kind == "sigmoid":
+            i, s = p
+            return i + math.log(h / y - 1.0) / -s
+        if kind == "sshape":
+            s, e = p
+            return s + (e - s) * math.sqrt(y / (2.0 * h)) if y <= 0.5 * h else e - (e - s) * math.sqrt((h - y) / (2.0 * h))
+        if kind == "zshape":
+            s, e = p
+            return s + (e - s) * math.sqrt((h - y) / (2.0 * h)) if y >= 0.5 * h else e - (e - s) * math.sqrt(y / (2.0 * h))
+        if kind == "concave":
+            i, e = p
+            return h * (i - e) / y + 2.0 * e - i
+    except (ValueError, ZeroDivisionError):
+        return math.nan if y != h else math.inf
+    raise ValueError(f"{kind} is not monotonic")
+
+
+def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
+    """Vectorised :func:`tsukamoto`."""
+    h = height
+    with np.errstate(all="ignore"):
+        if kind == "ramp":
+            s, e = params
+            return s + (e - s) * y / h
+        if kind == "sigmoid":
+            i, s = params
+            return i + np.log(h / y - 1.0) / -s
+        if kind == "sshape":
+            s, e = params
+            return np.where(y <= 0.5 * h, s + (e - s) * np.sqrt(y / (2.0 * h)), e - (e - s) * np.sqrt((h - y) / (2.0 * h)))
+        if kind == "zshape":
+            s, e = params
+            return np.where(y >= 0.5 * h, s + (e - s) * np.sqrt((h - y) / (2.0 * h)), e - (e - s) * np.sqrt(y / (2.0 * h)))
+        if kind == "concave":
+            i, e = params
+            return h * (i - e) / y + 2.0 * e - i
+    raise ValueError(f"{kind} is not monotonic")

@@ -280,7 +280,7 @@ def _specialised(op: OutputPlan, plan: Plan) -> bool:
     if op.kind == "singleton":
         return op.method == "COGS" and all(t.kind == "singleton" for t in op.terms)
     if op.kind == "ts":
-        return True
+        return not any(t.kind in shapes.TSUKAMOTO_KINDS for t in op.terms)
     return op.kind == "mamdani" and op.exact and op.grid is not None and op.method == "COG"
 
 
