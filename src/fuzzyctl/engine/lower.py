@@ -216,6 +216,10 @@ def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> No
         bad = "needs start < end"
     elif tp.kind == "pishape" and not (p[0] < p[1] and p[2] < p[3]):
         bad = "needs a < b and c < d"
+    elif tp.kind in ("arc", "semiellipse") and p[0] == p[1]:
+        bad = "needs start != end"
+    elif tp.kind == "cosine_half" and p[1] == 0.0:
+        bad = "needs a nonzero half width"
     if bad:
         ctx.err(f"{where}: {tp.kind} {bad}", span, "shape-params")
 

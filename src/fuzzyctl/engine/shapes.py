@@ -29,7 +29,7 @@ PWL_KINDS = frozenset({"points", "triangle", "trapezoid", "rectangle", "ramp", "
 #: Takagi-Sugeno output terms: a value, not a fuzzy set.
 TS_KINDS = frozenset({"constant", "linear", "function"})
 #: Monotonic shapes a weighted average can invert (Tsukamoto outputs, fuzzylite).
-TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave"})
+TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "arc"})
 #: Smooth parametric shapes (integrated by adaptive quadrature on outputs).
 SMOOTH_KINDS = frozenset(
     {
@@ -46,6 +46,9 @@ SMOOTH_KINDS = frozenset(
         "pishape",
         "spike",
         "concave",
+        "cosine_half",
+        "arc",
+        "semiellipse",
     }
 )
 
@@ -224,6 +227,24 @@ def _smooth(kind: str, p: Sequence[float], x: float) -> float:
         if i >= e and x > e:
             return (i - e) / (i - 2.0 * e + x)
         return 1.0
+    if kind == "cosine_half":
+        c, hw = p
+        if x < c - abs(hw) or x > c + abs(hw):
+            return 0.0
+        return 0.5 * (1.0 + math.cos(math.pi * (x - c) / hw))
+    if kind == "arc":
+        s, e = p
+        r = e - s
+        if (s < e and s <= x <= e) or (s > e and e <= x <= s):
+            return math.sqrt(max(r * r - (x - e) * (x - e), 0.0)) / abs(r)
+        return 1.0 if (s < e and x > e) or (s > e and x < e) else 0.0
+    if kind == "semiellipse":
+        s, e = min(p), max(p)
+        r = 0.5 * (e - s)
+        c = s + r
+        if s <= x <= e:
+            return math.sqrt(max(r * r - (x - c) * (x - c), 0.0)) / r
+        return 0.0
     raise ValueError(f"unknown shape kind {kind!r}")
 
 
@@ -292,6 +313,23 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
             inc = (e - i) / (2.0 * e - i - x)
             dec = (i - e) / (i - 2.0 * e + x)
         return np.where((i <= e) & (x < e), inc, np.where((i >= e) & (x > e), dec, 1.0))
+    if kind == "cosine_half":
+        c, hw = p
+        inside = (x >= c - np.abs(hw)) & (x <= c + np.abs(hw))
+        return np.where(inside, 0.5 * (1.0 + np.cos(np.pi * (x - c) / hw)), 0.0)
+    if kind == "arc":
+        s, e = p
+        r = e - s
+        inside = ((s < e) & (s <= x) & (x <= e)) | ((s > e) & (e <= x) & (x <= s))
+        arc = np.sqrt(np.maximum(r * r - (x - e) * (x - e), 0.0)) / np.abs(r)
+        beyond = ((s < e) & (x > e)) | ((s > e) & (x < e))
+        return np.where(inside, arc, np.where(beyond, 1.0, 0.0))
+    if kind == "semiellipse":
+        s, e = np.minimum(p[0], p[1]), np.maximum(p[0], p[1])
+        r = 0.5 * (e - s)
+        c = s + r
+        inside = (x >= s) & (x <= e)
+        return np.where(inside, np.sqrt(np.maximum(r * r - (x - c) * (x - c), 0.0)) / r, 0.0)
     raise ValueError(f"unknown shape kind {kind!r}")
 
 
@@ -404,8 +442,14 @@ def support(kind: str, params: Sequence[float], height: float = 1.0) -> tuple[fl
         return (-inf, params[1])
     if kind == "pishape":
         return (params[0], params[3])
-    if kind == "concave":
-        return (-inf, inf)
+    if kind == "cosine_half":
+        c, hw = params
+        return (c - abs(hw), c + abs(hw))
+    if kind == "semiellipse":
+        return (min(params), max(params))
+    if kind == "arc":
+        s, e = params
+        return (s, inf) if s < e else (-inf, s)
     return (-inf, inf)
 
 
@@ -443,6 +487,11 @@ def characteristic_points(kind: str, params: Sequence[float]) -> tuple[float, ..
         return tuple(c + k * abs(w) / 10.0 for k in (-40, -8, -2, 0, 2, 8, 40))
     if kind == "concave":
         return (p[0], p[1])
+    if kind == "cosine_half":
+        c, hw = p
+        return (c - abs(hw), c - 0.5 * abs(hw), c, c + 0.5 * abs(hw), c + abs(hw))
+    if kind in ("arc", "semiellipse"):
+        return (p[0], 0.5 * (p[0] + p[1]), p[1])
     pts = pwl_points(kind, params)
     if pts is not None:
         return tuple(x for x, _y in pts)
@@ -504,6 +553,10 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
         if kind == "concave":
             i, e = p
             return h * (i - e) / y + 2.0 * e - i
+        if kind == "arc":
+            s, e = p
+            r = e - s
+            return e + (-1.0 if s < e else 1.0) * math.sqrt(max(r * r - (y * r / h) ** 2, 0.0))
     except (ValueError, ZeroDivisionError):
         return math.nan if y != h else math.inf
     raise ValueError(f"{kind} is not monotonic")
@@ -528,4 +581,8 @@ def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
         if kind == "concave":
             i, e = params
             return h * (i - e) / y + 2.0 * e - i
+        if kind == "arc":
+            s, e = params
+            r = e - s
+            return e + np.where(s < e, -1.0, 1.0) * np.sqrt(np.maximum(r * r - (y * r / h) ** 2, 0.0))
     raise ValueError(f"{kind} is not monotonic")
