@@ -6,7 +6,6 @@ from __future__ import annotations
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.model import Document, FunctionBlock
 
 if TYPE_CHECKING:

@@ -17,7 +17,9 @@ import fuzzyctl
 from tests.conftest import shared_path
 
 FL = ("conformance", "fuzzylite")
-FILES = sorted(str(p.relative_to(shared_path(*FL))) for p in shared_path(*FL).rglob("*.fld") if "original" not in p.parts)
+FILES = sorted(
+    str(p.relative_to(shared_path(*FL))) for p in shared_path(*FL).rglob("*.fld") if "original" not in p.parts
+)
 MAMDANI_TOL = 5e-4  # of the range
 TS_TOL = 1e-6
 STALE = {("mamdani/Laundry.fld", "Detergent")}

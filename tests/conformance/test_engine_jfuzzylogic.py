@@ -24,7 +24,11 @@ RIEMANN = 1.3e-3  # of the output range
 MEMBERSHIP = sorted(p.name for p in shared_path(*JFL.parts, "expected", "membership").glob("*.tsv"))
 GRIDS = sorted(p.name for p in shared_path(*JFL.parts, "expected", "grids").glob("*.tsv"))
 # jFuzzyLogic guesses a universe for gaussian outputs without RANGE; we require a RANGE.
-NEEDS_RANGE = {"fcl_QoS_LarsenQoSFewRules.tsv", "fcl_QoS_MamdaniQoSFewRules.tsv", "fcl_QoS_MamdaniQoSManyRules.tsv"}
+NEEDS_RANGE = {
+    "fcl_QoS_LarsenQoSFewRules.tsv",
+    "fcl_QoS_MamdaniQoSFewRules.tsv",
+    "fcl_QoS_MamdaniQoSManyRules.tsv",
+}
 # IEC semantics differ here: WITH on one conclusion of several (junit3, robot), WITH clipping
 # the degree rather than scaling the set (tipper_with, robot).
 IEC_DIFFERS = {"tests_junit3_cogs_with.tsv", "fcl_robot_with_weights.tsv", "fcl_tipper_with.tsv"}
@@ -35,7 +39,11 @@ def _table(path: Path) -> tuple[list[str], list[str], np.ndarray]:
     comments = [ln for ln in lines if ln.startswith("#")]
     body = [ln for ln in lines if ln.strip() and not ln.startswith("#")]
     head = body[0].split("\t")
-    data = np.array([[float(v) for v in ln.split("\t")] for ln in body[1:]]) if len(body) > 1 else np.zeros((0, len(head)))
+    data = (
+        np.array([[float(v) for v in ln.split("\t")] for ln in body[1:]])
+        if len(body) > 1
+        else np.zeros((0, len(head)))
+    )
     return comments, head, data
 
 
@@ -54,8 +62,14 @@ def test_membership_tables_exact(name: str) -> None:
             assert degrees[term] == pytest.approx(want, abs=1e-12), (name, row[0], term)
 
 
-@pytest.mark.parametrize("name", sorted(p.name for p in shared_path(*JFL.parts, "tests").glob("junit_*.txt")
-                                        if p.name not in ("junit_tipper.txt", "junit_functions.txt")))
+@pytest.mark.parametrize(
+    "name",
+    sorted(
+        p.name
+        for p in shared_path(*JFL.parts, "tests").glob("junit_*.txt")
+        if p.name not in ("junit_tipper.txt", "junit_functions.txt")
+    ),
+)
 def test_junit_rounded_tables(name: str) -> None:
     """jFuzzyLogic's own unit-test tables: round(100 * value)."""
     _c, head, data = _table(shared_path(*JFL.parts, "tests", name))

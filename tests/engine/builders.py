@@ -73,7 +73,9 @@ def figure7() -> m.FunctionBlock:
                 "No1",
                 (
                     rule("1", and_(is_("temp", "cold"), is_("pressure", "low")), then("valve", "inlet")),
-                    rule("2", and_(is_("temp", "cold"), is_("pressure", "high")), then("valve", "closed", 0.8)),
+                    rule(
+                        "2", and_(is_("temp", "cold"), is_("pressure", "high")), then("valve", "closed", 0.8)
+                    ),
                     rule("3", and_(is_("temp", "hot"), is_("pressure", "low")), then("valve", "closed")),
                     rule("4", and_(is_("temp", "hot"), is_("pressure", "high")), then("valve", "drainage")),
                 ),

@@ -53,7 +53,9 @@ def input_term(draw: Any) -> m.MembershipFunction:
     if kind == "gaussian":
         return m.ShapeMF("gaussian", (c, round(draw(st.floats(0.3, 4.0)), 3)))
     if kind == "bell":
-        return m.ShapeMF("bell", (c, round(draw(st.floats(0.5, 4.0)), 3), round(draw(st.floats(0.5, 4.0)), 3)))
+        return m.ShapeMF(
+            "bell", (c, round(draw(st.floats(0.5, 4.0)), 3), round(draw(st.floats(0.5, 4.0)), 3))
+        )
     return m.ShapeMF("sigmoid", (c, round(draw(st.floats(-4.0, 4.0).filter(lambda s: abs(s) > 0.2)), 3)))
 
 
@@ -92,33 +94,53 @@ def system(
     k_out = draw(st.integers(2, 4))
     out_names = [f"o{j}" for j in range(k_out)]
     if smooth_output:
-        out_mfs = [m.ShapeMF("gaussian", (round(draw(st.floats(1, 9)), 3), round(draw(st.floats(0.3, 2.5)), 3)))
-                   for _ in out_names]
+        out_mfs = [
+            m.ShapeMF("gaussian", (round(draw(st.floats(1, 9)), 3), round(draw(st.floats(0.3, 2.5)), 3)))
+            for _ in out_names
+        ]
     else:
         out_mfs = [draw(pwl_term()) for _ in out_names]
     rules = []
     for r in range(draw(st.integers(1, 5))):
         w = round(draw(st.floats(0.1, 1.0)), 2) if weights and draw(st.booleans()) else None
-        rules.append(m.Rule(str(r + 1), draw(condition(inputs)), (m.Conclusion("y", draw(st.sampled_from(out_names)), w),)))
+        rules.append(
+            m.Rule(
+                str(r + 1), draw(condition(inputs)), (m.Conclusion("y", draw(st.sampled_from(out_names)), w),)
+            )
+        )
     return m.FunctionBlock(
         "random",
-        variables=tuple(m.Variable(v, m.VarKind.INPUT) for v in inputs) + (m.Variable("y", m.VarKind.OUTPUT),),
+        variables=(*tuple(m.Variable(v, m.VarKind.INPUT) for v in inputs), m.Variable("y", m.VarKind.OUTPUT)),
         fuzzify=tuple(fuzz),
-        defuzzify=(m.DefuzzifyBlock("y", tuple(m.Term(n, mf) for n, mf in zip(out_names, out_mfs, strict=True)),
-                                    m.Range(LO, HI), draw(st.sampled_from(methods)), m.Default(-1.0)),),
-        rule_blocks=(m.RuleBlock("rb", tuple(rules), draw(st.sampled_from(ands)), None, draw(st.sampled_from(acts)),
-                                 draw(st.sampled_from(accus))),),
+        defuzzify=(
+            m.DefuzzifyBlock(
+                "y",
+                tuple(m.Term(n, mf) for n, mf in zip(out_names, out_mfs, strict=True)),
+                m.Range(LO, HI),
+                draw(st.sampled_from(methods)),
+                m.Default(-1.0),
+            ),
+        ),
+        rule_blocks=(
+            m.RuleBlock(
+                "rb",
+                tuple(rules),
+                draw(st.sampled_from(ands)),
+                None,
+                draw(st.sampled_from(acts)),
+                draw(st.sampled_from(accus)),
+            ),
+        ),
     )
 
 
 def input_values(draw: Any, fb: m.FunctionBlock, n: int) -> list[dict[str, float]]:
-    return [
-        {v.name: round(draw(st.floats(LO - 1, HI + 1)), 4) for v in fb.inputs} for _ in range(n)
-    ]
+    return [{v.name: round(draw(st.floats(LO - 1, HI + 1)), 4) for v in fb.inputs} for _ in range(n)]
 
 
 def describe(fb: m.FunctionBlock) -> str:
     """A compact text of a random system (for assertion messages)."""
+
     def mf(x: m.MembershipFunction) -> str:
         if isinstance(x, m.ShapeMF):
             return f"{x.kind}{x.params}"
@@ -144,6 +166,8 @@ def describe(fb: m.FunctionBlock) -> str:
     for rb in fb.rule_blocks:
         lines.append(f"AND {rb.and_op} ACT {rb.act} ACCU {rb.accu}")
         for r in rb.rules:
-            lines.append(f"  {r.label}: IF {cond(r.condition) if r.condition else ''} THEN "
-                         + ", ".join(f"{c.variable} IS {c.term} WITH {c.weight}" for c in r.conclusions))
+            lines.append(
+                f"  {r.label}: IF {cond(r.condition) if r.condition else ''} THEN "
+                + ", ".join(f"{c.variable} IS {c.term} WITH {c.weight}" for c in r.conclusions)
+            )
     return "\n".join(lines)

@@ -117,8 +117,13 @@ def evaluate(
                 assert term is not None
                 v = w * a
                 old = mu.get(term.name, 0.0)
-                mu[term.name] = {"MAX": max(old, v), "BSUM": min(1.0, old + v), "SUM": old + v,
-                                 "NSUM": old + v, "PROBOR": old + v - old * v}[accu]
+                mu[term.name] = {
+                    "MAX": max(old, v),
+                    "BSUM": min(1.0, old + v),
+                    "SUM": old + v,
+                    "NSUM": old + v,
+                    "PROBOR": old + v - old * v,
+                }[accu]
             den = sum(mu.values())
             num = sum(float(db.term(n).mf.value) * v for n, v in mu.items())  # type: ignore[union-attr,arg-type]
             result[out.name] = num / den if den > 0 else math.nan
@@ -166,9 +171,13 @@ def evaluate(
                 assert term is not None
                 mu_t = _mf(term.mf, sp)
                 c = w * (np.minimum(a, mu_t) if act == "MIN" else a * mu_t)
-                acc_sp = {"MAX": lambda p, q: np.maximum(p, q), "BSUM": lambda p, q: np.minimum(1.0, p + q),
-                          "SUM": lambda p, q: p + q, "NSUM": lambda p, q: p + q,
-                          "PROBOR": lambda p, q: p + q - p * q}[accu](acc_sp, c)
+                acc_sp = {
+                    "MAX": lambda p, q: np.maximum(p, q),
+                    "BSUM": lambda p, q: np.minimum(1.0, p + q),
+                    "SUM": lambda p, q: p + q,
+                    "NSUM": lambda p, q: p + q,
+                    "PROBOR": lambda p, q: p + q - p * q,
+                }[accu](acc_sp, c)
             acc_sp = acc_sp / norm
             top = max(acc.max(), acc_sp.max() if len(sp) else 0.0)
             hit = acc >= top * (1 - max_tol)

@@ -20,7 +20,11 @@ def _controller(out_terms: dict, rules: list, **kw: object) -> fuzzyctl.engine.C
 
 def _trapezoid_centroid(a: float, b: float, c: float, d: float, h: float) -> float:
     """Centroid of the clipped triangle/trapezoid from the three elementary pieces."""
-    parts = [((b - a) * h / 2, a + 2 * (b - a) / 3), ((c - b) * h, (b + c) / 2), ((d - c) * h / 2, c + (d - c) / 3)]
+    parts = [
+        ((b - a) * h / 2, a + 2 * (b - a) / 3),
+        ((c - b) * h, (b + c) / 2),
+        ((d - c) * h / 2, c + (d - c) / 3),
+    ]
     area = sum(p[0] for p in parts)
     return sum(p[0] * p[1] for p in parts) / area
 
@@ -34,14 +38,20 @@ def test_clipped_triangle(h: float) -> None:
         ("RM", c - h * (c - b)),
         ("MOM", (a + h * (b - a) + c - h * (c - b)) / 2),
     ]:
-        ctl = _controller({"t": shape("triangle", a, b, c)}, [rule("1", is_("x", "h"), then("y", "t"))],
-                          method=method, rng=(0, 10))
+        ctl = _controller(
+            {"t": shape("triangle", a, b, c)},
+            [rule("1", is_("x", "h"), then("y", "t"))],
+            method=method,
+            rng=(0, 10),
+        )
         assert ctl.evaluate({"x": h})["y"] == pytest.approx(want, rel=1e-13, abs=1e-13), method
         assert ctl.evaluate_batch({"x": [h]})["y"][0] == pytest.approx(want, rel=1e-13, abs=1e-13), method
 
 
 def test_coa_of_a_falling_triangle() -> None:
-    ctl = _controller({"t": shape("triangle", 0, 0, 1)}, [rule("1", is_("x", "one"), then("y", "t"))], method="COA")
+    ctl = _controller(
+        {"t": shape("triangle", 0, 0, 1)}, [rule("1", is_("x", "one"), then("y", "t"))], method="COA"
+    )
     assert ctl.evaluate({"x": 0.5})["y"] == pytest.approx(1 - 1 / math.sqrt(2), rel=1e-14)
     assert ctl.evaluate_batch({"x": [0.5]})["y"][0] == pytest.approx(1 - 1 / math.sqrt(2), rel=1e-14)
 
@@ -89,7 +99,9 @@ def test_smooth_centroid_within_quadrature_tolerance() -> None:
     # a Gaussian on [m - s, m + 5 s]: the mean of a truncated normal
     m_, s = 3.0, 0.7
     lo, hi = m_ - s, m_ + 5 * s
-    ctl = _controller({"g": shape("gaussian", m_, s)}, [rule("1", is_("x", "one"), then("y", "g"))], rng=(lo, hi))
+    ctl = _controller(
+        {"g": shape("gaussian", m_, s)}, [rule("1", is_("x", "one"), then("y", "g"))], rng=(lo, hi)
+    )
 
     def phi(z: float) -> float:
         return math.exp(-z * z / 2) / math.sqrt(2 * math.pi)
@@ -105,7 +117,11 @@ def test_clipped_smooth_plateau_edges() -> None:
     # min(h, gaussian): LM/RM where the Gaussian crosses h
     m_, s, h = 5.0, 1.0, 0.4
     for method, sign in [("LM", -1), ("RM", 1)]:
-        ctl = _controller({"g": shape("gaussian", m_, s)}, [rule("1", is_("x", "h"), then("y", "g"))],
-                          rng=(0, 10), method=method)
+        ctl = _controller(
+            {"g": shape("gaussian", m_, s)},
+            [rule("1", is_("x", "h"), then("y", "g"))],
+            rng=(0, 10),
+            method=method,
+        )
         want = m_ + sign * s * math.sqrt(-2 * math.log(h))
         assert ctl.evaluate({"x": h})["y"] == pytest.approx(want, abs=1e-9)

@@ -3,6 +3,8 @@ monotone, De Morgan holds for every AND/OR pair with real membership functions."
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -26,12 +28,19 @@ def test_outputs_stay_inside_the_range(data: st.DataObject) -> None:
 
 
 @settings(max_examples=40, deadline=None)
-@given(st.lists(st.floats(-50, 50), min_size=2, max_size=5, unique=True),
-       st.lists(st.floats(0, 1), min_size=2, max_size=2), st.sampled_from(["MAX", "SUM", "BSUM"]))
+@given(
+    st.lists(st.floats(-50, 50), min_size=2, max_size=5, unique=True),
+    st.lists(st.floats(0, 1), min_size=2, max_size=2),
+    st.sampled_from(["MAX", "SUM", "BSUM"]),
+)
 def test_cogs_stays_inside_the_singletons_hull(positions: list[float], x: list[float], accu: str) -> None:
     outs = {f"s{i}": single(p) for i, p in enumerate(positions)}
-    rules = [rule(str(i), is_("x", "lo" if i % 2 else "hi"), then("y", f"s{i}")) for i in range(len(positions))]
-    fb = mamdani({"x": {"lo": shape("ramp", 1, 0), "hi": shape("ramp", 0, 1)}}, outs, rules, method="COGS", accu=accu)
+    rules = [
+        rule(str(i), is_("x", "lo" if i % 2 else "hi"), then("y", f"s{i}")) for i in range(len(positions))
+    ]
+    fb = mamdani(
+        {"x": {"lo": shape("ramp", 1, 0), "hi": shape("ramp", 0, 1)}}, outs, rules, method="COGS", accu=accu
+    )
     for v in x:
         y = fuzzyctl.compile(fb).evaluate({"x": v})["y"]
         assert min(positions) - 1e-12 <= y <= max(positions) + 1e-12
@@ -41,7 +50,7 @@ def test_cogs_stays_inside_the_singletons_hull(positions: list[float], x: list[f
 def ruspini(draw: st.DrawFn, n: int) -> list[float]:
     """n strictly increasing peaks in [0, 10]."""
     xs = sorted(set(round(v, 3) for v in draw(st.lists(st.floats(0, 10), min_size=n, max_size=n))))
-    if len(xs) < n or min(b - a for a, b in zip(xs, xs[1:], strict=False)) < 0.05:
+    if len(xs) < n or min(b - a for a, b in itertools.pairwise(xs)) < 0.05:
         xs = [10.0 * i / (n - 1) for i in range(n)]
     return xs
 
@@ -57,9 +66,15 @@ def _partition(peaks: list[float]) -> dict[str, m.MembershipFunction]:
 
 
 @settings(max_examples=30, deadline=None)
-@given(st.integers(2, 5).flatmap(lambda n: st.tuples(ruspini(n), st.lists(st.floats(-20, 20), min_size=n, max_size=n))),
-       st.sampled_from(["singletons", "translated"]))
-def test_monotone_rule_bases_give_monotone_controllers(spec: tuple[list[float], list[float]], outputs: str) -> None:
+@given(
+    st.integers(2, 5).flatmap(
+        lambda n: st.tuples(ruspini(n), st.lists(st.floats(-20, 20), min_size=n, max_size=n))
+    ),
+    st.sampled_from(["singletons", "translated"]),
+)
+def test_monotone_rule_bases_give_monotone_controllers(
+    spec: tuple[list[float], list[float]], outputs: str
+) -> None:
     peaks, centres = spec
     centres = sorted(centres)
     n = len(peaks)
@@ -76,8 +91,10 @@ def test_monotone_rule_bases_give_monotone_controllers(spec: tuple[list[float], 
 
 @pytest.mark.parametrize("and_op", sorted(AND_TO_OR))
 def test_de_morgan_for_every_operator_pair(and_op: str) -> None:
-    terms = {"x": {"g": shape("gaussian", 4, 2), "t": shape("triangle", 0, 3, 9)},
-             "z": {"b": shape("bell", 5, 2, 1.5), "s": shape("sigmoid", 5, -1.2)}}
+    terms = {
+        "x": {"g": shape("gaussian", 4, 2), "t": shape("triangle", 0, 3, 9)},
+        "z": {"b": shape("bell", 5, 2, 1.5), "s": shape("sigmoid", 5, -1.2)},
+    }
     rules = [
         rule("lhs", m.Not(and_(is_("x", "g"), is_("z", "b"))), then("y", "o")),
         rule("rhs", or_(is_("x", "g", negated=True), is_("z", "b", negated=True)), then("y", "o")),

@@ -7,6 +7,7 @@ Discrete term is our points term and its largest/smallest of maximum our RM/LM."
 
 from __future__ import annotations
 
+import itertools
 import math
 import warnings
 from typing import Any
@@ -38,13 +39,14 @@ def term(draw: Any, output: bool) -> tuple[m.MembershipFunction, Any]:
         return m.ShapeMF(kind, (a, b, c, d)), fl.Trapezoid("", a, b, c, d)
     if kind == "points":
         n = draw(st.integers(2, 5))
-        xs = draw(sorted_floats(n).filter(lambda v: all(p < q for p, q in zip(v, v[1:], strict=False))))
+        xs = draw(sorted_floats(n).filter(lambda v: all(p < q for p, q in itertools.pairwise(v))))
         ys = draw(st.lists(st.floats(0, 1).map(lambda y: round(y, 3)), min_size=n, max_size=n))
         if output:
             ys[0] = ys[-1] = 0.0
             ys[n // 2] = max(ys[n // 2], 0.5)
         return m.PointsMF(tuple(m.Point(x, y) for x, y in zip(xs, ys, strict=True))), fl.Discrete(
-            "", np.array([[x, y] for x, y in zip(xs, ys, strict=True)]))
+            "", np.array([[x, y] for x, y in zip(xs, ys, strict=True)])
+        )
     c = round(draw(st.floats(LO, HI)), 3)
     if kind == "gaussian":
         s = round(draw(st.floats(0.3, 3.0)), 3)
@@ -96,26 +98,51 @@ def pair(draw: Any) -> tuple[m.FunctionBlock, Any]:
         rules.append(m.Rule(str(r + 1), c, (m.Conclusion("y", o, w),)))
         texts.append(f"if {text} then y is {o}" + (f" with {w}" if w is not None else ""))
     fb = m.FunctionBlock(
-        "diff", variables=tuple(m.Variable(v, m.VarKind.INPUT) for v in inputs) + (m.Variable("y", m.VarKind.OUTPUT),),
+        "diff",
+        variables=(*tuple(m.Variable(v, m.VarKind.INPUT) for v in inputs), m.Variable("y", m.VarKind.OUTPUT)),
         fuzzify=tuple(fuzz),
-        defuzzify=(m.DefuzzifyBlock("y", tuple(m.Term(f"o{j}", p[0]) for j, p in enumerate(outs)), m.Range(LO, HI),
-                                    method, m.Default(math.nan)),),
+        defuzzify=(
+            m.DefuzzifyBlock(
+                "y",
+                tuple(m.Term(f"o{j}", p[0]) for j, p in enumerate(outs)),
+                m.Range(LO, HI),
+                method,
+                m.Default(math.nan),
+            ),
+        ),
         rule_blocks=(m.RuleBlock("rb", tuple(rules), and_op, None, act, accu),),
     )
-    defuzz = {"COG": fl.Centroid(RES), "LM": fl.SmallestOfMaximum(RES), "RM": fl.LargestOfMaximum(RES)}[method]
-    out = fl.OutputVariable("y", minimum=LO, maximum=HI, aggregation=NORMS_OR[accu if accu != "MAX" else "MAX"](),
-                            defuzzifier=defuzz, terms=[p[1] for p in outs])
+    defuzz = {"COG": fl.Centroid(RES), "LM": fl.SmallestOfMaximum(RES), "RM": fl.LargestOfMaximum(RES)}[
+        method
+    ]
+    out = fl.OutputVariable(
+        "y",
+        minimum=LO,
+        maximum=HI,
+        aggregation=NORMS_OR[accu if accu != "MAX" else "MAX"](),
+        defuzzifier=defuzz,
+        terms=[p[1] for p in outs],
+    )
     engine = fl.Engine("diff", input_variables=fl_inputs, output_variables=[out], load=False)
-    block = fl.RuleBlock("rb", conjunction=NORMS_AND[and_op](), disjunction=NORMS_OR[PAIR[and_op]](),
-                         implication=NORMS_AND[act](), activation=fl.General())
+    block = fl.RuleBlock(
+        "rb",
+        conjunction=NORMS_AND[and_op](),
+        disjunction=NORMS_OR[PAIR[and_op]](),
+        implication=NORMS_AND[act](),
+        activation=fl.General(),
+    )
     block.rules = [fl.Rule.create(t, engine) for t in texts]
     engine.rule_blocks = [block]
     return fb, engine
 
 
-@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@settings(
+    max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much]
+)
 @given(pair(), st.lists(st.tuples(st.floats(LO, HI), st.floats(LO, HI)), min_size=2, max_size=2))
-def test_agrees_with_pyfuzzylite_at_resolution_1e6(system: tuple[m.FunctionBlock, Any], xs: list[tuple[float, float]]) -> None:
+def test_agrees_with_pyfuzzylite_at_resolution_1e6(
+    system: tuple[m.FunctionBlock, Any], xs: list[tuple[float, float]]
+) -> None:
     fb, engine = system
     c = fuzzyctl.compile(fb, compat="pyfuzzylite")
     for x in xs:
@@ -139,5 +166,7 @@ def test_agrees_with_pyfuzzylite_at_resolution_1e6(system: tuple[m.FunctionBlock
         else:
             assert abs(got - want) <= 1e-5 * (HI - LO), (got, want, values)
     c.reset()
-    batch = c.evaluate_batch({v.name: np.array([round(x[i], 4) for x in xs]) for i, v in enumerate(fb.inputs)})["y"]
+    batch = c.evaluate_batch(
+        {v.name: np.array([round(x[i], 4) for x in xs]) for i, v in enumerate(fb.inputs)}
+    )["y"]
     assert batch.shape == (2,)

@@ -77,14 +77,23 @@ def test_points_vertical_edges_and_constant_extension() -> None:
     assert shapes.pwl_value(pts, 1.5) == pytest.approx(0.1)
     assert shapes.pwl_value(pts, 2.5) == pytest.approx(0.75)
     assert shapes.pwl_value(pts, 9.0) == 0.5  # constant after the last
-    np.testing.assert_allclose(shapes.pwl_value_np(pts, np.array([0.0, 1.5, 2.0, 2.5, 9.0])),
-                               [0.2, 0.1, 1.0, 0.75, 0.5])
+    np.testing.assert_allclose(
+        shapes.pwl_value_np(pts, np.array([0.0, 1.5, 2.0, 2.5, 9.0])), [0.2, 0.1, 1.0, 0.75, 0.5]
+    )
 
 
 def test_tsukamoto_inverts_monotonic_terms() -> None:
-    for kind, params in [("ramp", (2, 8)), ("ramp", (8, 2)), ("sigmoid", (5, 2)), ("sshape", (2, 8)), ("arc", (2, 6)),
-                         ("arc", (6, 2)),
-                         ("zshape", (2, 8)), ("concave", (5, 8)), ("concave", (5, 2))]:
+    for kind, params in [
+        ("ramp", (2, 8)),
+        ("ramp", (8, 2)),
+        ("sigmoid", (5, 2)),
+        ("sshape", (2, 8)),
+        ("arc", (2, 6)),
+        ("arc", (6, 2)),
+        ("zshape", (2, 8)),
+        ("concave", (5, 8)),
+        ("concave", (5, 2)),
+    ]:
         for y in (0.1, 0.3, 0.5, 0.7, 0.9):
             x = shapes.tsukamoto(kind, params, 1.0, y)
             assert shapes.membership(kind, params, 1.0, x) == pytest.approx(y, abs=1e-12), (kind, y)

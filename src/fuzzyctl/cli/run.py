@@ -18,7 +18,9 @@ from fuzzyctl.cli.app import app
 
 SetOpt = Annotated[
     list[str] | None,
-    typer.Option("--set", "-s", help="An input value, NAME=VALUE (repeat for each input).", show_default=False),
+    typer.Option(
+        "--set", "-s", help="An input value, NAME=VALUE (repeat for each input).", show_default=False
+    ),
 ]
 BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to run (default: the first).")]
 CompatOpt = Annotated[
@@ -58,10 +60,16 @@ def _fmt(v: float) -> str:
 def eval_(
     file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
     set_: SetOpt = None,
-    csv_in: Annotated[Path | None, typer.Option("--csv", help="Evaluate every row of a CSV file (header = input names).")] = None,
-    output: Annotated[Path | None, typer.Option("--output", "-o", help="Write the CSV result here (atomically).")] = None,
+    csv_in: Annotated[
+        Path | None, typer.Option("--csv", help="Evaluate every row of a CSV file (header = input names).")
+    ] = None,
+    output: Annotated[
+        Path | None, typer.Option("--output", "-o", help="Write the CSV result here (atomically).")
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the outputs as JSON.")] = False,
-    table: Annotated[bool, typer.Option("--table", help="With --csv and no -o: print a table, not CSV.")] = False,
+    as_table: Annotated[
+        bool, typer.Option("--table", help="With --csv and no -o: print a table, not CSV.")
+    ] = False,
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
 ) -> None:
@@ -70,7 +78,7 @@ def eval_(
     if csv_in is not None:
         if set_:
             raise typer.BadParameter("use either --set or --csv", param_hint="--set")
-        _eval_csv(ctl, csv_in, output, table)
+        _eval_csv(ctl, csv_in, output, as_table)
         return
     if output is not None:
         raise typer.BadParameter("--output needs --csv", param_hint="--output")
@@ -103,7 +111,11 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
     unknown = [h for h in header if h not in ctl.inputs]
     if unknown:
         raise InputError(f"{path}: column {unknown[0]!r} is not an input (inputs: {', '.join(ctl.inputs)})")
-    missing = [n for n, spec in zip(ctl.inputs, ctl.plan.inputs, strict=True) if n not in header and spec.default is None]
+    missing = [
+        n
+        for n, spec in zip(ctl.inputs, ctl.plan.inputs, strict=True)
+        if n not in header and spec.default is None
+    ]
     if missing:
         raise InputError(f"{path}: no column for input {missing[0]!r}")
     cols = np.empty((len(header), len(body)))
@@ -114,9 +126,13 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
             try:
                 v = float(cell)
             except ValueError:
-                raise InputError(f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a number") from None
+                raise InputError(
+                    f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a number"
+                ) from None
             if not math.isfinite(v):
-                raise InputError(f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a finite number")
+                raise InputError(
+                    f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a finite number"
+                )
             cols[c, r] = v
     n = len(body)
     results: dict[str, Any] = {o: np.empty(n) for o in ctl.outputs}
@@ -126,13 +142,13 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
     with Progress(disable=not show, transient=True) as progress:
         task = progress.add_task(f"evaluating {path.name}", total=n)
         for start in range(0, n, CHUNK_ROWS):
-            part = {h: cols[i, start:start + CHUNK_ROWS] for i, h in enumerate(header)}
+            part = {h: cols[i, start : start + CHUNK_ROWS] for i, h in enumerate(header)}
             try:
                 out = ctl.evaluate_batch(part)
             except InputError as exc:
                 raise InputError(f"{path}: {exc} (data rows from {start + 1})") from None
             for k, v in out.items():
-                results[k][start:start + CHUNK_ROWS] = v
+                results[k][start : start + CHUNK_ROWS] = v
             progress.advance(task, min(CHUNK_ROWS, n - start))
     buf = io.StringIO()
     writer = csv.writer(buf, lineterminator="\n")
@@ -169,7 +185,9 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
 def explain(
     file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
     set_: SetOpt = None,
-    png: Annotated[Path | None, typer.Option("--png", help="Also draw the accumulated output sets to a PNG file.")] = None,
+    png: Annotated[
+        Path | None, typer.Option("--png", help="Also draw the accumulated output sets to a PNG file.")
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="The whole explanation as JSON.")] = False,
     width: Annotated[int, typer.Option("--width", help="Width of the text plot.")] = 64,
     block: BlockOpt = None,
@@ -216,8 +234,13 @@ def explain(
     for col in ("output", "value", "method", "accumulation", "fired"):
         outs.add_column(col, justify="right" if col == "value" else "left")
     for o in e.outputs:
-        outs.add_row(o.name, f"{o.value:.10g}", o.method, o.accumulation or "per rule",
-                     "yes" if o.fired else "no (default)")
+        outs.add_row(
+            o.name,
+            f"{o.value:.10g}",
+            o.method,
+            o.accumulation or "per rule",
+            "yes" if o.fired else "no (default)",
+        )
     con.print(outs)
     for o in e.outputs:
         if o.kind == "ts" and o.weights:

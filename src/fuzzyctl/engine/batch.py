@@ -48,13 +48,34 @@ from fuzzyctl.engine.plan import (
 
 Arr = npt.NDArray[np.float64]
 W = Any  # a weight: float or array
+Result = tuple[Arr, npt.NDArray[np.bool_]]  # (values, fired)
 
 _NP_FUNCS: dict[str, Any] = {
-    "sin": np.sin, "cos": np.cos, "tan": np.tan, "asin": np.arcsin, "acos": np.arccos, "atan": np.arctan,
-    "sinh": np.sinh, "cosh": np.cosh, "tanh": np.tanh, "exp": np.exp, "log": np.log, "ln": np.log,
-    "log10": np.log10, "sqrt": np.sqrt, "abs": np.abs, "fabs": np.abs, "floor": np.floor, "ceil": np.ceil,
-    "round": np.round, "sign": np.sign, "pow": np.power, "atan2": np.arctan2, "fmod": np.fmod,
-    "min": np.minimum, "max": np.maximum,
+    "sin": np.sin,
+    "cos": np.cos,
+    "tan": np.tan,
+    "asin": np.arcsin,
+    "acos": np.arccos,
+    "atan": np.arctan,
+    "sinh": np.sinh,
+    "cosh": np.cosh,
+    "tanh": np.tanh,
+    "exp": np.exp,
+    "log": np.log,
+    "ln": np.log,
+    "log10": np.log10,
+    "sqrt": np.sqrt,
+    "abs": np.abs,
+    "fabs": np.abs,
+    "floor": np.floor,
+    "ceil": np.ceil,
+    "round": np.round,
+    "sign": np.sign,
+    "pow": np.power,
+    "atan2": np.arctan2,
+    "fmod": np.fmod,
+    "min": np.minimum,
+    "max": np.maximum,
 }
 
 
@@ -127,7 +148,9 @@ class BatchEvaluator:
             return shapes.pwl_value_np(t.pwl, x)
         if t.kind == "function":
             assert t.expr is not None
-            return np.broadcast_to(np.asarray(eval_expr_np(t.expr, vals, [], x), dtype=np.float64), x.shape).copy()
+            return np.broadcast_to(
+                np.asarray(eval_expr_np(t.expr, vals, [], x), dtype=np.float64), x.shape
+            ).copy()
         params = [self._pv(p, vals) for p in t.params]
         return shapes.membership_np(t.kind, params, self._pv(t.height, vals), x)
 
@@ -210,7 +233,9 @@ class BatchEvaluator:
             outs[oi] = _apply_default(op, value, fired, state, oi)
         return outs
 
-    def _contribs(self, op: OutputPlan, concl: list[list[tuple[Arr, W]]]) -> list[tuple[int | None, Arr, W, str]]:
+    def _contribs(
+        self, op: OutputPlan, concl: list[list[tuple[Arr, W]]]
+    ) -> list[tuple[int | None, Arr, W, str]]:
         before = self.plan.options.weight_before_activation
         out = []
         for c in op.contributions:
@@ -220,8 +245,14 @@ class BatchEvaluator:
             out.append((c.term, ah, w, c.act))
         return out
 
-    def _output(self, op: OutputPlan, concl: list[list[tuple[Arr, W]]], vals: Sequence[Arr], outs: Sequence[Arr],
-                n: int) -> tuple[Arr, Arr]:
+    def _output(
+        self,
+        op: OutputPlan,
+        concl: list[list[tuple[Arr, W]]],
+        vals: Sequence[Arr],
+        outs: Sequence[Arr],
+        n: int,
+    ) -> Result:
         contribs = self._contribs(op, concl)
         if op.kind == "degree":
             v = np.zeros(n)
@@ -236,28 +267,52 @@ class BatchEvaluator:
             return self._mamdani(op, op.grid, contribs, n)
         return self._rows(op, concl, vals, outs, n)
 
-    def _rows(self, op: OutputPlan, concl: list[list[tuple[Arr, W]]], vals: Sequence[Arr], outs: Sequence[Arr],
-              n: int) -> tuple[Arr, Arr]:
+    def _rows(
+        self,
+        op: OutputPlan,
+        concl: list[list[tuple[Arr, W]]],
+        vals: Sequence[Arr],
+        outs: Sequence[Arr],
+        n: int,
+    ) -> Result:
         value = np.full(n, np.nan)
         fired = np.zeros(n, dtype=bool)
         for r in range(n):
-            row_concl = [[(float(np.asarray(a)[r] if np.ndim(a) else a), float(np.asarray(w)[r] if np.ndim(w) else w))
-                          for a, w in rc] for rc in concl]
+            row_concl = [
+                [
+                    (
+                        float(np.asarray(a)[r] if np.ndim(a) else a),
+                        float(np.asarray(w)[r] if np.ndim(w) else w),
+                    )
+                    for a, w in rc
+                ]
+                for rc in concl
+            ]
             row_vals = [float(v[r]) for v in vals]
             row_outs = [float(o[r]) for o in outs]
             rec = self.interp._output(op, row_concl, row_vals, row_outs)
             value[r], fired[r] = rec.value, rec.fired
         return value, fired
 
-    def _ts(self, op: OutputPlan, contribs: list[tuple[int | None, Arr, W, str]], vals: Sequence[Arr],
-            outs: Sequence[Arr], n: int) -> tuple[Arr, Arr]:
+    def _ts(
+        self,
+        op: OutputPlan,
+        contribs: list[tuple[int | None, Arr, W, str]],
+        vals: Sequence[Arr],
+        outs: Sequence[Arr],
+        n: int,
+    ) -> Result:
         zs: dict[int, Arr] = {}
 
         def z_of(t: int, wt: Arr) -> Arr:
             term = op.terms[t]
             if term.kind in shapes.TSUKAMOTO_KINDS:
-                return np.asarray(shapes.tsukamoto_np(term.kind, [self._pv(p, vals) for p in term.params],
-                                                      self._pv(term.height, vals), wt), dtype=np.float64)
+                return np.asarray(
+                    shapes.tsukamoto_np(
+                        term.kind, [self._pv(p, vals) for p in term.params], self._pv(term.height, vals), wt
+                    ),
+                    dtype=np.float64,
+                )
             if t not in zs:
                 if term.kind in ("singleton", "constant"):
                     z = np.full(n, 1.0) * self._pv(term.params[0], vals)
@@ -294,8 +349,9 @@ class BatchEvaluator:
             value = num / den if op.method == "WTAVER" else num
         return np.where(fired, value, np.nan), fired
 
-    def _singleton(self, op: OutputPlan, contribs: list[tuple[int | None, Arr, W, str]], vals: Sequence[Arr],
-                   n: int) -> tuple[Arr, Arr]:
+    def _singleton(
+        self, op: OutputPlan, contribs: list[tuple[int | None, Arr, W, str]], vals: Sequence[Arr], n: int
+    ) -> Result:
         accu = op.accu or "MAX"
         acc: dict[tuple[int, int], Arr] = {}
         pos: dict[tuple[int, int], Any] = {}
@@ -303,7 +359,11 @@ class BatchEvaluator:
             assert t is not None
             term = op.terms[t]
             params = [self._pv(p, vals) for p in term.params]
-            pairs = [(params[0], 1.0)] if term.kind == "singleton" else list(zip(params[0::2], params[1::2], strict=True))
+            pairs = (
+                [(params[0], 1.0)]
+                if term.kind == "singleton"
+                else list(zip(params[0::2], params[1::2], strict=True))
+            )
             for i, (x, y) in enumerate(pairs):
                 c = w * TNORMS[act].array(a, y)
                 acc[(t, i)] = accumulate_np(accu, acc.get((t, i), np.zeros(n)), c)
@@ -331,8 +391,9 @@ class BatchEvaluator:
 
     # ------------------------------------------------------------------ exact Mamdani on a grid
 
-    def _mamdani(self, op: OutputPlan, grid: GridPlan, contribs: list[tuple[int | None, Arr, W, str]],
-                 n: int) -> tuple[Arr, Arr]:
+    def _mamdani(
+        self, op: OutputPlan, grid: GridPlan, contribs: list[tuple[int | None, Arr, W, str]], n: int
+    ) -> Result:
         accu = op.accu or "MAX"
         groups = _merge(contribs, accu)
         per_term: dict[int, int] = {}
@@ -352,9 +413,15 @@ class BatchEvaluator:
                     ar, mo = a * fa, a * fm
                 area += w * ar
                 moment += w * mo
-            general = sorted(set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]})
+            general = sorted(
+                set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]}
+            )
             for j in general:
-                lines = [(grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]]
+                lines = [
+                    (grid.left[t][j], grid.right[t][j], a, w, mn)
+                    for t, a, w, mn in groups
+                    if t in grid.active[j]
+                ]
                 if not lines:
                     continue
                 X, V, extra = _interval(grid.xs[j], grid.xs[j + 1], lines, accu, n)
@@ -372,7 +439,9 @@ class BatchEvaluator:
         # CoA, LM, RM, MoM: every interval as pieces
         xs_all, vs_all = [], []
         for j in range(len(grid.xs) - 1):
-            lines = [(grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]]
+            lines = [
+                (grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]
+            ]
             if not lines:
                 continue
             X, V, _extra = _interval(grid.xs[j], grid.xs[j + 1], lines, accu, n)
@@ -392,7 +461,9 @@ class BatchEvaluator:
         return np.where(fired, value, np.nan), fired
 
 
-def _apply_default(op: OutputPlan, value: Arr, fired: Arr, state: list[float | None], oi: int) -> Arr:
+def _apply_default(
+    op: OutputPlan, value: Arr, fired: npt.NDArray[np.bool_], state: list[float | None], oi: int
+) -> Arr:
     if fired.all():
         if len(value):
             state[oi] = float(value[-1])
@@ -438,7 +509,9 @@ def _merge(contribs: list[tuple[int | None, Arr, W, str]], accu: str) -> list[tu
     return out
 
 
-def _band_eval(bands: Sequence[tuple[float, float, tuple[float, ...], tuple[float, ...]]], h: Arr) -> tuple[Arr, Arr]:
+def _band_eval(
+    bands: Sequence[tuple[float, float, tuple[float, ...], tuple[float, ...]]], h: Arr
+) -> tuple[Arr, Arr]:
     if len(bands) == 1:
         (_lo, _hi, ac, mc) = bands[0]
         return ac[0] + h * (ac[1] + h * ac[2]), mc[0] + h * (mc[1] + h * (mc[2] + h * mc[3]))
@@ -446,12 +519,12 @@ def _band_eval(bands: Sequence[tuple[float, float, tuple[float, ...], tuple[floa
     idx = np.searchsorted(edges, h, side="left")
     A = np.array([b[2] for b in bands])[idx]
     M = np.array([b[3] for b in bands])[idx]
-    return (A[:, 0] + h * (A[:, 1] + h * A[:, 2]),
-            M[:, 0] + h * (M[:, 1] + h * (M[:, 2] + h * M[:, 3])))
+    return (A[:, 0] + h * (A[:, 1] + h * A[:, 2]), M[:, 0] + h * (M[:, 1] + h * (M[:, 2] + h * M[:, 3])))
 
 
-def _interval(x0: float, x1: float, lines: list[tuple[float, float, Arr, W, bool]], accu: str,
-              n: int) -> tuple[Arr, Arr, tuple[Arr, Arr] | None]:
+def _interval(
+    x0: float, x1: float, lines: list[tuple[float, float, Arr, W, bool]], accu: str, n: int
+) -> tuple[Arr, Arr, tuple[Arr, Arr] | None]:
     """Candidate points of one grid interval (sorted per row), the accumulated degree there,
     and for PROBOR the exact (area, moment)."""
     zeros, ones = np.zeros(n), np.ones(n)
@@ -492,7 +565,7 @@ def _interval(x0: float, x1: float, lines: list[tuple[float, float, Arr, W, bool
                 v = w[:, None] * np.minimum(a2, y) if np.ndim(w) else w * np.minimum(a2, y)
                 if tk is not None:
                     exact = (w[:, None] if np.ndim(w) else w) * a2
-                    v = np.where(T == tk[:, None], exact, v)
+                    v = np.where(tk[:, None] == T, exact, v)
             else:
                 v = (w[:, None] if np.ndim(w) else w) * a2 * y
             vs.append(np.broadcast_to(v, T.shape))
@@ -567,31 +640,35 @@ def _mean_distinct(x: Arr) -> Arr:
         return np.asarray(np.where(keep, s, 0.0).sum(axis=1) / cnt, dtype=np.float64)
 
 
-def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -> tuple[Arr, Arr]:
+def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -> Result:
     sup = np.maximum(np.maximum(v0.max(axis=1), v1.max(axis=1)), gv.max(axis=1))
     fired = sup > 0.0
     s = sup[:, None] * (1.0 - pwl.MAX_TOL)
     gxb = np.broadcast_to(gx, gv.shape)
     hit0, hit1, hitg = v0 >= s, v1 >= s, gv >= s
     if method == "LM":
-        value = np.minimum(np.minimum(np.where(hit0, x0, np.inf).min(axis=1), np.where(hit1, x1, np.inf).min(axis=1)),
-                           np.where(hitg, gxb, np.inf).min(axis=1))
+        value = np.minimum(
+            np.minimum(np.where(hit0, x0, np.inf).min(axis=1), np.where(hit1, x1, np.inf).min(axis=1)),
+            np.where(hitg, gxb, np.inf).min(axis=1),
+        )
     elif method == "RM":
-        value = np.maximum(np.maximum(np.where(hit0, x0, -np.inf).max(axis=1),
-                                      np.where(hit1, x1, -np.inf).max(axis=1)),
-                           np.where(hitg, gxb, -np.inf).max(axis=1))
+        value = np.maximum(
+            np.maximum(np.where(hit0, x0, -np.inf).max(axis=1), np.where(hit1, x1, -np.inf).max(axis=1)),
+            np.where(hitg, gxb, -np.inf).max(axis=1),
+        )
     else:
         plateau = hit0 & hit1 & (x1 > x0)
         length = np.where(plateau, x1 - x0, 0.0).sum(axis=1)
         mom = np.where(plateau, (x1 - x0) * 0.5 * (x0 + x1), 0.0).sum(axis=1)
-        pts = np.concatenate([np.where(hit0, x0, np.nan), np.where(hit1, x1, np.nan), np.where(hitg, gxb, np.nan)],
-                             axis=1)
+        pts = np.concatenate(
+            [np.where(hit0, x0, np.nan), np.where(hit1, x1, np.nan), np.where(hitg, gxb, np.nan)], axis=1
+        )
         with np.errstate(all="ignore"):
             value = np.where(length > 0.0, mom / length, _mean_distinct(pts))
     return np.where(fired, value, np.nan), fired
 
 
-def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> tuple[Arr, Arr]:
+def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> Result:
     dx = x1 - x0
     areas = 0.5 * dx * (v0 + v1)
     total = areas.sum(axis=1)
@@ -617,12 +694,18 @@ def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> tuple[Arr, Arr]:
     cum = np.cumsum(areas, axis=1)
     ok = (cum >= half[:, None]) & (areas > 0.0)
     i_left = np.argmax(ok, axis=1)
-    before = np.take_along_axis(cum, i_left[:, None], axis=1)[:, 0] - np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
+    before = (
+        np.take_along_axis(cum, i_left[:, None], axis=1)[:, 0]
+        - np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
+    )
     left = solve(i_left, half - before, False)
     rcum = np.cumsum(areas[:, ::-1], axis=1)[:, ::-1]
     ok_r = (rcum >= half[:, None]) & (areas > 0.0)
     i_right = areas.shape[1] - 1 - np.argmax(ok_r[:, ::-1], axis=1)
-    before_r = np.take_along_axis(rcum, i_right[:, None], axis=1)[:, 0] - np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
+    before_r = (
+        np.take_along_axis(rcum, i_right[:, None], axis=1)[:, 0]
+        - np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
+    )
     right = solve(i_right, half - before_r, True)
     return np.where(fired, 0.5 * (left + right), np.nan), fired
 

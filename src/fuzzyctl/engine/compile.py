@@ -16,17 +16,30 @@ from fuzzyctl.model import Document, FunctionBlock
 COMPAT_PROFILES: dict[str, Options] = {
     "iec": Options(),
     # fuzzylite 6 (C++), the tool that produced the .fld reference files
-    "fuzzylite": Options(weight_before_activation=True, firing_threshold=1e-6, ts_default_accu="SUM",
-                         singleton_default_accu="SUM", hedges_carry_over=True),
+    "fuzzylite": Options(
+        weight_before_activation=True,
+        firing_threshold=1e-6,
+        ts_default_accu="SUM",
+        singleton_default_accu="SUM",
+        hedges_carry_over=True,
+    ),
     # pyfuzzylite 8: like fuzzylite but no firing threshold and per-conclusion hedges
-    "pyfuzzylite": Options(weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"),
+    "pyfuzzylite": Options(
+        weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"
+    ),
     # jFuzzyLogic 3.3: WITH scales the condition degree
     "jfuzzylogic": Options(weight_before_activation=True, weight_whole_rule=True),
 }
 
 
-def compile_block(model: Document | FunctionBlock, *, block: str | None = None, backend: str = "python",
-                  compat: str = "iec", **options: Any) -> Controller:
+def compile_block(
+    model: Document | FunctionBlock,
+    *,
+    block: str | None = None,
+    backend: str = "python",
+    compat: str = "iec",
+    **options: Any,
+) -> Controller:
     """Compile a function block into a :class:`Controller`.
 
     ``block`` picks a function block of a document by name (default: the first).  ``backend``

@@ -117,18 +117,22 @@ class Controller:
                 if self._degree[i]:
                     bad = np.flatnonzero((arr < 0.0) | (arr > 1.0))
                     if bad.size:
-                        raise InputError(f"input {spec.name!r} is used as a degree and must be in [0, 1] "
-                                         f"(row {int(bad[0])}: {arr[bad[0]]})")
+                        raise InputError(
+                            f"input {spec.name!r} is used as a degree and must be in [0, 1] "
+                            f"(row {int(bad[0])}: {arr[bad[0]]})"
+                        )
             arrays.append(arr)  # type: ignore[arg-type]
         n = n or 0
-        full = [a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
-                for i, a in enumerate(arrays)]
+        full = [
+            a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
+            for i, a in enumerate(arrays)
+        ]
         result = {o.name: np.empty(n) for o in self.plan.outputs}
         for start in range(0, n, chunk):
-            part = [a[start:start + chunk] for a in full]
+            part = [a[start : start + chunk] for a in full]
             out = self._batch_chunk(part)
             for o, arr in zip(self.plan.outputs, out, strict=True):
-                result[o.name][start:start + chunk] = arr
+                result[o.name][start : start + chunk] = arr
         return {k: v for k, v in result.items() if k in self.outputs}
 
     def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
@@ -154,7 +158,7 @@ class Controller:
 def _number(name: str, raw: Any) -> float:
     if isinstance(raw, float):
         v = raw
-    elif isinstance(raw, numbers.Real) and not isinstance(raw, str):
+    elif isinstance(raw, numbers.Real):
         v = float(raw)
     else:
         raise InputError(f"input {name!r} must be a number, got {type(raw).__name__} {raw!r}")

@@ -85,7 +85,8 @@ class Explanation:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (NaN becomes None)."""
-        return _clean(dataclasses.asdict(self))
+        out: dict[str, Any] = _clean(dataclasses.asdict(self))
+        return out
 
 
 def _clean(v: Any) -> Any:
@@ -162,5 +163,17 @@ def _output(plan: Plan, index: int, o: OutputRecord) -> OutputTrace:
         bps = [(op.low, 0.0), (op.high, 0.0)]
         exact = True
     singles = tuple(o.points) if op.kind == "singleton" else ()
-    return OutputTrace(op.name, o.value, o.fired, op.kind, op.method, op.accu, op.low, op.high, tuple(bps),
-                       singles, tuple(o.weights), exact)
+    return OutputTrace(
+        op.name,
+        o.value,
+        o.fired,
+        op.kind,
+        op.method,
+        op.accu,
+        op.low,
+        op.high,
+        tuple(bps),
+        singles,
+        tuple(o.weights),
+        exact,
+    )

@@ -47,7 +47,9 @@ def _interp(points: Points, x: float) -> float:
     return points[-1][1]
 
 
-def build_grid(terms: Sequence[Points], low: float, high: float, used: Collection[int] | None = None) -> GridPlan:
+def build_grid(
+    terms: Sequence[Points], low: float, high: float, used: Collection[int] | None = None
+) -> GridPlan:
     """Cut ``[low, high]`` at every breakpoint of ``terms``.  ``used`` are the terms some rule
     concludes (the others never contribute; default: all)."""
     cuts = {low, high}
@@ -72,7 +74,9 @@ def build_grid(terms: Sequence[Points], low: float, high: float, used: Collectio
     return GridPlan(xs, left, right, point, active, shared, solo, bands, full)
 
 
-def _full(xs: Sequence[float], left: Sequence[float], right: Sequence[float], js: Sequence[int]) -> tuple[float, float]:
+def _full(
+    xs: Sequence[float], left: Sequence[float], right: Sequence[float], js: Sequence[int]
+) -> tuple[float, float]:
     area = moment = 0.0
     for j in js:
         x0, x1, v0, v1 = xs[j], xs[j + 1], left[j], right[j]
@@ -100,10 +104,8 @@ def _segment_polys(x0: float, x1: float, lo: float, hi: float, h_mid: float) -> 
     area_unit = L * tk + 0.5 * D * tk**2 + h * (1.0 - tk)  # integral over t in [0, 1]
     tmom_unit = 0.5 * L * tk**2 + D * tk**3 / 3.0 + 0.5 * h * (1.0 - tk**2)  # integral of t * c(t)
     area = dx * area_unit
-    if rising:
-        moment = x0 * area + dx * dx * tmom_unit
-    else:  # mirrored: t' = 1 - t measured from x1 going left
-        moment = x1 * area - dx * dx * tmom_unit
+    # a falling segment is mirrored: t' = 1 - t measured from x1 going left
+    moment = x0 * area + dx * dx * tmom_unit if rising else x1 * area - dx * dx * tmom_unit
     return area, moment
 
 

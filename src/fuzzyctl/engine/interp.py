@@ -42,7 +42,6 @@ from fuzzyctl.engine.plan import (
     TermPlan,
 )
 
-
 # --------------------------------------------------------------------------- expressions
 
 
@@ -244,12 +243,15 @@ class Interpreter:
             out_values[oi] = rec.value
             records[oi] = rec
         chained_final = [chained_value(i) for i in range(len(plan.chained))]
-        return Record(term_degrees, rule_degrees, concl_degrees, chained_final,
-                      [r for r in records if r is not None])
+        return Record(
+            term_degrees, rule_degrees, concl_degrees, chained_final, [r for r in records if r is not None]
+        )
 
     # ------------------------------------------------------------------ outputs
 
-    def _contribs(self, op: OutputPlan, concl: list[list[tuple[float, float]]]) -> list[tuple[int | None, float, float, str]]:
+    def _contribs(
+        self, op: OutputPlan, concl: list[list[tuple[float, float]]]
+    ) -> list[tuple[int | None, float, float, str]]:
         """(term, effective degree, effective weight, act) of every activated set, weight
         applied after activation (IEC) or folded into the degree (compat)."""
         out = []
@@ -262,8 +264,13 @@ class Interpreter:
                 out.append((c.term, ah, w, c.act))
         return out
 
-    def _output(self, op: OutputPlan, concl: list[list[tuple[float, float]]], values: Sequence[float],
-                outs: Sequence[float]) -> OutputRecord:
+    def _output(
+        self,
+        op: OutputPlan,
+        concl: list[list[tuple[float, float]]],
+        values: Sequence[float],
+        outs: Sequence[float],
+    ) -> OutputRecord:
         contribs = self._contribs(op, concl)
         if op.kind == "degree":
             v = 0.0
@@ -278,8 +285,13 @@ class Interpreter:
             return self._exact(op, contribs, values)
         return self._smooth(op, contribs, values)
 
-    def _ts(self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float],
-            outs: Sequence[float]) -> OutputRecord:
+    def _ts(
+        self,
+        op: OutputPlan,
+        contribs: list[tuple[int | None, float, float, str]],
+        values: Sequence[float],
+        outs: Sequence[float],
+    ) -> OutputRecord:
         zs: dict[tuple[int, float], float] = {}
 
         def z_of(t: int, wt: float) -> float:
@@ -307,8 +319,9 @@ class Interpreter:
         rec.value = math.fsum(num) / total if op.method == "WTAVER" else math.fsum(num)
         return rec
 
-    def _singleton(self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]],
-                   values: Sequence[float]) -> OutputRecord:
+    def _singleton(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
         accu = op.accu or "MAX"
         acc: dict[tuple[int, int], float] = {}
         pos: dict[tuple[int, int], float] = {}
@@ -338,8 +351,9 @@ class Interpreter:
             rec.value = {"LM": xs[0], "RM": xs[-1], "MOM": math.fsum(xs) / len(xs)}[op.method]
         return rec
 
-    def _exact(self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]],
-               values: Sequence[float]) -> OutputRecord:
+    def _exact(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
         assert op.low is not None and op.high is not None
         grid = op.grid
         if grid is None:
@@ -361,8 +375,9 @@ class Interpreter:
             rec.value, rec.fired = value, True
         return rec
 
-    def _smooth(self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]],
-                values: Sequence[float]) -> OutputRecord:
+    def _smooth(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
         assert op.low is not None and op.high is not None
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
@@ -394,10 +409,14 @@ def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:
     return 1.0 - d if negated else d
 
 
-def ts_value(term: TermPlan, values: Sequence[float], outs: Sequence[float], pv: Any, weight: float = 1.0) -> float:
+def ts_value(
+    term: TermPlan, values: Sequence[float], outs: Sequence[float], pv: Any, weight: float = 1.0
+) -> float:
     """z of a Takagi-Sugeno term (of a Tsukamoto term: where it reaches ``weight``)."""
     if term.kind in shapes.TSUKAMOTO_KINDS:
-        return shapes.tsukamoto(term.kind, [pv(p, values) for p in term.params], pv(term.height, values), weight)
+        return shapes.tsukamoto(
+            term.kind, [pv(p, values) for p in term.params], pv(term.height, values), weight
+        )
     if term.kind in ("singleton", "constant"):
         return float(pv(term.params[0], values))
     if term.kind == "linear":
@@ -409,16 +428,25 @@ def ts_value(term: TermPlan, values: Sequence[float], outs: Sequence[float], pv:
     return eval_expr(term.expr, values, outs)
 
 
-def accumulated_function(op: OutputPlan, contribs: Sequence[tuple[int | None, float, float, str]],
-                         values: Sequence[float], pv: Any) -> quadrature.Integrand:
+def accumulated_function(
+    op: OutputPlan, contribs: Sequence[tuple[int | None, float, float, str]], values: Sequence[float], pv: Any
+) -> quadrature.Integrand:
     """mu(u) of a Mamdani output as a vectorised function (for quadrature and plots)."""
     accu = op.accu or "MAX"
     resolved = []
     for t, a, w, act in contribs:
         assert t is not None
         term = op.terms[t]
-        resolved.append((term.kind, [pv(p, values) for p in term.params], pv(term.height, values), a, w,
-                         TNORMS[act].array))
+        resolved.append(
+            (
+                term.kind,
+                [pv(p, values) for p in term.params],
+                pv(term.height, values),
+                a,
+                w,
+                TNORMS[act].array,
+            )
+        )
 
     def f(x: Any) -> Any:
         acc = np.zeros_like(x)

@@ -121,15 +121,33 @@ SNORMS: dict[str, Norm] = {
 SOURCE_HELPERS: dict[str, Any] = {"_ham_t": _ham_t, "_ham_s": _ham_s, "min": min, "max": max}
 
 # Table 3: AND -> OR and back.  The open-level norms pair with their duals.
-AND_TO_OR = {"MIN": "MAX", "PROD": "ASUM", "BDIF": "BSUM", "DMIN": "DMAX", "NIPMIN": "NIPMAX",
-             "HAMACHER": "HAMACHER", "EINSTEIN": "EINSTEIN"}
+AND_TO_OR = {
+    "MIN": "MAX",
+    "PROD": "ASUM",
+    "BDIF": "BSUM",
+    "DMIN": "DMAX",
+    "NIPMIN": "NIPMAX",
+    "HAMACHER": "HAMACHER",
+    "EINSTEIN": "EINSTEIN",
+}
 OR_TO_AND = {v: k for k, v in AND_TO_OR.items()}
 
 # Spellings other tools write for the same operators.
-AND_ALIASES = {"EPROD": "EINSTEIN", "HPROD": "HAMACHER", "NMIN": "NIPMIN", "DPROD": "DMIN",
-               "ALGEBRAIC_PRODUCT": "PROD"}
-OR_ALIASES = {"PROBOR": "ASUM", "ESUM": "EINSTEIN", "HSUM": "HAMACHER", "NMAX": "NIPMAX",
-              "DSUM": "DMAX", "ALGEBRAIC_SUM": "ASUM"}
+AND_ALIASES = {
+    "EPROD": "EINSTEIN",
+    "HPROD": "HAMACHER",
+    "NMIN": "NIPMIN",
+    "DPROD": "DMIN",
+    "ALGEBRAIC_PRODUCT": "PROD",
+}
+OR_ALIASES = {
+    "PROBOR": "ASUM",
+    "ESUM": "EINSTEIN",
+    "HSUM": "HAMACHER",
+    "NMAX": "NIPMAX",
+    "DSUM": "DMAX",
+    "ALGEBRAIC_SUM": "ASUM",
+}
 
 
 def resolve_pair(and_op: str | None, or_op: str | None) -> tuple[str, str]:
@@ -171,8 +189,14 @@ def resolve_act(act: str | None) -> str:
 #: uniform scale never changes a defuzzified value, so NSUM is accumulated like SUM and
 #: normalised only where degrees are shown or reused (explanations, chained inference).
 ACCU_NAMES = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR", "EINSTEIN", "HAMACHER", "DMAX", "NIPMAX"})
-ACCU_ALIASES = {"ASUM": "PROBOR", "ESUM": "EINSTEIN", "HSUM": "HAMACHER", "NMAX": "NIPMAX",
-                "DSUM": "DMAX", "USUM": "SUM"}
+ACCU_ALIASES = {
+    "ASUM": "PROBOR",
+    "ESUM": "EINSTEIN",
+    "HSUM": "HAMACHER",
+    "NMAX": "NIPMAX",
+    "DSUM": "DMAX",
+    "USUM": "SUM",
+}
 #: Accumulations whose result on piecewise-linear activated sets is integrated exactly.
 EXACT_ACCU = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR"})
 

@@ -3,6 +3,7 @@ PNG (matplotlib, imported only when asked for)."""
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import tempfile
@@ -14,12 +15,9 @@ from fuzzyctl.engine.explain import Explanation, OutputTrace
 def _value_at(bps: tuple[tuple[float, float], ...], x: float) -> float:
     """The polyline's upper value at x (vertical edges included)."""
     best = 0.0
-    for (x0, y0), (x1, y1) in zip(bps, bps[1:], strict=False):
+    for (x0, y0), (x1, y1) in itertools.pairwise(bps):
         if x0 <= x <= x1:
-            if x1 == x0:
-                best = max(best, y0, y1)
-            else:
-                best = max(best, y0 + (y1 - y0) * (x - x0) / (x1 - x0))
+            best = max(best, y0, y1) if x1 == x0 else max(best, y0 + (y1 - y0) * (x - x0) / (x1 - x0))
     return best
 
 
@@ -63,7 +61,9 @@ def ascii_plot(trace: OutputTrace, width: int = 64, height: int = 10) -> str:
     if mark is not None:
         rows.append("      " + " " * mark + f"^ {trace.name} = {trace.value:.6g}")
     else:
-        rows.append(f"      {trace.name} = {trace.value:.6g}" + ("" if trace.fired else " (no rule fired: default)"))
+        rows.append(
+            f"      {trace.name} = {trace.value:.6g}" + ("" if trace.fired else " (no rule fired: default)")
+        )
     return "\n".join(rows)
 
 
@@ -82,7 +82,9 @@ def save_png(explanation: Explanation, path: str | Path) -> None:
             xs = [x for x, _ in o.singletons]
             ax.vlines(xs, 0, [v for _, v in o.singletons], linewidth=3)
         elif o.breakpoints:
-            ax.fill_between([p[0] for p in o.breakpoints], [p[1] for p in o.breakpoints], step=None, alpha=0.4)
+            ax.fill_between(
+                [p[0] for p in o.breakpoints], [p[1] for p in o.breakpoints], step=None, alpha=0.4
+            )
             ax.plot([p[0] for p in o.breakpoints], [p[1] for p in o.breakpoints], linewidth=1)
         if math.isfinite(o.value):
             ax.axvline(o.value, color="red", linestyle="--", label=f"{o.name} = {o.value:.6g}")

@@ -34,7 +34,7 @@ Line = tuple[float, float, float, float, bool]
 @cache
 def gauss_legendre(n: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """Nodes and weights on [0, 1]."""
-    x, w = np.polynomial.legendre.leggauss(n)
+    x, w = np.polynomial.legendre.leggauss(n)  # type: ignore[no-untyped-call]
     return tuple(float(v) for v in (x + 1.0) / 2.0), tuple(float(v) for v in w / 2.0)
 
 
@@ -132,7 +132,9 @@ def grid_pieces(grid: GridPlan, contribs: Sequence[tuple[int, float, float, bool
     return out
 
 
-def point_values(grid: GridPlan, contribs: Sequence[tuple[int, float, float, bool]], accu: str) -> list[float]:
+def point_values(
+    grid: GridPlan, contribs: Sequence[tuple[int, float, float, bool]], accu: str
+) -> list[float]:
     """The accumulated degree exactly at each grid point (matters only at vertical edges)."""
     from fuzzyctl.engine.operators import accumulate
 
@@ -242,12 +244,14 @@ def bisector(pieces: Sequence[Piece], total: float) -> float:
     return 0.5 * (left + right)
 
 
-def maxima(pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> tuple[float, float, float, float]:
+def maxima(
+    pieces: Sequence[Piece], points: Sequence[tuple[float, float]]
+) -> tuple[float, float, float, float]:
     """``(height, LM, RM, MoM)`` of the accumulated set: the supremum, the smallest and the
     largest u reaching it, and the mean of the maximising set (the centroid of its intervals,
     or the mean of its points when it has no length)."""
     sup = 0.0
-    for x0, x1, v0, v1, _f in pieces:
+    for _x0, _x1, v0, v1, _f in pieces:
         sup = max(sup, v0, v1)
     for _x, v in points:
         sup = max(sup, v)
@@ -273,11 +277,17 @@ def maxima(pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> tu
             lm = min(lm, x)
             rm = max(rm, x)
             isolated.add(x)
-    mom = plateau_mom / plateau_len if plateau_len > 0.0 else (math.fsum(isolated) / len(isolated) if isolated else math.nan)
+    mom = (
+        plateau_mom / plateau_len
+        if plateau_len > 0.0
+        else (math.fsum(isolated) / len(isolated) if isolated else math.nan)
+    )
     return sup, lm, rm, mom
 
 
-def defuzzify_pieces(method: str, pieces: Sequence[Piece], points: Sequence[tuple[float, float]]) -> float | None:
+def defuzzify_pieces(
+    method: str, pieces: Sequence[Piece], points: Sequence[tuple[float, float]]
+) -> float | None:
     """The defuzzified value, or None when the set is empty (no rule fired)."""
     # "fired" means the set has area: a set that is 0 almost everywhere (a lone vertical edge
     # at the end of the range) has no centre and no meaningful maximum either
@@ -288,5 +298,5 @@ def defuzzify_pieces(method: str, pieces: Sequence[Piece], points: Sequence[tupl
         return moment / area
     if method == "COA":
         return bisector([p for p in pieces if p[1] > p[0]], area)
-    sup, lm, rm, mom = maxima(pieces, points)
+    _sup, lm, rm, mom = maxima(pieces, points)
     return {"LM": lm, "RM": rm, "MOM": mom}[method]

@@ -19,20 +19,38 @@ import numpy as np
 
 from fuzzyctl.engine.shapes import FloatArray
 
-_XGK = np.array([
-    0.991455371120812639206854697526329, 0.949107912342758524526189684047851,
-    0.864864423359769072789712788640926, 0.741531185599394439863864773280788,
-    0.586087235467691130294144845693013, 0.405845151377397166906606412076961,
-    0.207784955007898467600689403773245, 0.0,
-])
-_WGK = np.array([
-    0.022935322010529224963732008058970, 0.063092092629978553290700663189204,
-    0.104790010322250183839876322541518, 0.140653259715525918745189590510238,
-    0.169004726639267902826583426598550, 0.190350578064785409913256402421014,
-    0.204432940075298892414161999234649, 0.209482141084727828012999174891714,
-])
-_WG = np.array([0.129484966168869693270611432679082, 0.279705391489276667901467771423780,
-                0.381830050505118944950369775488975, 0.417959183673469387755102040816327])
+_XGK = np.array(
+    [
+        0.991455371120812639206854697526329,
+        0.949107912342758524526189684047851,
+        0.864864423359769072789712788640926,
+        0.741531185599394439863864773280788,
+        0.586087235467691130294144845693013,
+        0.405845151377397166906606412076961,
+        0.207784955007898467600689403773245,
+        0.0,
+    ]
+)
+_WGK = np.array(
+    [
+        0.022935322010529224963732008058970,
+        0.063092092629978553290700663189204,
+        0.104790010322250183839876322541518,
+        0.140653259715525918745189590510238,
+        0.169004726639267902826583426598550,
+        0.190350578064785409913256402421014,
+        0.204432940075298892414161999234649,
+        0.209482141084727828012999174891714,
+    ]
+)
+_WG = np.array(
+    [
+        0.129484966168869693270611432679082,
+        0.279705391489276667901467771423780,
+        0.381830050505118944950369775488975,
+        0.417959183673469387755102040816327,
+    ]
+)
 # 15 nodes on [-1, 1] and their weights; the 7-point Gauss rule uses every other node.
 NODES = np.concatenate([-_XGK[:-1], [0.0], _XGK[:-1][::-1]])
 WK = np.concatenate([_WGK[:-1], [_WGK[-1]], _WGK[:-1][::-1]])
@@ -43,7 +61,9 @@ Integrand = Callable[[FloatArray], FloatArray]
 MAX_INTERVALS = 40_000
 
 
-def _rule(f: Integrand, a: FloatArray, b: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
+def _rule(
+    f: Integrand, a: FloatArray, b: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray]:
     half = 0.5 * (b - a)
     mid = 0.5 * (a + b)
     x = mid[:, None] + half[:, None] * NODES[None, :]
@@ -55,7 +75,9 @@ def _rule(f: Integrand, a: FloatArray, b: FloatArray) -> tuple[FloatArray, Float
     return k, np.abs(k - g), km, np.abs(km - gm), y
 
 
-def integrate(f: Integrand, cuts: Sequence[float], rtol: float = 1e-10) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+def integrate(
+    f: Integrand, cuts: Sequence[float], rtol: float = 1e-10
+) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """Integrate ``f`` and ``x f`` over ``[cuts[0], cuts[-1]]``.  Returns the accepted
     intervals ``(a, b, area, moment)``, sorted by ``a``."""
     edges = np.array(sorted(set(cuts)), dtype=np.float64)
@@ -125,7 +147,9 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
     value is reached on one (MoM: their centroid), else the peaks within 1e-12 of the
     height (MoM: their mean)."""
     half = 0.5 * (B - A)
-    x = np.concatenate([(0.5 * (A + B))[:, None] + half[:, None] * NODES[None, :], A[:, None], B[:, None]], axis=1)
+    x = np.concatenate(
+        [(0.5 * (A + B))[:, None] + half[:, None] * NODES[None, :], A[:, None], B[:, None]], axis=1
+    )
     xs = np.unique(x.ravel())
     ys = f(xs)
     n = len(xs)
@@ -138,7 +162,9 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         i = int(i)
         if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
             continue
-        peaks.append(_golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i])))
+        peaks.append(
+            _golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i]))
+        )
     sup = max([top, *(v for _x, v in peaks)])
     # plateaus: runs of at least two nodes exactly at the top value
     runs: list[tuple[float, float]] = []

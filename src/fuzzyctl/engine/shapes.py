@@ -197,7 +197,7 @@ def _smooth(kind: str, p: Sequence[float], x: float) -> float:
         return a * b
     if kind == "bell":
         c, w, s = p
-        return 1.0 / (1.0 + abs((x - c) / w) ** (2.0 * s))
+        return 1.0 / (1.0 + float(abs((x - c) / w) ** (2.0 * s)))
     if kind == "sigmoid":
         return _sig(x, p[0], p[1])
     if kind == "dsigmoid":
@@ -396,7 +396,10 @@ def _pwl_dynamic(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -
         # rectangle, ramp and binary change form with the order of their parameters: evaluate
         # each sample through the scalar definition (rare: variable points on such shapes).
         out = np.array(
-            [membership(kind, [float(f[i]) for f in flat], float(hh[i]), float(xx[i])) for i in range(xx.size)]
+            [
+                membership(kind, [float(f[i]) for f in flat], float(hh[i]), float(xx[i]))
+                for i in range(xx.size)
+            ]
         )
         return out.reshape(shape)
     order = np.argsort(xs, axis=1, kind="stable")
@@ -461,7 +464,10 @@ def characteristic_points(kind: str, params: Sequence[float]) -> tuple[float, ..
         m, s = p
         return tuple(m + k * abs(s) for k in (-8, -4, -2, -1, 0, 1, 2, 4, 8))
     if kind == "gaussian2":
-        return tuple([p[0] + k * abs(p[1]) for k in (-8, -4, -2, -1, 0)] + [p[2] + k * abs(p[3]) for k in (0, 1, 2, 4, 8)])
+        return tuple(
+            [p[0] + k * abs(p[1]) for k in (-8, -4, -2, -1, 0)]
+            + [p[2] + k * abs(p[3]) for k in (0, 1, 2, 4, 8)]
+        )
     if kind == "bell":
         c, w, _s = p
         return tuple(c + k * abs(w) for k in (-16, -4, -2, -1, 0, 1, 2, 4, 16))
@@ -524,7 +530,9 @@ def hedge_np(name: str, x: Any) -> Any:
     if name == "extremely":
         return np.where(x <= 0.5, 2.0 * x * x, 1.0 - 2.0 * (1.0 - x) * (1.0 - x))
     if name == "seldom":
-        return np.where(x <= 0.5, np.sqrt(0.5 * np.maximum(x, 0.0)), 1.0 - np.sqrt(0.5 * np.maximum(1.0 - x, 0.0)))
+        return np.where(
+            x <= 0.5, np.sqrt(0.5 * np.maximum(x, 0.0)), 1.0 - np.sqrt(0.5 * np.maximum(1.0 - x, 0.0))
+        )
     if name == "any":
         return np.ones_like(x)
     raise ValueError(f"unknown hedge {name!r}")
@@ -546,10 +554,18 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
             return i + math.log(h / y - 1.0) / -s
         if kind == "sshape":
             s, e = p
-            return s + (e - s) * math.sqrt(y / (2.0 * h)) if y <= 0.5 * h else e - (e - s) * math.sqrt((h - y) / (2.0 * h))
+            return (
+                s + (e - s) * math.sqrt(y / (2.0 * h))
+                if y <= 0.5 * h
+                else e - (e - s) * math.sqrt((h - y) / (2.0 * h))
+            )
         if kind == "zshape":
             s, e = p
-            return s + (e - s) * math.sqrt((h - y) / (2.0 * h)) if y >= 0.5 * h else e - (e - s) * math.sqrt(y / (2.0 * h))
+            return (
+                s + (e - s) * math.sqrt((h - y) / (2.0 * h))
+                if y >= 0.5 * h
+                else e - (e - s) * math.sqrt(y / (2.0 * h))
+            )
         if kind == "concave":
             i, e = p
             return h * (i - e) / y + 2.0 * e - i
@@ -574,10 +590,14 @@ def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
             return i + np.log(h / y - 1.0) / -s
         if kind == "sshape":
             s, e = params
-            return np.where(y <= 0.5 * h, s + (e - s) * np.sqrt(y / (2.0 * h)), e - (e - s) * np.sqrt((h - y) / (2.0 * h)))
+            return np.where(
+                y <= 0.5 * h, s + (e - s) * np.sqrt(y / (2.0 * h)), e - (e - s) * np.sqrt((h - y) / (2.0 * h))
+            )
         if kind == "zshape":
             s, e = params
-            return np.where(y >= 0.5 * h, s + (e - s) * np.sqrt((h - y) / (2.0 * h)), e - (e - s) * np.sqrt(y / (2.0 * h)))
+            return np.where(
+                y >= 0.5 * h, s + (e - s) * np.sqrt((h - y) / (2.0 * h)), e - (e - s) * np.sqrt(y / (2.0 * h))
+            )
         if kind == "concave":
             i, e = params
             return h * (i - e) / y + 2.0 * e - i

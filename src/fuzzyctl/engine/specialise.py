@@ -53,9 +53,16 @@ class _Gen:
         self.lines: list[str] = []
         self.n = 0
         self.env: dict[str, Any] = {
-            "_NAN": math.nan, "_INF": math.inf, "_exp": math.exp, "_cos": math.cos, "_sqrt": math.sqrt,
-            "_m": shapes.membership, "_H": shapes.HEDGES, "_pieces": pwl.interval_pieces,
-            "_am": pwl.area_moment, "_eval_expr": eval_expr,
+            "_NAN": math.nan,
+            "_INF": math.inf,
+            "_exp": math.exp,
+            "_cos": math.cos,
+            "_sqrt": math.sqrt,
+            "_m": shapes.membership,
+            "_H": shapes.HEDGES,
+            "_pieces": pwl.interval_pieces,
+            "_am": pwl.area_moment,
+            "_eval_expr": eval_expr,
         }
         self.consts: dict[int, str] = {}
 
@@ -123,13 +130,16 @@ class _Gen:
 
     # ------------------------------------------------------------------ conditions
 
-    def cond(self, c: CondPlan, degrees: dict[tuple[int, int], str], chained: dict[tuple[int, int], str],
-             bare: dict[int, str]) -> str:
+    def cond(
+        self,
+        c: CondPlan,
+        degrees: dict[tuple[int, int], str],
+        chained: dict[tuple[int, int], str],
+        bare: dict[int, str],
+    ) -> str:
         if isinstance(c, CTerm | CChained):
-            if "any" in c.hedges:
-                d = "1.0"
-            else:
-                d = (degrees if isinstance(c, CTerm) else chained)[(c.var, c.term)]
+            table = degrees if isinstance(c, CTerm) else chained
+            d = "1.0" if "any" in c.hedges else table[(c.var, c.term)]
             return self.hedged(d, c.hedges, c.negated)
         if isinstance(c, CDegree):
             return f"v{c.slot}" if c.slot is not None else bare[c.chained or 0]
@@ -195,8 +205,8 @@ def specialise(plan: Plan) -> Fast:
             for o in c.operands:
                 collect(o)
 
-    for r in plan.rules:
-        collect(r.condition)
+    for rp in plan.rules:
+        collect(rp.condition)
     degrees: dict[tuple[int, int], str] = {}
     for var, term in sorted(needed):
         fi = plan.fuzzy_inputs[var]
@@ -206,8 +216,8 @@ def specialise(plan: Plan) -> Fast:
     # ---- chained accumulators
     chained: dict[tuple[int, int], str] = {}
     bare: dict[int, str] = {}
-    for ci, ch in enumerate(plan.chained):
-        for ti in range(len(ch.terms)):
+    for ci, chp in enumerate(plan.chained):
+        for ti in range(len(chp.terms)):
             chained[(ci, ti)] = f"c{ci}_{ti}"
             g.emit(f"c{ci}_{ti} = 0.0")
         bare[ci] = f"cb{ci}"
@@ -231,7 +241,7 @@ def specialise(plan: Plan) -> Fast:
         if opts.firing_threshold > 0.0:
             g.emit(f"if {r} <= {_lit(opts.firing_threshold)}: {r} = 0.0")
         carried = r
-        for k, cp in enumerate(rule.conclusions):
+        for cp in rule.conclusions:
             base = carried if opts.hedges_carry_over else r
             h = g.hedged(base, cp.hedges, False) if cp.hedges else base
             if opts.hedges_carry_over:
@@ -246,7 +256,9 @@ def specialise(plan: Plan) -> Fast:
     # ---- outputs
     need_cc = any(not _specialised(op, plan) for op in plan.outputs)
     if need_cc:
-        cc = ", ".join("[" + ", ".join(f"({h}, {w})" for h, w in concl_names[ri]) + "]" for ri in range(len(plan.rules)))
+        cc = ", ".join(
+            "[" + ", ".join(f"({h}, {w})" for h, w in concl_names[ri]) + "]" for ri in range(len(plan.rules))
+        )
         g.emit(f"cc = [{cc}]")
     g.emit(f"outs = [_NAN] * {len(plan.outputs)}")
     for oi in plan.output_order:
@@ -255,7 +267,7 @@ def specialise(plan: Plan) -> Fast:
     g.emit("return outs")
     src = "def _fast(v, state):\n" + "\n".join(g.lines) + "\n"
     env = dict(g.env)
-    exec(compile(src, f"<fuzzyctl specialised {plan.name}>", "exec"), env)  # noqa: S102 - our own generated code
+    exec(compile(src, f"<fuzzyctl specialised {plan.name}>", "exec"), env)
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn
@@ -284,7 +296,9 @@ def _specialised(op: OutputPlan, plan: Plan) -> bool:
     return op.kind == "mamdani" and op.exact and op.grid is not None and op.method == "COG"
 
 
-def _contrib_src(plan: Plan, op: OutputPlan, concl: list[list[tuple[str, str]]]) -> list[tuple[int | None, str, str, str]]:
+def _contrib_src(
+    plan: Plan, op: OutputPlan, concl: list[list[tuple[str, str]]]
+) -> list[tuple[int | None, str, str, str]]:
     """(term, degree expr, weight expr, act) with the weight placement of the options."""
     out = []
     for c in op.contributions:
@@ -328,8 +342,9 @@ def _gen_output(g: _Gen, plan: Plan, oi: int, op: OutputPlan, concl: list[list[t
     g.emit(f"outs[{oi}] = {val}; state[{oi}] = {val}")
 
 
-def _gen_singleton(g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str, str, str]], val: str,
-                   fired: str) -> None:
+def _gen_singleton(
+    g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str, str, str]], val: str, fired: str
+) -> None:
     accu = op.accu or "MAX"
     by_term: dict[int, list[str]] = {}
     for t, h, w, _act in contribs:
@@ -354,8 +369,14 @@ def _gen_singleton(g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str
     g.emit(f"{val} = ({num}) / den if {fired} else _NAN")
 
 
-def _gen_ts(g: _Gen, plan: Plan, op: OutputPlan, contribs: list[tuple[int | None, str, str, str]], val: str,
-            fired: str) -> None:
+def _gen_ts(
+    g: _Gen,
+    plan: Plan,
+    op: OutputPlan,
+    contribs: list[tuple[int | None, str, str, str]],
+    val: str,
+    fired: str,
+) -> None:
     zs: dict[int, str] = {}
 
     def z(t: int) -> str:
@@ -408,8 +429,9 @@ def _gen_ts(g: _Gen, plan: Plan, op: OutputPlan, contribs: list[tuple[int | None
         g.emit(f"{val} = num if {fired} else _NAN")
 
 
-def _gen_cog(g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str, str, str]], val: str,
-             fired: str) -> None:
+def _gen_cog(
+    g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str, str, str]], val: str, fired: str
+) -> None:
     grid = op.grid
     assert grid is not None
     accu = op.accu or "MAX"
@@ -473,12 +495,16 @@ def _gen_cog(g: _Gen, op: OutputPlan, contribs: list[tuple[int | None, str, str,
         members = [(t, h, w, mn) for t, h, w, mn in groups if t in grid.active[j]]
         if not members:
             continue
-        lines = ", ".join(f"({_lit(grid.left[t][j])}, {_lit(grid.right[t][j])}, {h}, {w}, {mn})"
-                          for t, h, w, mn in members)
+        lines = ", ".join(
+            f"({_lit(grid.left[t][j])}, {_lit(grid.right[t][j])}, {h}, {w}, {mn})" for t, h, w, mn in members
+        )
         cond = " or ".join(f"{h} > 0.0" for _t, h, _w, _mn in members)
         g.emit(f"if {cond}:")
-        g.emit(f"_ps = []; _pieces({_lit(grid.xs[j])}, {_lit(grid.xs[j + 1])}, "
-               f"[l for l in ({lines},) if l[2] * l[3] > 0.0], {accu!r}, _ps)", 2)
+        g.emit(
+            f"_ps = []; _pieces({_lit(grid.xs[j])}, {_lit(grid.xs[j + 1])}, "
+            f"[l for l in ({lines},) if l[2] * l[3] > 0.0], {accu!r}, _ps)",
+            2,
+        )
         g.emit("_a, _mo = _am(_ps); A += _a; M += _mo", 2)
     g.emit(f"{fired} = A > 0.0")
     g.emit(f"{val} = M / A if {fired} else _NAN")
