@@ -424,6 +424,11 @@ class BatchEvaluator:
                 ]
                 if not lines:
                     continue
+                if accu == "MAX" and len(lines) == 2:
+                    ar2, mo2 = _max_of_two(grid.xs[j], grid.xs[j + 1], lines[0], lines[1])
+                    area += ar2
+                    moment += mo2
+                    continue
                 X, V, extra = _interval(grid.xs[j], grid.xs[j + 1], lines, accu, n)
                 if extra is not None:
                     area += extra[0]
@@ -520,6 +525,66 @@ def _band_eval(
     A = np.array([b[2] for b in bands])[idx]
     M = np.array([b[3] for b in bands])[idx]
     return (A[:, 0] + h * (A[:, 1] + h * A[:, 2]), M[:, 0] + h * (M[:, 1] + h * (M[:, 2] + h * M[:, 3])))
+
+
+def _polyline_am(x0: float, dx: float, ts: list[Arr], vs: list[Arr]) -> tuple[Arr, Arr]:
+    """Area and moment of the polyline through (x0 + t dx, v) for ordered ts (sums kept in
+    t-space: area = dx/2 sum d s, moment = x0 area + dx^2/6 sum d (t0 (s + v0) + t1 (s + v1)))."""
+    area = np.zeros_like(vs[0])
+    tmom = np.zeros_like(vs[0])
+    for k in range(len(ts) - 1):
+        d = ts[k + 1] - ts[k]
+        s = vs[k] + vs[k + 1]
+        area += d * s
+        tmom += d * (ts[k] * (s + vs[k]) + ts[k + 1] * (s + vs[k + 1]))
+    area *= 0.5 * dx
+    return area, x0 * area + (dx * dx / 6.0) * tmom
+
+
+def _clipped_line_am(x0: float, dx: float, line: tuple[float, float, Arr, W, bool]) -> tuple[Arr, Arr]:
+    L, R, a, w, mn = line
+    if not mn:
+        return _polyline_am(x0, dx, [np.zeros_like(a), np.ones_like(a)], [w * a * L, w * a * R])
+    tk = np.clip((a - L) / (R - L), 0.0, 1.0) if R != L else np.zeros_like(a)
+    ts = [np.zeros_like(a), tk, np.ones_like(a)]
+    return _polyline_am(x0, dx, ts, [w * np.minimum(a, L), w * np.minimum(a, L + (R - L) * tk), w * np.minimum(a, R)])
+
+
+def _max_of_two(
+    x0: float, x1: float, l1: tuple[float, float, Arr, W, bool], l2: tuple[float, float, Arr, W, bool]
+) -> tuple[Arr, Arr]:
+    """Exact area and moment of max(c1, c2) on one interval without sorting candidates:
+    max = c1 + c2 - min(c1, c2), and min(c1, c2) = min(H, p1, p2) is concave (two lines)
+    clipped at the constant H, whose breakpoints come out ordered by construction."""
+    dx = x1 - x0
+    a1, b1 = _clipped_line_am(x0, dx, l1)
+    a2, b2 = _clipped_line_am(x0, dx, l2)
+    (L1, R1, h1, w1, mn1), (L2, R2, h2, w2, mn2) = l1, l2
+    # the line parts p_i(t) = P_i + S_i t and the constant parts
+    P1, S1 = (w1 * L1, w1 * (R1 - L1)) if mn1 else (w1 * h1 * L1, w1 * h1 * (R1 - L1))
+    P2, S2 = (w2 * L2, w2 * (R2 - L2)) if mn2 else (w2 * h2 * L2, w2 * h2 * (R2 - L2))
+    P1, S1, P2, S2 = (np.asarray(v, dtype=np.float64) for v in (P1, S1, P2, S2))
+    H = np.minimum(w1 * h1 if mn1 else np.inf, w2 * h2 if mn2 else np.inf)
+    zeros = np.zeros_like(h1 + h2)
+    ones = zeros + 1.0
+    with np.errstate(all="ignore"):
+        ts = np.clip(np.where(S1 != S2, (P2 - P1) / (S1 - S2), 0.0), 0.0, 1.0)
+        ts = np.where(np.isnan(ts), 0.0, ts)
+
+        def m(t: Arr) -> Arr:
+            return np.asarray(np.minimum(P1 + S1 * t, P2 + S2 * t))
+
+        def cross(t0: Arr, t1: Arr) -> Arr:
+            v0, v1 = m(t0), m(t1)
+            c = t0 + (H - v0) / (v1 - v0) * (t1 - t0)
+            return np.asarray(np.where((v0 - H) * (v1 - H) < 0.0, c, t0))
+
+        ca = cross(zeros, ts)
+        cb = cross(ts, ones)
+    pts = [zeros, ca, ts, cb, ones]
+    vals = [np.minimum(H, m(p)) for p in pts]
+    a3, b3 = _polyline_am(x0, dx, pts, vals)
+    return a1 + a2 - a3, b1 + b2 - b3
 
 
 def _interval(

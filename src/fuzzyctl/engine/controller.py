@@ -93,7 +93,7 @@ class Controller:
         named = dict(zip(self.inputs, values, strict=True))
         return explain_mod.build(self.plan, named, rec)
 
-    def evaluate_batch(self, data: Any, *, chunk: int = 8192) -> dict[str, npt.NDArray[np.float64]]:
+    def evaluate_batch(self, data: Any, *, chunk: int = 16384) -> dict[str, npt.NDArray[np.float64]]:
         """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
         arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays."""
         columns = _columns(data)
