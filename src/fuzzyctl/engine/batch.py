@@ -517,14 +517,25 @@ def _merge(contribs: list[tuple[int | None, Arr, W, str]], accu: str) -> list[tu
 def _band_eval(
     bands: Sequence[tuple[float, float, tuple[float, ...], tuple[float, ...]]], h: Arr
 ) -> tuple[Arr, Arr]:
-    if len(bands) == 1:
-        (_lo, _hi, ac, mc) = bands[0]
-        return ac[0] + h * (ac[1] + h * ac[2]), mc[0] + h * (mc[1] + h * (mc[2] + h * mc[3]))
-    edges = np.array([b[1] for b in bands[:-1]])
-    idx = np.searchsorted(edges, h, side="left")
-    A = np.array([b[2] for b in bands])[idx]
-    M = np.array([b[3] for b in bands])[idx]
-    return (A[:, 0] + h * (A[:, 1] + h * A[:, 2]), M[:, 0] + h * (M[:, 1] + h * (M[:, 2] + h * M[:, 3])))
+    """Area and moment polynomials of :attr:`GridPlan.min_bands` at degrees ``h``.
+
+    The pieces join continuously, so the value is the first band's polynomial at h clipped
+    into it plus, for each further band, its increase over the part of it below h; constant
+    bands (above the term's top) add nothing."""
+    area = np.zeros_like(h)
+    moment = np.zeros_like(h)
+    for k, (lo, hi, ac, mc) in enumerate(bands):
+        if k > 0 and ac[1] == ac[2] == 0.0 and mc[1] == mc[2] == mc[3] == 0.0:
+            continue
+        u = np.clip(h, lo, hi)
+        a = ac[0] + u * (ac[1] + u * ac[2])
+        mo = mc[0] + u * (mc[1] + u * (mc[2] + u * mc[3]))
+        if k > 0:
+            a = a - (ac[0] + lo * (ac[1] + lo * ac[2]))
+            mo = mo - (mc[0] + lo * (mc[1] + lo * (mc[2] + lo * mc[3])))
+        area += a
+        moment += mo
+    return area, moment
 
 
 def _polyline_am(x0: float, dx: float, ts: list[Arr], vs: list[Arr]) -> tuple[Arr, Arr]:
