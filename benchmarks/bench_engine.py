@@ -66,7 +66,7 @@ def latency(single: Callable[[float, float], float], model: str, budget: float) 
     n = int(min(2000, max(20, budget / est)))
     best = float("inf")
     for r in range(3):
-        a, b = x1[r * n:(r + 1) * n].tolist(), x2[r * n:(r + 1) * n].tolist()
+        a, b = x1[r * n : (r + 1) * n].tolist(), x2[r * n : (r + 1) * n].tolist()
         t0 = time.perf_counter()
         for u, v in zip(a, b, strict=True):
             single(u, v)
@@ -74,8 +74,12 @@ def latency(single: Callable[[float, float], float], model: str, budget: float) 
     return best
 
 
-def throughput(batch: Callable[[np.ndarray, np.ndarray], Any], model: str, budget: float,
-               chunks: tuple[int, ...] = (N_BATCH,)) -> float:
+def throughput(
+    batch: Callable[[np.ndarray, np.ndarray], Any],
+    model: str,
+    budget: float,
+    chunks: tuple[int, ...] = (N_BATCH,),
+) -> float:
     x1, x2 = samples(model, N_BATCH, 3)
     t0 = time.perf_counter()
     batch(x1[:200], x2[:200])
@@ -90,7 +94,7 @@ def throughput(batch: Callable[[np.ndarray, np.ndarray], Any], model: str, budge
         for _ in range(3):
             t0 = time.perf_counter()
             for s in range(0, N_BATCH, chunk):
-                batch(x1[s:s + chunk], x2[s:s + chunk])
+                batch(x1[s : s + chunk], x2[s : s + chunk])
             best = max(best, N_BATCH / (time.perf_counter() - t0))
     return best
 
@@ -149,25 +153,37 @@ def main() -> None:
         }
         for name, build in libs.items():
             p_single, p_batch = build(model)
-            errs = [abs(p_single(float(a), float(b)) - e) for a, b, e in list(zip(x1, x2, exact, strict=True))[:300]]
+            errs = [
+                abs(p_single(float(a), float(b)) - e)
+                for a, b, e in list(zip(x1, x2, exact, strict=True))[:300]
+            ]
             rec = {"single_s": latency(p_single, model, budget), "max_err": float(max(errs))}
             if p_batch is not None:
                 chunks = (1_000, 10_000, N_BATCH) if name.startswith("pyfuzzylite") else (10_000,)
                 rec["batch_per_s"] = throughput(p_batch, model, 10 * budget, chunks)
             else:
-                rec["batch_per_s"] = throughput(lambda a, b, f=p_single: [f(u, v) for u, v in zip(a, b, strict=True)],
-                                                model, 5 * budget)
+                rec["batch_per_s"] = throughput(
+                    lambda a, b, f=p_single: [f(u, v) for u, v in zip(a, b, strict=True)], model, 5 * budget
+                )
             results.setdefault(name, {})[model] = rec
         # our exactness against a fine reference: pyfuzzylite's midpoint rule at resolution 200,000
         if "pyfuzzylite 1000" in libs:
             ref_single = peers.build_pyfuzzylite(model, resolution=200_000)[0]
-            diff = max(abs(ref_single(float(a), float(b)) - e) for a, b, e in list(zip(x1, x2, exact, strict=True))[:100])
+            diff = max(
+                abs(ref_single(float(a), float(b)) - e)
+                for a, b, e in list(zip(x1, x2, exact, strict=True))[:100]
+            )
             results["fuzzyctl (exact)"][model]["vs_pyfuzzylite_200k"] = float(diff)
 
     base = results.get("pyfuzzylite 1000")
-    print(f"python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores; numpy {np.__version__}")
-    head = ("| engine | tipper single | x pyfl | grid49 single | x pyfl | tipper batch/s | x pyfl | grid49 batch/s "
-            "| x pyfl | tipper max err | grid49 max err |")
+    print(
+        f"python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores; "
+        f"numpy {np.__version__}"
+    )
+    head = (
+        "| engine | tipper single | x pyfl | grid49 single | x pyfl | tipper batch/s | x pyfl "
+        "| grid49 batch/s | x pyfl | tipper max err | grid49 max err |"
+    )
     print(head)
     print("|" + "---|" * (head.count("|") - 1))
     for name, per in results.items():
@@ -185,9 +201,12 @@ def main() -> None:
         cells += [f"{per['tipper']['max_err']:.2g}", f"{per['grid49']['max_err']:.2g}"]
         print("| " + " | ".join(cells) + " |")
     if "vs_pyfuzzylite_200k" in results["fuzzyctl (exact)"]["tipper"]:
-        print("fuzzyctl vs pyfuzzylite at resolution 200,000: tipper "
-              f"{results['fuzzyctl (exact)']['tipper']['vs_pyfuzzylite_200k']:.2g}, grid49 "
-              f"{results['fuzzyctl (exact)']['grid49']['vs_pyfuzzylite_200k']:.2g} (max |difference|, 100 samples)")
+        print(
+            "fuzzyctl vs pyfuzzylite at resolution 200,000: tipper "
+            f"{results['fuzzyctl (exact)']['tipper']['vs_pyfuzzylite_200k']:.2g}, grid49 "
+            f"{results['fuzzyctl (exact)']['grid49']['vs_pyfuzzylite_200k']:.2g} "
+            "(max |difference|, 100 samples)"
+        )
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
 

@@ -558,7 +558,9 @@ def _clipped_line_am(x0: float, dx: float, line: tuple[float, float, Arr, W, boo
         return _polyline_am(x0, dx, [np.zeros_like(a), np.ones_like(a)], [w * a * L, w * a * R])
     tk = np.clip((a - L) / (R - L), 0.0, 1.0) if R != L else np.zeros_like(a)
     ts = [np.zeros_like(a), tk, np.ones_like(a)]
-    return _polyline_am(x0, dx, ts, [w * np.minimum(a, L), w * np.minimum(a, L + (R - L) * tk), w * np.minimum(a, R)])
+    return _polyline_am(
+        x0, dx, ts, [w * np.minimum(a, L), w * np.minimum(a, L + (R - L) * tk), w * np.minimum(a, R)]
+    )
 
 
 def _max_of_two(
