@@ -19,10 +19,10 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.engine import pwl, shapes
+from fuzzyctl.engine.expr import eval_expr_np
 from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
 from fuzzyctl.engine.plan import (
-    EX,
     CAnd,
     CChained,
     CDegree,
@@ -31,13 +31,6 @@ from fuzzyctl.engine.plan import (
     COr,
     CTerm,
     CTrue,
-    EBinary,
-    ECall,
-    EInput,
-    ENum,
-    EOutput,
-    EUnary,
-    ExprPlan,
     GridPlan,
     OutputPlan,
     Plan,
@@ -49,73 +42,6 @@ from fuzzyctl.engine.plan import (
 Arr = npt.NDArray[np.float64]
 W = Any  # a weight: float or array
 Result = tuple[Arr, npt.NDArray[np.bool_]]  # (values, fired)
-
-_NP_FUNCS: dict[str, Any] = {
-    "sin": np.sin,
-    "cos": np.cos,
-    "tan": np.tan,
-    "asin": np.arcsin,
-    "acos": np.arccos,
-    "atan": np.arctan,
-    "sinh": np.sinh,
-    "cosh": np.cosh,
-    "tanh": np.tanh,
-    "exp": np.exp,
-    "log": np.log,
-    "ln": np.log,
-    "log10": np.log10,
-    "sqrt": np.sqrt,
-    "abs": np.abs,
-    "fabs": np.abs,
-    "floor": np.floor,
-    "ceil": np.ceil,
-    "round": np.round,
-    "sign": np.sign,
-    "pow": np.power,
-    "atan2": np.arctan2,
-    "fmod": np.fmod,
-    "min": np.minimum,
-    "max": np.maximum,
-}
-
-
-def eval_expr_np(e: ExprPlan, vals: Sequence[Arr], outs: Sequence[Arr], x: Any = None) -> Any:
-    with np.errstate(all="ignore"):
-        if isinstance(e, ENum):
-            return e.value
-        if isinstance(e, EInput):
-            return vals[e.slot]
-        if isinstance(e, EOutput):
-            return outs[e.output]
-        if isinstance(e, EX):
-            return x
-        if isinstance(e, EUnary):
-            v = eval_expr_np(e.operand, vals, outs, x)
-            return -v if e.op == "-" else v
-        if isinstance(e, EBinary):
-            a = np.asarray(eval_expr_np(e.left, vals, outs, x), dtype=np.float64)
-            b = np.asarray(eval_expr_np(e.right, vals, outs, x), dtype=np.float64)
-            if e.op == "+":
-                return a + b
-            if e.op == "-":
-                return a - b
-            if e.op == "*":
-                return a * b
-            if e.op == "/":
-                return a / b
-            if e.op == "%":
-                return np.fmod(a, b)
-            return np.power(a, b)
-        assert isinstance(e, ECall)
-        args = [np.asarray(eval_expr_np(a, vals, outs, x), dtype=np.float64) for a in e.args]
-        if e.function == "min" or e.function == "max":
-            f = _NP_FUNCS[e.function]
-            r = args[0]
-            for a in args[1:]:
-                r = f(r, a)
-            return r
-        return _NP_FUNCS[e.function](*args)
-
 
 class BatchEvaluator:
     """Evaluates a plan on columns of samples."""
@@ -558,9 +484,11 @@ def _clipped_line_am(x0: float, dx: float, line: tuple[float, float, Arr, W, boo
         return _polyline_am(x0, dx, [np.zeros_like(a), np.ones_like(a)], [w * a * L, w * a * R])
     tk = np.clip((a - L) / (R - L), 0.0, 1.0) if R != L else np.zeros_like(a)
     ts = [np.zeros_like(a), tk, np.ones_like(a)]
-    return _polyline_am(
-        x0, dx, ts, [w * np.minimum(a, L), w * np.minimum(a, L + (R - L) * tk), w * np.minimum(a, R)]
-    )
+    # at a kink the set is exactly w*a: recomputing it from tk loses the low bits when a is
+    # tiny (1 - (1 - a) != a), and the centroid of a set of tiny degrees is a ratio of them
+    inside = (L - a) * (R - a) < 0.0
+    mid = np.where(inside, a, np.minimum(a, L + (R - L) * tk))
+    return _polyline_am(x0, dx, ts, [w * np.minimum(a, L), w * mid, w * np.minimum(a, R)])
 
 
 def _max_of_two(
@@ -587,15 +515,18 @@ def _max_of_two(
         def m(t: Arr) -> Arr:
             return np.asarray(np.minimum(P1 + S1 * t, P2 + S2 * t))
 
-        def cross(t0: Arr, t1: Arr) -> Arr:
+        def cross(t0: Arr, t1: Arr) -> tuple[Arr, Arr]:
             v0, v1 = m(t0), m(t1)
             c = t0 + (H - v0) / (v1 - v0) * (t1 - t0)
-            return np.asarray(np.where((v0 - H) * (v1 - H) < 0.0, c, t0))
+            hit = (v0 - H) * (v1 - H) < 0.0
+            return np.asarray(np.where(hit, c, t0)), hit
 
-        ca = cross(zeros, ts)
-        cb = cross(ts, ones)
+        ca, hit_a = cross(zeros, ts)
+        cb, hit_b = cross(ts, ones)
     pts = [zeros, ca, ts, cb, ones]
     vals = [np.minimum(H, m(p)) for p in pts]
+    vals[1] = np.where(hit_a, H, vals[1])  # exactly H where min(p1, p2) crosses it
+    vals[3] = np.where(hit_b, H, vals[3])
     a3, b3 = _polyline_am(x0, dx, pts, vals)
     return a1 + a2 - a3, b1 + b2 - b3
 

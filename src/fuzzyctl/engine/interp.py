@@ -16,10 +16,10 @@ from typing import Any
 import numpy as np
 
 from fuzzyctl.engine import pwl, quadrature, shapes
+from fuzzyctl.engine.expr import eval_expr, eval_expr_np
 from fuzzyctl.engine.grid import build_grid
 from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np
 from fuzzyctl.engine.plan import (
-    EX,
     CAnd,
     CChained,
     CDegree,
@@ -28,83 +28,12 @@ from fuzzyctl.engine.plan import (
     COr,
     CTerm,
     CTrue,
-    EBinary,
-    ECall,
-    EInput,
-    ENum,
-    EOutput,
-    EUnary,
-    ExprPlan,
     OutputPlan,
     Plan,
     PParam,
     Slot,
     TermPlan,
 )
-
-# --------------------------------------------------------------------------- expressions
-
-
-def _div(a: float, b: float) -> float:
-    if b == 0.0:
-        return math.nan if a == 0.0 or a != a else math.copysign(math.inf, a) * math.copysign(1.0, b)
-    return a / b
-
-
-def _call(name: str, args: list[float]) -> float:
-    try:
-        if name in ("abs", "fabs"):
-            return abs(args[0])
-        if name in ("log", "ln"):
-            return math.log(args[0]) if args[0] > 0 else (-math.inf if args[0] == 0 else math.nan)
-        if name == "sign":
-            return math.copysign(1.0, args[0]) if args[0] != 0 else 0.0
-        if name == "pow":
-            return float(args[0] ** args[1])
-        if name == "fmod":
-            return math.fmod(args[0], args[1])
-        if name == "round":
-            return float(round(args[0]))
-        if name in ("min", "max"):
-            return float(min(args) if name == "min" else max(args))
-        fn = getattr(math, name)
-        return float(fn(*args))
-    except (ValueError, ZeroDivisionError):
-        return math.nan
-    except OverflowError:
-        return math.inf
-
-
-def eval_expr(e: ExprPlan, values: Sequence[float], outputs: Sequence[float], x: float = math.nan) -> float:
-    """Evaluate a function term (C-like: division by zero gives inf/nan, never raises)."""
-    if isinstance(e, ENum):
-        return e.value
-    if isinstance(e, EInput):
-        return values[e.slot]
-    if isinstance(e, EOutput):
-        return outputs[e.output]
-    if isinstance(e, EX):
-        return x
-    if isinstance(e, EUnary):
-        v = eval_expr(e.operand, values, outputs, x)
-        return -v if e.op == "-" else v
-    if isinstance(e, EBinary):
-        a = eval_expr(e.left, values, outputs, x)
-        b = eval_expr(e.right, values, outputs, x)
-        if e.op == "+":
-            return a + b
-        if e.op == "-":
-            return a - b
-        if e.op == "*":
-            return a * b
-        if e.op == "/":
-            return _div(a, b)
-        if e.op == "%":
-            return math.fmod(a, b) if b != 0.0 else math.nan
-        return _call("pow", [a, b])
-    assert isinstance(e, ECall)
-    return _call(e.function, [eval_expr(a, values, outputs, x) for a in e.args])
-
 
 # --------------------------------------------------------------------------- records
 
@@ -405,7 +334,7 @@ class Interpreter:
 
 def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:
     for h in reversed(hedges):  # the hedge nearest the term applies first
-        d = shapes.HEDGES[h](d)
+        d = shapes.hedge_function(h)(d)
     return 1.0 - d if negated else d
 
 
@@ -448,10 +377,17 @@ def accumulated_function(
             )
         )
 
+    exprs = [op.terms[t].expr if t is not None else None for t, _a, _w, _act in contribs]
+    vals = list(values)
+
     def f(x: Any) -> Any:
         acc = np.zeros_like(x)
-        for kind, params, h, a, w, act in resolved:
-            mu = shapes.membership_np(kind, params, h, x)
+        for (kind, params, h, a, w, act), ex in zip(resolved, exprs, strict=True):
+            if kind == "function":
+                assert ex is not None
+                mu = np.broadcast_to(np.asarray(eval_expr_np(ex, vals, [], x), dtype=np.float64), x.shape)
+            else:
+                mu = shapes.membership_np(kind, params, h, x)
             acc = accumulate_np(accu, acc, w * act(a, mu))
         return acc
 

@@ -341,7 +341,7 @@ def _expr_outputs(e: ExprPlan, out: set[int]) -> None:
 def _hedges(ctx: _Ctx, hedges: tuple[str, ...], span: m.Span | None, where: str) -> tuple[str, ...] | None:
     hs = tuple(h.lower() for h in hedges)
     for h in hs:
-        if h not in HEDGE_NAMES:
+        if h not in HEDGE_NAMES and shapes.power_of(h) is None:
             ctx.err(
                 f"{where}: unknown hedge {h!r} (known: {', '.join(sorted(HEDGE_NAMES))})",
                 span,

@@ -8,7 +8,7 @@ from fuzzyctl import model as m
 from fuzzyctl.engine import operators as ops
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.grid import build_grid
-from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term
+from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
 from fuzzyctl.engine.plan import Contribution, OutputPlan, RulePlan, Slot
 
 METHOD_ALIASES = {
@@ -80,7 +80,8 @@ def _output(
         ctx.err(f"DEFUZZIFY {var.name}: unknown method {db.method!r}", db.span, "method-unknown")
         return None
     accu = accu_for(var.name, db)
-    kinds = {t.kind for t in tps}
+    # a function of x is a fuzzy set (smooth, integrated numerically), not a Sugeno value
+    kinds = {"function_of_x" if t.kind == "function" and uses_x(t.expr) else t.kind for t in tps}
     if not tps:
         ctx.err(f"DEFUZZIFY {var.name} has no terms", db.span, "no-terms")
         return None

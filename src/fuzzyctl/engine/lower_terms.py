@@ -25,7 +25,7 @@ from fuzzyctl.engine.plan import (
 )
 
 FUNCTIONS = frozenset(
-    {
+    [
         "sin",
         "cos",
         "tan",
@@ -38,6 +38,7 @@ FUNCTIONS = frozenset(
         "exp",
         "log",
         "log10",
+        "ln",
         "sqrt",
         "abs",
         "fabs",
@@ -50,8 +51,13 @@ FUNCTIONS = frozenset(
         "atan2",
         "fmod",
         "sign",
-        "ln",
-    }
+        "eq",
+        "neq",
+        "lt",
+        "le",
+        "gt",
+        "ge",
+    ]
 )
 CONSTANTS = {"pi": math.pi, "e": math.e}
 
@@ -185,7 +191,7 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
         tp = TermPlan(t.name, mf.kind, params, h)
         _check_shape(ctx, tp, t.span, where)
     else:
-        ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, allow_x=not is_output)
+        ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, allow_x=True)
         if ex is None:
             return None
         tp = TermPlan(t.name, "function", (), 1.0, ex)
@@ -240,3 +246,19 @@ def _first_terms(ctx: _Ctx, var: str, terms: Iterable[m.Term]) -> list[m.Term]:
         seen[t.name] = t
         out.append(t)
     return out
+
+
+def uses_x(e: ExprPlan | None) -> bool:
+    """Whether a function term reads ``x``: then it is a membership function of x (fuzzylite
+    Function as a fuzzy set), not a Takagi-Sugeno value."""
+    if e is None:
+        return False
+    if isinstance(e, EX):
+        return True
+    if isinstance(e, EUnary):
+        return uses_x(e.operand)
+    if isinstance(e, EBinary):
+        return uses_x(e.left) or uses_x(e.right)
+    if isinstance(e, ECall):
+        return any(uses_x(a) for a in e.args)
+    return False

@@ -519,8 +519,29 @@ HEDGES: dict[str, Callable[[float], float]] = {
 """fuzzylite's hedges (``Is.hedges``), applied innermost (closest to the term) first."""
 
 
+def power_of(name: str) -> float | None:
+    """The exponent of a power hedge ``"pow:p"`` (Octave FIS hedge codes), else None."""
+    if not name.startswith("pow:"):
+        return None
+    try:
+        return float(name[4:])
+    except ValueError:
+        return None
+
+
+def hedge_function(name: str) -> Callable[[float], float]:
+    """The scalar function of a hedge name (``HEDGES`` or ``"pow:p"``)."""
+    p = power_of(name)
+    if p is not None:
+        return lambda x: float(max(x, 0.0) ** p)
+    return HEDGES[name]
+
+
 def hedge_np(name: str, x: Any) -> Any:
     """Vectorised hedge."""
+    p = power_of(name)
+    if p is not None:
+        return np.maximum(x, 0.0) ** p
     if name == "not":
         return 1.0 - x
     if name == "very":

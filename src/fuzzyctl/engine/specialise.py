@@ -18,7 +18,8 @@ from collections.abc import Callable
 from typing import Any
 
 from fuzzyctl.engine import pwl, shapes
-from fuzzyctl.engine.interp import Interpreter, eval_expr
+from fuzzyctl.engine.expr import eval_expr
+from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.operators import SNORMS, TNORMS
 from fuzzyctl.engine.plan import (
     CAnd,
@@ -163,7 +164,7 @@ class _Gen:
     def hedged(self, d: str, hedges: tuple[str, ...], negated: bool) -> str:
         for h in reversed(hedges):
             t = self.tmp()
-            self.emit(f"{t} = _H[{h!r}]({d})")
+            self.emit(f"{t} = {self.obj(shapes.hedge_function(h))}({d})")
             d = t
         if negated:
             t = self.tmp()
