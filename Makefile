@@ -23,7 +23,8 @@ system-deps:
 	@bash scripts/system-deps.sh
 
 run: $(VENV)/.installed
-	$(BIN)/fuzzyctl --version
+	$(BIN)/fuzzyctl check examples/figure7.fcl
+	$(BIN)/fuzzyctl eval examples/figure7.fcl --csv examples/figure7_inputs.csv --table
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check src tests benchmarks

@@ -4,10 +4,12 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.model import Document, FunctionBlock
+
+if TYPE_CHECKING:
+    from fuzzyctl.engine.controller import Controller
 
 
 def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
@@ -46,6 +48,13 @@ def _looks_like_path(value: str) -> bool:
 
 def compile(
     model: Document | FunctionBlock, *, block: str | None = None, backend: str = "python", **options: Any
-) -> Any:
-    """Turn a model into an evaluator (see ``fuzzyctl.engine``)."""
-    raise FuzzyctlError("no engine is available yet")
+) -> Controller:
+    """Turn a model into a :class:`~fuzzyctl.engine.Controller` (see ``fuzzyctl.engine``).
+
+    ``block`` names the function block of a document (default: the first); ``backend`` is
+    ``"python"`` or ``"interpreted"``; ``compat="fuzzylite"`` etc. reproduces other tools'
+    semantics (default IEC 61131-7).  Raises
+    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
+    from fuzzyctl.engine.compile import compile_block
+
+    return compile_block(model, block=block, backend=backend, **options)

@@ -1,0 +1,203 @@
+"""The compiled controller: input checking, scalar and batch evaluation, explanations, and
+the state an instance keeps between evaluations (DEFAULT := NC)."""
+
+from __future__ import annotations
+
+import math
+import numbers
+from collections.abc import Callable, Mapping
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from fuzzyctl.diagnostics import InputError
+from fuzzyctl.engine import explain as explain_mod
+from fuzzyctl.engine.interp import Interpreter
+from fuzzyctl.engine.plan import Plan
+
+_INF = math.inf
+
+
+class Controller:
+    """Evaluates one function block.  Create it with :func:`fuzzyctl.compile`.
+
+    An instance keeps the previous value of each output for ``DEFAULT := NC`` (and for outputs
+    without DEFAULT): :meth:`reset` forgets them.  Batch rows are successive evaluations of
+    the same instance, in order, as a PLC cycle would see them."""
+
+    def __init__(self, plan: Plan, *, specialise: bool = True) -> None:
+        self.plan = plan
+        self.name = plan.name
+        self.inputs: tuple[str, ...] = tuple(i.name for i in plan.inputs)
+        self.outputs: tuple[str, ...] = tuple(o.name for o in plan.outputs if o.is_output)
+        self._interp = Interpreter(plan)
+        self._state: list[float | None] = [None] * len(plan.outputs)
+        self._required = tuple(i.name for i in plan.inputs if i.default is None)
+        self._degree = tuple(i.degree for i in plan.inputs)
+        self._fast: Callable[[list[float], list[float | None]], list[float]] | None = None
+        self._batch: Any = None
+        if specialise:
+            from fuzzyctl.engine.specialise import specialise as make_fast
+
+            self._fast = make_fast(plan)
+            from fuzzyctl.engine.batch import BatchEvaluator
+
+            self._batch = BatchEvaluator(plan)
+
+    # ------------------------------------------------------------------ inputs
+
+    def _values(self, inputs: Mapping[str, Any]) -> list[float]:
+        values: list[float] = []
+        for i, spec in enumerate(self.plan.inputs):
+            if spec.name in inputs:
+                raw = inputs[spec.name]
+            elif spec.default is not None:
+                raw = spec.default
+            else:
+                raise InputError(f"missing input {spec.name!r} (inputs: {', '.join(self.inputs)})")
+            v = _number(spec.name, raw)
+            if self._degree[i] and not 0.0 <= v <= 1.0:
+                raise InputError(f"input {spec.name!r} is used as a degree and must be in [0, 1], got {v}")
+            values.append(v)
+        if len(inputs) > len(values) or any(k not in self.inputs for k in inputs):
+            unknown = [k for k in inputs if k not in self.inputs]
+            if unknown:
+                raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(self.inputs)})")
+        return values
+
+    # ------------------------------------------------------------------ evaluation
+
+    def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+        """Evaluate once: ``{"temp": 20.0, ...} -> {"valve": 35.7, ...}``."""
+        values = self._values(inputs)
+        if self._fast is not None:
+            res = self._fast(values, self._state)
+        else:
+            rec = self._interp.run(values, self._state)
+            res = [o.value for o in rec.outputs]
+        plan = self.plan
+        return {plan.outputs[i].name: res[i] for i in range(len(res)) if plan.outputs[i].is_output}
+
+    def evaluate_reference(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+        """Evaluate through the interpreter (the unspecialised path), for cross-checks."""
+        values = self._values(inputs)
+        rec = self._interp.run(values, self._state)
+        return {o.name: r.value for o, r in zip(self.plan.outputs, rec.outputs, strict=True) if o.is_output}
+
+    def explain(self, inputs: Mapping[str, Any]) -> explain_mod.Explanation:
+        """Evaluate once and return every intermediate result (this counts as an evaluation:
+        the NC state advances)."""
+        values = self._values(inputs)
+        rec = self._interp.run(values, self._state)
+        named = dict(zip(self.inputs, values, strict=True))
+        return explain_mod.build(self.plan, named, rec)
+
+    def evaluate_batch(self, data: Any, *, chunk: int = 16384) -> dict[str, npt.NDArray[np.float64]]:
+        """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
+        arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays."""
+        columns = _columns(data)
+        n = None
+        arrays: list[npt.NDArray[np.float64]] = []
+        for name in columns:
+            if name not in self.inputs:
+                raise InputError(f"unknown input {name!r} (inputs: {', '.join(self.inputs)})")
+        for i, spec in enumerate(self.plan.inputs):
+            if spec.name in columns:
+                arr = _column_array(spec.name, columns[spec.name])
+            elif spec.default is not None:
+                arr = None
+            else:
+                raise InputError(f"missing input {spec.name!r} (inputs: {', '.join(self.inputs)})")
+            if arr is not None:
+                if n is None:
+                    n = len(arr)
+                elif len(arr) != n:
+                    raise InputError(f"input {spec.name!r} has {len(arr)} values, expected {n}")
+                if self._degree[i]:
+                    bad = np.flatnonzero((arr < 0.0) | (arr > 1.0))
+                    if bad.size:
+                        raise InputError(
+                            f"input {spec.name!r} is used as a degree and must be in [0, 1] "
+                            f"(row {int(bad[0])}: {arr[bad[0]]})"
+                        )
+            arrays.append(arr)  # type: ignore[arg-type]
+        n = n or 0
+        full = [
+            a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
+            for i, a in enumerate(arrays)
+        ]
+        result = {o.name: np.empty(n) for o in self.plan.outputs}
+        for start in range(0, n, chunk):
+            part = [a[start : start + chunk] for a in full]
+            out = self._batch_chunk(part)
+            for o, arr in zip(self.plan.outputs, out, strict=True):
+                result[o.name][start : start + chunk] = arr
+        return {k: v for k, v in result.items() if k in self.outputs}
+
+    def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
+        if self._batch is not None:
+            outs: list[npt.NDArray[np.float64]] = self._batch.run(part, self._state)
+            return outs
+        m = len(part[0]) if part else 0
+        res = [np.empty(m) for _ in self.plan.outputs]
+        for r in range(m):
+            rec = self._interp.run([float(a[r]) for a in part], self._state)
+            for k, o in enumerate(rec.outputs):
+                res[k][r] = o.value
+        return res
+
+    def reset(self) -> None:
+        """Forget the previous outputs (as after a cold restart): NC outputs start at 0."""
+        self._state = [None] * len(self.plan.outputs)
+
+    def __repr__(self) -> str:
+        return f"Controller({self.name!r}, inputs={list(self.inputs)}, outputs={list(self.outputs)})"
+
+
+def _number(name: str, raw: Any) -> float:
+    if isinstance(raw, float):
+        v = raw
+    elif isinstance(raw, numbers.Real):
+        v = float(raw)
+    else:
+        raise InputError(f"input {name!r} must be a number, got {type(raw).__name__} {raw!r}")
+    if not -_INF < v < _INF:
+        raise InputError(f"input {name!r} must be a finite number, got {v}")
+    return v
+
+
+def _columns(data: Any) -> dict[str, Any]:
+    if isinstance(data, Mapping):
+        return {str(k): v for k, v in data.items()}
+    cols = getattr(data, "columns", None)
+    if cols is not None:
+        return {str(c): data[c] for c in cols}
+    raise InputError("batch data must map input names to columns (a dict of arrays or a DataFrame)")
+
+
+def _column_array(name: str, col: Any) -> npt.NDArray[np.float64]:
+    raw = col.to_numpy() if hasattr(col, "to_numpy") else col
+    try:
+        arr = np.asarray(raw, dtype=np.float64)
+    except (TypeError, ValueError):
+        items = list(raw)
+        for i, v in enumerate(items):
+            try:
+                _number(name, v)
+            except InputError as exc:
+                raise InputError(f"{exc} (row {i})") from None
+        raise InputError(f"input {name!r} is not numeric") from None
+    if arr.ndim != 1:
+        arr = arr.reshape(-1)
+    if np.asarray(raw).dtype.kind in "USO":  # strings that happen to parse are still strings
+        items = list(raw)
+        for i, v in enumerate(items):
+            try:
+                _number(name, v)
+            except InputError as exc:
+                raise InputError(f"{exc} (row {i})") from None
+    bad = np.flatnonzero(~np.isfinite(arr))
+    if bad.size:
+        raise InputError(f"input {name!r} must be finite (row {int(bad[0])}: {arr[bad[0]]})")
+    return arr

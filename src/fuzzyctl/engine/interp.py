@@ -1,0 +1,405 @@
+"""The scalar interpreter: evaluates a :class:`~fuzzyctl.engine.plan.Plan` for one input
+vector and records every intermediate result (term degrees, rule degrees, accumulated sets).
+
+It is the reference the specialised scalar path and the numpy batch path are tested against,
+serves ``explain()``, and evaluates what the specialiser does not handle (membership points or
+output terms given by variables, smooth output sets).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from fuzzyctl.engine import pwl, quadrature, shapes
+from fuzzyctl.engine.expr import eval_expr, eval_expr_np
+from fuzzyctl.engine.grid import build_grid
+from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np
+from fuzzyctl.engine.plan import (
+    CAnd,
+    CChained,
+    CDegree,
+    CNot,
+    CondPlan,
+    COr,
+    CTerm,
+    CTrue,
+    OutputPlan,
+    Plan,
+    PParam,
+    Slot,
+    TermPlan,
+)
+
+# --------------------------------------------------------------------------- records
+
+
+@dataclass
+class OutputRecord:
+    """What one output did in one evaluation."""
+
+    value: float
+    fired: bool
+    pieces: list[pwl.Piece] = field(default_factory=list)  # exact accumulated set
+    points: list[tuple[float, float]] = field(default_factory=list)  # singletons / point values
+    samples: tuple[Any, Any] | None = None  # (x, mu) arrays for smooth sets
+    weights: list[tuple[str, float, float]] = field(default_factory=list)  # TS: (term, weight, z)
+
+
+@dataclass
+class Record:
+    """Everything one evaluation computed (the raw material of an explanation)."""
+
+    term_degrees: list[list[float]]
+    rule_degrees: list[float]
+    conclusion_degrees: list[list[tuple[float, float]]]  # per rule: (hedged degree, weight)
+    chained_degrees: list[list[float]]
+    outputs: list[OutputRecord]
+
+
+# --------------------------------------------------------------------------- the interpreter
+
+
+class Interpreter:
+    """Evaluates a plan one input vector at a time."""
+
+    def __init__(self, plan: Plan) -> None:
+        self.plan = plan
+        self._is_min = {"MIN"}
+
+    def pv(self, p: PParam, values: Sequence[float]) -> float:
+        return values[p.index] if isinstance(p, Slot) else p
+
+    def term_degree(self, t: TermPlan, x: float, values: Sequence[float]) -> float:
+        if t.pwl is not None:
+            return shapes.pwl_value(t.pwl, x)
+        if t.kind == "function":
+            assert t.expr is not None
+            return eval_expr(t.expr, values, [], x)
+        params = [self.pv(p, values) for p in t.params]
+        return shapes.membership(t.kind, params, self.pv(t.height, values), x)
+
+    def run(self, values: Sequence[float], state: list[float | None]) -> Record:
+        """Evaluate; ``state`` holds each output's previous value (NC) and is updated."""
+        plan = self.plan
+        opts = plan.options
+        term_degrees = [
+            [self.term_degree(t, values[fi.slot], values) for t in fi.terms] for fi in plan.fuzzy_inputs
+        ]
+        chained_acc: list[list[float]] = [[0.0] * len(c.terms) for c in plan.chained]
+        chained_bare = [0.0] * len(plan.chained)
+        chained_read: list[list[float] | None] = [None] * len(plan.chained)
+        rule_degrees = [0.0] * len(plan.rules)
+        concl_degrees: list[list[tuple[float, float]]] = [[] for _ in plan.rules]
+
+        def chained_value(var: int) -> list[float]:
+            got = chained_read[var]
+            if got is None:
+                accs = chained_acc[var]
+                if plan.chained[var].accu == "NSUM":
+                    top = max([1.0, *accs])
+                    accs = [a / top for a in accs]
+                got = accs
+                chained_read[var] = got
+            return got
+
+        def cond(c: CondPlan) -> float:
+            if isinstance(c, CTerm):
+                d = term_degrees[c.var][c.term] if "any" not in c.hedges else 1.0
+                return _hedged(d, c.hedges, c.negated)
+            if isinstance(c, CChained):
+                d = chained_value(c.var)[c.term] if "any" not in c.hedges else 1.0
+                return _hedged(d, c.hedges, c.negated)
+            if isinstance(c, CDegree):
+                if c.slot is not None:
+                    return values[c.slot]
+                assert c.chained is not None
+                return chained_bare[c.chained]
+            if isinstance(c, CNot):
+                return 1.0 - cond(c.operand)
+            if isinstance(c, CAnd):
+                f = TNORMS[c.op].scalar
+                v = cond(c.operands[0])
+                for o in c.operands[1:]:
+                    v = f(v, cond(o))
+                return v
+            if isinstance(c, COr):
+                g = SNORMS[c.op].scalar
+                v = cond(c.operands[0])
+                for o in c.operands[1:]:
+                    v = g(v, cond(o))
+                return v
+            assert isinstance(c, CTrue)
+            return 1.0
+
+        for ri in plan.order:
+            rule = plan.rules[ri]
+            a = cond(rule.condition)
+            if a <= opts.firing_threshold:
+                a = 0.0
+            rule_degrees[ri] = a
+            carried = a
+            for cp in rule.conclusions:
+                base = carried if opts.hedges_carry_over else a
+                ah = _hedged(base, cp.hedges, False) if cp.hedges else base
+                if opts.hedges_carry_over:
+                    carried = ah
+                w = self.pv(cp.weight, values)
+                concl_degrees[ri].append((ah, w))
+                for ch in cp.chained:
+                    accu = plan.chained[ch].accu
+                    if cp.term is None:
+                        chained_bare[ch] = accumulate(accu, chained_bare[ch], w * ah)
+                    else:
+                        chained_acc[ch][cp.term] = accumulate(accu, chained_acc[ch][cp.term], w * ah)
+
+        out_values = [math.nan] * len(plan.outputs)
+        records: list[OutputRecord | None] = [None] * len(plan.outputs)
+        for oi in plan.output_order:
+            op = plan.outputs[oi]
+            rec = self._output(op, concl_degrees, values, out_values)
+            if not rec.fired:
+                if op.no_change:
+                    prev = state[oi]
+                    rec.value = prev if prev is not None else (op.default if op.default is not None else 0.0)
+                else:
+                    rec.value = op.default if op.default is not None else 0.0
+            state[oi] = rec.value
+            out_values[oi] = rec.value
+            records[oi] = rec
+        chained_final = [chained_value(i) for i in range(len(plan.chained))]
+        return Record(
+            term_degrees, rule_degrees, concl_degrees, chained_final, [r for r in records if r is not None]
+        )
+
+    # ------------------------------------------------------------------ outputs
+
+    def _contribs(
+        self, op: OutputPlan, concl: list[list[tuple[float, float]]]
+    ) -> list[tuple[int | None, float, float, str]]:
+        """(term, effective degree, effective weight, act) of every activated set, weight
+        applied after activation (IEC) or folded into the degree (compat)."""
+        out = []
+        before = self.plan.options.weight_before_activation
+        for c in op.contributions:
+            ah, w = concl[c.rule][c.conclusion]
+            if before:
+                ah, w = ah * w, 1.0
+            if ah * w > 0.0:
+                out.append((c.term, ah, w, c.act))
+        return out
+
+    def _output(
+        self,
+        op: OutputPlan,
+        concl: list[list[tuple[float, float]]],
+        values: Sequence[float],
+        outs: Sequence[float],
+    ) -> OutputRecord:
+        contribs = self._contribs(op, concl)
+        if op.kind == "degree":
+            v = 0.0
+            for _t, a, w, _act in contribs:
+                v = accumulate(op.accu or "MAX", v, w * a)
+            return OutputRecord(v, True)
+        if op.kind == "ts":
+            return self._ts(op, contribs, values, outs)
+        if op.kind == "singleton":
+            return self._singleton(op, contribs, values)
+        if op.exact:
+            return self._exact(op, contribs, values)
+        return self._smooth(op, contribs, values)
+
+    def _ts(
+        self,
+        op: OutputPlan,
+        contribs: list[tuple[int | None, float, float, str]],
+        values: Sequence[float],
+        outs: Sequence[float],
+    ) -> OutputRecord:
+        zs: dict[tuple[int, float], float] = {}
+
+        def z_of(t: int, wt: float) -> float:
+            key = (t, wt if op.terms[t].kind in shapes.TSUKAMOTO_KINDS else 0.0)
+            if key not in zs:
+                zs[key] = ts_value(op.terms[t], values, outs, self.pv, wt)
+            return zs[key]
+
+        rec = OutputRecord(math.nan, False)
+        if op.accu is None:
+            items = [(t, w * a) for t, a, w, _act in contribs if t is not None]
+        else:
+            acc: dict[int, float] = {}
+            for t, a, w, _act in contribs:
+                if t is not None:
+                    acc[t] = accumulate(op.accu, acc.get(t, 0.0), w * a)
+            items = sorted(acc.items())
+        num = [wt * z_of(t, wt) for t, wt in items]
+        den = [wt for _t, wt in items]
+        rec.weights = [(op.terms[t].name, wt, z_of(t, wt)) for t, wt in items]
+        total = math.fsum(den)
+        if not total > 0.0:
+            return rec
+        rec.fired = True
+        rec.value = math.fsum(num) / total if op.method == "WTAVER" else math.fsum(num)
+        return rec
+
+    def _singleton(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
+        accu = op.accu or "MAX"
+        acc: dict[tuple[int, int], float] = {}
+        pos: dict[tuple[int, int], float] = {}
+        for t, a, w, act in contribs:
+            assert t is not None
+            term = op.terms[t]
+            params = [self.pv(p, values) for p in term.params]
+            if term.kind == "singleton":
+                pairs = [(params[0], 1.0)]
+            else:
+                pairs = list(zip(params[0::2], params[1::2], strict=True))
+            for i, (x, y) in enumerate(pairs):
+                c = w * TNORMS[act].scalar(a, y)
+                acc[(t, i)] = accumulate(accu, acc.get((t, i), 0.0), c)
+                pos[(t, i)] = x
+        rec = OutputRecord(math.nan, False)
+        rec.points = sorted((pos[k], v) for k, v in acc.items())
+        total = math.fsum(v for _x, v in rec.points)
+        if not total > 0.0:
+            return rec
+        rec.fired = True
+        if op.method == "COGS":
+            rec.value = math.fsum(x * v for x, v in rec.points) / total
+        else:
+            sup = max(v for _x, v in rec.points)
+            xs = sorted({x for x, v in rec.points if v == sup})
+            rec.value = {"LM": xs[0], "RM": xs[-1], "MOM": math.fsum(xs) / len(xs)}[op.method]
+        return rec
+
+    def _exact(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
+        assert op.low is not None and op.high is not None
+        grid = op.grid
+        if grid is None:
+            pts = []
+            for t in op.terms:
+                params = [self.pv(p, values) for p in t.params]
+                got = shapes.pwl_points(t.kind, params, self.pv(t.height, values))
+                assert got is not None
+                pts.append(got)
+            grid = build_grid(pts, op.low, op.high)
+        cs = [(t, a, w, act == "MIN") for t, a, w, act in contribs if t is not None]
+        accu = op.accu or "MAX"
+        pieces = pwl.grid_pieces(grid, cs, accu)
+        pv = pwl.point_values(grid, cs, accu)
+        points = list(zip(grid.xs, pv, strict=True))
+        rec = OutputRecord(math.nan, False, pieces, points)
+        value = pwl.defuzzify_pieces(op.method, pieces, points)
+        if value is not None:
+            rec.value, rec.fired = value, True
+        return rec
+
+    def _smooth(
+        self, op: OutputPlan, contribs: list[tuple[int | None, float, float, str]], values: Sequence[float]
+    ) -> OutputRecord:
+        assert op.low is not None and op.high is not None
+        rec = OutputRecord(math.nan, False)
+        f = accumulated_function(op, contribs, values, self.pv)
+        cuts = smooth_cuts(op, values, self.pv)
+        xs = np.linspace(op.low, op.high, 401)
+        rec.samples = (xs, f(xs))
+        if not contribs:
+            return rec
+        A, B, K, KM = quadrature.integrate(f, cuts, self.plan.options.quad_rtol)
+        area = float(np.sum(K))
+        if op.method in ("COG", "COA"):
+            if not area > 0.0:
+                return rec
+            rec.fired = True
+            rec.value = float(np.sum(KM)) / area if op.method == "COG" else quadrature.bisector(f, A, B, K)
+            return rec
+        if not area > 0.0:
+            return rec
+        sup, lm, rm, mom = quadrature.maxima(f, A, B)
+        if sup > 0.0:
+            rec.fired = True
+            rec.value = {"LM": lm, "RM": rm, "MOM": mom}[op.method]
+        return rec
+
+
+def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:
+    for h in reversed(hedges):  # the hedge nearest the term applies first
+        d = shapes.hedge_function(h)(d)
+    return 1.0 - d if negated else d
+
+
+def ts_value(
+    term: TermPlan, values: Sequence[float], outs: Sequence[float], pv: Any, weight: float = 1.0
+) -> float:
+    """z of a Takagi-Sugeno term (of a Tsukamoto term: where it reaches ``weight``)."""
+    if term.kind in shapes.TSUKAMOTO_KINDS:
+        return shapes.tsukamoto(
+            term.kind, [pv(p, values) for p in term.params], pv(term.height, values), weight
+        )
+    if term.kind in ("singleton", "constant"):
+        return float(pv(term.params[0], values))
+    if term.kind == "linear":
+        cs = [pv(p, values) for p in term.params]
+        n = len(values)
+        v = math.fsum(c * x for c, x in zip(cs[:n], values, strict=False))
+        return v + (cs[n] if len(cs) > n else 0.0)
+    assert term.expr is not None
+    return eval_expr(term.expr, values, outs)
+
+
+def accumulated_function(
+    op: OutputPlan, contribs: Sequence[tuple[int | None, float, float, str]], values: Sequence[float], pv: Any
+) -> quadrature.Integrand:
+    """mu(u) of a Mamdani output as a vectorised function (for quadrature and plots)."""
+    accu = op.accu or "MAX"
+    resolved = []
+    for t, a, w, act in contribs:
+        assert t is not None
+        term = op.terms[t]
+        resolved.append(
+            (
+                term.kind,
+                [pv(p, values) for p in term.params],
+                pv(term.height, values),
+                a,
+                w,
+                TNORMS[act].array,
+            )
+        )
+
+    exprs = [op.terms[t].expr if t is not None else None for t, _a, _w, _act in contribs]
+    vals = list(values)
+
+    def f(x: Any) -> Any:
+        acc = np.zeros_like(x)
+        for (kind, params, h, a, w, act), ex in zip(resolved, exprs, strict=True):
+            if kind == "function":
+                assert ex is not None
+                mu = np.broadcast_to(np.asarray(eval_expr_np(ex, vals, [], x), dtype=np.float64), x.shape)
+            else:
+                mu = shapes.membership_np(kind, params, h, x)
+            acc = accumulate_np(accu, acc, w * act(a, mu))
+        return acc
+
+    return f
+
+
+def smooth_cuts(op: OutputPlan, values: Sequence[float], pv: Any) -> list[float]:
+    assert op.low is not None and op.high is not None
+    cuts = [op.low, op.high]
+    for t in op.terms:
+        params = [pv(p, values) for p in t.params]
+        for c in shapes.characteristic_points(t.kind, params):
+            if op.low < c < op.high:
+                cuts.append(c)
+    return cuts

@@ -1,0 +1,550 @@
+"""Lowering: FunctionBlock -> :class:`~fuzzyctl.engine.plan.Plan`, with every semantic
+decision the standard leaves open made here, once (documented in docs/engine.md).
+
+:func:`lower` returns the plan and the diagnostics; a plan is produced only when there is no
+error.  Whatever the FCL parser accepts either lowers or yields an error diagnostic here, so
+:func:`fuzzyctl.engine.support.unsupported` is this module's diagnostics.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import heapq
+
+from fuzzyctl import model as m
+from fuzzyctl.diagnostics import Diagnostic
+from fuzzyctl.engine import operators as ops
+from fuzzyctl.engine import shapes
+from fuzzyctl.engine.lower_outputs import _output
+from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _param, _term
+from fuzzyctl.engine.plan import (
+    CAnd,
+    CChained,
+    CDegree,
+    ChainedPlan,
+    CNot,
+    ConclusionPlan,
+    CondPlan,
+    COr,
+    CTerm,
+    CTrue,
+    EBinary,
+    ECall,
+    EOutput,
+    EUnary,
+    ExprPlan,
+    FuzzyInputPlan,
+    InputPlan,
+    Options,
+    OutputPlan,
+    Plan,
+    PParam,
+    RulePlan,
+    Slot,
+)
+
+FUNCTIONS = frozenset(
+    {
+        "sin",
+        "cos",
+        "tan",
+        "asin",
+        "acos",
+        "atan",
+        "sinh",
+        "cosh",
+        "tanh",
+        "exp",
+        "log",
+        "log10",
+        "sqrt",
+        "abs",
+        "fabs",
+        "floor",
+        "ceil",
+        "round",
+        "pow",
+        "min",
+        "max",
+        "atan2",
+        "fmod",
+        "sign",
+        "ln",
+    }
+)
+HEDGE_NAMES = frozenset(shapes.HEDGES)
+
+
+def lower(fb: m.FunctionBlock, options: Options | None = None) -> tuple[Plan | None, list[Diagnostic]]:
+    """Lower ``fb``; returns ``(plan, diagnostics)`` with ``plan`` None when there are errors."""
+    ctx = _Ctx(fb, options or Options())
+    plan = _lower(ctx)
+    if any(d.is_error for d in ctx.diags):
+        return None, ctx.diags
+    return plan, ctx.diags
+
+
+# --------------------------------------------------------------------------- the block
+
+
+def _lower(ctx: _Ctx) -> Plan | None:
+    fb = ctx.fb
+    seen_vars: set[str] = set()
+    for v in fb.variables:
+        if v.name in seen_vars:
+            ctx.err(f"variable {v.name!r} is declared twice", v.span, "duplicate-variable")
+        seen_vars.add(v.name)
+    inputs: list[InputPlan] = []
+    for v in fb.inputs:
+        ctx.slots[v.name] = len(inputs)
+        default = (
+            float(v.initial)
+            if isinstance(v.initial, int | float) and not isinstance(v.initial, bool)
+            else None
+        )
+        inputs.append(InputPlan(v.name, default))
+    for v in fb.locals:
+        if isinstance(v.initial, int | float) and not isinstance(v.initial, bool):
+            ctx.constants[v.name] = float(v.initial)
+    output_names = {v.name: i for i, v in enumerate(fb.outputs)}
+
+    # ---- rule blocks: operators
+    block_ops: list[tuple[str, str, str, str | None]] = []
+    for rb in fb.rule_blocks:
+        try:
+            and_op, or_op = ops.resolve_pair(rb.and_op, rb.or_op)
+        except KeyError as exc:
+            ctx.err(
+                f"rule block {rb.name or ''}: unknown AND/OR operator {exc.args[0]!r}",
+                rb.span,
+                "operator-unknown",
+            )
+            and_op, or_op = "MIN", "MAX"
+        try:
+            act = ops.resolve_act(rb.act)
+        except KeyError:
+            ctx.err(f"rule block {rb.name or ''}: unknown activation {rb.act!r}", rb.span, "act-unknown")
+            act = "MIN"
+        accu: str | None = None
+        if rb.accu is not None:
+            try:
+                accu = ops.resolve_accu(rb.accu)
+            except KeyError:
+                ctx.err(
+                    f"rule block {rb.name or ''}: unknown accumulation {rb.accu!r}", rb.span, "accu-unknown"
+                )
+        block_ops.append((and_op, or_op, act, accu))
+
+    # ---- who is concluded, and how
+    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]] = {}
+    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]] = {}
+    for bi, rb in enumerate(fb.rule_blocks):
+        for rule in rb.rules:
+            for c in rule.conclusions:
+                target = concluded_bare if c.term is None else concluded_terms
+                target.setdefault(c.variable, []).append((bi, c))
+                var = fb.variable(c.variable)
+                if var is None:
+                    ctx.err(
+                        f"rule {rule.label}: conclusion on undeclared variable {c.variable!r}",
+                        c.span,
+                        "undeclared-variable",
+                    )
+                elif var.kind is m.VarKind.INPUT:
+                    ctx.err(
+                        f"rule {rule.label}: conclusion on input {c.variable!r}",
+                        c.span,
+                        "conclusion-on-input",
+                    )
+
+    def term_source(name: str) -> list[m.Term] | None:
+        db = fb.defuzzify_block(name)
+        if db is not None:
+            return _first_terms(ctx, name, db.terms)
+        fz = fb.fuzzify_block(name)
+        if fz is not None and name not in ctx.slots:
+            return _first_terms(ctx, name, fz.terms)
+        return None
+
+    # ---- fuzzified inputs
+    fuzzy_inputs: list[FuzzyInputPlan] = []
+    fuzzy_index: dict[str, int] = {}
+    for fz in fb.fuzzify:
+        var = fb.variable(fz.variable)
+        if var is None:
+            ctx.err(f"FUZZIFY of undeclared variable {fz.variable!r}", fz.span, "undeclared-variable")
+            continue
+        if var.kind is not m.VarKind.INPUT:
+            if fz.variable not in concluded_terms and fz.variable not in concluded_bare:
+                ctx.err(
+                    f"FUZZIFY {fz.variable}: {var.kind.value} variable never receives a value "
+                    "(only inputs, or variables concluded by rules, can be used in conditions)",
+                    fz.span,
+                    "fuzzify-no-value",
+                )
+            continue
+        terms = [_term(ctx, t, fz.variable, {}, False) for t in _first_terms(ctx, fz.variable, fz.terms)]
+        for t in terms:
+            if t is not None and t.kind in shapes.TS_KINDS - {"function"}:
+                ctx.err(
+                    f"term {fz.variable}.{t.name}: {t.kind} is an output-only term", fz.span, "ts-on-input"
+                )
+        fuzzy_index[fz.variable] = len(fuzzy_inputs)
+        fuzzy_inputs.append(
+            FuzzyInputPlan(fz.variable, ctx.slots[fz.variable], tuple(t for t in terms if t is not None))
+        )
+
+    # ---- chained variables: concluded by rules and read in conditions
+    referenced: list[str] = []
+    for _rb, rule in fb.rules():
+        if rule.condition is not None:
+            _collect_vars(rule.condition, referenced)
+    chained_names = [n for n in dict.fromkeys(referenced) if n in concluded_terms or n in concluded_bare]
+    chained_index = {n: i for i, n in enumerate(chained_names)}
+    chained_term_names: dict[str, list[str]] = {}
+    for n in chained_names:
+        src = term_source(n)
+        chained_term_names[n] = [t.name for t in src] if src is not None else []
+
+    def accu_for(name: str, db: m.DefuzzifyBlock | None) -> str | None:
+        if db is not None and db.accu is not None:
+            try:
+                return ops.resolve_accu(db.accu)
+            except KeyError:
+                ctx.err(f"DEFUZZIFY {name}: unknown accumulation {db.accu!r}", db.span, "accu-unknown")
+                return None
+        found: list[str] = []
+        for bi, _c in concluded_terms.get(name, []) + concluded_bare.get(name, []):
+            a = block_ops[bi][3]
+            if a is not None and a not in found:
+                found.append(a)
+        if len(found) > 1:
+            ctx.warn(
+                f"rule blocks concluding {name} disagree on ACCU ({', '.join(found)}); {found[0]} is used",
+                db.span if db else None,
+                "accu-disagree",
+            )
+        return found[0] if found else None
+
+    chained: list[ChainedPlan] = []
+    for n in chained_names:
+        chained.append(
+            ChainedPlan(n, tuple(chained_term_names[n]), accu_for(n, fb.defuzzify_block(n)) or "MAX")
+        )
+
+    # ---- rules
+    rules: list[RulePlan] = []
+    rule_deps: list[set[str]] = []
+    rule_concludes: list[set[str]] = []
+    for bi, rb in enumerate(fb.rule_blocks):
+        and_op, or_op, act, _accu = block_ops[bi]
+        for rule in rb.rules:
+            deps: set[str] = set()
+            cond = (
+                _cond(
+                    ctx,
+                    rule.condition,
+                    and_op,
+                    or_op,
+                    fuzzy_index,
+                    chained_index,
+                    chained_term_names,
+                    concluded_bare,
+                    inputs,
+                    deps,
+                    rule.label,
+                )
+                if rule.condition is not None
+                else CTrue()
+            )
+            concls: list[ConclusionPlan] = []
+            conclusions = rule.conclusions
+            if ctx.options.weight_whole_rule:
+                w_rule = next((c.weight for c in conclusions if c.weight is not None), None)
+                if w_rule is not None:
+                    conclusions = tuple(dataclasses.replace(c, weight=w_rule) for c in conclusions)
+            for c in conclusions:
+                cp = _conclusion(ctx, c, rule.label, output_names, chained_index, term_source, inputs)
+                if cp is not None:
+                    concls.append(cp)
+            if cond is None:
+                continue
+            rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls)))
+            rule_deps.append(deps)
+            rule_concludes.append({c.variable for c in rule.conclusions})
+
+    order = _rule_order(ctx, rule_deps, rule_concludes, rules)
+
+    # ---- outputs
+    outputs: list[OutputPlan] = []
+    output_deps: list[set[int]] = []
+    for oi, var in enumerate(fb.outputs):
+        op = _output(
+            ctx, var, oi, rules, output_names, concluded_terms, concluded_bare, accu_for, term_source
+        )
+        if op is None:
+            continue
+        outputs.append(op)
+        deps_o: set[int] = set()
+        for t in op.terms:
+            if t.expr is not None:
+                _expr_outputs(t.expr, deps_o)
+        output_deps.append(deps_o)
+    if any(d.is_error for d in ctx.diags):
+        return None
+    output_order = _topo(
+        ctx,
+        [(i, sorted(d)) for i, d in enumerate(output_deps)],
+        lambda cyc: (
+            "function terms of outputs depend on each other in a cycle: "
+            + " -> ".join(outputs[i].name for i in cyc)
+        ),
+    )
+    if output_order is None or order is None:
+        return None
+    return Plan(
+        fb.name,
+        tuple(inputs),
+        tuple(fuzzy_inputs),
+        tuple(chained),
+        tuple(rules),
+        tuple(order),
+        tuple(outputs),
+        tuple(output_order),
+        ctx.options,
+    )
+
+
+def _collect_vars(c: m.Condition, out: list[str]) -> None:
+    if isinstance(c, m.Is | m.Degree):
+        out.append(c.variable)
+    elif isinstance(c, m.Not):
+        _collect_vars(c.operand, out)
+    else:
+        for o in c.operands:
+            _collect_vars(o, out)
+
+
+def _expr_outputs(e: ExprPlan, out: set[int]) -> None:
+    if isinstance(e, EOutput):
+        out.add(e.output)
+    elif isinstance(e, EUnary):
+        _expr_outputs(e.operand, out)
+    elif isinstance(e, EBinary):
+        _expr_outputs(e.left, out)
+        _expr_outputs(e.right, out)
+    elif isinstance(e, ECall):
+        for a in e.args:
+            _expr_outputs(a, out)
+
+
+def _hedges(ctx: _Ctx, hedges: tuple[str, ...], span: m.Span | None, where: str) -> tuple[str, ...] | None:
+    hs = tuple(h.lower() for h in hedges)
+    for h in hs:
+        if h not in HEDGE_NAMES and shapes.power_of(h) is None:
+            ctx.err(
+                f"{where}: unknown hedge {h!r} (known: {', '.join(sorted(HEDGE_NAMES))})",
+                span,
+                "hedge-unknown",
+            )
+            return None
+    return hs
+
+
+def _cond(
+    ctx: _Ctx,
+    c: m.Condition,
+    and_op: str,
+    or_op: str,
+    fuzzy_index: dict[str, int],
+    chained_index: dict[str, int],
+    chained_terms: dict[str, list[str]],
+    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]],
+    inputs: list[InputPlan],
+    deps: set[str],
+    label: str,
+) -> CondPlan | None:
+    def rec(x: m.Condition) -> CondPlan | None:
+        return _cond(
+            ctx,
+            x,
+            and_op,
+            or_op,
+            fuzzy_index,
+            chained_index,
+            chained_terms,
+            concluded_bare,
+            inputs,
+            deps,
+            label,
+        )
+
+    where = f"rule {label}"
+    if isinstance(c, m.Is):
+        hs = _hedges(ctx, c.hedges, c.span, where)
+        if hs is None:
+            return None
+        if c.variable in chained_index:
+            names = chained_terms[c.variable]
+            deps.add(c.variable)
+            if c.term.lower() == "any" and c.term not in names:
+                hs = (*hs, "any")
+            if "any" in hs:
+                return CChained(chained_index[c.variable], 0, hs, c.negated)
+            if c.term not in names:
+                ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
+                return None
+            return CChained(chained_index[c.variable], names.index(c.term), hs, c.negated)
+        if c.variable in fuzzy_index:
+            fz = ctx.fb.fuzzify_block(c.variable)
+            assert fz is not None
+            names = [t.name for t in _dedup(fz.terms)]
+            if c.term.lower() == "any" and c.term not in names:  # fuzzylite "x is any"
+                hs = (*hs, "any")
+            if "any" in hs:
+                return CTerm(fuzzy_index[c.variable], 0, hs, c.negated)
+            if c.term not in names:
+                ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
+                return None
+            return CTerm(fuzzy_index[c.variable], names.index(c.term), hs, c.negated)
+        var = ctx.fb.variable(c.variable)
+        if var is None:
+            ctx.err(f"{where}: undeclared variable {c.variable!r}", c.span, "undeclared-variable")
+        elif var.kind is m.VarKind.INPUT:
+            ctx.err(f"{where}: input {c.variable!r} has no FUZZIFY block", c.span, "no-fuzzify")
+        else:
+            ctx.err(
+                f"{where}: {c.variable!r} is used in a condition but no rule concludes on it",
+                c.span,
+                "never-concluded",
+            )
+        return None
+    if isinstance(c, m.Degree):
+        if c.variable in ctx.slots:
+            i = ctx.slots[c.variable]
+            inputs[i] = InputPlan(inputs[i].name, inputs[i].default, True)
+            return CDegree(slot=i)
+        if c.variable in chained_index and c.variable in concluded_bare:
+            deps.add(c.variable)
+            return CDegree(chained=chained_index[c.variable])
+        ctx.err(
+            f"{where}: bare variable {c.variable!r} in a condition must be an input (a degree) "
+            "or a variable concluded without a term",
+            c.span,
+            "degree-variable",
+        )
+        return None
+    if isinstance(c, m.Not):
+        inner = rec(c.operand)
+        return CNot(inner) if inner is not None else None
+    parts = [rec(o) for o in c.operands]
+    if any(p is None for p in parts):
+        return None
+    kids = tuple(p for p in parts if p is not None)
+    return CAnd(and_op, kids) if isinstance(c, m.And) else COr(or_op, kids)
+
+
+def _dedup(terms: tuple[m.Term, ...]) -> list[m.Term]:
+    seen: set[str] = set()
+    out = []
+    for t in terms:
+        if t.name not in seen:
+            seen.add(t.name)
+            out.append(t)
+    return out
+
+
+def _conclusion(
+    ctx: _Ctx,
+    c: m.Conclusion,
+    label: str,
+    output_names: dict[str, int],
+    chained_index: dict[str, int],
+    term_source: object,
+    inputs: list[InputPlan],
+) -> ConclusionPlan | None:
+    where = f"rule {label}"
+    var = ctx.fb.variable(c.variable)
+    if var is None or var.kind is m.VarKind.INPUT:
+        return None  # reported while scanning conclusions
+    weight: PParam = 1.0
+    if c.weight is not None:
+        w = _param(ctx, c.weight, f"{where} WITH")
+        if w is None:
+            return None
+        if isinstance(w, Slot):
+            inputs[w.index] = InputPlan(inputs[w.index].name, inputs[w.index].default, True)
+        elif w < 0.0:
+            ctx.err(f"{where}: negative weight {w}", c.span, "weight-negative")
+            return None
+        weight = w
+    hs = _hedges(ctx, c.hedges, c.span, where)
+    if hs is None:
+        return None
+    term_idx: int | None = None
+    if c.term is not None:
+        assert callable(term_source)
+        src = term_source(c.variable)
+        if src is None:
+            ctx.err(f"{where}: {c.variable} has no terms (no DEFUZZIFY block)", c.span, "no-defuzzify")
+            return None
+        names = [t.name for t in src]
+        if c.term not in names:
+            ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
+            return None
+        term_idx = names.index(c.term)
+    outs = (output_names[c.variable],) if c.variable in output_names else ()
+    chs = (chained_index[c.variable],) if c.variable in chained_index else ()
+    return ConclusionPlan(outs, chs, term_idx, weight, hs)
+
+
+def _topo(ctx: _Ctx, nodes: list[tuple[int, list[int]]], cycle_msg: object) -> list[int] | None:
+    """Kahn's algorithm keeping the written order among independent nodes."""
+    n = len(nodes)
+    indeg = [0] * n
+    users: list[list[int]] = [[] for _ in range(n)]
+    for i, deps in nodes:
+        for d in set(deps):
+            if d == i:
+                continue
+            indeg[i] += 1
+            users[d].append(i)
+    heap = [i for i in range(n) if indeg[i] == 0]
+    heapq.heapify(heap)
+    out: list[int] = []
+    while heap:
+        i = heapq.heappop(heap)
+        out.append(i)
+        for u in users[i]:
+            indeg[u] -= 1
+            if indeg[u] == 0:
+                heapq.heappush(heap, u)
+    self_loops = [i for i, deps in nodes if i in deps]
+    if len(out) < n or self_loops:
+        stuck = [i for i in range(n) if i not in out] or self_loops
+        assert callable(cycle_msg)
+        ctx.err(cycle_msg(stuck), None, "dependency-cycle")
+        return None
+    return out
+
+
+def _rule_order(
+    ctx: _Ctx, deps: list[set[str]], concludes: list[set[str]], rules: list[RulePlan]
+) -> list[int] | None:
+    producers: dict[str, list[int]] = {}
+    for i, cs in enumerate(concludes):
+        for v in cs:
+            producers.setdefault(v, []).append(i)
+    nodes = [(i, [p for v in d for p in producers.get(v, [])]) for i, d in enumerate(deps)]
+
+    def msg(stuck: list[int]) -> str:
+        names = sorted({v for i in stuck for v in deps[i]})
+        return (
+            "chained inference forms a cycle through "
+            + ", ".join(names)
+            + " (rules "
+            + ", ".join(rules[i].label for i in stuck)
+            + ")"
+        )
+
+    return _topo(ctx, nodes, msg)

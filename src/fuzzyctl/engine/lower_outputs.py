@@ -1,0 +1,207 @@
+"""Lowering of outputs: method, accumulation, range and grid (used by :mod:`~fuzzyctl.engine.lower`)."""
+
+from __future__ import annotations
+
+import math
+
+from fuzzyctl import model as m
+from fuzzyctl.engine import operators as ops
+from fuzzyctl.engine import shapes
+from fuzzyctl.engine.grid import build_grid
+from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
+from fuzzyctl.engine.plan import Contribution, OutputPlan, RulePlan, Slot
+
+METHOD_ALIASES = {
+    "MM": "MOM",
+    "COGF": "WTAVER",
+    "CENTROID": "COG",
+    "BISECTOR": "COA",
+    "SOM": "LM",
+    "LOM": "RM",
+    "WTAV": "WTAVER",
+}
+
+
+# --------------------------------------------------------------------------- outputs
+
+
+def _output(
+    ctx: _Ctx,
+    var: m.Variable,
+    oi: int,
+    rules: list[RulePlan],
+    output_names: dict[str, int],
+    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]],
+    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]],
+    accu_for: object,
+    term_source: object,
+) -> OutputPlan | None:
+    assert callable(accu_for)
+    fb = ctx.fb
+    db = fb.defuzzify_block(var.name)
+    contributions = [
+        Contribution(ri, ci, c.term, r.act, c.weight)
+        for ri, r in enumerate(rules)
+        for ci, c in enumerate(r.conclusions)
+        if oi in c.outputs
+    ]
+    if db is None:
+        if var.name in concluded_terms:
+            ctx.err(
+                f"output {var.name} is concluded with terms but has no DEFUZZIFY block",
+                var.span,
+                "no-defuzzify",
+            )
+            return None
+        if var.name not in concluded_bare:
+            ctx.warn(
+                f"output {var.name} is never concluded by a rule and has no DEFUZZIFY block; it stays 0",
+                var.span,
+                "output-unused",
+            )
+        accu = accu_for(var.name, None) or "MAX"
+        return OutputPlan(var.name, "degree", "DEGREE", accu, (), tuple(contributions), 0.0, False)
+    if var.name in concluded_bare:
+        ctx.err(
+            f"output {var.name} has a DEFUZZIFY block but a rule concludes it without a term",
+            concluded_bare[var.name][0][1].span,
+            "bare-on-defuzzified",
+        )
+        return None
+    terms = [_term(ctx, t, var.name, output_names, True) for t in _first_terms(ctx, var.name, db.terms)]
+    if any(t is None for t in terms):
+        return None
+    tps = tuple(t for t in terms if t is not None)
+    default = db.default.value if db.default is not None else None
+    no_change = db.default.no_change if db.default is not None else True
+    method_raw = (db.method or "").upper() or None
+    method = METHOD_ALIASES.get(method_raw, method_raw) if method_raw else None
+    if method is not None and method not in m.DEFUZZ_METHODS:
+        ctx.err(f"DEFUZZIFY {var.name}: unknown method {db.method!r}", db.span, "method-unknown")
+        return None
+    accu = accu_for(var.name, db)
+    # a function of x is a fuzzy set (smooth, integrated numerically), not a Sugeno value
+    kinds = {"function_of_x" if t.kind == "function" and uses_x(t.expr) else t.kind for t in tps}
+    if not tps:
+        ctx.err(f"DEFUZZIFY {var.name} has no terms", db.span, "no-terms")
+        return None
+    singletonish = kinds <= {"singleton", "singletons"}
+    ts_terms = bool(kinds & shapes.TS_KINDS)
+    if method in ("COGS", "WTAVER", "WTSUM") and kinds <= shapes.TSUKAMOTO_KINDS:
+        # Tsukamoto: a weighted average of where each monotonic term reaches its degree
+        ts_accu = accu if accu is not None else ctx.options.ts_default_accu
+        return OutputPlan(
+            var.name,
+            "ts",
+            "WTSUM" if method == "WTSUM" else "WTAVER",
+            ts_accu,
+            tps,
+            tuple(contributions),
+            default,
+            no_change,
+        )
+    if ts_terms or (singletonish and method in ("WTAVER", "WTSUM")):
+        if not kinds <= shapes.TS_KINDS | {"singleton"}:
+            ctx.err(
+                f"DEFUZZIFY {var.name}: Takagi-Sugeno terms (constant, linear, function) "
+                "cannot be mixed with fuzzy sets",
+                db.span,
+                "mixed-terms",
+            )
+            return None
+        if method not in (None, "WTAVER", "WTSUM", "COGS", "COG"):
+            ctx.err(
+                f"DEFUZZIFY {var.name}: {method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
+                db.span,
+                "method-ts",
+            )
+            return None
+        for t in tps:
+            if t.kind == "linear" and len(t.params) > len(fb.inputs) + 1:
+                ctx.err(
+                    f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
+                    f"{len(fb.inputs)} inputs",
+                    db.span,
+                    "linear-arity",
+                )
+                return None
+        ts_accu = accu if accu is not None else ctx.options.ts_default_accu
+        return OutputPlan(
+            var.name,
+            "ts",
+            "WTSUM" if method == "WTSUM" else "WTAVER",
+            ts_accu,
+            tps,
+            tuple(contributions),
+            default,
+            no_change,
+        )
+    if singletonish:
+        if method == "COA":
+            ctx.err(
+                f"DEFUZZIFY {var.name}: CoA is not applicable to singletons (IEC 61131-7 Table 1, note 3)",
+                db.span,
+                "coa-singletons",
+            )
+            return None
+        meth = "COGS" if method in (None, "COG", "COGS") else method
+        s_accu = accu or ctx.options.singleton_default_accu or "MAX"
+        return OutputPlan(var.name, "singleton", meth, s_accu, tps, tuple(contributions), default, no_change)
+    if kinds & {"singleton", "singletons"}:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: singletons cannot be mixed with fuzzy sets in one output",
+            db.span,
+            "mixed-terms",
+        )
+        return None
+    meth = method or "COG"
+    if meth in ("COGS", "WTAVER", "WTSUM"):
+        ctx.err(
+            f"DEFUZZIFY {var.name}: {meth} needs singleton or Takagi-Sugeno terms", db.span, "method-terms"
+        )
+        return None
+    rng = db.range or var.range
+    if rng is not None:
+        low, high = float(rng.low), float(rng.high)
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            ctx.err(f"DEFUZZIFY {var.name}: RANGE must be finite with min < max", rng.span, "range-invalid")
+            return None
+    else:
+        lows, highs = [], []
+        for t in tps:
+            if not t.constant:
+                ctx.err(
+                    f"DEFUZZIFY {var.name}: term {t.name} has variable parameters; give a RANGE",
+                    db.span,
+                    "range-needed",
+                )
+                return None
+            lo, hi = shapes.support(
+                t.kind,
+                [float(p) for p in t.params if not isinstance(p, Slot)],
+                float(t.height) if not isinstance(t.height, Slot) else 1.0,
+            )
+            if not (math.isfinite(lo) and math.isfinite(hi)):
+                ctx.err(
+                    f"DEFUZZIFY {var.name}: term {t.name} ({t.kind}) is not zero outside a finite interval; "
+                    "give a RANGE",
+                    db.span,
+                    "range-needed",
+                )
+                return None
+            lows.append(lo)
+            highs.append(hi)
+        low, high = min(lows), max(highs)
+        if not low < high:
+            ctx.err(f"DEFUZZIFY {var.name}: the terms have no extent; give a RANGE", db.span, "range-needed")
+            return None
+    acc = accu or "MAX"
+    acts = {c.act for c in contributions}
+    exact = kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
+    grid = None
+    if exact and all(t.constant for t in tps):
+        used = {c.term for c in contributions if c.term is not None}
+        grid = build_grid([t.pwl for t in tps if t.pwl is not None], low, high, used)
+    return OutputPlan(
+        var.name, "mamdani", meth, acc, tps, tuple(contributions), default, no_change, low, high, exact, grid
+    )

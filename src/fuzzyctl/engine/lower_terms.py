@@ -1,0 +1,264 @@
+"""Lowering of parameters, function expressions and terms (used by :mod:`~fuzzyctl.engine.lower`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from fuzzyctl import model as m
+from fuzzyctl.diagnostics import Diagnostic, error, warning
+from fuzzyctl.engine import shapes
+from fuzzyctl.engine.plan import (
+    EX,
+    EBinary,
+    ECall,
+    EInput,
+    ENum,
+    EOutput,
+    EUnary,
+    ExprPlan,
+    Options,
+    PParam,
+    Slot,
+    TermPlan,
+)
+
+FUNCTIONS = frozenset(
+    [
+        "sin",
+        "cos",
+        "tan",
+        "asin",
+        "acos",
+        "atan",
+        "sinh",
+        "cosh",
+        "tanh",
+        "exp",
+        "log",
+        "log10",
+        "ln",
+        "sqrt",
+        "abs",
+        "fabs",
+        "floor",
+        "ceil",
+        "round",
+        "pow",
+        "min",
+        "max",
+        "atan2",
+        "fmod",
+        "sign",
+        "eq",
+        "neq",
+        "lt",
+        "le",
+        "gt",
+        "ge",
+    ]
+)
+CONSTANTS = {"pi": math.pi, "e": math.e}
+
+
+@dataclass
+class _Ctx:
+    fb: m.FunctionBlock
+    options: Options
+    diags: list[Diagnostic] = field(default_factory=list)
+    slots: dict[str, int] = field(default_factory=dict)
+    constants: dict[str, float] = field(default_factory=dict)
+
+    def err(self, msg: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
+        self.diags.append(error(msg, span, code=code, hint=hint))
+
+    def warn(self, msg: str, span: m.Span | None, code: str) -> None:
+        self.diags.append(warning(msg, span, code=code))
+
+
+# --------------------------------------------------------------------------- parameters and terms
+
+
+def _param(ctx: _Ctx, p: m.Param, where: str) -> PParam | None:
+    if isinstance(p, m.Ref):
+        if p.name in ctx.slots:
+            return Slot(ctx.slots[p.name])
+        if p.name in ctx.constants:
+            return ctx.constants[p.name]
+        ctx.err(
+            f"{where}: parameter {p.name!r} is not a VAR_INPUT (only inputs can give values at run time)",
+            p.span,
+            "param-not-input",
+        )
+        return None
+    v = float(p)
+    if not math.isfinite(v):
+        ctx.err(f"{where}: parameter {v} is not a finite number", None, "param-not-finite")
+        return None
+    return v
+
+
+def _expr(ctx: _Ctx, e: m.Expr, where: str, outputs: dict[str, int], allow_x: bool) -> ExprPlan | None:
+    if isinstance(e, m.Num):
+        return ENum(float(e.value))
+    if isinstance(e, m.Name):
+        if e.name in ctx.slots:
+            return EInput(ctx.slots[e.name])
+        if e.name in outputs:
+            return EOutput(outputs[e.name])
+        if e.name in ctx.constants:
+            return ENum(ctx.constants[e.name])
+        if allow_x and e.name == "x":
+            return EX()
+        if e.name.lower() in CONSTANTS:
+            return ENum(CONSTANTS[e.name.lower()])
+        ctx.err(
+            f"{where}: function refers to {e.name!r}, which is not an input or output", None, "function-name"
+        )
+        return None
+    if isinstance(e, m.Unary):
+        inner = _expr(ctx, e.operand, where, outputs, allow_x)
+        return EUnary(e.op, inner) if inner is not None else None
+    if isinstance(e, m.Binary):
+        if e.op not in {"+", "-", "*", "/", "^", "%"}:
+            ctx.err(f"{where}: unknown operator {e.op!r} in function", None, "function-op")
+            return None
+        left = _expr(ctx, e.left, where, outputs, allow_x)
+        right = _expr(ctx, e.right, where, outputs, allow_x)
+        return EBinary(e.op, left, right) if left is not None and right is not None else None
+    fname = e.function.lower()
+    if fname not in FUNCTIONS:
+        ctx.err(f"{where}: unknown function {e.function!r}", None, "function-unknown")
+        return None
+    args = [_expr(ctx, a, where, outputs, allow_x) for a in e.args]
+    if any(a is None for a in args):
+        return None
+    return ECall(fname, tuple(a for a in args if a is not None))
+
+
+def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bool) -> TermPlan | None:
+    where = f"term {var}.{t.name}"
+    mf = t.mf
+    if isinstance(mf, m.PointsMF):
+        if not mf.points:
+            ctx.err(f"{where} has no points", t.span, "term-empty")
+            return None
+        raw: list[PParam | None] = []
+        for pt in mf.points:
+            raw += [_param(ctx, pt.x, where), _param(ctx, pt.y, where)]
+        if any(p is None for p in raw):
+            return None
+        params = tuple(p for p in raw if p is not None)
+        tp = TermPlan(t.name, "points", params)
+    elif isinstance(mf, m.SingletonMF):
+        v = _param(ctx, mf.value, where)
+        if v is None:
+            return None
+        tp = TermPlan(t.name, "singleton", (v,))
+    elif isinstance(mf, m.SingletonsMF):
+        raw = []
+        for pt in mf.points:
+            raw += [_param(ctx, pt.x, where), _param(ctx, pt.y, where)]
+        if any(p is None for p in raw) or not raw:
+            if not raw:
+                ctx.err(f"{where} has no points", t.span, "term-empty")
+            return None
+        tp = TermPlan(t.name, "singletons", tuple(p for p in raw if p is not None))
+    elif isinstance(mf, m.ShapeMF):
+        spec = m.SHAPES.get(mf.kind)
+        if spec is None:
+            ctx.err(f"{where}: unknown shape {mf.kind!r}", t.span, "shape-unknown")
+            return None
+        if not spec.variadic and len(mf.params) != len(spec.params):
+            ctx.err(
+                f"{where}: {mf.kind} takes {len(spec.params)} parameters "
+                f"({', '.join(spec.params)}), got {len(mf.params)}",
+                t.span,
+                "shape-arity",
+            )
+            return None
+        raw = [_param(ctx, p, where) for p in mf.params]
+        h = _param(ctx, mf.height, where)
+        if any(p is None for p in raw) or h is None:
+            return None
+        params = tuple(p for p in raw if p is not None)
+        if mf.kind in ("constant", "linear") and not is_output:
+            ctx.err(
+                f"{where}: {mf.kind} terms are Takagi-Sugeno outputs, not input sets", t.span, "ts-on-input"
+            )
+            return None
+        tp = TermPlan(t.name, mf.kind, params, h)
+        _check_shape(ctx, tp, t.span, where)
+    else:
+        ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, allow_x=True)
+        if ex is None:
+            return None
+        tp = TermPlan(t.name, "function", (), 1.0, ex)
+    if tp.constant and tp.kind in shapes.PWL_KINDS:
+        pts = shapes.pwl_points(
+            tp.kind,
+            [float(p) for p in tp.params if not isinstance(p, Slot)],
+            float(tp.height) if not isinstance(tp.height, Slot) else 1.0,
+        )
+        tp = TermPlan(tp.name, tp.kind, tp.params, tp.height, tp.expr, pts)
+    return tp
+
+
+def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> None:
+    if not tp.constant:
+        return
+    p = [float(v) for v in tp.params if not isinstance(v, Slot)]
+    bad = None
+    if tp.kind == "triangle" and not (p[0] <= p[1] <= p[2]):
+        bad = "needs a <= b <= c"
+    elif tp.kind == "trapezoid" and not (p[0] <= p[1] <= p[2] <= p[3]):
+        bad = "needs a <= b <= c <= d"
+    elif tp.kind in ("gaussian", "gaussian2") and (p[1] == 0.0 or (tp.kind == "gaussian2" and p[3] == 0.0)):
+        bad = "needs a nonzero standard deviation"
+    elif (tp.kind == "bell" and p[1] == 0.0) or (tp.kind in ("cosine", "spike") and p[1] == 0.0):
+        bad = "needs a nonzero width"
+    elif tp.kind in ("sshape", "zshape") and not p[0] < p[1]:
+        bad = "needs start < end"
+    elif tp.kind == "pishape" and not (p[0] < p[1] and p[2] < p[3]):
+        bad = "needs a < b and c < d"
+    elif tp.kind in ("arc", "semiellipse") and p[0] == p[1]:
+        bad = "needs start != end"
+    elif tp.kind == "cosine_half" and p[1] == 0.0:
+        bad = "needs a nonzero half width"
+    if bad:
+        ctx.err(f"{where}: {tp.kind} {bad}", span, "shape-params")
+
+
+def _first_terms(ctx: _Ctx, var: str, terms: Iterable[m.Term]) -> list[m.Term]:
+    """Terms in declaration order; a repeated name keeps its first definition (as fuzzylite
+    C++ does) and is reported."""
+    seen: dict[str, m.Term] = {}
+    out: list[m.Term] = []
+    for t in terms:
+        if t.name in seen:
+            ctx.warn(
+                f"term {t.name!r} of {var} is defined twice; the first definition is used",
+                t.span,
+                "duplicate-term",
+            )
+            continue
+        seen[t.name] = t
+        out.append(t)
+    return out
+
+
+def uses_x(e: ExprPlan | None) -> bool:
+    """Whether a function term reads ``x``: then it is a membership function of x (fuzzylite
+    Function as a fuzzy set), not a Takagi-Sugeno value."""
+    if e is None:
+        return False
+    if isinstance(e, EX):
+        return True
+    if isinstance(e, EUnary):
+        return uses_x(e.operand)
+    if isinstance(e, EBinary):
+        return uses_x(e.left) or uses_x(e.right)
+    if isinstance(e, ECall):
+        return any(uses_x(a) for a in e.args)
+    return False
