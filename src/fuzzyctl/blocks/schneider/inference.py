@@ -14,19 +14,24 @@ output and intermediate fuzzy sets sampled on ``Discr`` points, two inference le
    (OP_DEFUZ); with OUT_PT = 1 an output term is reduced to its point and the output is
    the mean of those points weighted by their aggregated degrees.
 
-The t-norms and the aggregation come from :mod:`fuzzyctl.engine.operators`; what is
-particular to XFUZ is only the sampling on Discr points and the two levels.
+The terms, t-norms, aggregation and the sampled defuzzifiers come from the engine
+(:mod:`fuzzyctl.engine.shapes`, :mod:`~fuzzyctl.engine.operators`,
+:mod:`~fuzzyctl.engine.sampled`); what is particular to XFUZ is the choice of the Discr
+points and the two levels.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
+from fuzzyctl.engine.operators import TNORMS, accumulate, accumulate_np
+from fuzzyctl.engine.sampled import mean_of_maxima, sampled_centroid, weighted_mean
+from fuzzyctl.engine.shapes import Points, pwl_points, pwl_value, pwl_value_np
 from fuzzyctl.formats.xfuz_tables import (
     INT16_MAX,
     INT16_MIN,
@@ -41,22 +46,18 @@ FloatArray = NDArray[np.float64]
 __all__ = ["InferenceResult", "XfuzInference", "discretisation_points", "to_word", "trapezoid"]
 
 
-def trapezoid(x: FloatArray | float, mf: XMembership) -> FloatArray:
-    """Degree of an XFUZ term (points A <= B <= C <= D, open sides at -32768/32767).
+def term_points(mf: XMembership) -> Points:
+    """An XFUZ term as an engine breakpoint list: 0 at A, 1 on [B, C], 0 at D.  The open
+    sides (-32768, 32767) are ordinary abscissae at the ends of the 16-bit range, and a
+    vertical side belongs to the plateau (the engine takes the upper value on an edge)."""
+    points = pwl_points("trapezoid", [float(p) for p in mf.points])
+    assert points is not None
+    return points
 
-    1 on [B, C], linear on ]A, B[ and ]C, D[, 0 elsewhere; a vertical side (A = B or
-    C = D) belongs to the plateau."""
-    xs = np.asarray(x, dtype=np.float64)
-    a, b, c, d = (float(p) for p in mf.points)
-    with np.errstate(divide="ignore", invalid="ignore"):
-        rise = np.where(b > a, (xs - a) / (b - a if b > a else 1.0), 0.0)
-        fall = np.where(d > c, (d - xs) / (d - c if d > c else 1.0), 0.0)
-    mu = np.where(
-        (xs >= b) & (xs <= c),
-        1.0,
-        np.where((xs > a) & (xs < b), rise, np.where((xs > c) & (xs < d), fall, 0.0)),
-    )
-    return np.asarray(mu, dtype=np.float64)
+
+def trapezoid(x: FloatArray | float, mf: XMembership) -> FloatArray:
+    """Degree of an XFUZ term at ``x`` (scalar or array), by the engine's shape formulas."""
+    return pwl_value_np(term_points(mf), np.asarray(x, dtype=np.float64))
 
 
 def discretisation_points(low: int, high: int, discr: int) -> FloatArray:
@@ -86,12 +87,13 @@ class InferenceResult:
         return any(d > 0.0 for d in self.degrees)
 
 
-def _min_and(values: Sequence[float]) -> float:
-    return min(values)
-
-
-def _prod_and(values: Sequence[float]) -> float:
-    return math.prod(values)
+def _conjunction(norm: str, values: Sequence[float]) -> float:
+    """OP_ET over a rule's predicates."""
+    t = TNORMS[norm].scalar
+    result = values[0]
+    for v in values[1:]:
+        result = t(result, v)
+    return result
 
 
 class XfuzInference:
@@ -107,6 +109,9 @@ class XfuzInference:
         for mf in kb.memberships:
             if mf.slot in self.points:
                 self.sampled[mf.number] = trapezoid(self.points[mf.slot], mf)
+        self.input_terms = tuple(
+            (m.number, m.slot, term_points(m)) for m in kb.memberships if 0 <= m.slot < 8
+        )
         self.levels = tuple(kb.rule_level(r) for r in kb.rules)
         self.outputs = sorted(
             {m.slot for m in kb.memberships if 0 <= m.slot < 18 and slot_kind(m.slot) is SlotKind.OUTPUT}
@@ -123,13 +128,12 @@ class XfuzInference:
     ) -> InferenceResult:
         """Evaluate the rules for the 8 input words."""
         kb = self.kb
-        conj: Callable[[Sequence[float]], float] = _prod_and if op_et == 1 else _min_and
+        and_norm = "PROD" if op_et == 1 else "MIN"
+        impl = TNORMS["PROD" if op_impl == 1 else "MIN"].array
         sets: dict[int, FloatArray] = {slot: np.zeros_like(xs) for slot, xs in self.points.items()}
         points_degree: dict[int, float] = {}  # singleton mode: aggregated degree of each output term
         degrees = [0.0] * len(kb.rules)
-        input_degree = {
-            m.number: float(trapezoid(float(inputs[m.slot]), m)) for m in kb.memberships if 0 <= m.slot < 8
-        }
+        input_degree = {n: pwl_value(points, float(inputs[slot])) for n, slot, points in self.input_terms}
 
         def predicate(number: int) -> float:
             if number in input_degree:
@@ -139,28 +143,25 @@ class XfuzInference:
                 # Only reachable when OUT_PT changed without REFRESH (2.8: "evaluation
                 # erroneous"); we take such predicates as false.
                 return 0.0
-            return float(np.max(np.minimum(sets[mf.slot], self.sampled[number])))
+            # OP_CONJ: max over the Discr points of min(F, mu).
+            return float(np.max(TNORMS["MIN"].array(sets[mf.slot], self.sampled[number])))
 
         for level in (1, 2):
             for r, rule in enumerate(kb.rules):
                 if self.levels[r] != level:
                     continue
                 truths = [1.0 - predicate(n) if neg else predicate(n) for n, neg in rule.predicates]
-                degree = conj(truths) if truths else 0.0
+                degree = _conjunction(and_norm, truths) if truths else 0.0
                 degrees[r] = degree
                 if degree <= 0.0:
                     continue
                 for number in rule.conclusions:
                     mf = kb.memberships[number]
                     if out_pt and slot_kind(mf.slot) is SlotKind.OUTPUT:
-                        points_degree[number] = max(points_degree.get(number, 0.0), degree)
+                        points_degree[number] = accumulate("MAX", points_degree.get(number, 0.0), degree)
                     elif number in self.sampled:
-                        limited = (
-                            degree * self.sampled[number]
-                            if op_impl == 1
-                            else np.minimum(degree, self.sampled[number])
-                        )
-                        np.maximum(sets[mf.slot], limited, out=sets[mf.slot])
+                        limited = impl(degree, self.sampled[number])  # OP_IMPL
+                        sets[mf.slot] = accumulate_np("MAX", sets[mf.slot], limited)  # OP_AGREG
         outputs: dict[int, float | None] = {}
         for slot in self.outputs:
             outputs[slot - 7] = self._defuzzify(slot, sets, points_degree, op_defuz, out_pt)
@@ -176,19 +177,13 @@ class XfuzInference:
     ) -> float | None:
         if out_pt:
             weights = [
-                (w, self.kb.memberships[n].singleton())
+                (self.kb.memberships[n].singleton(), w)
                 for n, w in points_degree.items()
                 if self.kb.memberships[n].slot == slot
             ]
-            total = sum(w for w, _ in weights)
-            return sum(w * x for w, x in weights) / total if total > 0 else None
+            return weighted_mean([x for x, _ in weights], [w for _, w in weights])
         if slot not in sets:
             return None
-        f, xs = sets[slot], self.points[slot]
-        total = float(f.sum())
-        if total <= 0.0:
-            return None
         if op_defuz == 1:
-            top = float(f.max())
-            return float(xs[f == top].mean())
-        return float((f * xs).sum() / total)
+            return mean_of_maxima(self.points[slot], sets[slot])
+        return sampled_centroid(self.points[slot], sets[slot])
