@@ -42,7 +42,7 @@ from collections.abc import Iterator
 from dataclasses import replace
 from typing import Any
 
-from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
 from fuzzyctl.formats import Format, Loaded, Loss
 from fuzzyctl.formats.xfuz_tables import (
     ESV_SIZE,
@@ -526,6 +526,16 @@ def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
     constants = read_tables(text, path=path)
     stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
     block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
+    if not constants.out_pt or block.locals:
+        diags.append(
+            Diagnostic(
+                Severity.NOTE,
+                "evaluated as FCL (fuzzyctl eval) this program has IEC semantics: an exact centre of "
+                "gravity and crisp values through intermediate variables; the XFUZ block (fuzzyctl "
+                "blocks xfuz) computes on the Discr points and chains fuzzy sets (manual 2.2)",
+                code="xfuz-semantics",
+            )
+        )
     diags = [replace(d, file=path) for d in diags]
     if any(d.is_error for d in diags):
         raise DiagnosticError(diags, text)
