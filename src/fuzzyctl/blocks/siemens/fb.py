@@ -16,9 +16,9 @@ Each :meth:`FuzzyFB.execute` is one call of the block:
   are evaluated, and each output takes its new value - or keeps its last one when no rule
   fired for it (0.0 before the first value, 1.5).
 
-The values are REALs: what the block writes is rounded to IEEE single precision, as in the
-PLC.  A rule with an empty IF part acts with degree 1 (1.5); that is the engine's reading
-of ``Rule.condition is None``.
+The values are REALs: the block reads its inputs and writes its outputs in IEEE single
+precision, as the PLC holds them.  A rule with an empty IF part acts with degree 1 (1.5);
+that is the engine's reading of ``Rule.condition is None``.
 """
 
 from __future__ import annotations
@@ -230,10 +230,11 @@ class FuzzyFB:
             x = getattr(self, f"INPUT{i}")
             if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
                 raise InputError(f"INPUT{i} ({name}) = {x!r} is not a finite REAL")
+            x = real(x)  # what a REAL parameter holds, however it was written
             limits = self._in_limits[i - 1]
             if limits is not None:
-                x = min(max(float(x), limits[0]), limits[1])  # 1.5: clamped to MIN/MAX
-            values[name] = float(x)
+                x = min(max(x, limits[0]), limits[1])  # 1.5: clamped to MIN/MAX
+            values[name] = x
         result = self._controller.evaluate(values)
         for j, name in enumerate(self._outputs, start=1):
             y = float(result[name])
