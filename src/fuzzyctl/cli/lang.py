@@ -16,11 +16,26 @@ from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, app, err_console
 
 
 def _load(file: Path):  # type: ignore[no-untyped-def]
-    from fuzzyctl.fcl import load_file
-    from fuzzyctl.fcl.checks import load_plugins
+    """Load and check ``file``; when the language checks pass, add what the engine reports
+    (features it will not evaluate, decisions worth knowing) so that ``check`` never says OK
+    to a file ``eval`` refuses."""
+    from dataclasses import replace
 
-    load_plugins()
-    return load_file(file)
+    from fuzzyctl.diagnostics import has_errors
+    from fuzzyctl.engine.support import unsupported
+    from fuzzyctl.fcl import load_file
+
+    result = load_file(file)
+    if result.document is None or has_errors(result.diagnostics):
+        return result
+    # The engine validates models from every reader, so it re-finds some language errors;
+    # keep only what the language checks did not already say about the same line.
+    seen = {(d.code, d.span.line if d.span else None) for d in result.diagnostics}
+    for fb in result.document.blocks:
+        for d in unsupported(fb):
+            if (d.code, d.span.line if d.span else None) not in seen:
+                result.diagnostics.append(replace(d, file=d.file or result.source.path))
+    return result
 
 
 @app.command()

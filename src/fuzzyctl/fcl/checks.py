@@ -60,22 +60,6 @@ def providers() -> dict[str, Provider]:
     return dict(_PROVIDERS)
 
 
-# Modules that register providers when imported; missing ones are skipped (the engine
-# lands in another branch).
-PLUGIN_MODULES = ("fuzzyctl.engine.support",)
-
-
-def load_plugins() -> None:
-    import importlib
-
-    for name in PLUGIN_MODULES:
-        try:
-            importlib.import_module(name)
-        except ModuleNotFoundError as exc:
-            if exc.name is None or not name.startswith(exc.name):
-                raise
-
-
 def run_checks(doc: Document, context: CheckContext | None = None) -> list[Diagnostic]:
     """Every provider's diagnostics, sorted by position."""
     ctx = context or CheckContext(doc.path)
