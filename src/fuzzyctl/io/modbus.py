@@ -13,6 +13,7 @@ changes between minor versions (3.16 moved to ``SimData``/``SimDevice``).
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import math
 from collections.abc import Sequence
@@ -102,7 +103,10 @@ def plan_reads(points: Sequence[ModbusPoint], max_gap: int = 8) -> list[tuple[Sp
                 and p.address <= span.start + span.count + max_gap
                 and max(end, span.start + span.count) - span.start <= MAX_READ
             ):
-                plan[-1] = (Span(span.table, span.start, max(end, span.start + span.count) - span.start), members)
+                plan[-1] = (
+                    Span(span.table, span.start, max(end, span.start + span.count) - span.start),
+                    members,
+                )
                 members.append(i)
                 continue
         plan.append((Span(p.table, p.address, p.width), [i]))
@@ -117,7 +121,12 @@ def plan_writes(points: Sequence[ModbusPoint], values: Sequence[float]) -> list[
             cells[(p.table, p.address + k)] = reg
     runs: list[tuple[str, int, list[int]]] = []
     for (table, addr), reg in sorted(cells.items()):
-        if runs and runs[-1][0] == table and runs[-1][1] + len(runs[-1][2]) == addr and len(runs[-1][2]) < MAX_WRITE:
+        if (
+            runs
+            and runs[-1][0] == table
+            and runs[-1][1] + len(runs[-1][2]) == addr
+            and len(runs[-1][2]) < MAX_WRITE
+        ):
             runs[-1][2].append(reg)
         else:
             runs.append((table, addr, [reg]))
@@ -131,7 +140,9 @@ class ModbusClientOptions(BaseModel):
     port: int = Field(default=502, ge=1, le=65535)
     unit: int = Field(default=1, ge=0, le=255, description="unit identifier (device id)")
     timeout: float = Field(default=1.0, gt=0, le=60)
-    max_gap: int = Field(default=8, ge=0, le=100, description="unused registers read through to merge requests")
+    max_gap: int = Field(
+        default=8, ge=0, le=100, description="unused registers read through to merge requests"
+    )
 
 
 class ModbusClient(Connector):
@@ -156,7 +167,7 @@ class ModbusClient(Connector):
         client = AsyncModbusTcpClient(o.host, port=o.port, timeout=o.timeout, retries=0, reconnect_delay=0)
         try:
             ok = await asyncio.wait_for(client.connect(), o.timeout + 1)
-        except (OSError, asyncio.TimeoutError) as exc:
+        except (TimeoutError, OSError) as exc:
             client.close()
             raise LinkError(f"{self.endpoint()}: {exc or 'timed out'}") from exc
         if not ok:
@@ -169,7 +180,7 @@ class ModbusClient(Connector):
 
         try:
             response = await asyncio.wait_for(request, self.options.timeout + 1)
-        except (ModbusException, OSError, asyncio.TimeoutError) as exc:
+        except (TimeoutError, ModbusException, OSError) as exc:
             raise LinkError(f"{self.endpoint()}: {what}: {exc or 'timed out'}") from exc
         if response.isError():
             raise LinkError(f"{self.endpoint()}: {what}: the device answered {response}")
@@ -185,7 +196,8 @@ class ModbusClient(Connector):
         for span, members in plan_reads(pts, self.options.max_gap):
             call = client.read_holding_registers if span.table == "holding" else client.read_input_registers
             resp = await self._call(
-                f"read {span.table} {span.start}+{span.count}", call(span.start, count=span.count, device_id=unit)
+                f"read {span.table} {span.start}+{span.count}",
+                call(span.start, count=span.count, device_id=unit),
             )
             regs = resp.registers
             if len(regs) < span.count:
@@ -210,10 +222,8 @@ class ModbusClient(Connector):
     async def close(self) -> None:
         client, self._client = self._client, None
         if client is not None:
-            try:
+            with contextlib.suppress(Exception):  # closing a broken transport must never fail the caller
                 client.close()
-            except Exception:  # closing a broken transport must never fail the caller
-                pass
 
 
 class ModbusServerOptions(BaseModel):
@@ -262,17 +272,17 @@ class ModbusServer(Connector):
             await server.serve_forever(background=True)
         except OSError as exc:
             raise LinkError(f"{self.endpoint()}: cannot listen: {exc}") from exc
-        if server.transport is None:
+        sockets = getattr(server.transport, "sockets", None)
+        if not sockets:
             raise LinkError(f"{self.endpoint()}: cannot listen")
-        self.port = server.transport.sockets[0].getsockname()[1]
+        self.port = sockets[0].getsockname()[1]
         self._server = server
 
     def _check(self, pts: Sequence[ModbusPoint]) -> None:
         for p in pts:
             if p.address + p.width > self.options.registers:
-                raise LinkError(
-                    f"{self.endpoint()}: {p.describe()} is beyond the {self.options.registers} registers served"
-                )
+                served = self.options.registers
+                raise LinkError(f"{self.endpoint()}: {p.describe()} is beyond the {served} registers served")
 
     async def read(self, points: Sequence[Point]) -> list[float]:
         server = self._server
@@ -302,7 +312,5 @@ class ModbusServer(Connector):
     async def close(self) -> None:
         server, self._server = self._server, None
         if server is not None:
-            try:
+            with contextlib.suppress(Exception):  # a server already torn down
                 await server.shutdown()
-            except Exception:  # a server already torn down
-                pass

@@ -8,6 +8,7 @@ are written rounded to the nearest (halves away from zero) and saturated to thei
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import math
 from collections.abc import Sequence
@@ -98,7 +99,7 @@ class OpcUaClient(Connector):
         return self.options.url
 
     async def connect(self) -> None:
-        from asyncua import Client
+        from asyncua.client.client import Client
 
         await self.close()
         o = self.options
@@ -118,6 +119,7 @@ class OpcUaClient(Connector):
 
     async def _resolve(self, points: Sequence[OpcUaPoint]) -> list[Any]:
         from asyncua import ua
+        from asyncua.ua.uaerrors import UaError
 
         client = self._client
         out = []
@@ -130,7 +132,7 @@ class OpcUaClient(Connector):
                         node_id = ua.NodeId.from_string(f"ns={idx};{p.node}")
                     else:
                         node_id = ua.NodeId.from_string(p.node)
-                except (ValueError, ua.UaError) as exc:
+                except (ValueError, UaError) as exc:
                     raise LinkError(f"{self.options.url}: node {p.describe()}: {exc}") from exc
                 node = self._nodes[p] = client.get_node(node_id)
             out.append(node)
@@ -170,10 +172,8 @@ class OpcUaClient(Connector):
 
 
 async def _disconnect(client: Any) -> None:
-    try:
+    with contextlib.suppress(Exception):  # the session is already gone
         await asyncio.wait_for(client.disconnect(), 2.0)
-    except Exception:  # the session is already gone
-        pass
 
 
 class OpcUaServerPoint(Point):
@@ -226,7 +226,7 @@ class OpcUaServer(Connector):
         return self._idx
 
     async def connect(self) -> None:
-        from asyncua import Server
+        from asyncua.server.server import Server
 
         if self._server is not None:
             return
@@ -257,11 +257,11 @@ class OpcUaServer(Connector):
         obj = self._objects.get(obj_name)
         if obj is None:
             obj = self._objects[obj_name] = await self._server.nodes.objects.add_object(
-                ua.NodeId(obj_name, self._idx), ua.QualifiedName(obj_name, self._idx)
+                ua.NodeId(ua.String(obj_name), ua.Int16(self._idx)), ua.QualifiedName(obj_name, self._idx)
             )
         initial = math.nan if p.type in ("Float", "Double") else 0
         node = await obj.add_variable(
-            ua.NodeId(p.node, self._idx),
+            ua.NodeId(ua.String(p.node), ua.Int16(self._idx)),
             ua.QualifiedName(var_name, self._idx),
             to_variant(initial, p.type).Value,
         )
@@ -298,7 +298,5 @@ class OpcUaServer(Connector):
     async def close(self) -> None:
         server, self._server = self._server, None
         if server is not None:
-            try:
+            with contextlib.suppress(Exception):  # already stopped
                 await server.stop()
-            except Exception:  # already stopped
-                pass

@@ -10,6 +10,7 @@ loop keeps serving the other connections.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import logging
 import math
 import struct
@@ -123,9 +124,7 @@ class S7Client(Connector):
             members.sort(key=lambda i: pts[i].offset)
             group: list[int] = []
             for i in [*members, -1]:
-                if i >= 0 and (
-                    not group or pts[i].offset + pts[i].width - pts[group[0]].offset <= MAX_SPAN
-                ):
+                if i >= 0 and (not group or pts[i].offset + pts[i].width - pts[group[0]].offset <= MAX_SPAN):
                     group.append(i)
                     continue
                 start = pts[group[0]].offset
@@ -159,7 +158,5 @@ class S7Client(Connector):
     async def close(self) -> None:
         client, self._client = self._client, None
         if client is not None:
-            try:
+            with contextlib.suppress(Exception):  # a connection already broken
                 await asyncio.to_thread(client.disconnect)
-            except Exception:  # a connection already broken
-                pass

@@ -163,8 +163,13 @@ class SiemensAdapter(Adapter):
         if name.upper() in ("INFO", "ENO"):
             return name.upper()
         k = kb or self.kb
-        return _lookup(name, k.labels, r"OUTPUT[1-4]", "an output",
-                       ", ".join(k.outputs) + ", OUTPUT1..OUTPUT4, INFO or ENO")
+        return _lookup(
+            name,
+            k.labels,
+            r"OUTPUT[1-4]",
+            "an output",
+            ", ".join(k.outputs) + ", OUTPUT1..OUTPUT4, INFO or ENO",
+        )
 
     def param_key(self, name: str) -> str:
         if name.upper() in self.PARAMS:
@@ -183,7 +188,7 @@ class SiemensAdapter(Adapter):
             return float(self.status["INFO"])
         if key == "ENO":
             return float(self.block.ENO)
-        return self.block.read_output(int(key[6:]))
+        return float(self.block.read_output(int(key[6:])))
 
     def get_param(self, key: str) -> int:
         return int(getattr(self.block, key))
@@ -282,8 +287,13 @@ class XfuzAdapter(Adapter):
             return name.upper()
         k = kb or self.kb
         outs = [n for n, lab in k.labels.items() if lab.startswith("OUT")]
-        return _lookup(name, k.labels, r"OUT[1-6]", "an output",
-                       ", ".join(outs) + ", OUT1..OUT6, O1_CALC..O6_CALC, STATUS or ERROR")
+        return _lookup(
+            name,
+            k.labels,
+            r"OUT[1-6]",
+            "an output",
+            ", ".join(outs) + ", OUT1..OUT6, O1_CALC..O6_CALC, STATUS or ERROR",
+        )
 
     def param_key(self, name: str) -> str:
         if name.upper() in self.PARAMS:
@@ -395,4 +405,3 @@ def make_adapter(kb: PreparedKB, style: str, period: float, span_rule: bool = Tr
     if style == "siemens":
         return SiemensAdapter(kb)
     return XfuzAdapter(kb, period, span_rule)
-

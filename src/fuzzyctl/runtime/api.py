@@ -15,6 +15,7 @@ docs/runtime.md has the reference with curl examples.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import math
 import secrets
 import time
@@ -31,6 +32,7 @@ from fuzzyctl.runtime.adapters import NotSupported
 
 if TYPE_CHECKING:
     from fuzzyctl.runtime.core import Runtime
+    from fuzzyctl.runtime.instance import Instance
 
 __all__ = ["API_PREFIX", "create_app"]
 
@@ -62,7 +64,7 @@ class StartStopBody(_Body):
 
 class ParametersBody(_Body):
     values: dict[str, float] = Field(
-        min_length=1, description="parameters by manual name, e.g. {\"START_STOP\": 65535} or {\"MAN_AUTO\": 1}"
+        min_length=1, description='parameters by manual name, e.g. {"START_STOP": 65535} or {"MAN_AUTO": 1}'
     )
 
 
@@ -230,7 +232,7 @@ def create_app(runtime: Runtime) -> FastAPI:
     Writer = Annotated[None, Depends(require_token)]
     InstanceName = Annotated[str, Path(description="instance name (the [instances.<name>] table)")]
 
-    def get_instance(name: str) -> Any:
+    def get_instance(name: str) -> Instance:
         if name not in runtime.instances:
             raise HTTPException(404, f"no instance {name!r}")
         return runtime.instances[name]
@@ -411,10 +413,8 @@ def create_app(runtime: Runtime) -> FastAPI:
                 if delay < 0:
                     next_time = loop.time()
                     delay = 0
-                try:
+                with contextlib.suppress(asyncio.TimeoutError):
                     await asyncio.wait_for(ws.receive_text(), delay)
-                except asyncio.TimeoutError:
-                    pass
         except WebSocketDisconnect:
             return
 

@@ -55,8 +55,12 @@ class RuntimeConfig(_Strict):
     state_dir: str | None = Field(
         default=None, description="token and event log directory (default ~/.local/state/fuzzyctl)"
     )
-    event_log: str = Field(default="events.jsonl", description="JSON-lines event file in state_dir; '' for none")
-    switch_interval: float = Field(default=0.0005, gt=0, le=0.1, description="Python thread switch interval (s)")
+    event_log: str = Field(
+        default="events.jsonl", description="JSON-lines event file in state_dir; '' for none"
+    )
+    switch_interval: float = Field(
+        default=0.0005, gt=0, le=0.1, description="Python thread switch interval (s)"
+    )
     spin: float = Field(default=0.0002, ge=0, le=0.005, description="busy-wait before each release (s)")
 
 
@@ -65,7 +69,9 @@ class ApiConfig(_Strict):
     host: str = "127.0.0.1"
     port: int = Field(default=8765, ge=0, le=65535)
     token_file: str = Field(default="api-token", description="in state_dir unless absolute")
-    live_rate_max: float = Field(default=20.0, gt=0, le=20.0, description="WebSocket updates per second, at most")
+    live_rate_max: float = Field(
+        default=20.0, gt=0, le=20.0, description="WebSocket updates per second, at most"
+    )
 
 
 class ConnectionConfig(_Strict):
@@ -173,6 +179,38 @@ def _pydantic_problems(path: Path | str, table: str, exc: ValidationError) -> li
     return out
 
 
+def _binding(
+    spec: Mapping[str, Any],
+    where: str,
+    output: bool,
+    path: Path,
+    conns: dict[str, ConnectionConfig],
+    problems: list[str],
+) -> BindingConfig | None:
+    """Check one binding table; its address by the protocol of its connection."""
+    spec = dict(spec)
+    conn_name = spec.pop("connection", None)
+    safe = spec.pop("safe", None) if output else None
+    if conn_name is None:
+        problems.append(f"{_where(path, where, 'connection')}: required key is missing")
+        return None
+    if conn_name not in conns:
+        known = ", ".join(conns) or "none defined"
+        problems.append(f"{_where(path, where, 'connection')}: no connection {conn_name!r} ({known})")
+        return None
+    if safe is not None and (
+        isinstance(safe, bool) or not isinstance(safe, int | float) or not math.isfinite(safe)
+    ):
+        problems.append(f"{_where(path, where, 'safe')}: a safe value is a finite number")
+        return None
+    try:
+        point = connector_class(conns[conn_name].type).point_model.model_validate(spec)
+    except ValidationError as exc:
+        problems.extend(_pydantic_problems(path, where, exc))
+        return None
+    return BindingConfig(connection=conn_name, point=point, safe=None if safe is None else float(safe))
+
+
 def load_config(path: str | Path) -> Config:
     """Read and validate a configuration file; raises :class:`ConfigError`."""
     path = Path(path)
@@ -215,7 +253,7 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
             conn = ConnectionConfig.model_validate({**own, "options": rest})
             connector_class(kind).options_model.model_validate(rest)
         except ValidationError as exc:
-            problems += _pydantic_problems(path, tname, exc)
+            problems.extend(_pydantic_problems(path, tname, exc))
             continue
         if conn.reconnect_max < conn.reconnect_min:
             problems.append(f"{_where(path, tname, 'reconnect_max')}: must be >= reconnect_min")
@@ -230,35 +268,12 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
         try:
             t = _InstanceTable.model_validate(table)
         except ValidationError as exc:
-            problems += _pydantic_problems(path, tname, exc)
+            problems.extend(_pydantic_problems(path, tname, exc))
             continue
         n_before = len(problems)
 
-        def binding(
-            spec: Mapping[str, Any], where: str, output: bool, conns: dict[str, ConnectionConfig] = connections
-        ) -> BindingConfig | None:
-            spec = dict(spec)
-            conn_name = spec.pop("connection", None)
-            safe = spec.pop("safe", None) if output else None
-            if conn_name is None:
-                problems.append(f"{_where(path, where, 'connection')}: required key is missing")
-                return None
-            if conn_name not in conns:
-                known = ", ".join(conns) or "none defined"
-                problems.append(f"{_where(path, where, 'connection')}: no connection {conn_name!r} ({known})")
-                return None
-            if safe is not None and (
-                isinstance(safe, bool) or not isinstance(safe, int | float) or not math.isfinite(safe)
-            ):
-                problems.append(f"{_where(path, where, 'safe')}: a safe value is a finite number")
-                return None
-            kind = conns[conn_name].type
-            try:
-                point = connector_class(kind).point_model.model_validate(spec)
-            except ValidationError as exc:
-                problems.extend(_pydantic_problems(path, where, exc))
-                return None
-            return BindingConfig(connection=conn_name, point=point, safe=None if safe is None else float(safe))
+        def binding(spec: Mapping[str, Any], where: str, output: bool) -> BindingConfig | None:
+            return _binding(spec, where, output, path, connections, problems)
 
         inputs: dict[str, BindingConfig] = {}
         for key, spec in t.inputs.items():
@@ -268,12 +283,16 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
         outputs: dict[str, tuple[BindingConfig, ...]] = {}
         for key, specs in t.outputs.items():
             many = specs if isinstance(specs, list) else [specs]
-            bs = [binding(s, f"{tname}.outputs.{key}" + (f"[{i}]" if isinstance(specs, list) else ""), True)
-                  for i, s in enumerate(many)]
+            bs = [
+                binding(s, f"{tname}.outputs.{key}" + (f"[{i}]" if isinstance(specs, list) else ""), True)
+                for i, s in enumerate(many)
+            ]
             if all(bs):
                 safes = {b.safe for b in bs if b and b.safe is not None}
                 if len(safes) > 1:
-                    problems.append(f"{_where(path, f'{tname}.outputs.{key}', 'safe')}: differing safe values")
+                    problems.append(
+                        f"{_where(path, f'{tname}.outputs.{key}', 'safe')}: differing safe values"
+                    )
                 outputs[key] = tuple(b for b in bs if b)
         parameters: dict[str, BindingConfig] = {}
         for key, spec in t.parameters.items():
@@ -281,8 +300,8 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
             if b:
                 parameters[key] = b
         for i, conn_name in enumerate(t.expose):
-            conn = connections.get(conn_name)
-            if conn is None or conn.type != "opcua-server":
+            exposed = connections.get(conn_name)
+            if exposed is None or exposed.type != "opcua-server":
                 problems.append(
                     f"{_where(path, tname, f'expose[{i}]')}: {conn_name!r} is not an opcua-server connection"
                 )

@@ -39,7 +39,9 @@ class Runtime:
     manager).  ``api=False`` runs without the HTTP server; ``event_log`` overrides the
     configured event file (None: memory only)."""
 
-    def __init__(self, config: Config, *, api: bool | None = None, event_log: Path | None | str = "config") -> None:
+    def __init__(
+        self, config: Config, *, api: bool | None = None, event_log: Path | str | None = "config"
+    ) -> None:
         self.config = config
         if event_log == "config":
             name = config.runtime.event_log
@@ -58,7 +60,8 @@ class Runtime:
             self.events.close()
             raise
         phases = auto_phases(
-            [i.config.period for i in self.instances.values()], [i.config.phase for i in self.instances.values()]
+            [i.config.period for i in self.instances.values()],
+            [i.config.phase for i in self.instances.values()],
         )
         self.scheduler = Scheduler(
             [i.task for i in self.instances.values()],
@@ -110,7 +113,9 @@ class Runtime:
                 span_rule=icfg.span_rule,
             )
         except DiagnosticError as exc:
-            raise ConfigError([f"{where(t, 'knowledge_base')}: {icfg.knowledge_base}:\n{exc.render()}"]) from exc
+            raise ConfigError(
+                [f"{where(t, 'knowledge_base')}: {icfg.knowledge_base}:\n{exc.render()}"]
+            ) from exc
         except FuzzyctlError as exc:
             raise ConfigError([f"{where(t, 'knowledge_base')}: {exc}"]) from exc
         adapter = make_adapter(kb, icfg.style, icfg.period, icfg.span_rule)
@@ -130,7 +135,9 @@ class Runtime:
         exposed_outputs: dict[str, list[tuple[Link, Any]]] = {}
         for name, bindings in icfg.outputs.items():
             try:
-                targets = [(self.links[b.connection], self.links[b.connection].output(b.point)) for b in bindings]
+                targets = [
+                    (self.links[b.connection], self.links[b.connection].output(b.point)) for b in bindings
+                ]
                 exposed_outputs[name] = targets
             except LinkError as exc:
                 problems.append(f"{where(f'{t}.outputs', name)}: {exc}")
@@ -180,7 +187,9 @@ class Runtime:
                 adapter.output_key(name)
             except InputError:
                 continue
-            outputs.setdefault(name, []).append((link, link.output(point(name, types.get(name, value_type), False))))
+            outputs.setdefault(name, []).append(
+                (link, link.output(point(name, types.get(name, value_type), False)))
+            )
         params = {"START_STOP": "UInt16"} if siemens else {
             "MAN_AUTO": "Boolean", "START": "Boolean", "CONT_ASK": "Boolean", "INHIB": "Boolean",
             "COMMAND": "Int16", "T_OFB": "Int16",
@@ -250,7 +259,9 @@ class Runtime:
     async def _io(self) -> None:
         self._loop = asyncio.get_running_loop()
         self._io_stop = asyncio.Event()
-        link_tasks = [asyncio.create_task(link.run(self._io_stop), name=f"link-{n}") for n, link in self.links.items()]
+        link_tasks = [
+            asyncio.create_task(link.run(self._io_stop), name=f"link-{n}") for n, link in self.links.items()
+        ]
         server: Any = None
         server_task = None
         if self._api_socket is not None:
@@ -260,9 +271,11 @@ class Runtime:
 
             app = create_app(self)
             server = uvicorn.Server(
-                uvicorn.Config(app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio")
+                uvicorn.Config(
+                    app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio"
+                )
             )
-            server.install_signal_handlers = lambda: None  # type: ignore[method-assign]  # the CLI owns signals
+            server.install_signal_handlers = lambda: None  # the CLI owns signals
             server_task = asyncio.create_task(server.serve(sockets=[self._api_socket]), name="api")
         self._io_ready.set()
         await self._io_stop.wait()

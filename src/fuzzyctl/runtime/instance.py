@@ -20,6 +20,7 @@ knowledge base prepared beforehand, outside the lock.
 
 from __future__ import annotations
 
+import itertools
 import math
 import statistics
 import threading
@@ -130,7 +131,9 @@ class Instance:
 
     def bind_output(self, name: str, targets: list[tuple[Link, OutCell]], safe: float | None) -> None:
         key = self.adapter.output_key(name)
-        self.outputs.append(OutputBinding(name, key, [c for _, c in targets], [lk for lk, _ in targets], safe))
+        self.outputs.append(
+            OutputBinding(name, key, [c for _, c in targets], [lk for lk, _ in targets], safe)
+        )
 
     def bind_param(self, name: str, link: Link, cell: InCell, mirror: OutCell) -> None:
         key = self.adapter.param_key(name)
@@ -189,16 +192,15 @@ class Instance:
             good = b.link.up and math.isfinite(v)
             if good:
                 b.last_good = v
-            elif b.link.up:  # the link is fine but the value is not a number
-                problems.inputs.append(b.name)
-            elif b.last_good is None:
+            elif b.link.up or b.last_good is None:  # the link is fine but the value is not a number
                 problems.inputs.append(b.name)
             valid = good or not b.link.up
             if valid != b.valid and b.link.up:
                 b.valid = valid
                 self.events.emit(
                     "input-valid" if valid else "input-invalid",
-                    f"{self.name}: input {b.name} = {v!r}" + ("" if valid else ", running on its last good value"),
+                    f"{self.name}: input {b.name} = {v!r}"
+                    + ("" if valid else ", running on its last good value"),
                     level="info" if valid else "warning",
                     instance=self.name,
                     input=b.name,
@@ -340,7 +342,9 @@ class Instance:
             self.adapter.force(key, value)
             self.events.emit(
                 "force",
-                f"{self.name}: {key} " + ("released" if value is None else f"forced to {value:g}") + f" ({source})",
+                f"{self.name}: {key} "
+                + ("released" if value is None else f"forced to {value:g}")
+                + f" ({source})",
                 instance=self.name,
                 input=key,
                 value=value,
@@ -419,7 +423,7 @@ class Instance:
                 instance=self.name,
                 procedure=procedure,
                 warnings=[d.message for d in kb.warnings],
-                **{k: v for k, v in info.items() if k != "time"},
+                details={k: v for k, v in info.items() if k != "time"},
             )
             if style == "siemens":
                 self.events.emit(
@@ -490,7 +494,7 @@ class Instance:
         jitters = sorted(r.jitter for r in records)
         durations = sorted(r.duration for r in records)
         starts = [r.start for r in records]
-        intervals = [b - a for a, b in zip(starts, starts[1:], strict=False)]
+        intervals = [b - a for a, b in itertools.pairwise(starts)]
         return {
             **summary,
             "kept": len(records),
@@ -499,7 +503,7 @@ class Instance:
             "jitter_p99": percentile(jitters, 99),
             "duration_p50": percentile(durations, 50),
             "duration_p99": percentile(durations, 99),
-            "last_duration": durations and records[-1].duration or 0.0,
+            "last_duration": (durations and records[-1].duration) or 0.0,
             "interval_mean": statistics.fmean(intervals) if intervals else 0.0,
         }
 

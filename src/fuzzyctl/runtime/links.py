@@ -15,6 +15,7 @@ complete exchange, so an instance that sees the link up also sees fresh inputs.
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import math
 import time
 from dataclasses import dataclass, field
@@ -105,25 +106,27 @@ class Link:
             values = await self.connector.read(points)
             now = time.perf_counter()
             for p, v in zip(points, values, strict=True):
-                cell = self._in[p]
-                cell.value, cell.stamp = v, now
-        out_points, out_values, sent = [], [], []
-        for p, cell in self._out.items():
-            v = cell.value
-            if v is not None:
+                in_cell = self._in[p]
+                in_cell.value, in_cell.stamp = v, now
+        out_points: list[Point] = []
+        out_values: list[float] = []
+        sent: list[OutCell] = []
+        for p, out_cell in self._out.items():
+            value = out_cell.value
+            if value is not None:
                 out_points.append(p)
-                out_values.append(v)
-                sent.append(cell)
-        for p, cell in self._mirror.items():
-            v = cell.value
-            if v is not None and v != cell.sent:
+                out_values.append(value)
+                sent.append(out_cell)
+        for p, out_cell in self._mirror.items():
+            value = out_cell.value
+            if value is not None and value != out_cell.sent:
                 out_points.append(p)
-                out_values.append(v)
-                sent.append(cell)
+                out_values.append(value)
+                sent.append(out_cell)
         if out_points:
             await self.connector.write(out_points, out_values)
-            for cell, v in zip(sent, out_values, strict=True):
-                cell.sent = v
+            for out_cell, value in zip(sent, out_values, strict=True):
+                out_cell.sent = value
         self.counters.exchanges += 1
         self.counters.last_exchange_ms = (time.perf_counter() - t0) * 1e3
 
@@ -200,7 +203,5 @@ async def _wait(stop: asyncio.Event, seconds: float) -> None:
     if seconds <= 0:
         await asyncio.sleep(0)
         return
-    try:
+    with contextlib.suppress(asyncio.TimeoutError):
         await asyncio.wait_for(stop.wait(), seconds)
-    except asyncio.TimeoutError:
-        pass

@@ -118,6 +118,8 @@ class Scheduler:
                 if rec.overrun:
                     self._on_overrun[i](rec.end)
                 heapq.heapreplace(heap, (task.next_release, period, i))
-        except BaseException as exc:  # recorded for the runtime to report; the thread must not vanish silently
+        except (
+            BaseException
+        ) as exc:  # recorded for the runtime to report; the thread must not vanish silently
             self.error = exc
             raise
