@@ -13,16 +13,19 @@ from the real-time cycle thread, and talks to them only through its process imag
 from __future__ import annotations
 
 import abc
+import asyncio
 import importlib
-from collections.abc import Mapping, Sequence
+from collections.abc import Awaitable, Mapping, Sequence
 from enum import StrEnum
-from typing import Any, ClassVar
+from typing import Any, ClassVar, TypeVar
 
 from pydantic import BaseModel, ConfigDict
 
 from fuzzyctl.diagnostics import FuzzyctlError
 
-__all__ = ["CONNECTION_TYPES", "Connector", "LinkError", "LinkState", "Point", "create_connector"]
+T = TypeVar("T")
+
+__all__ = ["CONNECTION_TYPES", "bounded", "Connector", "LinkError", "LinkState", "Point", "create_connector"]
 
 
 class LinkState(StrEnum):
@@ -126,6 +129,24 @@ def create_connector(kind: str, name: str, options: Mapping[str, Any]) -> Connec
     """Build a connector from its configuration ``type`` and options (validated by the
     connector's own ``Options`` model)."""
     return connector_class(kind).from_options(name, options)
+
+
+async def bounded(awaitable: Awaitable[T], timeout: float, what: str) -> T:
+    """Await with a deadline that holds even when the awaited library swallows the
+    cancellation (``asyncio.wait_for`` waits for the cancelled task to finish; a protocol
+    stack stuck in its own retry loop would then hang the link)."""
+    task = asyncio.ensure_future(awaitable)
+    done, _ = await asyncio.wait({task}, timeout=timeout)
+    if not done:
+        task.cancel()
+        task.add_done_callback(_consume)
+        raise LinkError(f"{what}: no answer within {timeout:g} s")
+    return task.result()
+
+
+def _consume(task: asyncio.Future[Any]) -> None:
+    if not task.cancelled():
+        task.exception()  # retrieved, so asyncio does not log "exception never retrieved"
 
 
 def chunks(items: Sequence[Any], size: int) -> list[Sequence[Any]]:

@@ -14,15 +14,16 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import functools
 import logging
 import math
-from collections.abc import Sequence
+from collections.abc import Awaitable, Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fuzzyctl.io.base import Connector, LinkError, Point
+from fuzzyctl.io.base import Connector, LinkError, Point, bounded
 from fuzzyctl.io.codec import (
     WordOrder,
     float32_from_registers,
@@ -166,8 +167,8 @@ class ModbusClient(Connector):
         o = self.options
         client = AsyncModbusTcpClient(o.host, port=o.port, timeout=o.timeout, retries=0, reconnect_delay=0)
         try:
-            ok = await asyncio.wait_for(client.connect(), o.timeout + 1)
-        except (TimeoutError, OSError) as exc:
+            ok = await bounded(client.connect(), o.timeout + 1, "connect")
+        except (LinkError, OSError) as exc:
             client.close()
             raise LinkError(f"{self.endpoint()}: {exc or 'timed out'}") from exc
         if not ok:
@@ -175,12 +176,14 @@ class ModbusClient(Connector):
             raise LinkError(f"{self.endpoint()}: connection refused or timed out")
         self._client = client
 
-    async def _call(self, what: str, request: Any) -> Any:
+    async def _call(self, what: str, request: Callable[[], Awaitable[Any]]) -> Any:
         from pymodbus.exceptions import ModbusException
 
         try:
-            response = await asyncio.wait_for(request, self.options.timeout + 1)
-        except (TimeoutError, ModbusException, OSError) as exc:
+            # pymodbus raises ConnectionException as soon as the request is made on a closed
+            # transport, so the request is made inside the try.
+            response = await bounded(request(), self.options.timeout + 0.5, "no answer")
+        except (LinkError, ModbusException, OSError) as exc:
             raise LinkError(f"{self.endpoint()}: {what}: {exc or 'timed out'}") from exc
         if response.isError():
             raise LinkError(f"{self.endpoint()}: {what}: the device answered {response}")
@@ -197,7 +200,7 @@ class ModbusClient(Connector):
             call = client.read_holding_registers if span.table == "holding" else client.read_input_registers
             resp = await self._call(
                 f"read {span.table} {span.start}+{span.count}",
-                call(span.start, count=span.count, device_id=unit),
+                functools.partial(call, span.start, count=span.count, device_id=unit),
             )
             regs = resp.registers
             if len(regs) < span.count:
@@ -216,7 +219,7 @@ class ModbusClient(Connector):
                 raise LinkError(f"{self.endpoint()}: input registers are read-only for a client")
             await self._call(
                 f"write holding {start}+{len(regs)}",
-                client.write_registers(start, regs, device_id=self.options.unit),
+                functools.partial(client.write_registers, start, regs, device_id=self.options.unit),
             )
 
     async def close(self) -> None:

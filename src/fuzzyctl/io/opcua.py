@@ -17,7 +17,7 @@ from urllib.parse import urlsplit, urlunsplit
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fuzzyctl.io.base import Connector, LinkError, Point
+from fuzzyctl.io.base import Connector, LinkError, Point, bounded
 
 __all__ = ["OpcUaClient", "OpcUaClientOptions", "OpcUaPoint", "OpcUaServer", "OpcUaServerOptions"]
 
@@ -109,7 +109,7 @@ class OpcUaClient(Connector):
         if o.password is not None:
             client.set_password(o.password)
         try:
-            await asyncio.wait_for(client.connect(), o.timeout * 2)
+            await bounded(client.connect(), o.timeout * 2, "connect")
         # asyncua raises OSError, TimeoutError, its own UaError and ua status exceptions
         except Exception as exc:
             await _disconnect(client)
@@ -144,7 +144,7 @@ class OpcUaClient(Connector):
         pts: list[OpcUaPoint] = list(points)  # type: ignore[arg-type]
         try:
             nodes = await self._resolve(pts)
-            values = await asyncio.wait_for(self._client.read_values(nodes), self.options.timeout)
+            values = await bounded(self._client.read_values(nodes), self.options.timeout, "read")
         except LinkError:
             raise
         except Exception as exc:
@@ -158,7 +158,7 @@ class OpcUaClient(Connector):
         try:
             nodes = await self._resolve(pts)
             data = [to_variant(v, p.type) for p, v in zip(pts, values, strict=True)]
-            await asyncio.wait_for(self._client.write_values(nodes, data), self.options.timeout)
+            await bounded(self._client.write_values(nodes, data), self.options.timeout, "write")
         except LinkError:
             raise
         except Exception as exc:
@@ -173,7 +173,7 @@ class OpcUaClient(Connector):
 
 async def _disconnect(client: Any) -> None:
     with contextlib.suppress(Exception):  # the session is already gone
-        await asyncio.wait_for(client.disconnect(), 2.0)
+        await bounded(client.disconnect(), 2.0, "disconnect")
 
 
 class OpcUaServerPoint(Point):

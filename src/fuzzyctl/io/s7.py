@@ -19,7 +19,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from fuzzyctl.io.base import Connector, LinkError, Point
+from fuzzyctl.io.base import Connector, LinkError, Point, bounded
 from fuzzyctl.io.codec import real_from_bytes, real_to_bytes
 
 __all__ = ["S7Client", "S7Options", "S7Point"]
@@ -86,7 +86,7 @@ class S7Client(Connector):
 
     async def _run(self, what: str, fn: Any, *args: Any) -> Any:
         try:
-            return await asyncio.wait_for(asyncio.to_thread(fn, *args), self.options.timeout + 1)
+            return await bounded(asyncio.to_thread(fn, *args), self.options.timeout + 1, "no answer")
         # snap7 raises its own errors, OSError, RuntimeError and struct errors on a broken
         # connection: all of them mean the link is unusable.
         except Exception as exc:

@@ -154,18 +154,20 @@ class Link:
                 attempt += 1
                 try:
                     await self._connect()
-                except LinkError as exc:
+                # A protocol library may raise more than LinkError on a broken peer; any of
+                # them means "not connected", and the link must keep retrying.
+                except Exception as exc:
                     self.counters.failures += 1
                     self.counters.last_error = str(exc)
                     await self.connector.close()
                     self.events.emit(
                         "link-retry",
-                        f"{self.name}: {exc}; next attempt in {delay:.3g} s",
+                        f"{self.name}: {describe(exc)}; next attempt in {delay:.3g} s",
                         level="warning",
                         link=self.name,
                         attempt=attempt,
                         delay=delay,
-                        error=str(exc),
+                        error=describe(exc),
                     )
                     await _wait(stop, delay)
                     delay = min(delay * 2, cfg.reconnect_max)
@@ -185,18 +187,28 @@ class Link:
             start = loop.time()
             try:
                 await self.exchange()
-            except LinkError as exc:
+            except Exception as exc:  # as above: whatever broke, the link is down
                 self.counters.failures += 1
-                self.counters.last_error = str(exc)
+                self.counters.last_error = describe(exc)
                 self._set_state(LinkState.DOWN)
                 self.events.emit(
-                    "link-lost", f"{self.name}: {exc}", level="error", link=self.name, error=str(exc)
+                    "link-lost",
+                    f"{self.name}: {describe(exc)}",
+                    level="error",
+                    link=self.name,
+                    error=describe(exc),
                 )
                 await self.connector.close()
                 continue
             await _wait(stop, max(0.0, start + cfg.poll_interval - loop.time()))
         await self.connector.close()
         self._set_state(LinkState.CLOSED)
+
+
+def describe(exc: BaseException) -> str:
+    """An exception as a message (the type when it says nothing else)."""
+    text = str(exc)
+    return text if isinstance(exc, LinkError) and text else f"{type(exc).__name__}: {text}".rstrip(": ")
 
 
 async def _wait(stop: asyncio.Event, seconds: float) -> None:
