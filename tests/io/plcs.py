@@ -79,7 +79,9 @@ class ModbusPLC:
         self._lt.run(self._server.async_setValues(0, 16 if table == "holding" else 4, address, regs))
 
     def registers(self, address: int, count: int, table: str = "holding") -> list[int]:
-        return list(self._lt.run(self._server.async_getValues(0, 3 if table == "holding" else 4, address, count)))
+        return list(
+            self._lt.run(self._server.async_getValues(0, 3 if table == "holding" else 4, address, count))
+        )
 
     def set_float(self, address: int, value: float, word_order: str = "big", table: str = "holding") -> None:
         self.set_registers(address, list(float32_to_registers(value, word_order)), table)  # type: ignore[arg-type]
@@ -156,7 +158,9 @@ class OpcUaPLC:
             plant = await server.nodes.objects.add_object(self.idx, "Plant")
             for n in self.names:
                 node = await plant.add_variable(
-                    ua.NodeId(f"Plant.{n}", self.idx), n, ua.Variant(float(values.get(n, 0.0)), ua.VariantType.Float)
+                    ua.NodeId(f"Plant.{n}", self.idx),
+                    n,
+                    ua.Variant(float(values.get(n, 0.0)), ua.VariantType.Float),
                 )
                 await node.set_writable()
                 self.nodes[n] = node

@@ -11,7 +11,7 @@ from fuzzyctl.io import LinkError, create_connector
 from fuzzyctl.io.modbus import ModbusPoint
 from fuzzyctl.io.opcua import OpcUaPoint, OpcUaServerPoint
 from fuzzyctl.io.s7 import S7Point
-from tests.io.plcs import ModbusPLC, OpcUaPLC, S7PLC
+from tests.io.plcs import S7PLC, ModbusPLC, OpcUaPLC
 
 
 def run(coro):  # type: ignore[no-untyped-def]
@@ -36,7 +36,9 @@ def test_modbus_client_reads_and_writes_float32_in_both_word_orders_and_scaled_i
                 ModbusPoint(table="input", address=10),
             ]
             values = await c.read(pts)
-            await c.write([ModbusPoint(address=20), ModbusPoint(address=22, type="int16", scale=0.5)], [99.5, -3.0])
+            await c.write(
+                [ModbusPoint(address=20), ModbusPoint(address=22, type="int16", scale=0.5)], [99.5, -3.0]
+            )
             await c.close()
             return values
 
@@ -77,7 +79,9 @@ def test_s7_client_reads_and_writes_reals_and_ints_in_a_data_block() -> None:
         async def go() -> list[float]:
             c = create_connector("s7", "plc", {"port": plc.port, "slot": 1})
             await c.connect()
-            values = await c.read([S7Point(db=1, offset=0), S7Point(db=1, offset=8), S7Point(db=1, offset=20, type="int")])
+            values = await c.read(
+                [S7Point(db=1, offset=0), S7Point(db=1, offset=8), S7Point(db=1, offset=20, type="int")]
+            )
             await c.write([S7Point(db=1, offset=40), S7Point(db=1, offset=44, type="int")], [6.75, 301.6])
             await c.close()
             return values
@@ -114,7 +118,9 @@ def test_opcua_server_exposes_nodes_that_a_client_writes_and_reads() -> None:
     from asyncua.client.client import Client
 
     async def go() -> tuple[list[float], float, bool]:
-        srv = create_connector("opcua-server", "ua", {"url": "opc.tcp://127.0.0.1:0/fz", "namespace": "urn:t"})
+        srv = create_connector(
+            "opcua-server", "ua", {"url": "opc.tcp://127.0.0.1:0/fz", "namespace": "urn:t"}
+        )
         await srv.connect()
         inp = OpcUaServerPoint(node="tank.Level", writable=True)
         out = OpcUaServerPoint(node="tank.Valve")

@@ -48,12 +48,25 @@ def assert_log_complete(runtime: Runtime, path: Path) -> list[Event]:
     return events
 
 
-def kinds_for(events: list[Event], instance: str | None = None, link: str | None = None) -> list[str]:
-    """Event kinds about an instance or a link, in order, without the retries."""
+SAFETY_KINDS = {
+    "link-lost",
+    "link-up",
+    "hold-start",
+    "hold-end",
+    "safe-enter",
+    "safe-exit",
+    "input-invalid",
+    "input-valid",
+}
+
+
+def safety_sequence(events: list[Event], instance: str | None = None, link: str | None = None) -> list[str]:
+    """The safety-related event kinds about an instance or a link, in order (retries and
+    overruns, which a loaded machine may add anywhere, left out)."""
     return [
         e.kind
         for e in events
-        if e.kind != "link-retry" and ((instance and e.instance == instance) or (link and e.link == link))
+        if e.kind in SAFETY_KINDS and ((instance and e.instance == instance) or (link and e.link == link))
     ]
 
 

@@ -13,7 +13,14 @@ from fuzzyctl.runtime.adapters import INFO_HOLD, INFO_SAFE, STATUS_IO_FAULT_BIT
 from fuzzyctl.runtime.kb import KnowledgeBaseSource
 from tests.conftest import EXAMPLES
 from tests.io.plcs import wait_until
-from tests.runtime.helpers import FPLTEST_FCL, assert_log_complete, close, fpltest_reference, make_runtime
+from tests.runtime.helpers import (
+    FPLTEST_FCL,
+    assert_log_complete,
+    close,
+    fpltest_reference,
+    make_runtime,
+    safety_sequence,
+)
 
 
 def master(rt) -> ModbusTcpClient:  # type: ignore[no-untyped-def]
@@ -112,7 +119,7 @@ def test_a_nan_input_is_never_propagated_hold_then_safe_then_recovery(tmp_path: 
     finally:
         rt.stop()
     events = assert_log_complete(rt, tmp_path / "events.jsonl")
-    kinds = [e.kind for e in events if e.instance == "valve"]
+    kinds = safety_sequence(events, instance="valve")
     i = kinds.index("input-invalid")
     assert kinds[i : i + 5] == ["input-invalid", "hold-start", "safe-enter", "input-valid", "safe-exit"]
 
@@ -135,7 +142,9 @@ period = 0.002
     seen: list[tuple[str, float, int]] = []
     # Inputs are unbound: INPUT1 = 0, INPUT2 = 0 -> clamped to Temp 0, Pressure 50: cold AND low -> inlet.
     inst.task.add(
-        lambda ctx: seen.append((inst.adapter.kb.source.sha256, inst.adapter.block.OUTPUT1, inst.adapter.block.INFO))
+        lambda ctx: seen.append(
+            (inst.adapter.kb.source.sha256, inst.adapter.block.OUTPUT1, inst.adapter.block.INFO)
+        )
     )
     try:
         rt.start()
@@ -177,7 +186,9 @@ params = {{ MAN_AUTO = 1, START = 1, CONT_ASK = 0, T_OFB = 0 }}
     inst = rt.instances["debit"]
     inst.adapter.block["INP4"] = -50  # Pression (INP1) 0, Temperature -50 -> OUT3 = 8
     log: list[tuple[int, bool, int]] = []
-    inst.task.add(lambda ctx: log.append((inst.adapter.block["OUT3"], inst.adapter.block.inferred, inst.downloads)))
+    inst.task.add(
+        lambda ctx: log.append((inst.adapter.block["OUT3"], inst.adapter.block.inferred, inst.downloads))
+    )
     fcl_text, _ = convert(fuzzyctl.load(tables), "fcl", lossy=True)
     try:
         rt.start()

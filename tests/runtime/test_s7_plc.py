@@ -7,7 +7,14 @@ from __future__ import annotations
 from pathlib import Path
 
 from tests.io.plcs import S7PLC, ModbusPLC, wait_until
-from tests.runtime.helpers import FPLTEST_FCL, assert_log_complete, close, fpltest_reference, make_runtime
+from tests.runtime.helpers import (
+    FPLTEST_FCL,
+    assert_log_complete,
+    close,
+    fpltest_reference,
+    make_runtime,
+    safety_sequence,
+)
 
 
 def test_s7_plc_outputs_match_the_engine(tmp_path: Path) -> None:
@@ -85,7 +92,9 @@ INFO = {{ connection = "out", address = 2, type = "uint16" }}
         cpu.set_real(4, 65.0)
         wait_until(lambda: close(out.float(0), 40.0), 10)
         cpu.stop()
-        wait_until(lambda: out.float(0) == 55.5 and out.registers(2, 1) == [0x41], 10)  # safe value, INFO 16#41
+        wait_until(
+            lambda: out.float(0) == 55.5 and out.registers(2, 1) == [0x41], 10
+        )  # safe value, INFO 16#41
         cpu.start()  # same port, the DB still holds the process values
         wait_until(lambda: close(out.float(0), 40.0) and out.registers(2, 1) == [0], 15)
     finally:
@@ -93,7 +102,7 @@ INFO = {{ connection = "out", address = 2, type = "uint16" }}
         cpu.close()
         out.close()
     events = assert_log_complete(rt, tmp_path / "events.jsonl")
-    seq = [e.kind for e in events if e.kind != "link-retry" and (e.instance == "valve" or e.link == "cpu")]
+    seq = safety_sequence(events, instance="valve", link="cpu")
     start = seq.index("link-lost")
     assert seq[start:] == ["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]
     assert fpltest_reference(9.0, 65.0) == 40.0
