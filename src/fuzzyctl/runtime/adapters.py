@@ -200,6 +200,8 @@ class SiemensAdapter(Adapter):
         setattr(self.block, key, int(value))
 
     def execute(self, period: float) -> None:
+        for key, value in self._forced.items():  # bound or not, a forced input holds its value
+            self.block.write_input(int(key[5:]), value)
         self.block.execute()
 
     def install(self, kb: PreparedKB) -> None:

@@ -12,7 +12,8 @@ the block style does not have, 422 an invalid request or knowledge base (with
 docs/runtime.md has the reference with curl examples.
 """
 
-from __future__ import annotations
+# No `from __future__ import annotations`: FastAPI resolves the Annotated aliases defined
+# inside create_app() at run time.
 
 import asyncio
 import contextlib
@@ -22,6 +23,8 @@ import time
 from typing import TYPE_CHECKING, Annotated, Any, Literal
 
 from fastapi import Depends, FastAPI, HTTPException, Path, Query, Request, WebSocket, WebSocketDisconnect
+from fastapi.encoders import jsonable_encoder
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from pydantic import BaseModel, ConfigDict, Field
@@ -200,7 +203,7 @@ class DownloadResult(BaseModel):
 # ---------------------------------------------------------------------------- app
 
 
-def create_app(runtime: Runtime) -> FastAPI:
+def create_app(runtime: "Runtime") -> FastAPI:
     """The API of a runtime (its token must be set: ``runtime.token``)."""
     app = FastAPI(
         title="fuzzyctl runtime",
@@ -232,10 +235,15 @@ def create_app(runtime: Runtime) -> FastAPI:
     Writer = Annotated[None, Depends(require_token)]
     InstanceName = Annotated[str, Path(description="instance name (the [instances.<name>] table)")]
 
-    def get_instance(name: str) -> Instance:
+    def get_instance(name: str) -> "Instance":
         if name not in runtime.instances:
             raise HTTPException(404, f"no instance {name!r}")
         return runtime.instances[name]
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid_request(_request: Request, exc: RequestValidationError) -> JSONResponse:
+        # FastAPI's own handler echoes the input, which may be NaN (not JSON): clean it.
+        return JSONResponse({"detail": clean(jsonable_encoder(exc.errors()))}, status_code=422)
 
     @app.exception_handler(InputError)
     async def _input_error(_request: Request, exc: InputError) -> JSONResponse:
