@@ -23,13 +23,14 @@ from __future__ import annotations
 import itertools
 import math
 import statistics
+from array import array
 import threading
 import time
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any
 
-from fuzzyctl.blocks.task import CycleContext, CyclicTask
+from fuzzyctl.blocks.task import CycleContext, CycleRecord, CyclicTask
 from fuzzyctl.diagnostics import FuzzyctlError, InputError
 from fuzzyctl.runtime.adapters import Adapter
 from fuzzyctl.runtime.config import InstanceConfig
@@ -37,7 +38,40 @@ from fuzzyctl.runtime.events import EventLog
 from fuzzyctl.runtime.kb import PreparedKB
 from fuzzyctl.runtime.links import InCell, Link, OutCell
 
-__all__ = ["Instance", "SafetyState"]
+__all__ = ["CycleRing", "Instance", "SafetyState"]
+
+RING_SIZE = 2000  # cycles whose timings are kept per instance (20 s at 10 ms)
+
+
+class CycleRing:
+    """Start, jitter and execution time of the last ``size`` cycles, in flat arrays of
+    doubles: unlike a record object per cycle, they give Python's cyclic garbage collector
+    nothing to scan, whose pauses would otherwise show up as jitter of every instance."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.start = array("d", bytes(8 * size))
+        self.jitter = array("d", bytes(8 * size))
+        self.duration = array("d", bytes(8 * size))
+        self.count = 0
+
+    def push(self, start: float, jitter: float, duration: float) -> None:
+        k = self.count % self.size
+        self.start[k], self.jitter[k], self.duration[k] = start, jitter, duration
+        self.count += 1
+
+    def last(self) -> tuple[float, float, float] | None:
+        if not self.count:
+            return None
+        k = (self.count - 1) % self.size
+        return self.start[k], self.jitter[k], self.duration[k]
+
+    def ordered(self) -> tuple[list[float], list[float], list[float]]:
+        """The kept cycles, oldest first: (starts, jitters, durations)."""
+        n = min(self.count, self.size)
+        k = self.count % self.size
+        idx = list(range(k, self.size)) + list(range(k)) if self.count > self.size else list(range(n))
+        return [self.start[i] for i in idx], [self.jitter[i] for i in idx], [self.duration[i] for i in idx]
 
 
 class SafetyState(StrEnum):
@@ -119,6 +153,7 @@ class Instance:
         self._started = False
         self._overruns_logged = 0
         self._overrun_logged_at = -math.inf
+        self.ring = CycleRing(RING_SIZE)
         task.add(self.cycle)
 
     # ------------------------------------------------------------------ bindings
@@ -297,9 +332,15 @@ class Instance:
         for o in self.outputs:
             o.key = self.adapter.output_key(o.name, kb)
 
-    def note_overrun(self, now: float) -> None:
-        """Called by the scheduler after an overrun; logs at most one event a second with
-        the count since the previous one (so nothing is lost and nothing floods)."""
+    def after_cycle(self, rec: CycleRecord) -> None:
+        """Called by the scheduler after each cycle: timings into the ring, overruns logged."""
+        self.ring.push(rec.start, rec.jitter, rec.duration)
+        if rec.overrun:
+            self._note_overrun(rec.end)
+
+    def _note_overrun(self, now: float) -> None:
+        """Logs at most one event a second with the count since the previous one (so
+        nothing is lost and nothing floods)."""
         if now - self._overrun_logged_at >= 1.0:
             count = self.task.stats.overruns - self._overruns_logged
             self._overruns_logged = self.task.stats.overruns
@@ -441,7 +482,7 @@ class Instance:
         with self.lock:
             adapter = self.adapter
             stats = self.task.stats
-            last = stats.records[-1] if stats.records else None
+            last = self.ring.last()
             values = adapter.values()
             inputs = {}
             for name in adapter.kb.inputs:
@@ -473,7 +514,7 @@ class Instance:
                 "overruns": stats.overruns,
                 "last_cycle": None
                 if last is None
-                else {"start": last.start, "duration": last.duration, "jitter": last.jitter},
+                else {"start": last[0], "jitter": last[1], "duration": last[2]},
                 "links": {lk.name: lk.state.value for lk in self.links},
                 "knowledge_base": {
                     "origin": adapter.kb.source.origin,
@@ -488,22 +529,19 @@ class Instance:
     def statistics(self) -> dict[str, Any]:
         """Cycle statistics: counts over the whole run, percentiles over the kept cycles."""
         with self.lock:
-            stats = self.task.stats
-            records = list(stats.records)
-            summary = stats.summary()
-        jitters = sorted(r.jitter for r in records)
-        durations = sorted(r.duration for r in records)
-        starts = [r.start for r in records]
+            summary = self.task.stats.summary()
+            starts, jitter_list, duration_list = self.ring.ordered()
+        jitters, durations = sorted(jitter_list), sorted(duration_list)
         intervals = [b - a for a, b in itertools.pairwise(starts)]
         return {
             **summary,
-            "kept": len(records),
+            "kept": len(starts),
             "jitter_p50": percentile(jitters, 50),
             "jitter_p95": percentile(jitters, 95),
             "jitter_p99": percentile(jitters, 99),
             "duration_p50": percentile(durations, 50),
             "duration_p99": percentile(durations, 99),
-            "last_duration": (durations and records[-1].duration) or 0.0,
+            "last_duration": duration_list[-1] if duration_list else 0.0,
             "interval_mean": statistics.fmean(intervals) if intervals else 0.0,
         }
 

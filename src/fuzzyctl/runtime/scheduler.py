@@ -17,7 +17,7 @@ import threading
 import time
 from collections.abc import Callable, Sequence
 
-from fuzzyctl.blocks.task import CyclicTask
+from fuzzyctl.blocks.task import CycleRecord, CyclicTask
 
 __all__ = ["RuntimeClock", "Scheduler", "auto_phases"]
 
@@ -75,14 +75,14 @@ class Scheduler:
         clock: RuntimeClock,
         stop: threading.Event,
         *,
-        on_overrun: Sequence[Callable[[float], None]] | None = None,
+        on_cycle: Sequence[Callable[[CycleRecord], None]] | None = None,
         start_delay: float = 0.02,
     ) -> None:
         self.tasks = list(tasks)
         self.phases = list(phases)
         self.clock = clock
         self._stop = stop
-        self._on_overrun = list(on_overrun) if on_overrun else [lambda _t: None] * len(self.tasks)
+        self._on_cycle = list(on_cycle) if on_cycle else [lambda _r: None] * len(self.tasks)
         self._start_delay = start_delay
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
@@ -114,9 +114,7 @@ class Scheduler:
                 if self._stop.is_set():
                     break
                 task = self.tasks[i]
-                rec = task.step()
-                if rec.overrun:
-                    self._on_overrun[i](rec.end)
+                self._on_cycle[i](task.step())
                 heapq.heapreplace(heap, (task.next_release, period, i))
         except (
             BaseException
