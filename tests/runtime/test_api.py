@@ -12,6 +12,7 @@ from pathlib import Path
 import httpx
 import pytest
 from fastapi.testclient import TestClient
+from starlette.websockets import WebSocketDisconnect
 
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.runtime.api import create_app
@@ -106,7 +107,8 @@ def test_requests_are_validated(client: TestClient) -> None:
     r = client.put("/api/v1/instances/valve/force/Nope", json={"value": 1}, headers=AUTH)
     assert r.status_code == 400 and "Temp, Pressure" in r.json()["detail"]
     body = '{"value": NaN}'
-    r = client.put("/api/v1/instances/valve/force/Temp", content=body, headers=AUTH | {"content-type": "application/json"})
+    headers = AUTH | {"content-type": "application/json"}
+    r = client.put("/api/v1/instances/valve/force/Temp", content=body, headers=headers)
     assert r.status_code == 422
     assert client.get("/api/v1/events", params={"limit": 0}).status_code == 422
 
@@ -139,16 +141,17 @@ def test_writes_reach_the_block(client: TestClient, runtime: Runtime) -> None:
 
 def test_download_through_the_api(client: TestClient, runtime: Runtime) -> None:
     text = FPLTEST_FCL.read_text(encoding="utf-8").replace("TERM inlet := 100;", "TERM inlet := 70;")
-    r = client.put("/api/v1/instances/valve/knowledge_base", json={"text": text, "format": "fcl"}, headers=AUTH)
+    url = "/api/v1/instances/valve/knowledge_base"
+    r = client.put(url, json={"text": text, "format": "fcl"}, headers=AUTH)
     assert r.status_code == 200, r.text
     assert r.json()["procedure"].startswith("START_STOP = 0")
     wait_until(lambda: client.get("/api/v1/instances/valve").json()["outputs"]["Valve"] == 70.0)
     broken = text.replace("END_FUZZIFY", "END_FUZIFY", 1)
-    r = client.put("/api/v1/instances/valve/knowledge_base", json={"text": broken}, headers=AUTH)
+    r = client.put(url, json={"text": broken}, headers=AUTH)
     assert r.status_code == 422 and r.json()["diagnostics"][0]["line"] is not None
     renamed = text.replace("Temp", "Tmp")  # valid: this instance has no bindings that would miss Temp
-    assert client.put("/api/v1/instances/valve/knowledge_base", json={"text": renamed}, headers=AUTH).status_code == 200
-    r = client.put("/api/v1/instances/valve/knowledge_base", json={"text": text, "format": "docx"}, headers=AUTH)
+    assert client.put(url, json={"text": renamed}, headers=AUTH).status_code == 200
+    r = client.put(url, json={"text": text, "format": "docx"}, headers=AUTH)
     assert r.status_code == 422
     kinds = [e["kind"] for e in client.get("/api/v1/events").json()["events"]]
     assert kinds.count("download") == 2 and kinds.count("download-refused") == 2
@@ -163,9 +166,13 @@ def test_live_websocket_streams_snapshots_and_events(client: TestClient) -> None
     assert first["instances"]["valve"]["outputs"] == {"Valve": 100.0}
     with client.websocket_connect("/api/v1/live?instances=ghost") as ws:
         assert ws.receive_json()["type"] == "error"
-    with pytest.raises(Exception):  # rate above 20 Hz is refused at the handshake
-        with client.websocket_connect("/api/v1/live?rate=50") as ws:
-            ws.receive_json()
+    # A rate above 20 Hz is refused at the handshake (policy violation).
+    with (
+        pytest.raises(WebSocketDisconnect) as refused,
+        client.websocket_connect("/api/v1/live?rate=50") as ws,
+    ):
+        ws.receive_json()
+    assert refused.value.code == 1008
 
 
 def test_api_binds_127_0_0_1_with_a_0600_token_file(tmp_path: Path) -> None:

@@ -25,7 +25,7 @@ from fuzzyctl.diagnostics import FuzzyctlError
 
 T = TypeVar("T")
 
-__all__ = ["CONNECTION_TYPES", "bounded", "Connector", "LinkError", "LinkState", "Point", "create_connector"]
+__all__ = ["CONNECTION_TYPES", "Connector", "LinkError", "LinkState", "Point", "bounded", "create_connector"]
 
 
 class LinkState(StrEnum):

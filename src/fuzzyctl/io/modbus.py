@@ -12,7 +12,6 @@ changes between minor versions (3.16 moved to ``SimData``/``SimDevice``).
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import functools
 import logging

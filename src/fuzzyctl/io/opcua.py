@@ -7,7 +7,6 @@ are written rounded to the nearest (halves away from zero) and saturated to thei
 
 from __future__ import annotations
 
-import asyncio
 import contextlib
 import logging
 import math

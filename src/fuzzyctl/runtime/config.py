@@ -61,7 +61,10 @@ class RuntimeConfig(_Strict):
     switch_interval: float = Field(
         default=0.0005, gt=0, le=0.1, description="Python thread switch interval (s)"
     )
-    spin: float = Field(default=0.0002, ge=0, le=0.005, description="busy-wait before each release (s)")
+    spin: float = Field(default=0.0, ge=0, le=0.005, description="busy-wait before each release (s)")
+    realtime_priority: int = Field(
+        default=0, ge=0, le=99, description="SCHED_FIFO priority of the cycle thread (Linux; 0: normal)"
+    )
 
 
 class ApiConfig(_Strict):

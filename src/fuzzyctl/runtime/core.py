@@ -11,6 +11,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import gc
+import os
 import socket
 import sys
 import threading
@@ -69,6 +70,8 @@ class Runtime:
             self.clock,
             self._stop,
             on_cycle=[i.after_cycle for i in self.instances.values()],
+            priority=config.runtime.realtime_priority,
+            on_start=self._scheduler_started,
         )
         self.token: str | None = None
         self.api_address: tuple[str, int] | None = None
@@ -249,6 +252,16 @@ class Runtime:
         gc.freeze()  # startup objects out of the collector's way: shorter pauses in the cycle thread
         self.scheduler.start()
 
+    def _scheduler_started(self, problem: str | None) -> None:
+        if problem is not None:
+            self.events.emit("error", f"cycle thread: {problem}; running at normal priority", level="warning")
+        elif self.config.runtime.realtime_priority:
+            self.events.emit(
+                "runtime-start",
+                f"cycle thread at SCHED_FIFO priority {self.config.runtime.realtime_priority}",
+                priority=self.config.runtime.realtime_priority,
+            )
+
     def _io_main(self) -> None:
         try:
             asyncio.run(self._io())
@@ -257,6 +270,12 @@ class Runtime:
             self._io_ready.set()
 
     async def _io(self) -> None:
+        prio = self.config.runtime.realtime_priority
+        if prio > 1 and hasattr(os, "sched_setscheduler"):
+            # The I/O thread holds the GIL the cycle thread needs: if the OS preempted it for
+            # another process while it holds the GIL, the raised cycle thread would wait anyway.
+            with contextlib.suppress(OSError):
+                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio - 1))
         self._loop = asyncio.get_running_loop()
         self._io_stop = asyncio.Event()
         link_tasks = [

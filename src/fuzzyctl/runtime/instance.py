@@ -23,9 +23,9 @@ from __future__ import annotations
 import itertools
 import math
 import statistics
-from array import array
 import threading
 import time
+from array import array
 from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import Any

@@ -13,6 +13,7 @@ wake at the same instant.
 from __future__ import annotations
 
 import heapq
+import os
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -77,6 +78,8 @@ class Scheduler:
         *,
         on_cycle: Sequence[Callable[[CycleRecord], None]] | None = None,
         start_delay: float = 0.02,
+        priority: int = 0,
+        on_start: Callable[[str | None], None] | None = None,
     ) -> None:
         self.tasks = list(tasks)
         self.phases = list(phases)
@@ -87,6 +90,8 @@ class Scheduler:
         self._thread: threading.Thread | None = None
         self.error: BaseException | None = None
         self.origin = 0.0
+        self.priority = priority
+        self._on_start = on_start
 
     def start(self) -> None:
         self._thread = threading.Thread(target=self._run, name="fuzzyctl-cycles", daemon=True)
@@ -100,7 +105,24 @@ class Scheduler:
     def alive(self) -> bool:
         return self._thread is not None and self._thread.is_alive()
 
+    def _raise_priority(self) -> str | None:
+        """SCHED_FIFO for this thread when asked; returns why not, when it could not."""
+        if not self.priority:
+            return None
+        setter = getattr(os, "sched_setscheduler", None)
+        if setter is None:
+            return "real-time scheduling is not available on this system"
+        try:
+            # pid 0 is the calling thread on Linux: only the cycle thread is raised.
+            setter(0, os.SCHED_FIFO, os.sched_param(self.priority))
+        except OSError as exc:
+            return f"cannot use SCHED_FIFO priority {self.priority}: {exc.strerror or exc}"
+        return None
+
     def _run(self) -> None:
+        problem = self._raise_priority()
+        if self._on_start is not None:
+            self._on_start(problem)
         try:
             self.origin = self.clock.now() + self._start_delay
             heap = [
