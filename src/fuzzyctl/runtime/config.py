@@ -139,8 +139,8 @@ class _InstanceTable(_Strict):
 
 
 class _File(_Strict):
-    runtime: RuntimeConfig = Field(default_factory=RuntimeConfig)
-    api: ApiConfig = Field(default_factory=ApiConfig)
+    runtime: dict[str, Any] = Field(default_factory=dict)
+    api: dict[str, Any] = Field(default_factory=dict)
     connections: dict[str, dict[str, Any]] = Field(default_factory=dict)
     instances: dict[str, dict[str, Any]] = Field(default_factory=dict)
 
@@ -187,7 +187,7 @@ def _binding(
     where: str,
     output: bool,
     path: Path,
-    conns: dict[str, ConnectionConfig],
+    conns: dict[str, str],
     problems: list[str],
 ) -> BindingConfig | None:
     """Check one binding table; its address by the protocol of its connection."""
@@ -207,7 +207,7 @@ def _binding(
         problems.append(f"{_where(path, where, 'safe')}: a safe value is a finite number")
         return None
     try:
-        point = connector_class(conns[conn_name].type).point_model.model_validate(spec)
+        point = connector_class(conns[conn_name]).point_model.model_validate(spec)
     except ValidationError as exc:
         problems.extend(_pydantic_problems(path, where, exc))
         return None
@@ -233,13 +233,32 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
     except tomllib.TOMLDecodeError as exc:
         raise ConfigError([f"{path}: not valid TOML: {exc}"]) from exc
     problems: list[str] = []
+    for key in raw:
+        if key not in _File.model_fields:
+            problems.append(f"{_where(path, '(top level)', key)}: unknown table")
+    runtime_cfg, api_cfg = RuntimeConfig(), ApiConfig()
     try:
-        top = _File.model_validate(raw)
+        runtime_cfg = RuntimeConfig.model_validate(raw.get("runtime", {}))
     except ValidationError as exc:
-        raise ConfigError(_pydantic_problems(path, "", exc)) from exc
+        problems.extend(_pydantic_problems(path, "runtime", exc))
+    try:
+        api_cfg = ApiConfig.model_validate(raw.get("api", {}))
+    except ValidationError as exc:
+        problems.extend(_pydantic_problems(path, "api", exc))
+    try:
+        top = _File.model_validate(
+            {"connections": raw.get("connections", {}), "instances": raw.get("instances", {})}
+        )
+    except ValidationError as exc:
+        raise ConfigError(problems + _pydantic_problems(path, "", exc)) from exc
     base = path.resolve().parent
 
     connections: dict[str, ConnectionConfig] = {}
+    # name -> type of every connection with a known type, valid or not: bindings are
+    # checked against it, so that one bad connection does not make every binding an error
+    declared: dict[str, str] = {
+        n: t["type"] for n, t in top.connections.items() if t.get("type") in CONNECTION_TYPES
+    }
     for name, table in top.connections.items():
         tname = f"connections.{name}"
         own = {k: v for k, v in table.items() if k in ConnectionConfig.model_fields and k != "options"}
@@ -276,7 +295,7 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
         n_before = len(problems)
 
         def binding(spec: Mapping[str, Any], where: str, output: bool) -> BindingConfig | None:
-            return _binding(spec, where, output, path, connections, problems)
+            return _binding(spec, where, output, path, declared, problems)
 
         inputs: dict[str, BindingConfig] = {}
         for key, spec in t.inputs.items():
@@ -332,9 +351,9 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
         problems.append(f"{path}: no [instances.<name>] table: nothing to run")
     if problems:
         raise ConfigError(problems)
-    if top.runtime.state_dir is None:
+    if runtime_cfg.state_dir is None:
         state_dir = Path.home() / ".local" / "state" / "fuzzyctl"
     else:
-        sd = Path(top.runtime.state_dir).expanduser()
+        sd = Path(runtime_cfg.state_dir).expanduser()
         state_dir = sd if sd.is_absolute() else base / sd
-    return Config(path, top.runtime, top.api, connections, instances, state_dir)
+    return Config(path, runtime_cfg, api_cfg, connections, instances, state_dir)
