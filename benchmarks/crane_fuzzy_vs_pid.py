@@ -82,13 +82,14 @@ def table() -> list[tuple[str, tuple[float, float, float, float], sim.Quality]]:
 
 
 def print_table(rows: list[tuple[str, tuple[float, float, float, float], sim.Quality]]) -> None:
-    print("| controller | target m | load t | rope m | sway0 deg | settling s | ISE m^2 s | IAE m s | overshoot m |")
+    head = ("controller", "target m", "load t", "rope m", "sway0 deg", "settling s", "ISE m^2 s", "IAE m s")
+    print("| " + " | ".join((*head, "overshoot m")) + " |")
     print("|---|---|---|---|---|---|---|---|---|")
     for name, (target, load, rope, sway), q in rows:
         st = "never" if math.isinf(q.settling_time) else f"{q.settling_time:.1f}"
         print(
-            f"| {name} | {target:g} | {load / 1000:g} | {rope:g} | {sway:g} | {st} | {q.ise:.0f} | {q.iae:.1f} "
-            f"| {q.overshoot:.3f} |"
+            f"| {name} | {target:g} | {load / 1000:g} | {rope:g} | {sway:g} | {st} | {q.ise:.0f} "
+            f"| {q.iae:.1f} | {q.overshoot:.3f} |"
         )
 
 

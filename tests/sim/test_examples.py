@@ -29,7 +29,12 @@ def _cases(seed: int, n: int, ranges: dict[str, tuple[float, float]], corners: l
 
 # ---------------------------------------------------------------- crane (Annex C)
 
-CRANE_RANGES = {"target": (5.0, 40.0), "load_mass": (5000.0, 40000.0), "rope_length": (6.0, 20.0), "angle0": (-5.0, 5.0)}
+CRANE_RANGES = {
+    "target": (5.0, 40.0),
+    "load_mass": (5000.0, 40000.0),
+    "rope_length": (6.0, 20.0),
+    "angle0": (-5.0, 5.0),
+}
 CRANE_CASES = _cases(
     9,
     4,

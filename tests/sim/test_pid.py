@@ -70,8 +70,12 @@ def test_antiwindup_recovers_faster_after_saturation():
     def overshoot(antiwindup: str) -> float:
         plant = make_plant("fopdt", {"gain": 1.0, "time_constant": 5.0, "dead_time": 0.5})
         pid = PID(2.0, 4.0, low=0.0, high=1.5, antiwindup=antiwindup)
-        loop = Loop(plant, PIDLoop(pid, setpoint="w", measurement="y", drive="u"), period=0.05,
-                    setpoints={"w": profiles.constant(1.0)})
+        loop = Loop(
+            plant,
+            PIDLoop(pid, setpoint="w", measurement="y", drive="u"),
+            period=0.05,
+            setpoints={"w": profiles.constant(1.0)},
+        )
         return float(loop.run(60)["y"].max() - 1.0)
 
     assert overshoot("backcalc") < 0.5 * overshoot("none")
@@ -100,8 +104,12 @@ def test_closed_loop_pi_with_pole_cancellation_is_first_order():
     # G = K / (tau s + 1), PI with Ti = tau: closed loop 1 / (tau / (K Kp) s + 1).
     K, tau, kp, h = 2.0, 5.0, 1.5, 0.001
     plant = make_plant("fopdt", {"gain": K, "time_constant": tau, "dead_time": 0.0})
-    loop = Loop(plant, PIDLoop(PID(kp, tau), setpoint="w", measurement="y", drive="u"), period=h,
-                setpoints={"w": profiles.constant(1.0)})
+    loop = Loop(
+        plant,
+        PIDLoop(PID(kp, tau), setpoint="w", measurement="y", drive="u"),
+        period=h,
+        setpoints={"w": profiles.constant(1.0)},
+    )
     trace = loop.run(10.0)
     tc = tau / (K * kp)
     for t, y in zip(trace["t"][::500], trace["y"][::500], strict=True):
@@ -111,8 +119,13 @@ def test_closed_loop_pi_with_pole_cancellation_is_first_order():
 def test_closed_loop_p_only_has_the_textbook_offset():
     K, kp = 2.0, 3.0
     plant = make_plant("fopdt", {"gain": K, "time_constant": 2.0, "dead_time": 0.0})
-    loop = Loop(plant, PIDLoop(PID(kp), setpoint="w", measurement="y", drive="u"), period=0.01,
-                setpoints={"w": profiles.constant(1.0)}, integrator=FixedStep(0.01))
+    loop = Loop(
+        plant,
+        PIDLoop(PID(kp), setpoint="w", measurement="y", drive="u"),
+        period=0.01,
+        setpoints={"w": profiles.constant(1.0)},
+        integrator=FixedStep(0.01),
+    )
     trace = loop.run(30.0)
     assert trace["y"][-1] == pytest.approx(K * kp / (1 + K * kp), rel=1e-6)
 

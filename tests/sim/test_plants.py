@@ -31,8 +31,15 @@ def test_crane_free_sway_frequency_is_the_coupled_pendulums():
     M, m, rope = 8000.0, 25000.0, 12.0
     plant = make_plant(
         "crane",
-        {"trolley_mass": M, "load_mass": m, "rope_length": rope, "stall_force": 0.001, "top_speed": 1e3,
-         "sway_damping": 0.0, "angle0": 0.5},
+        {
+            "trolley_mass": M,
+            "load_mass": m,
+            "rope_length": rope,
+            "stall_force": 0.001,
+            "top_speed": 1e3,
+            "sway_damping": 0.0,
+            "angle0": 0.5,
+        },
     )
     states = _simulate(plant, {"power": 0.0, "wind": 0.0}, 30.0)
     theta = states[:, 2]
@@ -47,13 +54,26 @@ def test_crane_conserves_momentum_and_energy_without_drive():
     M, m, rope = 5000.0, 20000.0, 10.0
     plant = make_plant(
         "crane",
-        {"trolley_mass": M, "load_mass": m, "rope_length": rope, "stall_force": 0.001, "top_speed": 1e9,
-         "sway_damping": 0.0, "angle0": 30.0, "speed0": 1.0},
+        {
+            "trolley_mass": M,
+            "load_mass": m,
+            "rope_length": rope,
+            "stall_force": 0.001,
+            "top_speed": 1e9,
+            "sway_damping": 0.0,
+            "angle0": 30.0,
+            "speed0": 1.0,
+        },
     )
     s = _simulate(plant, {"power": 0.0, "wind": 0.0}, 10.0, dt=0.005)
     v, th, w = s[:, 1], s[:, 2], s[:, 3]
     momentum = (M + m) * v + m * rope * np.cos(th) * w
-    energy = 0.5 * (M + m) * v**2 + m * rope * np.cos(th) * v * w + 0.5 * m * rope**2 * w**2 - m * G * rope * np.cos(th)
+    energy = (
+        0.5 * (M + m) * v**2
+        + m * rope * np.cos(th) * v * w
+        + 0.5 * m * rope**2 * w**2
+        - m * G * rope * np.cos(th)
+    )
     assert np.ptp(momentum) < 1e-6 * abs(momentum[0])
     assert np.ptp(energy) < 1e-6 * abs(energy[0])
 
@@ -81,14 +101,24 @@ def test_pendulum_conserves_energy_and_momentum_without_friction():
     M, m, half = 1.0, 0.1, 0.5
     plant = make_plant(
         "pendulum",
-        {"cart_mass": M, "rod_mass": m, "half_length": half, "cart_friction": 0.0, "hinge_friction": 0.0,
-         "angle0": 170.0 - 180.0 + 5.0},
+        {
+            "cart_mass": M,
+            "rod_mass": m,
+            "half_length": half,
+            "cart_friction": 0.0,
+            "hinge_friction": 0.0,
+            "angle0": 170.0 - 180.0 + 5.0,
+        },
     )
     s = _simulate(plant, {"force": 0.0, "push": 0.0}, 3.0, dt=0.001)
     v, th, w = s[:, 1], s[:, 2], s[:, 3]
     momentum = (M + m) * v + m * half * np.cos(th) * w
-    energy = (0.5 * (M + m) * v**2 + m * half * np.cos(th) * v * w + 0.5 * (4 / 3) * m * half**2 * w**2
-              + m * G * half * np.cos(th))
+    energy = (
+        0.5 * (M + m) * v**2
+        + m * half * np.cos(th) * v * w
+        + 0.5 * (4 / 3) * m * half**2 * w**2
+        + m * G * half * np.cos(th)
+    )
     assert np.max(np.abs(th)) > 1.0  # it did fall
     assert np.ptp(momentum) < 1e-9
     assert np.ptp(energy) < 1e-7 * abs(energy[0])
@@ -99,8 +129,14 @@ def test_pendulum_falls_at_the_linearised_rate():
     M, m, half = 1.0, 0.1, 0.5
     plant = make_plant(
         "pendulum",
-        {"cart_mass": M, "rod_mass": m, "half_length": half, "cart_friction": 0.0, "hinge_friction": 0.0,
-         "angle0": 0.001},
+        {
+            "cart_mass": M,
+            "rod_mass": m,
+            "half_length": half,
+            "cart_friction": 0.0,
+            "hinge_friction": 0.0,
+            "angle0": 0.001,
+        },
     )
     s = _simulate(plant, {"force": 0.0, "push": 0.0}, 1.0, dt=0.001)
     lam = math.sqrt(G * (M + m) / (half * (4 / 3 * (M + m) - m)))
@@ -116,8 +152,12 @@ def test_pendulum_force_pushes_the_cart_and_tips_the_rod_back():
 def test_tank_energy_balance_with_heating_and_no_losses():
     plant = make_plant("tank", {"loss_transfer": 0.0, "temperature0": 20.0, "jacket_temperature0": 20.0})
     dt, duration = 1.0, 600.0
-    s = _simulate(plant, {"heating": 60.0, "valve": 0.0, "feed_temperature": 15.0, "ambient_temperature": 20.0},
-                  duration, dt)
+    s = _simulate(
+        plant,
+        {"heating": 60.0, "valve": 0.0, "feed_temperature": 15.0, "ambient_temperature": 20.0},
+        duration,
+        dt,
+    )
     vol, temp, jacket = s[-1]
     stored = RHO_C * vol * (temp - 20.0) + plant.jacket_capacity * (jacket - 20.0)
     assert vol == pytest.approx(0.5)  # valve closed
@@ -128,8 +168,13 @@ def test_tank_feed_mixes_at_the_feed_temperature():
     # No heat exchange: (V T)' = q T_feed with the flow constant (huge pump head).
     plant = make_plant(
         "tank",
-        {"loss_transfer": 0.0, "jacket_transfer": 1e-6, "pump_head": 1e9, "temperature0": 40.0,
-         "jacket_temperature0": 40.0},
+        {
+            "loss_transfer": 0.0,
+            "jacket_transfer": 1e-6,
+            "pump_head": 1e9,
+            "temperature0": 40.0,
+            "jacket_temperature0": 40.0,
+        },
     )
     u = {"heating": 0.0, "valve": 50.0, "feed_temperature": 10.0, "ambient_temperature": 20.0}
     s = _simulate(plant, u, 100.0, 0.5)
@@ -181,9 +226,9 @@ def test_fopdt_starts_at_rest_with_u0_and_adds_the_load():
 
 
 def test_parameters_are_checked_and_listed():
-    with pytest.raises(InputError, match="no parameter 'mass'.*load_mass"):
+    with pytest.raises(InputError, match=r"no parameter .mass.*load_mass"):
         make_plant("crane", {"mass": 3})
-    with pytest.raises(InputError, match="rope_length.*outside"):
+    with pytest.raises(InputError, match=r"rope_length.*outside"):
         make_plant("crane", {"rope_length": -1})
     with pytest.raises(InputError, match="unknown plant model 'boat'"):
         make_plant("boat")

@@ -7,8 +7,7 @@ import math
 import pytest
 
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.sim import Expression
-from fuzzyctl.sim import profiles
+from fuzzyctl.sim import Expression, profiles
 
 
 def test_arithmetic_and_functions():
