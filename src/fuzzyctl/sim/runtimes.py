@@ -57,6 +57,14 @@ def make_runtime(
     """The runtime ``kind`` (one of :data:`RUNTIMES`) for a model."""
     if kind == "engine":
         return EngineRuntime(model, block=block)
-    if kind in ("siemens", "xfuz", "native"):
-        raise InputError(f"controller runtime {kind!r} is not available in this build (available: engine)")
+    if kind == "siemens":
+        from fuzzyctl.sim.plc_runtimes import SiemensRuntime
+
+        return SiemensRuntime(model, block=block)
+    if kind == "xfuz":
+        from fuzzyctl.sim.plc_runtimes import XfuzRuntime
+
+        return XfuzRuntime(model, block=block, cycle=cycle or 0.01)
+    if kind == "native":
+        raise InputError("controller runtime 'native' is not available in this build (engine, siemens, xfuz)")
     raise InputError(f"unknown controller runtime {kind!r}; runtimes: {', '.join(RUNTIMES)}")
