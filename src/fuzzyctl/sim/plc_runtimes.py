@@ -20,7 +20,7 @@ from collections.abc import Mapping
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.model import Document, FunctionBlock, Point, PointsMF, Range, SingletonMF, Term
+from fuzzyctl.model import Document, FunctionBlock, PointsMF, Range, SingletonMF, Term
 
 WORD_MAX = 32767
 
@@ -153,7 +153,8 @@ class XfuzRuntime:
         self.inputs = tuple(v.name for v in fb.inputs)
         self.outputs = tuple(v.name for v in fb.outputs)
         factors: dict[str, float] = {}
-        for b in (*fb.fuzzify, *fb.defuzzify):
+        blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+        for b in blocks:
             given = (input_scale or {}).get(b.variable, (output_scale or {}).get(b.variable))
             factors[b.variable] = (
                 float(given) if given else _auto_factor([x for t in b.terms for x in _xs(t.mf)])
