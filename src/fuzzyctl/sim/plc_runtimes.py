@@ -20,7 +20,16 @@ from collections.abc import Mapping
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.model import Document, FunctionBlock, PointsMF, Range, SingletonMF, Term
+from fuzzyctl.model import (
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FuzzifyBlock,
+    PointsMF,
+    Range,
+    SingletonMF,
+    Term,
+)
 
 WORD_MAX = 32767
 
