@@ -225,7 +225,11 @@ def load_config(path: str | Path) -> SimConfig:
     )
     # Build it and run one cycle so that every mistake (an unknown signal in an expression,
     # a fuzzy input without a value) surfaces when the file is read, not mid-run.
-    build_loop(config).step()
+    try:
+        build_loop(config).step()
+    except InputError as exc:
+        msg = str(exc)
+        raise InputError(msg if msg.startswith(str(path)) else f"{path}: {msg}") from None
     return config
 
 
