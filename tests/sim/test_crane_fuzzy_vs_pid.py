@@ -22,12 +22,14 @@ SCENARIOS = [  # target m, load kg, rope m, initial sway deg
 
 def test_fuzzy_and_pid_both_put_the_load_down_and_the_table_is_printed():
     configs = {"fuzzy": load_config(EXAMPLES / "crane.toml"), "PID": load_config(EXAMPLES / "crane_pid.toml")}
-    lines = ["| controller | target | load t | rope | sway0 | settling s | ISE | overshoot m |", "|---" * 8 + "|"]
+    head = "| controller | target | load t | rope | sway0 | settling s | ISE | overshoot m |"
+    lines = [head, "|---" * 8 + "|"]
     for target, load, rope, sway in SCENARIOS:
         for name, cfg in configs.items():
             plant = {**cfg.plant_parameters, "load_mass": load, "rope_length": rope, "angle0": sway}
             run = dataclasses.replace(cfg, plant_parameters=plant, setpoints={"target": target})
-            q = quality(build_loop(run).run(100.0), "load_position", "target", band=0.1, limits={"angle": 2.0})
+            trace = build_loop(run).run(100.0)
+            q = quality(trace, "load_position", "target", band=0.1, limits={"angle": 2.0})
             lines.append(
                 f"| {name} | {target:g} | {load / 1000:g} | {rope:g} | {sway:g} | {q.settling_time:.1f} "
                 f"| {q.ise:.0f} | {q.overshoot:.3f} |"
