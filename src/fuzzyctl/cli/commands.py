@@ -5,4 +5,5 @@ from fuzzyctl.cli import (
     convert,  # noqa: F401
     lang,  # noqa: F401  (check, fmt)
     run,  # noqa: F401  (eval, explain)
+    simulate,  # noqa: F401  (simulate)
 )
