@@ -254,10 +254,12 @@ class Runtime:
 
     def _scheduler_started(self, problem: str | None) -> None:
         if problem is not None:
-            self.events.emit("error", f"cycle thread: {problem}; running at normal priority", level="warning")
+            self.events.emit(
+                "realtime", f"cycle thread: {problem}; running at normal priority", level="warning"
+            )
         elif self.config.runtime.realtime_priority:
             self.events.emit(
-                "runtime-start",
+                "realtime",
                 f"cycle thread at SCHED_FIFO priority {self.config.runtime.realtime_priority}",
                 priority=self.config.runtime.realtime_priority,
             )

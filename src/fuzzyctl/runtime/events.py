@@ -9,7 +9,8 @@ JSON-lines file by a writer thread, so the real-time cycle never waits for the d
 Kinds (docs/runtime.md lists their data): ``runtime-start``, ``runtime-stop``,
 ``link-up``, ``link-lost``, ``link-retry``, ``hold-start``, ``hold-end``, ``safe-enter``,
 ``safe-exit``, ``input-invalid``, ``input-valid``, ``download``, ``download-applied``,
-``download-refused``, ``parameter``, ``force``, ``error``, ``overrun``.
+``download-refused``, ``parameter``, ``force``, ``error``, ``error-cleared``, ``overrun``,
+``realtime``.
 """
 
 from __future__ import annotations
