@@ -4,6 +4,7 @@ reach the block, online download, the live stream, and the 127.0.0.1 binding wit
 
 from __future__ import annotations
 
+import json
 import os
 import stat
 from collections.abc import Iterator
@@ -197,6 +198,13 @@ def test_api_binds_127_0_0_1_with_a_0600_token_file(tmp_path: Path) -> None:
             timeout=5,
         )
         assert r.json() == {"START_STOP": 0}
+        # A real WebSocket client on the real server: live snapshots at 20 Hz.
+        from websockets.sync.client import connect
+
+        with connect(f"ws://127.0.0.1:{port}/api/v1/live?rate=20&instances=valve") as ws:
+            first, second = json.loads(ws.recv(timeout=5)), json.loads(ws.recv(timeout=5))
+        assert first["instances"]["valve"]["parameters"]["START_STOP"] == 0
+        assert second["time"] > first["time"]
     finally:
         rt.stop()
     rt2 = make_runtime(tmp_path, config, api=True)  # the second start reuses the token

@@ -204,4 +204,57 @@ params = {{ MAN_AUTO = 1, START = 1, CONT_ASK = 0, T_OFB = 0 }}
     switch = next(i for i, (_, inferred, _) in enumerate(after) if not inferred)
     assert after[switch][0] == 0
     assert all(o == 8 for o, inferred, _ in after[switch + 1 :] if inferred)
-    assert STATUS_IO_FAULT_BIT == 15
+
+
+def test_xfuz_lost_link_raises_status_bit_15_and_error_and_puts_safe_words_out(tmp_path: Path) -> None:
+    from tests.io.plcs import ModbusPLC
+
+    plc, out = ModbusPLC(), ModbusPLC()
+    rt = make_runtime(
+        tmp_path,
+        f"""
+[connections.plc]
+type = "modbus"
+port = {plc.port}
+timeout = 0.3
+poll_interval = 0.005
+reconnect_min = 0.05
+reconnect_max = 0.1
+
+[connections.out]
+type = "modbus"
+port = {out.port}
+poll_interval = 0.005
+
+[instances.debit]
+style = "xfuz"
+knowledge_base = "{EXAMPLES / "xfuz_3_3.xfuz"}"
+span_rule = false
+period = 0.01
+hold_time = 0.1
+params = {{ MAN_AUTO = 1, START = 1, CONT_ASK = 0, T_OFB = 0 }}
+
+[instances.debit.inputs]
+INP1 = {{ connection = "plc", address = 0, type = "int16" }}
+INP4 = {{ connection = "plc", address = 1, type = "int16" }}
+
+[instances.debit.outputs]
+OUT3 = {{ connection = "out", address = 0, type = "int16", safe = -7 }}
+STATUS = {{ connection = "out", address = 1, type = "int16" }}
+ERROR = {{ connection = "out", address = 2, type = "uint16" }}
+""",
+    )
+    try:
+        rt.start()
+        plc.set_registers(0, [0, int16_to_register(-50)])
+        wait_until(lambda: out.registers(0, 3) == [8, 0, 0], 10)
+        plc.stop()
+        fault = int16_to_register(-(1 << STATUS_IO_FAULT_BIT))  # bit 15 of a signed word
+        wait_until(lambda: out.registers(0, 3) == [int16_to_register(-7), fault, 1], 10)
+        snap = rt.instances["debit"].snapshot()
+        assert snap["state"] == "safe" and snap["status"] == {"STATUS": -32768, "ERROR": 1}
+        assert snap["outputs"] == {"OUT3": 8.0}  # the block still holds its own value
+    finally:
+        rt.stop()
+        plc.close()
+        out.close()
