@@ -102,6 +102,12 @@ def test_requests_are_validated(client: TestClient) -> None:
     assert r.status_code == 400 and "START_STOP" in r.json()["detail"]
     r = client.patch(url, json={"values": {"MAN_AUTO": 1}}, headers=AUTH)
     assert r.status_code == 400 and "not a parameter" in r.json()["detail"]
+    # All or nothing: T_OFB out of range, so MAN_AUTO is not written either.
+    r = client.patch(
+        "/api/v1/instances/debit/parameters", json={"values": {"MAN_AUTO": 0, "T_OFB": 99999}}, headers=AUTH
+    )
+    assert r.status_code == 400 and "T_OFB" in r.json()["detail"]
+    assert client.get("/api/v1/instances/debit").json()["parameters"]["MAN_AUTO"] == 1
     assert client.put("/api/v1/instances/valve/mode", json={"mode": "auto"}, headers=AUTH).status_code == 409
     r = client.put("/api/v1/instances/debit/mode", json={"mode": "semi"}, headers=AUTH)
     assert r.status_code == 422

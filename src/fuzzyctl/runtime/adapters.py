@@ -57,6 +57,7 @@ class Adapter:
     ``"hold"`` or ``"safe"``."""
 
     style: ClassVar[str]
+    PARAMS: ClassVar[dict[str, tuple[int, int]]] = {}
     fault: str | None = None
     block: Any
 
@@ -87,6 +88,16 @@ class Adapter:
         raise NotImplementedError
 
     def set_param(self, key: str, value: float) -> None:
+        self.check_param(key, value)
+        self._set_param(key, int(value))
+
+    def check_param(self, key: str, value: float) -> None:
+        """Raise InputError when ``value`` is not valid for parameter ``key``."""
+        low, high = self.PARAMS[key]
+        if not (math.isfinite(value) and float(value).is_integer() and low <= value <= high):
+            raise InputError(f"{key} = {value!r}: must be an integer {low}..{high}")
+
+    def _set_param(self, key: str, value: int) -> None:
         raise NotImplementedError
 
     def execute(self, period: float) -> None:
@@ -193,11 +204,8 @@ class SiemensAdapter(Adapter):
     def get_param(self, key: str) -> int:
         return int(getattr(self.block, key))
 
-    def set_param(self, key: str, value: float) -> None:
-        low, high = self.PARAMS[key]
-        if not (float(value).is_integer() and low <= value <= high):
-            raise InputError(f"{key} = {value!r}: a WORD is an integer {low}..{high}")
-        setattr(self.block, key, int(value))
+    def _set_param(self, key: str, value: int) -> None:
+        setattr(self.block, key, value)
 
     def execute(self, period: float) -> None:
         for key, value in self._forced.items():  # bound or not, a forced input holds its value
@@ -263,7 +271,7 @@ class XfuzAdapter(Adapter):
     a download raises it for one cycle (manual 2.6-4)."""
 
     style = "xfuz"
-    PARAMS = _XFUZ_PARAMS
+    PARAMS: ClassVar[dict[str, tuple[int, int]]] = _XFUZ_PARAMS
 
     def __init__(self, kb: PreparedKB, period: float, span_rule: bool) -> None:
         from fuzzyctl.blocks.schneider import XfuzFB
@@ -319,11 +327,8 @@ class XfuzAdapter(Adapter):
     def get_param(self, key: str) -> int:
         return int(self.block[key])
 
-    def set_param(self, key: str, value: float) -> None:
-        low, high = self.PARAMS[key]
-        if not (float(value).is_integer() and low <= value <= high):
-            raise InputError(f"{key} = {value!r}: must be an integer {low}..{high}")
-        self.block[key] = int(value)
+    def _set_param(self, key: str, value: int) -> None:
+        self.block[key] = value
 
     def execute(self, period: float) -> None:
         self.block.execute(period)

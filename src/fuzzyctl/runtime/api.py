@@ -341,9 +341,7 @@ def create_app(runtime: "Runtime") -> FastAPI:
     def set_parameters(name: InstanceName, body: ParametersBody, _: Writer) -> dict[str, int]:
         """Write block parameters by manual name (validated by the block style; all or
         nothing is checked first)."""
-        inst = get_instance(name)
-        keys = {k: inst.adapter.param_key(k) for k in body.values}
-        return {keys[k]: inst.set_parameter(k, v) for k, v in body.values.items()}
+        return get_instance(name).set_parameters(body.values)
 
     @app.put(f"{API_PREFIX}/instances/{{name}}/mode", tags=["write"])
     def set_mode(name: InstanceName, body: ModeBody, _: Writer) -> dict[str, int]:

@@ -15,6 +15,7 @@ Kinds (docs/runtime.md lists their data): ``runtime-start``, ``runtime-stop``,
 
 from __future__ import annotations
 
+import itertools
 import json
 import queue
 import threading
@@ -117,7 +118,18 @@ class EventLog:
     def since(self, after: int = 0, limit: int | None = None, kinds: set[str] | None = None) -> list[Event]:
         """Events with ``seq > after`` (oldest first), at most ``limit``."""
         with self._lock:
-            events = [e for e in self._events if e.seq > after and (kinds is None or e.kind in kinds)]
+            # The emitting cycle thread waits for this lock: copy only the new events (they
+            # are at the right end, sequence numbers have no gaps), not the whole log.
+            n_new = self._seq - after
+            if n_new <= 0:
+                return []
+            if n_new < len(self._events):
+                events = list(itertools.islice(reversed(self._events), n_new))
+                events.reverse()
+            else:
+                events = list(self._events)
+        if kinds is not None:
+            events = [e for e in events if e.kind in kinds]
         return events if limit is None else events[:limit]
 
     @property

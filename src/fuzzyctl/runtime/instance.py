@@ -154,6 +154,7 @@ class Instance:
         self._overruns_logged = 0
         self._overrun_logged_at = -math.inf
         self.ring = CycleRing(RING_SIZE)
+        self._links: list[Link] | None = None
         task.add(self.cycle)
 
     # ------------------------------------------------------------------ bindings
@@ -163,6 +164,7 @@ class Instance:
         if any(b.key == key for b in self.inputs):
             raise InputError(f"{name} ({key}) is bound twice")
         self.inputs.append(InputBinding(name, key, link, cell))
+        self._links = None
 
     def bind_output(self, name: str, targets: list[tuple[Link, OutCell]], safe: float | None) -> None:
         key = self.adapter.output_key(name)
@@ -173,9 +175,16 @@ class Instance:
     def bind_param(self, name: str, link: Link, cell: InCell, mirror: OutCell) -> None:
         key = self.adapter.param_key(name)
         self.params.append(ParamBinding(name, key, link, cell, mirror))
+        self._links = None
 
     @property
     def links(self) -> list[Link]:
+        """Every link the instance's bindings use (computed once, after binding)."""
+        if self._links is None:
+            self._links = self._collect_links()
+        return self._links
+
+    def _collect_links(self) -> list[Link]:
         seen: dict[str, Link] = {}
         for b in self.inputs:
             seen[b.link.name] = b.link
@@ -368,6 +377,17 @@ class Instance:
             new=self.adapter.get_param(key),
             source=source,
         )
+
+    def set_parameters(self, values: dict[str, float], source: str = "api") -> dict[str, int]:
+        """Write several parameters between two cycles; all are checked before any is
+        written (all or nothing).  Returns the new values by manual name."""
+        with self.lock:
+            keys = {name: self.adapter.param_key(name) for name in values}
+            for name, value in values.items():
+                self.adapter.check_param(keys[name], value)
+            for name, value in values.items():
+                self._set_param(keys[name], value, source)
+            return {k: self.adapter.get_param(k) for k in keys.values()}
 
     def set_parameter(self, name: str, value: float, source: str = "api") -> int:
         """Write a parameter by its manual name; returns the new value."""
