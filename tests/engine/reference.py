@@ -89,10 +89,15 @@ def _cond(c: m.Condition, fb: m.FunctionBlock, inputs: dict[str, float], and_op:
 
 
 def evaluate(
-    fb: m.FunctionBlock, inputs: dict[str, float], cells: int = 1_000_000, max_tol: float = 1e-15
+    fb: m.FunctionBlock,
+    inputs: dict[str, float],
+    cells: int = 1_000_000,
+    max_tol: float = 1e-15,
+    runs: dict[str, list[tuple[float, float]]] | None = None,
 ) -> dict[str, float]:
     """Outputs of ``fb`` (NaN where no rule fired).  ``max_tol``: relative tolerance deciding
-    that a sample reaches the maximum (LM, RM, MoM)."""
+    that a sample reaches the maximum (LM, RM, MoM); ``runs`` (when given) receives, per
+    output, the connected stretches of samples that reach it."""
     result: dict[str, float] = {}
     for out in fb.outputs:
         db = fb.defuzzify_block(out.name)
@@ -182,6 +187,10 @@ def evaluate(
             top = max(acc.max(), acc_sp.max() if len(sp) else 0.0)
             hit = acc >= top * (1 - max_tol)
             hit_sp = sp[acc_sp >= top * (1 - max_tol)] if len(sp) else sp
+            if runs is not None:
+                edges = np.flatnonzero(np.diff(np.concatenate([[0], hit.astype(np.int8), [0]])))
+                starts, ends = edges[::2], edges[1::2]
+                runs[out.name] = [(float(u[a]), float(u[b - 1])) for a, b in zip(starts, ends, strict=True)]
             if method == "LM":
                 result[out.name] = float(min([*u[hit][:1], *hit_sp]))
             elif method == "RM":

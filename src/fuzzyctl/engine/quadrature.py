@@ -202,7 +202,11 @@ def _golden(f: Integrand, lo: float, hi: float, x0: float, y0: float) -> tuple[f
             break
         c, d = hi - g * (hi - lo), lo + g * (hi - lo)
         fc, fd = f(np.array([c, d]))
-        if fc >= fd:
+        # A tie means both points sit on the flat top (in floating point): the peak lies
+        # between them, so keep the middle; favouring one side would bias LM/RM by ~sqrt(eps).
+        if fc == fd:
+            lo, hi = c, d
+        elif fc > fd:
             hi = d
         else:
             lo = c
