@@ -1,9 +1,12 @@
 """The engine against jFuzzyLogic 3.3's own outputs (../shared/conformance/jfuzzylogic).
 
 Membership tables must agree exactly (1e-12); defuzzified grids within the error of
-jFuzzyLogic's 1000-point Riemann sum (README: about range/1000; measured up to 1.25e-3 of
-the range where outputs have vertical edges), compiled with ``compat="jfuzzylogic"`` (WITH
-weights the condition degree and every conclusion of its rule).  The grids of IEC-mode
+jFuzzyLogic's 1000-point Riemann sum (README: 1e-3 x range), compiled with
+``compat="jfuzzylogic"`` (WITH weights the condition degree and every conclusion of its
+rule).  Where a file exceeds 1e-3 (vertical edges that fall on sample points: shashankrao,
+robot, up to 1.25e-3), the test proves the whole difference is that sum: jFuzzyLogic's
+left Riemann sum, emulated on *our* rule degrees and terms (x accumulated by repeated
+``+= step`` as its loop does), reproduces its outputs to 1e-12.  The grids of IEC-mode
 compilation are checked too, for the files where no jFuzzyLogic deviation applies."""
 
 from __future__ import annotations
@@ -16,10 +19,13 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
+from fuzzyctl.engine.explain import Explanation, OutputTrace
+from fuzzyctl.engine.shapes import membership_np, pwl_value_np, sort_points
+from fuzzyctl.model import FunctionBlock, PointsMF, ShapeMF
 from tests.conftest import shared_path
 
 JFL = Path("conformance/jfuzzylogic")
-RIEMANN = 1.3e-3  # of the output range
+RIEMANN = 1e-3  # of the output range (README)
 
 MEMBERSHIP = sorted(p.name for p in shared_path(*JFL.parts, "expected", "membership").glob("*.tsv"))
 GRIDS = sorted(p.name for p in shared_path(*JFL.parts, "expected", "grids").glob("*.tsv"))
@@ -81,6 +87,57 @@ def test_junit_rounded_tables(name: str) -> None:
             assert abs(got - want) <= 0.5 + 1e-9, (name, row[0], term, got, want)
 
 
+def _riemann_centroid(fb: FunctionBlock, trace: Explanation, out: OutputTrace) -> float:
+    """jFuzzyLogic's CoG: 1000 left samples of the accumulated set over the output's range."""
+    assert out.low is not None and out.high is not None
+    db = fb.defuzzify_block(out.name)
+    rb = fb.rule_blocks[0]
+    assert db is not None and len(fb.rule_blocks) == 1
+    step, x, xs = (out.high - out.low) / 1000, out.low, []
+    for _ in range(1000):
+        xs.append(x)
+        x += step  # the drift matters where a vertical edge sits on a sample
+    u = np.array(xs)
+    acc = np.zeros_like(u)
+    accu = (db.accu or rb.accu or "SUM").upper()  # jFuzzyLogic's default ACCU is SUM
+    for rule in trace.rules:
+        for concl in rule.conclusions:
+            term = db.term(concl.term or "")
+            if concl.variable != out.name or term is None or concl.degree <= 0.0:
+                continue
+            if isinstance(term.mf, ShapeMF):
+                mu = membership_np(term.mf.kind, [float(p) for p in term.mf.params], term.mf.height, u)
+            else:
+                assert isinstance(term.mf, PointsMF)
+                mu = pwl_value_np(sort_points([(float(p.x), float(p.y)) for p in term.mf.points]), u)
+            a = concl.degree * concl.weight  # jFuzzyLogic weighs before activation
+            v = np.minimum(a, mu) if (rb.act or "MIN").upper() == "MIN" else a * mu
+            acc = {"MAX": np.maximum(acc, v), "SUM": acc + v}.get(accu, np.minimum(1.0, acc + v))
+    return float((u * acc).sum() / acc.sum())
+
+
+def _riemann_error(name: str) -> float:
+    """Worst |emulated Riemann CoG - jFuzzyLogic| / range over the fired Mamdani CoG rows."""
+    comments, head, data = _table(shared_path(*JFL.parts, "expected", "grids", name))
+    src = re.search(r"source: (\S+)", comments[0])
+    assert src is not None
+    doc = fuzzyctl.load(shared_path(*JFL.parts, src.group(1)))
+    fb = doc.blocks[0]
+    c = fuzzyctl.compile(doc, compat="jfuzzylogic")
+    worst, checked = 0.0, 0
+    for row in data:
+        trace = c.explain({h: float(row[i]) for i, h in enumerate(head) if h in c.inputs})
+        for out in trace.outputs:
+            if out.kind != "mamdani" or out.method != "COG" or not out.fired:
+                continue
+            assert out.low is not None and out.high is not None
+            want = float(row[head.index(out.name)])
+            worst = max(worst, abs(_riemann_centroid(fb, trace, out) - want) / (out.high - out.low))
+            checked += 1
+    assert checked > 0
+    return worst
+
+
 def _grid(name: str, compat: str) -> tuple[float, float]:
     comments, head, data = _table(shared_path(*JFL.parts, "expected", "grids", name))
     src = re.search(r"source: (\S+)", comments[0])
@@ -105,14 +162,16 @@ def _grid(name: str, compat: str) -> tuple[float, float]:
 @pytest.mark.parametrize("name", [g for g in GRIDS if g not in NEEDS_RANGE])
 def test_grids_with_jfuzzylogic_semantics(name: str) -> None:
     worst_abs, worst_rel = _grid(name, "jfuzzylogic")
-    assert worst_rel <= RIEMANN  # Mamdani outputs: jFuzzyLogic's Riemann sum
+    if worst_rel > RIEMANN:  # prove the excess is jFuzzyLogic's sampling, nothing else
+        assert worst_rel <= 2 * RIEMANN and _riemann_error(name) <= 1e-12, name
     assert worst_abs <= 1e-9 or worst_rel > 0.0  # singleton and Takagi-Sugeno outputs: exact
 
 
 @pytest.mark.parametrize("name", [g for g in GRIDS if g not in NEEDS_RANGE | IEC_DIFFERS])
 def test_grids_with_iec_semantics_where_no_deviation_applies(name: str) -> None:
     _abs, worst_rel = _grid(name, "iec")
-    assert worst_rel <= RIEMANN
+    if worst_rel > RIEMANN:
+        assert worst_rel <= 2 * RIEMANN and _riemann_error(name) <= 1e-12, name
 
 
 @pytest.mark.parametrize("name", sorted(IEC_DIFFERS))
@@ -128,3 +187,12 @@ def test_unbounded_outputs_without_range_are_reported(name: str) -> None:
     assert src is not None
     with pytest.raises(DiagnosticError, match="give a RANGE"):
         fuzzyctl.compile(fuzzyctl.load(shared_path(*JFL.parts, src.group(1))))
+
+
+@pytest.mark.parametrize(
+    "name",
+    ["tests_tipper.tsv", "tests_junit_shashankrao.tsv", "fcl_robot_with_weights.tsv", "fcl_tipper_with.tsv"],
+)
+def test_jfuzzylogic_cog_is_a_riemann_sum_of_our_accumulated_sets(name: str) -> None:
+    """The sets are the same; only jFuzzyLogic's sampling differs (also where WITH applies)."""
+    assert _riemann_error(name) <= 1e-12

@@ -437,3 +437,20 @@ def test_power_hedges_and_comparison_functions() -> None:
     c = fuzzyctl.compile(fb)
     assert c.plan.outputs[0].kind == "mamdani" and not c.plan.outputs[0].exact  # quadrature
     assert c.evaluate({"v": 10.0})["y"] == pytest.approx(0.25, abs=1e-9)
+
+
+def test_explained_set_keeps_vertical_edges_across_gaps() -> None:
+    """Two sets apart, the right one starting with a vertical edge: the polyline must drop
+    to 0 between them and rise vertically, so its centroid is the output's value."""
+    fb = _one_input(
+        {"lo": shape("trapezoid", 0, 1, 2, 3), "hi": shape("triangle", 6, 6, 9)},
+        [rule("1", is_("x", "up"), then("y", "lo")), rule("2", is_("x", "down"), then("y", "hi"))],
+        rng=(0, 10),
+    )
+    out = fuzzyctl.compile(fb).explain({"x": 5.0}).output("y")
+    xs, ys = np.array(out.breakpoints).T
+    assert (6.0, 0.0) in out.breakpoints and (6.0, 0.5) in out.breakpoints
+    seg = np.diff(xs)
+    area = float((seg * (ys[:-1] + ys[1:]) / 2).sum())
+    moment = float((seg * (xs[:-1] * (2 * ys[:-1] + ys[1:]) + xs[1:] * (ys[:-1] + 2 * ys[1:])) / 6).sum())
+    assert moment / area == pytest.approx(out.value, abs=1e-12)

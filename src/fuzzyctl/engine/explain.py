@@ -108,6 +108,9 @@ def polyline(pieces: list[pwl.Piece], samples_per_poly: int = 16) -> list[tuple[
             pts.append((x, y))
 
     for x0, x1, v0, v1, factors in pieces:
+        if pts and x0 > pts[-1][0]:  # pieces where the set is 0 are left out: close the gap
+            add(pts[-1][0], 0.0)
+            add(x0, 0.0)
         add(x0, v0)
         if factors is not None:
             for i in range(1, samples_per_poly):
