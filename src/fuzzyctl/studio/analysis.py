@@ -231,6 +231,66 @@ def display_ranges(fb: FunctionBlock, settings: dict[str, Any] | None = None) ->
     return out
 
 
+def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[str, Any]]:
+    """How each term of each input and output looks, for the editors: ``{"points":
+    [[x, mu], ...]}`` (exact for piecewise-linear terms, 201 samples for smooth ones,
+    extended flat to the range ends), ``{"singleton": x}``, or ``{"text": ...}`` for terms
+    given by variables or expressions (edited in the text editor)."""
+    from fuzzyctl.engine.shapes import membership_np, pwl_points
+
+    out: dict[str, dict[str, Any]] = {}
+    for v in (*fb.inputs, *fb.outputs):
+        blk = fb.fuzzify_block(v.name) or fb.defuzzify_block(v.name)
+        low, high = ranges[v.name]
+        terms: dict[str, Any] = {}
+        for t in blk.terms if blk is not None else ():
+            mf = t.mf
+            shape: Any = {"text": type(mf).__name__}
+            if isinstance(mf, SingletonMF) and isinstance(mf.value, float | int):
+                shape = {"singleton": float(mf.value)}
+            elif isinstance(mf, PointsMF) and all(isinstance(c, float | int) for p in mf.points for c in (p.x, p.y)):
+                pts = [[float(p.x), float(p.y)] for p in mf.points]
+                shape = {"points": _extend(pts, low, high)}
+            elif isinstance(mf, SingletonsMF) and all(
+                isinstance(c, float | int) for p in mf.points for c in (p.x, p.y)
+            ):
+                shape = {"spikes": [[float(p.x), float(p.y)] for p in mf.points]}
+            elif (
+                isinstance(mf, ShapeMF)
+                and mf.kind not in ("constant", "linear")
+                and all(isinstance(p, float | int) for p in (*mf.params, mf.height))
+            ):
+                params = [float(p) for p in mf.params]
+                height = float(mf.height)  # type: ignore[arg-type]
+                try:
+                    exact = pwl_points(mf.kind, params, height)
+                    if exact is not None:
+                        pts = [[float(x), float(y)] for x, y in exact]
+                        shape = {"points": _extend(pts, low, high)}
+                    else:
+                        xs = np.linspace(low, high, 201)
+                        ys = membership_np(mf.kind, params, height, xs)
+                        shape = {"points": [[float(a), float(b)] for a, b in zip(xs, ys, strict=True)]}
+                except (ValueError, ZeroDivisionError, FloatingPointError):
+                    pass
+            terms[t.name] = shape
+        out[v.name] = terms
+    return out
+
+
+def _extend(points: list[list[float]], low: float, high: float) -> list[list[float]]:
+    """IEC points are constant beyond the first and the last point: draw that to the
+    range ends."""
+    if not points:
+        return points
+    pts = sorted(points, key=lambda p: p[0])
+    if low < pts[0][0]:
+        pts.insert(0, [low, pts[0][1]])
+    if high > pts[-1][0]:
+        pts.append([high, pts[-1][1]])
+    return pts
+
+
 # ---------------------------------------------------------------------------- controllers
 
 

@@ -241,9 +241,8 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         document, fb = model_of(body)
         text = analysis.fcl_text(document)
         report = analysis.check_text(text)
-        return _clean(
-            {"text": text, "ranges": analysis.display_ranges(fb, settings_of(body)), **report.to_dict()}
-        )
+        ranges = analysis.display_ranges(fb, settings_of(body))
+        return _clean({"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()})
 
     @app.post("/api/parse")
     def parse(body: TextBody) -> Any:
