@@ -132,25 +132,30 @@ def _diag(d: Diagnostic, element: str | None) -> dict[str, Any]:
     return out
 
 
-def _lines(span: Span | None) -> tuple[int, int] | None:
+Position = tuple[int, int]
+
+
+def _extent(span: Span | None) -> tuple[Position, Position] | None:
     if span is None:
         return None
-    return span.line, span.end_line or span.line
+    end_line = span.end_line or span.line
+    end_column = span.end_column if span.end_line else 10**9  # no end: the rest of the line
+    return (span.line, span.column), (end_line, end_column or 10**9)
 
 
-def _elements(document: Document) -> list[tuple[str, int, int]]:
-    """Every element with a source position, as ``(id, first line, last line)``.
+def _elements(document: Document) -> list[tuple[str, Position, Position]]:
+    """Every element with a source position, as ``(id, start, end)`` (line, column).
 
     Ids: ``var:<name>`` (declaration, FUZZIFY / DEFUZZIFY block), ``term:<var>:<term>``,
     ``ruleblock:<i>``, ``rule:<i>:<j>`` (block index, rule index), ``block`` (the rest of
     the function block).  Only the first function block is mapped (the one edited)."""
     fb = document.main
-    out: list[tuple[str, int, int]] = []
+    out: list[tuple[str, Position, Position]] = []
 
     def add(element: str, span: Span | None) -> None:
-        lines = _lines(span)
-        if lines is not None:
-            out.append((element, *lines))
+        extent = _extent(span)
+        if extent is not None:
+            out.append((element, *extent))
 
     add("block", fb.span)
     for v in fb.variables:
@@ -166,14 +171,15 @@ def _elements(document: Document) -> list[tuple[str, int, int]]:
     return out
 
 
-def _element_of(span: Span | None, elements: list[tuple[str, int, int]]) -> str | None:
-    """The innermost element whose lines contain the diagnostic's line."""
+def _element_of(span: Span | None, elements: list[tuple[str, Position, Position]]) -> str | None:
+    """The innermost element that contains the diagnostic's position."""
     if span is None:
         return None
-    best: tuple[int, str] | None = None
-    for element, first, last in elements:
-        if first <= span.line <= last:
-            size = last - first
+    here = (span.line, span.column)
+    best: tuple[tuple[int, int], str] | None = None
+    for element, start, end in elements:
+        if start <= here <= end:
+            size = (end[0] - start[0], end[1] - start[1] if end[0] == start[0] else 10**9)
             if best is None or size <= best[0]:
                 best = (size, element)
     return best[1] if best else None

@@ -476,8 +476,19 @@ export function init() {
     stop();
     archive = [];
     sim = null;
-    const r = rec();
-    if (r.loop && !$("#rec-source").dataset.touched) $("#rec-source").value = "sim";
+    // a loop configuration made for this controller: the simulated process is ready
+    if ($("#rec-source").dataset.touched) return;
+    fetch(`/api/sim/configs?current=${encodeURIComponent(state.path || "")}`)
+      .then((r) => r.json())
+      .then((res) => {
+        const match = (res.configs || []).find((c) => c.matches);
+        if (match && !$("#rec-source").dataset.touched) {
+          rec().loop = match.path;
+          $("#rec-source").value = "sim";
+          if (!$("#view-recorder").hidden) layout();
+        }
+      })
+      .catch(() => {});
   });
   $("#rec-source").addEventListener("change", () => ($("#rec-source").dataset.touched = "true"));
 }

@@ -87,7 +87,7 @@ async function refresh() {
 function camera() {
   const az = (+$("#sf-rot").value * Math.PI) / 180;
   const el_ = (+$("#sf-elev").value * Math.PI) / 180;
-  const r = 2.1;
+  const r = 2.6;
   return { eye: { x: r * Math.cos(el_) * Math.cos(az), y: r * Math.cos(el_) * Math.sin(az), z: r * Math.sin(el_) } };
 }
 
