@@ -33,7 +33,7 @@ def base_url(url: str) -> str:
     """``http://host:port`` plus ``/api/v1``, whatever of it the user typed."""
     parsed = urllib.parse.urlsplit(url.strip())
     if parsed.scheme not in ("http", "https") or not parsed.netloc:
-        raise OnlineError(f"{url!r}: give the runtime's address as http://host:port")
+        raise FuzzyctlError(f"{url!r}: give the runtime's address as http://host:port")
     path = parsed.path.rstrip("/")
     if path.endswith("/api/v1"):
         path = path[: -len("/api/v1")]
