@@ -141,7 +141,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         return document, document.blocks[body.block]
 
     def settings_of(body: ModelBody) -> dict[str, Any]:
-        return body.settings.model_dump(exclude_none=True, exclude_defaults=True)
+        return body.settings.model_dump(exclude_none=True)
 
     def opened(path: Path, text: str) -> dict[str, Any]:
         """What the browser gets for a file: the model, the settings, the check report."""

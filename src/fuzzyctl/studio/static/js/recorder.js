@@ -91,7 +91,8 @@ function renderCurves() {
 function signalOf(name) {
   const r = rec();
   r.signals ||= {};
-  return r.signals[name] || { kind: "constant", value: (range(name)[0] + range(name)[1]) / 2 };
+  const s = r.signals[name];
+  return s ? { kind: "constant", value: 0, ...s } : { kind: "constant", value: (range(name)[0] + range(name)[1]) / 2 };
 }
 
 function describe(s) {
@@ -219,8 +220,9 @@ async function startSim() {
 // --- sampling ----------------------------------------------------------------------
 
 async function sample() {
-  if (busy) return;
+  if (busy || !running) return;
   busy = true;
+  const session = running;
   try {
     const speed = source() === "online" ? 1 : +$("#rec-speed").value;
     simTime += 0.1 * speed;
@@ -230,9 +232,11 @@ async function sample() {
     if (source() === "test") {
       const times = Array.from({ length: n }, (_, i) => (k + i) * dt());
       const res = await post("/api/record", body({ signals: rec().signals || {}, times, length: length(), reset: k === 0 }));
+      if (session !== running) return; // stopped meanwhile: the recording ended at Stop
       res.t.forEach((t, i) => push(t, Object.fromEntries(Object.entries(res.values).map(([name, vs]) => [name, vs[i]]))));
     } else if (source() === "sim") {
       const res = await post("/api/sim/step", { id: sim.id, seconds: n * dt() });
+      if (session !== running) return;
       const rows = res.rows;
       const count = rows.t.length;
       for (const [c, vs] of Object.entries(rows)) simTrace[c].push(...vs);
@@ -244,6 +248,7 @@ async function sample() {
       shareTrajectory();
     } else {
       const detail = await post("/api/online/read", { url: online.url, instance: online.instance });
+      if (session !== running) return;
       online.detail = detail;
       push(k * dt(), { ...detail.inputs, ...detail.outputs });
     }
@@ -399,6 +404,7 @@ async function start() {
   }
   renderCurves();
   running = setInterval(sample, 100);
+  busy = false;
   $("#rec-start").disabled = true;
   $("#rec-stop").disabled = false;
   $("#view-recorder").dataset.running = "true";
