@@ -54,7 +54,15 @@ def opened(client: TestClient, path: str) -> dict[str, Any]:
 
 @pytest.mark.parametrize(
     "path",
-    ["../secret.fcl", "/etc/passwd", "sub/../../secret.fcl", "..", "link/secret.fcl", "outside.fcl", "a\x00b.fcl"],
+    [
+        "../secret.fcl",
+        "/etc/passwd",
+        "sub/../../secret.fcl",
+        "..",
+        "link/secret.fcl",
+        "outside.fcl",
+        "a\x00b.fcl",
+    ],
 )
 def test_no_path_leaves_the_project_directory(client: TestClient, project: Path, path: str) -> None:
     (project / "link").symlink_to(project.parent, target_is_directory=True)
@@ -85,7 +93,10 @@ def test_requests_are_validated(client: TestClient) -> None:
         ("/api/open", {"path": "crane.fcl", "extra": 1}),
         ("/api/explain", {"document": doc, "inputs": {"distance": "NaN", "angle": 0}}),
         ("/api/record", {"document": doc, "times": [0], "length": 5}),
-        ("/api/record", {"document": doc, "times": [0], "signals": {"angle": {"kind": "triangle", "duty": 101}}}),
+        (
+            "/api/record",
+            {"document": doc, "times": [0], "signals": {"angle": {"kind": "triangle", "duty": 101}}},
+        ),
         ("/api/surface", {"document": doc, "x": "distance", "y": "angle", "z": "power", "points": 500}),
         ("/api/sim/step", {"id": "../../etc", "seconds": 1}),
         ("/api/save", {"path": "x.fcl", "document": doc, "settings": {"unknown": 1}}),
@@ -94,14 +105,23 @@ def test_requests_are_validated(client: TestClient) -> None:
         text = json.dumps(body).replace('"NaN"', "NaN")
         r = client.post(path, content=text, headers={"content-type": "application/json"})
         assert r.status_code == 422, (path, r.text)
-    r = client.post("/api/check", json={"document": {"format": "fuzzyctl-model", "version": 1, "blocks": [{"nam": 1}]}})
+    r = client.post(
+        "/api/check", json={"document": {"format": "fuzzyctl-model", "version": 1, "blocks": [{"nam": 1}]}}
+    )
     assert r.status_code == 422 and "nam" in r.json()["detail"]
 
 
-def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(client: TestClient, project: Path) -> None:
+def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(
+    client: TestClient, project: Path
+) -> None:
     first = opened(client, "crane.fcl")
-    settings = {"ranges": {"distance": [-5.0, 25.0]}, "recorder": {"curves": ["distance", "power"], "length": 30.0}}
-    r = client.post("/api/save", json={"path": "copy.fcl", "document": first["document"], "settings": settings})
+    settings = {
+        "ranges": {"distance": [-5.0, 25.0]},
+        "recorder": {"curves": ["distance", "power"], "length": 30.0},
+    }
+    r = client.post(
+        "/api/save", json={"path": "copy.fcl", "document": first["document"], "settings": settings}
+    )
     assert r.status_code == 200, r.text
     saved = (project / "copy.fcl").read_text()
     assert "OPTIONS" in saved and "STUDIO" in saved
@@ -110,7 +130,10 @@ def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(client: Te
     assert again["settings"]["ranges"] == {"distance": [-5.0, 25.0]}
     assert again["settings"]["recorder"]["curves"] == ["distance", "power"]
     # the model read back is the crane (the studio block is not part of it)
-    assert fuzzyctl.load(project / "copy.fcl").main.rule_blocks == fuzzyctl.load(EXAMPLES / "crane.fcl").main.rule_blocks
+    assert (
+        fuzzyctl.load(project / "copy.fcl").main.rule_blocks
+        == fuzzyctl.load(EXAMPLES / "crane.fcl").main.rule_blocks
+    )
     assert again["document"] == first["document"] | {"blocks": again["document"]["blocks"]}
     assert again["document"]["blocks"][0]["options"] == []
     # a save over a file that changed on disk since it was opened is refused ...
@@ -118,12 +141,17 @@ def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(client: Te
     body = {"path": "copy.fcl", "document": again["document"], "expected_sha256": again["sha256"]}
     assert client.post("/api/save", json=body).status_code == 409
     # ... and so is Save As onto an existing file, unless confirmed
-    assert client.post("/api/save", json={"path": "figure7.fcl", "document": first["document"]}).status_code == 409
+    assert (
+        client.post("/api/save", json={"path": "figure7.fcl", "document": first["document"]}).status_code
+        == 409
+    )
     assert client.post("/api/save", json={**body, "overwrite": True}).status_code == 200
     assert client.post("/api/save", json={"path": "x.txt", "document": first["document"]}).status_code == 403
 
 
-def test_save_survives_a_failed_write(client: TestClient, project: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+def test_save_survives_a_failed_write(
+    client: TestClient, project: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
     before = (project / "crane.fcl").read_text()
     doc = opened(client, "crane.fcl")
 
@@ -132,9 +160,14 @@ def test_save_survives_a_failed_write(client: TestClient, project: Path, monkeyp
 
     monkeypatch.setattr(os, "replace", boom)
     with pytest.raises(OSError):
-        client.post("/api/save", json={"path": "crane.fcl", "document": doc["document"], "expected_sha256": doc["sha256"]})
+        client.post(
+            "/api/save",
+            json={"path": "crane.fcl", "document": doc["document"], "expected_sha256": doc["sha256"]},
+        )
     assert (project / "crane.fcl").read_text() == before
-    assert sorted(p.name for p in project.iterdir()) == sorted(["crane.fcl", "crane.toml", "figure7.fcl", "xfuz_3_3.xfuz"])
+    assert sorted(p.name for p in project.iterdir()) == sorted(
+        ["crane.fcl", "crane.toml", "figure7.fcl", "xfuz_3_3.xfuz"]
+    )
 
 
 # ---------------------------------------------------------------------------- checking
@@ -209,7 +242,9 @@ def test_diagnostics_name_their_rule(client: TestClient) -> None:
 
 def test_surface_is_the_engine_over_the_grid(client: TestClient) -> None:
     doc = opened(client, "figure7.fcl")["document"]
-    r = client.post("/api/surface", json={"document": doc, "x": "temp", "y": "pressure", "z": "valve", "points": 7})
+    r = client.post(
+        "/api/surface", json={"document": doc, "x": "temp", "y": "pressure", "z": "valve", "points": 7}
+    )
     data = r.json()
     ctl = fuzzyctl.compile(fuzzyctl.load(EXAMPLES / "figure7.fcl"))
     # the ranges come from the terms: temp 3..27, pressure 55..95
@@ -250,7 +285,9 @@ def test_explain_matches_the_engine(client: TestClient) -> None:
     e = client.post("/api/explain", json={"document": doc, "inputs": {"temp": 6, "pressure": 85}}).json()
     # docs/engine.md: temp 6 is cold 0.875, hot 0.125; rule 2 has degree 0.75
     degrees = {(t["variable"], t["term"]): t["degree"] for t in e["terms"]}
-    assert degrees[("temp", "cold")] == pytest.approx(0.875) and degrees[("pressure", "high")] == pytest.approx(0.75)
+    assert degrees[("temp", "cold")] == pytest.approx(0.875) and degrees[
+        ("pressure", "high")
+    ] == pytest.approx(0.75)
     assert next(r for r in e["rules"] if r["label"] == "2")["degree"] == pytest.approx(0.75)
     assert e["outputs"][0]["singletons"] == [[-100.0, 0.125], [0.0, pytest.approx(0.6)], [100.0, 0.25]]
 
@@ -284,9 +321,14 @@ def test_triangle_test_signal(duty: float) -> None:
 
 def test_recorder_evaluates_successive_cycles(client: TestClient) -> None:
     doc = opened(client, "crane.fcl")["document"]
-    signals = {"distance": {"kind": "triangle", "min": -4, "max": 20, "periods": 2}, "angle": {"kind": "constant", "value": 3}}
+    signals = {
+        "distance": {"kind": "triangle", "min": -4, "max": 20, "periods": 2},
+        "angle": {"kind": "constant", "value": 3},
+    }
     times = [i * 0.4 for i in range(150)]
-    data = client.post("/api/record", json={"document": doc, "signals": signals, "times": times, "length": 60, "reset": True}).json()
+    data = client.post(
+        "/api/record", json={"document": doc, "signals": signals, "times": times, "length": 60, "reset": True}
+    ).json()
     ctl = fuzzyctl.compile(fuzzyctl.load(EXAMPLES / "crane.fcl"))
     for i in (0, 17, 40, 75, 149):
         d = triangle_closed_form(times[i], -4, 20, 30, 0.5, 0)
@@ -300,7 +342,9 @@ def test_recorder_evaluates_successive_cycles(client: TestClient) -> None:
 
 def test_import_and_export_every_format(client: TestClient) -> None:
     raw = (EXAMPLES / "xfuz_3_3.xfuz").read_bytes()
-    r = client.post("/api/import", json={"filename": "xfuz_3_3.xfuz", "data_base64": base64.b64encode(raw).decode()})
+    r = client.post(
+        "/api/import", json={"filename": "xfuz_3_3.xfuz", "data_base64": base64.b64encode(raw).decode()}
+    )
     assert r.status_code == 200, r.text
     imported = r.json()
     assert imported["format"] == "xfuz" and imported["document"]["blocks"][0]["name"] == "xfuz_3_3"
@@ -314,14 +358,19 @@ def test_import_and_export_every_format(client: TestClient) -> None:
             back = fuzzyctl.load(out["text"], format=fmt)
             ctl = fuzzyctl.compile(back)
             assert ctl.evaluate({"distance": 7, "angle": -3})["power"] == pytest.approx(
-                fuzzyctl.compile(fuzzyctl.load(EXAMPLES / "crane.fcl")).evaluate({"distance": 7, "angle": -3})["power"]
+                fuzzyctl.compile(fuzzyctl.load(EXAMPLES / "crane.fcl")).evaluate(
+                    {"distance": 7, "angle": -3}
+                )["power"]
             )
 
 
 def test_a_lossy_export_lists_the_losses_first(client: TestClient) -> None:
     doc = opened(client, "figure7.fcl")["document"]
     rule = doc["blocks"][0]["rule_blocks"][0]["rules"][0]
-    rule["condition"] = {"type": "or", "operands": [rule["condition"], {"type": "is", "variable": "temp", "term": "hot"}]}
+    rule["condition"] = {
+        "type": "or",
+        "operands": [rule["condition"], {"type": "is", "variable": "temp", "term": "hot"}],
+    }
     first = client.post("/api/export", json={"document": doc, "format": "fis"}).json()
     assert first["text"] is None and first["losses"]
     assert any("rule '1'" in loss for loss in first["losses"])  # FIS has no nested AND/OR
@@ -332,27 +381,43 @@ def test_a_lossy_export_lists_the_losses_first(client: TestClient) -> None:
 # ---------------------------------------------------------------------------- simulation
 
 
-def test_simulated_process_is_the_sim_loop_with_the_edited_controller(client: TestClient, project: Path) -> None:
+def test_simulated_process_is_the_sim_loop_with_the_edited_controller(
+    client: TestClient, project: Path
+) -> None:
     configs = client.get("/api/sim/configs", params={"current": "crane.fcl"}).json()["configs"]
     crane = next(c for c in configs if c["path"] == "crane.toml")
     assert crane["matches"] and crane["plant"] == "crane"
     doc = opened(client, "crane.fcl")["document"]
     # the edited controller, not the file's: rule 3 says pos_high instead of pos_medium
     doc["blocks"][0]["rule_blocks"][0]["rules"][2]["conclusions"][0]["term"] = "pos_high"
-    info = client.post("/api/sim/start", json={"document": doc, "config": "crane.toml", "parameters": {"load_mass": 20000}, "setpoints": {"target": 15}}).json()
+    info = client.post(
+        "/api/sim/start",
+        json={
+            "document": doc,
+            "config": "crane.toml",
+            "parameters": {"load_mass": 20000},
+            "setpoints": {"target": 15},
+        },
+    ).json()
     rows = client.post("/api/sim/step", json={"id": info["id"], "seconds": 5.0}).json()["rows"]
     from fuzzyctl import sim
     from fuzzyctl.sim.config import build_loop, load_config
 
     config = load_config(project / "crane.toml")
-    edited = (project / "crane.fcl").read_text().replace(
-        "RULE 3 : IF distance IS far AND angle IS zero THEN power IS pos_medium",
-        "RULE 3 : IF distance IS far AND angle IS zero THEN power IS pos_high",
+    edited = (
+        (project / "crane.fcl")
+        .read_text()
+        .replace(
+            "RULE 3 : IF distance IS far AND angle IS zero THEN power IS pos_medium",
+            "RULE 3 : IF distance IS far AND angle IS zero THEN power IS pos_high",
+        )
     )
     model = fuzzyctl.load(edited)
     from dataclasses import replace
 
-    config = replace(config, plant_parameters={**config.plant_parameters, "load_mass": 20000}, setpoints={"target": 15})
+    config = replace(
+        config, plant_parameters={**config.plant_parameters, "load_mass": 20000}, setpoints={"target": 15}
+    )
     reference = build_loop(config, model=model).run(5.0)
     assert isinstance(reference, sim.Trace)
     n = len(rows["t"])
@@ -360,7 +425,9 @@ def test_simulated_process_is_the_sim_loop_with_the_edited_controller(client: Te
     assert rows["position"] == pytest.approx(list(reference["position"][:n]), abs=1e-12)
     assert rows["fb.power"] == pytest.approx(list(reference["fb.power"][:n]), abs=1e-12)
     assert rows["target"][0] == 15
-    assert client.delete(f"/api/sim/{info['id']}", headers={"content-type": "application/json"}).json() == {"stopped": True}
+    assert client.delete(f"/api/sim/{info['id']}", headers={"content-type": "application/json"}).json() == {
+        "stopped": True
+    }
     assert client.post("/api/sim/step", json={"id": info["id"], "seconds": 1}).status_code == 404
 
 
@@ -415,7 +482,13 @@ def test_online_proxy_reads_commands_and_downloads(client: TestClient, runtime: 
     assert r.status_code == 200, r.text
     assert runtime.instances["valve"].knowledge_base_source().text == diff["edited"]
     # what runs now is the edited base: inlet at 80
-    assert fuzzyctl.load(runtime.instances["valve"].knowledge_base_source().text).main.defuzzify[0].terms[2].mf.value == 80
+    assert (
+        fuzzyctl.load(runtime.instances["valve"].knowledge_base_source().text)
+        .main.defuzzify[0]
+        .terms[2]
+        .mf.value
+        == 80
+    )
     detail = client.post("/api/online/read", json=creds).json()
     assert detail["downloads"] == 1
     unreachable = client.post("/api/online/instances", json={"url": "http://127.0.0.1:9"})

@@ -7,6 +7,7 @@ Any console error fails the test.  Screenshots go to test-artifacts/studio/."""
 
 from __future__ import annotations
 
+import json
 import shutil
 import socket
 import subprocess
@@ -27,6 +28,7 @@ from tests.studio.test_api import triangle_closed_form
 playwright_api = pytest.importorskip("playwright.sync_api")
 CHROMIUM = "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts" / "studio"
+RECORDED = "(() => {{ const d = document.querySelector('#rec-chart').data; return d && d[0].x.length >= {}; }})()"
 ARGS = [
     "--headless",
     "--no-sandbox",
@@ -126,7 +128,9 @@ def open_file(pg: Any, path: str) -> None:
 
 
 def surface_z(pg: Any) -> list[list[float]]:
-    pg.wait_for_function("document.querySelector('#sf-chart').data && document.querySelector('#sf-chart').data.length")
+    pg.wait_for_function(
+        "document.querySelector('#sf-chart').data && document.querySelector('#sf-chart').data.length"
+    )
     z: list[list[float]] = pg.evaluate("document.querySelector('#sf-chart').data[0].z")
     return z
 
@@ -147,7 +151,9 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     pg.fill("#new-outputs", "1")
     pg.click("#new-ok")
     pg.wait_for_selector("#diagram svg")
-    assert pg.locator("#diagram .node.input").count() == 2 and pg.locator("#diagram .node.output").count() == 1
+    assert (
+        pg.locator("#diagram .node.input").count() == 2 and pg.locator("#diagram .node.output").count() == 1
+    )
     shot(pg, "01-new-project")
     # rename input1 and reduce it to three terms (evenly spread over -100..100)
     pg.click('#diagram [data-id="var:input1"]')
@@ -182,8 +188,14 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     pg.select_option("#term-select", label="zero")
     pg.wait_for_function("document.querySelector('#mf-chart')._fullLayout")
     box = pg.locator("#mf-chart").bounding_box()
-    xa = pg.evaluate("(() => { const a = document.querySelector('#mf-chart')._fullLayout.xaxis; return [a.l2p(0) + a._offset, a.l2p(50) + a._offset]; })()")
-    ya = pg.evaluate("(() => { const a = document.querySelector('#mf-chart')._fullLayout.yaxis; return a.l2p(1) + a._offset; })()")
+    xa = pg.evaluate(
+        "(() => { const a = document.querySelector('#mf-chart')._fullLayout.xaxis;"
+        " return [a.l2p(0) + a._offset, a.l2p(50) + a._offset]; })()"
+    )
+    ya = pg.evaluate(
+        "(() => { const a = document.querySelector('#mf-chart')._fullLayout.yaxis;"
+        " return a.l2p(1) + a._offset; })()"
+    )
     pg.mouse.move(box["x"] + xa[0], box["y"] + ya)
     pg.mouse.down()
     for k in range(1, 11):
@@ -194,7 +206,9 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     assert 45 <= moved <= 55, moved
     shot(pg, "04-dragged-point")
     tab(pg, "surface")
-    pg.wait_for_function(f"JSON.stringify(document.querySelector('#sf-chart').data[0].z) !== {repr(__import__('json').dumps(before))}")
+    pg.wait_for_function(
+        f"JSON.stringify(document.querySelector('#sf-chart').data[0].z) !== {json.dumps(before)!r}"
+    )
     after = surface_z(pg)
     assert after != before
     # the surface is the engine's for the edited model
@@ -229,7 +243,10 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     pg.click("#sig-ok")
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
-    pg.wait_for_function("document.querySelector('#rec-chart').data && document.querySelector('#rec-chart').data[0].x.length >= 140", timeout=20000)
+    pg.wait_for_function(
+        RECORDED.format(140),
+        timeout=20000,
+    )
     pg.click("#rec-stop")
     # move the reading line to sample 37 and read every value
     values = reading(pg, 37)
@@ -239,7 +256,9 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     assert values["input2"] == -100
     ctl.reset()
     assert out == pytest.approx(ctl.evaluate({"temp": temp, "input2": -100})["output1"], abs=1e-9)
-    pg.wait_for_function(f"Math.abs(parseFloat(document.querySelector('#rec-bars').dataset.value) - {out}) < 1e-9")
+    pg.wait_for_function(
+        f"Math.abs(parseFloat(document.querySelector('#rec-bars').dataset.value) - {out}) < 1e-9"
+    )
     shot(pg, "06-recorder-triangle")
 
     # save as, then reload: the same rules, the moved point, the recorder settings
@@ -272,7 +291,10 @@ def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
     pg.press("#rec-length", "Tab")
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
-    pg.wait_for_function("document.querySelector('#rec-chart').data && document.querySelector('#rec-chart').data[0].x.length >= 120", timeout=30000)
+    pg.wait_for_function(
+        RECORDED.format(120),
+        timeout=30000,
+    )
     pg.click("#rec-stop")
     values = reading(pg, 100)
     t, position, power = values["t"], values["position"], values["fb_power"]
@@ -288,7 +310,9 @@ def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
     assert position > 1.0  # the trolley moved towards the target
     # the 3D display overlays the path the loop took over the control surface
     tab(pg, "surface")
-    pg.wait_for_function("document.querySelector('#sf-chart').data && document.querySelector('#sf-chart').data.length === 2")
+    pg.wait_for_function(
+        "document.querySelector('#sf-chart').data && document.querySelector('#sf-chart').data.length === 2"
+    )
     path = pg.evaluate("document.querySelector('#sf-chart').data[1]")
     assert path["type"] == "scatter3d" and len(path["x"]) >= k
     assert path["x"][k] == pytest.approx(trace["fb.distance"][k], abs=1e-9)
@@ -342,7 +366,9 @@ period = 0.05
         pg.click("#on-force")
         ctl = fuzzyctl.compile(fuzzyctl.load(project / "siemens_fpltest.fcl"))
         expect = ctl.evaluate({"Temp": 5, "Pressure": 60})["Valve"]
-        pg.wait_for_function(f"Math.abs(parseFloat(document.querySelector('#on-out-Valve').textContent) - {expect}) < 0.01")
+        pg.wait_for_function(
+            f"Math.abs(parseFloat(document.querySelector('#on-out-Valve').textContent) - {expect}) < 0.01"
+        )
         pg.click("#on-stop")
         pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('START_STOP=0')")
         pg.click("#on-start")
@@ -367,12 +393,17 @@ period = 0.05
         expect = new.evaluate({"Temp": 5, "Pressure": 60})["Valve"]
         assert expect != edited
         tab(pg, "online")
-        pg.wait_for_function(f"Math.abs(parseFloat(document.querySelector('#on-out-Valve').textContent) - {expect}) < 0.01")
+        pg.wait_for_function(
+            f"Math.abs(parseFloat(document.querySelector('#on-out-Valve').textContent) - {expect}) < 0.01"
+        )
         # the recorder records the live values
         tab(pg, "recorder")
         pg.select_option("#rec-source", "online")
         pg.click("#rec-start")
-        pg.wait_for_function("document.querySelector('#rec-chart').data && document.querySelector('#rec-chart').data[0].x.length >= 3", timeout=15000)
+        pg.wait_for_function(
+            RECORDED.format(3),
+            timeout=15000,
+        )
         pg.click("#rec-stop")
         assert reading(pg, 1)["Valve"] == pytest.approx(expect, abs=0.01)
         shot(pg, "10-online")

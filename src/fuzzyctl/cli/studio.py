@@ -56,7 +56,9 @@ def studio(
     shown = "127.0.0.1" if host in ("127.0.0.1", "0.0.0.0") else host
     url = f"http://{shown}:{bound}/"
     if host not in ("127.0.0.1", "localhost", "::1"):
-        err_console.print(f"warning: listening on {host}: anyone who reaches it can read and write {project_root}")
+        err_console.print(
+            f"warning: listening on {host}: anyone who reaches it can read and write {project_root}"
+        )
     typer.echo(f"fuzzyctl studio on {url}  (project directory {project_root}; Ctrl-C stops)", err=False)
     if open_browser:
         import webbrowser

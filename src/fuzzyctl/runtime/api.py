@@ -322,7 +322,12 @@ def create_app(runtime: "Runtime") -> FastAPI:
         """The knowledge base the instance runs, as it was loaded or downloaded (the
         studio shows its difference to the edited one before a download)."""
         source = get_instance(name).knowledge_base_source()
-        return {"format": source.format, "origin": source.origin, "sha256": source.sha256, "text": source.text}
+        return {
+            "format": source.format,
+            "origin": source.origin,
+            "sha256": source.sha256,
+            "text": source.text,
+        }
 
     @app.get(f"{API_PREFIX}/links", response_model=dict[str, LinkInfo], tags=["read"])
     def read_links() -> Any:

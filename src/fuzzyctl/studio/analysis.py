@@ -18,18 +18,25 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError, has_errors
 from fuzzyctl.model import (
+    DefuzzifyBlock,
     Document,
     FunctionBlock,
+    FuzzifyBlock,
+    Param,
     PointsMF,
+    Ref,
     ShapeMF,
     SingletonMF,
     SingletonsMF,
     Span,
     Term,
 )
+
+FloatArray = npt.NDArray[np.float64]
 
 # ---------------------------------------------------------------------------- model I/O
 
@@ -160,7 +167,8 @@ def _elements(document: Document) -> list[tuple[str, Position, Position]]:
     add("block", fb.span)
     for v in fb.variables:
         add(f"var:{v.name}", v.span)
-    for blk in (*fb.fuzzify, *fb.defuzzify):
+    term_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in term_blocks:
         add(f"var:{blk.variable}", blk.span)
         for t in blk.terms:
             add(f"term:{blk.variable}:{t.name}", t.span)
@@ -254,20 +262,22 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
             shape: Any = {"text": type(mf).__name__}
             if isinstance(mf, SingletonMF) and isinstance(mf.value, float | int):
                 shape = {"singleton": float(mf.value)}
-            elif isinstance(mf, PointsMF) and all(isinstance(c, float | int) for p in mf.points for c in (p.x, p.y)):
-                pts = [[float(p.x), float(p.y)] for p in mf.points]
+            elif isinstance(mf, PointsMF) and all(
+                isinstance(c, float | int) for p in mf.points for c in (p.x, p.y)
+            ):
+                pts = [[_num(p.x), _num(p.y)] for p in mf.points]
                 shape = {"points": _extend(pts, low, high)}
             elif isinstance(mf, SingletonsMF) and all(
                 isinstance(c, float | int) for p in mf.points for c in (p.x, p.y)
             ):
-                shape = {"spikes": [[float(p.x), float(p.y)] for p in mf.points]}
+                shape = {"spikes": [[_num(p.x), _num(p.y)] for p in mf.points]}
             elif (
                 isinstance(mf, ShapeMF)
                 and mf.kind not in ("constant", "linear")
                 and all(isinstance(p, float | int) for p in (*mf.params, mf.height))
             ):
-                params = [float(p) for p in mf.params]
-                height = float(mf.height)  # type: ignore[arg-type]
+                params = [_num(p) for p in mf.params]
+                height = _num(mf.height)
                 try:
                     exact = pwl_points(mf.kind, params, height)
                     if exact is not None:
@@ -282,6 +292,11 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
             terms[t.name] = shape
         out[v.name] = terms
     return out
+
+
+def _num(p: Param) -> float:
+    assert not isinstance(p, Ref)  # callers checked that every parameter is a number
+    return float(p)
 
 
 def _extend(points: list[list[float]], low: float, high: float) -> list[list[float]]:
@@ -354,8 +369,8 @@ def surface(
         raise FuzzyctlError(f"{z!r} is not an output")
     if x == y:
         raise FuzzyctlError("choose two different inputs for X and Y")
-    xs = np.linspace(*ranges[x], points)
-    ys = np.linspace(*ranges[y], points)
+    xs = np.linspace(ranges[x][0], ranges[x][1], points)
+    ys = np.linspace(ranges[y][0], ranges[y][1], points)
     gx, gy = np.meshgrid(xs, ys)  # z[j][i] is at (xs[i], ys[j]), plotly's surface layout
     frames: list[dict[str, Any]] = []
     values: list[float | None] = [None]
@@ -389,7 +404,7 @@ def explain(controller: Any, inputs: dict[str, float]) -> dict[str, Any]:
 # ---------------------------------------------------------------------------- test signals
 
 
-def test_signal(spec: dict[str, Any], t: np.ndarray, length: float, low: float, high: float) -> np.ndarray:
+def test_signal(spec: dict[str, Any], t: FloatArray, length: float, low: float, high: float) -> FloatArray:
     """The curve generator of the Siemens manual (6.7) at times ``t``.
 
     ``constant`` (``value``), ``minimum`` / ``maximum`` (the input's range limits),
@@ -435,16 +450,21 @@ def record(
     """One stretch of the curve recorder: the inputs the test signals give at ``times``
     and the outputs the engine computes from them (successive cycles of one instance)."""
     t = np.asarray(times, dtype=float)
-    columns: dict[str, np.ndarray] = {}
+    columns: dict[str, FloatArray] = {}
     for v in fb.inputs:
         low, high = ranges[v.name]
-        columns[v.name] = test_signal(signals.get(v.name, {"kind": "constant", "value": 0.0}), t, length, low, high)
+        columns[v.name] = test_signal(
+            signals.get(v.name, {"kind": "constant", "value": 0.0}), t, length, low, high
+        )
     if reset:
         controller.reset()
     outputs = controller.evaluate_batch(columns) if len(t) else {o.name: np.empty(0) for o in fb.outputs}
     return {
         "t": t.tolist(),
-        "values": {**{k: _finite(v) for k, v in columns.items()}, **{k: _finite(v) for k, v in outputs.items()}},
+        "values": {
+            **{k: _finite(v) for k, v in columns.items()},
+            **{k: _finite(v) for k, v in outputs.items()},
+        },
     }
 
 

@@ -15,8 +15,8 @@ from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Request
-from fastapi.exceptions import RequestValidationError
 from fastapi.encoders import jsonable_encoder
+from fastapi.exceptions import RequestValidationError
 from fastapi.responses import FileResponse, JSONResponse, Response
 from fastapi.staticfiles import StaticFiles
 
@@ -24,7 +24,14 @@ from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
 from fuzzyctl.model import Document, FunctionBlock
 from fuzzyctl.studio import analysis, online
-from fuzzyctl.studio.project import PathError, ProjectDir, save_atomically, sha256, split_settings, with_settings
+from fuzzyctl.studio.project import (
+    PathError,
+    ProjectDir,
+    save_atomically,
+    sha256,
+    split_settings,
+    with_settings,
+)
 from fuzzyctl.studio.schemas import (
     DownloadBody,
     ExplainBody,
@@ -152,7 +159,13 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         if suffix == ".fcl":
             report = analysis.check_text(text, rel)
             if report.document is None:
-                return {"path": rel, "text": text, "sha256": sha256(text), "document": None, **report.to_dict()}
+                return {
+                    "path": rel,
+                    "text": text,
+                    "sha256": sha256(text),
+                    "document": None,
+                    **report.to_dict(),
+                }
             document, settings = split_settings(report.document)
         else:
             document, settings = split_settings(read_text(text, suffix.lstrip("."), path=rel).document)
@@ -189,8 +202,13 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
             "root": str(project.root),
             "file": file,
             "formats": [
-                {"name": f.name, "extensions": list(f.extensions), "read": f.read is not None,
-                 "write": f.write is not None, "description": f.description}
+                {
+                    "name": f.name,
+                    "extensions": list(f.extensions),
+                    "read": f.read is not None,
+                    "write": f.write is not None,
+                    "description": f.description,
+                }
                 for f in formats.available()
             ],
         }
@@ -242,7 +260,9 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         text = analysis.fcl_text(document)
         report = analysis.check_text(text)
         ranges = analysis.display_ranges(fb, settings_of(body))
-        return _clean({"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()})
+        return _clean(
+            {"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()}
+        )
 
     @app.post("/api/parse")
     def parse(body: TextBody) -> Any:
@@ -369,7 +389,9 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         try:
             return sims.step(body.id, body.seconds)
         except KeyError:
-            return JSONResponse({"detail": "no such simulation (it was stopped or replaced)"}, status_code=404)
+            return JSONResponse(
+                {"detail": "no such simulation (it was stopped or replaced)"}, status_code=404
+            )
 
     @app.delete("/api/sim/{sid}")
     def sim_stop(sid: str) -> dict[str, bool]:
@@ -399,7 +421,9 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         base = f"/instances/{online.quote(body.instance)}"
         tok = body.token
         if body.action in ("start", "stop"):
-            return online.call(body.url, "PUT", f"{base}/start_stop", token=tok, body={"running": body.action == "start"})
+            return online.call(
+                body.url, "PUT", f"{base}/start_stop", token=tok, body={"running": body.action == "start"}
+            )
         if body.action in ("auto", "manual"):
             return online.call(body.url, "PUT", f"{base}/mode", token=tok, body={"mode": body.action})
         if not body.target:
@@ -427,7 +451,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         """Send the edited knowledge base (FCL, without the studio's settings)."""
         if not body.instance:
             raise InputError("choose an instance")
-        document, fb = model_of(body)
+        _document, fb = model_of(body)
         text = analysis.fcl_text(Document((fb,)))
         return online.call(
             body.url,
@@ -441,7 +465,9 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
 
     @app.get("/vendor/plotly.min.js", include_in_schema=False)
     def plotly_file() -> FileResponse:
-        return FileResponse(plotly_js, media_type="text/javascript", headers={"Cache-Control": "max-age=86400"})
+        return FileResponse(
+            plotly_js, media_type="text/javascript", headers={"Cache-Control": "max-age=86400"}
+        )
 
     @app.get("/", include_in_schema=False)
     def index() -> FileResponse:

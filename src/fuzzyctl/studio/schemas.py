@@ -47,7 +47,9 @@ class RecorderSettings(Body):
 class Settings(Body):
     """The studio's view settings, kept in the project's OPTIONS block."""
 
-    ranges: dict[Name, Annotated[list[Finite], Field(min_length=2, max_length=2)]] = Field(default_factory=dict)
+    ranges: dict[Name, Annotated[list[Finite], Field(min_length=2, max_length=2)]] = Field(
+        default_factory=dict
+    )
     surface: SurfaceSettings | None = None
     recorder: RecorderSettings | None = None
 
@@ -128,7 +130,9 @@ class OnlineBody(Body):
 
 class OnlineCommandBody(OnlineBody):
     action: Literal["start", "stop", "auto", "manual", "force", "release", "manual_value"]
-    target: Name | None = Field(default=None, description="the input (force, release) or output (manual_value)")
+    target: Name | None = Field(
+        default=None, description="the input (force, release) or output (manual_value)"
+    )
     value: Finite | None = None
 
 

@@ -66,9 +66,13 @@ def describe_configs(root: Path, files: list[str], current: str | None) -> list[
                 "plant": plant.kind,
                 "structure": controller.get("structure", "direct") if isinstance(controller, dict) else None,
                 "controller_file": (
-                    target.relative_to(root).as_posix() if target is not None and target.is_relative_to(root) else None
+                    target.relative_to(root).as_posix()
+                    if target is not None and target.is_relative_to(root)
+                    else None
                 ),
-                "matches": current is not None and target is not None and target == (root / current).resolve(),
+                "matches": current is not None
+                and target is not None
+                and target == (root / current).resolve(),
                 "duration": data.get("duration", 60),
                 "parameters": [
                     {
@@ -130,9 +134,15 @@ class SimSessions:
             "units": loop.units,
             "duration": config.duration,
             "fuzzy": {
-                "inputs": [c[3:] for c in loop.columns if c.startswith("fb.") and c[3:] in [v.name for v in fb.inputs]],
+                "inputs": [
+                    c[3:]
+                    for c in loop.columns
+                    if c.startswith("fb.") and c[3:] in [v.name for v in fb.inputs]
+                ],
                 "outputs": [
-                    c[3:] for c in loop.columns if c.startswith("fb.") and c[3:] in [v.name for v in fb.outputs]
+                    c[3:]
+                    for c in loop.columns
+                    if c.startswith("fb.") and c[3:] in [v.name for v in fb.outputs]
                 ],
             },
         }

@@ -329,6 +329,7 @@ function values(record) {
   const tbody = $("#rec-values tbody");
   tbody.replaceChildren(el("tr", {}, el("th", {}, "t [s]"), el("td", { class: "num", id: "rec-val-t", "data-value": record.t }, fmt(record.t))));
   for (const [name, v] of Object.entries(record.v)) {
+    if (name === "t") continue;
     tbody.append(el("tr", {}, el("th", {}, name), el("td", { class: "num", id: `rec-val-${name.replace(/\./g, "_")}`, "data-value": v ?? "" }, fmt(v))));
   }
 }
