@@ -28,7 +28,11 @@ from tests.studio.test_api import triangle_closed_form
 playwright_api = pytest.importorskip("playwright.sync_api")
 CHROMIUM = "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts" / "studio"
-RECORDED = "(() => {{ const d = document.querySelector('#rec-chart').data; return d && d[0].x.length >= {}; }})()"
+RECORDED = (
+    "(() => { const d = document.querySelector('#rec-chart').data; "
+    "return d && d[0].x.length >= %s })()"
+)
+# the recorder chart holds at least that many samples
 ARGS = [
     "--headless",
     "--no-sandbox",
@@ -244,7 +248,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
     pg.wait_for_function(
-        RECORDED.format(140),
+        (RECORDED % 140),
         timeout=20000,
     )
     pg.click("#rec-stop")
@@ -292,7 +296,7 @@ def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
     pg.wait_for_function(
-        RECORDED.format(120),
+        (RECORDED % 120),
         timeout=30000,
     )
     pg.click("#rec-stop")
@@ -401,7 +405,7 @@ period = 0.05
         pg.select_option("#rec-source", "online")
         pg.click("#rec-start")
         pg.wait_for_function(
-            RECORDED.format(3),
+            (RECORDED % 3),
             timeout=15000,
         )
         pg.click("#rec-stop")
