@@ -6,7 +6,7 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run simulate docs-img test lint typecheck pytest system-deps clean
+.PHONY: run simulate docs-img test fuzz lint typecheck pytest system-deps clean
 STUDIO_PORT ?= 8770
 
 $(BIN)/python:
@@ -46,6 +46,10 @@ pytest: $(VENV)/.installed-dev system-deps
 	$(BIN)/pytest
 
 test: lint typecheck pytest
+
+# Property tests with fresh random examples (make test replays a fixed set).
+fuzz: $(VENV)/.installed-dev system-deps
+	HYPOTHESIS_PROFILE=fuzz $(BIN)/pytest -q $$(grep -rl '@given' tests)
 
 clean:
 	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache
