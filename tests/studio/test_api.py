@@ -255,6 +255,37 @@ def test_surface_is_the_engine_over_the_grid(client: TestClient) -> None:
             assert z[j][i] == pytest.approx(ctl.evaluate({"temp": t, "pressure": p})["valve"], abs=1e-9)
 
 
+GAP = """FUNCTION_BLOCK gap
+VAR_INPUT x : REAL; w : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM lo := (0, 1) (4, 0); TERM hi := (6, 0) (10, 1); END_FUZZIFY
+FUZZIFY w TERM any := (0, 1) (10, 1); END_FUZZIFY
+DEFUZZIFY y TERM a := 5; TERM b := 10; METHOD : CoGS; DEFAULT := NC; END_DEFUZZIFY
+RULEBLOCK r AND : MIN; ACCU : MAX;
+RULE 1 : IF x IS lo AND w IS any THEN y IS a;
+RULE 2 : IF x IS hi AND w IS any THEN y IS b;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_surface_points_are_fresh_evaluations_where_no_rule_fires(client: TestClient, project: Path) -> None:
+    # DEFAULT := NC and a gap between 4 and 6 where no rule fires: each grid point shows
+    # what one evaluation after a reset gives (0), not the previous grid point's value
+    (project / "gap.fcl").write_text(GAP)
+    doc = opened(client, "gap.fcl")["document"]
+    data = client.post(
+        "/api/surface", json={"document": doc, "x": "x", "y": "w", "z": "y", "points": 11}
+    ).json()
+    z = data["frames"][0]["z"]
+    ctl = fuzzyctl.compile(fuzzyctl.load(GAP))
+    for j, w in enumerate(data["y"]):
+        for i, x in enumerate(data["x"]):
+            ctl.reset()
+            assert z[j][i] == pytest.approx(ctl.evaluate({"x": x, "w": w})["y"], abs=1e-9)
+    assert z[3][5] == 0 and z[3][3] == 5 and z[3][7] == 10
+
+
 def test_4d_frames_step_the_third_input(client: TestClient, project: Path) -> None:
     (project / "three.fcl").write_text(
         """FUNCTION_BLOCK three

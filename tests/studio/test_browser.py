@@ -8,145 +8,24 @@ Any console error fails the test.  Screenshots go to test-artifacts/studio/."""
 from __future__ import annotations
 
 import json
-import shutil
 import socket
 import subprocess
 import sys
-import threading
 import time
-from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
 import pytest
 
 import fuzzyctl
-from fuzzyctl.studio import create_app
-from tests.conftest import EXAMPLES, ROOT
+from tests.conftest import EXAMPLES
+from tests.studio.browser import RECORDED, fcl_text, open_file, reading, settle, shot, surface_z, tab
 from tests.studio.test_api import triangle_closed_form
 
-playwright_api = pytest.importorskip("playwright.sync_api")
-CHROMIUM = "/usr/bin/chromium"
-ARTIFACTS = ROOT / "test-artifacts" / "studio"
-RECORDED = (
-    "(() => { const d = document.querySelector('#rec-chart').data; "
-    "return d && d[0].x.length >= %s })()"
-)
-# the recorder chart holds at least that many samples
-ARGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--no-first-run",
-]
+pytest.importorskip("playwright.sync_api")
 
 
-@pytest.fixture(scope="module")
-def project(tmp_path_factory: pytest.TempPathFactory) -> Path:
-    root = tmp_path_factory.mktemp("studio-project")
-    for name in ("crane.fcl", "crane.toml", "siemens_fpltest.fcl"):
-        shutil.copy(EXAMPLES / name, root / name)
-    return root
-
-
-@pytest.fixture(scope="module")
-def studio(project: Path) -> Iterator[str]:
-    import uvicorn
-
-    app = create_app(project)
-    sock = socket.socket()
-    sock.bind(("127.0.0.1", 0))
-    port = sock.getsockname()[1]
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="off"))
-    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
-    thread.start()
-    deadline = time.monotonic() + 10
-    while not server.started and time.monotonic() < deadline:
-        time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}/"
-    server.should_exit = True
-    thread.join(5)
-
-
-@pytest.fixture(scope="module")
-def browser() -> Iterator[Any]:
-    if not Path(CHROMIUM).exists():
-        pytest.fail(f"{CHROMIUM} missing: `make test` installs Debian's chromium (scripts/system-deps.sh)")
-    with playwright_api.sync_playwright() as p:
-        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
-        yield b
-        b.close()
-
-
-@pytest.fixture
-def page(browser: Any, studio: str, request: pytest.FixtureRequest) -> Iterator[Any]:
-    context = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
-    pg = context.new_page()
-    errors: list[str] = []
-    pg.on("console", lambda m: m.type == "error" and errors.append(m.text))
-    pg.on("pageerror", lambda e: errors.append(f"{e} {e.stack}"))
-    pg.goto(studio)
-    pg.wait_for_selector("body[data-ready=true]")
-    yield pg
-    ARTIFACTS.mkdir(parents=True, exist_ok=True)
-    pg.screenshot(path=str(ARTIFACTS / f"{request.node.name}-end.png"))
-    context.close()
-    assert errors == [], f"console errors: {errors}"
-
-
-def shot(pg: Any, name: str) -> None:
-    ARTIFACTS.mkdir(parents=True, exist_ok=True)
-    pg.screenshot(path=str(ARTIFACTS / f"{name}.png"))
-
-
-def tab(pg: Any, view: str) -> None:
-    pg.click(f'[role=tab][data-view="{view}"]')
-    pg.wait_for_selector(f"#view-{view}:not([hidden])")
-
-
-def settle(pg: Any) -> None:
-    """Wait for the pending check of the model."""
-    pg.wait_for_timeout(400)
-
-
-def reading(pg: Any, index: int) -> dict[str, float]:
-    """Put the reading line on sample ``index`` and read every value at once."""
-    pg.wait_for_function("document.querySelector('#view-recorder').dataset.running === 'false'")
-    pg.wait_for_timeout(300)  # a request under way when Stop was pressed is dropped
-    pg.eval_on_selector("#rec-read", f"(e) => {{ e.value = {index}; e.dispatchEvent(new Event('input')); }}")
-    values: dict[str, float] = pg.evaluate(
-        "Object.fromEntries([...document.querySelectorAll('#rec-values td[data-value]')]"
-        ".map((td) => [td.id.slice(8), parseFloat(td.dataset.value)]))"
-    )
-    return values
-
-
-def open_file(pg: Any, path: str) -> None:
-    pg.click("#btn-open")
-    pg.select_option("#open-list", path)
-    pg.click("#open-ok")
-    pg.wait_for_function(f"document.querySelector('#project-name').textContent.includes('{path}')")
-    settle(pg)
-
-
-def surface_z(pg: Any) -> list[list[float]]:
-    pg.wait_for_function(
-        "document.querySelector('#sf-chart').data && document.querySelector('#sf-chart').data.length"
-    )
-    z: list[list[float]] = pg.evaluate("document.querySelector('#sf-chart').data[0].z")
-    return z
-
-
-def fcl_text(pg: Any) -> str:
-    tab(pg, "text")
-    pg.wait_for_function("document.querySelector('#code-input').value.includes('FUNCTION_BLOCK')")
-    text: str = pg.input_value("#code-input")
-    return text
-
-
-def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: Path) -> None:
+def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_project: Path) -> None:
     pg = page
     # File > New: the manual's "Define Project" dialog
     pg.click("#btn-new")
@@ -270,11 +149,11 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     pg.fill("#saveas-path", "mixer.fcl")
     pg.click("#saveas-ok")
     pg.wait_for_function("document.querySelector('#status').textContent.includes('saved mixer.fcl')")
-    saved = fuzzyctl.load(project / "mixer.fcl").main
+    saved = fuzzyctl.load(browser_project / "mixer.fcl").main
     assert [r.label for r in saved.rule_blocks[0].rules] == ["1", "2", "3"]
     zero = saved.fuzzify_block("temp").term("zero")
     assert zero is not None and zero.mf.points[1].x == moved  # type: ignore[union-attr]
-    assert "STUDIO" in (project / "mixer.fcl").read_text()
+    assert "STUDIO" in (browser_project / "mixer.fcl").read_text()
     pg.reload()
     pg.wait_for_selector("body[data-ready=true]")
     open_file(pg, "mixer.fcl")
@@ -285,7 +164,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, project: 
     assert "Curve" in pg.inner_text("#rec-sig-temp")
 
 
-def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
+def test_simulated_crane_loop_and_trajectory(page: Any, browser_project: Path) -> None:
     pg = page
     open_file(pg, "crane.fcl")
     tab(pg, "recorder")
@@ -306,7 +185,7 @@ def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
     # the same loop run by fuzzyctl.sim
     from fuzzyctl.sim.config import build_loop, load_config
 
-    trace = build_loop(load_config(project / "crane.toml")).run(t + 1)
+    trace = build_loop(load_config(browser_project / "crane.toml")).run(t + 1)
     k = round(t / 0.05)
     assert trace["t"][k] == pytest.approx(t)
     assert position == pytest.approx(trace["position"][k], abs=1e-9)
@@ -323,7 +202,7 @@ def test_simulated_crane_loop_and_trajectory(page: Any, project: Path) -> None:
     shot(pg, "08-crane-trajectory")
 
 
-def test_online_monitoring_and_download(page: Any, project: Path, tmp_path: Path) -> None:
+def test_online_monitoring_and_download(page: Any, browser_project: Path, tmp_path: Path) -> None:
     pg = page
     state = tmp_path / "state"
     config = tmp_path / "serve.toml"
@@ -338,8 +217,14 @@ event_log = ""
 [api]
 port = {port}
 [instances.valve]
-knowledge_base = "{project / "siemens_fpltest.fcl"}"
+knowledge_base = "{browser_project / "siemens_fpltest.fcl"}"
 period = 0.05
+[instances.debit]
+knowledge_base = "{EXAMPLES / "xfuz_3_3.xfuz"}"
+style = "xfuz"
+span_rule = false
+period = 0.05
+params = {{ MAN_AUTO = 1, START = 1 }}
 """
     )
     proc = subprocess.Popen(
@@ -368,7 +253,7 @@ period = 0.05
         pg.select_option("#on-force-input", "Pressure")
         pg.fill("#on-force-value", "60")
         pg.click("#on-force")
-        ctl = fuzzyctl.compile(fuzzyctl.load(project / "siemens_fpltest.fcl"))
+        ctl = fuzzyctl.compile(fuzzyctl.load(browser_project / "siemens_fpltest.fcl"))
         expect = ctl.evaluate({"Temp": 5, "Pressure": 60})["Valve"]
         pg.wait_for_function(
             f"Math.abs(parseFloat(document.querySelector('#on-out-Valve').textContent) - {expect}) < 0.01"
@@ -411,6 +296,15 @@ period = 0.05
         pg.click("#rec-stop")
         assert reading(pg, 1)["Valve"] == pytest.approx(expect, abs=0.01)
         shot(pg, "10-online")
+        # MAN_AUTO: the XFUZ instance switches to manual and back
+        tab(pg, "online")
+        pg.select_option("#on-instance", "debit")
+        pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('MAN_AUTO=1')")
+        pg.click("#on-manual")
+        pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('MAN_AUTO=0')")
+        pg.click("#on-auto")
+        pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('MAN_AUTO=1')")
+        tab(pg, "project")  # the On line view stops polling before the runtime goes
     finally:
         proc.terminate()
         proc.wait(10)

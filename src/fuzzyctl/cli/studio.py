@@ -50,6 +50,7 @@ def studio(
     sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
     try:
         sock.bind((host, port))
+        sock.listen(128)  # the URL printed below accepts connections at once (queued until uvicorn runs)
     except OSError as exc:
         raise FuzzyctlError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
     bound = sock.getsockname()[1]

@@ -341,6 +341,20 @@ class ControllerCache:
         return controller
 
 
+def pointwise(fb: FunctionBlock) -> FunctionBlock:
+    """``fb`` with ``DEFAULT := NC`` read as a fresh start: where no rule fires, an output
+    shows its DEFAULT value (0 without one), as one evaluation after a reset gives.  A grid
+    evaluated as a batch would otherwise carry the previous grid point's value into the
+    gaps, and the surface would depend on the order of the sweep."""
+    outputs = tuple(
+        replace(d, default=replace(d.default, no_change=False))
+        if d.default is not None and d.default.no_change
+        else d
+        for d in fb.defuzzify
+    )
+    return fb if outputs == fb.defuzzify else replace(fb, defuzzify=outputs)
+
+
 def _finite(values: Any) -> list[float | None]:
     return [float(v) if math.isfinite(v) else None for v in np.asarray(values, dtype=float).ravel()]
 

@@ -283,11 +283,11 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
     @app.post("/api/surface")
     def surface(body: SurfaceBody) -> Any:
         """The 3D display: an output over two inputs (``evaluate_batch``), optionally one
-        frame per step of a third input (4D)."""
+        frame per step of a third input (4D); every grid point is a fresh evaluation."""
         _doc, fb = model_of(body)
         ranges = analysis.display_ranges(fb, settings_of(body))
         return analysis.surface(
-            cache.get(fb, "surface"),
+            cache.get(analysis.pointwise(fb), "surface"),
             fb,
             x=body.x,
             y=body.y,

@@ -16,7 +16,8 @@ function box(parent, x, y, w, h, label, sub, kind, id, onOpen) {
   g.append(svg("rect", { x, y, width: w, height: h, rx: 6 }));
   g.append(svg("text", { x: x + w / 2, y: y + h / 2 - (sub ? 4 : -4), "text-anchor": "middle", class: "label" }, label));
   if (sub) g.append(svg("text", { x: x + w / 2, y: y + h / 2 + 13, "text-anchor": "middle", class: "sub" }, sub));
-  const diags = diagnosticsFor(id);
+  // a variable's box also carries the diagnostics of its terms
+  const diags = id.startsWith("var:") ? [...diagnosticsFor(id), ...diagnosticsFor(`term:${id.slice(4)}`)] : diagnosticsFor(id);
   if (diags.length) {
     const bad = diags.some((d) => d.severity === "error");
     g.append(svg("circle", { cx: x + w - 4, cy: y + 4, r: 9, class: bad ? "mark error" : "mark warning" }));

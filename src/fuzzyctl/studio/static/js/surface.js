@@ -10,6 +10,7 @@ let frame = 0;
 let rotating = null;
 let animating = null;
 let timer = null;
+let seq = 0; // surface requests sent
 export let trajectory = null; // {x: name, y: name, z: name, points: {name: [...]}} from the recorder
 
 export function setTrajectory(t) {
@@ -72,10 +73,15 @@ async function refresh() {
     $("#sf-note").textContent = "The 3D display needs two inputs.";
     return;
   }
+  const mine = ++seq;
+  const fixed = { ...(s.fixed || {}) };
   try {
-    data = await post("/api/surface", body({ x: s.x, y: s.y, z: s.z, fixed: s.fixed || {}, points: s.points || 31 }));
+    const answer = await post("/api/surface", body({ x: s.x, y: s.y, z: s.z, fixed, points: s.points || 31 }));
+    if (mine !== seq) return; // a newer request is under way: its answer is the one to show
+    data = answer;
     frame = 0;
     draw();
+    $("#sf-chart").dataset.fixed = JSON.stringify(fixed);
     $("#sf-note").textContent = `${s.z} over ${s.x} and ${s.y}; click a point to explain it.`;
     emit("surface", data);
   } catch (err) {
@@ -129,6 +135,7 @@ async function toggleAnimation() {
   const input = $("#sf-anim").value;
   const s = settings();
   if (!input) return status("choose a 4D input (one not on X or Y)", "error");
+  ++seq;
   try {
     data = await post("/api/surface", body({ x: s.x, y: s.y, z: s.z, fixed: s.fixed || {}, points: Math.min(s.points || 31, 31), animate: input, step_percent: +$("#sf-step").value }));
   } catch (err) {

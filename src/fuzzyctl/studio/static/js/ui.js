@@ -20,7 +20,24 @@ export function openDialog(selector, focus = null) {
   const dialog = $(selector);
   return new Promise((resolve) => {
     dialog.returnValue = "cancel";
-    dialog.addEventListener("close", () => resolve(dialog.returnValue), { once: true });
+    // Enter in a field answers with the primary button (the form's implicit submission
+    // would pick the first button, Cancel)
+    const onKey = (e) => {
+      const primary = dialog.querySelector("button.primary");
+      if (e.key === "Enter" && e.target.tagName === "INPUT" && primary) {
+        e.preventDefault();
+        dialog.close(primary.value);
+      }
+    };
+    dialog.addEventListener("keydown", onKey);
+    dialog.addEventListener(
+      "close",
+      () => {
+        dialog.removeEventListener("keydown", onKey);
+        resolve(dialog.returnValue);
+      },
+      { once: true },
+    );
     dialog.showModal();
     if (focus) focus.focus();
   });
