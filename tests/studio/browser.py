@@ -19,8 +19,7 @@ ARGS = [
 ]
 # the recorder chart holds at least that many samples
 RECORDED = (
-    "(() => { const d = document.querySelector('#rec-chart').data; "
-    "return d && d[0].x.length >= %s })()"
+    "(() => { const d = document.querySelector('#rec-chart').data; return d && d[0].x.length >= %s })()"
 )
 
 

@@ -44,7 +44,8 @@ def set_range(pg: Any, lo: float, hi: float) -> None:
 
 def x_span(pg: Any) -> float:
     span: float = pg.evaluate(
-        "(() => { const r = document.querySelector('#mf-chart')._fullLayout.xaxis.range; return r[1] - r[0]; })()"
+        "(() => { const r = document.querySelector('#mf-chart')._fullLayout.xaxis.range;"
+        " return r[1] - r[0]; })()"
     )
     return span
 
@@ -217,9 +218,7 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     # an unknown term: a semantic error, also with its line
     broken[at] = "        RULE 2 : IF input1 IS huge THEN output1 IS p_large;"
     pg.fill("#code-input", "\n".join(broken))
-    pg.wait_for_function(
-        "document.querySelector('#text-diags').textContent.includes('huge')"
-    )
+    pg.wait_for_function("document.querySelector('#text-diags').textContent.includes('huge')")
     shot(pg, "13-text-diagnostic")
     # an AND rule and an OR rule written as text: the table shows the first in cells,
     # the second as text
@@ -248,8 +247,12 @@ def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> N
     pg = page
     new_project(pg, "three", 3, 1)
     tab(pg, "rules")
-    table = [("n_big", "n_big", "n_big", "n_large"), ("p_big", "zero", "zero", "p_small"),
-             ("zero", "zero", "p_big", "p_large"), ("zero", "p_big", "n_big", "n_small")]
+    table = [
+        ("n_big", "n_big", "n_big", "n_large"),
+        ("p_big", "zero", "zero", "p_small"),
+        ("zero", "zero", "p_big", "p_large"),
+        ("zero", "p_big", "n_big", "n_small"),
+    ]
     for j, (a, b, c, y) in enumerate(table):
         pg.click("#rule-append")
         for var, term in (("input1", a), ("input2", b), ("input3", c), ("output1", y)):
@@ -320,7 +323,8 @@ def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> N
         pg.fill(f"#ex-in-{name}", str(value))
     pg.wait_for_function("document.querySelector('#ex-terms').textContent.includes('0.6')")
     rows = pg.evaluate(
-        "[...document.querySelectorAll('#ex-terms tbody tr')].map((r) => [...r.cells].slice(0, 3).map((c) => c.textContent))"
+        "[...document.querySelectorAll('#ex-terms tbody tr')]"
+        ".map((r) => [...r.cells].slice(0, 3).map((c) => c.textContent))"
     )
     degrees = {(v, t): float(d) for v, t, d in rows}
     assert degrees[("input1", "n_big")] == pytest.approx(0.5)  # (-100, 1) (-50, 0) at -75
@@ -365,9 +369,7 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
     # more than 500 samples: the archive is full and the oldest records are gone
-    pg.wait_for_function(
-        "document.querySelector('#rec-chart').layout.xaxis.range[0] >= 60", timeout=20000
-    )
+    pg.wait_for_function("document.querySelector('#rec-chart').layout.xaxis.range[0] >= 60", timeout=20000)
     pg.click("#rec-stop")
     values = reading(pg, 75)
     assert values["Temp"] == 0  # the range minimum
