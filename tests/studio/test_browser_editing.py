@@ -434,6 +434,16 @@ def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
     pg.wait_for_function("document.querySelector('#status').textContent.includes('saved imported.fcl')")
     again = fuzzyctl.compile(fuzzyctl.load(browser_project / "imported.fcl"))
     assert again.evaluate(point) == pytest.approx(ref.evaluate(point))
+    # a change, then Save (no dialog: the project has its file now)
+    tab(pg, "variable")
+    pg.select_option("#var-select", "PL")
+    pg.select_option("#out-method", "MOM")
+    settle(pg)
+    assert pg.inner_text("#project-name").startswith("●")  # unsaved changes
+    pg.click("#btn-save")
+    pg.wait_for_function("!document.querySelector('#project-name').textContent.startsWith('●')")
+    block = fuzzyctl.load(browser_project / "imported.fcl").main.defuzzify_block("PL")
+    assert block is not None and block.method == "MOM"
     # Tab reaches the buttons of the menu bar in order
     pg.focus("#btn-new")
     pg.keyboard.press("Tab")
