@@ -1,11 +1,13 @@
 # Two commands do everything on a fresh machine (see README):
-#   make run   - create .venv, install, simulate the container crane demo (CSV, PNG, HTML in build/sim)
+#   make run   - create .venv, install, start the studio on the container crane (its simulated plant
+#                ready in the curve recorder) and print its URL
 #   make test  - create .venv, install dev extras and system packages, run ruff, mypy, pytest
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run docs-img test fuzz lint typecheck pytest system-deps clean
+.PHONY: run simulate docs-img test fuzz lint typecheck pytest system-deps clean
+STUDIO_PORT ?= 8770
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -23,6 +25,11 @@ system-deps:
 	@bash scripts/system-deps.sh
 
 run: $(VENV)/.installed
+	@echo "crane demo: open http://127.0.0.1:$(STUDIO_PORT)/?view=recorder and press Start (simulated process)"
+	$(BIN)/fuzzyctl studio examples/crane.fcl --port $(STUDIO_PORT)
+
+# The crane demo without a browser: CSV, PNG and HTML in build/sim.
+simulate: $(VENV)/.installed
 	$(BIN)/fuzzyctl simulate examples/crane.toml --out-dir build/sim
 
 # The plot in the README: generated from the crane example, never drawn by hand.

@@ -4,6 +4,7 @@
 set -euo pipefail
 NEEDED=(
   fuzzylite:fuzzylite  # fuzzylite 6.0 command: outside oracle for our FIS/FLL exports
+  chromium:chromium    # the browser the studio tests drive (Playwright with executable_path)
 )
 missing=()
 for entry in "${NEEDED[@]}"; do

@@ -7,4 +7,5 @@ from fuzzyctl.cli import (
     run,  # noqa: F401  (eval, explain)
     serve,  # noqa: F401  (serve: the soft controller)
     simulate,  # noqa: F401  (simulate)
+    studio,  # noqa: F401  (studio: the browser configuration tool)
 )

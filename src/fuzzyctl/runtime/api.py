@@ -189,6 +189,13 @@ class LinkInfo(BaseModel):
     points: int
 
 
+class KnowledgeBaseText(BaseModel):
+    format: str
+    origin: str
+    sha256: str
+    text: str
+
+
 class DownloadResult(BaseModel):
     format: str
     origin: str
@@ -307,6 +314,20 @@ def create_app(runtime: "Runtime") -> FastAPI:
     @app.get(f"{API_PREFIX}/statistics", response_model=dict[str, Statistics], tags=["read"])
     def read_all_statistics() -> Any:
         return {n: i.statistics() for n, i in runtime.instances.items()}
+
+    @app.get(
+        f"{API_PREFIX}/instances/{{name}}/knowledge_base", response_model=KnowledgeBaseText, tags=["read"]
+    )
+    def read_knowledge_base(name: InstanceName) -> Any:
+        """The knowledge base the instance runs, as it was loaded or downloaded (the
+        studio shows its difference to the edited one before a download)."""
+        source = get_instance(name).knowledge_base_source()
+        return {
+            "format": source.format,
+            "origin": source.origin,
+            "sha256": source.sha256,
+            "text": source.text,
+        }
 
     @app.get(f"{API_PREFIX}/links", response_model=dict[str, LinkInfo], tags=["read"])
     def read_links() -> Any:

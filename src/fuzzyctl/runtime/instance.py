@@ -35,7 +35,7 @@ from fuzzyctl.diagnostics import FuzzyctlError, InputError
 from fuzzyctl.runtime.adapters import Adapter
 from fuzzyctl.runtime.config import InstanceConfig
 from fuzzyctl.runtime.events import EventLog
-from fuzzyctl.runtime.kb import PreparedKB
+from fuzzyctl.runtime.kb import KnowledgeBaseSource, PreparedKB
 from fuzzyctl.runtime.links import InCell, Link, OutCell
 
 __all__ = ["CycleRing", "Instance", "SafetyState"]
@@ -545,6 +545,12 @@ class Instance:
                 },
                 "downloads": self.downloads,
             }
+
+    def knowledge_base_source(self) -> KnowledgeBaseSource:
+        """The text of the knowledge base the instance runs (the last one downloaded)."""
+        with self.lock:
+            source: KnowledgeBaseSource = self.adapter.kb.source
+            return source
 
     def statistics(self) -> dict[str, Any]:
         """Cycle statistics: counts over the whole run, percentiles over the kept cycles."""

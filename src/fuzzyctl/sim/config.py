@@ -31,6 +31,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzyctl.diagnostics import InputError
+from fuzzyctl.model import Document
 from fuzzyctl.sim import profiles
 from fuzzyctl.sim.integrate import make_integrator
 from fuzzyctl.sim.loop import Loop
@@ -254,16 +255,23 @@ def _pid(config: SimConfig) -> PID:
         raise InputError(f"{where}: {exc}") from None
 
 
-def build_loop(config: SimConfig, *, runtime: str | None = None, cycle: float | None = None) -> Loop:
+def build_loop(
+    config: SimConfig,
+    *,
+    runtime: str | None = None,
+    cycle: float | None = None,
+    model: Document | None = None,
+) -> Loop:
     """A fresh :class:`~fuzzyctl.sim.loop.Loop` for the configuration; ``runtime``/``cycle``
-    override the file's."""
+    override the file's, ``model`` the fuzzy controller its file holds (the studio runs the
+    knowledge base being edited)."""
     path = config.path
     try:
         plant = make_plant(config.plant, config.plant_parameters)
     except InputError as exc:
         raise InputError(f"{path}: [plant] {exc}") from None
     period = cycle if cycle is not None else config.cycle
-    structure = _structure(config, runtime or config.runtime, period)
+    structure = _structure(config, runtime or config.runtime, period, model)
     try:
         integrator = make_integrator(
             **{
@@ -294,18 +302,20 @@ def build_loop(config: SimConfig, *, runtime: str | None = None, cycle: float | 
     return loop
 
 
-def _structure(config: SimConfig, runtime: str, period: float) -> Structure:
+def _structure(config: SimConfig, runtime: str, period: float, model: Document | None = None) -> Structure:
     path, c = config.path, config.controller
     kind = c.get("structure", "direct")
     fuzzy: FuzzyRuntime | None = None
     if kind != "pid":
         import fuzzyctl
 
-        fcl = config.fcl_path
-        assert fcl is not None
-        if not fcl.exists():
-            raise InputError(f"{path}: [controller] file {c['file']!r}: no such file ({fcl})")
-        fuzzy = make_runtime(fuzzyctl.load(fcl), runtime, block=c.get("block"), cycle=period)
+        if model is None:
+            fcl = config.fcl_path
+            assert fcl is not None
+            if not fcl.exists():
+                raise InputError(f"{path}: [controller] file {c['file']!r}: no such file ({fcl})")
+            model = fuzzyctl.load(fcl)
+        fuzzy = make_runtime(model, runtime, block=c.get("block"), cycle=period)
     try:
         if kind == "direct":
             assert fuzzy is not None

@@ -1,0 +1,477 @@
+"""The studio's HTTP API (FastAPI) and its static front end.
+
+The browser holds the model being edited (fuzzyctl's JSON form) and sends it with every
+request; the server checks it, writes it as FCL, evaluates it with the engine, runs the
+simulated process and talks to a running ``fuzzyctl serve``.  Files are read and written
+only inside the project directory.  docs/studio.md is the user's guide.
+"""
+
+# No `from __future__ import annotations`: FastAPI reads the annotations at run time.
+
+import base64
+import binascii
+import math
+from pathlib import Path
+from typing import Any
+
+from fastapi import FastAPI, Request
+from fastapi.encoders import jsonable_encoder
+from fastapi.exceptions import RequestValidationError
+from fastapi.responses import FileResponse, JSONResponse, Response
+from fastapi.staticfiles import StaticFiles
+
+from fuzzyctl import __version__
+from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
+from fuzzyctl.model import Document, FunctionBlock
+from fuzzyctl.studio import analysis, online
+from fuzzyctl.studio.project import (
+    PathError,
+    ProjectDir,
+    save_atomically,
+    sha256,
+    split_settings,
+    with_settings,
+)
+from fuzzyctl.studio.schemas import (
+    DownloadBody,
+    ExplainBody,
+    ExportBody,
+    ImportBody,
+    ModelBody,
+    OnlineBody,
+    OnlineCommandBody,
+    PathBody,
+    RecordBody,
+    SaveBody,
+    SimStartBody,
+    SimStepBody,
+    SurfaceBody,
+    TextBody,
+)
+from fuzzyctl.studio.simulate import SimSessions, describe_configs
+
+STATIC = Path(__file__).parent / "static"
+MAX_BODY = 16 * 1024 * 1024
+LOCAL_HOSTS = {"127.0.0.1", "localhost", "[::1]", "::1"}
+
+
+def plotly_bundle() -> Path:
+    """plotly.js as shipped inside the ``plotly`` Python package (offline, no CDN)."""
+    import plotly
+
+    path = Path(plotly.__file__).parent / "package_data" / "plotly.min.js"
+    if not path.is_file():
+        raise FuzzyctlError(f"plotly.min.js not found in the plotly package ({path})")
+    return path
+
+
+def _clean(obj: Any) -> Any:
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: _clean(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_clean(v) for v in obj]
+    return obj
+
+
+def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.0.1") -> FastAPI:
+    """The studio for the project directory ``root``; ``file`` (relative to it) is opened
+    at start.  Requests naming another host than the one bound are refused (DNS
+    rebinding), and so are writes from another origin (CSRF)."""
+    project = ProjectDir.at(root)
+    if file is not None:
+        project.resolve(file)
+    cache = analysis.ControllerCache()
+    sims = SimSessions()
+    plotly_js = plotly_bundle()
+    app = FastAPI(
+        title="fuzzyctl studio",
+        version=__version__,
+        description="Edit, analyse, simulate and download fuzzy knowledge bases (docs/studio.md).",
+        openapi_url="/api/openapi.json",
+        docs_url="/api/docs",
+        redoc_url=None,
+    )
+    check_host = host in LOCAL_HOSTS
+
+    @app.middleware("http")
+    async def _guard(request: Request, call_next: Any) -> Response:
+        hostname = (request.headers.get("host") or "").rsplit(":", 1)[0]
+        if check_host and hostname not in LOCAL_HOSTS:
+            return JSONResponse({"detail": f"host {hostname!r} not served"}, status_code=403)
+        if request.method not in ("GET", "HEAD", "OPTIONS"):
+            origin = request.headers.get("origin")
+            if origin is not None and origin.split("://", 1)[-1] != request.headers.get("host"):
+                return JSONResponse({"detail": "cross-origin request refused"}, status_code=403)
+            length = request.headers.get("content-length")
+            if length is not None and length.isdigit() and int(length) > MAX_BODY:
+                return JSONResponse({"detail": "request too large"}, status_code=413)
+            kind = request.headers.get("content-type", "")
+            if request.url.path.startswith("/api/") and not kind.startswith("application/json"):
+                return JSONResponse({"detail": "send JSON (content-type: application/json)"}, status_code=415)
+        response: Response = await call_next(request)
+        return response
+
+    @app.exception_handler(RequestValidationError)
+    async def _invalid(_request: Request, exc: RequestValidationError) -> JSONResponse:
+        return JSONResponse({"detail": _clean(jsonable_encoder(exc.errors()))}, status_code=422)
+
+    @app.exception_handler(PathError)
+    async def _path_error(_request: Request, exc: PathError) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=403)
+
+    @app.exception_handler(online.OnlineError)
+    async def _online_error(_request: Request, exc: online.OnlineError) -> JSONResponse:
+        return JSONResponse(
+            {"detail": str(exc), "status": exc.status, "runtime": _clean(exc.body)}, status_code=502
+        )
+
+    @app.exception_handler(DiagnosticError)
+    async def _diagnostics(_request: Request, exc: DiagnosticError) -> JSONResponse:
+        return JSONResponse(
+            {"detail": exc.render(), "diagnostics": [d.to_dict() for d in exc.diagnostics]}, status_code=422
+        )
+
+    @app.exception_handler(FuzzyctlError)
+    async def _error(_request: Request, exc: FuzzyctlError) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=422)
+
+    # ------------------------------------------------------------------ helpers
+
+    def model_of(body: ModelBody) -> tuple[Document, FunctionBlock]:
+        document, _settings = split_settings(analysis.document_from_json(body.document))
+        if not document.blocks:
+            raise FuzzyctlError("the model has no function block")
+        if body.block >= len(document.blocks):
+            raise FuzzyctlError(f"block {body.block}: the model has {len(document.blocks)} function block(s)")
+        return document, document.blocks[body.block]
+
+    def settings_of(body: ModelBody) -> dict[str, Any]:
+        return body.settings.model_dump(exclude_none=True)
+
+    def opened(path: Path, text: str) -> dict[str, Any]:
+        """What the browser gets for a file: the model, the settings, the check report."""
+        from fuzzyctl.formats import read_text
+
+        rel = project.relative(path)
+        suffix = path.suffix.lower()
+        if suffix == ".fcl":
+            report = analysis.check_text(text, rel)
+            if report.document is None:
+                return {
+                    "path": rel,
+                    "text": text,
+                    "sha256": sha256(text),
+                    "document": None,
+                    **report.to_dict(),
+                }
+            document, settings = split_settings(report.document)
+        else:
+            document, settings = split_settings(read_text(text, suffix.lstrip("."), path=rel).document)
+            report = analysis.check_text(analysis.fcl_text(document), rel)
+            return {
+                "path": None,
+                "imported_from": rel,
+                "text": analysis.fcl_text(document),
+                "sha256": None,
+                "document": analysis.document_to_json(document),
+                "settings": settings,
+                "ranges": analysis.display_ranges(document.main, settings),
+                **report.to_dict(),
+            }
+        return {
+            "path": rel,
+            "text": text,
+            "sha256": sha256(text),
+            "document": analysis.document_to_json(document),
+            "settings": settings,
+            "ranges": analysis.display_ranges(document.main, settings),
+            **report.to_dict(),
+        }
+
+    # ------------------------------------------------------------------ files
+
+    @app.get("/api/info")
+    def info() -> dict[str, Any]:
+        """Version, project directory, the file opened at start, formats."""
+        from fuzzyctl import formats
+
+        return {
+            "version": __version__,
+            "root": str(project.root),
+            "file": file,
+            "formats": [
+                {
+                    "name": f.name,
+                    "extensions": list(f.extensions),
+                    "read": f.read is not None,
+                    "write": f.write is not None,
+                    "description": f.description,
+                }
+                for f in formats.available()
+            ],
+        }
+
+    @app.get("/api/files")
+    def files() -> dict[str, Any]:
+        """The files of the project directory the studio can open."""
+        return {"root": str(project.root), "files": project.listing()}
+
+    @app.post("/api/open")
+    def open_file(body: PathBody) -> Any:
+        """Read a project file (FCL), or import another format (it then has no path until
+        it is saved as FCL)."""
+        path = project.resolve(body.path, must_exist=True)
+        from fuzzyctl.formats import decode
+
+        text = decode(path.read_bytes())
+        return _clean(opened(path, text))
+
+    @app.post("/api/save")
+    def save(body: SaveBody) -> Any:
+        """Write the model as FCL (with the studio settings in an OPTIONS block),
+        atomically.  Refused when the file changed on disk since it was opened."""
+        if not body.path.lower().endswith(".fcl"):
+            raise PathError("projects are FCL files: the name must end in .fcl")
+        path = project.resolve(body.path)
+        document, _fb = model_of(body)
+        text = analysis.fcl_text(with_settings(document, settings_of(body)))
+        if path.exists():
+            current = sha256(path.read_text(encoding="utf-8", errors="replace"))
+            if body.expected_sha256 is None and not body.overwrite:
+                return JSONResponse({"detail": f"{body.path} exists", "exists": True}, status_code=409)
+            if body.expected_sha256 is not None and body.expected_sha256 != current and not body.overwrite:
+                return JSONResponse(
+                    {"detail": f"{body.path} was changed on disk since it was opened", "changed": True},
+                    status_code=409,
+                )
+        save_atomically(path, text)
+        report = analysis.check_text(text, body.path)
+        return {"path": project.relative(path), "sha256": sha256(text), "text": text, **report.to_dict()}
+
+    # ------------------------------------------------------------------ checking
+
+    @app.post("/api/check")
+    def check(body: ModelBody) -> Any:
+        """``fuzzyctl check`` of the model: diagnostics tied to elements, the conformance
+        level, the FCL text, display ranges."""
+        document, fb = model_of(body)
+        text = analysis.fcl_text(document)
+        report = analysis.check_text(text)
+        ranges = analysis.display_ranges(fb, settings_of(body))
+        return _clean(
+            {"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()}
+        )
+
+    @app.post("/api/parse")
+    def parse(body: TextBody) -> Any:
+        """The text editor: check FCL text; the model when it has no errors."""
+        report = analysis.check_text(body.text)
+        out: dict[str, Any] = report.to_dict()
+        if report.document is not None:
+            document, settings = split_settings(report.document)
+            out["document"] = analysis.document_to_json(document)
+            out["settings"] = settings
+            out["ranges"] = analysis.display_ranges(document.main, settings)
+        else:
+            out["document"] = None
+        return _clean(out)
+
+    # ------------------------------------------------------------------ analysis
+
+    @app.post("/api/surface")
+    def surface(body: SurfaceBody) -> Any:
+        """The 3D display: an output over two inputs (``evaluate_batch``), optionally one
+        frame per step of a third input (4D); every grid point is a fresh evaluation."""
+        _doc, fb = model_of(body)
+        ranges = analysis.display_ranges(fb, settings_of(body))
+        return analysis.surface(
+            cache.get(analysis.pointwise(fb), "surface"),
+            fb,
+            x=body.x,
+            y=body.y,
+            z=body.z,
+            fixed=body.fixed,
+            ranges=ranges,
+            points=body.points,
+            animate=body.animate,
+            step_percent=body.step_percent,
+        )
+
+    @app.post("/api/explain")
+    def explain(body: ExplainBody) -> Any:
+        """Term degrees, rule degrees, accumulated sets and outputs at one point."""
+        _doc, fb = model_of(body)
+        return analysis.explain(cache.get(fb, "explain"), body.inputs)
+
+    @app.post("/api/record")
+    def record(body: RecordBody) -> Any:
+        """The curve recorder's off-line test: test signals at the given times and the
+        outputs of successive evaluations (``reset`` starts a new recording)."""
+        _doc, fb = model_of(body)
+        ranges = analysis.display_ranges(fb, settings_of(body))
+        signals = {k: v.model_dump() for k, v in body.signals.items()}
+        return analysis.record(
+            cache.get(fb, "recorder"),
+            fb,
+            signals=signals,
+            times=body.times,
+            length=body.length,
+            ranges=ranges,
+            reset=body.reset,
+        )
+
+    # ------------------------------------------------------------------ formats
+
+    @app.post("/api/import")
+    def import_file(body: ImportBody) -> Any:
+        """Read an uploaded file in any format ``fuzzyctl convert`` knows."""
+        from fuzzyctl import formats
+
+        try:
+            data = base64.b64decode(body.data_base64, validate=True)
+        except (binascii.Error, ValueError):
+            raise InputError("data_base64 is not base64") from None
+        fmt = formats.get(body.format) if body.format else formats.for_path(body.filename)
+        loaded = formats.read_text(formats.decode(data), fmt.name, path=body.filename)
+        document, settings = split_settings(loaded.document)
+        text = analysis.fcl_text(document)
+        report = analysis.check_text(text)
+        return _clean(
+            {
+                "format": fmt.name,
+                "document": analysis.document_to_json(document),
+                "settings": settings,
+                "text": text,
+                "ranges": analysis.display_ranges(document.main, settings),
+                "warnings": [d.to_dict() for d in loaded.diagnostics],
+                **report.to_dict(),
+            }
+        )
+
+    @app.post("/api/export")
+    def export(body: ExportBody) -> Any:
+        """The model in another format.  Without ``lossy`` a format that cannot express
+        everything answers ``losses`` and no text, so the browser can ask first."""
+        from fuzzyctl import formats
+
+        document, _fb = model_of(body)
+        fmt = formats.get(body.format)
+        if fmt.write is None:
+            raise FuzzyctlError(f"format {fmt.name!r} can be read but not written")
+        losses = [str(loss) for loss in fmt.losses(document)]
+        if losses and not body.lossy:
+            return {"format": fmt.name, "losses": losses, "text": None}
+        text, _ = formats.convert(document, fmt.name, lossy=True)
+        name = (document.main.name or "project") + fmt.extensions[0]
+        return {"format": fmt.name, "losses": losses, "text": text, "filename": name}
+
+    # ------------------------------------------------------------------ simulation
+
+    @app.get("/api/sim/configs")
+    def sim_configs(current: str | None = None) -> Any:
+        """The loop configurations (TOML) in the project directory."""
+        listing = [f["path"] for f in project.listing()]
+        return {"configs": _clean(describe_configs(project.root, listing, current))}
+
+    @app.post("/api/sim/start")
+    def sim_start(body: SimStartBody) -> Any:
+        """Build the loop of a configuration around the edited knowledge base."""
+        path = project.resolve(body.config, must_exist=True)
+        _doc, fb = model_of(body)
+        _sid, result = sims.start(path, fb, parameters=body.parameters, setpoints=body.setpoints)
+        return _clean(result)
+
+    @app.post("/api/sim/step")
+    def sim_step(body: SimStepBody) -> Any:
+        """Run the next ``seconds`` of a loop; the rows recorded."""
+        try:
+            return sims.step(body.id, body.seconds)
+        except KeyError:
+            return JSONResponse(
+                {"detail": "no such simulation (it was stopped or replaced)"}, status_code=404
+            )
+
+    @app.delete("/api/sim/{sid}")
+    def sim_stop(sid: str) -> dict[str, bool]:
+        return {"stopped": sims.stop(sid)}
+
+    # ------------------------------------------------------------------ on line
+
+    @app.post("/api/online/instances")
+    def online_instances(body: OnlineBody) -> Any:
+        """Connect: the runtime's health and instances."""
+        health = online.call(body.url, "GET", "/health")
+        instances = online.call(body.url, "GET", "/instances")
+        return {"health": health, "instances": instances, "api": online.base_url(body.url)}
+
+    @app.post("/api/online/read")
+    def online_read(body: OnlineBody) -> Any:
+        """Live values of the chosen instance."""
+        if not body.instance:
+            raise InputError("choose an instance")
+        return online.call(body.url, "GET", f"/instances/{online.quote(body.instance)}")
+
+    @app.post("/api/online/command")
+    def online_command(body: OnlineCommandBody) -> Any:
+        """START_STOP, MAN_AUTO, forcing and manual values (need the token)."""
+        if not body.instance:
+            raise InputError("choose an instance")
+        base = f"/instances/{online.quote(body.instance)}"
+        tok = body.token
+        if body.action in ("start", "stop"):
+            return online.call(
+                body.url, "PUT", f"{base}/start_stop", token=tok, body={"running": body.action == "start"}
+            )
+        if body.action in ("auto", "manual"):
+            return online.call(body.url, "PUT", f"{base}/mode", token=tok, body={"mode": body.action})
+        if not body.target:
+            raise InputError(f"{body.action}: name the input or output")
+        target = online.quote(body.target)
+        if body.action == "release":
+            return online.call(body.url, "DELETE", f"{base}/force/{target}", token=tok)
+        if body.value is None:
+            raise InputError(f"{body.action}: give a value")
+        where = "force" if body.action == "force" else "manual"
+        return online.call(body.url, "PUT", f"{base}/{where}/{target}", token=tok, body={"value": body.value})
+
+    @app.post("/api/online/diff")
+    def online_diff(body: DownloadBody) -> Any:
+        """The running knowledge base and the edited one, both as FCL (the confirm
+        dialog of a download shows their difference)."""
+        if not body.instance:
+            raise InputError("choose an instance")
+        running = online.knowledge_base_fcl(body.url, body.instance)
+        _document, fb = model_of(body)
+        return {"running": running, "edited": analysis.fcl_text(Document((fb,)))}
+
+    @app.post("/api/online/download")
+    def online_download(body: DownloadBody) -> Any:
+        """Send the edited knowledge base (FCL, without the studio's settings)."""
+        if not body.instance:
+            raise InputError("choose an instance")
+        _document, fb = model_of(body)
+        text = analysis.fcl_text(Document((fb,)))
+        return online.call(
+            body.url,
+            "PUT",
+            f"/instances/{online.quote(body.instance)}/knowledge_base",
+            token=body.token,
+            body={"text": text, "format": "fcl"},
+        )
+
+    # ------------------------------------------------------------------ front end
+
+    @app.get("/vendor/plotly.min.js", include_in_schema=False)
+    def plotly_file() -> FileResponse:
+        return FileResponse(
+            plotly_js, media_type="text/javascript", headers={"Cache-Control": "max-age=86400"}
+        )
+
+    @app.get("/", include_in_schema=False)
+    def index() -> FileResponse:
+        return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
+
+    app.mount("/static", StaticFiles(directory=STATIC), name="static")
+    return app

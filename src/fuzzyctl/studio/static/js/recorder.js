@@ -1,0 +1,512 @@
+// The curve recorder (manual 6.7): up to five variables against time, display length
+// 10-9999 s with 150 values per display, an archive of 500 records, a reading line, the
+// bars of rule effectiveness over the output's singletons with the centre of gravity.
+// Sources: test signals (off line), a simulated process (issue 9), a running runtime.
+import { state, on, inputs, outputs, range, body, fmt, status, isInput } from "./state.js";
+import { post, del } from "./api.js";
+import { $, el, plot, openDialog, COLORS } from "./ui.js";
+import { setTrajectory } from "./surface.js";
+import { online } from "./online.js";
+
+const POINTS = 150;
+const ARCHIVE = 500;
+let archive = []; // [{t, v: {name: value}}]
+let running = null;
+let t0 = 0; // left edge of the display
+let simTime = 0; // recorder time reached
+let k = 0; // samples taken
+let busy = false;
+let sim = null; // {id, info, config}
+let simTrace = null; // full-resolution fuzzy signals for the 3D overlay
+let configs = [];
+let selectedCurve = 0;
+let lastBars = 0;
+
+function rec() {
+  return (state.settings.recorder ||= { curves: [], length: 60, signals: {} });
+}
+const source = () => $("#rec-source").value;
+const length = () => rec().length || 60;
+const dt = () => length() / POINTS;
+
+function available() {
+  if (source() === "sim" && sim) return sim.info.columns.filter((c) => c !== "t");
+  if (source() === "online" && online.detail) return [...Object.keys(online.detail.inputs || {}), ...Object.keys(online.detail.outputs || {})];
+  return [...inputs(), ...outputs()].map((v) => v.name);
+}
+
+function fuzzyName(name) {
+  return name.startsWith("fb.") ? name.slice(3) : name;
+}
+
+function scale(name) {
+  const base = fuzzyName(name);
+  if ([...inputs(), ...outputs()].some((v) => v.name === base) && (source() !== "sim" || name.startsWith("fb."))) return range(base);
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (const r of archive) {
+    const v = r.v[name];
+    if (typeof v === "number") {
+      lo = Math.min(lo, v);
+      hi = Math.max(hi, v);
+    }
+  }
+  if (!Number.isFinite(lo)) return [0, 1];
+  if (hi - lo < 1e-9) return [lo - 1, hi + 1];
+  const pad = (hi - lo) * 0.05;
+  return [lo - pad, hi + pad];
+}
+
+// --- curve and signal selection --------------------------------------------------------
+
+function renderCurves() {
+  const names = available();
+  const r = rec();
+  r.curves = (r.curves || []).filter((c) => names.includes(c)).slice(0, 5);
+  if (!r.curves.length) r.curves = names.slice(0, Math.min(5, names.length));
+  const tbody = $("#rec-curves tbody");
+  tbody.replaceChildren();
+  for (let i = 0; i < 5; i++) {
+    const radio = el("input", { type: "radio", name: "rec-curve", checked: i === selectedCurve, "aria-label": `curve ${i + 1}` });
+    radio.addEventListener("change", () => {
+      selectedCurve = i;
+      draw();
+    });
+    const select = el("select", { "aria-label": `curve ${i + 1} variable`, id: `rec-curve-${i}` }, el("option", { value: "" }, "—"), ...names.map((n) => el("option", { value: n, selected: r.curves[i] === n }, n)));
+    select.addEventListener("change", () => {
+      const list = [...r.curves];
+      list[i] = select.value;
+      r.curves = list.filter(Boolean);
+      renderCurves();
+      draw();
+    });
+    tbody.append(el("tr", { style: `--c:${COLORS[i]}` }, el("td", {}, radio, el("span", { class: "swatch" })), el("td", {}, select), el("td", { class: "num", id: `rec-cur-${i}` }, "")));
+  }
+  const outs = source() === "sim" ? outputs().map((v) => v.name) : outputs().map((v) => v.name);
+  const bar = $("#rec-bar-output");
+  if (!outs.includes(r.bar_output)) r.bar_output = outs[0];
+  bar.replaceChildren(...outs.map((n) => el("option", { value: n, selected: n === r.bar_output }, n)));
+}
+
+function signalOf(name) {
+  const r = rec();
+  r.signals ||= {};
+  const s = r.signals[name];
+  return s ? { kind: "constant", value: 0, ...s } : { kind: "constant", value: (range(name)[0] + range(name)[1]) / 2 };
+}
+
+function describe(s) {
+  if (s.kind === "constant") return `Constant ${fmt(s.value)}`;
+  if (s.kind === "triangle") return `Curve ${fmt(s.min)}…${fmt(s.max)}, ${fmt(s.periods)} per., ${fmt(s.duty)} %, ${fmt(s.phase)} %`;
+  return s.kind[0].toUpperCase() + s.kind.slice(1);
+}
+
+function renderSignals() {
+  const row = $("#rec-test");
+  row.replaceChildren(el("span", { class: "hint" }, "Curve parameters:"));
+  for (const v of inputs()) {
+    const button = el("button", { id: `rec-sig-${v.name}`, title: "set the test signal" }, `${v.name}: ${describe(signalOf(v.name))}`);
+    button.addEventListener("click", () => editSignal(v.name));
+    row.append(button);
+  }
+  const outs = el("span", { class: "hint", id: "rec-outputs-now" }, "");
+  row.append(outs);
+}
+
+async function editSignal(name) {
+  const s = { ...signalOf(name) };
+  const [lo, hi] = range(name);
+  $("#sig-input").textContent = name;
+  $("#sig-kind").value = s.kind;
+  $("#sig-value").value = s.value ?? (lo + hi) / 2;
+  $("#sig-min").value = s.min ?? lo;
+  $("#sig-max").value = s.max ?? hi;
+  $("#sig-periods").value = s.periods ?? 1;
+  $("#sig-duty").value = s.duty ?? 50;
+  $("#sig-phase").value = s.phase ?? 0;
+  const read = () => ({
+    kind: $("#sig-kind").value,
+    value: parseFloat($("#sig-value").value) || 0,
+    min: parseFloat($("#sig-min").value),
+    max: parseFloat($("#sig-max").value),
+    periods: Math.max(0.01, parseFloat($("#sig-periods").value) || 1),
+    duty: Math.max(0, Math.min(100, parseFloat($("#sig-duty").value) || 0)),
+    phase: Math.max(0, Math.min(100, parseFloat($("#sig-phase").value) || 0)),
+  });
+  const preview = async () => {
+    const sig = read();
+    $("#sig-triangle").disabled = sig.kind !== "triangle";
+    $("#sig-value").disabled = sig.kind !== "constant";
+    const times = Array.from({ length: POINTS }, (_, i) => i * dt());
+    try {
+      const res = await post("/api/record", body({ signals: { [name]: clean(sig, lo, hi) }, times, length: length(), reset: true }));
+      plot($("#sig-preview"), [{ x: res.t, y: res.values[name], mode: "lines", line: { color: COLORS[0] } }], { margin: { l: 40, r: 10, t: 10, b: 30 }, yaxis: { range: [lo, hi] } }, { staticPlot: true });
+    } catch (err) {
+      status(err.message, "error");
+    }
+  };
+  const dialog = $("#dlg-signal");
+  const handler = () => preview();
+  dialog.addEventListener("change", handler);
+  preview();
+  const answer = await openDialog("#dlg-signal", $("#sig-kind"));
+  dialog.removeEventListener("change", handler);
+  if (answer !== "ok") return;
+  rec().signals[name] = clean(read(), lo, hi);
+  renderSignals();
+}
+
+function clean(sig, lo, hi) {
+  const out = { kind: sig.kind };
+  if (sig.kind === "constant") out.value = sig.value;
+  if (sig.kind === "triangle") Object.assign(out, { min: Number.isFinite(sig.min) ? sig.min : lo, max: Number.isFinite(sig.max) ? sig.max : hi, periods: sig.periods, duty: sig.duty, phase: sig.phase });
+  return out;
+}
+
+// --- simulated process ----------------------------------------------------------------
+
+async function renderSim() {
+  const row = $("#rec-sim");
+  row.replaceChildren();
+  try {
+    configs = (await fetch(`/api/sim/configs?current=${encodeURIComponent(state.path || "")}`).then((r) => r.json())).configs || [];
+  } catch (_) {
+    configs = [];
+  }
+  if (!configs.length) {
+    row.append(el("span", { class: "hint" }, "No loop configuration (TOML with a [plant] table, docs/sim.md) in the project directory."));
+    return;
+  }
+  const r = rec();
+  if (!configs.some((c) => c.path === r.loop)) r.loop = configs[0].path;
+  const select = el("select", { id: "rec-loop", "aria-label": "plant" }, ...configs.map((c) => el("option", { value: c.path, selected: c.path === r.loop }, `${c.title} (${c.plant}${c.matches ? ", this controller" : ""})`)));
+  select.addEventListener("change", () => {
+    r.loop = select.value;
+    renderSim();
+  });
+  row.append(el("label", {}, "Plant ", select));
+  const c = configs.find((x) => x.path === r.loop);
+  const box = el("details", { class: "params" }, el("summary", {}, "Plant parameters and setpoints"));
+  for (const p of c.parameters) {
+    box.append(el("label", { title: p.doc }, `${p.name} [${p.unit}] `, el("input", { type: "number", step: "any", value: p.value, size: 7, "data-param": p.name })));
+  }
+  for (const [name, value] of Object.entries(c.setpoints)) {
+    box.append(el("label", {}, `setpoint ${name} `, el("input", { type: "number", step: "any", value, size: 7, "data-setpoint": name })));
+  }
+  row.append(box, el("span", { class: "hint" }, ` inputs: ${Object.entries(c.inputs).map(([k, v]) => `${k} = ${v}`).join(", ")}`));
+}
+
+async function startSim() {
+  const r = rec();
+  const parameters = {};
+  const setpoints = {};
+  for (const input of document.querySelectorAll("#rec-sim [data-param]")) {
+    const v = parseFloat(input.value);
+    if (Number.isFinite(v)) parameters[input.dataset.param] = v;
+  }
+  for (const input of document.querySelectorAll("#rec-sim [data-setpoint]")) {
+    const v = parseFloat(input.value);
+    if (Number.isFinite(v)) setpoints[input.dataset.setpoint] = v;
+  }
+  if (sim) del(`/api/sim/${sim.id}`).catch(() => {});
+  const info = await post("/api/sim/start", body({ config: r.loop, parameters, setpoints }));
+  sim = { id: info.id, info };
+  simTrace = Object.fromEntries(info.columns.map((c) => [c, []]));
+  const fuzzy = [...info.fuzzy.inputs, ...info.fuzzy.outputs].map((n) => `fb.${n}`);
+  const measured = info.columns.filter((c) => c !== "t" && !c.startsWith("fb."));
+  r.curves = [...fuzzy, ...measured].filter((c) => info.columns.includes(c)).slice(0, 5);
+}
+
+// --- sampling ----------------------------------------------------------------------
+
+async function sample() {
+  if (busy || !running) return;
+  busy = true;
+  const session = running;
+  try {
+    const speed = source() === "online" ? 1 : +$("#rec-speed").value;
+    simTime += 0.1 * speed;
+    const due = Math.floor(simTime / dt()) + 1 - k;
+    if (due <= 0) return;
+    const n = Math.min(due, 500);
+    if (source() === "test") {
+      const times = Array.from({ length: n }, (_, i) => (k + i) * dt());
+      const res = await post("/api/record", body({ signals: rec().signals || {}, times, length: length(), reset: k === 0 }));
+      if (session !== running) return; // stopped meanwhile: the recording ended at Stop
+      res.t.forEach((t, i) => push(t, Object.fromEntries(Object.entries(res.values).map(([name, vs]) => [name, vs[i]]))));
+    } else if (source() === "sim") {
+      const res = await post("/api/sim/step", { id: sim.id, seconds: n * dt() });
+      if (session !== running) return;
+      const rows = res.rows;
+      const count = rows.t.length;
+      for (const [c, vs] of Object.entries(rows)) simTrace[c].push(...vs);
+      // keep the rows at the recorder's sampling instants
+      for (let i = 0; i < count; i++) {
+        const t = rows.t[i];
+        if (t + 1e-9 >= k * dt()) push(t, Object.fromEntries(Object.keys(rows).map((c) => [c, rows[c][i]])));
+      }
+      shareTrajectory();
+    } else {
+      const detail = await post("/api/online/read", { url: online.url, instance: online.instance });
+      if (session !== running) return;
+      online.detail = detail;
+      push(k * dt(), { ...detail.inputs, ...detail.outputs });
+    }
+    draw();
+    if (Date.now() - lastBars > 300) {
+      lastBars = Date.now();
+      bars(archive[archive.length - 1]);
+    }
+  } catch (err) {
+    stop();
+    status(err.message, "error");
+  } finally {
+    busy = false;
+  }
+}
+
+function push(t, values) {
+  archive.push({ t, v: values });
+  if (archive.length > ARCHIVE) archive.shift();
+  k++;
+  while (t > t0 + length()) t0 += length() / 4; // the manual's shift by a quarter
+}
+
+function shareTrajectory() {
+  const fuzzy = sim.info.fuzzy;
+  const points = {};
+  for (const n of [...fuzzy.inputs, ...fuzzy.outputs]) points[n] = simTrace[`fb.${n}`];
+  setTrajectory({ points });
+}
+
+// --- drawing ---------------------------------------------------------------------------
+
+function windowRecords() {
+  return archive.filter((r) => r.t >= t0 - 1e-9 && r.t <= t0 + length() + 1e-9);
+}
+
+function readingRecord() {
+  const t = t0 + (+$("#rec-read").value) * dt();
+  let best = null;
+  for (const r of archive) if (!best || Math.abs(r.t - t) < Math.abs(best.t - t)) best = r;
+  return best;
+}
+
+function draw() {
+  const r = rec();
+  const shown = windowRecords();
+  const traces = r.curves.map((name, i) => {
+    const [lo, hi] = scale(name);
+    return { x: shown.map((x) => x.t), y: shown.map((x) => (typeof x.v[name] === "number" ? (x.v[name] - lo) / (hi - lo) : null)), mode: "lines", line: { color: COLORS[i], width: i === selectedCurve ? 2.5 : 1.5 }, name, hoverinfo: "skip" };
+  });
+  const sel = r.curves[selectedCurve] || r.curves[0];
+  const [lo, hi] = sel ? scale(sel) : [0, 1];
+  const ticks = [0, 0.25, 0.5, 0.75, 1];
+  const stopped = !running;
+  const reading = stopped && archive.length ? readingRecord() : null;
+  const shapes = reading ? [{ type: "line", x0: reading.t, x1: reading.t, y0: -0.02, y1: 1.02, line: { color: "#333", width: 1.5 } }] : [];
+  plot($("#rec-chart"), traces, {
+    xaxis: { range: [t0, t0 + length()], title: { text: "time [s]" } },
+    yaxis: { range: [-0.03, 1.03], tickvals: ticks, ticktext: ticks.map((f) => fmt(lo + f * (hi - lo), 4)), title: { text: sel || "" } },
+    shapes,
+    margin: { l: 60, r: 15, t: 10, b: 40 },
+  }, { staticPlot: true });
+  const last = reading || archive[archive.length - 1];
+  r.curves.forEach((name, i) => {
+    const cell = $(`#rec-cur-${i}`);
+    if (cell) cell.textContent = last ? fmt(last.v[name]) : "";
+  });
+  for (let i = r.curves.length; i < 5; i++) if ($(`#rec-cur-${i}`)) $(`#rec-cur-${i}`).textContent = "";
+  const scroll = $("#rec-scroll");
+  const span = archive.length ? archive[archive.length - 1].t - archive[0].t : 0;
+  scroll.max = String(Math.max(0, Math.round((span - length()) / dt())));
+  scroll.disabled = running !== null || +scroll.max === 0;
+  $("#rec-read").disabled = running !== null || !archive.length;
+  if (reading) values(reading);
+}
+
+function values(record) {
+  const tbody = $("#rec-values tbody");
+  tbody.replaceChildren(el("tr", {}, el("th", {}, "t [s]"), el("td", { class: "num", id: "rec-val-t", "data-value": record.t }, fmt(record.t))));
+  for (const [name, v] of Object.entries(record.v)) {
+    if (name === "t") continue;
+    tbody.append(el("tr", {}, el("th", {}, name), el("td", { class: "num", id: `rec-val-${name.replace(/\./g, "_")}`, "data-value": v ?? "" }, fmt(v))));
+  }
+}
+
+async function bars(record) {
+  if (!record || !state.doc) return;
+  const point = {};
+  for (const v of inputs()) {
+    const value = source() === "sim" ? record.v[`fb.${v.name}`] : record.v[v.name];
+    if (typeof value !== "number") return;
+    point[v.name] = value;
+  }
+  const output = rec().bar_output;
+  let e;
+  try {
+    e = await post("/api/explain", body({ inputs: point }));
+  } catch (err) {
+    return;
+  }
+  const b = state.doc.blocks[state.block];
+  const blk = b.defuzzify.find((d) => d.variable === output);
+  if (!blk) return;
+  const curves = (state.report.curves || {})[output] || {};
+  const position = (term) => {
+    const t = blk.terms.find((x) => x.name === term);
+    if (t && t.mf.type === "singleton" && typeof t.mf.value === "number") return t.mf.value;
+    const c = curves[term];
+    if (c && c.points) {
+      const top = Math.max(...c.points.map((p) => p[1]));
+      const xs = c.points.filter((p) => p[1] === top).map((p) => p[0]);
+      return xs.reduce((a, x) => a + x, 0) / xs.length;
+    }
+    return null;
+  };
+  const xs = [];
+  const ys = [];
+  const labels = [];
+  for (const r of e.rules) {
+    for (const c of r.conclusions) {
+      if (c.variable !== output || c.term === null) continue;
+      const x = position(c.term);
+      if (x === null) continue;
+      xs.push(x);
+      ys.push(r.degree * c.weight);
+      labels.push(r.label);
+    }
+  }
+  const o = e.outputs.find((x) => x.name === output);
+  const [lo, hi] = range(output);
+  const width = (hi - lo) / 60;
+  plot($("#rec-bars"), [
+    { type: "bar", x: xs, y: ys, width: xs.map(() => width), text: labels, textposition: "inside", insidetextanchor: "start", marker: { color: COLORS[0] }, hoverinfo: "skip" },
+    { x: [o.value], y: [-0.06], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
+  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${fmt(o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12, 1.05], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
+  $("#rec-bars").dataset.value = String(o.value);
+  $("#rec-bars").dataset.rules = JSON.stringify(labels.map((l, i) => [l, ys[i]]));
+}
+
+// --- start / stop ----------------------------------------------------------------------
+
+async function start() {
+  stop();
+  archive = [];
+  t0 = 0;
+  simTime = -0.1 * (source() === "online" ? 1 : +$("#rec-speed").value);
+  k = 0;
+  try {
+    if (source() === "sim") await startSim();
+    if (source() === "online" && !(online.url && online.instance)) throw new Error("connect to a runtime and pick an instance on the On line view first");
+  } catch (err) {
+    status(err.message, "error");
+    return;
+  }
+  renderCurves();
+  running = setInterval(sample, 100);
+  busy = false;
+  $("#rec-start").disabled = true;
+  $("#rec-stop").disabled = false;
+  $("#view-recorder").dataset.running = "true";
+  sample();
+  status(`curve recorder running (${source()})`);
+}
+
+function stop() {
+  if (running) clearInterval(running);
+  const was = running !== null;
+  running = null;
+  $("#rec-start").disabled = false;
+  $("#rec-stop").disabled = true;
+  $("#view-recorder").dataset.running = "false";
+  if (was) {
+    $("#rec-read").value = String(Math.min(POINTS - 1, Math.round((archive.length ? archive[archive.length - 1].t - t0 : 0) / dt())));
+    draw();
+    const r = readingRecord();
+    if (r) bars(r);
+    status(`curve recorder stopped: ${archive.length} record(s) in the archive; move the reading line`);
+  }
+}
+
+function setLength(value) {
+  const v = Math.max(10, Math.min(9999, value || 60));
+  rec().length = v;
+  $("#rec-length").value = v;
+  $("#rec-sampling").textContent = `sampling time ${fmt(v / POINTS, 4)} s, archive ${ARCHIVE} records`;
+}
+
+function layout() {
+  const src = source();
+  $("#rec-test").hidden = src !== "test";
+  $("#rec-sim").hidden = src !== "sim";
+  $("#rec-speed").disabled = src === "online";
+  if (src === "sim") renderSim();
+  renderSignals();
+  renderCurves();
+  draw();
+}
+
+export function init() {
+  $("#rec-source").addEventListener("change", () => {
+    stop();
+    layout();
+  });
+  $("#rec-length").addEventListener("change", (e) => setLength(parseFloat(e.target.value)));
+  $("#rec-start").addEventListener("click", start);
+  $("#rec-stop").addEventListener("click", stop);
+  $("#rec-stop").disabled = true;
+  $("#rec-scroll").addEventListener("input", (e) => {
+    const first = archive.length ? archive[0].t : 0;
+    t0 = first + +e.target.value * dt();
+    draw();
+    const r = readingRecord();
+    if (r) bars(r);
+  });
+  $("#rec-read").addEventListener("input", () => {
+    draw();
+    const r = readingRecord();
+    if (r) bars(r);
+  });
+  $("#rec-bar-output").addEventListener("change", (e) => {
+    rec().bar_output = e.target.value;
+    const r = running ? archive[archive.length - 1] : readingRecord();
+    if (r) bars(r);
+  });
+  document.addEventListener("keydown", (e) => {
+    if (!$("#view-recorder").hidden && e.altKey && e.key.toLowerCase() === "s") {
+      e.preventDefault();
+      running ? stop() : start();
+    }
+  });
+  on("loaded", () => {
+    stop();
+    archive = [];
+    sim = null;
+    // a loop configuration made for this controller: the simulated process is ready
+    if ($("#rec-source").dataset.touched) return;
+    fetch(`/api/sim/configs?current=${encodeURIComponent(state.path || "")}`)
+      .then((r) => r.json())
+      .then((res) => {
+        const match = (res.configs || []).find((c) => c.matches);
+        if (match && !$("#rec-source").dataset.touched) {
+          rec().loop = match.path;
+          $("#rec-source").value = "sim";
+          if (!$("#view-recorder").hidden) layout();
+        }
+      })
+      .catch(() => {});
+  });
+  $("#rec-source").addEventListener("change", () => ($("#rec-source").dataset.touched = "true"));
+}
+
+export function shown() {
+  if (!state.doc) return;
+  setLength(length());
+  layout();
+}
+
+export function isRunning() {
+  return running !== null;
+}
+export { isInput };

@@ -1,0 +1,74 @@
+"""Browser fixtures shared by the studio's Playwright tests: one studio server and one
+chromium (Debian's, no browser download) for the whole session, a fresh page per test
+that fails the test on any console error and leaves a screenshot in test-artifacts/."""
+
+from __future__ import annotations
+
+import shutil
+import socket
+import threading
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from fuzzyctl.studio import create_app
+from tests.conftest import EXAMPLES
+from tests.studio.browser import ARGS, ARTIFACTS, CHROMIUM
+
+
+@pytest.fixture(scope="session")
+def browser_project(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The studio's project directory: a copy of some examples."""
+    root = tmp_path_factory.mktemp("studio-project")
+    for name in ("crane.fcl", "crane.toml", "siemens_fpltest.fcl"):
+        shutil.copy(EXAMPLES / name, root / name)
+    return root
+
+
+@pytest.fixture(scope="session")
+def studio(browser_project: Path) -> Iterator[str]:
+    import uvicorn
+
+    app = create_app(browser_project)
+    sock = socket.socket()
+    sock.bind(("127.0.0.1", 0))
+    port = sock.getsockname()[1]
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="off"))
+    thread = threading.Thread(target=server.run, kwargs={"sockets": [sock]}, daemon=True)
+    thread.start()
+    deadline = time.monotonic() + 10
+    while not server.started and time.monotonic() < deadline:
+        time.sleep(0.05)
+    yield f"http://127.0.0.1:{port}/"
+    server.should_exit = True
+    thread.join(5)
+
+
+@pytest.fixture(scope="session")
+def browser() -> Iterator[Any]:
+    sync_api = pytest.importorskip("playwright.sync_api")
+    if not Path(CHROMIUM).exists():
+        pytest.fail(f"{CHROMIUM} missing: `make test` installs Debian's chromium (scripts/system-deps.sh)")
+    with sync_api.sync_playwright() as p:
+        b = p.chromium.launch(executable_path=CHROMIUM, args=ARGS)
+        yield b
+        b.close()
+
+
+@pytest.fixture
+def page(browser: Any, studio: str, request: pytest.FixtureRequest) -> Iterator[Any]:
+    context = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
+    pg = context.new_page()
+    errors: list[str] = []
+    pg.on("console", lambda m: m.type == "error" and errors.append(m.text))
+    pg.on("pageerror", lambda e: errors.append(f"{e} {e.stack}"))
+    pg.goto(studio)
+    pg.wait_for_selector("body[data-ready=true]")
+    yield pg
+    ARTIFACTS.mkdir(parents=True, exist_ok=True)
+    pg.screenshot(path=str(ARTIFACTS / f"{request.node.name}-end.png"))
+    context.close()
+    assert errors == [], f"console errors: {errors}"
