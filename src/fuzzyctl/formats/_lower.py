@@ -43,8 +43,9 @@ from fuzzyctl.model import (
 # equals a MATLAB/fuzzylite rule weight.
 POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
 DEFAULT_WHEN_ABSENT = 0.0
-"""What our engine outputs when no rule fired and no DEFAULT is written (IEC 61131-7
-leaves it open; fuzzyctl uses 0, see docs/formats.md)."""
+"""What our engine outputs before any rule has fired when no DEFAULT value is written: an
+output without DEFAULT, or with ``DEFAULT := NC``, keeps its previous value (docs/engine.md),
+which FIS and FLL say as ``Default=0`` with ``LockPrevious=1`` / ``lock-previous: true``."""
 
 
 def rule_label(block: RuleBlock, rule: Rule) -> str:
@@ -223,8 +224,8 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
     # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
     defuzzify = []
     for d in fb.defuzzify:
-        default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT)
-        if default.value is None:
+        default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT, no_change=True)
+        if default.value is None:  # DEFAULT := NC: 0 until a rule fires (the engine's NC start)
             default = Default(DEFAULT_WHEN_ABSENT, default.no_change)
         defuzzify.append(replace(d, default=default))
     fb = replace(fb, rule_blocks=tuple(new_blocks), defuzzify=tuple(defuzzify))

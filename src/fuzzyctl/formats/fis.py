@@ -23,7 +23,7 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Format, Loaded
@@ -542,8 +542,9 @@ def _rules(
                     code="fis-unsupported",
                 )
             index, hedges, _ = _hedges(code, dialect, rep, line)
-            if hedges and dialect == "fuzzylite":
-                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py)
+            if dialect == "fuzzylite":
+                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py):
+                # a conclusion without hedges of its own still gets the earlier ones
                 hedges = running = (*hedges, *running)
             elif hedges:
                 if not all(_is_ts_term(t.mf) for t in var.terms):
@@ -724,6 +725,14 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
                 clamp=_flag(var.entries, "LockRange", rep),
             )
         )
+    # AggMethod is the aggregation of Mamdani outputs; Sugeno outputs weigh every rule on its
+    # own (MATLAB, and fuzzylite's "aggregation: none").  With both kinds in one file
+    # (fuzzylite's hybrid) it is said on the Mamdani outputs alone.
+    block_accu: str | None = None
+    if any_mamdani_output and all(d.method not in {"WTAVER", "WTSUM"} for d in defuzzify):
+        block_accu = accu
+    elif any_mamdani_output:
+        defuzzify = [d if d.method in {"WTAVER", "WTSUM"} else replace(d, accu=accu) for d in defuzzify]
     rules = _rules(rules_s, inputs, outputs, rep, dialect, count("NumRules"), system.line)
     rep.raise_if_errors()
     name_entry = system_value("Name")
@@ -744,7 +753,7 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             for v in inputs
         ),
         defuzzify=tuple(defuzzify),
-        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, accu if any_mamdani_output else None),)
+        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, block_accu),)
         if rules_s is not None
         else (),
         span=rep.span(system.line),
