@@ -95,7 +95,11 @@ def case(draw: Any) -> tuple[m.FunctionBlock, str]:
                 v, tuple(m.Term(f"t{j}", s[0]) for j, s in enumerate(sets)), m.Range(*IN_RANGE), clamp=lock
             )
         )
-        fll += [f"InputVariable: {v}", f"  range: {IN_RANGE[0]} {IN_RANGE[1]}", f"  lock-range: {lock}".lower()]
+        fll += [
+            f"InputVariable: {v}",
+            f"  range: {IN_RANGE[0]} {IN_RANGE[1]}",
+            f"  lock-range: {lock}".lower(),
+        ]
         fll += [f"  term: t{j} {s[1]}" for j, s in enumerate(sets)]
     k_out = draw(st.integers(2, 4))
     out_terms: list[m.Term] = []
@@ -137,7 +141,9 @@ def case(draw: Any) -> tuple[m.FunctionBlock, str]:
         w = round(draw(st.floats(0.1, 1.0)), 2) if draw(st.booleans()) else None
         rules.append(m.Rule(str(r + 1), cond, (m.Conclusion("y", o),), weight=w))
         texts.append(f"if {text} then y is {o}" + (f" with {w}" if w is not None else ""))
-    blocks = [m.RuleBlock("rb", tuple(rules), and_op, or_op, act, None if ts else "MAX", rule_activation=activation)]
+    blocks = [
+        m.RuleBlock("rb", tuple(rules), and_op, or_op, act, None if ts else "MAX", rule_activation=activation)
+    ]
     fll += [
         "RuleBlock: rb",
         "  enabled: true",
@@ -197,7 +203,9 @@ def _pyfuzzylite(text: str, names: list[str], rows: list[list[float]]) -> list[f
     return out
 
 
-def _three_paths(fb: m.FunctionBlock, rows: list[list[float]]) -> tuple[list[float], list[float], list[float]]:
+def _three_paths(
+    fb: m.FunctionBlock, rows: list[list[float]]
+) -> tuple[list[float], list[float], list[float]]:
     names = [v.name for v in fb.inputs]
     fast = fuzzyctl.compile(fb)
     reference = fuzzyctl.compile(fb, backend="interpreted")
@@ -216,9 +224,13 @@ def _same(a: float, b: float, tol: float) -> bool:
     return (math.isnan(a) and math.isnan(b)) or abs(a - b) <= tol
 
 
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much])
+@settings(
+    max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.filter_too_much]
+)
 @given(case(), st.lists(st.lists(SAMPLE, min_size=2, max_size=2), min_size=6, max_size=6))
-def test_agrees_with_pyfuzzylite_and_the_three_paths_agree(drawn: tuple[m.FunctionBlock, str], xs: Any) -> None:
+def test_agrees_with_pyfuzzylite_and_the_three_paths_agree(
+    drawn: tuple[m.FunctionBlock, str], xs: Any
+) -> None:
     fb, text = drawn
     names = [v.name for v in fb.inputs]
     rows = [[round(x[i], 4) for i in range(len(names))] for x in xs]
@@ -244,7 +256,10 @@ def _one_rule(
         fuzzify=(m.FuzzifyBlock("x", (m.Term("high", m.ShapeMF("ramp", (0.0, 1.0))),), m.Range(0.0, 1.0)),),
         defuzzify=(
             m.DefuzzifyBlock(
-                "y", (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),), m.Range(0.0, 10.0), method,
+                "y",
+                (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),),
+                m.Range(0.0, 10.0),
+                method,
                 m.Default(-1.0),
             ),
         ),
@@ -274,7 +289,9 @@ def test_rule_weight_scales_the_degree_before_activation_unlike_with() -> None:
 
 def test_rule_weight_given_by_an_input_is_read_at_each_evaluation() -> None:
     fb = _one_rule(weight=m.Ref("w"))
-    fb = m.FunctionBlock(fb.name, (*fb.variables, m.Variable("w", m.VarKind.INPUT)), fb.fuzzify, fb.defuzzify, fb.rule_blocks)
+    fb = m.FunctionBlock(
+        fb.name, (*fb.variables, m.Variable("w", m.VarKind.INPUT)), fb.fuzzify, fb.defuzzify, fb.rule_blocks
+    )
     c = fuzzyctl.compile(fb)
     assert c.evaluate({"x": 1.0, "w": 0.2})["y"] == pytest.approx(9.0, abs=1e-12)  # MIN(0.2, tri) ends at 9
     batch = c.evaluate_batch({"x": [1.0, 1.0], "w": [0.2, 0.6]})["y"]
@@ -319,11 +336,14 @@ def test_lock_range_limits_inputs_before_fuzzification_and_outputs_after_default
 )
 def test_rule_activation_methods(activation: str, expected: list[float]) -> None:
     """Three rules with degrees 0.6, 0.9, 0.3 on one Takagi-Sugeno output."""
-    terms = tuple(m.Term(f"c{i}", m.ShapeMF("constant", (float(10 ** i),))) for i in range(3))
+    terms = tuple(m.Term(f"c{i}", m.ShapeMF("constant", (float(10**i),))) for i in range(3))
     rules = tuple(m.Rule(str(i + 1), m.Degree(f"d{i}"), (m.Conclusion("y", f"c{i}"),)) for i in range(3))
     fb = m.FunctionBlock(
         "sel",
-        variables=(*(m.Variable(f"d{i}", m.VarKind.INPUT) for i in range(3)), m.Variable("y", m.VarKind.OUTPUT)),
+        variables=(
+            *(m.Variable(f"d{i}", m.VarKind.INPUT) for i in range(3)),
+            m.Variable("y", m.VarKind.OUTPUT),
+        ),
         defuzzify=(m.DefuzzifyBlock("y", terms, None, "WTSUM", m.Default(0.0)),),
         rule_blocks=(m.RuleBlock("rb", rules, rule_activation=activation),),
     )
@@ -343,14 +363,20 @@ def test_highest_breaks_ties_by_rule_order() -> None:
         variables=(m.Variable("d", m.VarKind.INPUT), m.Variable("y", m.VarKind.OUTPUT)),
         defuzzify=(
             m.DefuzzifyBlock(
-                "y", (m.Term("a", m.ShapeMF("constant", (1.0,))), m.Term("b", m.ShapeMF("constant", (2.0,)))),
-                None, "WTAVER", m.Default(0.0),
+                "y",
+                (m.Term("a", m.ShapeMF("constant", (1.0,))), m.Term("b", m.ShapeMF("constant", (2.0,)))),
+                None,
+                "WTAVER",
+                m.Default(0.0),
             ),
         ),
         rule_blocks=(
             m.RuleBlock(
                 "rb",
-                (m.Rule("1", m.Degree("d"), (m.Conclusion("y", "a"),)), m.Rule("2", m.Degree("d"), (m.Conclusion("y", "b"),))),
+                (
+                    m.Rule("1", m.Degree("d"), (m.Conclusion("y", "a"),)),
+                    m.Rule("2", m.Degree("d"), (m.Conclusion("y", "b"),)),
+                ),
                 rule_activation="Highest 1",
             ),
         ),
@@ -366,7 +392,9 @@ def test_function_argument_names_the_point() -> None:
     d = fb.defuzzify[0]
     expr = m.Binary("/", m.Name("u"), m.Num(10.0))
     ramp = m.Term("t", m.FunctionMF(expr, "u / 10", argument="u"))
-    fb = m.FunctionBlock(fb.name, fb.variables, fb.fuzzify, (m.DefuzzifyBlock("y", (ramp,), d.range, "COG"),), fb.rule_blocks)
+    fb = m.FunctionBlock(
+        fb.name, fb.variables, fb.fuzzify, (m.DefuzzifyBlock("y", (ramp,), d.range, "COG"),), fb.rule_blocks
+    )
     assert fuzzyctl.compile(fb).evaluate({"x": 1.0})["y"] == pytest.approx(20.0 / 3.0, abs=1e-8)
 
 
@@ -397,15 +425,25 @@ def test_negative_rule_weight_and_lock_range_without_range_are_reported() -> Non
 def test_rule_activation_with_chained_inference_is_reported() -> None:
     chained = m.FunctionBlock(
         "chain",
-        variables=(m.Variable("x", m.VarKind.INPUT), m.Variable("y", m.VarKind.OUTPUT), m.Variable("z", m.VarKind.OUTPUT)),
+        variables=(
+            m.Variable("x", m.VarKind.INPUT),
+            m.Variable("y", m.VarKind.OUTPUT),
+            m.Variable("z", m.VarKind.OUTPUT),
+        ),
         fuzzify=(m.FuzzifyBlock("x", (m.Term("high", m.ShapeMF("ramp", (0.0, 1.0))),)),),
         defuzzify=(
-            m.DefuzzifyBlock("y", (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),), m.Range(0.0, 10.0), "COG"),
-            m.DefuzzifyBlock("z", (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),), m.Range(0.0, 10.0), "COG"),
+            m.DefuzzifyBlock(
+                "y", (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),), m.Range(0.0, 10.0), "COG"
+            ),
+            m.DefuzzifyBlock(
+                "z", (m.Term("t", m.ShapeMF("triangle", (0.0, 5.0, 10.0))),), m.Range(0.0, 10.0), "COG"
+            ),
         ),
         rule_blocks=(
             m.RuleBlock("a", (m.Rule("1", m.Is("x", "high"), (m.Conclusion("y", "t"),)),)),
-            m.RuleBlock("b", (m.Rule("1", m.Is("y", "t"), (m.Conclusion("z", "t"),)),), rule_activation="First 1"),
+            m.RuleBlock(
+                "b", (m.Rule("1", m.Is("y", "t"), (m.Conclusion("z", "t"),)),), rule_activation="First 1"
+            ),
         ),
     )
     assert any(d.code == "rule-activation-chained" for d in unsupported(chained))

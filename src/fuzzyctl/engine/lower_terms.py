@@ -80,7 +80,7 @@ class _Ctx:
 # --------------------------------------------------------------------------- parameters and terms
 
 
-def _param(ctx: _Ctx, p: m.Param, where: str) -> PParam | None:
+def _param(ctx: _Ctx, p: m.Param, where: str, allow_infinite: bool = False) -> PParam | None:
     if isinstance(p, m.Ref):
         if p.name in ctx.slots:
             return Slot(ctx.slots[p.name])
@@ -93,7 +93,7 @@ def _param(ctx: _Ctx, p: m.Param, where: str) -> PParam | None:
         )
         return None
     v = float(p)
-    if not math.isfinite(v):
+    if math.isnan(v) or (math.isinf(v) and not allow_infinite):
         ctx.err(f"{where}: parameter {v} is not a finite number", None, "param-not-finite")
         return None
     return v
@@ -185,7 +185,8 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
                 "shape-arity",
             )
             return None
-        raw = [_param(ctx, p, where) for p in mf.params]
+        shoulders = mf.kind in ("triangle", "trapezoid")  # infinite vertices: MATLAB/fuzzylite shoulders
+        raw = [_param(ctx, p, where, shoulders) for p in mf.params]
         h = _param(ctx, mf.height, where)
         if any(p is None for p in raw) or h is None:
             return None

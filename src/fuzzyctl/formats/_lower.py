@@ -85,9 +85,22 @@ def uncumulate(hedges: list[tuple[str, ...]]) -> list[tuple[str, ...]] | None:
     return written
 
 
-def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss]) -> list[Rule]:
+def split_for_running_hedges(rule: Rule) -> list[Rule]:
+    """``rule`` itself when fuzzylite's running conclusion hedges can say its conclusions'
+    hedges (:func:`uncumulate`), else one rule per conclusion."""
+    if uncumulate([c.hedges for c in rule.conclusions]) is not None:
+        return [rule]
+    return [
+        replace(rule, label=f"{rule.label}_{j + 1}", conclusions=(c,)) for j, c in enumerate(rule.conclusions)
+    ]
+
+
+def split_rules(
+    fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss], running_hedges: bool = True
+) -> list[Rule]:
     """Rules equivalent to ``rule`` whose weight is a single rule weight (MATLAB/fuzzylite)
-    and whose conclusion hedges can be written; splits per conclusion when needed."""
+    and, with ``running_hedges`` (fuzzylite), whose conclusion hedges can be written; splits
+    per conclusion when needed."""
     act = block.act or "MIN"
     groups: dict[float, list[Conclusion]] = {}
     for c in rule.conclusions:
@@ -118,27 +131,11 @@ def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Lo
         groups.setdefault(w_rule * w_conclusion, []).append(replace(c, weight=None))
     out_rules: list[Rule] = []
     for i, (weight, conclusions) in enumerate(groups.items()):
-        written = uncumulate([c.hedges for c in conclusions])
         label = rule.label if len(groups) == 1 else f"{rule.label}_{i + 1}"
-        if written is None:
-            for j, c in enumerate(conclusions):
-                out_rules.append(
-                    replace(
-                        rule,
-                        label=f"{label}_{j + 1}",
-                        conclusions=(c,),
-                        weight=None if weight == 1.0 else weight,
-                    )
-                )
-        else:
-            out_rules.append(
-                replace(
-                    rule,
-                    label=label,
-                    conclusions=tuple(conclusions),
-                    weight=None if weight == 1.0 else weight,
-                )
-            )
+        one = replace(
+            rule, label=label, conclusions=tuple(conclusions), weight=None if weight == 1.0 else weight
+        )
+        out_rules.extend(split_for_running_hedges(one) if running_hedges else [one])
     return out_rules
 
 
@@ -170,9 +167,13 @@ def support(term: Term) -> tuple[float, float] | None:
     return None
 
 
-def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
+def prepare(
+    document: Document, target: str, running_hedges: bool = True
+) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
     """The main function block rewritten for FIS/FLL, the losses, and the renaming applied
-    (old name -> new name, variables and terms share one map per variable)."""
+    (old name -> new name, variables and terms share one map per variable).  With
+    ``running_hedges`` rules are split where fuzzylite's running conclusion hedges cannot
+    say the model's (the FIS writer decides later, see :func:`split_for_running_hedges`)."""
     losses: list[Loss] = []
     fb = document.main
     for other in document.blocks[1:]:
@@ -218,7 +219,7 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
             if any(a.variable in local_names for a in _atoms(condition) if isinstance(a, Is)):
                 losses.append(Loss(label, "a condition on a local variable cannot be written"))
                 continue
-            rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses))
+            rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses, running_hedges))
         new_blocks.append(replace(block, rules=tuple(rules)))
 
     # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
@@ -227,7 +228,10 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
         default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT, no_change=True)
         if default.value is None:  # DEFAULT := NC: 0 until a rule fires (the engine's NC start)
             default = Default(DEFAULT_WHEN_ABSENT, default.no_change)
-        defuzzify.append(replace(d, default=default))
+        method = d.method
+        if d.terms and all(isinstance(t.mf, SingletonMF) for t in d.terms) and method in (None, "COG"):
+            method = "COGS"  # CoG of singletons is CoGS (docs/engine.md): say it as a weighted average
+        defuzzify.append(replace(d, default=default, method=method))
     fb = replace(fb, rule_blocks=tuple(new_blocks), defuzzify=tuple(defuzzify))
     fb, renames = rename(fb)
     return fb, losses, renames
@@ -347,6 +351,40 @@ def is_point_output(block: DefuzzifyBlock) -> bool:
     return (block.method or "") in POINT_METHODS
 
 
+SUM_LIKE = frozenset({"SUM", "NSUM"})
+"""Accumulations that add every rule's degree (NSUM's normalisation never changes a weighted
+average): for a weighted-average output they equal "every rule counts"."""
+
+
+def point_accumulation(fb: FunctionBlock, block: DefuzzifyBlock) -> str | None:
+    """How the engine combines the degrees of a weighted-average output's terms: its own
+    ACCU, else that of the rule blocks concluding it, else none (every rule counts on its
+    own) - except an output of singletons defuzzified by CoGS, which accumulates with MAX
+    (IEC 61131-7), see docs/engine.md."""
+    if block.accu is not None:
+        return block.accu
+    for rb in fb.rule_blocks:
+        if rb.accu is not None and any(c.variable == block.variable for r in rb.rules for c in r.conclusions):
+            return rb.accu
+    singletons = bool(block.terms) and all(isinstance(t.mf, SingletonMF) for t in block.terms)
+    return "MAX" if singletons and (block.method or "COGS") in {"COGS", "COG"} else None
+
+
+def term_concluded_twice(fb: FunctionBlock, variable: str) -> bool:
+    """Whether some term of ``variable`` receives more than one rule's degree."""
+    seen: set[str] = set()
+    for rb in fb.rule_blocks:
+        if not rb.enabled:
+            continue
+        for rule in rb.rules:
+            for c in rule.conclusions:
+                if c.variable == variable and c.term is not None:
+                    if c.term in seen:
+                        return True
+                    seen.add(c.term)
+    return False
+
+
 def finite(x: float) -> bool:
     return not (math.isnan(x) or math.isinf(x))
 
@@ -358,10 +396,13 @@ __all__ = [
     "VarKind",
     "finite",
     "is_point_output",
+    "point_accumulation",
     "prepare",
     "rule_label",
+    "split_for_running_hedges",
     "split_rules",
     "support",
+    "term_concluded_twice",
     "term_losses",
     "uncumulate",
 ]

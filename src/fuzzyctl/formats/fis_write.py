@@ -15,11 +15,23 @@ from dataclasses import dataclass, replace
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number, hedge_power
 from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import is_point_output, prepare, rule_label, support, term_losses, uncumulate
+from fuzzyctl.formats._lower import (
+    SUM_LIKE,
+    is_point_output,
+    point_accumulation,
+    prepare,
+    rule_label,
+    split_for_running_hedges,
+    support,
+    term_concluded_twice,
+    term_losses,
+    uncumulate,
+)
 from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES
 from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
 from fuzzyctl.model import (
     And,
+    Conclusion,
     Condition,
     DefuzzifyBlock,
     Document,
@@ -31,6 +43,7 @@ from fuzzyctl.model import (
     Point,
     PointsMF,
     Range,
+    Ref,
     Rule,
     RuleBlock,
     ShapeMF,
@@ -75,9 +88,12 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
             mf = t.mf
             if isinstance(mf, FunctionMF):
                 return True
+            if _has_refs(mf):
+                continue  # a loss, reported with the term
             if (
                 isinstance(mf, ShapeMF)
                 and mf.kind not in {"constant", "linear"}
+                and mf.kind in FIS_OF_KIND
                 and (FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0)  # type: ignore[arg-type]
             ):
                 return True
@@ -85,8 +101,36 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
                 return True
     for _, rule in fb.rules():
         hedges = [a.hedges for a in _ises(rule.condition)] + [c.hedges for c in rule.conclusions]
-        if any(h in {("extremely",), ("seldom",)} for h in hedges) or any(c.hedges for c in rule.conclusions):
+        if any(h in {("extremely",), ("seldom",)} for h in hedges):
             return True
+        if any(c.hedges and _octave_consequent_code(fb, c) is None for c in rule.conclusions):
+            return True
+    return False
+
+
+def _octave_consequent_code(fb: FunctionBlock, conclusion: Conclusion) -> int | None:
+    """Octave's code for the hedges of a Sugeno consequent: code ``.p`` raises the rule's degree
+    to 1/(p/10) (the reader's inverse), so a degree^q is written with p = 10/q."""
+    block = fb.defuzzify_block(conclusion.variable)
+    if block is None or not is_point_output(block):
+        return None
+    power = 1.0
+    for h in conclusion.hedges:
+        p = hedge_power(h)
+        if p is None or p <= 0.0:
+            return None
+        power *= p
+    code = 10.0 / power
+    if abs(code - round(code)) > 1e-9 or not 1 <= round(code) <= 98:
+        return None
+    return round(code)
+
+
+def _has_refs(mf: object) -> bool:
+    if isinstance(mf, ShapeMF):
+        return isinstance(mf.height, Ref) or any(isinstance(p, Ref) for p in mf.params)
+    if isinstance(mf, PointsMF):
+        return any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points)
     return False
 
 
@@ -126,7 +170,15 @@ def _ises(condition: Condition | None) -> list[Is]:
 
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as a FIS can state it, and what had to be dropped."""
-    fb, losses, _ = prepare(document, "FIS")
+    fb, losses, _ = prepare(document, "FIS", running_hedges=False)
+    if _needs_fuzzylite(fb):  # fuzzylite reads conclusion hedges as running ones
+        fb = replace(
+            fb,
+            rule_blocks=tuple(
+                replace(b, rules=tuple(r2 for r in b.rules for r2 in split_for_running_hedges(r)))
+                for b in fb.rule_blocks
+            ),
+        )
     supported = set(FIS_OF_KIND) | {"constant", "linear"}
     # Inputs of a FIS cannot be clamped (fuzzylite's FIS importer rejects LockRange there).
     fuzzify: list[FuzzifyBlock] = []
@@ -138,6 +190,16 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             f = replace(f, clamp=False)
         fuzzify.append(_with_range(f, losses))  # type: ignore[arg-type]
     fb = replace(fb, fuzzify=tuple(fuzzify))
+    for d in fb.defuzzify:
+        accu = point_accumulation(fb, d) if is_point_output(d) else None
+        if accu is not None and accu not in SUM_LIKE and term_concluded_twice(fb, d.variable):
+            losses.append(
+                Loss(
+                    f"output {d.variable!r}",
+                    f"several rules conclude one term and accumulate with {accu}; a Sugeno FIS weighs "
+                    "every rule on its own",
+                )
+            )
     defuzzify: list[DefuzzifyBlock] = []
     for d in fb.defuzzify:
         kept = []
@@ -154,6 +216,10 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 kept.append(t)
         defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
+    for f in fb.fuzzify:
+        for t in f.terms:
+            if isinstance(t.mf, SingletonMF):
+                losses.append(Loss(f"term {t.name!r} of {f.variable!r}", "FIS has no singleton input term"))
     fb = replace(
         fb,
         fuzzify=tuple(
@@ -162,7 +228,8 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 terms=tuple(
                     t
                     for t in f.terms
-                    if term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                    if not isinstance(t.mf, SingletonMF)
+                    and term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
                 ),
             )
             for f in fb.fuzzify
@@ -286,8 +353,11 @@ def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: b
     for a in atoms:
         if isinstance(a, Is) and _hedge_code(a.hedges, fuzzylite) is None:
             return f"FIS has no code for the hedges {' '.join(a.hedges)}"
-    written = uncumulate([x.hedges for x in rule.conclusions])
-    if written is None or any(_hedge_code(h, fuzzylite) is None for h in written):
+    if fuzzylite:
+        written = uncumulate([x.hedges for x in rule.conclusions])
+        if written is None or any(_hedge_code(h, fuzzylite) is None for h in written):
+            return "FIS has no code for these conclusion hedges"
+    elif any(x.hedges and _octave_consequent_code(fb, x) is None for x in rule.conclusions):
         return "FIS has no code for these conclusion hedges"
     for x in rule.conclusions:
         blk = fb.defuzzify_block(x.variable)
@@ -440,6 +510,11 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylit
         ante.append(_entry(index, a.negated, a.hedges, fuzzylite))
     written = uncumulate([c.hedges for c in rule.conclusions]) or [c.hedges for c in rule.conclusions]
     hedges_of = {c.variable: h for c, h in zip(rule.conclusions, written, strict=True)}
+    octave = {
+        c.variable: _octave_consequent_code(fb, c) or 0
+        for c in rule.conclusions
+        if c.hedges and not fuzzylite
+    }
     cons = []
     for d in fb.defuzzify:
         c = next((x for x in rule.conclusions if x.variable == d.variable), None)
@@ -447,7 +522,10 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylit
             cons.append("0")
             continue
         index = [t.name for t in d.terms].index(c.term or "") + 1
-        cons.append(_entry(index, False, hedges_of[d.variable], fuzzylite))
+        if fuzzylite or not octave.get(d.variable):
+            cons.append(_entry(index, False, hedges_of[d.variable], fuzzylite))
+        else:
+            cons.append(f"{index + octave[d.variable] / 100.0:.2f}")
     weight = 1.0 if rule.weight is None else float(rule.weight)  # type: ignore[arg-type]
     connection = 2 if isinstance(rule.condition, Or) else 1
     return f"{' '.join(ante)}, {' '.join(cons)} ({fmt_number(weight)}) : {connection}"
