@@ -119,7 +119,8 @@ def _worst(a: Controller, b: Controller, data: dict[str, np.ndarray]) -> float:
 @pytest.mark.parametrize(("path", "source"), CASES, ids=[f"{k}:{p.relative_to(SHARED)}" for k, p in CASES])
 def test_round_trip_keeps_evaluation(path: str, source: Path, record_property: pytest.RecordProperty) -> None:
     kind, targets = PATHS[path]
-    label = " -> ".join([kind, *targets]) if path == "fcl" else f"{kind} -> model -> {kind}"
+    chain = " -> ".join([kind, *targets]) if path == "fcl" else f"{kind} -> model -> {kind}"
+    label = f"round trip {chain}, files"
 
     def report(category: str, detail: str = "") -> None:
         record_property("roundtrip", f"{label}\t{category}\t{detail}")
@@ -147,4 +148,4 @@ def test_round_trip_keeps_evaluation(path: str, source: Path, record_property: p
     data = _inputs(first, original.main, seed=len(source.name))
     worst = max(_worst(first, fuzzyctl.compile(doc), data) for doc in documents[1:])
     report("compared", f"{len(next(iter(data.values())))} inputs")
-    assert worst <= TOLERANCE, f"{source.name}: {label} changes the outputs by up to {worst:.3g}"
+    assert worst <= TOLERANCE, f"{source.name}: {chain} changes the outputs by up to {worst:.3g}"

@@ -185,8 +185,12 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
                 "shape-arity",
             )
             return None
-        shoulders = mf.kind in ("triangle", "trapezoid")  # infinite vertices: MATLAB/fuzzylite shoulders
-        raw = [_param(ctx, p, where, shoulders) for p in mf.params]
+        # infinite vertices are MATLAB/fuzzylite shoulders; fuzzylite's Binary points to +-inf
+        shoulders = mf.kind in ("triangle", "trapezoid")
+        raw = [
+            _param(ctx, p, where, shoulders or (mf.kind == "binary" and i == 1))
+            for i, p in enumerate(mf.params)
+        ]
         h = _param(ctx, mf.height, where)
         if any(p is None for p in raw) or h is None:
             return None
