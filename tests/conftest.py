@@ -11,6 +11,8 @@ from pathlib import Path
 
 import pytest
 
+from tests.conformance.measurements import pytest_terminal_summary  # noqa: F401  (a pytest hook)
+
 ROOT = Path(__file__).resolve().parent.parent
 SHARED = Path(os.environ.get("FUZZYCTL_SHARED", ROOT.parent / "shared")).resolve()
 EXAMPLES = ROOT / "examples"

@@ -67,9 +67,9 @@ def _evaluate(path: Path, fmt: str, inputs: np.ndarray, names: list[str], work: 
     )
     out = work / "outputs.fld"
     out.unlink(missing_ok=True)
+    command = [FUZZYLITE or "fuzzylite", "-i", str(path), "-if", fmt, "-of", "fld", "-d", str(data)]
     result = subprocess.run(
-        [FUZZYLITE or "fuzzylite", "-i", str(path), "-if", fmt, "-of", "fld", "-d", str(data)]
-        + ["-o", str(out), "-decimals", "12"],
+        [*command, "-o", str(out), "-decimals", "12"],
         capture_output=True,
         text=True,
         timeout=60,

@@ -1,4 +1,7 @@
-"""Conformance tests report their measurements with ``record_property``: ``("report", line)``
+"""The "conformance measurements" section of the test report (registered in tests/conftest.py,
+which the xdist controller loads too).
+
+Conformance tests report their measurements with ``record_property``: ``("report", line)``
 lines are printed as they are; ``("roundtrip", "path\tcategory\tdetail")`` items are counted
 per path and category (details separated by \x1f are counted one by one).  The hook prints
 them after the run, so that the numbers are visible in ``make test`` without ``-s`` (also
