@@ -1,7 +1,10 @@
 """Imports every command module so that each registers its commands on the app."""
 
 from fuzzyctl.cli import (
+    blocks,  # noqa: F401  (fuzzyctl blocks ...)
     convert,  # noqa: F401
     lang,  # noqa: F401  (check, fmt)
     run,  # noqa: F401  (eval, explain)
+    serve,  # noqa: F401  (serve: the soft controller)
+    simulate,  # noqa: F401  (simulate)
 )
