@@ -28,6 +28,7 @@ from fuzzyctl.model import (
     Not,
     Or,
     PointsMF,
+    Range,
     Ref,
     Rule,
     RuleBlock,
@@ -232,9 +233,22 @@ def prepare(
         if d.terms and all(isinstance(t.mf, SingletonMF) for t in d.terms) and method in (None, "COG"):
             method = "COGS"  # CoG of singletons is CoGS (docs/engine.md): say it as a weighted average
         defuzzify.append(replace(d, default=default, method=method))
-    fb = replace(fb, rule_blocks=tuple(new_blocks), defuzzify=tuple(defuzzify))
+    # An input singleton is the triangle (v, v, v): degree 1 exactly at v, 0 elsewhere, in our
+    # engine, MATLAB's trimf and fuzzylite's Triangle alike.
+    fuzzify = tuple(
+        replace(f, terms=tuple(_singleton_as_triangle(t) for t in f.terms)) for f in fb.fuzzify
+    )
+    fb = replace(fb, rule_blocks=tuple(new_blocks), fuzzify=fuzzify, defuzzify=tuple(defuzzify))
     fb, renames = rename(fb)
     return fb, losses, renames
+
+
+def _singleton_as_triangle(term: Term) -> Term:
+    mf = term.mf
+    if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
+        v = float(mf.value)
+        return replace(term, mf=ShapeMF("triangle", (v, v, v)))
+    return term
 
 
 def _atoms(condition: Condition | None) -> list[Condition]:
@@ -385,6 +399,45 @@ def term_concluded_twice(fb: FunctionBlock, variable: str) -> bool:
     return False
 
 
+def with_range(
+    fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss], target: str
+) -> FuzzifyBlock | DefuzzifyBlock:
+    """FIS and FLL variables have a range: the block's RANGE, else the variable's, else the
+    span of bounded terms (the engine's universe of an output without RANGE)."""
+    if blk.range is not None:
+        return blk
+    var = fb.variable(blk.variable)
+    if var is not None and var.range is not None:
+        return replace(blk, range=var.range)
+    spans = [support(t) for t in blk.terms]
+    if blk.terms and all(s is not None for s in spans):
+        low = min(s[0] for s in spans if s)
+        high = max(s[1] for s in spans if s)
+        return replace(blk, range=Range(low, high))
+    if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
+        losses.append(
+            Loss(f"output {blk.variable!r}", f"has no RANGE and unbounded terms; {target} needs a range")
+        )
+    if isinstance(blk, DefuzzifyBlock):
+        return replace(blk, range=Range(-math.inf, math.inf))
+    # An input's range changes nothing (inputs are not clamped): the span of the terms'
+    # breakpoints is what an editor shows.
+    xs = [x for t in blk.terms for x in _breakpoints(t) if math.isfinite(x)]
+    low, high = (min(xs), max(xs)) if xs else (0.0, 1.0)
+    return replace(blk, range=Range(low, high if high > low else low + 1.0))
+
+
+def _breakpoints(term: Term) -> list[float]:
+    mf = term.mf
+    if isinstance(mf, PointsMF):
+        return [float(p.x) for p in mf.points if not isinstance(p.x, Ref)]
+    if isinstance(mf, ShapeMF) and mf.kind not in {"constant", "linear"}:
+        return [float(p) for p in mf.params if not isinstance(p, Ref)]
+    if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
+        return [float(mf.value)]
+    return []
+
+
 def finite(x: float) -> bool:
     return not (math.isnan(x) or math.isinf(x))
 
@@ -405,4 +458,5 @@ __all__ = [
     "term_concluded_twice",
     "term_losses",
     "uncumulate",
+    "with_range",
 ]

@@ -14,6 +14,8 @@ from dataclasses import replace
 from typing import Any
 
 from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats._common import identifier, is_identifier
+from fuzzyctl.formats._lower import rename
 from fuzzyctl.model import Document, FunctionBlock, Rule, RuleBlock
 
 _POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
@@ -82,6 +84,15 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 )
             rules = []
             for rule in block.rules:
+                if rule.condition is None:
+                    losses.append(
+                        Loss(
+                            f"rule {rule.label!r}",
+                            "FCL has no rule without a condition (MATLAB's all don't-care, fuzzylite's "
+                            "'x is any'); dropped",
+                        )
+                    )
+                    continue
                 rule = _rule_weight_to_conclusions(fb, block, rule, losses)
                 if any(c.hedges for c in rule.conclusions):
                     losses.append(Loss(f"rule {rule.label!r}", "FCL has no hedges on conclusions"))
@@ -90,7 +101,12 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rule_blocks.append(replace(block, rules=tuple(rules), enabled=True, rule_activation=None))
         fuzzify = tuple(replace(f, clamp=False) for f in fb.fuzzify)
         defuzzify = tuple(replace(d, clamp=False) for d in fb.defuzzify)
-        blocks.append(replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify))
+        fb = replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify)
+        # names that are not FCL identifiers ("sugeno tipper", "Cheap-Tip") are renamed: not a loss
+        fb, _renames = rename(fb)
+        if fb.name is not None and not is_identifier(fb.name):
+            fb = replace(fb, name=identifier(fb.name, set()))
+        blocks.append(fb)
     return replace(document, blocks=tuple(blocks)), losses
 
 

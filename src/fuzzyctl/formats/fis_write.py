@@ -22,14 +22,15 @@ from fuzzyctl.formats._lower import (
     prepare,
     rule_label,
     split_for_running_hedges,
-    support,
     term_concluded_twice,
     term_losses,
     uncumulate,
+    with_range,
 )
 from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES
 from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
 from fuzzyctl.model import (
+    OPERATOR_PAIRS,
     And,
     Conclusion,
     Condition,
@@ -188,7 +189,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)")
             )
             f = replace(f, clamp=False)
-        fuzzify.append(_with_range(f, losses))  # type: ignore[arg-type]
+        fuzzify.append(with_range(fb, f, losses, 'FIS'))  # type: ignore[arg-type]
     fb = replace(fb, fuzzify=tuple(fuzzify))
     for d in fb.defuzzify:
         accu = point_accumulation(fb, d) if is_point_output(d) else None
@@ -214,11 +215,11 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 continue
             if term_losses(d.variable, t, supported, "FIS", losses):
                 kept.append(t)
-        defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))  # type: ignore[arg-type]
+        defuzzify.append(with_range(fb, replace(d, terms=tuple(kept)), losses, 'FIS'))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
     for f in fb.fuzzify:
         for t in f.terms:
-            if isinstance(t.mf, SingletonMF):
+            if isinstance(t.mf, SingletonMF):  # a literal one became trimf [v v v] in prepare()
                 losses.append(Loss(f"term {t.name!r} of {f.variable!r}", "FIS has no singleton input term"))
     fb = replace(
         fb,
@@ -236,6 +237,14 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         ),
     )
 
+    # Nested conditions in the form FIS can say (one AND or OR of literals per rule).
+    fb = replace(
+        fb,
+        rule_blocks=tuple(
+            replace(b, rules=tuple(r2 for r in b.rules for r2 in _one_level(fb, b, r)))
+            for b in fb.rule_blocks
+        ),
+    )
     # One rule block with one set of operators.
     enabled = [b for b in fb.rule_blocks if b.enabled]
     for b in fb.rule_blocks:
@@ -312,22 +321,91 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     return Document((fb,), document.path), losses
 
 
-def _with_range(blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss]) -> FuzzifyBlock | DefuzzifyBlock:
-    """A FIS variable needs a Range: take RANGE, else the span of bounded terms."""
-    if blk.range is not None:
-        return blk
-    spans = [support(t) for t in blk.terms]
-    if blk.terms and all(s is not None for s in spans):
-        low = min(s[0] for s in spans if s)
-        high = max(s[1] for s in spans if s)
-        return replace(blk, range=Range(low, high))
-    if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
-        losses.append(Loss(f"output {blk.variable!r}", "has no RANGE and unbounded terms; FIS needs a Range"))
-    return (
-        replace(blk, range=Range(-math.inf, math.inf))
-        if isinstance(blk, DefuzzifyBlock)
-        else replace(blk, range=Range(0.0, 1.0) if not blk.terms else Range(-math.inf, math.inf))
-    )
+def _flat(condition: Condition) -> Condition:
+    """Nested ANDs (ORs) joined into one: associative for every t-norm (s-norm)."""
+    if isinstance(condition, And | Or):
+        kind = type(condition)
+        operands: list[Condition] = []
+        for o in (_flat(x) for x in condition.operands):
+            operands.extend(o.operands if isinstance(o, kind) else (o,))
+        return kind(tuple(operands), condition.span)
+    return condition
+
+
+def _fis_form(condition: Condition | None) -> bool:
+    if condition is None or isinstance(condition, Is):
+        return True
+    if isinstance(condition, And | Or) and all(isinstance(o, Is) for o in condition.operands):
+        return len({o.variable for o in condition.operands if isinstance(o, Is)}) == len(condition.operands)
+    return False
+
+
+def _dnf(condition: Condition) -> list[tuple[Is, ...]] | None:
+    """The condition as a disjunction of conjunctions of literals (None: a NOT of a compound)."""
+    if isinstance(condition, Is):
+        return [(condition,)]
+    if isinstance(condition, Or):
+        out: list[tuple[Is, ...]] = []
+        for o in condition.operands:
+            part = _dnf(o)
+            if part is None:
+                return None
+            out += part
+        return out
+    if isinstance(condition, And):
+        product: list[tuple[Is, ...]] = [()]
+        for o in condition.operands:
+            part = _dnf(o)
+            if part is None:
+                return None
+            product = [a + b for a in product for b in part]
+            if len(product) > MAX_SPLIT:
+                return None
+        return product
+    return None
+
+
+MAX_SPLIT = 64
+"""At most this many rules replace one rule with a nested condition."""
+
+
+def _one_level(fb: FunctionBlock, block: RuleBlock, rule: Rule) -> list[Rule]:
+    """``rule`` with a condition FIS can say: nested same operators flattened; a mix of AND
+    and OR split into one rule per disjunct of its disjunctive normal form, which is exact
+    when AND is MIN, OR is MAX (a distributive lattice) and every conclusion goes to a
+    Mamdani output accumulated with MAX (max over the rules = OR of their conditions, since
+    activation, weights and hedges are monotonic).  Otherwise the rule is left as it is and
+    reported as a loss."""
+    if rule.condition is None or _fis_form(rule.condition):
+        return [rule]
+    flat = _flat(rule.condition)
+    if _fis_form(flat):
+        return [replace(rule, condition=flat)]
+    and_op = block.and_op or ("MIN" if block.or_op in (None, "MAX") else None)
+    or_op = block.or_op or OPERATOR_PAIRS.get(and_op or "", None)
+    if (and_op, or_op) != ("MIN", "MAX"):
+        return [rule]
+    for c in rule.conclusions:
+        d = fb.defuzzify_block(c.variable)
+        concluding = [
+            b.accu
+            for b in fb.rule_blocks
+            if b.accu and any(x.variable == c.variable for r in b.rules for x in r.conclusions)
+        ]
+        accu = (d.accu if d else None) or (concluding[0] if concluding else "MAX")
+        if d is None or is_point_output(d) or accu != "MAX":
+            return [rule]
+    disjuncts = _dnf(flat)
+    if disjuncts is None or len(disjuncts) > MAX_SPLIT:
+        return [rule]
+    out = []
+    for k, conjunction in enumerate(disjuncts, start=1):
+        literals = tuple(dict.fromkeys(conjunction))  # x IS a AND x IS a is x IS a
+        if len({a.variable for a in literals}) != len(literals):
+            return [rule]  # tests one input twice: no FIS form
+        condition: Condition = literals[0] if len(literals) == 1 else And(literals, flat.span)
+        out.append(replace(rule, label=f"{rule.label}_{k}", condition=condition))
+    return out
 
 
 def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: bool) -> str | None:

@@ -8,7 +8,15 @@ from dataclasses import replace
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number
 from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import SUM_LIKE, point_accumulation, prepare, rule_label, term_losses, uncumulate
+from fuzzyctl.formats._lower import (
+    SUM_LIKE,
+    point_accumulation,
+    prepare,
+    rule_label,
+    term_losses,
+    uncumulate,
+    with_range,
+)
 from fuzzyctl.formats._terms import FLL_OF_KIND, FLL_TYPES
 from fuzzyctl.formats.fll import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.model import (
@@ -43,6 +51,11 @@ exact; fuzzylite approximates with this many midpoint samples)."""
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as FLL can state it, and what had to be dropped."""
     fb, losses, _ = prepare(document, "FLL")
+    fb = replace(
+        fb,
+        fuzzify=tuple(with_range(fb, f, losses, "FLL") for f in fb.fuzzify),  # type: ignore[misc]
+        defuzzify=tuple(with_range(fb, d, losses, "FLL") for d in fb.defuzzify),  # type: ignore[misc]
+    )
     supported = set(FLL_OF_KIND) | {"constant", "linear"}
     all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for blk in all_blocks:

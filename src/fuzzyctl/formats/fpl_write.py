@@ -3,6 +3,7 @@ cannot express, and the lowering ``fuzzyctl convert --lossy`` uses."""
 
 from __future__ import annotations
 
+import re
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
@@ -200,7 +201,8 @@ def write_fpl(block: FunctionBlock | Document) -> str:
     problems = [d for d in check_fpl(fb) if d.is_error]
     if problems:
         raise DiagnosticError(problems)
-    out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {fb.name or 'fuzzy'}"]
+    project = re.sub(r"\W", "_", fb.name or "fuzzy")  # a name with spaces (MATLAB's) is no FPL word
+    out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {project}"]
     for var in fb.variables:
         if var.kind is VarKind.LOCAL:
             continue
