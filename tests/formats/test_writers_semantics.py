@@ -100,7 +100,7 @@ def test_matlab_default_is_the_middle_of_the_range_and_stays_matlab() -> None:
 def test_mixed_and_or_under_min_max_becomes_one_rule_per_disjunct() -> None:
     cond = m.And((m.Or((m.Is("a", "lo"), m.Is("a", "hi", negated=True))), m.Is("b", "hi")))
     fb = _block((m.Rule("1", cond, (m.Conclusion("y", "small"),), weight=0.7),))
-    again, text = _through(fb, "fis")
+    again, _text = _through(fb, "fis")
     # (a lo AND b hi) OR (a not hi AND b hi): two rules, each an AND
     assert [type(r.condition) for r in again.main.rule_blocks[0].rules] == [m.And, m.And]
     _same(fb, again, _grid())
@@ -156,6 +156,7 @@ def test_octave_consequent_hedge_is_written_as_octave_reads_it() -> None:
     )
     fb = _block(rules, out_terms=terms, method="WTAVER", default=m.Default(7.5), accu=None)
     lowered, losses = get("fis").lower(m.Document((fb,)))
+    assert not losses
     text = get("fis").write(lowered)
     assert not text.startswith("%") and "2.30, 1.30" in text.replace(" 0,", ",")
     again = read_text(text, "fis").document
