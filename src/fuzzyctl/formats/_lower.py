@@ -9,24 +9,32 @@ share, plus the :class:`Loss` list for what it had to drop.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import identifier
 from fuzzyctl.model import (
     And,
+    Binary,
+    Call,
     Conclusion,
     Condition,
     Default,
     DefuzzifyBlock,
     Degree,
     Document,
+    Expr,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
     Is,
+    MembershipFunction,
+    Name,
     Not,
     Or,
+    Param,
+    Point,
     PointsMF,
     Range,
     Ref,
@@ -36,6 +44,7 @@ from fuzzyctl.model import (
     SingletonMF,
     SingletonsMF,
     Term,
+    Unary,
     VarKind,
 )
 
@@ -261,25 +270,83 @@ def _atoms(condition: Condition | None) -> list[Condition]:
     return [condition]
 
 
-def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
-    """Rename variables and terms to identifiers (``LDL-Level`` -> ``LDL_Level``)."""
+def rename(
+    fb: FunctionBlock,
+    valid_variable: Callable[[str], bool] | None = None,
+    valid_term: Callable[[str], bool] | None = None,
+) -> tuple[FunctionBlock, dict[str, str]]:
+    """Rename variables and terms the target cannot write to identifiers (``LDL-Level`` ->
+    ``LDL_Level``).  By default a name must be an ASCII identifier; a format with other
+    rules passes its own checks."""
+
+    def fixer(valid: Callable[[str], bool] | None) -> Callable[[str, set[str]], str]:
+        def fix(name: str, taken: set[str]) -> str:
+            if valid is None:
+                return identifier(name, taken)
+            if valid(name) and name not in taken:
+                taken.add(name)
+                return name
+            # identifier() gives an ASCII identifier, which may still be one the target
+            # reserves (FCL's ``if``): number it until the target accepts it
+            base = identifier(name, set())
+            candidate, n = base, 2
+            while candidate in taken or not valid(candidate):
+                candidate, n = f"{base}_{n}", n + 1
+            taken.add(candidate)
+            return candidate
+
+        return fix
+
+    fix_variable, fix_term = fixer(valid_variable), fixer(valid_term)
     taken_vars: set[str] = set()
-    var_map = {v.name: identifier(v.name, taken_vars) for v in fb.variables}
+    var_map = {v.name: fix_variable(v.name, taken_vars) for v in fb.variables}
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
-    if all(k == v for k, v in var_map.items()) and all(
-        identifier(t.name, set()) == t.name for blk in blocks for t in blk.terms
-    ):
-        return fb, {}
     term_maps: dict[str, dict[str, str]] = {}
     for blk in blocks:
         taken: set[str] = set()
-        term_maps[blk.variable] = {t.name: identifier(t.name, taken) for t in blk.terms}
+        term_maps[blk.variable] = {t.name: fix_term(t.name, taken) for t in blk.terms}
+    if all(k == v for k, v in var_map.items()) and all(
+        k == v for names in term_maps.values() for k, v in names.items()
+    ):
+        return fb, {}
 
     def v(name: str) -> str:
         return var_map.get(name, name)
 
     def t(var: str, name: str | None) -> str | None:
         return None if name is None else term_maps.get(var, {}).get(name, name)
+
+    def param(p: Param) -> Param:
+        return Ref(v(p.name), p.span) if isinstance(p, Ref) else p
+
+    def point(p: Point) -> Point:
+        return replace(p, x=param(p.x), y=param(p.y))
+
+    def expr(e: Expr, argument: str | None) -> Expr:
+        if isinstance(e, Name):
+            return e if e.name == argument else Name(v(e.name))
+        if isinstance(e, Unary):
+            return replace(e, operand=expr(e.operand, argument))
+        if isinstance(e, Binary):
+            return replace(e, left=expr(e.left, argument), right=expr(e.right, argument))
+        if isinstance(e, Call):
+            return replace(e, args=tuple(expr(a, argument) for a in e.args))
+        return e
+
+    def mf(f: MembershipFunction) -> MembershipFunction:
+        """Parameters and expressions that name variables follow the variables."""
+        if isinstance(f, ShapeMF):
+            return replace(f, params=tuple(param(p) for p in f.params), height=param(f.height))
+        if isinstance(f, PointsMF | SingletonsMF):
+            return replace(f, points=tuple(point(p) for p in f.points))
+        if isinstance(f, SingletonMF):
+            return replace(f, value=param(f.value))
+        return replace(f, expr=expr(f.expr, f.argument))
+
+    def terms(b: FuzzifyBlock | DefuzzifyBlock) -> tuple[Term, ...]:
+        return tuple(
+            replace(term, name=t(b.variable, term.name) or term.name, mf=mf(term.mf)) for term in b.terms
+        )
 
     def cond(c: Condition | None) -> Condition | None:
         if c is None:
@@ -295,22 +362,8 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
     renamed = replace(
         fb,
         variables=tuple(replace(x, name=v(x.name)) for x in fb.variables),
-        fuzzify=tuple(
-            replace(
-                b,
-                variable=v(b.variable),
-                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
-            )
-            for b in fb.fuzzify
-        ),
-        defuzzify=tuple(
-            replace(
-                b,
-                variable=v(b.variable),
-                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
-            )
-            for b in fb.defuzzify
-        ),
+        fuzzify=tuple(replace(b, variable=v(b.variable), terms=terms(b)) for b in fb.fuzzify),
+        defuzzify=tuple(replace(b, variable=v(b.variable), terms=terms(b)) for b in fb.defuzzify),
         rule_blocks=tuple(
             replace(
                 b,
@@ -319,7 +372,12 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
                         r,
                         condition=cond(r.condition),
                         conclusions=tuple(
-                            replace(c, variable=v(c.variable), term=t(c.variable, c.term))
+                            replace(
+                                c,
+                                variable=v(c.variable),
+                                term=t(c.variable, c.term),
+                                weight=None if c.weight is None else param(c.weight),
+                            )
                             for c in r.conclusions
                         ),
                     )

@@ -10,11 +10,14 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import re
 from dataclasses import replace
+from functools import cache
+from importlib import resources
 from typing import Any
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats._common import identifier, is_identifier
+from fuzzyctl.formats._common import identifier
 from fuzzyctl.formats._lower import rename
 from fuzzyctl.model import Document, FunctionBlock, Rule, RuleBlock
 
@@ -53,6 +56,56 @@ def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule,
         w = float(rule.weight) * (1.0 if c.weight is None else float(c.weight))  # type: ignore[arg-type]
         conclusions.append(replace(c, weight=w))
     return replace(rule, weight=None, conclusions=tuple(conclusions))
+
+
+@cache
+def fcl_keywords() -> frozenset[str]:
+    """Upper-case words FCL reads as something other than a name: every keyword terminal of
+    the grammar (``fcl.lark``: ``IF: "IF"i``, ...), and ``NAN``/``INF``/``INFINITY``, which
+    the grammar reads as numbers wherever a number may stand."""
+    grammar = resources.files("fuzzyctl.fcl").joinpath("fcl.lark").read_text(encoding="utf-8")
+    words = re.findall(r'^[A-Z_]+\s*:\s*"([A-Za-z_]+)"i\s*$', grammar, re.MULTILINE)
+    return frozenset(w.upper() for w in words) | {"NAN", "INF", "INFINITY"}
+
+
+_FCL_ID = re.compile(r"[^\W\d]\w*")  # fcl.lark's ID: a Unicode letter or '_', then word characters
+
+
+def fcl_name(name: str) -> bool:
+    """True when FCL reads ``name`` back as one variable name: an identifier, no keyword
+    in any letter case (a variable ``if`` or ``Rule`` would end the statement)."""
+    return _FCL_ID.fullmatch(name) is not None and name.upper() not in fcl_keywords()
+
+
+def fcl_term(name: str) -> bool:
+    """Term names may be several words (ridderware JFuzzy's ``Rear Left``), each a name."""
+    return bool(name) and all(fcl_name(w) for w in name.split(" "))
+
+
+def _fcl_block_name(name: str) -> bool:
+    """fcl.lark's FB_NAME also takes hyphens inside (``FUNCTION_BLOCK tank-level``)."""
+    return all(fcl_name(w) for w in name.split("-"))
+
+
+def _labels(block: RuleBlock) -> RuleBlock:
+    """Rule labels FCL reads (``\\w+``, each once); others are numbered in order."""
+    labels = [r.label for r in block.rules]
+    if all(re.fullmatch(r"\w+", str(x)) for x in labels) and len(set(labels)) == len(labels):
+        return block
+    return replace(block, rules=tuple(replace(r, label=str(i)) for i, r in enumerate(block.rules, 1)))
+
+
+def _fcl_identifier(name: str, taken: set[str]) -> str:
+    """``name`` when FCL reads it and it is free, else an identifier close to it."""
+    if fcl_name(name) and name not in taken:
+        taken.add(name)
+        return name
+    base = identifier(name, set())
+    candidate, n = base, 2
+    while candidate in taken or not fcl_name(candidate):
+        candidate, n = f"{base}_{n}", n + 1
+    taken.add(candidate)
+    return candidate
 
 
 def lower(document: Document) -> tuple[Document, list[Loss]]:
@@ -102,10 +155,19 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         fuzzify = tuple(replace(f, clamp=False) for f in fb.fuzzify)
         defuzzify = tuple(replace(d, clamp=False) for d in fb.defuzzify)
         fb = replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify)
-        # names that are not FCL identifiers ("sugeno tipper", "Cheap-Tip") are renamed: not a loss
-        fb, _renames = rename(fb)
-        if fb.name is not None and not is_identifier(fb.name):
-            fb = replace(fb, name=identifier(fb.name, set()))
+        # names FCL cannot read back (MATLAB's "sugeno tipper", "a/b", a variable "if") are
+        # renamed: not a loss
+        fb, _renames = rename(fb, fcl_name, fcl_term)
+        if fb.name is not None and not _fcl_block_name(fb.name):
+            fb = replace(fb, name=_fcl_identifier(fb.name, set()))
+        taken: set[str] = set()
+        fb = replace(
+            fb,
+            rule_blocks=tuple(
+                _labels(replace(b, name=None if b.name is None else _fcl_identifier(b.name, taken)))
+                for b in fb.rule_blocks
+            ),
+        )
         blocks.append(fb)
     return replace(document, blocks=tuple(blocks)), losses
 
