@@ -37,5 +37,5 @@ def pytest_terminal_summary(terminalreporter: Any) -> None:
         counts = ", ".join(f"{c}: {n}" for (p, c), n in sorted(files.items()) if p == path)
         terminalreporter.write_line(f"{path}: {counts}")
         for (p, category, item), n in sorted(details.items(), key=lambda kv: (kv[0][0], kv[0][1], -kv[1])):
-            if p == path and category != "compared":
+            if p == path:
                 terminalreporter.write_line(f"    {category}: {item} ({n})")

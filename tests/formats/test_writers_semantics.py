@@ -249,3 +249,52 @@ MF2='d':'constant',[0]
     # the Sugeno output weighs every rule: both rules count, 10 either way
     assert fuzzyctl.compile(fb).evaluate({"a": 0.4})["s"] == 10.0
     assert math.isfinite(fuzzyctl.compile(fb).evaluate({"a": 0.4})["m"])
+
+
+def _fis_losses(fb: m.FunctionBlock) -> list[str]:
+    lowered, losses = get("fis").lower(m.Document((fb,)))
+    if losses:  # what is written without them must still read back
+        read_text(get("fis").write(lowered), "fis")
+    return [f"{loss.element}: {loss.reason}" for loss in losses]
+
+
+def test_fis_never_writes_a_shape_its_reader_refuses() -> None:
+    """A trapezoid out of order (the FCL reader takes it, MATLAB's trapmf does not) and a
+    zero-width Gaussian are losses, not files the FIS reader rejects."""
+    bad = (
+        m.FuzzifyBlock(
+            "a",
+            (m.Term("lo", T("trapezoid", (1.0, 0.0, 2.0, 3.0))), m.Term("hi", T("gaussian", (5.0, 0.0)))),
+            m.Range(0.0, 10.0),
+        ),
+    )
+    fb = _block((m.Rule("1", m.Is("a", "lo"), (m.Conclusion("y", "big"),)),), inputs=bad)
+    losses = _fis_losses(fb)
+    assert any("'lo' of 'a'" in x and "a <= b <= c <= d" in x for x in losses), losses
+    assert any("'hi' of 'a'" in x and "sigma must not be 0" in x for x in losses), losses
+
+
+def test_fis_weighted_average_output_of_fuzzy_sets_is_a_loss() -> None:
+    """COGS over point-list terms (jfuzzyqt's Tsukamoto file): a Sugeno FIS output holds
+    constants, linear functions or fuzzylite's monotonic shapes only."""
+    terms = (
+        m.Term("up", m.PointsMF((m.Point(0.0, 0.0), m.Point(5.0, 0.4), m.Point(10.0, 1.0)))),
+        m.Term("down", m.PointsMF((m.Point(0.0, 1.0), m.Point(5.0, 0.6), m.Point(10.0, 0.0)))),
+    )
+    fb = _block((m.Rule("1", m.Is("a", "lo"), (m.Conclusion("y", "up"),)),), out_terms=terms, method="COGS")
+    losses = _fis_losses(fb)
+    assert any("'up' of 'y'" in x and "weighted-average output" in x for x in losses), losses
+
+
+def test_tsukamoto_sigmoids_are_written_in_the_fuzzylite_dialect() -> None:
+    """sigmf is a MATLAB type, but a Sugeno output of sigmoids only reads back as fuzzylite's
+    Tsukamoto: the writer must say so (the dialect comment), or the reader refuses it."""
+    terms = (m.Term("up", T("sigmoid", (5.0, 2.0))), m.Term("down", T("sigmoid", (5.0, -2.0))))
+    rules = (
+        m.Rule("1", m.Is("a", "lo"), (m.Conclusion("y", "up"),)),
+        m.Rule("2", m.Is("a", "hi"), (m.Conclusion("y", "down"),)),
+    )
+    fb = _block(rules, out_terms=terms, method="WTAVER", accu=None)
+    again, text = _through(fb, "fis")
+    assert text.startswith("%")
+    _same(fb, again, _grid())

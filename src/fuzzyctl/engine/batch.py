@@ -286,7 +286,8 @@ class BatchEvaluator:
         den = np.zeros(n)
         for t, wt in items:
             z = z_of(t, wt)
-            num = num + np.where(wt > 0.0, wt * z, 0.0)
+            with np.errstate(invalid="ignore"):  # 0 * inf where a Tsukamoto term is not reached
+                num = num + np.where(wt > 0.0, wt * z, 0.0)
             den = den + wt
         fired = den > 0.0
         with np.errstate(all="ignore"):

@@ -29,7 +29,7 @@ from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Format, Loaded
 from fuzzyctl.formats._common import Reporter, parse_number, power_hedge, unique_name
 from fuzzyctl.formats._expr import ExprError, eval_constant, names_in, parse_expr
-from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS
+from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -300,20 +300,9 @@ def _membership(
                 code="fis-extra-param",
             )
     values = mapping.to_model(params[: mapping.arity])
-    if kind_lower == "trimf" and not values[0] <= values[1] <= values[2]:
-        raise rep.fail(
-            f"trimf parameters must satisfy a <= b <= c, found {params[:3]}", line, code="fis-params"
-        )
-    if kind_lower == "trapmf" and not values[0] <= values[1] <= values[2] <= values[3]:
-        raise rep.fail(
-            f"trapmf parameters must satisfy a <= b <= c <= d, found {params[:4]}", line, code="fis-params"
-        )
-    if kind_lower in {"gaussmf", "gauss2mf"} and (
-        values[1] == 0 or (kind_lower == "gauss2mf" and values[3] == 0)
-    ):
-        raise rep.fail(f"{kind_lower}: sigma must not be 0", line, code="fis-params")
-    if kind_lower == "gbellmf" and values[1] == 0:
-        raise rep.fail("gbellmf: width a must not be 0", line, code="fis-params")
+    problem = fis_shape_problem(kind_lower, values)
+    if problem is not None:
+        raise rep.fail(problem, line, code="fis-params")
     return ShapeMF(mapping.kind, values, height)
 
 

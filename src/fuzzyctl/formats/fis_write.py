@@ -8,6 +8,7 @@ with a comment naming that dialect, which our reader and fuzzylite honour.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -27,7 +28,7 @@ from fuzzyctl.formats._lower import (
     uncumulate,
     with_range,
 )
-from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES
+from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
@@ -71,8 +72,45 @@ class _Plan:
     fuzzylite: bool
 
 
+def _term_problem(term: Term, point_output: bool) -> str | None:
+    """Why the FIS reader would refuse this (otherwise writable) term; ``None``: it reads it."""
+    mf = term.mf
+    if point_output:
+        ts_term = (isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}) or (
+            isinstance(mf, FunctionMF) and mf.argument is None
+        )
+        if not ts_term and not (isinstance(mf, ShapeMF) and mf.kind in MONOTONIC_KINDS):
+            return (
+                "a weighted-average output of a FIS has constant, linear or (fuzzylite's Tsukamoto) "
+                "monotonic terms"
+            )
+    elif isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}:
+        return "a Mamdani output of a FIS has no constant or linear terms"
+    if isinstance(mf, ShapeMF) and mf.kind in FIS_OF_KIND and not _has_refs(mf):
+        return fis_shape_problem(FIS_OF_KIND[mf.kind], tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
+    if isinstance(mf, PointsMF) and not _has_refs(mf):
+        as_matlab = _points_as_matlab(mf)
+        xs = [float(p.x) for p in mf.points]  # type: ignore[arg-type]
+        if as_matlab is not None:
+            return fis_shape_problem(as_matlab[0], tuple(as_matlab[1]))
+        if any(b < a for a, b in itertools.pairwise(xs)):
+            return "points in descending x cannot be written as discretemf"
+    return None
+
+
+def _input_term_readable(variable: str, term: Term, losses: list[Loss]) -> bool:
+    problem = _term_problem(term, point_output=False)
+    if problem is not None:
+        losses.append(Loss(f"term {term.name!r} of {variable!r}", problem))
+    return problem is None
+
+
 def _needs_fuzzylite(fb: FunctionBlock) -> bool:
     for d in fb.defuzzify:
+        if is_point_output(d) and any(
+            isinstance(t.mf, ShapeMF) and t.mf.kind in MONOTONIC_KINDS for t in d.terms
+        ):
+            return True  # Tsukamoto: MATLAB's Sugeno outputs have constant or linear terms only
         default = d.default
         if d.clamp or (default is not None and default.no_change):
             return True
@@ -214,7 +252,11 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 )
                 continue
             if term_losses(d.variable, t, supported, "FIS", losses):
-                kept.append(t)
+                problem = _term_problem(t, is_point_output(d))
+                if problem is None:
+                    kept.append(t)
+                else:
+                    losses.append(Loss(f"term {t.name!r} of {d.variable!r}", problem))
         defuzzify.append(with_range(fb, replace(d, terms=tuple(kept)), losses, 'FIS'))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
     for f in fb.fuzzify:
@@ -231,6 +273,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                     for t in f.terms
                     if not isinstance(t.mf, SingletonMF)
                     and term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                    and _input_term_readable(f.variable, t, losses)
                 ),
             )
             for f in fb.fuzzify
