@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import identifier
+from fuzzyctl.formats._common import identifier, is_identifier
 from fuzzyctl.model import (
     And,
     Binary,
@@ -178,14 +178,19 @@ def support(term: Term) -> tuple[float, float] | None:
 
 
 def prepare(
-    document: Document, target: str, running_hedges: bool = True
+    document: Document, target: str, running_hedges: bool = True, reserved: frozenset[str] = frozenset()
 ) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
     """The main function block rewritten for FIS/FLL, the losses, and the renaming applied
     (old name -> new name, variables and terms share one map per variable).  With
     ``running_hedges`` rules are split where fuzzylite's running conclusion hedges cannot
-    say the model's (the FIS writer decides later, see :func:`split_for_running_hedges`)."""
+    say the model's (the FIS writer decides later, see :func:`split_for_running_hedges`).
+    Names that are not identifiers, or are ``reserved`` words of the target, are renamed."""
     losses: list[Loss] = []
     fb = document.main
+    # jFuzzyLogic's COGF is the weighted average of the terms' values (docs/engine.md)
+    fb = replace(
+        fb, defuzzify=tuple(replace(d, method="WTAVER") if d.method == "COGF" else d for d in fb.defuzzify)
+    )
     for other in document.blocks[1:]:
         losses.append(
             Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written")
@@ -248,7 +253,10 @@ def prepare(
         replace(f, terms=tuple(_singleton_as_triangle(t) for t in f.terms)) for f in fb.fuzzify
     )
     fb = replace(fb, rule_blocks=tuple(new_blocks), fuzzify=fuzzify, defuzzify=tuple(defuzzify))
-    fb, renames = rename(fb)
+    def valid(name: str) -> bool:
+        return is_identifier(name) and name not in reserved
+
+    fb, renames = rename(fb, valid, valid)
     return fb, losses, renames
 
 

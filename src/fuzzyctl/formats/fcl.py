@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import math
 import re
 from dataclasses import replace
 from functools import cache
@@ -17,9 +18,20 @@ from importlib import resources
 from typing import Any
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats._common import identifier
+from fuzzyctl.formats._common import hedge_power, identifier
 from fuzzyctl.formats._lower import rename
-from fuzzyctl.model import Document, FunctionBlock, Rule, RuleBlock
+from fuzzyctl.model import (
+    POWER_HEDGE_PREFIX,
+    And,
+    Condition,
+    Document,
+    FunctionBlock,
+    Is,
+    Not,
+    Or,
+    Rule,
+    RuleBlock,
+)
 
 _POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
 
@@ -95,6 +107,42 @@ def _labels(block: RuleBlock) -> RuleBlock:
     return replace(block, rules=tuple(replace(r, label=str(i)) for i, r in enumerate(block.rules, 1)))
 
 
+def _power_words(hedges: tuple[str, ...]) -> tuple[str, ...] | None:
+    """Power hedges (Octave's ``d^p``) as FCL hedge words: ``very`` is d^2, ``somewhat``
+    sqrt(d), so d^4 is ``very very``; ``None`` when a power has no such form."""
+    words: list[str] = []
+    for hedge in hedges:
+        if not hedge.startswith(POWER_HEDGE_PREFIX):
+            words.append(hedge)
+            continue
+        power = hedge_power(hedge)
+        if power is None or power <= 0:
+            return None
+        exponent = math.log2(power)
+        if exponent != round(exponent) or abs(exponent) > 8:
+            return None
+        words += ["very" if exponent > 0 else "somewhat"] * abs(round(exponent))
+    return tuple(words)
+
+
+def _hedges_in_fcl(condition: Condition, where: str, losses: list[Loss]) -> Condition:
+    """Octave's power hedges said with FCL's hedge words where they can be."""
+    if isinstance(condition, Is):
+        if not any(h.startswith(POWER_HEDGE_PREFIX) for h in condition.hedges):
+            return condition
+        words = _power_words(condition.hedges)
+        if words is None:
+            losses.append(Loss(where, f"FCL has no hedge for {' '.join(condition.hedges)}; dropped"))
+            words = tuple(h for h in condition.hedges if not h.startswith(POWER_HEDGE_PREFIX))
+        return replace(condition, hedges=words)
+    if isinstance(condition, Not):
+        return replace(condition, operand=_hedges_in_fcl(condition.operand, where, losses))
+    if isinstance(condition, And | Or):
+        operands = tuple(_hedges_in_fcl(c, where, losses) for c in condition.operands)
+        return replace(condition, operands=operands)
+    return condition
+
+
 def _fcl_identifier(name: str, taken: set[str]) -> str:
     """``name`` when FCL reads it and it is free, else an identifier close to it."""
     if fcl_name(name) and name not in taken:
@@ -137,7 +185,8 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 )
             rules = []
             for rule in block.rules:
-                if rule.condition is None:
+                condition = rule.condition
+                if condition is None:
                     losses.append(
                         Loss(
                             f"rule {rule.label!r}",
@@ -147,6 +196,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                     )
                     continue
                 rule = _rule_weight_to_conclusions(fb, block, rule, losses)
+                rule = replace(rule, condition=_hedges_in_fcl(condition, f"rule {rule.label!r}", losses))
                 if any(c.hedges for c in rule.conclusions):
                     losses.append(Loss(f"rule {rule.label!r}", "FCL has no hedges on conclusions"))
                     rule = replace(rule, conclusions=tuple(replace(c, hedges=()) for c in rule.conclusions))

@@ -345,10 +345,15 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}")
         )
     for d in fb.defuzzify:
-        if d.method == "COGF" or (d.accu or "") == "NSUM":
-            losses.append(
-                Loss(f"output {d.variable!r}", f"FIS has no {d.method if d.method == 'COGF' else 'NSUM'}")
-            )
+        if (d.accu or "") == "NSUM":
+            losses.append(Loss(f"output {d.variable!r}", "FIS has no NSUM"))
+    if "NSUM" in accu_values and not any(d.accu == "NSUM" for d in fb.defuzzify):
+        losses.append(Loss("aggregation", "FIS has no NSUM"))
+    # what is written anyway (--lossy) says the nearest FIS aggregation
+    accu_values = {"SUM" if a == "NSUM" else a for a in accu_values}
+    fb = replace(
+        fb, defuzzify=tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify)
+    )
     methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
     if len(methods) > 1:
         losses.append(

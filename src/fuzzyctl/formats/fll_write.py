@@ -18,7 +18,7 @@ from fuzzyctl.formats._lower import (
     with_range,
 )
 from fuzzyctl.formats._terms import FLL_OF_KIND, FLL_TYPES
-from fuzzyctl.formats.fll import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.formats.fll import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -50,7 +50,8 @@ exact; fuzzylite approximates with this many midpoint samples)."""
 
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as FLL can state it, and what had to be dropped."""
-    fb, losses, _ = prepare(document, "FLL")
+    # a variable or term called "very" or "then" would read as a hedge or a keyword
+    fb, losses, _ = prepare(document, "FLL", reserved=HEDGE_WORDS | KEYWORDS)
     fb = replace(
         fb,
         fuzzify=tuple(with_range(fb, f, losses, "FLL") for f in fb.fuzzify),  # type: ignore[misc]
@@ -79,8 +80,6 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rules.append(rule)
         blocks.append(replace(block, rules=tuple(rules)))
     for d in fb.defuzzify:
-        if d.method in {"COGF"}:
-            losses.append(Loss(f"output {d.variable!r}", f"FLL has no defuzzification method {d.method}"))
         if d.method in {"COGS", "WTAVER", "WTSUM"}:
             continue  # NSUM adds the degrees of a weighted average, written UnboundedSum
         if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
