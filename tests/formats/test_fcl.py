@@ -210,3 +210,24 @@ def test_variable_references_follow_a_renamed_variable() -> None:
     assert term.expr.left.name in new
     weight = again.rule_blocks[0].rules[0].conclusions[0].weight
     assert isinstance(weight, m.Ref) and weight.name in new
+
+
+def test_octave_power_hedges_become_very_and_somewhat_or_a_loss() -> None:
+    """Octave's hedge codes raise a degree to a power (``2.4``: term 2, d^4): FCL says d^4 as
+    ``very very`` (d^2 twice) and has no word for d^3."""
+    rules = "1 1, 1 (1) : 1\n2.4 -2, 2 (1) : 1\n1 2, 3 (1) : 2\n"
+    source = read_text(
+        FIS.replace("NumRules=4", "NumRules=3").split("[Rules]")[0] + "[Rules]\n" + rules, "fis"
+    )
+    text, losses = convert(source.document, "fcl")
+    assert not losses and "IS very very Then" in text
+    again = read_text(text, "fcl").document
+    rng = np.random.default_rng(9)
+    xs, ys = list(rng.uniform(0, 10, 300)), list(rng.uniform(0, 10, 300))
+    want = fuzzyctl.compile(source.document).evaluate_batch({"if": xs, "Is": ys})["RANGE"]
+    names = [v.name for v in again.main.inputs]
+    got = fuzzyctl.compile(again).evaluate_batch(dict(zip(names, (xs, ys), strict=True)))
+    assert np.allclose(want, got[again.main.outputs[0].name], rtol=0.0, atol=1e-9, equal_nan=True)
+    cubed = read_text(FIS.replace("2 2, 2 (1) : 1", "2.3 2, 2 (1) : 1"), "fis").document
+    _text, losses = convert(cubed, "fcl", lossy=True)
+    assert [loss.reason for loss in losses] == ["FCL has no hedge for pow:3; dropped"]
