@@ -12,6 +12,8 @@ from pathlib import Path
 import pytest
 from hypothesis import settings
 
+from tests.conformance.measurements import pytest_terminal_summary  # noqa: F401  (a pytest hook)
+
 # `make test` must give the same verdict on every run, so property tests replay a fixed
 # sequence of examples there; `make fuzz` draws fresh ones (and more of them) to hunt bugs.
 settings.register_profile("ci", derandomize=True, print_blob=True)

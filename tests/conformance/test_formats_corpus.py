@@ -25,7 +25,7 @@ def _files(kind: str) -> list[Path]:
 
 
 @pytest.mark.parametrize("kind", ["fis", "fll"])
-def test_load_rate_and_rejections(kind: str) -> None:
+def test_load_rate_and_rejections(kind: str, record_property: pytest.RecordProperty) -> None:
     rejected = {k: v for k, v in _rejected().items() if k.startswith(f"{kind}/")}
     files = _files(kind)
     assert files, "corpus is empty"
@@ -38,10 +38,12 @@ def test_load_rate_and_rejections(kind: str) -> None:
             failures[f"{kind}/{path.name}"] = next(d for d in exc.diagnostics if d.is_error)
     well_formed = len(files) - len(rejected)
     rate = loaded / well_formed
-    print(
-        f"\n{kind}: {loaded}/{len(files)} files load; {loaded}/{well_formed} well-formed = {rate:.1%}; "
-        f"{len(failures)} rejected"
+    summary = (
+        f"load rate {kind}: {loaded}/{len(files)} files load; {loaded}/{well_formed} well-formed = "
+        f"{rate:.1%}; {len(failures)} rejected at their defect"
     )
+    print("\n" + summary)
+    record_property("report", summary)  # shown in the "conformance measurements" section
     assert rate >= 0.98
     for name, diagnostic in failures.items():
         assert name in rejected, f"{name} rejected but listed as well-formed: {diagnostic.render()}"
@@ -49,6 +51,8 @@ def test_load_rate_and_rejections(kind: str) -> None:
         assert diagnostic.code == code and diagnostic.span is not None and diagnostic.span.line == line, (
             f"{name}: expected {code} at line {line}, got {diagnostic.render()}"
         )
+        # what the user sees names the file, the line and the problem
+        assert f"{Path(name).name}:{line}:" in diagnostic.render() and diagnostic.message
     unexpected_loads = set(rejected) - set(failures)
     assert not unexpected_loads, f"listed as broken but loaded: {sorted(unexpected_loads)}"
 

@@ -6,8 +6,10 @@ import math
 
 import pytest
 
+import fuzzyctl
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import fll, get
+from fuzzyctl.formats import convert, fll, get, read_text
 from fuzzyctl.model import And, Is, Or, PointsMF, ShapeMF
 
 SYSTEM = """Engine: demo
@@ -134,3 +136,44 @@ def test_written_fll_reads_back_equal_and_undoes_running_hedges() -> None:
     text = fmt.write(lowered)
     assert "then y is very big and z is seldom l" in text
     assert fll.read(text).document.main == lowered.main
+
+
+def test_names_that_are_fll_hedges_or_keywords_are_renamed() -> None:
+    """A term ``very`` or a variable ``then`` (fine in FCL) would read as a hedge or a keyword
+    in a fuzzylite rule: the FLL writer renames them, and the system computes the same."""
+    tri = m.ShapeMF("triangle", (0.0, 5.0, 10.0))
+    fb = m.FunctionBlock(
+        "f",
+        variables=(m.Variable("then", m.VarKind.INPUT), m.Variable("y", m.VarKind.OUTPUT)),
+        fuzzify=(m.FuzzifyBlock("then", (m.Term("very", tri), m.Term("any", tri)), m.Range(0, 10)),),
+        defuzzify=(
+            m.DefuzzifyBlock(
+                "y",
+                (m.Term("not", m.SingletonMF(2.0)), m.Term("b", m.SingletonMF(8.0))),
+                m.Range(0, 10),
+                "COGS",
+            ),
+        ),
+        rule_blocks=(
+            m.RuleBlock(
+                "rb",
+                (
+                    m.Rule("1", m.Is("then", "very", hedges=("very",)), (m.Conclusion("y", "not"),)),
+                    m.Rule("2", m.Is("then", "any", negated=True), (m.Conclusion("y", "b"),)),
+                ),
+                "MIN",
+                None,
+                "MIN",
+                "MAX",
+            ),
+        ),
+    )
+    text, losses = convert(m.Document((fb,)), "fll")
+    assert not losses
+    again = read_text(text, "fll").document.main
+    assert not {v.name for v in again.variables} & {"then", "very", "any", "not"}
+    assert not {t.name for b in (*again.fuzzify, *again.defuzzify) for t in b.terms} & {"very", "any", "not"}
+    xs = [0.5, 2.5, 5.0, 7.5, 9.5]
+    want = fuzzyctl.compile(fb).evaluate_batch({"then": xs})["y"]
+    got = fuzzyctl.compile(again).evaluate_batch({again.inputs[0].name: xs})["y"]
+    assert list(want) == list(got)

@@ -5,9 +5,13 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import numpy as np
 import pytest
 
+import fuzzyctl
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, Severity
+from fuzzyctl.formats import convert, read_text
 from fuzzyctl.formats.fpl import parse_fpl, read_fpl
 from fuzzyctl.formats.fpl_write import check_fpl, write_fpl
 from fuzzyctl.model import (
@@ -259,3 +263,52 @@ def test_siemens_1_3_fpltest_reads_like_the_fcl_transcription() -> None:
         rule_blocks=tuple(replace(rb, act=None) for rb in fpl.rule_blocks),
     )
     assert no_ranges == fcl
+
+
+def test_names_fpl_cannot_read_are_renamed() -> None:
+    """MATLAB names such as ``dV*`` or ``Rear Left`` and FPL keywords (``If``, ``Min``) are no
+    FPL words: the writer renames them and the project reads back and evaluates the same."""
+    pts = m.PointsMF((m.Point(0.0, 0.0), m.Point(5.0, 1.0), m.Point(10.0, 0.0)))
+    fb = m.FunctionBlock(
+        "my project",
+        variables=(
+            m.Variable("dV*", m.VarKind.INPUT),
+            m.Variable("If", m.VarKind.INPUT),
+            m.Variable("Min", m.VarKind.OUTPUT),
+        ),
+        fuzzify=(
+            m.FuzzifyBlock("dV*", (m.Term("Rear Left", pts),), m.Range(0, 10)),
+            m.FuzzifyBlock("If", (m.Term("end", pts),), m.Range(0, 10)),
+        ),
+        defuzzify=(
+            m.DefuzzifyBlock(
+                "Min",
+                (m.Term("is", m.SingletonMF(2.0)), m.Term("b", m.SingletonMF(8.0))),
+                m.Range(0, 10),
+                "COGS",
+            ),
+        ),
+        rule_blocks=(
+            m.RuleBlock(
+                "rb",
+                (
+                    m.Rule("1", m.Is("dV*", "Rear Left"), (m.Conclusion("Min", "is"),)),
+                    m.Rule("2", m.Is("If", "end"), (m.Conclusion("Min", "b"),)),
+                ),
+                "MIN",
+                None,
+                None,
+                "MAX",
+            ),
+        ),
+    )
+    text, losses = convert(m.Document((fb,)), "fpl", lossy=True)
+    assert not [loss for loss in losses if "name" in loss.reason]
+    again = read_text(text, "fpl").document.main
+    names = {v.name for v in again.variables} | {t.name for b in again.fuzzify for t in b.terms}
+    assert not names & {"dV*", "If", "Min", "Rear Left", "end", "is"}
+    xs = np.linspace(0.5, 9.5, 7)
+    want = fuzzyctl.compile(fb).evaluate_batch({"dV*": xs, "If": xs[::-1]})["Min"]
+    a, b = (v.name for v in again.inputs)
+    got = fuzzyctl.compile(again).evaluate_batch({a: xs, b: xs[::-1]})[again.outputs[0].name]
+    assert np.allclose(want, got, rtol=0.0, atol=1e-9)

@@ -73,3 +73,15 @@ def test_write_atomic_replaces_whole_file(tmp_path: Path) -> None:
     formats.write_atomic(target, "one\n")
     formats.write_atomic(target, "two\n")
     assert target.read_text() == "two\n" and [p.name for p in tmp_path.iterdir()] == ["t.txt"]
+
+
+def test_convert_formats_by_option_whatever_the_extensions(tmp_path: Path) -> None:
+    """--from and --to override the extensions (a MATLAB FIS saved as .txt)."""
+    src = shared_path("conformance", "fuzzylite", "takagi-sugeno", "matlab", "tippersg.fis")
+    renamed = tmp_path / "tipper.txt"
+    renamed.write_bytes(src.read_bytes())
+    assert main(["convert", str(renamed), str(tmp_path / "out.dat"), "--from", "fis", "--to", "fll"]) == 0
+    again = formats.read_path(tmp_path / "out.dat", "fll").document.main
+    original = formats.read_path(src).document.main
+    assert [v.name for v in again.variables] == [v.name for v in original.variables]
+    assert main(["convert", str(renamed), str(tmp_path / "out.fll")]) == 1  # .txt: format unknown

@@ -18,10 +18,10 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.engine import pwl, shapes
+from fuzzyctl.engine import pwl, selection, shapes
 from fuzzyctl.engine.expr import eval_expr_np
 from fuzzyctl.engine.interp import Interpreter
-from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
+from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np, clamp_np
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -86,6 +86,9 @@ class BatchEvaluator:
         plan = self.plan
         opts = plan.options
         n = len(vals[0]) if vals else 0
+        vals = [
+            v if i.clamp is None else clamp_np(v, *i.clamp) for i, v in zip(plan.inputs, vals, strict=True)
+        ]
         degrees: dict[tuple[int, int], Arr] = {}
         for var, term in self.needed:
             fi = plan.fuzzy_inputs[var]
@@ -131,12 +134,27 @@ class BatchEvaluator:
             assert isinstance(c, CTrue)
             return np.ones(n)
 
+        threshold = opts.firing_threshold
+
+        def weighted(ri: int) -> Arr:
+            rule = plan.rules[ri]
+            a = cond(rule.condition)
+            if rule.weight != 1.0:
+                a = a * self._pv(rule.weight, vals)
+            return np.where(a <= threshold, 0.0, a) if threshold > 0.0 else a
+
+        selected: dict[int, Arr] = {}
+        for sel in plan.selections:  # these rules read no chained variable: evaluate them first
+            stacked = np.stack([np.broadcast_to(weighted(ri), (n,)) for ri in sel.rules], axis=1)
+            chosen = selection.select_np(sel, stacked)
+            for j, ri in enumerate(sel.rules):
+                d = chosen[:, j]
+                selected[ri] = np.where(d <= threshold, 0.0, d) if threshold > 0.0 else d
+
         concl: list[list[tuple[Arr, W]]] = [[] for _ in plan.rules]
         for ri in plan.order:
             rule = plan.rules[ri]
-            a = cond(rule.condition)
-            if opts.firing_threshold > 0.0:
-                a = np.where(a <= opts.firing_threshold, 0.0, a)
+            a = selected[ri] if rule.selection is not None else weighted(ri)
             carried = a
             for cp in rule.conclusions:
                 base = carried if opts.hedges_carry_over else a
@@ -268,7 +286,8 @@ class BatchEvaluator:
         den = np.zeros(n)
         for t, wt in items:
             z = z_of(t, wt)
-            num = num + np.where(wt > 0.0, wt * z, 0.0)
+            with np.errstate(invalid="ignore"):  # 0 * inf where a Tsukamoto term is not reached
+                num = num + np.where(wt > 0.0, wt * z, 0.0)
             den = den + wt
         fired = den > 0.0
         with np.errstate(all="ignore"):
@@ -395,6 +414,8 @@ class BatchEvaluator:
 def _apply_default(
     op: OutputPlan, value: Arr, fired: npt.NDArray[np.bool_], state: list[float | None], oi: int
 ) -> Arr:
+    if op.clamp is not None:  # lock-range: NC keeps the limited value, DEFAULT is limited too
+        value = clamp_np(value, *op.clamp)
     if fired.all():
         if len(value):
             state[oi] = float(value[-1])
@@ -408,6 +429,8 @@ def _apply_default(
         out = np.where(fired, value, filled)
     else:
         out = np.where(fired, value, initial)
+    if op.clamp is not None:
+        out = clamp_np(out, *op.clamp)
     if len(out):
         state[oi] = float(out[-1])
     return np.asarray(out, dtype=np.float64)

@@ -15,13 +15,14 @@ from fuzzyctl.model import Document, FunctionBlock
 #: ``"iec"`` is IEC 61131-7 as documented in docs/engine.md.
 COMPAT_PROFILES: dict[str, Options] = {
     "iec": Options(),
-    # fuzzylite 6 (C++), the tool that produced the .fld reference files
+    # fuzzylite 6 (C++), the tool that produced the .fld reference files.  Its conclusion
+    # hedges carrying over to the next conclusions is a matter of reading its rule text: our
+    # FLL and FIS readers resolve it; for fuzzylite's FCL exports add hedges_carry_over=True.
     "fuzzylite": Options(
         weight_before_activation=True,
         firing_threshold=1e-6,
         ts_default_accu="SUM",
         singleton_default_accu="SUM",
-        hedges_carry_over=True,
     ),
     # pyfuzzylite 8: like fuzzylite but no firing threshold and per-conclusion hedges
     "pyfuzzylite": Options(

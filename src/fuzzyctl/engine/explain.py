@@ -34,8 +34,9 @@ class ConclusionTrace:
 class RuleTrace:
     block: str | None
     label: str
-    degree: float  # the condition's degree of fulfilment
+    degree: float  # the degree the rule fires with: its condition's, times a rule weight, if selected
     conclusions: tuple[ConclusionTrace, ...]
+    condition: float | None = None  # the condition's degree of fulfilment alone
 
     @property
     def fired(self) -> bool:
@@ -144,7 +145,8 @@ def build(plan: Plan, inputs: dict[str, float], rec: Record) -> Explanation:
                 var = ch.name
                 term = ch.terms[cp.term] if cp.term is not None else None
             concl.append(ConclusionTrace(var, term, w, d))
-        rules.append(RuleTrace(r.block, r.label, rec.rule_degrees[ri], tuple(concl)))
+        condition = rec.condition_degrees[ri] if rec.condition_degrees else None
+        rules.append(RuleTrace(r.block, r.label, rec.rule_degrees[ri], tuple(concl), condition))
     outs = tuple(_output(plan, i, o) for i, o in enumerate(rec.outputs))
     return Explanation(dict(inputs), terms, tuple(rules), chained, outs)
 

@@ -15,10 +15,10 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.engine import pwl, quadrature, shapes
+from fuzzyctl.engine import pwl, quadrature, selection, shapes
 from fuzzyctl.engine.expr import eval_expr, eval_expr_np
 from fuzzyctl.engine.grid import build_grid
-from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np
+from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np, clamp
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -55,10 +55,11 @@ class Record:
     """Everything one evaluation computed (the raw material of an explanation)."""
 
     term_degrees: list[list[float]]
-    rule_degrees: list[float]
+    rule_degrees: list[float]  # the degree each rule fires with (weight and selection applied)
     conclusion_degrees: list[list[tuple[float, float]]]  # per rule: (hedged degree, weight)
     chained_degrees: list[list[float]]
     outputs: list[OutputRecord]
+    condition_degrees: list[float] = field(default_factory=list)  # each rule's condition alone
 
 
 # --------------------------------------------------------------------------- the interpreter
@@ -87,6 +88,7 @@ class Interpreter:
         """Evaluate; ``state`` holds each output's previous value (NC) and is updated."""
         plan = self.plan
         opts = plan.options
+        values = clamp_inputs(plan, values)
         term_degrees = [
             [self.term_degree(t, values[fi.slot], values) for t in fi.terms] for fi in plan.fuzzy_inputs
         ]
@@ -136,11 +138,25 @@ class Interpreter:
             assert isinstance(c, CTrue)
             return 1.0
 
+        cond_degrees = [math.nan] * len(plan.rules)
+        threshold = opts.firing_threshold
+
+        def weighted(ri: int) -> float:
+            rule = plan.rules[ri]
+            c = cond(rule.condition)
+            cond_degrees[ri] = c
+            a = c * self.pv(rule.weight, values) if rule.weight != 1.0 else c
+            return 0.0 if a <= threshold else a
+
+        selected: dict[int, float] = {}
+        for sel in plan.selections:  # these rules read no chained variable: evaluate them first
+            degrees = selection.select(sel, [weighted(ri) for ri in sel.rules])
+            for ri, d in zip(sel.rules, degrees, strict=True):
+                selected[ri] = 0.0 if d <= threshold else d
+
         for ri in plan.order:
             rule = plan.rules[ri]
-            a = cond(rule.condition)
-            if a <= opts.firing_threshold:
-                a = 0.0
+            a = selected[ri] if rule.selection is not None else weighted(ri)
             rule_degrees[ri] = a
             carried = a
             for cp in rule.conclusions:
@@ -168,12 +184,19 @@ class Interpreter:
                     rec.value = prev if prev is not None else (op.default if op.default is not None else 0.0)
                 else:
                     rec.value = op.default if op.default is not None else 0.0
+            if op.clamp is not None:
+                rec.value = clamp(rec.value, *op.clamp)
             state[oi] = rec.value
             out_values[oi] = rec.value
             records[oi] = rec
         chained_final = [chained_value(i) for i in range(len(plan.chained))]
         return Record(
-            term_degrees, rule_degrees, concl_degrees, chained_final, [r for r in records if r is not None]
+            term_degrees,
+            rule_degrees,
+            concl_degrees,
+            chained_final,
+            [r for r in records if r is not None],
+            cond_degrees,
         )
 
     # ------------------------------------------------------------------ outputs
@@ -330,6 +353,13 @@ class Interpreter:
             rec.fired = True
             rec.value = {"LM": lm, "RM": rm, "MOM": mom}[op.method]
         return rec
+
+
+def clamp_inputs(plan: Plan, values: Sequence[float]) -> Sequence[float]:
+    """The input vector with every lock-range input limited to its range."""
+    if not any(i.clamp is not None for i in plan.inputs):
+        return values
+    return [v if i.clamp is None else clamp(v, *i.clamp) for i, v in zip(plan.inputs, values, strict=True)]
 
 
 def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:

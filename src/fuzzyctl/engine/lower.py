@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import dataclasses
 import heapq
+import math
 
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic
 from fuzzyctl.engine import operators as ops
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine import selection, shapes
 from fuzzyctl.engine.lower_outputs import _output
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _param, _term
 from fuzzyctl.engine.plan import (
@@ -40,6 +41,7 @@ from fuzzyctl.engine.plan import (
     Plan,
     PParam,
     RulePlan,
+    SelectionPlan,
     Slot,
 )
 
@@ -76,7 +78,12 @@ HEDGE_NAMES = frozenset(shapes.HEDGES)
 
 
 def lower(fb: m.FunctionBlock, options: Options | None = None) -> tuple[Plan | None, list[Diagnostic]]:
-    """Lower ``fb``; returns ``(plan, diagnostics)`` with ``plan`` None when there are errors."""
+    """Lower ``fb``; returns ``(plan, diagnostics)`` with ``plan`` None when there are errors.
+
+    A disabled rule block (fuzzylite ``enabled: false``, model ``RuleBlock.enabled``) fires
+    none of its rules: it is left out here, as if it were not written."""
+    if not all(rb.enabled for rb in fb.rule_blocks):
+        fb = dataclasses.replace(fb, rule_blocks=tuple(rb for rb in fb.rule_blocks if rb.enabled))
     ctx = _Ctx(fb, options or Options())
     plan = _lower(ctx)
     if any(d.is_error for d in ctx.diags):
@@ -193,6 +200,10 @@ def _lower(ctx: _Ctx) -> Plan | None:
         fuzzy_inputs.append(
             FuzzyInputPlan(fz.variable, ctx.slots[fz.variable], tuple(t for t in terms if t is not None))
         )
+        if fz.clamp:
+            bounds = _clamp_bounds(ctx, fz.range or var.range, f"FUZZIFY {fz.variable}", fz.span)
+            slot = ctx.slots[fz.variable]
+            inputs[slot] = dataclasses.replace(inputs[slot], clamp=bounds)
 
     # ---- chained variables: concluded by rules and read in conditions
     referenced: list[str] = []
@@ -236,8 +247,10 @@ def _lower(ctx: _Ctx) -> Plan | None:
     rules: list[RulePlan] = []
     rule_deps: list[set[str]] = []
     rule_concludes: list[set[str]] = []
+    selections: list[SelectionPlan] = []
     for bi, rb in enumerate(fb.rule_blocks):
         and_op, or_op, act, _accu = block_ops[bi]
+        first_rule = len(rules)
         for rule in rb.rules:
             deps: set[str] = set()
             cond = (
@@ -267,11 +280,18 @@ def _lower(ctx: _Ctx) -> Plan | None:
                 cp = _conclusion(ctx, c, rule.label, output_names, chained_index, term_source, inputs)
                 if cp is not None:
                     concls.append(cp)
-            if cond is None:
+            weight = _rule_weight(ctx, rule, inputs)
+            if cond is None or weight is None:
                 continue
-            rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls)))
+            rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls), weight))
             rule_deps.append(deps)
             rule_concludes.append({c.variable for c in rule.conclusions})
+        if rb.rule_activation is not None:
+            sel = _selection(ctx, rb, tuple(range(first_rule, len(rules))), rule_deps)
+            if sel is not None:
+                for ri in sel.rules:
+                    rules[ri] = dataclasses.replace(rules[ri], selection=len(selections))
+                selections.append(sel)
 
     order = _rule_order(ctx, rule_deps, rule_concludes, rules)
 
@@ -284,6 +304,11 @@ def _lower(ctx: _Ctx) -> Plan | None:
         )
         if op is None:
             continue
+        db = fb.defuzzify_block(var.name)
+        if db is not None and db.clamp:
+            op = dataclasses.replace(
+                op, clamp=_clamp_bounds(ctx, db.range or var.range, f"DEFUZZIFY {var.name}", db.span)
+            )
         outputs.append(op)
         deps_o: set[int] = set()
         for t in op.terms:
@@ -312,7 +337,63 @@ def _lower(ctx: _Ctx) -> Plan | None:
         tuple(outputs),
         tuple(output_order),
         ctx.options,
+        tuple(selections),
     )
+
+
+def _clamp_bounds(
+    ctx: _Ctx, rng: m.Range | None, where: str, span: m.Span | None
+) -> tuple[float, float] | None:
+    """The interval a lock-range limits a value to."""
+    if rng is None:
+        ctx.err(f"{where}: limiting the value to its range (lock-range) needs a RANGE", span, "clamp-range")
+        return None
+    low, high = float(rng.low), float(rng.high)
+    if math.isnan(low) or math.isnan(high) or low > high:
+        ctx.err(f"{where}: RANGE({low:g}..{high:g}) cannot limit a value", rng.span or span, "clamp-range")
+        return None
+    return low, high
+
+
+def _rule_weight(ctx: _Ctx, rule: m.Rule, inputs: list[InputPlan]) -> PParam | None:
+    """The rule weight (MATLAB / fuzzylite): it scales the condition degree."""
+    if rule.weight is None:
+        return 1.0
+    w = _param(ctx, rule.weight, f"rule {rule.label} weight")
+    if w is None:
+        return None
+    if isinstance(w, Slot):
+        inputs[w.index] = dataclasses.replace(inputs[w.index], degree=True)
+    elif w < 0.0:
+        ctx.err(f"rule {rule.label}: negative rule weight {w:g}", rule.span, "weight-negative")
+        return None
+    return w
+
+
+def _selection(
+    ctx: _Ctx, rb: m.RuleBlock, members: tuple[int, ...], rule_deps: list[set[str]]
+) -> SelectionPlan | None:
+    """fuzzylite's rule activation method of a block (None: every rule fires)."""
+    assert rb.rule_activation is not None
+    where = f"rule block {rb.name or ''}".rstrip()
+    try:
+        sel = selection.parse(rb.rule_activation, members)
+    except ValueError as exc:
+        ctx.err(f"{where}: {exc}", rb.item_span("rule_activation"), "rule-activation")
+        return None
+    if sel is None:
+        return None
+    if any(rule_deps[ri] for ri in members):
+        # the selection compares every degree of the block at once, so its conditions must
+        # not wait for other rules (fuzzylite evaluates blocks in sequence instead)
+        ctx.err(
+            f"{where}: rule activation {rb.rule_activation!r} with conditions on variables concluded "
+            "by rules (chained inference) is not supported",
+            rb.span,
+            "rule-activation-chained",
+        )
+        return None
+    return sel
 
 
 def _collect_vars(c: m.Condition, out: list[str]) -> None:

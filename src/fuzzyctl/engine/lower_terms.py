@@ -80,7 +80,7 @@ class _Ctx:
 # --------------------------------------------------------------------------- parameters and terms
 
 
-def _param(ctx: _Ctx, p: m.Param, where: str) -> PParam | None:
+def _param(ctx: _Ctx, p: m.Param, where: str, allow_infinite: bool = False) -> PParam | None:
     if isinstance(p, m.Ref):
         if p.name in ctx.slots:
             return Slot(ctx.slots[p.name])
@@ -93,16 +93,23 @@ def _param(ctx: _Ctx, p: m.Param, where: str) -> PParam | None:
         )
         return None
     v = float(p)
-    if not math.isfinite(v):
+    if math.isnan(v) or (math.isinf(v) and not allow_infinite):
         ctx.err(f"{where}: parameter {v} is not a finite number", None, "param-not-finite")
         return None
     return v
 
 
-def _expr(ctx: _Ctx, e: m.Expr, where: str, outputs: dict[str, int], allow_x: bool) -> ExprPlan | None:
+def _expr(
+    ctx: _Ctx, e: m.Expr, where: str, outputs: dict[str, int], allow_x: bool, argument: str | None = None
+) -> ExprPlan | None:
+    """Lower an expression.  ``argument`` (model ``FunctionMF.argument``) names the point a
+    membership function is evaluated at and wins over a variable of that name (fuzzylite
+    binds ``x`` last); without it, ``x`` is the point when no variable is called so."""
     if isinstance(e, m.Num):
         return ENum(float(e.value))
     if isinstance(e, m.Name):
+        if argument is not None and e.name == argument:
+            return EX()
         if e.name in ctx.slots:
             return EInput(ctx.slots[e.name])
         if e.name in outputs:
@@ -118,20 +125,20 @@ def _expr(ctx: _Ctx, e: m.Expr, where: str, outputs: dict[str, int], allow_x: bo
         )
         return None
     if isinstance(e, m.Unary):
-        inner = _expr(ctx, e.operand, where, outputs, allow_x)
+        inner = _expr(ctx, e.operand, where, outputs, allow_x, argument)
         return EUnary(e.op, inner) if inner is not None else None
     if isinstance(e, m.Binary):
         if e.op not in {"+", "-", "*", "/", "^", "%"}:
             ctx.err(f"{where}: unknown operator {e.op!r} in function", None, "function-op")
             return None
-        left = _expr(ctx, e.left, where, outputs, allow_x)
-        right = _expr(ctx, e.right, where, outputs, allow_x)
+        left = _expr(ctx, e.left, where, outputs, allow_x, argument)
+        right = _expr(ctx, e.right, where, outputs, allow_x, argument)
         return EBinary(e.op, left, right) if left is not None and right is not None else None
     fname = e.function.lower()
     if fname not in FUNCTIONS:
         ctx.err(f"{where}: unknown function {e.function!r}", None, "function-unknown")
         return None
-    args = [_expr(ctx, a, where, outputs, allow_x) for a in e.args]
+    args = [_expr(ctx, a, where, outputs, allow_x, argument) for a in e.args]
     if any(a is None for a in args):
         return None
     return ECall(fname, tuple(a for a in args if a is not None))
@@ -178,7 +185,12 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
                 "shape-arity",
             )
             return None
-        raw = [_param(ctx, p, where) for p in mf.params]
+        # infinite vertices are MATLAB/fuzzylite shoulders; fuzzylite's Binary points to +-inf
+        shoulders = mf.kind in ("triangle", "trapezoid")
+        raw = [
+            _param(ctx, p, where, shoulders or (mf.kind == "binary" and i == 1))
+            for i, p in enumerate(mf.params)
+        ]
         h = _param(ctx, mf.height, where)
         if any(p is None for p in raw) or h is None:
             return None
@@ -191,7 +203,7 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
         tp = TermPlan(t.name, mf.kind, params, h)
         _check_shape(ctx, tp, t.span, where)
     else:
-        ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, allow_x=True)
+        ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, True, mf.argument)
         if ex is None:
             return None
         tp = TermPlan(t.name, "function", (), 1.0, ex)

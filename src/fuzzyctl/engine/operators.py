@@ -240,3 +240,18 @@ def activate(name: str, a: float, mu: float) -> float:
 
 def is_finite(x: float) -> bool:
     return math.isfinite(x)
+
+
+def clamp(value: float, low: float, high: float) -> float:
+    """``value`` limited to ``[low, high]``, NaN kept (fuzzylite ``lock-range``: model
+    ``FuzzifyBlock.clamp`` / ``DefuzzifyBlock.clamp``)."""
+    if value < low:
+        return low
+    if value > high:
+        return high
+    return value
+
+
+def clamp_np(values: Any, low: float, high: float) -> Any:
+    """:func:`clamp` on an array (``np.clip`` keeps NaN)."""
+    return np.clip(values, low, high)

@@ -125,6 +125,9 @@ class InputPlan:
     name: str
     default: float | None = None  # the declared initial value: the input may be omitted
     degree: bool = False  # used as a degree (bare variable in a condition or a WITH weight)
+    #: ``(low, high)``: the value is limited to this range before anything reads it
+    #: (fuzzylite ``lock-range`` on an input, model ``FuzzifyBlock.clamp``)
+    clamp: tuple[float, float] | None = None
 
 
 # --------------------------------------------------------------------------- conditions
@@ -202,11 +205,34 @@ class ConclusionPlan:
 
 @dataclass(frozen=True)
 class RulePlan:
+    """A rule.  Its activation degree is ``weight * condition`` (the MATLAB / fuzzylite rule
+    weight, model ``Rule.weight``), set to 0 at or below ``Options.firing_threshold``, then
+    passed through the rule block's :class:`SelectionPlan` when ``selection`` is set."""
+
     label: str
     block: str | None
     condition: CondPlan
     act: str
     conclusions: tuple[ConclusionPlan, ...]
+    weight: PParam = 1.0
+    selection: int | None = None  # index into Plan.selections
+
+
+@dataclass(frozen=True)
+class SelectionPlan:
+    """fuzzylite's rule activation method of one rule block (model ``RuleBlock.rule_activation``):
+    which of the block's ``rules`` (indices into :attr:`Plan.rules`, in block order) fire, with
+    which degree.  ``method`` is ``FIRST``, ``LAST`` (the first/last ``count`` rules whose
+    degree is > 0 and >= ``threshold``), ``HIGHEST``, ``LOWEST`` (the ``count`` rules with the
+    highest/lowest degree > 0, earlier rules first on ties), ``PROPORTIONAL`` (every degree
+    divided by their sum) or ``THRESHOLD`` (the rules whose degree satisfies ``comparison``
+    ``threshold``).  Formulas: :mod:`fuzzyctl.engine.selection`."""
+
+    method: str
+    rules: tuple[int, ...]
+    count: int = 1
+    threshold: float = 0.0
+    comparison: str = ">="
 
 
 # --------------------------------------------------------------------------- outputs
@@ -279,6 +305,9 @@ class OutputPlan:
     exact: bool = False
     grid: GridPlan | None = None
     is_output: bool = True  # False for a local variable with DEFUZZIFY (not returned)
+    #: ``(low, high)``: the final value (DEFAULT and NC included) is limited to this range
+    #: (fuzzylite ``lock-range`` on an output, model ``DefuzzifyBlock.clamp``)
+    clamp: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -319,6 +348,7 @@ class Plan:
     outputs: tuple[OutputPlan, ...]
     output_order: tuple[int, ...]  # defuzzification order (function terms read earlier outputs)
     options: Options = Options()
+    selections: tuple[SelectionPlan, ...] = ()  # rule activation methods of rule blocks (fuzzylite)
 
     def input_index(self, name: str) -> int:
         for i, inp in enumerate(self.inputs):

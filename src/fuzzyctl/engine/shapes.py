@@ -73,10 +73,10 @@ def pwl_points(kind: str, params: Sequence[float], height: float = 1.0) -> Point
         return tuple((x, y * h) for x, y in pts)
     if kind == "triangle":
         a, b, c = p
-        return ((a, 0.0), (b, h), (c, 0.0))
+        return _shoulders(((a, 0.0), (b, h), (c, 0.0)), h)
     if kind == "trapezoid":
         a, b, c, d = p
-        return ((a, 0.0), (b, h), (c, h), (d, 0.0))
+        return _shoulders(((a, 0.0), (b, h), (c, h), (d, 0.0)), h)
     if kind == "rectangle":
         s, e = min(p), max(p)
         return ((s, 0.0), (s, h), (e, h), (e, 0.0))
@@ -93,6 +93,16 @@ def pwl_points(kind: str, params: Sequence[float], height: float = 1.0) -> Point
             return ((s, h), (s, 0.0))
         return ((s, 0.0),)
     return None
+
+
+def _shoulders(points: Points, h: float) -> Points:
+    """A triangle or trapezoid with vertices at -inf / +inf is a shoulder (MATLAB
+    ``trapmf [-Inf -Inf 2 4]``; fuzzylite gives the height beyond a finite vertex whose
+    neighbour is infinite): the infinite vertices are dropped and the ends continue flat."""
+    if all(math.isfinite(x) for x, _y in points):
+        return points
+    finite = tuple((x, y) for x, y in points if math.isfinite(x))
+    return finite or ((0.0, h),)
 
 
 def pwl_value(points: Points, x: float) -> float:

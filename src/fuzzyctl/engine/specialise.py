@@ -17,7 +17,7 @@ import math
 from collections.abc import Callable
 from typing import Any
 
-from fuzzyctl.engine import pwl, shapes
+from fuzzyctl.engine import pwl, selection, shapes
 from fuzzyctl.engine.expr import eval_expr
 from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.operators import SNORMS, TNORMS
@@ -64,6 +64,7 @@ class _Gen:
             "_pieces": pwl.interval_pieces,
             "_am": pwl.area_moment,
             "_eval_expr": eval_expr,
+            "_select": selection.select,
         }
         self.consts: dict[int, str] = {}
 
@@ -192,8 +193,14 @@ def specialise(plan: Plan) -> Fast:
     g.env["_interp"] = interp
     g.env["_plan"] = plan
     opts = plan.options
-    for i in range(len(plan.inputs)):
+    for i, inp in enumerate(plan.inputs):
         g.emit(f"v{i} = v[{i}]")
+        if inp.clamp is not None:  # lock-range: the limited value is what everything reads
+            lo, hi = inp.clamp
+            g.emit(f"if v{i} < {_lit(lo)}: v{i} = {_lit(lo)}")
+            g.emit(f"elif v{i} > {_lit(hi)}: v{i} = {_lit(hi)}")
+    if any(inp.clamp is not None for inp in plan.inputs):
+        g.emit(f"v = [{', '.join(f'v{i}' for i in range(len(plan.inputs)))}]")
     # ---- fuzzification: only the terms some condition reads
     needed: set[tuple[int, int]] = set()
 
@@ -224,6 +231,26 @@ def specialise(plan: Plan) -> Fast:
         bare[ci] = f"cb{ci}"
         g.emit(f"cb{ci} = 0.0")
     normalised: set[int] = set()
+    threshold = _lit(opts.firing_threshold)
+
+    def weighted(ri: int, r: str) -> None:
+        """``r = weight * condition``, 0 at or below the firing threshold."""
+        rule = plan.rules[ri]
+        a = g.cond(rule.condition, degrees, chained, bare)
+        g.emit(f"{r} = {a}" if rule.weight == 1.0 else f"{r} = {g.param(rule.weight)} * {a}")
+        if opts.firing_threshold > 0.0:
+            g.emit(f"if {r} <= {threshold}: {r} = 0.0")
+
+    # ---- rule blocks with a rule activation method: their rules read no chained variable
+    for k, sel in enumerate(plan.selections):
+        for ri in sel.rules:
+            weighted(ri, f"r{ri}")
+        g.env[f"_sel{k}"] = sel
+        g.emit(f"s{k} = _select(_sel{k}, [{', '.join(f'r{ri}' for ri in sel.rules)}])")
+        for j, ri in enumerate(sel.rules):
+            g.emit(f"r{ri} = s{k}[{j}]")
+            if opts.firing_threshold > 0.0:
+                g.emit(f"if r{ri} <= {threshold}: r{ri} = 0.0")
     # ---- rules
     concl_names: list[list[tuple[str, str]]] = [[] for _ in plan.rules]
     for ri in plan.order:
@@ -236,11 +263,9 @@ def specialise(plan: Plan) -> Fast:
                 g.emit(f"top = max(1.0, {', '.join(names)})")
                 for nme in names:
                     g.emit(f"{nme} = {nme} / top")
-        a = g.cond(rule.condition, degrees, chained, bare)
         r = f"r{ri}"
-        g.emit(f"{r} = {a}")
-        if opts.firing_threshold > 0.0:
-            g.emit(f"if {r} <= {_lit(opts.firing_threshold)}: {r} = 0.0")
+        if rule.selection is None:
+            weighted(ri, r)
         carried = r
         for cp in rule.conclusions:
             base = carried if opts.hedges_carry_over else r
@@ -340,6 +365,10 @@ def _gen_output(g: _Gen, plan: Plan, oi: int, op: OutputPlan, concl: list[list[t
         g.emit(f"if {val} is None: {val} = {init}", 2)
     else:
         g.emit(f"{val} = {init}", 2)
+    if op.clamp is not None:
+        lo, hi = op.clamp
+        g.emit(f"if {val} < {_lit(lo)}: {val} = {_lit(lo)}")
+        g.emit(f"elif {val} > {_lit(hi)}: {val} = {_lit(hi)}")
     g.emit(f"outs[{oi}] = {val}; state[{oi}] = {val}")
 
 

@@ -9,25 +9,34 @@ share, plus the :class:`Loss` list for what it had to drop.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import identifier
+from fuzzyctl.formats._common import identifier, is_identifier
 from fuzzyctl.model import (
     And,
+    Binary,
+    Call,
     Conclusion,
     Condition,
     Default,
     DefuzzifyBlock,
     Degree,
     Document,
+    Expr,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
     Is,
+    MembershipFunction,
+    Name,
     Not,
     Or,
+    Param,
+    Point,
     PointsMF,
+    Range,
     Ref,
     Rule,
     RuleBlock,
@@ -35,6 +44,7 @@ from fuzzyctl.model import (
     SingletonMF,
     SingletonsMF,
     Term,
+    Unary,
     VarKind,
 )
 
@@ -43,8 +53,9 @@ from fuzzyctl.model import (
 # equals a MATLAB/fuzzylite rule weight.
 POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
 DEFAULT_WHEN_ABSENT = 0.0
-"""What our engine outputs when no rule fired and no DEFAULT is written (IEC 61131-7
-leaves it open; fuzzyctl uses 0, see docs/formats.md)."""
+"""What our engine outputs before any rule has fired when no DEFAULT value is written: an
+output without DEFAULT, or with ``DEFAULT := NC``, keeps its previous value (docs/engine.md),
+which FIS and FLL say as ``Default=0`` with ``LockPrevious=1`` / ``lock-previous: true``."""
 
 
 def rule_label(block: RuleBlock, rule: Rule) -> str:
@@ -84,9 +95,22 @@ def uncumulate(hedges: list[tuple[str, ...]]) -> list[tuple[str, ...]] | None:
     return written
 
 
-def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss]) -> list[Rule]:
+def split_for_running_hedges(rule: Rule) -> list[Rule]:
+    """``rule`` itself when fuzzylite's running conclusion hedges can say its conclusions'
+    hedges (:func:`uncumulate`), else one rule per conclusion."""
+    if uncumulate([c.hedges for c in rule.conclusions]) is not None:
+        return [rule]
+    return [
+        replace(rule, label=f"{rule.label}_{j + 1}", conclusions=(c,)) for j, c in enumerate(rule.conclusions)
+    ]
+
+
+def split_rules(
+    fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss], running_hedges: bool = True
+) -> list[Rule]:
     """Rules equivalent to ``rule`` whose weight is a single rule weight (MATLAB/fuzzylite)
-    and whose conclusion hedges can be written; splits per conclusion when needed."""
+    and, with ``running_hedges`` (fuzzylite), whose conclusion hedges can be written; splits
+    per conclusion when needed."""
     act = block.act or "MIN"
     groups: dict[float, list[Conclusion]] = {}
     for c in rule.conclusions:
@@ -117,27 +141,11 @@ def split_rules(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Lo
         groups.setdefault(w_rule * w_conclusion, []).append(replace(c, weight=None))
     out_rules: list[Rule] = []
     for i, (weight, conclusions) in enumerate(groups.items()):
-        written = uncumulate([c.hedges for c in conclusions])
         label = rule.label if len(groups) == 1 else f"{rule.label}_{i + 1}"
-        if written is None:
-            for j, c in enumerate(conclusions):
-                out_rules.append(
-                    replace(
-                        rule,
-                        label=f"{label}_{j + 1}",
-                        conclusions=(c,),
-                        weight=None if weight == 1.0 else weight,
-                    )
-                )
-        else:
-            out_rules.append(
-                replace(
-                    rule,
-                    label=label,
-                    conclusions=tuple(conclusions),
-                    weight=None if weight == 1.0 else weight,
-                )
-            )
+        one = replace(
+            rule, label=label, conclusions=tuple(conclusions), weight=None if weight == 1.0 else weight
+        )
+        out_rules.extend(split_for_running_hedges(one) if running_hedges else [one])
     return out_rules
 
 
@@ -169,11 +177,20 @@ def support(term: Term) -> tuple[float, float] | None:
     return None
 
 
-def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
+def prepare(
+    document: Document, target: str, running_hedges: bool = True, reserved: frozenset[str] = frozenset()
+) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
     """The main function block rewritten for FIS/FLL, the losses, and the renaming applied
-    (old name -> new name, variables and terms share one map per variable)."""
+    (old name -> new name, variables and terms share one map per variable).  With
+    ``running_hedges`` rules are split where fuzzylite's running conclusion hedges cannot
+    say the model's (the FIS writer decides later, see :func:`split_for_running_hedges`).
+    Names that are not identifiers, or are ``reserved`` words of the target, are renamed."""
     losses: list[Loss] = []
     fb = document.main
+    # jFuzzyLogic's COGF is the weighted average of the terms' values (docs/engine.md)
+    fb = replace(
+        fb, defuzzify=tuple(replace(d, method="WTAVER") if d.method == "COGF" else d for d in fb.defuzzify)
+    )
     for other in document.blocks[1:]:
         losses.append(
             Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written")
@@ -217,19 +234,38 @@ def prepare(document: Document, target: str) -> tuple[FunctionBlock, list[Loss],
             if any(a.variable in local_names for a in _atoms(condition) if isinstance(a, Is)):
                 losses.append(Loss(label, "a condition on a local variable cannot be written"))
                 continue
-            rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses))
+            rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses, running_hedges))
         new_blocks.append(replace(block, rules=tuple(rules)))
 
     # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
     defuzzify = []
     for d in fb.defuzzify:
-        default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT)
-        if default.value is None:
+        default = d.default if d.default is not None else Default(DEFAULT_WHEN_ABSENT, no_change=True)
+        if default.value is None:  # DEFAULT := NC: 0 until a rule fires (the engine's NC start)
             default = Default(DEFAULT_WHEN_ABSENT, default.no_change)
-        defuzzify.append(replace(d, default=default))
-    fb = replace(fb, rule_blocks=tuple(new_blocks), defuzzify=tuple(defuzzify))
-    fb, renames = rename(fb)
+        method = d.method
+        if d.terms and all(isinstance(t.mf, SingletonMF) for t in d.terms) and method in (None, "COG"):
+            method = "COGS"  # CoG of singletons is CoGS (docs/engine.md): say it as a weighted average
+        defuzzify.append(replace(d, default=default, method=method))
+    # An input singleton is the triangle (v, v, v): degree 1 exactly at v, 0 elsewhere, in our
+    # engine, MATLAB's trimf and fuzzylite's Triangle alike.
+    fuzzify = tuple(
+        replace(f, terms=tuple(_singleton_as_triangle(t) for t in f.terms)) for f in fb.fuzzify
+    )
+    fb = replace(fb, rule_blocks=tuple(new_blocks), fuzzify=fuzzify, defuzzify=tuple(defuzzify))
+    def valid(name: str) -> bool:
+        return is_identifier(name) and name not in reserved
+
+    fb, renames = rename(fb, valid, valid)
     return fb, losses, renames
+
+
+def _singleton_as_triangle(term: Term) -> Term:
+    mf = term.mf
+    if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
+        v = float(mf.value)
+        return replace(term, mf=ShapeMF("triangle", (v, v, v)))
+    return term
 
 
 def _atoms(condition: Condition | None) -> list[Condition]:
@@ -242,25 +278,83 @@ def _atoms(condition: Condition | None) -> list[Condition]:
     return [condition]
 
 
-def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
-    """Rename variables and terms to identifiers (``LDL-Level`` -> ``LDL_Level``)."""
+def rename(
+    fb: FunctionBlock,
+    valid_variable: Callable[[str], bool] | None = None,
+    valid_term: Callable[[str], bool] | None = None,
+) -> tuple[FunctionBlock, dict[str, str]]:
+    """Rename variables and terms the target cannot write to identifiers (``LDL-Level`` ->
+    ``LDL_Level``).  By default a name must be an ASCII identifier; a format with other
+    rules passes its own checks."""
+
+    def fixer(valid: Callable[[str], bool] | None) -> Callable[[str, set[str]], str]:
+        def fix(name: str, taken: set[str]) -> str:
+            if valid is None:
+                return identifier(name, taken)
+            if valid(name) and name not in taken:
+                taken.add(name)
+                return name
+            # identifier() gives an ASCII identifier, which may still be one the target
+            # reserves (FCL's ``if``): number it until the target accepts it
+            base = identifier(name, set())
+            candidate, n = base, 2
+            while candidate in taken or not valid(candidate):
+                candidate, n = f"{base}_{n}", n + 1
+            taken.add(candidate)
+            return candidate
+
+        return fix
+
+    fix_variable, fix_term = fixer(valid_variable), fixer(valid_term)
     taken_vars: set[str] = set()
-    var_map = {v.name: identifier(v.name, taken_vars) for v in fb.variables}
+    var_map = {v.name: fix_variable(v.name, taken_vars) for v in fb.variables}
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
-    if all(k == v for k, v in var_map.items()) and all(
-        identifier(t.name, set()) == t.name for blk in blocks for t in blk.terms
-    ):
-        return fb, {}
     term_maps: dict[str, dict[str, str]] = {}
     for blk in blocks:
         taken: set[str] = set()
-        term_maps[blk.variable] = {t.name: identifier(t.name, taken) for t in blk.terms}
+        term_maps[blk.variable] = {t.name: fix_term(t.name, taken) for t in blk.terms}
+    if all(k == v for k, v in var_map.items()) and all(
+        k == v for names in term_maps.values() for k, v in names.items()
+    ):
+        return fb, {}
 
     def v(name: str) -> str:
         return var_map.get(name, name)
 
     def t(var: str, name: str | None) -> str | None:
         return None if name is None else term_maps.get(var, {}).get(name, name)
+
+    def param(p: Param) -> Param:
+        return Ref(v(p.name), p.span) if isinstance(p, Ref) else p
+
+    def point(p: Point) -> Point:
+        return replace(p, x=param(p.x), y=param(p.y))
+
+    def expr(e: Expr, argument: str | None) -> Expr:
+        if isinstance(e, Name):
+            return e if e.name == argument else Name(v(e.name))
+        if isinstance(e, Unary):
+            return replace(e, operand=expr(e.operand, argument))
+        if isinstance(e, Binary):
+            return replace(e, left=expr(e.left, argument), right=expr(e.right, argument))
+        if isinstance(e, Call):
+            return replace(e, args=tuple(expr(a, argument) for a in e.args))
+        return e
+
+    def mf(f: MembershipFunction) -> MembershipFunction:
+        """Parameters and expressions that name variables follow the variables."""
+        if isinstance(f, ShapeMF):
+            return replace(f, params=tuple(param(p) for p in f.params), height=param(f.height))
+        if isinstance(f, PointsMF | SingletonsMF):
+            return replace(f, points=tuple(point(p) for p in f.points))
+        if isinstance(f, SingletonMF):
+            return replace(f, value=param(f.value))
+        return replace(f, expr=expr(f.expr, f.argument))
+
+    def terms(b: FuzzifyBlock | DefuzzifyBlock) -> tuple[Term, ...]:
+        return tuple(
+            replace(term, name=t(b.variable, term.name) or term.name, mf=mf(term.mf)) for term in b.terms
+        )
 
     def cond(c: Condition | None) -> Condition | None:
         if c is None:
@@ -276,22 +370,8 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
     renamed = replace(
         fb,
         variables=tuple(replace(x, name=v(x.name)) for x in fb.variables),
-        fuzzify=tuple(
-            replace(
-                b,
-                variable=v(b.variable),
-                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
-            )
-            for b in fb.fuzzify
-        ),
-        defuzzify=tuple(
-            replace(
-                b,
-                variable=v(b.variable),
-                terms=tuple(replace(term, name=t(b.variable, term.name) or term.name) for term in b.terms),
-            )
-            for b in fb.defuzzify
-        ),
+        fuzzify=tuple(replace(b, variable=v(b.variable), terms=terms(b)) for b in fb.fuzzify),
+        defuzzify=tuple(replace(b, variable=v(b.variable), terms=terms(b)) for b in fb.defuzzify),
         rule_blocks=tuple(
             replace(
                 b,
@@ -300,7 +380,12 @@ def rename(fb: FunctionBlock) -> tuple[FunctionBlock, dict[str, str]]:
                         r,
                         condition=cond(r.condition),
                         conclusions=tuple(
-                            replace(c, variable=v(c.variable), term=t(c.variable, c.term))
+                            replace(
+                                c,
+                                variable=v(c.variable),
+                                term=t(c.variable, c.term),
+                                weight=None if c.weight is None else param(c.weight),
+                            )
                             for c in r.conclusions
                         ),
                     )
@@ -346,6 +431,79 @@ def is_point_output(block: DefuzzifyBlock) -> bool:
     return (block.method or "") in POINT_METHODS
 
 
+SUM_LIKE = frozenset({"SUM", "NSUM"})
+"""Accumulations that add every rule's degree (NSUM's normalisation never changes a weighted
+average): for a weighted-average output they equal "every rule counts"."""
+
+
+def point_accumulation(fb: FunctionBlock, block: DefuzzifyBlock) -> str | None:
+    """How the engine combines the degrees of a weighted-average output's terms: its own
+    ACCU, else that of the rule blocks concluding it, else none (every rule counts on its
+    own) - except an output of singletons defuzzified by CoGS, which accumulates with MAX
+    (IEC 61131-7), see docs/engine.md."""
+    if block.accu is not None:
+        return block.accu
+    for rb in fb.rule_blocks:
+        if rb.accu is not None and any(c.variable == block.variable for r in rb.rules for c in r.conclusions):
+            return rb.accu
+    singletons = bool(block.terms) and all(isinstance(t.mf, SingletonMF) for t in block.terms)
+    return "MAX" if singletons and (block.method or "COGS") in {"COGS", "COG"} else None
+
+
+def term_concluded_twice(fb: FunctionBlock, variable: str) -> bool:
+    """Whether some term of ``variable`` receives more than one rule's degree."""
+    seen: set[str] = set()
+    for rb in fb.rule_blocks:
+        if not rb.enabled:
+            continue
+        for rule in rb.rules:
+            for c in rule.conclusions:
+                if c.variable == variable and c.term is not None:
+                    if c.term in seen:
+                        return True
+                    seen.add(c.term)
+    return False
+
+
+def with_range(
+    fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss], target: str
+) -> FuzzifyBlock | DefuzzifyBlock:
+    """FIS and FLL variables have a range: the block's RANGE, else the variable's, else the
+    span of bounded terms (the engine's universe of an output without RANGE)."""
+    if blk.range is not None:
+        return blk
+    var = fb.variable(blk.variable)
+    if var is not None and var.range is not None:
+        return replace(blk, range=var.range)
+    spans = [support(t) for t in blk.terms]
+    if blk.terms and all(s is not None for s in spans):
+        low = min(s[0] for s in spans if s)
+        high = max(s[1] for s in spans if s)
+        return replace(blk, range=Range(low, high))
+    if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
+        losses.append(
+            Loss(f"output {blk.variable!r}", f"has no RANGE and unbounded terms; {target} needs a range")
+        )
+    if isinstance(blk, DefuzzifyBlock):
+        return replace(blk, range=Range(-math.inf, math.inf))
+    # An input's range changes nothing (inputs are not clamped): the span of the terms'
+    # breakpoints is what an editor shows.
+    xs = [x for t in blk.terms for x in _breakpoints(t) if math.isfinite(x)]
+    low, high = (min(xs), max(xs)) if xs else (0.0, 1.0)
+    return replace(blk, range=Range(low, high if high > low else low + 1.0))
+
+
+def _breakpoints(term: Term) -> list[float]:
+    mf = term.mf
+    if isinstance(mf, PointsMF):
+        return [float(p.x) for p in mf.points if not isinstance(p.x, Ref)]
+    if isinstance(mf, ShapeMF) and mf.kind not in {"constant", "linear"}:
+        return [float(p) for p in mf.params if not isinstance(p, Ref)]
+    if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
+        return [float(mf.value)]
+    return []
+
+
 def finite(x: float) -> bool:
     return not (math.isnan(x) or math.isinf(x))
 
@@ -357,10 +515,14 @@ __all__ = [
     "VarKind",
     "finite",
     "is_point_output",
+    "point_accumulation",
     "prepare",
     "rule_label",
+    "split_for_running_hedges",
     "split_rules",
     "support",
+    "term_concluded_twice",
     "term_losses",
     "uncumulate",
+    "with_range",
 ]

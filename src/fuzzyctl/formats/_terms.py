@@ -96,3 +96,20 @@ MONOTONIC_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "
 
 def shape(kind: str, params: tuple[float, ...], height: float = 1.0) -> ShapeMF:
     return ShapeMF(kind, params, height)
+
+
+def fis_shape_problem(fis_kind: str, values: tuple[float, ...]) -> str | None:
+    """Why the FIS reader refuses a membership function of MATLAB type ``fis_kind`` with
+    model-order parameters ``values`` (``None``: it reads it).  The writer asks the same
+    question, so that it never writes a file the reader refuses."""
+    if fis_kind == "trimf" and not values[0] <= values[1] <= values[2]:
+        return f"trimf parameters must satisfy a <= b <= c, found {list(values[:3])}"
+    if fis_kind == "trapmf" and not values[0] <= values[1] <= values[2] <= values[3]:
+        return f"trapmf parameters must satisfy a <= b <= c <= d, found {list(values[:4])}"
+    if fis_kind in {"gaussmf", "gauss2mf"} and (
+        values[1] == 0 or (fis_kind == "gauss2mf" and values[3] == 0)
+    ):
+        return f"{fis_kind}: sigma must not be 0"
+    if fis_kind == "gbellmf" and values[1] == 0:
+        return "gbellmf: width a must not be 0"
+    return None

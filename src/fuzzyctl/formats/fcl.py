@@ -10,11 +10,28 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import math
+import re
 from dataclasses import replace
+from functools import cache
+from importlib import resources
 from typing import Any
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.model import Document, FunctionBlock, Rule, RuleBlock
+from fuzzyctl.formats._common import hedge_power, identifier
+from fuzzyctl.formats._lower import rename
+from fuzzyctl.model import (
+    POWER_HEDGE_PREFIX,
+    And,
+    Condition,
+    Document,
+    FunctionBlock,
+    Is,
+    Not,
+    Or,
+    Rule,
+    RuleBlock,
+)
 
 _POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
 
@@ -53,6 +70,92 @@ def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule,
     return replace(rule, weight=None, conclusions=tuple(conclusions))
 
 
+@cache
+def fcl_keywords() -> frozenset[str]:
+    """Upper-case words FCL reads as something other than a name: every keyword terminal of
+    the grammar (``fcl.lark``: ``IF: "IF"i``, ...), and ``NAN``/``INF``/``INFINITY``, which
+    the grammar reads as numbers wherever a number may stand."""
+    grammar = resources.files("fuzzyctl.fcl").joinpath("fcl.lark").read_text(encoding="utf-8")
+    words = re.findall(r'^[A-Z_]+\s*:\s*"([A-Za-z_]+)"i\s*$', grammar, re.MULTILINE)
+    return frozenset(w.upper() for w in words) | {"NAN", "INF", "INFINITY"}
+
+
+_FCL_ID = re.compile(r"[^\W\d]\w*")  # fcl.lark's ID: a Unicode letter or '_', then word characters
+
+
+def fcl_name(name: str) -> bool:
+    """True when FCL reads ``name`` back as one variable name: an identifier, no keyword
+    in any letter case (a variable ``if`` or ``Rule`` would end the statement)."""
+    return _FCL_ID.fullmatch(name) is not None and name.upper() not in fcl_keywords()
+
+
+def fcl_term(name: str) -> bool:
+    """Term names may be several words (ridderware JFuzzy's ``Rear Left``), each a name."""
+    return bool(name) and all(fcl_name(w) for w in name.split(" "))
+
+
+def _fcl_block_name(name: str) -> bool:
+    """fcl.lark's FB_NAME also takes hyphens inside (``FUNCTION_BLOCK tank-level``)."""
+    return all(fcl_name(w) for w in name.split("-"))
+
+
+def _labels(block: RuleBlock) -> RuleBlock:
+    """Rule labels FCL reads (``\\w+``, each once); others are numbered in order."""
+    labels = [r.label for r in block.rules]
+    if all(re.fullmatch(r"\w+", str(x)) for x in labels) and len(set(labels)) == len(labels):
+        return block
+    return replace(block, rules=tuple(replace(r, label=str(i)) for i, r in enumerate(block.rules, 1)))
+
+
+def _power_words(hedges: tuple[str, ...]) -> tuple[str, ...] | None:
+    """Power hedges (Octave's ``d^p``) as FCL hedge words: ``very`` is d^2, ``somewhat``
+    sqrt(d), so d^4 is ``very very``; ``None`` when a power has no such form."""
+    words: list[str] = []
+    for hedge in hedges:
+        if not hedge.startswith(POWER_HEDGE_PREFIX):
+            words.append(hedge)
+            continue
+        power = hedge_power(hedge)
+        if power is None or power <= 0:
+            return None
+        exponent = math.log2(power)
+        if exponent != round(exponent) or abs(exponent) > 8:
+            return None
+        words += ["very" if exponent > 0 else "somewhat"] * abs(round(exponent))
+    return tuple(words)
+
+
+def _hedges_in_fcl(condition: Condition, where: str, losses: list[Loss]) -> Condition:
+    """Octave's power hedges said with FCL's hedge words where they can be."""
+    if isinstance(condition, Is):
+        if not any(h.startswith(POWER_HEDGE_PREFIX) for h in condition.hedges):
+            return condition
+        words = _power_words(condition.hedges)
+        if words is None:
+            losses.append(Loss(where, f"FCL has no hedge for {' '.join(condition.hedges)}; dropped"))
+            words = tuple(h for h in condition.hedges if not h.startswith(POWER_HEDGE_PREFIX))
+        return replace(condition, hedges=words)
+    if isinstance(condition, Not):
+        return replace(condition, operand=_hedges_in_fcl(condition.operand, where, losses))
+    if isinstance(condition, And | Or):
+        operands = tuple(_hedges_in_fcl(c, where, losses) for c in condition.operands)
+        return replace(condition, operands=operands)
+    return condition
+
+
+def _fcl_identifier(name: str, taken: set[str]) -> str:
+    """``name`` when FCL reads it and it is free, else an identifier close to it."""
+    if fcl_name(name) and name not in taken:
+        taken.add(name)
+        return name
+    base = identifier(name, set())
+    candidate, n = base, 2
+    while candidate in taken or not fcl_name(candidate):
+        candidate, n = f"{base}_{n}", n + 1
+    taken.add(candidate)
+    return candidate
+
+
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """Rewrite what FCL says differently, report what it cannot say at all."""
     losses: list[Loss] = []
@@ -82,7 +185,18 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 )
             rules = []
             for rule in block.rules:
+                condition = rule.condition
+                if condition is None:
+                    losses.append(
+                        Loss(
+                            f"rule {rule.label!r}",
+                            "FCL has no rule without a condition (MATLAB's all don't-care, fuzzylite's "
+                            "'x is any'); dropped",
+                        )
+                    )
+                    continue
                 rule = _rule_weight_to_conclusions(fb, block, rule, losses)
+                rule = replace(rule, condition=_hedges_in_fcl(condition, f"rule {rule.label!r}", losses))
                 if any(c.hedges for c in rule.conclusions):
                     losses.append(Loss(f"rule {rule.label!r}", "FCL has no hedges on conclusions"))
                     rule = replace(rule, conclusions=tuple(replace(c, hedges=()) for c in rule.conclusions))
@@ -90,7 +204,21 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rule_blocks.append(replace(block, rules=tuple(rules), enabled=True, rule_activation=None))
         fuzzify = tuple(replace(f, clamp=False) for f in fb.fuzzify)
         defuzzify = tuple(replace(d, clamp=False) for d in fb.defuzzify)
-        blocks.append(replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify))
+        fb = replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify)
+        # names FCL cannot read back (MATLAB's "sugeno tipper", "a/b", a variable "if") are
+        # renamed: not a loss
+        fb, _renames = rename(fb, fcl_name, fcl_term)
+        if fb.name is not None and not _fcl_block_name(fb.name):
+            fb = replace(fb, name=_fcl_identifier(fb.name, set()))
+        taken: set[str] = set()
+        fb = replace(
+            fb,
+            rule_blocks=tuple(
+                _labels(replace(b, name=None if b.name is None else _fcl_identifier(b.name, taken)))
+                for b in fb.rule_blocks
+            ),
+        )
+        blocks.append(fb)
     return replace(document, blocks=tuple(blocks)), losses
 
 

@@ -23,13 +23,13 @@ from __future__ import annotations
 import itertools
 import math
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Format, Loaded
 from fuzzyctl.formats._common import Reporter, parse_number, power_hedge, unique_name
 from fuzzyctl.formats._expr import ExprError, eval_constant, names_in, parse_expr
-from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS
+from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -300,20 +300,9 @@ def _membership(
                 code="fis-extra-param",
             )
     values = mapping.to_model(params[: mapping.arity])
-    if kind_lower == "trimf" and not values[0] <= values[1] <= values[2]:
-        raise rep.fail(
-            f"trimf parameters must satisfy a <= b <= c, found {params[:3]}", line, code="fis-params"
-        )
-    if kind_lower == "trapmf" and not values[0] <= values[1] <= values[2] <= values[3]:
-        raise rep.fail(
-            f"trapmf parameters must satisfy a <= b <= c <= d, found {params[:4]}", line, code="fis-params"
-        )
-    if kind_lower in {"gaussmf", "gauss2mf"} and (
-        values[1] == 0 or (kind_lower == "gauss2mf" and values[3] == 0)
-    ):
-        raise rep.fail(f"{kind_lower}: sigma must not be 0", line, code="fis-params")
-    if kind_lower == "gbellmf" and values[1] == 0:
-        raise rep.fail("gbellmf: width a must not be 0", line, code="fis-params")
+    problem = fis_shape_problem(kind_lower, values)
+    if problem is not None:
+        raise rep.fail(problem, line, code="fis-params")
     return ShapeMF(mapping.kind, values, height)
 
 
@@ -542,8 +531,9 @@ def _rules(
                     code="fis-unsupported",
                 )
             index, hedges, _ = _hedges(code, dialect, rep, line)
-            if hedges and dialect == "fuzzylite":
-                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py)
+            if dialect == "fuzzylite":
+                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py):
+                # a conclusion without hedges of its own still gets the earlier ones
                 hedges = running = (*hedges, *running)
             elif hedges:
                 if not all(_is_ts_term(t.mf) for t in var.terms):
@@ -724,6 +714,14 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
                 clamp=_flag(var.entries, "LockRange", rep),
             )
         )
+    # AggMethod is the aggregation of Mamdani outputs; Sugeno outputs weigh every rule on its
+    # own (MATLAB, and fuzzylite's "aggregation: none").  With both kinds in one file
+    # (fuzzylite's hybrid) it is said on the Mamdani outputs alone.
+    block_accu: str | None = None
+    if any_mamdani_output and all(d.method not in {"WTAVER", "WTSUM"} for d in defuzzify):
+        block_accu = accu
+    elif any_mamdani_output:
+        defuzzify = [d if d.method in {"WTAVER", "WTSUM"} else replace(d, accu=accu) for d in defuzzify]
     rules = _rules(rules_s, inputs, outputs, rep, dialect, count("NumRules"), system.line)
     rep.raise_if_errors()
     name_entry = system_value("Name")
@@ -744,7 +742,7 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             for v in inputs
         ),
         defuzzify=tuple(defuzzify),
-        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, accu if any_mamdani_output else None),)
+        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, block_accu),)
         if rules_s is not None
         else (),
         span=rep.span(system.line),

@@ -8,6 +8,7 @@ with a comment naming that dialect, which our reader and fuzzylite honour.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
@@ -15,11 +16,24 @@ from dataclasses import dataclass, replace
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number, hedge_power
 from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import is_point_output, prepare, rule_label, support, term_losses, uncumulate
-from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES
+from fuzzyctl.formats._lower import (
+    SUM_LIKE,
+    is_point_output,
+    point_accumulation,
+    prepare,
+    rule_label,
+    split_for_running_hedges,
+    term_concluded_twice,
+    term_losses,
+    uncumulate,
+    with_range,
+)
+from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
 from fuzzyctl.model import (
+    OPERATOR_PAIRS,
     And,
+    Conclusion,
     Condition,
     DefuzzifyBlock,
     Document,
@@ -31,6 +45,7 @@ from fuzzyctl.model import (
     Point,
     PointsMF,
     Range,
+    Ref,
     Rule,
     RuleBlock,
     ShapeMF,
@@ -57,8 +72,45 @@ class _Plan:
     fuzzylite: bool
 
 
+def _term_problem(term: Term, point_output: bool) -> str | None:
+    """Why the FIS reader would refuse this (otherwise writable) term; ``None``: it reads it."""
+    mf = term.mf
+    if point_output:
+        ts_term = (isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}) or (
+            isinstance(mf, FunctionMF) and mf.argument is None
+        )
+        if not ts_term and not (isinstance(mf, ShapeMF) and mf.kind in MONOTONIC_KINDS):
+            return (
+                "a weighted-average output of a FIS has constant, linear or (fuzzylite's Tsukamoto) "
+                "monotonic terms"
+            )
+    elif isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}:
+        return "a Mamdani output of a FIS has no constant or linear terms"
+    if isinstance(mf, ShapeMF) and mf.kind in FIS_OF_KIND and not _has_refs(mf):
+        return fis_shape_problem(FIS_OF_KIND[mf.kind], tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
+    if isinstance(mf, PointsMF) and not _has_refs(mf):
+        as_matlab = _points_as_matlab(mf)
+        xs = [float(p.x) for p in mf.points]  # type: ignore[arg-type]
+        if as_matlab is not None:
+            return fis_shape_problem(as_matlab[0], tuple(as_matlab[1]))
+        if any(b < a for a, b in itertools.pairwise(xs)):
+            return "points in descending x cannot be written as discretemf"
+    return None
+
+
+def _input_term_readable(variable: str, term: Term, losses: list[Loss]) -> bool:
+    problem = _term_problem(term, point_output=False)
+    if problem is not None:
+        losses.append(Loss(f"term {term.name!r} of {variable!r}", problem))
+    return problem is None
+
+
 def _needs_fuzzylite(fb: FunctionBlock) -> bool:
     for d in fb.defuzzify:
+        if is_point_output(d) and any(
+            isinstance(t.mf, ShapeMF) and t.mf.kind in MONOTONIC_KINDS for t in d.terms
+        ):
+            return True  # Tsukamoto: MATLAB's Sugeno outputs have constant or linear terms only
         default = d.default
         if d.clamp or (default is not None and default.no_change):
             return True
@@ -75,9 +127,12 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
             mf = t.mf
             if isinstance(mf, FunctionMF):
                 return True
+            if _has_refs(mf):
+                continue  # a loss, reported with the term
             if (
                 isinstance(mf, ShapeMF)
                 and mf.kind not in {"constant", "linear"}
+                and mf.kind in FIS_OF_KIND
                 and (FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0)  # type: ignore[arg-type]
             ):
                 return True
@@ -85,8 +140,36 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
                 return True
     for _, rule in fb.rules():
         hedges = [a.hedges for a in _ises(rule.condition)] + [c.hedges for c in rule.conclusions]
-        if any(h in {("extremely",), ("seldom",)} for h in hedges) or any(c.hedges for c in rule.conclusions):
+        if any(h in {("extremely",), ("seldom",)} for h in hedges):
             return True
+        if any(c.hedges and _octave_consequent_code(fb, c) is None for c in rule.conclusions):
+            return True
+    return False
+
+
+def _octave_consequent_code(fb: FunctionBlock, conclusion: Conclusion) -> int | None:
+    """Octave's code for the hedges of a Sugeno consequent: code ``.p`` raises the rule's degree
+    to 1/(p/10) (the reader's inverse), so a degree^q is written with p = 10/q."""
+    block = fb.defuzzify_block(conclusion.variable)
+    if block is None or not is_point_output(block):
+        return None
+    power = 1.0
+    for h in conclusion.hedges:
+        p = hedge_power(h)
+        if p is None or p <= 0.0:
+            return None
+        power *= p
+    code = 10.0 / power
+    if abs(code - round(code)) > 1e-9 or not 1 <= round(code) <= 98:
+        return None
+    return round(code)
+
+
+def _has_refs(mf: object) -> bool:
+    if isinstance(mf, ShapeMF):
+        return isinstance(mf.height, Ref) or any(isinstance(p, Ref) for p in mf.params)
+    if isinstance(mf, PointsMF):
+        return any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points)
     return False
 
 
@@ -126,7 +209,15 @@ def _ises(condition: Condition | None) -> list[Is]:
 
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as a FIS can state it, and what had to be dropped."""
-    fb, losses, _ = prepare(document, "FIS")
+    fb, losses, _ = prepare(document, "FIS", running_hedges=False)
+    if _needs_fuzzylite(fb):  # fuzzylite reads conclusion hedges as running ones
+        fb = replace(
+            fb,
+            rule_blocks=tuple(
+                replace(b, rules=tuple(r2 for r in b.rules for r2 in split_for_running_hedges(r)))
+                for b in fb.rule_blocks
+            ),
+        )
     supported = set(FIS_OF_KIND) | {"constant", "linear"}
     # Inputs of a FIS cannot be clamped (fuzzylite's FIS importer rejects LockRange there).
     fuzzify: list[FuzzifyBlock] = []
@@ -136,8 +227,18 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)")
             )
             f = replace(f, clamp=False)
-        fuzzify.append(_with_range(f, losses))  # type: ignore[arg-type]
+        fuzzify.append(with_range(fb, f, losses, 'FIS'))  # type: ignore[arg-type]
     fb = replace(fb, fuzzify=tuple(fuzzify))
+    for d in fb.defuzzify:
+        accu = point_accumulation(fb, d) if is_point_output(d) else None
+        if accu is not None and accu not in SUM_LIKE and term_concluded_twice(fb, d.variable):
+            losses.append(
+                Loss(
+                    f"output {d.variable!r}",
+                    f"several rules conclude one term and accumulate with {accu}; a Sugeno FIS weighs "
+                    "every rule on its own",
+                )
+            )
     defuzzify: list[DefuzzifyBlock] = []
     for d in fb.defuzzify:
         kept = []
@@ -151,9 +252,17 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 )
                 continue
             if term_losses(d.variable, t, supported, "FIS", losses):
-                kept.append(t)
-        defuzzify.append(_with_range(replace(d, terms=tuple(kept)), losses))  # type: ignore[arg-type]
+                problem = _term_problem(t, is_point_output(d))
+                if problem is None:
+                    kept.append(t)
+                else:
+                    losses.append(Loss(f"term {t.name!r} of {d.variable!r}", problem))
+        defuzzify.append(with_range(fb, replace(d, terms=tuple(kept)), losses, 'FIS'))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
+    for f in fb.fuzzify:
+        for t in f.terms:
+            if isinstance(t.mf, SingletonMF):  # a literal one became trimf [v v v] in prepare()
+                losses.append(Loss(f"term {t.name!r} of {f.variable!r}", "FIS has no singleton input term"))
     fb = replace(
         fb,
         fuzzify=tuple(
@@ -162,13 +271,23 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 terms=tuple(
                     t
                     for t in f.terms
-                    if term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                    if not isinstance(t.mf, SingletonMF)
+                    and term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                    and _input_term_readable(f.variable, t, losses)
                 ),
             )
             for f in fb.fuzzify
         ),
     )
 
+    # Nested conditions in the form FIS can say (one AND or OR of literals per rule).
+    fb = replace(
+        fb,
+        rule_blocks=tuple(
+            replace(b, rules=tuple(r2 for r in b.rules for r2 in _one_level(fb, b, r)))
+            for b in fb.rule_blocks
+        ),
+    )
     # One rule block with one set of operators.
     enabled = [b for b in fb.rule_blocks if b.enabled]
     for b in fb.rule_blocks:
@@ -226,10 +345,15 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}")
         )
     for d in fb.defuzzify:
-        if d.method == "COGF" or (d.accu or "") == "NSUM":
-            losses.append(
-                Loss(f"output {d.variable!r}", f"FIS has no {d.method if d.method == 'COGF' else 'NSUM'}")
-            )
+        if (d.accu or "") == "NSUM":
+            losses.append(Loss(f"output {d.variable!r}", "FIS has no NSUM"))
+    if "NSUM" in accu_values and not any(d.accu == "NSUM" for d in fb.defuzzify):
+        losses.append(Loss("aggregation", "FIS has no NSUM"))
+    # what is written anyway (--lossy) says the nearest FIS aggregation
+    accu_values = {"SUM" if a == "NSUM" else a for a in accu_values}
+    fb = replace(
+        fb, defuzzify=tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify)
+    )
     methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
     if len(methods) > 1:
         losses.append(
@@ -245,22 +369,91 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
     return Document((fb,), document.path), losses
 
 
-def _with_range(blk: FuzzifyBlock | DefuzzifyBlock, losses: list[Loss]) -> FuzzifyBlock | DefuzzifyBlock:
-    """A FIS variable needs a Range: take RANGE, else the span of bounded terms."""
-    if blk.range is not None:
-        return blk
-    spans = [support(t) for t in blk.terms]
-    if blk.terms and all(s is not None for s in spans):
-        low = min(s[0] for s in spans if s)
-        high = max(s[1] for s in spans if s)
-        return replace(blk, range=Range(low, high))
-    if isinstance(blk, DefuzzifyBlock) and not is_point_output(blk):
-        losses.append(Loss(f"output {blk.variable!r}", "has no RANGE and unbounded terms; FIS needs a Range"))
-    return (
-        replace(blk, range=Range(-math.inf, math.inf))
-        if isinstance(blk, DefuzzifyBlock)
-        else replace(blk, range=Range(0.0, 1.0) if not blk.terms else Range(-math.inf, math.inf))
-    )
+def _flat(condition: Condition) -> Condition:
+    """Nested ANDs (ORs) joined into one: associative for every t-norm (s-norm)."""
+    if isinstance(condition, And | Or):
+        kind = type(condition)
+        operands: list[Condition] = []
+        for o in (_flat(x) for x in condition.operands):
+            operands.extend(o.operands if isinstance(o, kind) else (o,))
+        return kind(tuple(operands), condition.span)
+    return condition
+
+
+def _fis_form(condition: Condition | None) -> bool:
+    if condition is None or isinstance(condition, Is):
+        return True
+    if isinstance(condition, And | Or) and all(isinstance(o, Is) for o in condition.operands):
+        return len({o.variable for o in condition.operands if isinstance(o, Is)}) == len(condition.operands)
+    return False
+
+
+def _dnf(condition: Condition) -> list[tuple[Is, ...]] | None:
+    """The condition as a disjunction of conjunctions of literals (None: a NOT of a compound)."""
+    if isinstance(condition, Is):
+        return [(condition,)]
+    if isinstance(condition, Or):
+        out: list[tuple[Is, ...]] = []
+        for o in condition.operands:
+            part = _dnf(o)
+            if part is None:
+                return None
+            out += part
+        return out
+    if isinstance(condition, And):
+        product: list[tuple[Is, ...]] = [()]
+        for o in condition.operands:
+            part = _dnf(o)
+            if part is None:
+                return None
+            product = [a + b for a in product for b in part]
+            if len(product) > MAX_SPLIT:
+                return None
+        return product
+    return None
+
+
+MAX_SPLIT = 64
+"""At most this many rules replace one rule with a nested condition."""
+
+
+def _one_level(fb: FunctionBlock, block: RuleBlock, rule: Rule) -> list[Rule]:
+    """``rule`` with a condition FIS can say: nested same operators flattened; a mix of AND
+    and OR split into one rule per disjunct of its disjunctive normal form, which is exact
+    when AND is MIN, OR is MAX (a distributive lattice) and every conclusion goes to a
+    Mamdani output accumulated with MAX (max over the rules = OR of their conditions, since
+    activation, weights and hedges are monotonic).  Otherwise the rule is left as it is and
+    reported as a loss."""
+    if rule.condition is None or _fis_form(rule.condition):
+        return [rule]
+    flat = _flat(rule.condition)
+    if _fis_form(flat):
+        return [replace(rule, condition=flat)]
+    and_op = block.and_op or ("MIN" if block.or_op in (None, "MAX") else None)
+    or_op = block.or_op or OPERATOR_PAIRS.get(and_op or "", None)
+    if (and_op, or_op) != ("MIN", "MAX"):
+        return [rule]
+    for c in rule.conclusions:
+        d = fb.defuzzify_block(c.variable)
+        concluding = [
+            b.accu
+            for b in fb.rule_blocks
+            if b.accu and any(x.variable == c.variable for r in b.rules for x in r.conclusions)
+        ]
+        accu = (d.accu if d else None) or (concluding[0] if concluding else "MAX")
+        if d is None or is_point_output(d) or accu != "MAX":
+            return [rule]
+    disjuncts = _dnf(flat)
+    if disjuncts is None or len(disjuncts) > MAX_SPLIT:
+        return [rule]
+    out = []
+    for k, conjunction in enumerate(disjuncts, start=1):
+        literals = tuple(dict.fromkeys(conjunction))  # x IS a AND x IS a is x IS a
+        if len({a.variable for a in literals}) != len(literals):
+            return [rule]  # tests one input twice: no FIS form
+        condition: Condition = literals[0] if len(literals) == 1 else And(literals, flat.span)
+        out.append(replace(rule, label=f"{rule.label}_{k}", condition=condition))
+    return out
 
 
 def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: bool) -> str | None:
@@ -286,8 +479,11 @@ def _rule_problem(fb: FunctionBlock, rule: Rule, outputs: set[str], fuzzylite: b
     for a in atoms:
         if isinstance(a, Is) and _hedge_code(a.hedges, fuzzylite) is None:
             return f"FIS has no code for the hedges {' '.join(a.hedges)}"
-    written = uncumulate([x.hedges for x in rule.conclusions])
-    if written is None or any(_hedge_code(h, fuzzylite) is None for h in written):
+    if fuzzylite:
+        written = uncumulate([x.hedges for x in rule.conclusions])
+        if written is None or any(_hedge_code(h, fuzzylite) is None for h in written):
+            return "FIS has no code for these conclusion hedges"
+    elif any(x.hedges and _octave_consequent_code(fb, x) is None for x in rule.conclusions):
         return "FIS has no code for these conclusion hedges"
     for x in rule.conclusions:
         blk = fb.defuzzify_block(x.variable)
@@ -440,6 +636,11 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylit
         ante.append(_entry(index, a.negated, a.hedges, fuzzylite))
     written = uncumulate([c.hedges for c in rule.conclusions]) or [c.hedges for c in rule.conclusions]
     hedges_of = {c.variable: h for c, h in zip(rule.conclusions, written, strict=True)}
+    octave = {
+        c.variable: _octave_consequent_code(fb, c) or 0
+        for c in rule.conclusions
+        if c.hedges and not fuzzylite
+    }
     cons = []
     for d in fb.defuzzify:
         c = next((x for x in rule.conclusions if x.variable == d.variable), None)
@@ -447,7 +648,10 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylit
             cons.append("0")
             continue
         index = [t.name for t in d.terms].index(c.term or "") + 1
-        cons.append(_entry(index, False, hedges_of[d.variable], fuzzylite))
+        if fuzzylite or not octave.get(d.variable):
+            cons.append(_entry(index, False, hedges_of[d.variable], fuzzylite))
+        else:
+            cons.append(f"{index + octave[d.variable] / 100.0:.2f}")
     weight = 1.0 if rule.weight is None else float(rule.weight)  # type: ignore[arg-type]
     connection = 2 if isinstance(rule.condition, Or) else 1
     return f"{' '.join(ante)}, {' '.join(cons)} ({fmt_number(weight)}) : {connection}"

@@ -8,9 +8,17 @@ from dataclasses import replace
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number
 from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import prepare, rule_label, term_losses, uncumulate
+from fuzzyctl.formats._lower import (
+    SUM_LIKE,
+    point_accumulation,
+    prepare,
+    rule_label,
+    term_losses,
+    uncumulate,
+    with_range,
+)
 from fuzzyctl.formats._terms import FLL_OF_KIND, FLL_TYPES
-from fuzzyctl.formats.fll import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.formats.fll import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -42,7 +50,13 @@ exact; fuzzylite approximates with this many midpoint samples)."""
 
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """The model as FLL can state it, and what had to be dropped."""
-    fb, losses, _ = prepare(document, "FLL")
+    # a variable or term called "very" or "then" would read as a hedge or a keyword
+    fb, losses, _ = prepare(document, "FLL", reserved=HEDGE_WORDS | KEYWORDS)
+    fb = replace(
+        fb,
+        fuzzify=tuple(with_range(fb, f, losses, "FLL") for f in fb.fuzzify),  # type: ignore[misc]
+        defuzzify=tuple(with_range(fb, d, losses, "FLL") for d in fb.defuzzify),  # type: ignore[misc]
+    )
     supported = set(FLL_OF_KIND) | {"constant", "linear"}
     all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for blk in all_blocks:
@@ -66,8 +80,8 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rules.append(rule)
         blocks.append(replace(block, rules=tuple(rules)))
     for d in fb.defuzzify:
-        if d.method in {"COGF"}:
-            losses.append(Loss(f"output {d.variable!r}", f"FLL has no defuzzification method {d.method}"))
+        if d.method in {"COGS", "WTAVER", "WTSUM"}:
+            continue  # NSUM adds the degrees of a weighted average, written UnboundedSum
         if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
             losses.append(
                 Loss(
@@ -207,7 +221,13 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         out.append(f"  range: {fmt_number(rng.low)} {fmt_number(rng.high)}" if rng else "  range: -inf inf")
         out.append(f"  lock-range: {'true' if d.clamp else 'false'}")
         point = (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
-        accu = d.accu or (accu_of_block.get(var.name) if not point else None)
+        if point:
+            # pyfuzzylite 8 aggregates a weighted average's terms as our engine does (fuzzylite 6
+            # ignores the aggregation there and lets every rule count)
+            accu = point_accumulation(fb, d)
+            accu = "SUM" if accu in SUM_LIKE else accu
+        else:
+            accu = d.accu or accu_of_block.get(var.name)
         out.append(f"  aggregation: {_ACCU_NAMES[accu] if accu else ('none' if point else 'Maximum')}")
         method = d.method or "COG"
         name = _DEFUZZ_NAMES.get(method, "Centroid")

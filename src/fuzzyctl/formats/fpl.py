@@ -63,8 +63,10 @@ EXTENSIONS = (".fpl",)
 __all__ = [
     "EXTENSIONS",
     "FORMAT",
+    "KEYWORDS",
     "NAME",
     "FplResult",
+    "is_fpl_name",
     "leaves",
     "parse_fpl",
     "read_fpl",
@@ -113,6 +115,16 @@ _STRUCTURAL = _OBJECTS | {
     "INITIALLY",
     "DEFAULT",
 }
+# Words FPL reads as keywords wherever they stand (upper-cased): no name may be one of them.
+KEYWORDS = frozenset(_STRUCTURAL | {"IS", "AND", "OR", "NOT"})
+_WORD = re.compile(r"[^\W\d]\w*")
+
+
+def is_fpl_name(name: str) -> bool:
+    """True when FPL reads ``name`` back as one name (a word, not a keyword)."""
+    return _WORD.fullmatch(name) is not None and name.upper() not in KEYWORDS
+
+
 # The manual's texts for the tolerated elements (Siemens 1.3, "Tolerated FPL Elements").
 _TOLERATED_ATTRIBUTES = {
     "MAP": "MAP ignored: no mapping possible",

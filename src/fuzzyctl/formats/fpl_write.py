@@ -6,7 +6,9 @@ from __future__ import annotations
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
-from fuzzyctl.formats.fpl import leaves
+from fuzzyctl.formats._common import identifier
+from fuzzyctl.formats._lower import rename
+from fuzzyctl.formats.fpl import is_fpl_name, leaves
 from fuzzyctl.model import (
     And,
     Condition,
@@ -200,7 +202,11 @@ def write_fpl(block: FunctionBlock | Document) -> str:
     problems = [d for d in check_fpl(fb) if d.is_error]
     if problems:
         raise DiagnosticError(problems)
-    out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {fb.name or 'fuzzy'}"]
+    project = fb.name or "fuzzy"
+    if not is_fpl_name(project):  # a name with spaces (MATLAB's) is no FPL word
+        project = identifier(project, set())
+        project = project if is_fpl_name(project) else f"{project}_fpl"
+    out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {project}"]
     for var in fb.variables:
         if var.kind is VarKind.LOCAL:
             continue
@@ -326,4 +332,6 @@ def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
         defuzzify=tuple(defuzzify),
         rule_blocks=tuple(rule_blocks),
     )
+    # names FPL cannot read back (MATLAB's "dV*", "Rear Left", a variable "If") are renamed
+    lowered, _renames = rename(lowered, is_fpl_name, is_fpl_name)
     return Document((lowered,), path=document.path, comments=document.comments), losses

@@ -494,16 +494,15 @@ def _term_xs(mf: MembershipFunction) -> list[float]:
 
 
 def _rounded(mf: MembershipFunction) -> MembershipFunction:
+    def r(v: object) -> bool:  # a finite literal (a MATLAB shoulder at +-inf stays as it is)
+        return isinstance(v, int | float) and math.isfinite(v)
+
     if isinstance(mf, PointsMF):
-        return PointsMF(
-            tuple(replace(p, x=float(round(p.x))) if isinstance(p.x, int | float) else p for p in mf.points)
-        )
-    if isinstance(mf, SingletonMF) and isinstance(mf.value, int | float):
-        return SingletonMF(float(round(mf.value)))
+        return PointsMF(tuple(replace(p, x=float(round(p.x))) if r(p.x) else p for p in mf.points))  # type: ignore[arg-type]
+    if isinstance(mf, SingletonMF) and r(mf.value):
+        return SingletonMF(float(round(mf.value)))  # type: ignore[arg-type]
     if isinstance(mf, ShapeMF):
-        return replace(
-            mf, params=tuple(float(round(p)) if isinstance(p, int | float) else p for p in mf.params)
-        )
+        return replace(mf, params=tuple(float(round(p)) if r(p) else p for p in mf.params))  # type: ignore[arg-type]
     return mf
 
 
