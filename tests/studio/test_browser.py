@@ -22,8 +22,6 @@ from tests.conftest import EXAMPLES
 from tests.studio.browser import RECORDED, fcl_text, open_file, reading, settle, shot, surface_z, tab
 from tests.studio.test_api import triangle_closed_form
 
-pytest.importorskip("playwright.sync_api")
-
 
 def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_project: Path) -> None:
     pg = page

@@ -20,8 +20,6 @@ import fuzzyctl
 from tests.conftest import shared_path
 from tests.studio.browser import fcl_text, new_project, open_file, reading, settle, shot, surface_z, tab
 
-pytest.importorskip("playwright.sync_api")
-
 
 def points(pg: Any) -> list[float]:
     """The x column of the points table (the selected term)."""
