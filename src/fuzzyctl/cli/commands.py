@@ -1,6 +1,7 @@
 """Imports every command module so that each registers its commands on the app."""
 
 from fuzzyctl.cli import (
+    blocks,  # noqa: F401  (fuzzyctl blocks ...)
     convert,  # noqa: F401
     lang,  # noqa: F401  (check, fmt)
     run,  # noqa: F401  (eval, explain)

@@ -1,0 +1,329 @@
+"""Writing FPL for Siemens S7 Fuzzy Control (manual 1.3): the writer, what the subset
+cannot express, and the lowering ``fuzzyctl convert --lossy`` uses."""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
+from fuzzyctl.formats.fpl import leaves
+from fuzzyctl.model import (
+    And,
+    Condition,
+    Default,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    Is,
+    MembershipFunction,
+    PointsMF,
+    Range,
+    Rule,
+    ShapeMF,
+    SingletonMF,
+    Span,
+    Variable,
+    VarKind,
+    is_constant,
+)
+
+__all__ = ["check_fpl", "lower_fpl", "write_fpl"]
+
+
+def _num(x: float) -> str:
+    return repr(float(x))
+
+
+def _as_points(mf: MembershipFunction) -> list[tuple[float, float]] | None:
+    """Points of a piecewise-linear term, or None when FPL cannot hold it."""
+    if isinstance(mf, PointsMF):
+        if not all(is_constant(p.x) and is_constant(p.y) for p in mf.points):
+            return None
+        return [(float(p.x), float(p.y)) for p in mf.points]  # type: ignore[arg-type]
+    if isinstance(mf, ShapeMF) and all(is_constant(v) for v in mf.params) and mf.height == 1.0:
+        v = [float(x) for x in mf.params]  # type: ignore[arg-type]
+        if mf.kind == "triangle":
+            return [(v[0], 0.0), (v[1], 1.0), (v[2], 0.0)]
+        if mf.kind == "trapezoid":
+            return [(v[0], 0.0), (v[1], 1.0), (v[2], 1.0), (v[3], 0.0)]
+        if mf.kind == "rectangle":
+            return [(v[0], 0.0), (v[0], 1.0), (v[1], 1.0), (v[1], 0.0)]
+    return None
+
+
+def _fpl_points(points: list[tuple[float, float]]) -> list[tuple[float, float]]:
+    """IEC points -> the Siemens form: a vertical edge is written by its upper point only."""
+    pts = list(points)
+    if len(pts) >= 2 and pts[0][1] == 0.0 and pts[1][1] > 0 and pts[0][0] == pts[1][0]:
+        pts.pop(0)
+    if len(pts) >= 2 and pts[-1][1] == 0.0 and pts[-2][1] > 0 and pts[-1][0] == pts[-2][0]:
+        pts.pop()
+    return pts
+
+
+def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
+    """What of ``block`` the FPL subset cannot say (errors) or drops (warnings).
+
+    The limits of the Siemens product (8 inputs, 7 terms, ...) are not checked here; the
+    ``siemens`` profile of :mod:`fuzzyctl.blocks.siemens` does that."""
+    diags: list[Diagnostic] = []
+
+    def err(msg: str, span: Span | None, code: str, hint: str | None = None) -> None:
+        diags.append(error(msg, span, code=code, hint=hint))
+
+    if len(block.rule_blocks) > 1:
+        err(
+            "FPL for Fuzzy Control holds one set of rules; this program has "
+            f"{len(block.rule_blocks)} rule blocks",
+            block.rule_blocks[1].span,
+            "fpl-expr-ruleblocks",
+        )
+    if block.locals:
+        err("FPL for Fuzzy Control has no intermediate variables", block.locals[0].span, "fpl-expr-local")
+    for rb in block.rule_blocks:
+        if rb.and_op not in (None, "MIN"):
+            err(
+                f"AND : {rb.and_op} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op"
+            )
+        if rb.accu not in (None, "MAX"):
+            err(f"ACCU : {rb.accu} cannot be written in FPL (Fuzzy Control uses MAX)", rb.span, "fpl-expr-op")
+        if rb.act not in (None, "MIN", "PROD") or (rb.act == "PROD" and not _all_singletons(block)):
+            err(f"ACT : {rb.act} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op")
+        if not rb.enabled or rb.rule_activation is not None:
+            err(
+                f"rule block {rb.name}: FPL has no disabled rule blocks or rule activation methods",
+                rb.span,
+                "fpl-expr-ruleblocks",
+            )
+        for rule in rb.rules:
+            _check_condition(rule.condition, rule, diags)
+            if rule.weight is not None and rule.weight != 1.0:
+                err(f"rule {rule.label}: rule weights cannot be written in FPL", rule.span, "fpl-expr-weight")
+            for c in rule.conclusions:
+                if c.hedges:
+                    err(f"rule {rule.label}: hedges cannot be written in FPL", c.span, "fpl-expr-rule")
+                if c.term is None:
+                    err(f"rule {rule.label}: a conclusion needs a term", c.span, "fpl-expr-rule")
+                if c.weight is not None and c.weight != 1.0:
+                    err(
+                        f"rule {rule.label}: WITH weights cannot be written in FPL",
+                        c.span,
+                        "fpl-expr-weight",
+                        hint="remove the WITH or scale the rule another way",
+                    )
+    for fz in block.fuzzify:
+        for t in fz.terms:
+            if _as_points(t.mf) is None:
+                err(
+                    f"{fz.variable}.{t.name}: only piecewise-linear terms with constant points can be "
+                    "written in FPL",
+                    t.span,
+                    "fpl-expr-term",
+                    hint="equations are not permissible (1.3)",
+                )
+    for dz in block.defuzzify:
+        if dz.method not in (None, "COG", "COGS"):
+            err(
+                f"METHOD : {dz.method} cannot be written in FPL (Fuzzy Control computes the centre of "
+                "gravity)",
+                dz.span,
+                "fpl-expr-method",
+            )
+        if dz.default is not None and not dz.default.no_change:
+            diags.append(
+                warning(
+                    f"{dz.variable}: DEFAULT := {dz.default.value} is not written: Fuzzy "
+                    "Control keeps the last value when no rule fires",
+                    dz.span,
+                    code="fpl-expr-default",
+                )
+            )
+        for t in dz.terms:
+            if isinstance(t.mf, SingletonMF):
+                if not is_constant(t.mf.value):
+                    err(
+                        f"{dz.variable}.{t.name}: a singleton given by a variable cannot be written in FPL",
+                        t.span,
+                        "fpl-expr-term",
+                    )
+            elif _as_points(t.mf) is None:
+                err(
+                    f"{dz.variable}.{t.name}: only singletons and piecewise-linear terms can be "
+                    "written in FPL",
+                    t.span,
+                    "fpl-expr-term",
+                )
+    for v in block.variables:
+        if v.kind is VarKind.OUTPUT and block.defuzzify_block(v.name) is None:
+            err(f"output {v.name} has no DEFUZZIFY block", v.span, "fpl-expr-output")
+    return diags
+
+
+def _all_singletons(block: FunctionBlock) -> bool:
+    return all(isinstance(t.mf, SingletonMF) for d in block.defuzzify for t in d.terms)
+
+
+def _check_condition(cond: Condition | None, rule: Rule, diags: list[Diagnostic]) -> None:
+    if cond is None:
+        return
+    if isinstance(cond, And):
+        for c in cond.operands:
+            _check_condition(c, rule, diags)
+    elif isinstance(cond, Is) and not cond.negated and not cond.hedges:
+        return
+    else:
+        diags.append(
+            error(
+                f"rule {rule.label}: only 'variable IS term' joined by AND can be written in FPL "
+                "(no OR, NOT or hedges)",
+                getattr(cond, "span", None) or rule.span,
+                code="fpl-expr-rule",
+            )
+        )
+
+
+def _singleton_width(dz: DefuzzifyBlock, variable: Variable | None) -> float:
+    rng = dz.range or (variable.range if variable else None)
+    if rng is not None and rng.high > rng.low:
+        return (rng.high - rng.low) / 200.0  # the manual's narrow rectangle: 1/200 of the range
+    values = [float(t.mf.value) for t in dz.terms if isinstance(t.mf, SingletonMF)]  # type: ignore[arg-type]
+    spread = max(values) - min(values) if values else 0.0
+    return spread / 200.0 if spread > 0 else 0.01
+
+
+def write_fpl(block: FunctionBlock | Document) -> str:
+    """FPL text for a function block (the first one of a document).
+
+    Raises :class:`~fuzzyctl.diagnostics.DiagnosticError` listing what FPL cannot express
+    (see :func:`check_fpl`)."""
+    fb = block.main if isinstance(block, Document) else block
+    problems = [d for d in check_fpl(fb) if d.is_error]
+    if problems:
+        raise DiagnosticError(problems)
+    out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {fb.name or 'fuzzy'}"]
+    for var in fb.variables:
+        if var.kind is VarKind.LOCAL:
+            continue
+        out.append(f"VAR {var.name}")
+        out.append("TYPE float")
+        fz = fb.fuzzify_block(var.name)
+        dz = fb.defuzzify_block(var.name)
+        rng = var.range or (fz.range if fz else None) or (dz.range if dz else None)
+        members: list[tuple[str, list[tuple[float, float]]]] = []
+        for t in fz.terms if fz else ():
+            members.append((t.name, _fpl_points(_as_points(t.mf) or [])))
+        for t in dz.terms if dz else ():
+            if isinstance(t.mf, SingletonMF):
+                x, half = float(t.mf.value), _singleton_width(dz, var) / 2.0  # type: ignore[arg-type]
+                members.append((t.name, [(x - half, 1.0), (x + half, 1.0)]))
+            else:
+                members.append((t.name, _fpl_points(_as_points(t.mf) or [])))
+        if rng is None:
+            xs = [x for _, pts in members for x, _ in pts]
+            rng = Range(min(xs), max(xs)) if xs else None
+        if rng is not None:
+            out += [f"MIN {_num(rng.low)}", f"MAX {_num(rng.high)}"]
+        for name, pts in members:
+            out += [f"MEMBER {name}", "POINTS " + " ".join(f"{_num(x)},{_num(y)}" for x, y in pts), "END"]
+        out.append("END")
+    base = fb.rule_blocks[0] if fb.rule_blocks else None
+    base_name = base.name if base and base.name else "rules"
+    out.append(f"FUZZY {base_name}")
+    for rb_rule in base.rules if base else ():
+        out.append(f"RULE {rb_rule.label}")
+        subconditions = list(leaves(rb_rule.condition))
+        if subconditions:
+            out.append("IF " + " AND ".join(f"({c.variable} is {c.term})" for c in subconditions))
+        if rb_rule.conclusions:
+            out.append("THEN " + " AND ".join(f"{c.variable} = {c.term}" for c in rb_rule.conclusions))
+        out.append("END")
+    out.append("END")
+    for var in fb.inputs:
+        out += ["CONNECT", f"FROM {var.name}", f"TO {base_name}", "END"]
+    for var in fb.outputs:
+        out += ["CONNECT", f"FROM {base_name}", f"TO {var.name}", "END"]
+    out.append("END")
+    return "\n".join(out) + "\n"
+
+
+def _loss(d: Diagnostic) -> tuple[str, str]:
+    where = f"line {d.span.line}" if d.span is not None else "program"
+    return where, d.message
+
+
+def _fpl_condition(cond: Condition | None) -> bool:
+    if cond is None:
+        return True
+    if isinstance(cond, Is):
+        return not cond.negated and not cond.hedges
+    return isinstance(cond, And) and all(_fpl_condition(c) for c in cond.operands)
+
+
+def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
+    """``document`` reduced to what FPL can say, and what was dropped as ``(element,
+    reason)`` pairs: further function blocks, rule blocks and intermediate variables,
+    weights, DEFAULT values (Fuzzy Control keeps the last value), other operators, rules
+    with OR/NOT/hedges and terms FPL cannot hold (with the rules that use them)."""
+    fb = document.main
+    losses = [(f"function block {b.name}", "an FPL file holds one project") for b in document.blocks[1:]]
+    diags = check_fpl(fb)
+    losses += [_loss(d) for d in diags if d.is_error or d.code == "fpl-expr-default"]
+    local_names = {v.name for v in fb.locals}
+    keep_terms: set[tuple[str, str]] = set()
+    fuzzify = []
+    for fz in fb.fuzzify:
+        if fz.variable in local_names:
+            continue
+        terms = tuple(t for t in fz.terms if _as_points(t.mf) is not None)
+        keep_terms.update((fz.variable, t.name) for t in terms)
+        fuzzify.append(replace(fz, terms=terms))
+    defuzzify = []
+    for dz in fb.defuzzify:
+        if dz.variable in local_names:
+            continue
+        terms = tuple(
+            t
+            for t in dz.terms
+            if (isinstance(t.mf, SingletonMF) and is_constant(t.mf.value)) or _as_points(t.mf) is not None
+        )
+        keep_terms.update((dz.variable, t.name) for t in terms)
+        singletons = all(isinstance(t.mf, SingletonMF) for t in terms)
+        defuzzify.append(
+            replace(
+                dz,
+                terms=terms,
+                method="COGS" if singletons else "COG",
+                default=Default(no_change=True),
+                accu=None,
+            )
+        )
+    rule_blocks = []
+    for rb in fb.rule_blocks[:1]:
+        rules = []
+        for rule in rb.rules:
+            used = [(c.variable, c.term) for c in leaves(rule.condition)]
+            used += [(c.variable, c.term or "") for c in rule.conclusions]
+            plain = _fpl_condition(rule.condition) and not any(c.hedges for c in rule.conclusions)
+            if plain and all(u in keep_terms for u in used):
+                conclusions = tuple(replace(c, weight=None) for c in rule.conclusions)
+                rules.append(replace(rule, conclusions=conclusions, weight=None))
+        rule_blocks.append(
+            replace(
+                rb,
+                rules=tuple(rules) if rb.enabled else (),
+                and_op="MIN",
+                or_op=None,
+                accu="MAX",
+                act=None if rb.act in (None, "MIN") else "MIN",
+                enabled=True,
+                rule_activation=None,
+            )
+        )
+    lowered = replace(
+        fb,
+        variables=tuple(v for v in fb.variables if v.name not in local_names),
+        fuzzify=tuple(fuzzify),
+        defuzzify=tuple(defuzzify),
+        rule_blocks=tuple(rule_blocks),
+    )
+    return Document((lowered,), path=document.path, comments=document.comments), losses

@@ -1,0 +1,578 @@
+"""Schneider XFUZ knowledge-base tables as files, and their translation to and from the
+fuzzyctl model (hence FCL).
+
+Two file layouts hold the same content, the constants of the block and the three arrays:
+
+A ``.xfuz`` file holds either; the reader tells them apart by the first character.
+
+JSON::
+
+    {"format": "xfuz-tables", "version": 1,
+     "constants": {"OP_CONJ": 0, "OP_ET": 0, "OP_IMPL": 0, "OP_AGREG": 0, "OP_DEFUZ": 0,
+                   "OUT_PT": 0, "CONTASK$": 1, "T_OFB$": 200, "O1_DEF$": 0, ...},
+     "ESV": [62 words], "FA": [576 words], "RG": [384 words]}
+
+CSV, one word per row like the manual's "ligne N : value" listings::
+
+    table,index,value,note
+    CONST,OP_ET,0,
+    ESV,0,0,INP1 BorneInf
+    FA,0,24934,FA0 Nom(1-2)
+
+Missing words are 0 and missing constants take the manual's defaults; shorter arrays are
+padded with 0.  The ``note`` column is ignored on reading.
+
+Model mapping: INPi/OUTj become VAR_INPUT/VAR_OUTPUT ``INPi``/``OUTj`` of type INT (the
+tables carry no names for them), VARk a local VAR named by its ESV name.  Each FA record is
+a term (``(xC,1) (xD,0)`` for a left-open half trapezoid, ``(xA,0) (xB,1)`` for a right-open
+one, a triangle or trapezoid otherwise; a singleton when OUT_PT = 1), each RG record a rule
+``RULE n`` of AND-ed predicates (NOT for +100).  OP_ET, OP_IMPL and OP_DEFUZ become AND,
+ACT and METHOD (COG, MOM; COGS when OUT_PT = 1); Oi_DEF$ the DEFAULT.  What FCL has no place
+for (Discr, the slot of a renamed variable, CONTASK$, T_OFB$) goes in an OPTIONS block as
+``XFUZ key value;`` lines, so that tables -> FCL -> tables gives back the same words.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import json
+import re
+from collections.abc import Iterator
+from dataclasses import replace
+from typing import Any
+
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
+from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats.xfuz_tables import (
+    ESV_SIZE,
+    FA_SIZE,
+    OPEN_HIGH,
+    OPEN_LOW,
+    RG_SIZE,
+    SlotKind,
+    StatusBit,
+    XfuzConstants,
+    XMembership,
+    decode_kb,
+    esv_offsets,
+    slot_kind,
+    slot_label,
+)
+from fuzzyctl.model import (
+    And,
+    Conclusion,
+    Condition,
+    Default,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FuzzifyBlock,
+    Is,
+    MembershipFunction,
+    OptionsBlock,
+    Point,
+    PointsMF,
+    Range,
+    Rule,
+    RuleBlock,
+    SingletonMF,
+    Span,
+    Term,
+    Variable,
+    VarKind,
+)
+
+NAME = "xfuz"
+EXTENSIONS = (".xfuz",)
+FORMAT_TAG = "xfuz-tables"
+
+__all__ = [
+    "EXTENSIONS",
+    "FORMAT",
+    "NAME",
+    "model_from_constants",
+    "read_tables",
+    "read_xfuz",
+    "write_tables",
+]
+
+_CONSTANT_KEYS = (
+    "OP_CONJ",
+    "OP_ET",
+    "OP_IMPL",
+    "OP_AGREG",
+    "OP_DEFUZ",
+    "OUT_PT",
+    "CONTASK$",
+    "T_OFB$",
+    *(f"O{i}_DEF$" for i in range(1, 7)),
+)
+_DEFAULTS = {"CONTASK$": 1, "T_OFB$": 200}
+
+
+# --------------------------------------------------------------------------- table files
+
+
+def _constants_from_mapping(values: dict[str, int], tables: dict[str, list[int]]) -> XfuzConstants:
+    def get(key: str) -> int:
+        return values.get(key, _DEFAULTS.get(key, 0))
+
+    # A table that is not given at all keeps the block's default (an empty base).
+    given = {name.lower(): tuple(words) for name, words in tables.items()}
+    return XfuzConstants(
+        op_conj=get("OP_CONJ"),
+        op_et=get("OP_ET"),
+        op_impl=get("OP_IMPL"),
+        op_agreg=get("OP_AGREG"),
+        op_defuz=get("OP_DEFUZ"),
+        out_pt=bool(get("OUT_PT")),
+        contask=bool(get("CONTASK$")),
+        t_ofb=get("T_OFB$"),
+        o_def=tuple(get(f"O{i}_DEF$") for i in range(1, 7)),
+        **given,
+    )
+
+
+def _constants_mapping(c: XfuzConstants) -> dict[str, int]:
+    values = {
+        "OP_CONJ": c.op_conj,
+        "OP_ET": c.op_et,
+        "OP_IMPL": c.op_impl,
+        "OP_AGREG": c.op_agreg,
+        "OP_DEFUZ": c.op_defuz,
+        "OUT_PT": int(c.out_pt),
+        "CONTASK$": int(c.contask),
+        "T_OFB$": c.t_ofb,
+    }
+    values.update({f"O{i + 1}_DEF$": v for i, v in enumerate(c.o_def)})
+    return values
+
+
+def _is_int(v: Any) -> bool:
+    return isinstance(v, int) and not isinstance(v, bool)
+
+
+def _read_json(text: str, path: str | None) -> XfuzConstants:
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise DiagnosticError(
+            [error(f"not valid JSON: {exc.msg}", Span(exc.lineno, exc.colno), code="xfuz-json", file=path)],
+            text,
+        ) from None
+    diags: list[Diagnostic] = []
+    if not isinstance(data, dict):
+        raise DiagnosticError(
+            [error("expected a JSON object with ESV, FA and RG", code="xfuz-json", file=path)]
+        )
+    if data.get("format", FORMAT_TAG) != FORMAT_TAG:
+        diags.append(
+            error(f"format is {data.get('format')!r}, expected {FORMAT_TAG!r}", code="xfuz-json", file=path)
+        )
+    consts = data.get("constants", {})
+    if not isinstance(consts, dict):
+        diags.append(error("constants must be an object", code="xfuz-json", file=path))
+        consts = {}
+    for key, value in consts.items():
+        if key not in _CONSTANT_KEYS:
+            diags.append(
+                error(
+                    f"unknown constant {key!r} (known: {', '.join(_CONSTANT_KEYS)})",
+                    code="xfuz-json",
+                    file=path,
+                )
+            )
+        elif not _is_int(value):
+            diags.append(
+                error(f"constant {key} must be an integer, got {value!r}", code="xfuz-json", file=path)
+            )
+    tables: dict[str, list[int]] = {}
+    for name, size in (("ESV", ESV_SIZE), ("FA", FA_SIZE), ("RG", RG_SIZE)):
+        if name not in data:
+            continue
+        words = data[name]
+        if not isinstance(words, list) or not all(_is_int(w) for w in words):
+            diags.append(error(f"{name} must be an array of integers", code="xfuz-json", file=path))
+            continue
+        if len(words) > size:
+            diags.append(
+                error(f"{name} has {len(words)} words; the table holds {size}", code="xfuz-json", file=path)
+            )
+        tables[name] = words
+    for key in data:
+        if key not in ("format", "version", "constants", "ESV", "FA", "RG", "comment"):
+            diags.append(warning(f"unknown key {key!r} ignored", code="xfuz-json", file=path))
+    return _finish(consts, tables, diags, text, path)
+
+
+def _finish(
+    consts: dict[str, int], tables: dict[str, list[int]], diags: list[Diagnostic], text: str, path: str | None
+) -> XfuzConstants:
+    if any(d.is_error for d in diags):
+        raise DiagnosticError(diags, text)
+    try:
+        return _constants_from_mapping(consts, tables)
+    except ValueError as exc:
+        raise DiagnosticError([*diags, error(str(exc), code="xfuz-value", file=path)], text) from None
+
+
+def _read_csv(text: str, path: str | None) -> XfuzConstants:
+    diags: list[Diagnostic] = []
+    consts: dict[str, int] = {}
+    sizes = {"ESV": ESV_SIZE, "FA": FA_SIZE, "RG": RG_SIZE}
+    tables: dict[str, list[int]] = {name: [0] * size for name, size in sizes.items()}
+    seen: dict[tuple[str, str], int] = {}
+    for lineno, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+        if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
+            continue
+        cells = [c.strip() for c in row]
+        if cells[0].lower() == "table" and len(cells) > 2 and cells[2].lower() == "value":
+            continue  # the header row
+        span = Span(lineno, 1)
+        if len(cells) < 3:
+            diags.append(error("expected table,index,value[,note]", span, code="xfuz-csv", file=path))
+            continue
+        table, index, value = cells[0].upper(), cells[1], cells[2]
+        try:
+            number = int(value, 0) if value.lower().startswith(("0x", "-0x")) else int(value)
+        except ValueError:
+            diags.append(error(f"value {value!r} is not an integer", span, code="xfuz-csv", file=path))
+            continue
+        key = (table, index.upper())
+        if key in seen:
+            diags.append(
+                error(
+                    f"{table} {index} is given twice (first on line {seen[key]})",
+                    span,
+                    code="xfuz-csv",
+                    file=path,
+                )
+            )
+            continue
+        seen[key] = lineno
+        if table == "CONST":
+            if index.upper() not in _CONSTANT_KEYS:
+                diags.append(error(f"unknown constant {index!r}", span, code="xfuz-csv", file=path))
+            else:
+                consts[index.upper()] = number
+        elif table in sizes:
+            if not index.isdigit() or int(index) >= sizes[table]:
+                diags.append(
+                    error(
+                        f"{table} index {index!r} is not 0..{sizes[table] - 1}",
+                        span,
+                        code="xfuz-csv",
+                        file=path,
+                    )
+                )
+            else:
+                tables[table][int(index)] = number
+        else:
+            diags.append(
+                error(f"table {cells[0]!r} is not CONST, ESV, FA or RG", span, code="xfuz-csv", file=path)
+            )
+    return _finish(consts, tables, diags, text, path)
+
+
+def read_tables(text: str, *, path: str | None = None) -> XfuzConstants:
+    """Read a table file: JSON when it starts with ``{``, else CSV."""
+    if text.lstrip().startswith("{"):
+        return _read_json(text, path)
+    return _read_csv(text, path)
+
+
+def _notes(c: XfuzConstants) -> dict[tuple[str, int], str]:
+    notes: dict[tuple[str, int], str] = {}
+    for slot in range(18):
+        label = slot_label(slot)
+        if slot < 8:
+            notes[("ESV", 2 * slot)], notes[("ESV", 2 * slot + 1)] = f"{label} BorneInf", f"{label} BorneSup"
+        else:
+            base = 16 + 3 * (slot - 8) if slot < 14 else 34 + 3 * (slot - 14)
+            for k, what in enumerate(("BorneInf", "BorneSup", "Discr")):
+                notes[("ESV", base + k)] = f"{label} {what}"
+            if slot >= 14:
+                for k in range(4):
+                    notes[("ESV", 46 + 4 * (slot - 14) + k)] = f"{label} Nom({2 * k + 1}-{2 * k + 2})"
+    for n in range(64):
+        for k, what in enumerate(
+            ("Nom(1-2)", "Nom(3-4)", "Nom(5-6)", "Nom(7-8)", "Variable", "xA", "xB", "xC", "xD")
+        ):
+            notes[("FA", 9 * n + k)] = f"FA{n} {what}"
+    for r in range(64):
+        for k, what in enumerate(("Pred1", "Pred2", "Pred3", "Pred4", "Concl1", "Concl2")):
+            notes[("RG", 6 * r + k)] = f"REG{r} {what}"
+    return notes
+
+
+def _used_ranges(c: XfuzConstants) -> Iterator[tuple[str, int]]:
+    """The words worth writing: every non-zero word, whole records of used functions and
+    rules, and the terminators."""
+    kb = decode_kb(c)
+    keep: set[tuple[str, int]] = set()
+    for name, words in (("ESV", c.esv), ("FA", c.fa), ("RG", c.rg)):
+        keep.update((name, k) for k, w in enumerate(words) if w)
+    for v in kb.variables:
+        keep.update(("ESV", k) for k in esv_offsets(v.slot) if k is not None)
+    for mf in kb.memberships:
+        keep.update(("FA", 9 * mf.number + k) for k in range(9))
+    for rule in kb.rules:
+        keep.update(("RG", 6 * rule.number + k) for k in range(6))
+    order = {"ESV": 0, "FA": 1, "RG": 2}
+    yield from sorted(keep, key=lambda t: (order[t[0]], t[1]))
+
+
+def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
+    """Table file text in the ``json`` or ``csv`` layout."""
+    if layout == "json":
+        body = {
+            "format": FORMAT_TAG,
+            "version": 1,
+            "constants": _constants_mapping(constants),
+            "ESV": list(constants.esv),
+            "FA": list(constants.fa),
+            "RG": list(constants.rg),
+        }
+        text = json.dumps(body, indent=1)
+        # One table per line is easier to read and diff than one word per line.
+        return (
+            re.sub(r"\[\s+([-\d,\s]+?)\s+\]", lambda m: "[" + re.sub(r"\s+", " ", m.group(1)) + "]", text)
+            + "\n"
+        )
+    if layout != "csv":
+        raise ValueError(f"layout must be 'json' or 'csv', not {layout!r}")
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow(["table", "index", "value", "note"])
+    for key, value in _constants_mapping(constants).items():
+        w.writerow(["CONST", key, value, ""])
+    notes = _notes(constants)
+    tables = {"ESV": constants.esv, "FA": constants.fa, "RG": constants.rg}
+    for table, index in _used_ranges(constants):
+        w.writerow([table, index, tables[table][index], notes.get((table, index), "")])
+    return out.getvalue()
+
+
+# --------------------------------------------------------------------------- tables -> model
+
+
+_IDENT = re.compile(r"^[^\W\d]\w*$")
+
+
+def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
+    if singleton:
+        return SingletonMF(float(mf.singleton()))
+    a, b, c, d = (float(x) for x in mf.points)
+    left_open, right_open = mf.a == OPEN_LOW and mf.b == OPEN_LOW, mf.c == OPEN_HIGH and mf.d == OPEN_HIGH
+    pts: list[tuple[float, float]]
+    if left_open and right_open:
+        pts = [(float(OPEN_LOW), 1.0), (float(OPEN_HIGH), 1.0)]
+    elif left_open:
+        pts = [(c, 1.0), (d, 0.0)]
+    elif right_open:
+        pts = [(a, 0.0), (b, 1.0)]
+    elif b == c:
+        pts = [(a, 0.0), (b, 1.0), (d, 0.0)]
+    else:
+        pts = [(a, 0.0), (b, 1.0), (c, 1.0), (d, 0.0)]
+    return PointsMF(tuple(Point(float(x), y) for x, y in pts))
+
+
+def _options_text(c: XfuzConstants, renamed: list[tuple[str, str]], discr: list[tuple[str, int]]) -> str:
+    lines = ["(* XFUZ data with no FCL equivalent; read back by fuzzyctl's XFUZ writer *)"]
+    lines += [f"XFUZ SLOT {name} {label};" for name, label in renamed]
+    lines += [f"XFUZ DISCR {name} {n};" for name, n in discr]
+    lines += [f"XFUZ CONTASK$ {int(c.contask)};", f"XFUZ T_OFB$ {c.t_ofb};"]
+    return "\n".join(lines)
+
+
+def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[FunctionBlock, list[Diagnostic]]:
+    """Decode the tables into a function block.  Errors (a table that cannot be decoded)
+    and warnings (what the block would flag in STATUS, what changes on the way) come back
+    as diagnostics; the block is only meaningful when there is no error."""
+    kb = decode_kb(c)
+    diags: list[Diagnostic] = []
+    for issue in kb.issues:
+        # Rules pointing nowhere and functions of non-existent variables cannot be decoded;
+        # everything else can, and is what the block itself would flag in STATUS.
+        fatal = issue.bit == StatusBit.RULE_REFERENCE or (
+            issue.bit == StatusBit.MF_ORDER and "does not exist" in issue.message
+        )
+        text = f"{issue.location}: {issue.message} (XFUZ STATUS bit {issue.bit})".lstrip(": ")
+        diags.append(
+            error(text, code=f"xfuz-status-{issue.bit}")
+            if fatal
+            else warning(text, code=f"xfuz-status-{issue.bit}")
+        )
+    names: dict[int, str] = {}
+    renamed: list[tuple[str, str]] = []
+    for v in kb.variables:
+        label = v.label
+        if v.kind is SlotKind.INTERMEDIATE and v.name and v.name != label:
+            if _IDENT.match(v.name):
+                names[v.slot] = v.name
+                renamed.append((v.name, label))
+            else:
+                diags.append(
+                    warning(
+                        f"{label}: name {v.name!r} is not an identifier; the variable is called {label}",
+                        code="xfuz-name",
+                    )
+                )
+                names[v.slot] = label
+        else:
+            names[v.slot] = label
+    # Variables in the order their functions appear in FA, then the ones without functions.
+    order = list(
+        dict.fromkeys([m.slot for m in kb.memberships if 0 <= m.slot < 18] + [v.slot for v in kb.variables])
+    )
+    term_names: dict[int, str] = {}
+    terms: dict[int, list[Term]] = {slot: [] for slot in order}
+    last_slot, regrouped = -1, False
+    for mf in kb.memberships:
+        if not 0 <= mf.slot < 18:
+            continue
+        regrouped |= mf.slot != last_slot and bool(terms[mf.slot])
+        last_slot = mf.slot
+        tname = mf.name if mf.name and _IDENT.match(mf.name) else f"FA{mf.number}"
+        if tname != mf.name:
+            diags.append(
+                warning(
+                    f"FA{mf.number}: name {mf.name!r} is not an identifier; the term is called {tname}",
+                    code="xfuz-name",
+                )
+            )
+        if any(t.name == tname for t in terms[mf.slot]):
+            diags.append(
+                warning(
+                    f"FA{mf.number}: {names[mf.slot]} already has a term {tname}; this one is "
+                    f"called {tname}_{mf.number}",
+                    code="xfuz-name",
+                )
+            )
+            tname = f"{tname}_{mf.number}"
+        term_names[mf.number] = tname
+        singleton = c.out_pt and slot_kind(mf.slot) is SlotKind.OUTPUT
+        if singleton and len(set(mf.points)) > 1:
+            diags.append(
+                warning(
+                    f"FA{mf.number}: singleton mode keeps the point {mf.singleton()}; the other "
+                    "abscissae are not kept",
+                    code="xfuz-singleton",
+                )
+            )
+        terms[mf.slot].append(Term(tname, _mf_model(mf, singleton)))
+    if regrouped:
+        diags.append(
+            warning(
+                "the functions of a variable are not contiguous in FA; writing the tables back "
+                "groups them and renumbers the rules' references",
+                code="xfuz-order",
+            )
+        )
+
+    as_predicate = {
+        kb.memberships[n].slot for r in kb.rules for n, _ in r.predicates if 0 <= n < len(kb.memberships)
+    }
+    method = "COGS" if c.out_pt else ("MOM" if c.op_defuz == 1 else "COG")
+    variables: list[Variable] = []
+    fuzzify: list[FuzzifyBlock] = []
+    defuzzify: list[DefuzzifyBlock] = []
+    discr: list[tuple[str, int]] = []
+    for slot in order:
+        v = kb.variable(slot)
+        kind = slot_kind(slot)
+        vname = names[slot]
+        rng = Range(float(v.low), float(v.high)) if (v.low, v.high) != (0, 0) else None
+        vk = {SlotKind.INPUT: VarKind.INPUT, SlotKind.OUTPUT: VarKind.OUTPUT}.get(kind, VarKind.LOCAL)
+        variables.append(Variable(vname, vk, "INT", range=rng))
+        tt = tuple(terms[slot])
+        if (kind is SlotKind.INPUT or slot in as_predicate) and tt:
+            fuzzify.append(FuzzifyBlock(vname, tt))
+        if kind is not SlotKind.INPUT:
+            discr.append((vname, v.discr))
+            if tt:
+                default = Default(float(c.o_def[slot - 8])) if kind is SlotKind.OUTPUT else None
+                defuzzify.append(DefuzzifyBlock(vname, tt, range=rng, method=method, default=default))
+    rules: list[Rule] = []
+    for rule in kb.rules:
+        conds: list[Condition] = []
+        for number, negated in rule.predicates:
+            pred_mf = kb.membership(number)
+            if pred_mf is None or not 0 <= pred_mf.slot < 18:
+                continue
+            conds.append(Is(names[pred_mf.slot], term_names[number], negated=negated))
+        concl = tuple(
+            Conclusion(names[kb.memberships[n].slot], term_names[n])
+            for n in rule.conclusions
+            if 0 <= n < len(kb.memberships) and n in term_names
+        )
+        cond: Condition | None = conds[0] if len(conds) == 1 else (And(tuple(conds)) if conds else None)
+        rules.append(Rule(str(rule.number), cond, concl))
+    ops = {0: "MIN", 1: "PROD"}
+    block = FunctionBlock(
+        name,
+        tuple(variables),
+        tuple(fuzzify),
+        tuple(defuzzify),
+        (RuleBlock("xfuz", tuple(rules), and_op=ops[c.op_et], act=ops[c.op_impl], accu="MAX"),),
+        (OptionsBlock(_options_text(c, renamed, discr)),),
+    )
+    return block, diags
+
+
+def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
+    constants = read_tables(text, path=path)
+    stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
+    block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
+    if not constants.out_pt or block.locals:
+        diags.append(
+            Diagnostic(
+                Severity.NOTE,
+                "evaluated as FCL (fuzzyctl eval) this program has IEC semantics: an exact centre of "
+                "gravity and crisp values through intermediate variables; the XFUZ block (fuzzyctl "
+                "blocks xfuz) computes on the Discr points and chains fuzzy sets (manual 2.2)",
+                code="xfuz-semantics",
+            )
+        )
+    diags = [replace(d, file=path) for d in diags]
+    if any(d.is_error for d in diags):
+        raise DiagnosticError(diags, text)
+    return Document((block,), path=path), diags
+
+
+def read_xfuz(text: str, *, path: str | None = None) -> Document:
+    """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
+    return _decode(text, path)[0]
+
+
+# --------------------------------------------------------------------------- registry
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    document, diags = _decode(text, path)
+    return Loaded(document, tuple(diags))
+
+
+def _write(document: Document) -> str:
+    from fuzzyctl.formats.xfuz_write import write_xfuz
+
+    return write_xfuz(document)
+
+
+def _lower(document: Document) -> tuple[Document, list[Loss]]:
+    from fuzzyctl.formats.xfuz_write import lower_xfuz
+
+    lowered, losses = lower_xfuz(document)
+    return lowered, [Loss(element, reason) for element, reason in losses]
+
+
+FORMAT = Format(
+    NAME,
+    EXTENSIONS,
+    "Schneider XFUZ knowledge-base tables ESV/FA/RG and constants (JSON or CSV layout)",
+    read=_read,
+    write=_write,
+    lower=_lower,
+)
