@@ -84,7 +84,7 @@ def sources(plan: Plan) -> tuple[str, dict[str, str]]:
     prog = build_program(plan, "c")
     header, source = render_c(prog)
     prev = next(d for d in prog.of("state") if d.name.startswith("FZ_PREV"))
-    wrapper = _WRAPPER.format(name=prog.name, prev=prev.name, n_prev=prev.size)
+    wrapper = _WRAPPER.format(name=prog.name, prev=prev.name, n_prev=len(plan.outputs))
     return prog.name, {f"{prog.name}.h": header, f"{prog.name}.c": source, "fz_native.c": wrapper}
 
 

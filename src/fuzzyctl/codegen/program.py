@@ -163,8 +163,8 @@ class _Builder:
             g.fresh("PREV", "PREV"),
             "REAL",
             "state",
-            len(plan.outputs),
-            init_prev,
+            max(1, len(plan.outputs)),
+            init_prev or (0.0,),
             "previous output values (DEFAULT := NC)",
         )
         weights = self.new_params("W", "W", "WITH weights of the rules")

@@ -87,6 +87,8 @@ class _C:
         return f"({s})" if v < 0 else s
 
     def name(self, n: str) -> str:
+        if n in self.consts:  # file-scope tables: unique per block (several blocks may share a unit)
+            return f"{self.prog.name}_{n}"
         return f"fb->{n}" if n in self.fields else n
 
     def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
@@ -258,7 +260,7 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
         vals = ", ".join(str(int(v)) if d.type == "INT" else r.num(v) for v in d.init)
-        c.append(f"static const {_ctype(d, real)} {d.name}[{d.size}] = {{{vals}}};")
+        c.append(f"static const {_ctype(d, real)} {r.name(d.name)}[{d.size}] = {{{vals}}};")
     c.append("")
     c.append(f"void {name}_init({name} *fb)")
     c.append("{")
@@ -281,9 +283,11 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     c.append("{")
     read = _read_names(prog.body)
     temps = prog.of("temp")
-    for d in temps:
-        dim = f"[{d.size}]" if d.size is not None else ""
-        c.append(f"    {_ctype(d, real)} {d.name}{dim};")
+    for d in temps:  # zero-initialised: keeps -Wmaybe-uninitialized quiet at any -O
+        if d.size is not None:
+            c.append(f"    {_ctype(d, real)} {d.name}[{d.size}] = {{0}};")
+        else:
+            c.append(f"    {_ctype(d, real)} {d.name} = 0;")
     r.stmts(prog.body, 1)
     c += r.lines
     unread = [d.name for d in temps if d.name not in read]
@@ -297,6 +301,7 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     c.append("{")
     c.append("    size_t i;")
     c.append("    (void)in;")
+    c.append("    (void)out;")
     c.append("    for (i = 0; i < n; i++) {")
     for k, nm in enumerate(ins):
         c.append(f"        fb->{nm} = ({real})in[i * {len(ins)} + {k}];")

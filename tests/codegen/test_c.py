@@ -1,0 +1,139 @@
+"""Generated C against the engine.
+
+Every example and every expressible conformance system is generated (renamed ``s0``, ``s1``,
+... so that all share one library), compiled in ONE strict invocation of the system compiler
+(``cc -std=c99 -Wall -Wextra -Werror -pedantic``) and run on 10,000 random inputs each, as
+successive cycles of one instance (so DEFAULT := NC is exercised); outputs must match the
+engine within 1e-9 of the output's range.  The float build of the examples compiles as
+strictly and stays within 1e-4 of the range."""
+
+from __future__ import annotations
+
+import ctypes
+import shutil
+import subprocess
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fuzzyctl.codegen import CodegenError
+from fuzzyctl.codegen.program import build_program
+from fuzzyctl.codegen.render_c import render_c
+from fuzzyctl.engine.plan import Plan
+from tests.codegen import systems as S
+
+STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
+N = 10_000
+
+
+def _cc() -> str:
+    cc = shutil.which("cc")
+    if cc is None:
+        pytest.fail("the C tests need the system compiler 'cc'")
+    return cc
+
+
+def build_library(plans: list[Plan], out: Path, single: bool = False) -> ctypes.CDLL:
+    """All plans in one shared library, compiled in one strict cc invocation."""
+    sources = []
+    sizes = ["#include <stddef.h>"]
+    for plan in plans:
+        header, source = render_c(build_program(plan, "c"), single=single)
+        (out / f"{plan.name}.h").write_text(header)
+        (out / f"{plan.name}.c").write_text(source)
+        sources.append(str(out / f"{plan.name}.c"))
+        sizes.append(f'#include "{plan.name}.h"')
+    sizes += [f"size_t {p.name}_size(void) {{ return sizeof({p.name}); }}" for p in plans]
+    (out / "sizes.c").write_text("\n".join(sizes) + "\n")
+    # two strict compiler runs side by side (2 cores), one link
+    halves = [sources[0::2], sources[1::2] + [str(out / "sizes.c")]]
+    objs = [out / "part0.o", out / "part1.o"]
+    procs = []
+    for part, obj in zip(halves, objs, strict=True):
+        unit = out / f"{obj.stem}.c"
+        unit.write_text("".join(f'#include "{Path(src).name}"\n' for src in part))
+        cmd = [_cc(), *STRICT, "-O1", "-ffp-contract=off", "-fPIC", "-c", "-o", str(obj), str(unit)]
+        procs.append(subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True))
+    for p in procs:
+        _out, err = p.communicate()
+        assert p.returncode == 0, err[:4000]
+    lib = out / "systems.so"
+    res = subprocess.run([_cc(), "-shared", "-o", str(lib), *map(str, objs), "-lm"], capture_output=True, text=True)
+    assert res.returncode == 0, res.stderr[:4000]
+    return ctypes.CDLL(str(lib))
+
+
+def run(lib: ctypes.CDLL, plan: Plan, data: np.ndarray) -> np.ndarray:
+    """Successive rows through one instance (``NAME_batch``)."""
+    name = plan.name
+    size = getattr(lib, f"{name}_size")
+    size.restype = ctypes.c_size_t
+    inst = ctypes.create_string_buffer(int(size()))
+    getattr(lib, f"{name}_init")(inst)
+    n_out = sum(1 for o in plan.outputs if o.is_output)
+    data = np.ascontiguousarray(data, dtype=np.float64)
+    out = np.empty((len(data), n_out))
+    fn = getattr(lib, f"{name}_batch")
+    fn.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+    fn(inst, len(data), data.ctypes.data, out.ctypes.data)
+    return out
+
+
+def _systems() -> list[tuple[str, Plan]]:
+    out = []
+    for p in S.example_files():
+        out.append((f"examples/{p.name}", S.plan_of(p)))
+    for rel, p in S.conformance_files():
+        if rel not in S.NOT_EXPRESSIBLE_C:
+            out.append((rel, S.plan_of(p)))
+    return [(label, _renamed(plan, f"s{k}")) for k, (label, plan) in enumerate(out)]
+
+
+def _renamed(plan: Plan, name: str) -> Plan:
+    import dataclasses
+
+    return dataclasses.replace(plan, name=name)
+
+
+@pytest.fixture(scope="module")
+def compiled(tmp_path_factory: pytest.TempPathFactory) -> tuple[ctypes.CDLL, list[tuple[str, Plan]]]:
+    systems = _systems()
+    lib = build_library([p for _l, p in systems], tmp_path_factory.mktemp("c"))
+    return lib, systems
+
+
+def test_every_expressible_system_matches_the_engine(compiled: tuple[ctypes.CDLL, list[tuple[str, Plan]]]) -> None:
+    lib, systems = compiled
+    assert len(systems) >= 60  # examples + conformance
+    worst = {}
+    for label, plan in systems:
+        data = S.random_inputs(plan, N, seed=len(label))
+        got = run(lib, plan, data)
+        want = S.reference(plan, data)
+        worst[label] = S.max_error(plan, got, want)
+    bad = {k: v for k, v in worst.items() if not v <= 1e-9}
+    assert not bad, bad
+    print(f"\nC double: worst deviation {max(worst.values()):.2e} of the range over {len(worst)} systems")
+
+
+def test_the_not_expressible_list_is_exactly_what_the_generator_refuses() -> None:
+    refused = {}
+    for rel, p in S.conformance_files():
+        try:
+            build_program(S.plan_of(p), "c")
+        except CodegenError as exc:
+            refused[rel] = str(exc)
+    assert set(refused) == set(S.NOT_EXPRESSIBLE_C)
+    for msg in refused.values():  # the message names the element
+        assert msg.startswith(("output ", "term ")), msg
+
+
+def test_float_build_compiles_strictly_and_stays_close(tmp_path: Path) -> None:
+    plans = [_renamed(S.plan_of(p), f"f{k}") for k, p in enumerate(S.example_files())]
+    lib = build_library(plans, tmp_path, single=True)
+    for plan in plans:
+        data = S.random_inputs(plan, 2000, seed=3, single=True)
+        err = S.max_error(plan, run(lib, plan, data), S.reference(plan, data))
+        assert err <= 1e-4, (plan.name, err)
+    assert "typedef float f0_real;" in (tmp_path / "f0.h").read_text()
