@@ -417,6 +417,8 @@ def _combine(
     with b.if_(nl.eq(1)):
         b.set(v0, p0[0])
         b.set(v1, p1[0])
+    if p0.name and _capacity(g, p0) < 2:
+        return  # one activated set at most: nothing to combine
     with b.else_():
         if accu == "MAX":
             b.set(v0, p0[0])
@@ -475,6 +477,11 @@ def _combine(
             b.set(v1, _poly(g, p0, p1, nl, ex(1.0)))
         else:  # pragma: no cover - lowering marks other accumulations inexact
             raise AssertionError(accu)
+
+
+def _capacity(g: Gen, arr: Var) -> int:
+    size = next(d.size for d in g.decls if d.name == arr.name)
+    return size or 1
 
 
 def _poly(g: Gen, p0: Var, p1: Var, nl: Var, s: Ex) -> Var:

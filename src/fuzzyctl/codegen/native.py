@@ -106,7 +106,9 @@ def build(plan: Plan) -> Path:
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-build-") as tmp:
         for fname, text in files.items():
             Path(tmp, fname).write_text(text)
-        partial = out_dir / f".{lib.name}.{os.getpid()}.tmp"
+        fd, tmp_name = tempfile.mkstemp(dir=out_dir, prefix=f".{lib.stem}.", suffix=".tmp")
+        os.close(fd)
+        partial = Path(tmp_name)  # unique per build (threads share a pid)
         cmd = [cc, *CFLAGS, "-o", str(partial), str(Path(tmp, "fz_native.c")), "-lm"]
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         if res.returncode != 0:

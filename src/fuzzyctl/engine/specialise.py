@@ -20,7 +20,7 @@ from typing import Any
 from fuzzyctl.engine import pwl, shapes
 from fuzzyctl.engine.expr import eval_expr
 from fuzzyctl.engine.interp import Interpreter
-from fuzzyctl.engine.operators import SNORMS, TNORMS
+from fuzzyctl.engine.operators import SNORMS, SOURCE_HELPERS, TNORMS
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -64,6 +64,7 @@ class _Gen:
             "_pieces": pwl.interval_pieces,
             "_am": pwl.area_moment,
             "_eval_expr": eval_expr,
+            **SOURCE_HELPERS,  # the Hamacher templates call _ham_t / _ham_s
         }
         self.consts: dict[int, str] = {}
 
