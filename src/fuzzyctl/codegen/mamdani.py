@@ -2,17 +2,19 @@
 
 The generated code does at run time what :mod:`fuzzyctl.engine.grid` and
 :mod:`fuzzyctl.engine.pwl` do: sort each term's points, cut ``[low, high]`` at every
-breakpoint, and on each interval cut again where MIN activation clips a term and where
-activated sets cross (MAX) or their sum crosses 1 (BSUM); between those cuts the accumulated
-set is linear (or, for PROBOR, a product of linear factors integrated with Gauss-Legendre
-nodes exact for its degree).  CoG sums closed-form areas and moments, CoA solves the
-quadratic of the piece holding half the area, LM/RM/MoM scan the pieces' ends.  Because the
-grid is built at run time, term points stay tunable online.
+breakpoint of the output's terms, and on each interval cut again where MIN activation clips a
+term and where activated sets cross (MAX) or their sum crosses 1 (BSUM); between those cuts
+the accumulated set is linear (or, for PROBOR, a product of linear factors integrated with
+Gauss-Legendre nodes exact for its degree).  CoG sums closed-form areas and moments, CoA solves
+the quadratic of the piece holding half the area, LM/RM/MoM scan the pieces' ends.  Because
+the grid is built at run time, term points stay tunable online.
 
-The pieces are never stored: methods needing several looks (CoA: total, then from the left,
-then from the right; LM/RM/MoM: the height, then where it is reached) run the same loop
+The pieces are never stored: methods needing several looks (CoA: the total, then from the
+left, then from the right; LM/RM/MoM: the height, then where it is reached) run the same loop
 several times (``pass``), so memory is bounded by the number of activated sets, not by the
-number of pieces.
+number of pieces.  All exact outputs of a block share ONE copy of the algorithm: a loop over
+the outputs reads each one's range, method, accumulation, terms and activated sets from
+tables, which keeps the Structured Text short.
 """
 
 from __future__ import annotations
@@ -21,8 +23,11 @@ from dataclasses import dataclass
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen
-from fuzzyctl.codegen.ir import Ex, Var, ex, not_
+from fuzzyctl.codegen.ir import Ex, Index, Var, ex, not_
 from fuzzyctl.engine.pwl import MAX_TOL, gauss_legendre
+
+METHODS = {"COG": 1, "COA": 2, "LM": 3, "RM": 4, "MOM": 5}
+ACCUS = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
 
 
 @dataclass
@@ -35,199 +40,256 @@ class Group:
     is_min: bool
 
 
-def exact_output(
-    g: Gen,
-    label: str,
-    method: str,
-    accu: str,
-    low: float,
-    high: float,
-    points: list[list[tuple[Ex, Ex]]],
-    groups: list[Group],
-) -> tuple[Var, Var]:
-    """Emit the defuzzification of one output; returns (value, fired)."""
+@dataclass
+class ExactOutput:
+    name: str
+    method: str
+    accu: str
+    low: float
+    high: float
+    points: list[list[tuple[Ex, Ex]]]  # per term: its breakpoints (x, y)
+    groups: list[Group]
+
+
+def _const(g: Gen, hint: str, type_: str, values: list[float] | list[bool], comment: str = "") -> Var:
+    init = tuple(values) if type_ == "BOOL" else tuple(float(v) for v in values)
+    return g.declare(g.fresh(hint, hint), type_, "const", len(values), init, comment)
+
+
+def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
+    """Emit the defuzzification of every exact output; returns the arrays (value, fired),
+    indexed like ``outs``."""
     b = g.b
-    value = g.temp(hint="Y")
-    fired = g.temp("BOOL", "FIRED")
-    if not groups:
-        b.set(value, 0.0)
-        b.set(fired, False)
+    n_out = len(outs)
+    methods = {o.method for o in outs}
+    accus = {ACCUS[o.accu] for o in outs if len(o.groups) > 1}
+    maxima = bool(methods & {"LM", "RM", "MOM"})
+    # ---- tables: terms and their points, activated sets, per-output data
+    term_pts: list[list[tuple[Ex, Ex]]] = []
+    out_t0, out_t1, out_p0, out_p1, out_g0, out_g1 = [], [], [], [], [], []
+    groups: list[Group] = []
+    for o in outs:
+        base_t = len(term_pts)
+        out_t0.append(base_t)
+        out_p0.append(sum(len(p) for p in term_pts))
+        term_pts.extend(o.points)
+        out_t1.append(len(term_pts) - 1)
+        out_p1.append(sum(len(p) for p in term_pts) - 1)
+        out_g0.append(len(groups))
+        groups.extend(Group(gr.term + base_t, gr.a, gr.w, gr.is_min) for gr in o.groups)
+        out_g1.append(len(groups) - 1)
+    counts = [len(p) for p in term_pts]
+    offs = [sum(counts[:t]) for t in range(len(term_pts))]
+    n_pts, n_terms, n_groups = sum(counts), len(term_pts), len(groups)
+    max_pts = max(p1 - p0 + 1 for p0, p1 in zip(out_p0, out_p1, strict=True))
+    max_groups = max(max(1, len(o.groups)) for o in outs)
+
+    value = g.array("OVAL", "REAL", n_out)
+    fired = g.array("OFIRED", "BOOL", n_out)
+    if n_groups == 0:
+        o_ = g.counter("O")
+        with b.for_(o_, 0, n_out - 1) as ov:
+            b.set(value[ov], 0.0)
+            b.set(fired[ov], False)
         return value, fired
-    counts = [len(p) for p in points]
-    offs = [sum(counts[:t]) for t in range(len(points))]
-    n_pts = sum(counts)
-    used_terms = sorted({gr.term for gr in groups})
-    # ---- each term's points, sorted (they may come from inputs or be retuned online)
+
     wx = g.array("WX", "REAL", n_pts)
     wy = g.array("WY", "REAL", n_pts)
-    for t in used_terms:
-        for k, (x, y) in enumerate(points[t]):
+    for t, pts in enumerate(term_pts):
+        for k, (x, y) in enumerate(pts):
             b.set(wx[offs[t] + k], x)
             b.set(wy[offs[t] + k], y)
-        if counts[t] > 1:
-            T.sort_points(g, wx, wy, offs[t], counts[t])
-    # ---- the grid: [low, high] cut at every breakpoint inside it
-    gx = g.array("GX", "REAL", n_pts + 2)
-    ng = g.temp("INT", "NG")
+    toff = _const(g, "TOFF", "INT", offs, "first point of each output term")
+    tlast = _const(g, "TLAST", "INT", [o + c - 1 for o, c in zip(offs, counts, strict=True)])
+    tt = g.counter("TT")
+    with b.for_(tt, 0, n_terms - 1) as tv:
+        T.sort_points(g, wx, wy, toff[tv], tlast[tv])
+    gt = _const(g, "GT", "INT", [gr.term for gr in groups], "term of each activated set")
+    gmin = _const(g, "GMIN", "BOOL", [gr.is_min for gr in groups], "MIN activation (else PROD)")
+    ga = g.array("GA", "REAL", n_groups)
+    gw = g.array("GW", "REAL", n_groups)
+    for i, gr in enumerate(groups):
+        b.set(ga[i], gr.a)
+        b.set(gw[i], gr.w)
+    live = g.array("LIVE", "BOOL", n_terms)  # a set of the term has a*w > 0
+    with b.for_(tt, 0, n_terms - 1) as tv:
+        b.set(live[tv], False)
+    gg = g.counter("G")
+    with b.for_(gg, 0, n_groups - 1) as gv, b.if_((ga[gv] * gw[gv]).gt(0.0)):
+        b.set(live[gt[gv]], True)
+
+    tab = {
+        "T0": _const(g, "OT0", "INT", out_t0),
+        "T1": _const(g, "OT1", "INT", out_t1),
+        "P0": _const(g, "OP0", "INT", out_p0),
+        "P1": _const(g, "OP1", "INT", out_p1),
+        "G0": _const(g, "OG0", "INT", out_g0),
+        "G1": _const(g, "OG1", "INT", out_g1),
+        "MC": _const(g, "OMC", "INT", [METHODS[o.method] for o in outs], "1 CoG, 2 CoA, 3 LM, 4 RM, 5 MoM"),
+        "AC": _const(g, "OAC", "INT", [ACCUS[o.accu] for o in outs], "1 MAX, 2 SUM/NSUM, 3 BSUM, 4 PROBOR"),
+        "LOW": _const(g, "OLOW", "REAL", [o.low for o in outs], "defuzzification range"),
+        "HIGH": _const(g, "OHIGH", "REAL", [o.high for o in outs]),
+    }
+    v: dict[str, Var] = {}
+    for name, typ in (("O", "INT"), ("MC", "INT"), ("AC", "INT"), ("LOW", "REAL"), ("HIGH", "REAL"),
+                      ("NG", "INT"), ("NL", "INT"), ("NT", "INT"), ("NC", "INT"), ("J", "INT"),
+                      ("V0", "REAL"), ("V1", "REAL"), ("AREA", "REAL"), ("MOM", "REAL")):
+        v[name] = g.temp(typ, name)
+    probor = 4 in accus
+    if probor:
+        v["PR"] = g.temp("BOOL", "PR")
+    st = _method_state(g, methods)
+    arrays = {
+        "GX": g.array("GX", "REAL", max_pts + 2),
+        "LT": g.array("LT", "REAL", n_terms),
+        "RT": g.array("RT", "REAL", n_terms),
+        "LL": g.array("LL", "REAL", max_groups),
+        "LR": g.array("LR", "REAL", max_groups),
+        "LA": g.array("LA", "REAL", max_groups),
+        "LW": g.array("LW", "REAL", max_groups),
+        "LMIN": g.array("LMIN", "BOOL", max_groups),
+        "KINK": g.array("KINK", "REAL", max_groups),
+        "TS": g.array("TS", "REAL", max_groups + 2),
+        "P0": g.array("P0", "REAL", max_groups),
+        "P1": g.array("P1", "REAL", max_groups),
+        "CUT": g.array("CUT", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
+        "CV": g.array("CV", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
+    }
+    if maxima:
+        arrays["MUT"] = g.array("MUT", "REAL", n_terms)
+    gl = _gl_tables(g, max_groups) if probor else None
+    ctx = _Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw, live)
+
+    o_ = v["O"]
+    ov = Var(g.counter("OO"))
+    with b.for_(ov.name, 0, n_out - 1):
+        b.set(o_, ov)
+        b.set(v["MC"], tab["MC"][o_])
+        b.set(v["AC"], tab["AC"][o_])
+        b.set(v["LOW"], tab["LOW"][o_])
+        b.set(v["HIGH"], tab["HIGH"][o_])
+        _grid(ctx, tab["P0"][o_], tab["P1"][o_])
+        b.set(v["AREA"], 0.0)
+        b.set(v["MOM"], 0.0)
+        for name, (typ, init) in _STATE.items():
+            if name in st:
+                b.set(st[name], ex(init) if typ != "REAL" else float(init))
+        n_pass = g.temp("INT", "NPASS")
+        b.set(n_pass, 1)
+        with b.if_(v["MC"].eq(METHODS["COA"])):
+            b.set(n_pass, 3)
+        with b.elif_(v["MC"].ge(METHODS["LM"])):
+            b.set(n_pass, 2)
+        ps = Var(g.counter("PASS"))
+        with b.for_(ps.name, 1, n_pass):
+            ctx.pass_ = ps
+            forward = ps.ne(3)
+            ctx.forward = forward
+            if "COA" in methods:
+                with b.if_(ps.eq(2)):
+                    b.set(st["HALF"], 0.5 * v["AREA"])
+            if maxima:
+                with b.if_(ps.eq(2)):
+                    b.set(st["THR"], st["SUP"] * (1.0 - MAX_TOL))
+            jj = g.counter("JJ")
+            j, ng = v["J"], v["NG"]
+            with b.for_(jj, 0, ng - 1) as jv:
+                with b.if_(forward):
+                    b.set(j, jv)
+                with b.else_():
+                    b.set(j, ng - 2 - jv)
+                if maxima:
+                    with b.if_(v["MC"].ge(METHODS["LM"])):
+                        _grid_point(ctx, arrays["GX"][j], tab["T0"][o_], tab["T1"][o_],
+                                    tab["G0"][o_], tab["G1"][o_])
+                with b.if_(j.ge(0).and_(j.le(ng - 2))):
+                    _interval_lines(ctx, arrays["GX"][j], arrays["GX"][j + 1], tab)
+        _finish(ctx, value[o_], fired[o_])
+    return value, fired
+
+
+_STATE: dict[str, tuple[str, float]] = {
+    # CoA
+    "HALF": ("REAL", 0.0),
+    "CUM": ("REAL", 0.0),
+    "CUMR": ("REAL", 0.0),
+    "LEFT": ("REAL", 0.0),
+    "RIGHT": ("REAL", 0.0),
+    "FX0": ("REAL", 0.0),
+    "LX1": ("REAL", 0.0),
+    "HAVE": ("BOOL", False),
+    "FOUNDL": ("BOOL", False),
+    "FOUNDR": ("BOOL", False),
+    # LM / RM / MoM
+    "SUP": ("REAL", 0.0),
+    "THR": ("REAL", 0.0),
+    "LMX": ("REAL", 0.0),
+    "RMX": ("REAL", 0.0),
+    "PLEN": ("REAL", 0.0),
+    "PMOM": ("REAL", 0.0),
+    "ISUM": ("REAL", 0.0),
+    "LASTX": ("REAL", 0.0),
+    "ICNT": ("INT", 0),
+}
+_COA_STATE = ("HALF", "CUM", "CUMR", "LEFT", "RIGHT", "FX0", "LX1", "HAVE", "FOUNDL", "FOUNDR")
+
+
+def _method_state(g: Gen, methods: set[str]) -> dict[str, Var]:
+    st: dict[str, Var] = {}
+    for name, (typ, _init) in _STATE.items():
+        coa = name in _COA_STATE
+        if (coa and "COA" in methods) or (not coa and methods & {"LM", "RM", "MOM"}):
+            st[name] = g.temp(typ, name)
+    return st
+
+
+@dataclass
+class _Ctx:
+    g: Gen
+    v: dict[str, Var]
+    a: dict[str, Var]
+    st: dict[str, Var]
+    gl: tuple[Var, Var, Var, Var] | None
+    methods: set[str]
+    accus: set[int]
+    wx: Var
+    wy: Var
+    toff: Var
+    tlast: Var
+    gt: Var
+    gmin: Var
+    ga: Var
+    gw: Var
+    live: Var
+    pass_: Var | None = None
+    forward: Ex | None = None
+
+
+def _grid(c: _Ctx, p0: Ex, p1: Ex) -> None:
+    """grid.build_grid: [low, high] and every breakpoint strictly inside, sorted, unique."""
+    g, b = c.g, c.g.b
+    gx, ng, low, high = c.a["GX"], c.v["NG"], c.v["LOW"], c.v["HIGH"]
     b.set(gx[0], low)
     b.set(gx[1], high)
     b.set(ng, 2)
-    for t in used_terms:
-        k = g.counter("K")
-        with b.for_(k, offs[t], offs[t] + counts[t] - 1) as kv:
-            with b.if_(wx[kv].gt(low).and_(wx[kv].lt(high))):
-                b.set(gx[ng], wx[kv])
-                b.set(ng, ng + 1)
-    T.sort_points(g, gx, None, 0, ng)
+    k = g.counter("K")
+    with b.for_(k, p0, p1) as kv, b.if_(c.wx[kv].gt(low).and_(c.wx[kv].lt(high))):
+        b.set(gx[ng], c.wx[kv])
+        b.set(ng, ng + 1)
+    T.sort_points(g, gx, None, 0, ng - 1)
+    _dedupe(g, gx, ng)
+
+
+def _dedupe(g: Gen, arr: Var, n: Var) -> None:
+    """Drop repeated values from a sorted array (Python's sorted(set(...)))."""
+    b = g.b
     wr = g.temp("INT", "W")
     b.set(wr, 0)
     k = g.counter("K")
-    with b.for_(k, 1, ng - 1) as kv:
-        with b.if_(gx[kv].ne(gx[wr])):
-            b.set(wr, wr + 1)
-            b.set(gx[wr], gx[kv])
-    b.set(ng, wr + 1)
-    # ---- which terms carry an activated set at all
-    live: dict[int, Var] = {}
-    for t in used_terms:
-        lv = g.temp("BOOL", "LIVE")
-        b.set(lv, False)
-        for gr in groups:
-            if gr.term == t:
-                with b.if_((gr.a * gr.w).gt(0.0)):
-                    b.set(lv, True)
-        live[t] = lv
-
-    n_groups = len(groups)
-    ll, lr, la, lw = (g.array(h, "REAL", n_groups) for h in ("LL", "LR", "LA", "LW"))
-    lmin = g.array("LMIN", "BOOL", n_groups)
-    nl = g.temp("INT", "NL")
-    kk = g.array("KINK", "REAL", n_groups)
-    ts = g.array("TS", "REAL", n_groups + 2)
-    nt = g.temp("INT", "NT")
-    p0 = g.array("P0", "REAL", n_groups)
-    p1 = g.array("P1", "REAL", n_groups)
-    n_cut = max(1, n_groups * (n_groups - 1) // 2)
-    cut = g.array("CUT", "REAL", n_cut)
-    cv = g.array("CV", "REAL", n_cut)
-    nc = g.temp("INT", "NC")
-    v0 = g.temp(hint="V0")
-    v1 = g.temp(hint="V1")
-    probor = accu == "PROBOR" and n_groups > 1
-    pr = g.temp("BOOL", "PR") if probor else None
-    gl = _gl_tables(g, n_groups) if probor else None
-
-    # ---- per-method accumulators
-    acc_a = g.temp(hint="AREA")
-    acc_m = g.temp(hint="MOM")
-    b.set(acc_a, 0.0)
-    b.set(acc_m, 0.0)
-    st: dict[str, Var] = {}
-    if method == "COA":
-        for name, typ, init in (
-            ("HALF", "REAL", 0.0),
-            ("CUM", "REAL", 0.0),
-            ("CUMR", "REAL", 0.0),
-            ("LEFT", "REAL", 0.0),
-            ("RIGHT", "REAL", 0.0),
-            ("FX0", "REAL", 0.0),
-            ("LX1", "REAL", 0.0),
-            ("HAVE", "BOOL", False),
-            ("FOUNDL", "BOOL", False),
-            ("FOUNDR", "BOOL", False),
-        ):
-            st[name] = g.temp(typ, name)  # type: ignore[arg-type]
-            b.set(st[name], init)
-    elif method in ("LM", "RM", "MOM"):
-        for name, typ, init in (
-            ("SUP", "REAL", 0.0),
-            ("THR", "REAL", 0.0),
-            ("LMX", "REAL", 0.0),
-            ("RMX", "REAL", 0.0),
-            ("PLEN", "REAL", 0.0),
-            ("PMOM", "REAL", 0.0),
-            ("ISUM", "REAL", 0.0),
-            ("LASTX", "REAL", 0.0),
-            ("ICNT", "INT", 0),
-        ):
-            st[name] = g.temp(typ, name)  # type: ignore[arg-type]
-            b.set(st[name], init)
-    n_pass = {"COG": 1, "COA": 3}.get(method, 2)
-    ps = g.counter("PASS")
-    j = g.temp("INT", "J")
-    with b.for_(ps, 1, n_pass) as pv:
-        forward = pv.ne(3)
-        if method == "COA":
-            with b.if_(pv.eq(2)):
-                b.set(st["HALF"], 0.5 * acc_a)
-        if method in ("LM", "RM", "MOM"):
-            with b.if_(pv.eq(2)):
-                b.set(st["THR"], st["SUP"] * (1.0 - MAX_TOL))
-        jj = g.counter("JJ")
-        with b.for_(jj, 0, ng - 1) as jv:
-            with b.if_(forward):
-                b.set(j, jv)
-            with b.else_():
-                b.set(j, ng - 2 - jv)
-            if method in ("LM", "RM", "MOM"):
-                _grid_point(g, gx[j], pv, wx, wy, offs, counts, used_terms, groups, accu, st)
-            with b.if_(j.ge(0).and_(j.le(ng - 2))):
-                x0 = g.let(gx[j], "X0")
-                x1 = g.let(gx[j + 1], "X1")
-                dx = g.let(x1 - x0, "DX")
-                lims: dict[int, tuple[Var, Var]] = {}
-                for t in used_terms:
-                    lt_, rt_ = g.temp(hint="L"), g.temp(hint="R")
-                    b.set(lt_, 0.0)
-                    b.set(rt_, 0.0)
-                    with b.if_(live[t]):
-                        b.set(lt_, T.right_limit(g, wx, wy, offs[t], counts[t], x0))
-                        b.set(rt_, T.left_limit(g, wx, wy, offs[t], counts[t], x1))
-                    lims[t] = (lt_, rt_)
-                b.set(nl, 0)
-                for gr in groups:
-                    lt_, rt_ = lims[gr.term]
-                    with b.if_((gr.a * gr.w).gt(0.0).and_(lt_.ne(0.0).or_(rt_.ne(0.0)))):
-                        b.set(ll[nl], lt_)
-                        b.set(lr[nl], rt_)
-                        b.set(la[nl], gr.a)
-                        b.set(lw[nl], gr.w)
-                        b.set(lmin[nl], gr.is_min)
-                        b.set(nl, nl + 1)
-                with b.if_(nl.gt(0)):
-                    _interval(g, locals_=dict(
-                        x0=x0, x1=x1, dx=dx, ll=ll, lr=lr, la=la, lw=lw, lmin=lmin, nl=nl, kk=kk,
-                        ts=ts, nt=nt, p0=p0, p1=p1, cut=cut, cv=cv, nc=nc, v0=v0, v1=v1,
-                        pass_=pv, forward=forward, acc_a=acc_a, acc_m=acc_m,
-                    ), accu=accu, method=method, pr=pr, gl=gl, st=st)
-    # ---- the value
-    if method == "COG":
-        b.set(fired, acc_a.gt(0.0))
-        with b.if_(fired):
-            b.set(value, acc_m / acc_a)
-        with b.else_():
-            b.set(value, 0.0)
-    elif method == "COA":
-        b.set(fired, acc_a.gt(0.0))
-        with b.if_(not_(st["FOUNDL"])):
-            b.set(st["LEFT"], st["LX1"])
-        with b.if_(not_(st["FOUNDR"])):
-            b.set(st["RIGHT"], st["FX0"])
-        b.set(value, 0.5 * (st["LEFT"] + st["RIGHT"]))
-    else:
-        b.set(fired, acc_a.gt(0.0))
-        if method == "LM":
-            b.set(value, st["LMX"])
-        elif method == "RM":
-            b.set(value, st["RMX"])
-        else:
-            with b.if_(st["PLEN"].gt(0.0)):
-                b.set(value, st["PMOM"] / st["PLEN"])
-            with b.elif_(st["ICNT"].gt(0)):
-                b.set(value, st["ISUM"] / g.call("TO_REAL", st["ICNT"]))
-            with b.else_():
-                b.set(value, 0.0)
-    return value, fired
+    with b.for_(k, 1, n - 1) as kv, b.if_(arr[kv].ne(arr[wr])):
+        b.set(wr, wr + 1)
+        b.set(arr[wr], arr[kv])
+    b.set(n, wr + 1)
 
 
 def _gl_tables(g: Gen, n_groups: int) -> tuple[Var, Var, Var, Var]:
@@ -243,51 +305,58 @@ def _gl_tables(g: Gen, n_groups: int) -> tuple[Var, Var, Var, Var]:
         counts[n], offs[n] = m, len(xs)
         xs.extend(nodes)
         ws.extend(weights)
-    glx = g.declare(g.fresh("GLX", "GLX"), "REAL", "const", len(xs), tuple(xs), "Gauss-Legendre nodes")
-    glw = g.declare(g.fresh("GLW", "GLW"), "REAL", "const", len(ws), tuple(ws), "Gauss-Legendre weights")
-    gln = g.declare(g.fresh("GLN", "GLN"), "INT", "const", len(counts), tuple(float(c) for c in counts))
-    glo = g.declare(g.fresh("GLO", "GLO"), "INT", "const", len(offs), tuple(float(o) for o in offs))
-    return glx, glw, gln, glo
+    return (
+        _const(g, "GLX", "REAL", xs or [0.0], "Gauss-Legendre nodes on [0, 1]"),
+        _const(g, "GLW", "REAL", ws or [0.0], "Gauss-Legendre weights"),
+        _const(g, "GLN", "INT", counts, "nodes used for n factors"),
+        _const(g, "GLO", "INT", offs),
+    )
 
 
-def _grid_point(
-    g: Gen,
-    x: Ex,
-    pv: Var,
-    wx: Var,
-    wy: Var,
-    offs: list[int],
-    counts: list[int],
-    used_terms: list[int],
-    groups: list[Group],
-    accu: str,
-    st: dict[str, Var],
-) -> None:
+def _grid_point(c: _Ctx, x: Ex, t0: Ex, t1: Ex, g0: Ex, g1: Ex) -> None:
     """The accumulated degree exactly at a grid point (pwl.point_values): it can be the
     maximum at a vertical edge."""
-    b = g.b
+    g, b, st = c.g, c.g.b, c.st
     xp = g.let(x, "XP")
-    mu: dict[int, Var] = {}
-    for t in used_terms:
-        mu[t] = T.pwl_value(g, wx, wy, offs[t], counts[t], xp)
-    v = g.let(0.0, "PV")
-    for gr in groups:
-        with b.if_((gr.a * gr.w).gt(0.0)):
-            y = mu[gr.term]
-            c = gr.w * (g.min_(gr.a, y) if gr.is_min else gr.a * y)
-            b.set(v, T.accumulate(g, accu, v, c))
-    with b.if_(pv.eq(1)):
-        with b.if_(v.gt(st["SUP"])):
-            b.set(st["SUP"], v)
-    with b.else_():
-        with b.if_(v.ge(st["THR"])):
-            _candidate(g, xp, st)
+    mu = c.a["MUT"]
+    tt = g.counter("TT")
+    with b.for_(tt, t0, t1) as tv:
+        b.set(mu[tv], 0.0)
+        with b.if_(c.live[tv]):
+            b.set(mu[tv], T.pwl_value(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], xp))
+    pv = g.let(0.0, "PV")
+    gg = g.counter("G")
+    with b.for_(gg, g0, g1) as gv, b.if_((c.ga[gv] * c.gw[gv]).gt(0.0)):
+        y = mu[c.gt[gv]]
+        cc = g.temp(hint="PC")
+        with b.if_(c.gmin[gv]):
+            b.set(cc, c.gw[gv] * g.min_(c.ga[gv], y))
+        with b.else_():
+            b.set(cc, c.gw[gv] * (c.ga[gv] * y))
+        _accumulate_dynamic(c, pv, cc)
+    assert c.pass_ is not None
+    with b.if_(c.pass_.eq(1)):
+        with b.if_(pv.gt(st["SUP"])):
+            b.set(st["SUP"], pv)
+    with b.elif_(pv.ge(st["THR"])):
+        _candidate(c, xp)
 
 
-def _candidate(g: Gen, x: Ex, st: dict[str, Var]) -> None:
+def _accumulate_dynamic(c: _Ctx, acc: Var, val: Ex) -> None:
+    """acc := accumulate(accu of the current output, acc, val)."""
+    g, b = c.g, c.g.b
+    present = [(code, name) for name, code in (("MAX", 1), ("SUM", 2), ("BSUM", 3), ("PROBOR", 4))
+               if code in c.accus] or [(1, "MAX")]
+    for i, (code, name) in enumerate(present):
+        ctx_mgr = b.if_(c.v["AC"].eq(code)) if i == 0 else b.elif_(c.v["AC"].eq(code))
+        with ctx_mgr:
+            b.set(acc, T.accumulate(g, name, acc, val))
+
+
+def _candidate(c: _Ctx, x: Ex) -> None:
     """A point where the set reaches its height: LM, RM and the isolated points of MoM
     (visited in increasing x, so repeated points are adjacent)."""
-    b = g.b
+    b, st = c.g.b, c.st
     with b.if_(st["ICNT"].eq(0)):
         b.set(st["LMX"], x)
         b.set(st["RMX"], x)
@@ -305,48 +374,61 @@ def _candidate(g: Gen, x: Ex, st: dict[str, Var]) -> None:
             b.set(st["LASTX"], x)
 
 
-def _interval(
-    g: Gen,
-    locals_: dict[str, Var],
-    accu: str,
-    method: str,
-    pr: Var | None,
-    gl: tuple[Var, Var, Var, Var] | None,
-    st: dict[str, Var],
-) -> None:
-    """pwl.interval_pieces + pwl._combine on one grid interval, then each piece's action."""
-    b = g.b
-    L = locals_
-    x0, x1, dx = L["x0"], L["x1"], L["dx"]
-    ll, lr, la, lw, lmin, nl = L["ll"], L["lr"], L["la"], L["lw"], L["lmin"], L["nl"]
-    kk, ts, nt, p0, p1 = L["kk"], L["ts"], L["nt"], L["p0"], L["p1"]
-    cut, cv, nc, v0, v1 = L["cut"], L["cv"], L["nc"], L["v0"], L["v1"]
-    pv, forward = L["pass_"], L["forward"]
-    # kinks where MIN activation clips a term
+def _interval_lines(c: _Ctx, gx0: Ex, gx1: Ex, tab: dict[str, Var]) -> None:
+    """The activated sets on one grid interval as lines (L, R, a, w, is_min), then the
+    interval's pieces."""
+    g, b, v, a = c.g, c.g.b, c.v, c.a
+    o_ = v["O"]
+    x0 = g.let(gx0, "X0")
+    x1 = g.let(gx1, "X1")
+    tt = g.counter("TT")
+    lt_, rt_ = a["LT"], a["RT"]
+    with b.for_(tt, tab["T0"][o_], tab["T1"][o_]) as tv:
+        b.set(lt_[tv], 0.0)
+        b.set(rt_[tv], 0.0)
+        with b.if_(c.live[tv]):
+            b.set(lt_[tv], T.right_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], x0))
+            b.set(rt_[tv], T.left_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], x1))
+    nl = v["NL"]
+    b.set(nl, 0)
+    gg = g.counter("G")
+    with b.for_(gg, tab["G0"][o_], tab["G1"][o_]) as gv:
+        t_ = c.gt[gv]
+        with b.if_((c.ga[gv] * c.gw[gv]).gt(0.0).and_(lt_[t_].ne(0.0).or_(rt_[t_].ne(0.0)))):
+            b.set(a["LL"][nl], lt_[t_])
+            b.set(a["LR"][nl], rt_[t_])
+            b.set(a["LA"][nl], c.ga[gv])
+            b.set(a["LW"][nl], c.gw[gv])
+            b.set(a["LMIN"][nl], c.gmin[gv])
+            b.set(nl, nl + 1)
+    with b.if_(nl.gt(0)):
+        _interval(c, x0, x1)
+
+
+def _interval(c: _Ctx, x0: Var, x1: Var) -> None:
+    """pwl.interval_pieces: cut where MIN activation clips a line, then combine."""
+    g, b, v, a = c.g, c.g.b, c.v, c.a
+    ll, lr, la, lw, lmin = a["LL"], a["LR"], a["LA"], a["LW"], a["LMIN"]
+    kk, ts, p0, p1 = a["KINK"], a["TS"], a["P0"], a["P1"]
+    nl, nt, nc = v["NL"], v["NT"], v["NC"]
+    dx = g.let(x1 - x0, "DX")
     b.set(ts[0], 0.0)
     b.set(ts[1], 1.0)
     b.set(nt, 2)
     k = g.counter("K")
     with b.for_(k, 0, nl - 1) as kv:
         b.set(kk[kv], -1.0)
-        with b.if_(lmin[kv]):
-            with b.if_(((ll[kv] - la[kv]) * (lr[kv] - la[kv])).lt(0.0)):
-                b.set(kk[kv], (la[kv] - ll[kv]) / (lr[kv] - ll[kv]))
-                b.set(ts[nt], kk[kv])
-                b.set(nt, nt + 1)
-    T.sort_points(g, ts, None, 0, nt)
-    wr = g.temp("INT", "W")
-    b.set(wr, 0)
-    k = g.counter("K")
-    with b.for_(k, 1, nt - 1) as kv:
-        with b.if_(ts[kv].ne(ts[wr])):
-            b.set(wr, wr + 1)
-            b.set(ts[wr], ts[kv])
-    b.set(nt, wr + 1)
+        with b.if_(lmin[kv]), b.if_(((ll[kv] - la[kv]) * (lr[kv] - la[kv])).lt(0.0)):
+            b.set(kk[kv], (la[kv] - ll[kv]) / (lr[kv] - ll[kv]))
+            b.set(ts[nt], kk[kv])
+            b.set(nt, nt + 1)
+    T.sort_points(g, ts, None, 0, nt - 1)
+    _dedupe(g, ts, nt)
     ii = g.counter("II")
     i = g.temp("INT", "I")
+    assert c.forward is not None
     with b.for_(ii, 1, nt - 1) as iv:
-        with b.if_(forward):
+        with b.if_(c.forward):
             b.set(i, iv)
         with b.else_():
             b.set(i, nt - iv)
@@ -372,55 +454,42 @@ def _interval(
                             b.set(arr[kv], lw[kv] * y)
                 with b.else_():
                     b.set(arr[kv], lw[kv] * la[kv] * (ll[kv] + (lr[kv] - ll[kv]) * t))
-        _combine(g, p0, p1, nl, cut, cv, nc, v0, v1, xa, xb, accu, pr)
+        _combine(c, xa, xb)
         cc = g.counter("CC")
-        c = g.temp("INT", "C")
+        ci = g.temp("INT", "C")
+        cut, cv, v0, v1 = a["CUT"], a["CV"], v["V0"], v["V1"]
         with b.for_(cc, 0, nc) as ccv:
-            with b.if_(forward):
-                b.set(c, ccv)
+            with b.if_(c.forward):
+                b.set(ci, ccv)
             with b.else_():
-                b.set(c, nc - ccv)
+                b.set(ci, nc - ccv)
             pxa = g.let(xa, "PXA")
             pv0 = g.let(v0, "PV0")
-            with b.if_(c.gt(0)):
-                b.set(pxa, xa + cut[c - 1] * (xb - xa))
-                b.set(pv0, cv[c - 1])
+            with b.if_(ci.gt(0)):
+                b.set(pxa, xa + cut[ci - 1] * (xb - xa))
+                b.set(pv0, cv[ci - 1])
             pxb = g.let(xb, "PXB")
             pv1 = g.let(v1, "PV1")
-            with b.if_(c.lt(nc)):
-                b.set(pxb, xa + cut[c] * (xb - xa))
-                b.set(pv1, cv[c])
-            _piece(g, pxa, pxb, pv0, pv1, p0, p1, nl, pr, gl, method, pv, L, st)
+            with b.if_(ci.lt(nc)):
+                b.set(pxb, xa + cut[ci] * (xb - xa))
+                b.set(pv1, cv[ci])
+            _piece(c, pxa, pxb, pv0, pv1)
 
 
-def _combine(
-    g: Gen,
-    p0: Var,
-    p1: Var,
-    nl: Var,
-    cut: Var,
-    cv: Var,
-    nc: Var,
-    v0: Var,
-    v1: Var,
-    xa: Var,
-    xb: Var,
-    accu: str,
-    pr: Var | None,
-) -> None:
+def _combine(c: _Ctx, xa: Var, xb: Var) -> None:
     """pwl._combine: the accumulated values at the sub-interval's ends and the cuts inside it
     (MAX: where two sets cross; BSUM: where the sum crosses 1)."""
-    b = g.b
+    g, b, v, a = c.g, c.g.b, c.v, c.a
+    p0, p1, cut, cv = a["P0"], a["P1"], a["CUT"], a["CV"]
+    nl, nc, v0, v1 = v["NL"], v["NC"], v["V0"], v["V1"]
     b.set(nc, 0)
-    if pr is not None:
-        b.set(pr, False)
+    if "PR" in v:
+        b.set(v["PR"], False)
     with b.if_(nl.eq(1)):
         b.set(v0, p0[0])
         b.set(v1, p1[0])
-    if p0.name and _capacity(g, p0) < 2:
-        return  # one activated set at most: nothing to combine
-    with b.else_():
-        if accu == "MAX":
+    if 1 in c.accus:
+        with b.elif_(v["AC"].eq(1)):
             b.set(v0, p0[0])
             b.set(v1, p1[0])
             k = g.counter("K")
@@ -439,9 +508,9 @@ def _combine(
                 with b.if_((d0 * d1).lt(0.0)):
                     b.set(cut[nc], d0 / (d0 - d1))
                     b.set(nc, nc + 1)
-            T.sort_points(g, cut, None, 0, nc)
-            c = g.counter("C")
-            with b.for_(c, 0, nc - 1) as cvv:
+            T.sort_points(g, cut, None, 0, nc - 1)
+            cix = g.counter("C")
+            with b.for_(cix, 0, nc - 1) as cvv:
                 s = g.let(cut[cvv], "S")
                 b.set(cv[cvv], p0[0] + (p1[0] - p0[0]) * s)
                 k = g.counter("K")
@@ -449,153 +518,173 @@ def _combine(
                     y = g.let(p0[kv] + (p1[kv] - p0[kv]) * s, "Y")
                     with b.if_(y.gt(cv[cvv])):
                         b.set(cv[cvv], y)
-        elif accu in ("SUM", "NSUM", "BSUM"):
+    if c.accus & {2, 3}:
+        with b.elif_(v["AC"].eq(2).or_(v["AC"].eq(3))):
             s0 = g.let(0.0, "S0")
             s1 = g.let(0.0, "S1")
             k = g.counter("K")
             with b.for_(k, 0, nl - 1) as kv:
                 b.set(s0, s0 + p0[kv])
                 b.set(s1, s1 + p1[kv])
-            if accu == "BSUM":
-                with b.if_(((s0 - 1.0) * (s1 - 1.0)).lt(0.0)):
-                    b.set(cut[0], (1.0 - s0) / (s1 - s0))
-                    b.set(cv[0], 1.0)
-                    b.set(nc, 1)
-                b.set(v0, 1.0)
-                with b.if_(s0.lt(1.0)):
-                    b.set(v0, s0)
-                b.set(v1, 1.0)
-                with b.if_(s1.lt(1.0)):
-                    b.set(v1, s1)
-            else:
-                b.set(v0, s0)
-                b.set(v1, s1)
-        elif accu == "PROBOR":
-            assert pr is not None
-            b.set(pr, True)
-            b.set(v0, _poly(g, p0, p1, nl, ex(0.0)))
-            b.set(v1, _poly(g, p0, p1, nl, ex(1.0)))
-        else:  # pragma: no cover - lowering marks other accumulations inexact
-            raise AssertionError(accu)
+            b.set(v0, s0)
+            b.set(v1, s1)
+            if 3 in c.accus:
+                with b.if_(v["AC"].eq(3)):
+                    with b.if_(((s0 - 1.0) * (s1 - 1.0)).lt(0.0)):
+                        b.set(cut[0], (1.0 - s0) / (s1 - s0))
+                        b.set(cv[0], 1.0)
+                        b.set(nc, 1)
+                    b.set(v0, 1.0)
+                    with b.if_(s0.lt(1.0)):
+                        b.set(v0, s0)
+                    b.set(v1, 1.0)
+                    with b.if_(s1.lt(1.0)):
+                        b.set(v1, s1)
+    if 4 in c.accus:
+        with b.elif_(v["AC"].eq(4)):
+            b.set(v["PR"], True)
+            b.set(v0, _poly(c, ex(0.0)))
+            b.set(v1, _poly(c, ex(1.0)))
 
 
-def _capacity(g: Gen, arr: Var) -> int:
-    size = next(d.size for d in g.decls if d.name == arr.name)
-    return size or 1
-
-
-def _poly(g: Gen, p0: Var, p1: Var, nl: Var, s: Ex) -> Var:
+def _poly(c: _Ctx, s: Ex) -> Var:
     """1 - prod(1 - c_k(s)), folded as acc + c - acc*c (pwl._poly_value)."""
+    g = c.g
+    p0, p1, nl = c.a["P0"], c.a["P1"], c.v["NL"]
     acc = g.let(0.0, "PP")
     k = g.counter("K")
     with g.b.for_(k, 0, nl - 1) as kv:
-        c = g.let(p0[kv] + (p1[kv] - p0[kv]) * s, "PC")
-        g.b.set(acc, acc + c - acc * c)
+        cc = g.let(p0[kv] + (p1[kv] - p0[kv]) * s, "PC")
+        g.b.set(acc, acc + cc - acc * cc)
     return acc
 
 
-def _piece(
-    g: Gen,
-    xa: Var,
-    xb: Var,
-    v0: Var,
-    v1: Var,
-    p0: Var,
-    p1: Var,
-    nl: Var,
-    pr: Var | None,
-    gl: tuple[Var, Var, Var, Var] | None,
-    method: str,
-    pv: Var,
-    L: dict[str, Var],
-    st: dict[str, Var],
-) -> None:
-    b = g.b
+def _piece(c: _Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
+    """One piece of the accumulated set: its area and moment, then what the method needs."""
+    g, b, v, st = c.g, c.g.b, c.v, c.st
     pdx = g.let(xb - xa, "PDX")
     pa = g.temp(hint="PA")
     pm = g.temp(hint="PM")
-
-    def linear() -> None:
-        b.set(pa, 0.5 * pdx * (v0 + v1))
-        b.set(pm, pdx * (xa * (2.0 * v0 + v1) + xb * (v0 + 2.0 * v1)) / 6.0)
-
-    if pr is not None and gl is not None:
-        glx, glw, gln, glo = gl
-        with b.if_(pr):
-            a = g.let(0.0, "GA")
-            mo = g.let(0.0, "GM")
+    b.set(pa, 0.5 * pdx * (v0 + v1))
+    b.set(pm, pdx * (xa * (2.0 * v0 + v1) + xb * (v0 + 2.0 * v1)) / 6.0)
+    if c.gl is not None:
+        glx, glw, gln, glo = c.gl
+        nl = v["NL"]
+        with b.if_(v["PR"]):
+            ga_ = g.let(0.0, "GA")
+            gm_ = g.let(0.0, "GM")
             q = g.counter("Q")
             with b.for_(q, 0, gln[nl] - 1) as qv:
                 s = g.let(glx[glo[nl] + qv], "S")
-                f = _poly(g, p0, p1, nl, s)
-                b.set(a, a + glw[glo[nl] + qv] * f)
-                b.set(mo, mo + glw[glo[nl] + qv] * f * (xa + s * pdx))
-            b.set(pa, a * pdx)
-            b.set(pm, mo * pdx)
-        with b.else_():
-            linear()
-    else:
-        linear()
-    acc_a, acc_m = L["acc_a"], L["acc_m"]
-    if method == "COG":
-        b.set(acc_a, acc_a + pa)
-        b.set(acc_m, acc_m + pm)
-        return
-    if method == "COA":
-        with b.if_(pv.eq(1)):
-            b.set(acc_a, acc_a + pa)
-            with b.if_(xb.gt(xa)):
-                with b.if_(not_(st["HAVE"])):
-                    b.set(st["FX0"], xa)
-                    b.set(st["HAVE"], True)
-                b.set(st["LX1"], xb)
-        for side, p_no in (("L", 2), ("R", 3)):
-            found, cum = st["FOUNDL" if side == "L" else "FOUNDR"], st["CUM" if side == "L" else "CUMR"]
-            with b.if_(pv.eq(p_no).and_(xb.gt(xa)).and_(not_(found))):
-                with b.if_(pa.gt(0.0).and_((cum + pa).ge(st["HALF"]))):
-                    r = st["HALF"] - cum if side == "L" else pa - (st["HALF"] - cum)
-                    x = _solve(g, xa, xb, v0, v1, pdx, g.let(r, "RR"), p0, p1, nl, pr, gl)
-                    b.set(st["LEFT" if side == "L" else "RIGHT"], x)
-                    b.set(found, True)
+                f = _poly(c, s)
+                b.set(ga_, ga_ + glw[glo[nl] + qv] * f)
+                b.set(gm_, gm_ + glw[glo[nl] + qv] * f * (xa + s * pdx))
+            b.set(pa, ga_ * pdx)
+            b.set(pm, gm_ * pdx)
+    area, mom, mc = v["AREA"], v["MOM"], v["MC"]
+    assert c.pass_ is not None
+    ps = c.pass_
+    first = True
+
+    def branch(cond: Ex):  # type: ignore[no-untyped-def]
+        nonlocal first
+        mgr = b.if_(cond) if first else b.elif_(cond)
+        first = False
+        return mgr
+
+    if "COG" in c.methods:
+        with branch(mc.eq(METHODS["COG"])):
+            b.set(area, area + pa)
+            b.set(mom, mom + pm)
+    if "COA" in c.methods:
+        with branch(mc.eq(METHODS["COA"])):
+            with b.if_(ps.eq(1)):
+                b.set(area, area + pa)
+                with b.if_(xb.gt(xa)):
+                    with b.if_(not_(st["HAVE"])):
+                        b.set(st["FX0"], xa)
+                        b.set(st["HAVE"], True)
+                    b.set(st["LX1"], xb)
+            with b.elif_(xb.gt(xa)):
+                # pass 2 looks from the left, pass 3 from the right (pwl.bisector)
+                found = g.temp("BOOL", "FOUND")
+                cum = g.temp(hint="CUMX")
+                with b.if_(ps.eq(2)):
+                    b.set(found, st["FOUNDL"])
+                    b.set(cum, st["CUM"])
                 with b.else_():
-                    b.set(cum, cum + pa)
-        return
-    # LM / RM / MoM
-    with b.if_(pv.eq(1)):
-        b.set(acc_a, acc_a + pa)
-        with b.if_(v0.gt(st["SUP"])):
-            b.set(st["SUP"], v0)
-        with b.if_(v1.gt(st["SUP"])):
-            b.set(st["SUP"], v1)
-    with b.else_():
-        with b.if_(v0.ge(st["THR"])):
-            _candidate(g, xa, st)
-        with b.if_(v1.ge(st["THR"])):
-            _candidate(g, xb, st)
-        with b.if_(v0.ge(st["THR"]).and_(v1.ge(st["THR"])).and_(xb.gt(xa))):
-            b.set(st["PLEN"], st["PLEN"] + pdx)
-            b.set(st["PMOM"], st["PMOM"] + pdx * 0.5 * (xa + xb))
+                    b.set(found, st["FOUNDR"])
+                    b.set(cum, st["CUMR"])
+                with b.if_(not_(found)):
+                    with b.if_(pa.gt(0.0).and_((cum + pa).ge(st["HALF"]))):
+                        r = g.temp(hint="RR")
+                        with b.if_(ps.eq(2)):
+                            b.set(r, st["HALF"] - cum)
+                        with b.else_():
+                            b.set(r, pa - (st["HALF"] - cum))
+                        x = _solve(c, xa, xb, v0, v1, pdx, r)
+                        with b.if_(ps.eq(2)):
+                            b.set(st["LEFT"], x)
+                            b.set(st["FOUNDL"], True)
+                        with b.else_():
+                            b.set(st["RIGHT"], x)
+                            b.set(st["FOUNDR"], True)
+                    with b.elif_(ps.eq(2)):
+                        b.set(st["CUM"], cum + pa)
+                    with b.else_():
+                        b.set(st["CUMR"], cum + pa)
+    if c.methods & {"LM", "RM", "MOM"}:
+        with branch(mc.ge(METHODS["LM"])):
+            with b.if_(ps.eq(1)):
+                b.set(area, area + pa)
+                with b.if_(v0.gt(st["SUP"])):
+                    b.set(st["SUP"], v0)
+                with b.if_(v1.gt(st["SUP"])):
+                    b.set(st["SUP"], v1)
+            with b.else_():
+                with b.if_(v0.ge(st["THR"])):
+                    _candidate(c, xa)
+                with b.if_(v1.ge(st["THR"])):
+                    _candidate(c, xb)
+                with b.if_(v0.ge(st["THR"]).and_(v1.ge(st["THR"])).and_(xb.gt(xa))):
+                    b.set(st["PLEN"], st["PLEN"] + pdx)
+                    b.set(st["PMOM"], st["PMOM"] + pdx * 0.5 * (xa + xb))
 
 
-def _solve(
-    g: Gen,
-    xa: Var,
-    xb: Var,
-    v0: Var,
-    v1: Var,
-    pdx: Var,
-    r: Var,
-    p0: Var,
-    p1: Var,
-    nl: Var,
-    pr: Var | None,
-    gl: tuple[Var, Var, Var, Var] | None,
-) -> Var:
+def _solve(c: _Ctx, xa: Var, xb: Var, v0: Var, v1: Var, pdx: Var, r: Var) -> Var:
     """pwl._solve_in_piece: where the area from the piece's start reaches ``r``."""
-    b = g.b
+    g, b, v = c.g, c.g.b, c.v
     out = g.temp(hint="SOL")
-
-    def linear() -> None:
+    if c.gl is not None:
+        glx, glw, gln, glo = c.gl
+        nl = v["NL"]
+        with b.if_(v["PR"]):  # the partial area increases in s: bisection to the last bit
+            lo = g.let(0.0, "LO")
+            hi = g.let(1.0, "HI")
+            it = g.let(0, "IT", "INT")
+            go = g.let(True, "GO", "BOOL")
+            with b.while_(go):
+                mid = g.let(0.5 * (lo + hi), "MID")
+                with b.if_(mid.eq(lo).or_(mid.eq(hi))):
+                    b.set(go, False)
+                with b.else_():
+                    part = g.let(0.0, "PS")
+                    q = g.counter("Q")
+                    with b.for_(q, 0, gln[nl] - 1) as qv:
+                        f = _poly(c, glx[glo[nl] + qv] * mid)
+                        b.set(part, part + glw[glo[nl] + qv] * f)
+                    with b.if_((pdx * mid * part).lt(r)):
+                        b.set(lo, mid)
+                    with b.else_():
+                        b.set(hi, mid)
+                    b.set(it, it + 1)
+                    with b.if_(it.ge(200)):
+                        b.set(go, False)
+            b.set(out, xa + 0.5 * (lo + hi) * pdx)
+        ctx = b.else_()
+    else:
+        ctx = b.if_(ex(True))
+    with ctx:
         a0 = g.let(v0, "SV0")
         a1 = g.let(v1, "SV1")
         rr = g.let(r, "SR")
@@ -623,34 +712,42 @@ def _solve(
             b.set(out, xa + 2.0 * rr / den)
             with b.if_(xb.lt(out)):
                 b.set(out, xb)
-
-    if pr is None or gl is None:
-        linear()
-        return out
-    glx, glw, gln, glo = gl
-    with b.if_(pr):
-        lo = g.let(0.0, "LO")
-        hi = g.let(1.0, "HI")
-        it = g.let(0, "IT", "INT")
-        go = g.let(True, "GO", "BOOL")
-        with b.while_(go):
-            mid = g.let(0.5 * (lo + hi), "MID")
-            with b.if_(mid.eq(lo).or_(mid.eq(hi))):
-                b.set(go, False)
-            with b.else_():
-                part = g.let(0.0, "PS")
-                q = g.counter("Q")
-                with b.for_(q, 0, gln[nl] - 1) as qv:
-                    f = _poly(g, p0, p1, nl, glx[glo[nl] + qv] * mid)
-                    b.set(part, part + glw[glo[nl] + qv] * f)
-                with b.if_((pdx * mid * part).lt(r)):
-                    b.set(lo, mid)
-                with b.else_():
-                    b.set(hi, mid)
-                b.set(it, it + 1)
-                with b.if_(it.ge(200)):
-                    b.set(go, False)
-        b.set(out, xa + 0.5 * (lo + hi) * pdx)
-    with b.else_():
-        linear()
     return out
+
+
+def _finish(c: _Ctx, value: Index, fired: Index) -> None:
+    """The value of the current output from what the passes gathered."""
+    b, v, st = c.g.b, c.v, c.st
+    b.set(fired, v["AREA"].gt(0.0))
+    b.set(value, 0.0)
+    first = True
+
+    def branch(cond: Ex):  # type: ignore[no-untyped-def]
+        nonlocal first
+        mgr = b.if_(cond) if first else b.elif_(cond)
+        first = False
+        return mgr
+
+    mc = v["MC"]
+    if "COG" in c.methods:
+        with branch(mc.eq(METHODS["COG"]).and_(v["AREA"].gt(0.0))):
+            b.set(value, v["MOM"] / v["AREA"])
+    if "COA" in c.methods:
+        with branch(mc.eq(METHODS["COA"])):
+            with b.if_(not_(st["FOUNDL"])):
+                b.set(st["LEFT"], st["LX1"])
+            with b.if_(not_(st["FOUNDR"])):
+                b.set(st["RIGHT"], st["FX0"])
+            b.set(value, 0.5 * (st["LEFT"] + st["RIGHT"]))
+    if "LM" in c.methods:
+        with branch(mc.eq(METHODS["LM"])):
+            b.set(value, st["LMX"])
+    if "RM" in c.methods:
+        with branch(mc.eq(METHODS["RM"])):
+            b.set(value, st["RMX"])
+    if "MOM" in c.methods:
+        with branch(mc.eq(METHODS["MOM"])):
+            with b.if_(st["PLEN"].gt(0.0)):
+                b.set(value, st["PMOM"] / st["PLEN"])
+            with b.elif_(st["ICNT"].gt(0)):
+                b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))

@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen, Target
 from fuzzyctl.codegen.ir import Ex, Index, Int, Num, Program, Var, ex, not_
-from fuzzyctl.codegen.mamdani import Group, exact_output
+from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.lower_terms import uses_x
 from fuzzyctl.engine.plan import (
@@ -182,10 +182,18 @@ class _Builder:
             degrees = self._fuzzify()
             concl = self._rules(degrees, weights)
             values: dict[int, Ex] = {}
+            exact = [oi for oi in plan.output_order if plan.outputs[oi].kind == "mamdani"]
+            results: dict[int, tuple[Ex, Ex]] = {}
+            if exact:
+                with b.region("defuzzify (exact, piecewise linear)"):
+                    specs = [self._mamdani(plan.outputs[oi], self._contribs(plan.outputs[oi], concl)) for oi in exact]
+                    vals, fireds = exact_outputs(g, specs)
+                for k, oi in enumerate(exact):
+                    results[oi] = (vals[k], fireds[k])
             for oi in plan.output_order:
                 op = plan.outputs[oi]
                 with b.region(f"output {op.name}"):
-                    val, fired = self._output(oi, op, concl, values)
+                    val, fired = results[oi] if oi in results else self._output(oi, op, concl, values)
                     if op.kind == "degree":
                         b.set(outs[oi], val)
                     else:
@@ -246,32 +254,33 @@ class _Builder:
         by_var: dict[int, list[int]] = {}
         for var, term in sorted(needed):
             by_var.setdefault(var, []).append(term)
+        pwl_terms: list[tuple[int, int, list[tuple[Ex, Ex]]]] = []
+        smooth: dict[int, Params] = {}
+        for var, term_ids in by_var.items():
+            fi = plan.fuzzy_inputs[var]
+            px = self.new_params(f"{fi.name}_X", "PX", f"{fi.name}: term points x (sorted at run time)")
+            py = self.new_params(f"{fi.name}_Y", "PY", f"{fi.name}: term points degree")
+            smooth[var] = self.new_params(f"{fi.name}_P", "PP", f"{fi.name}: term parameters")
+            for ti in term_ids:
+                t = fi.terms[ti]
+                if t.kind in shapes.PWL_KINDS:
+                    pwl_terms.append((var, ti, self.pwl_points(t, px, py, t.name)))
+        if pwl_terms:
+            with g.b.region("fuzzify (piecewise-linear terms)"):
+                self._fuzzify_pwl(pwl_terms, degrees)
         for var, term_ids in by_var.items():
             fi = plan.fuzzy_inputs[var]
             x = self.inputs[fi.slot]
+            pp = smooth[var]
+            if all(fi.terms[ti].kind in shapes.PWL_KINDS for ti in term_ids):
+                continue
             with g.b.region(f"fuzzify {fi.name}"):
-                px = self.new_params(f"{fi.name}_X", "PX", f"{fi.name}: term points x (sorted at run time)")
-                py = self.new_params(f"{fi.name}_Y", "PY", f"{fi.name}: term points degree")
-                pp = self.new_params(f"{fi.name}_P", "PP", f"{fi.name}: term parameters")
-                work: tuple[Var, Var] | None = None
                 for ti in term_ids:
                     t = fi.terms[ti]
                     where = f"term {fi.name}.{t.name}"
                     if t.kind in shapes.PWL_KINDS:
-                        pts = self.pwl_points(t, px, py, t.name)
-                        n_max = max(
-                            (len(u.pwl) if u.pwl else len(u.params)) for u in fi.terms
-                        ) + 2
-                        if work is None:
-                            work = (g.array("IX", "REAL", n_max), g.array("IY", "REAL", n_max))
-                        wx, wy = work
-                        for k, (xe, ye) in enumerate(pts):
-                            g.b.set(wx[k], xe)
-                            g.b.set(wy[k], ye)
-                        if len(pts) > 1:
-                            T.sort_points(g, wx, wy, 0, len(pts))
-                        d = T.pwl_value(g, wx, wy, 0, len(pts), x)
-                    elif t.kind == "singleton":
+                        continue
+                    if t.kind == "singleton":
                         pos = self.pv(t.params[0], pp, f"{t.name} position")
                         d = g.temp(hint="MU")
                         with g.b.if_(x.eq(pos)):
@@ -291,6 +300,43 @@ class _Builder:
                         raise g.refuse(where, f"{t.kind} terms on inputs")
                     degrees[(var, ti)] = d
         return degrees
+
+    def _fuzzify_pwl(
+        self, terms: list[tuple[int, int, list[tuple[Ex, Ex]]]], degrees: dict[tuple[int, int], Ex]
+    ) -> None:
+        """Every piecewise-linear input term in one loop over a table: copy its points, sort
+        them (stably: they may come from inputs or be retuned), take the degree at its
+        input's value."""
+        g = self.g
+        b = g.b
+        counts = [len(p) for _v, _t, p in terms]
+        offs = [sum(counts[:k]) for k in range(len(terms))]
+        wx = g.array("IX", "REAL", sum(counts))
+        wy = g.array("IY", "REAL", sum(counts))
+        for k, (_v, _t, ps) in enumerate(terms):
+            for i, (xe, ye) in enumerate(ps):
+                b.set(wx[offs[k] + i], xe)
+                b.set(wy[offs[k] + i], ye)
+        slots = sorted({self.plan.fuzzy_inputs[v].slot for v, _t, _p in terms})
+        xin = g.array("XIN", "REAL", len(slots))
+        for k, slot in enumerate(slots):
+            b.set(xin[k], self.inputs[slot])
+        const = {
+            "IOFF": offs,
+            "ILAST": [o + c - 1 for o, c in zip(offs, counts, strict=True)],
+            "IVAR": [slots.index(self.plan.fuzzy_inputs[v].slot) for v, _t, _p in terms],
+        }
+        tab = {
+            k: g.declare(g.fresh(k, k), "INT", "const", len(vals), tuple(float(x) for x in vals))
+            for k, vals in const.items()
+        }
+        deg = g.array("DEG", "REAL", len(terms))
+        tt = g.counter("TT")
+        with b.for_(tt, 0, len(terms) - 1) as tv:
+            T.sort_points(g, wx, wy, tab["IOFF"][tv], tab["ILAST"][tv])
+            b.set(deg[tv], T.pwl_value(g, wx, wy, tab["IOFF"][tv], tab["ILAST"][tv], xin[tab["IVAR"][tv]]))
+        for k, (v, ti, _p) in enumerate(terms):
+            degrees[(v, ti)] = deg[k]
 
     # ------------------------------------------------------------------ rules
 
@@ -395,11 +441,10 @@ class _Builder:
             return v, ex(True)
         if op.kind == "singleton":
             return self._singleton(op, contribs)
-        if op.kind == "ts":
-            return self._ts(op, contribs, values)
-        return self._mamdani(op, contribs)
+        assert op.kind == "ts"
+        return self._ts(op, contribs, values)
 
-    def _mamdani(self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]]) -> tuple[Ex, Ex]:
+    def _mamdani(self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]]) -> ExactOutput:
         g = self.g
         assert op.low is not None and op.high is not None
         accu = op.accu or "MAX"
@@ -430,7 +475,7 @@ class _Builder:
                 gr = Group(t, g.let(a, "GA"), w, is_min)
                 merged[key] = gr
                 groups.append(gr)
-        return exact_output(g, op.name, op.method, accu, op.low, op.high, points, groups)
+        return ExactOutput(op.name, op.method, accu, op.low, op.high, points, groups)
 
     def _singleton(self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]]) -> tuple[Ex, Ex]:
         g = self.g

@@ -259,7 +259,7 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     c += [f'#include "{name}.h"', "#include <math.h>", ""]
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
-        vals = ", ".join(str(int(v)) if d.type == "INT" else r.num(v) for v in d.init)
+        vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
         c.append(f"static const {_ctype(d, real)} {r.name(d.name)}[{d.size}] = {{{vals}}};")
     c.append("")
     c.append(f"void {name}_init({name} *fb)")

@@ -382,15 +382,15 @@ def expression(
 # --------------------------------------------------------------------------- breakpoint lists
 
 
-def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, n: ExLike) -> None:
-    """Stable insertion sort of ``xs[off .. off+n-1]`` (and ``ys`` alongside) by x: the
-    engine sorts points given by variables stably at each evaluation (5.2.2)."""
+def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, last: ExLike) -> None:
+    """Stable insertion sort of ``xs[off .. last]`` (and ``ys`` alongside) by x: the engine
+    sorts points given by variables stably at each evaluation (5.2.2)."""
     i = g.counter("I")
     j = g.counter("J")
     kx = g.temp(hint="KX")
     ky = g.temp(hint="KY") if ys is not None else None
     moving = g.temp("BOOL", "MV")
-    with g.b.for_(i, ex(off) + 1, ex(off) + ex(n) - 1) as iv:
+    with g.b.for_(i, ex(off) + 1, last) as iv:
         g.b.set(kx, xs[iv])
         if ys is not None and ky is not None:
             g.b.set(ky, ys[iv])
@@ -412,12 +412,12 @@ def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, n: ExLike) -> None
             g.b.set(ys[Var(j) + 1], ky)
 
 
-def _interp(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex, out: Var) -> None:
+def _interp(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, out: Var) -> None:
     """grid._interp: linear between the first point right of x and its predecessor."""
     k = g.counter("K")
     done = g.temp("BOOL", "DN")
     g.b.set(done, False)
-    with g.b.for_(k, off + 1, off + n - 1) as kv:
+    with g.b.for_(k, ex(off) + 1, last) as kv:
         with g.b.if_(not_(done).and_(xs[kv].gt(x))):
             g.b.set(
                 out,
@@ -425,14 +425,13 @@ def _interp(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex, out: Var) -> None
             )
             g.b.set(done, True)
     with g.b.if_(not_(done)):
-        g.b.set(out, ys[off + n - 1])
+        g.b.set(out, ys[last])
 
 
-def pwl_value(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
+def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
     """shapes.pwl_value on the sorted segment: constant beyond the ends, the upper value on
     a vertical edge, linear between points."""
     out = g.temp(hint="MU")
-    last = off + n - 1
     with g.b.if_(x.lt(xs[off])):
         g.b.set(out, ys[off])
     with g.b.elif_(x.gt(xs[last])):
@@ -461,10 +460,9 @@ def pwl_value(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
     return out
 
 
-def right_limit(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
+def right_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
     """grid.right_limit: lim u -> x+ (the last point at x on a vertical edge)."""
     out = g.temp(hint="RL")
-    last = off + n - 1
     with g.b.if_(x.lt(xs[off])):
         g.b.set(out, ys[off])
     with g.b.elif_(x.ge(xs[last])):
@@ -478,14 +476,13 @@ def right_limit(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
                 g.b.set(out, ys[kv])
                 g.b.set(found, True)
         with g.b.if_(not_(found)):
-            _interp(g, xs, ys, off, n, x, out)
+            _interp(g, xs, ys, off, last, x, out)
     return out
 
 
-def left_limit(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
+def left_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
     """grid.left_limit: lim u -> x- (the first point at x on a vertical edge)."""
     out = g.temp(hint="LL")
-    last = off + n - 1
     with g.b.if_(x.le(xs[off])):
         g.b.set(out, ys[off])
     with g.b.elif_(x.gt(xs[last])):
@@ -499,5 +496,5 @@ def left_limit(g: Gen, xs: Var, ys: Var, off: int, n: int, x: Ex) -> Var:
                 g.b.set(out, ys[kv])
                 g.b.set(found, True)
         with g.b.if_(not_(found)):
-            _interp(g, xs, ys, off, n, x, out)
+            _interp(g, xs, ys, off, last, x, out)
     return out
