@@ -82,10 +82,25 @@ class _Var:
     storage: str  # input, output, static, temp
 
 
-class STBlock:
-    """One FUNCTION_BLOCK instance.  ``real`` is "REAL" (float32) or "LREAL" (float64)."""
+@dataclasses.dataclass
+class Translation:
+    """What blark's tree becomes: picklable, so that the (slow) parsing can run in worker
+    processes."""
 
-    def __init__(self, source: str, name: str | None = None) -> None:
+    name: str
+    vars: dict[str, _Var]
+    real: str
+    source: str
+    consts: list[Any]
+
+
+def translate(source: str, name: str | None = None) -> Translation:
+    """Parse ``source`` with blark and translate one FUNCTION_BLOCK into Python."""
+    return _Translator(source, name).result
+
+
+class _Translator:
+    def __init__(self, source: str, name: str | None) -> None:
         result = parse_source_code(source)
         if result.exception is not None:
             raise STError(f"blark cannot parse the text: {result.exception}")
@@ -122,11 +137,7 @@ class STBlock:
         for v in self.vars.values():
             if v.storage != "temp" and v.size is None:
                 lines.append(f"    S[{v.name!r}] = {self._py(v.name)}")
-        self.source = "\n".join(lines) + "\n"
-        env: dict[str, Any] = {"np": np, "R": self.R, "C": self.consts, "_ck": _ck, "_int": _int}
-        exec(compile(self.source, f"<st {self.name}>", "exec"), env)
-        self._fn = env["_step"]
-        self.reset()
+        self.result = Translation(self.name, self.vars, self.real, "\n".join(lines) + "\n", self.consts)
 
     # ------------------------------------------------------------------ declarations
 
@@ -165,30 +176,6 @@ class STBlock:
         else:
             raise STError(f"initial value {node!r} is not a literal")
         return -v if neg else v
-
-    def _convert(self, typ: str, v: Any) -> Any:
-        if v is None:
-            return None
-        if typ in ("REAL", "LREAL"):
-            return self.R(v)
-        if typ == "BOOL":
-            return bool(v)
-        return int(v)
-
-    def reset(self) -> None:
-        """A fresh instance: every static and output at its initial value."""
-        self.state: dict[str, Any] = {}
-        for v in self.vars.values():
-            if v.storage == "temp":
-                continue
-            zero = False if v.type == "BOOL" else 0
-            if v.size is None:
-                self.state[v.name] = self._convert(v.type, v.init if v.init is not None else zero)
-            else:
-                vals = v.init if v.init is not None else [zero] * v.size
-                if len(vals) != v.size:
-                    raise STError(f"{v.name}: {len(vals)} initial values for {v.size} elements")
-                self.state[v.name] = [self._convert(v.type, x) for x in vals]
 
     # ------------------------------------------------------------------ translation
 
@@ -289,6 +276,43 @@ class STBlock:
                 self._lines.append(pad + "pass")
             else:
                 raise STError(f"statement {type(s).__name__} is outside the emitted subset")
+
+
+class STBlock:
+    """One FUNCTION_BLOCK instance, from source text or a :class:`Translation`."""
+
+    def __init__(self, source: str | Translation, name: str | None = None) -> None:
+        tr = translate(source, name) if isinstance(source, str) else source
+        self.name, self.vars, self.real, self.source = tr.name, tr.vars, tr.real, tr.source
+        self.R = np.float32 if self.real == "REAL" else np.float64
+        env: dict[str, Any] = {"np": np, "R": self.R, "C": tr.consts, "_ck": _ck, "_int": _int}
+        exec(compile(self.source, f"<st {self.name}>", "exec"), env)
+        self._fn = env["_step"]
+        self.reset()
+
+    def _convert(self, typ: str, v: Any) -> Any:
+        if v is None:
+            return None
+        if typ in ("REAL", "LREAL"):
+            return self.R(v)
+        if typ == "BOOL":
+            return bool(v)
+        return int(v)
+
+    def reset(self) -> None:
+        """A fresh instance: every static and output at its initial value."""
+        self.state: dict[str, Any] = {}
+        for v in self.vars.values():
+            if v.storage == "temp":
+                continue
+            zero = False if v.type == "BOOL" else 0
+            if v.size is None:
+                self.state[v.name] = self._convert(v.type, v.init if v.init is not None else zero)
+            else:
+                vals = v.init if v.init is not None else [zero] * v.size
+                if len(vals) != v.size:
+                    raise STError(f"{v.name}: {len(vals)} initial values for {v.size} elements")
+                self.state[v.name] = [self._convert(v.type, x) for x in vals]
 
     # ------------------------------------------------------------------ running
 

@@ -27,7 +27,9 @@ NOT_EXPRESSIBLE_C = {
     "fuzzylite/mamdani/SimpleDimmerInverse.fcl": "smooth output terms (numerical integration)",
     "fuzzylite/mamdani/matlab/mam21.fcl": "smooth output terms (numerical integration)",
     "fuzzylite/mamdani/matlab/mam22.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/octave/investment_portfolio.fcl": "ACT EINSTEIN and smooth terms (numerical integration)",
+    "fuzzylite/mamdani/octave/investment_portfolio.fcl": (
+        "ACT EINSTEIN and smooth terms (numerical integration)"
+    ),
     "fuzzylite/mamdani/octave/mamdani_tip_calculator.fcl": "smooth output terms (numerical integration)",
     "fuzzylite/tsukamoto/tsukamoto.fcl": "Tsukamoto (monotonic) output terms",
 }

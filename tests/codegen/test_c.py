@@ -47,7 +47,7 @@ def build_library(plans: list[Plan], out: Path, single: bool = False) -> ctypes.
     sizes += [f"size_t {p.name}_size(void) {{ return sizeof({p.name}); }}" for p in plans]
     (out / "sizes.c").write_text("\n".join(sizes) + "\n")
     # two strict compiler runs side by side (2 cores), one link
-    halves = [sources[0::2], sources[1::2] + [str(out / "sizes.c")]]
+    halves = [sources[0::2], [*sources[1::2], str(out / "sizes.c")]]
     objs = [out / "part0.o", out / "part1.o"]
     procs = []
     for part, obj in zip(halves, objs, strict=True):
@@ -59,7 +59,9 @@ def build_library(plans: list[Plan], out: Path, single: bool = False) -> ctypes.
         _out, err = p.communicate()
         assert p.returncode == 0, err[:4000]
     lib = out / "systems.so"
-    res = subprocess.run([_cc(), "-shared", "-o", str(lib), *map(str, objs), "-lm"], capture_output=True, text=True)
+    res = subprocess.run(
+        [_cc(), "-shared", "-o", str(lib), *map(str, objs), "-lm"], capture_output=True, text=True
+    )
     assert res.returncode == 0, res.stderr[:4000]
     return ctypes.CDLL(str(lib))
 
@@ -103,7 +105,9 @@ def compiled(tmp_path_factory: pytest.TempPathFactory) -> tuple[ctypes.CDLL, lis
     return lib, systems
 
 
-def test_every_expressible_system_matches_the_engine(compiled: tuple[ctypes.CDLL, list[tuple[str, Plan]]]) -> None:
+def test_every_expressible_system_matches_the_engine(
+    compiled: tuple[ctypes.CDLL, list[tuple[str, Plan]]],
+) -> None:
     lib, systems = compiled
     assert len(systems) >= 60  # examples + conformance
     worst = {}

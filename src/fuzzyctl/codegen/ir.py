@@ -277,11 +277,11 @@ class Program:
 class Builder:
     """Collects statements with ``with`` blocks for nesting::
 
-        b = Builder()
-        with b.if_(x.lt(0.0)):
-            b.set(y, 0.0)
-        with b.else_():
-            b.set(y, x)
+    b = Builder()
+    with b.if_(x.lt(0.0)):
+        b.set(y, 0.0)
+    with b.else_():
+        b.set(y, x)
     """
 
     def __init__(self) -> None:

@@ -19,11 +19,12 @@ tables, which keeps the Structured Text short.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen
-from fuzzyctl.codegen.ir import Ex, Index, Var, ex, not_
+from fuzzyctl.codegen.ir import Ex, Index, Type, Var, ex, not_
 from fuzzyctl.engine.pwl import MAX_TOL, gauss_legendre
 
 METHODS = {"COG": 1, "COA": 2, "LM": 3, "RM": 4, "MOM": 5}
@@ -51,8 +52,8 @@ class ExactOutput:
     groups: list[Group]
 
 
-def _const(g: Gen, hint: str, type_: str, values: list[float] | list[bool], comment: str = "") -> Var:
-    init = tuple(values) if type_ == "BOOL" else tuple(float(v) for v in values)
+def _const(g: Gen, hint: str, type_: Type, values: Sequence[float], comment: str = "") -> Var:
+    init = tuple(float(v) for v in values)
     return g.declare(g.fresh(hint, hint), type_, "const", len(values), init, comment)
 
 
@@ -87,8 +88,7 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     value = g.array("OVAL", "REAL", n_out)
     fired = g.array("OFIRED", "BOOL", n_out)
     if n_groups == 0:
-        o_ = g.counter("O")
-        with b.for_(o_, 0, n_out - 1) as ov:
+        with b.for_(g.counter("O"), 0, n_out - 1) as ov:
             b.set(value[ov], 0.0)
             b.set(fired[ov], False)
         return value, fired
@@ -131,9 +131,23 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
         "HIGH": _const(g, "OHIGH", "REAL", [o.high for o in outs]),
     }
     v: dict[str, Var] = {}
-    for name, typ in (("O", "INT"), ("MC", "INT"), ("AC", "INT"), ("LOW", "REAL"), ("HIGH", "REAL"),
-                      ("NG", "INT"), ("NL", "INT"), ("NT", "INT"), ("NC", "INT"), ("J", "INT"),
-                      ("V0", "REAL"), ("V1", "REAL"), ("AREA", "REAL"), ("MOM", "REAL")):
+    scalars: tuple[tuple[str, Type], ...] = (
+        ("O", "INT"),
+        ("MC", "INT"),
+        ("AC", "INT"),
+        ("LOW", "REAL"),
+        ("HIGH", "REAL"),
+        ("NG", "INT"),
+        ("NL", "INT"),
+        ("NT", "INT"),
+        ("NC", "INT"),
+        ("J", "INT"),
+        ("V0", "REAL"),
+        ("V1", "REAL"),
+        ("AREA", "REAL"),
+        ("MOM", "REAL"),
+    )
+    for name, typ in scalars:
         v[name] = g.temp(typ, name)
     probor = 4 in accus
     if probor:
@@ -200,15 +214,16 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
                     b.set(j, ng - 2 - jv)
                 if maxima:
                     with b.if_(v["MC"].ge(METHODS["LM"])):
-                        _grid_point(ctx, arrays["GX"][j], tab["T0"][o_], tab["T1"][o_],
-                                    tab["G0"][o_], tab["G1"][o_])
+                        _grid_point(
+                            ctx, arrays["GX"][j], tab["T0"][o_], tab["T1"][o_], tab["G0"][o_], tab["G1"][o_]
+                        )
                 with b.if_(j.ge(0).and_(j.le(ng - 2))):
                     _interval_lines(ctx, arrays["GX"][j], arrays["GX"][j + 1], tab)
         _finish(ctx, value[o_], fired[o_])
     return value, fired
 
 
-_STATE: dict[str, tuple[str, float]] = {
+_STATE: dict[str, tuple[Type, float]] = {
     # CoA
     "HALF": ("REAL", 0.0),
     "CUM": ("REAL", 0.0),
@@ -335,9 +350,8 @@ def _grid_point(c: _Ctx, x: Ex, t0: Ex, t1: Ex, g0: Ex, g1: Ex) -> None:
             b.set(cc, c.gw[gv] * (c.ga[gv] * y))
         _accumulate_dynamic(c, pv, cc)
     assert c.pass_ is not None
-    with b.if_(c.pass_.eq(1)):
-        with b.if_(pv.gt(st["SUP"])):
-            b.set(st["SUP"], pv)
+    with b.if_(c.pass_.eq(1)), b.if_(pv.gt(st["SUP"])):
+        b.set(st["SUP"], pv)
     with b.elif_(pv.ge(st["THR"])):
         _candidate(c, xp)
 
@@ -345,8 +359,9 @@ def _grid_point(c: _Ctx, x: Ex, t0: Ex, t1: Ex, g0: Ex, g1: Ex) -> None:
 def _accumulate_dynamic(c: _Ctx, acc: Var, val: Ex) -> None:
     """acc := accumulate(accu of the current output, acc, val)."""
     g, b = c.g, c.g.b
-    present = [(code, name) for name, code in (("MAX", 1), ("SUM", 2), ("BSUM", 3), ("PROBOR", 4))
-               if code in c.accus] or [(1, "MAX")]
+    present = [
+        (code, name) for name, code in (("MAX", 1), ("SUM", 2), ("BSUM", 3), ("PROBOR", 4)) if code in c.accus
+    ] or [(1, "MAX")]
     for i, (code, name) in enumerate(present):
         ctx_mgr = b.if_(c.v["AC"].eq(code)) if i == 0 else b.elif_(c.v["AC"].eq(code))
         with ctx_mgr:

@@ -45,10 +45,60 @@ DINT_TO_REAL INT_TO_REAL REAL_TO_INT NORM_X SCALE_X OK
 RESERVED: frozenset[str] = frozenset((_IEC + _TWINCAT + _SCL).split())
 
 C_KEYWORDS: frozenset[str] = frozenset(
-    """auto break case char const continue default do double else enum extern float for goto if
-    inline int long register restrict return short signed sizeof static struct switch typedef union
-    unsigned void volatile while _Bool _Complex _Imaginary bool true false NULL NAN INFINITY main
-    exp log sqrt pow fabs cos sin tan""".split()
+    [
+        "auto",
+        "break",
+        "case",
+        "char",
+        "const",
+        "continue",
+        "default",
+        "do",
+        "double",
+        "else",
+        "enum",
+        "extern",
+        "float",
+        "for",
+        "goto",
+        "if",
+        "inline",
+        "int",
+        "long",
+        "register",
+        "restrict",
+        "return",
+        "short",
+        "signed",
+        "sizeof",
+        "static",
+        "struct",
+        "switch",
+        "typedef",
+        "union",
+        "unsigned",
+        "void",
+        "volatile",
+        "while",
+        "_Bool",
+        "_Complex",
+        "_Imaginary",
+        "bool",
+        "true",
+        "false",
+        "NULL",
+        "NAN",
+        "INFINITY",
+        "main",
+        "exp",
+        "log",
+        "sqrt",
+        "pow",
+        "fabs",
+        "cos",
+        "sin",
+        "tan",
+    ]
 )
 
 _IEC_IDENT = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")

@@ -204,5 +204,7 @@ def compile_native(plan: Plan) -> Controller:
     try:
         return NativeController(plan, build(plan))
     except (CodegenError, NativeError) as exc:
-        warnings.warn(f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3)
+        warnings.warn(
+            f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
+        )
         return Controller(plan, specialise=True)

@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen, Target
-from fuzzyctl.codegen.ir import Ex, Index, Int, Num, Program, Var, ex, not_
+from fuzzyctl.codegen.ir import Decl, Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.lower_terms import uses_x
@@ -73,9 +73,7 @@ class Params:
         self.g.decls.append(_param_decl(self))
 
 
-def _param_decl(p: Params) -> object:
-    from fuzzyctl.codegen.ir import Decl
-
+def _param_decl(p: Params) -> Decl:
     lines = [p.what] + [f"[{i}] {n}" for i, n in enumerate(p.notes)]
     return Decl(p.name, "REAL", "param", len(p.values), tuple(p.values), "\n".join(lines))
 
@@ -84,7 +82,7 @@ class _Builder:
     def __init__(self, plan: Plan, target: Target) -> None:
         self.plan = plan
         self.g = Gen(target)
-        self.inputs: list[Var] = []
+        self.inputs: list[Ex] = []
         self.params: list[Params] = []
 
     # ------------------------------------------------------------------ parameters
@@ -155,10 +153,9 @@ class _Builder:
             (op.default if op.default is not None else 0.0) if op.kind != "degree" else 0.0
             for op in plan.outputs
         )
-        for v in init_prev:
-            if not math.isfinite(v):
-                if g.target == "st":
-                    raise g.refuse("DEFAULT := nan", "portable Structured Text has no NaN")
+        for op, v in zip(plan.outputs, init_prev, strict=True):
+            if not math.isfinite(v) and g.target == "st":
+                raise g.refuse(f"output {op.name}: DEFAULT := nan", "portable Structured Text has no NaN")
         prev = g.declare(
             g.fresh("PREV", "PREV"),
             "REAL",
@@ -173,8 +170,8 @@ class _Builder:
             b.set(info, Int(INFO_DISABLED))
         if degree_inputs:
             bad: Ex = degree_inputs[0].lt(0.0).or_(degree_inputs[0].gt(1.0))
-            for v in degree_inputs[1:]:
-                bad = bad.or_(v.lt(0.0).or_(v.gt(1.0)))
+            for di in degree_inputs[1:]:
+                bad = bad.or_(di.lt(0.0).or_(di.gt(1.0)))
             with b.elif_(bad):
                 b.set(info, Int(INFO_DEGREE_RANGE))
         with b.else_():
@@ -186,7 +183,10 @@ class _Builder:
             results: dict[int, tuple[Ex, Ex]] = {}
             if exact:
                 with b.region("defuzzify (exact, piecewise linear)"):
-                    specs = [self._mamdani(plan.outputs[oi], self._contribs(plan.outputs[oi], concl)) for oi in exact]
+                    specs = [
+                        self._mamdani(plan.outputs[oi], self._contribs(plan.outputs[oi], concl))
+                        for oi in exact
+                    ]
                     vals, fireds = exact_outputs(g, specs)
                 for k, oi in enumerate(exact):
                     results[oi] = (vals[k], fireds[k])
@@ -280,22 +280,30 @@ class _Builder:
                     where = f"term {fi.name}.{t.name}"
                     if t.kind in shapes.PWL_KINDS:
                         continue
+                    d: Ex
                     if t.kind == "singleton":
                         pos = self.pv(t.params[0], pp, f"{t.name} position")
-                        d = g.temp(hint="MU")
+                        dv = g.temp(hint="MU")
                         with g.b.if_(x.eq(pos)):
-                            g.b.set(d, self.pv(t.height, None, ""))
+                            g.b.set(dv, self.pv(t.height, None, ""))
                         with g.b.else_():
-                            g.b.set(d, 0.0)
+                            g.b.set(dv, 0.0)
+                        d = dv
                     elif t.kind == "function":
                         assert t.expr is not None
                         d = g.let(T.expression(g, t.expr, self.inputs, _no_outputs, x, where), "MU")
                     elif t.kind in shapes.SMOOTH_KINDS:
-                        ps = [self.pv(p, pp, f"{t.name} {name}") for p, name in zip(
-                            t.params, _param_names(t.kind, len(t.params)), strict=True)]
-                        m = T.smooth(g, t.kind, ps, x, where)
+                        ps = [
+                            self.pv(p, pp, f"{t.name} {name}")
+                            for p, name in zip(t.params, _param_names(t.kind, len(t.params)), strict=True)
+                        ]
+                        m: Ex = T.smooth(g, t.kind, ps, x, where)
                         h = t.height
-                        d = m if (not isinstance(h, Slot) and h == 1.0) else g.let(self.pv(h, None, "") * m, "MU")
+                        d = (
+                            m
+                            if (not isinstance(h, Slot) and h == 1.0)
+                            else g.let(self.pv(h, None, "") * m, "MU")
+                        )
                     else:
                         raise g.refuse(where, f"{t.kind} terms on inputs")
                     degrees[(var, ti)] = d
@@ -378,9 +386,11 @@ class _Builder:
                     ah = T.hedged(g, base, cp.hedges, False) if cp.hedges else base
                     if opts.hedges_carry_over:
                         carried = ah
-                    w = self.pv(cp.weight, weights, f"rule {rule.label} conclusion {cj + 1}") if (
-                        isinstance(cp.weight, Slot) or cp.weight != 1.0
-                    ) else Num(1.0)
+                    w = (
+                        self.pv(cp.weight, weights, f"rule {rule.label} conclusion {cj + 1}")
+                        if (isinstance(cp.weight, Slot) or cp.weight != 1.0)
+                        else Num(1.0)
+                    )
                     concl[ri].append((ah, w))
                     for ch in cp.chained:
                         accu = plan.chained[ch].accu
@@ -415,10 +425,12 @@ class _Builder:
 
     # ------------------------------------------------------------------ outputs
 
-    def _contribs(self, op: OutputPlan, concl: list[list[tuple[Ex, Ex]]]) -> list[tuple[int | None, Ex, Ex, str]]:
+    def _contribs(
+        self, op: OutputPlan, concl: list[list[tuple[Ex, Ex]]]
+    ) -> list[tuple[int | None, Ex, Ex, str]]:
         """(term, degree, weight, act) with the weight placement of the options
         (``interp._contribs``; the a*w > 0 filter is emitted where they are used)."""
-        out = []
+        out: list[tuple[int | None, Ex, Ex, str]] = []
         for c in op.contributions:
             ah, w = concl[c.rule][c.conclusion]
             if self.plan.options.weight_before_activation and not (isinstance(w, Num) and w.value == 1.0):
@@ -484,16 +496,16 @@ class _Builder:
         sx = self.new_params(f"{op.name}_S", "OS", f"{op.name}: singleton positions")
         sy = self.new_params(f"{op.name}_SY", "OSY", f"{op.name}: singleton degrees")
         entries: list[list[tuple[Ex, Ex]]] = []
-        for t in op.terms:
-            if t.kind == "singleton":
-                entries.append([(self.pv(t.params[0], sx, t.name), Num(1.0))])
+        for term in op.terms:
+            if term.kind == "singleton":
+                entries.append([(self.pv(term.params[0], sx, term.name), Num(1.0))])
             else:
-                es = []
-                for k in range(0, len(t.params), 2):
+                es: list[tuple[Ex, Ex]] = []
+                for k in range(0, len(term.params), 2):
                     es.append(
                         (
-                            self.pv(t.params[k], sx, f"{t.name} x{k // 2}"),
-                            self.pv(t.params[k + 1], sy, f"{t.name} y{k // 2}"),
+                            self.pv(term.params[k], sx, f"{term.name} x{k // 2}"),
+                            self.pv(term.params[k + 1], sy, f"{term.name} y{k // 2}"),
                         )
                     )
                 entries.append(es)
@@ -509,13 +521,13 @@ class _Builder:
         value = g.temp(hint="Y")
         fired = g.temp("BOOL", "FIRED")
         total = g.let(0.0, "DEN")
-        for k in keys:
-            b.set(total, total + acc[k])
+        for key in keys:
+            b.set(total, total + acc[key])
         b.set(fired, total.gt(0.0))
         if op.method == "COGS":
             num = g.let(0.0, "NUM")
-            for k in keys:
-                b.set(num, num + entries[k[0]][k[1]][0] * acc[k])
+            for key in keys:
+                b.set(num, num + entries[key[0]][key[1]][0] * acc[key])
             with b.if_(fired):
                 b.set(value, num / total)
             with b.else_():
@@ -523,13 +535,13 @@ class _Builder:
             return value, fired
         # LM / RM / MoM over the positions reaching the largest degree (exact equality)
         sup = g.let(0.0, "SUP")
-        for k in keys:
-            with b.if_(acc[k].gt(sup)):
-                b.set(sup, acc[k])
+        for key in keys:
+            with b.if_(acc[key].gt(sup)):
+                b.set(sup, acc[key])
         lm, rm, s, n = g.let(0.0, "LMX"), g.let(0.0, "RMX"), g.let(0.0, "SUM"), g.let(0, "CNT", "INT")
-        for idx, k in enumerate(keys):
-            x = entries[k[0]][k[1]][0]
-            with b.if_(acc[k].eq(sup).and_(sup.gt(0.0))):
+        for idx, key in enumerate(keys):
+            x = entries[key[0]][key[1]][0]
+            with b.if_(acc[key].eq(sup).and_(sup.gt(0.0))):
                 with b.if_(n.eq(0).or_(x.lt(lm))):
                     b.set(lm, x)
                 with b.if_(n.eq(0).or_(x.gt(rm))):
@@ -566,7 +578,10 @@ class _Builder:
                 elif term.kind == "linear":
                     acc: Ex = Num(0.0)
                     for i, c in enumerate(term.params[:n_in]):
-                        acc = acc + self.pv(c, coef, f"{term.name} * {self.plan.inputs[i].name}") * self.inputs[i]
+                        acc = (
+                            acc
+                            + self.pv(c, coef, f"{term.name} * {self.plan.inputs[i].name}") * self.inputs[i]
+                        )
                     if len(term.params) > n_in:
                         acc = acc + self.pv(term.params[n_in], coef, f"{term.name} constant")
                     zs[t] = g.let(acc, "Z")

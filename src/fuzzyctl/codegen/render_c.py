@@ -145,9 +145,7 @@ class _C:
             elif isinstance(s, For):
                 v = s.var
                 cmp, inc = ("<=", "++") if s.step > 0 else (">=", "--")
-                self.emit(
-                    f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind
-                )
+                self.emit(f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind)
                 self.stmts(s.body, ind + 1)
                 self.emit("}", ind)
             elif isinstance(s, While):
@@ -215,8 +213,9 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     h += [f"#ifndef {guard}", f"#define {guard}", "", "#include <stddef.h>", ""]
     h.append(f"typedef {'float' if single else 'double'} {real};")
     h.append("")
-    h.append("/* One instance of the function block: set the inputs, call "
-             f"{name}_step(), read the outputs. */")
+    h.append(
+        f"/* One instance of the function block: set the inputs, call {name}_step(), read the outputs. */"
+    )
     h.append("typedef struct {")
     for storage, title in (
         ("input", "inputs"),
@@ -239,7 +238,7 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     h.append(f"#define {name.upper()}_N_INPUTS {n_in}")
     h.append(f"#define {name.upper()}_N_OUTPUTS {len(outs)}")
     h.append("")
-    h.append(f"/* Set the parameters to the FCL's values, clear the state, ENABLE = 1. */")
+    h.append("/* Set the parameters to the FCL's values, clear the state, ENABLE = 1. */")
     h.append(f"void {name}_init({name} *fb);")
     h.append(f"/* One evaluation (a PLC cycle); returns INFO: {prog.decl('INFO').comment}. */")
     h.append(f"unsigned char {name}_step({name} *fb);")
@@ -247,7 +246,8 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
         f"/* n evaluations in a row: in[i*{n_in} + k] is input k "
         f"({', '.join(d.name for d in prog.of('input') if d.name != 'ENABLE')}) of row i,"
     )
-    h.append(f"   out[i*{len(outs)} + k] output k ({', '.join(d.name for d in outs)}); returns INFO of the last row. */")
+    out_names = ", ".join(d.name for d in outs)
+    h.append(f"   out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row. */")
     h.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out);")
     h.append("")
     h.append(f"#endif /* {guard} */")
@@ -268,15 +268,15 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
         if d.storage not in ("input", "output", "param", "state"):
             continue
         if d.size is None:
-            v = d.init if d.init is not None else (0.0 if d.type == "REAL" else 0)
-            if isinstance(v, bool) or d.type != "REAL":
-                c.append(f"    fb->{d.name} = {int(v)};")  # type: ignore[arg-type]
+            one = d.init if isinstance(d.init, float | int | bool) else 0.0
+            if isinstance(one, bool) or d.type != "REAL":
+                c.append(f"    fb->{d.name} = {int(one)};")
             else:
-                c.append(f"    fb->{d.name} = {r.num(float(v))};")  # type: ignore[arg-type]
+                c.append(f"    fb->{d.name} = {r.num(float(one))};")
         else:
-            vals = d.init if isinstance(d.init, tuple) else (0.0,) * d.size
-            for i, v in enumerate(vals):
-                c.append(f"    fb->{d.name}[{i}] = {r.num(v)};")
+            values = d.init if isinstance(d.init, tuple) else (0.0,) * d.size
+            for i, val in enumerate(values):
+                c.append(f"    fb->{d.name}[{i}] = {r.num(val)};")
     c.append("}")
     c.append("")
     c.append(f"unsigned char {name}_step({name} *fb)")

@@ -118,9 +118,7 @@ class _ST:
                 self.emit("END_IF;", ind)
             elif isinstance(s, For):
                 by = "" if s.step == 1 else " BY -1"
-                self.emit(
-                    f"FOR {self.name(s.var)} := {self.ex(s.start)} TO {self.ex(s.stop)}{by} DO", ind
-                )
+                self.emit(f"FOR {self.name(s.var)} := {self.ex(s.start)} TO {self.ex(s.stop)}{by} DO", ind)
                 self.stmts(s.body, ind + 1) if s.body else self.emit(";", ind + 1)
                 self.emit("END_FOR;", ind)
             elif isinstance(s, While):

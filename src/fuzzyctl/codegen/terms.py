@@ -199,24 +199,24 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
     if kind == "gaussian":
         g.b.set(out, _gauss(g, x, p[0], p[1]))
     elif kind == "gaussian2":
-        a = g.temp(hint="G")
+        left = g.temp(hint="G")
         with g.b.if_(x.lt(p[0])):
-            g.b.set(a, _gauss(g, x, p[0], p[1]))
+            g.b.set(left, _gauss(g, x, p[0], p[1]))
         with g.b.else_():
-            g.b.set(a, 1.0)
-        c = g.temp(hint="G")
+            g.b.set(left, 1.0)
+        right = g.temp(hint="G")
         with g.b.if_(x.gt(p[2])):
-            g.b.set(c, _gauss(g, x, p[2], p[3]))
+            g.b.set(right, _gauss(g, x, p[2], p[3]))
         with g.b.else_():
-            g.b.set(c, 1.0)
-        g.b.set(out, a * c)
+            g.b.set(right, 1.0)
+        g.b.set(out, left * right)
     elif kind == "bell":
         u = _absv(g, (x - p[0]) / p[1])
-        e = g.let(2.0 * p[2], "E")
+        expo = g.let(2.0 * p[2], "E")
         pw = g.temp(hint="W")
         with g.b.if_(u.gt(0.0)):
-            g.b.set(pw, g.call("POW", u, e) if g.target == "c" else g.call("EXP", e * g.call("LN", u)))
-        with g.b.elif_(e.eq(0.0)):
+            g.b.set(pw, g.call("POW", u, expo) if g.target == "c" else g.call("EXP", expo * g.call("LN", u)))
+        with g.b.elif_(expo.eq(0.0)):
             g.b.set(pw, 1.0)
         with g.b.else_():
             g.b.set(pw, 0.0)
@@ -417,13 +417,12 @@ def _interp(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, out: Var
     k = g.counter("K")
     done = g.temp("BOOL", "DN")
     g.b.set(done, False)
-    with g.b.for_(k, ex(off) + 1, last) as kv:
-        with g.b.if_(not_(done).and_(xs[kv].gt(x))):
-            g.b.set(
-                out,
-                ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
-            )
-            g.b.set(done, True)
+    with g.b.for_(k, ex(off) + 1, last) as kv, g.b.if_(not_(done).and_(xs[kv].gt(x))):
+        g.b.set(
+            out,
+            ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
+        )
+        g.b.set(done, True)
     with g.b.if_(not_(done)):
         g.b.set(out, ys[last])
 
@@ -442,21 +441,20 @@ def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var
         g.b.set(found, False)
         g.b.set(done, False)
         k = g.counter("K")
-        with g.b.for_(k, off, last) as kv:
-            with g.b.if_(not_(done)):
-                with g.b.if_(xs[kv].eq(x)):
-                    with g.b.if_(not_(found)):
-                        g.b.set(out, ys[kv])
-                        g.b.set(found, True)
-                    with g.b.elif_(ys[kv].gt(out)):
-                        g.b.set(out, ys[kv])
-                with g.b.elif_(xs[kv].gt(x)):
-                    with g.b.if_(not_(found)):
-                        g.b.set(
-                            out,
-                            ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
-                        )
-                    g.b.set(done, True)
+        with g.b.for_(k, off, last) as kv, g.b.if_(not_(done)):
+            with g.b.if_(xs[kv].eq(x)):
+                with g.b.if_(not_(found)):
+                    g.b.set(out, ys[kv])
+                    g.b.set(found, True)
+                with g.b.elif_(ys[kv].gt(out)):
+                    g.b.set(out, ys[kv])
+            with g.b.elif_(xs[kv].gt(x)):
+                with g.b.if_(not_(found)):
+                    g.b.set(
+                        out,
+                        ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
+                    )
+                g.b.set(done, True)
     return out
 
 
@@ -471,10 +469,9 @@ def right_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> V
         found = g.temp("BOOL", "FD")
         g.b.set(found, False)
         k = g.counter("K")
-        with g.b.for_(k, last, off, step=-1) as kv:
-            with g.b.if_(not_(found).and_(xs[kv].eq(x))):
-                g.b.set(out, ys[kv])
-                g.b.set(found, True)
+        with g.b.for_(k, last, off, step=-1) as kv, g.b.if_(not_(found).and_(xs[kv].eq(x))):
+            g.b.set(out, ys[kv])
+            g.b.set(found, True)
         with g.b.if_(not_(found)):
             _interp(g, xs, ys, off, last, x, out)
     return out
@@ -491,10 +488,9 @@ def left_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Va
         found = g.temp("BOOL", "FD")
         g.b.set(found, False)
         k = g.counter("K")
-        with g.b.for_(k, off, last) as kv:
-            with g.b.if_(not_(found).and_(xs[kv].eq(x))):
-                g.b.set(out, ys[kv])
-                g.b.set(found, True)
+        with g.b.for_(k, off, last) as kv, g.b.if_(not_(found).and_(xs[kv].eq(x))):
+            g.b.set(out, ys[kv])
+            g.b.set(found, True)
         with g.b.if_(not_(found)):
             _interp(g, xs, ys, off, last, x, out)
     return out
