@@ -93,17 +93,45 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
             b.set(fired[ov], False)
         return value, fired
 
-    wx = g.array("WX", "REAL", n_pts)
-    wy = g.array("WY", "REAL", n_pts)
+    # ---- the output geometry (sorted points, grids, one-sided limits, degrees at grid
+    # points) depends only on the term points: it is kept in the instance and rebuilt only
+    # when a point changed (retuned online, or given by an input that moved)
+    rx = g.array("RX", "REAL", n_pts)
+    ry = g.array("RY", "REAL", n_pts)
     for t, pts in enumerate(term_pts):
         for k, (x, y) in enumerate(pts):
-            b.set(wx[offs[t] + k], x)
-            b.set(wy[offs[t] + k], y)
+            b.set(rx[offs[t] + k], x)
+            b.set(ry[offs[t] + k], y)
     toff = _const(g, "TOFF", "INT", offs, "first point of each output term")
     tlast = _const(g, "TLAST", "INT", [o + c - 1 for o, c in zip(offs, counts, strict=True)])
-    tt = g.counter("TT")
-    with b.for_(tt, 0, n_terms - 1) as tv:
-        T.sort_points(g, wx, wy, toff[tv], tlast[tv])
+    term_out = [oi for oi, o in enumerate(outs) for _t in o.points]
+    grid_size = [p1 - p0 + 3 for p0, p1 in zip(out_p0, out_p1, strict=True)]  # points + low, high
+    goff = [sum(grid_size[:oi]) for oi in range(n_out)]
+    loff = [sum(grid_size[term_out[t]] for t in range(u)) for u in range(n_terms)]
+    n_lim = sum(grid_size[term_out[t]] for t in range(n_terms))
+    cache = {
+        "CX": g.declare(g.fresh("CX", "CX"), "REAL", "state", n_pts, (0.0,) * n_pts, "cached term points"),
+        "CY": g.declare(g.fresh("CY", "CY"), "REAL", "state", n_pts, (0.0,) * n_pts),
+        "SX": g.declare(g.fresh("SX", "SX"), "REAL", "state", n_pts, (0.0,) * n_pts, "sorted term points"),
+        "SY": g.declare(g.fresh("SY", "SY"), "REAL", "state", n_pts, (0.0,) * n_pts),
+        "SGX": g.declare(
+            g.fresh("SGX", "SGX"), "REAL", "state", sum(grid_size), (0.0,) * sum(grid_size), "grids"
+        ),
+        "SNG": g.declare(g.fresh("SNG", "SNG"), "INT", "state", n_out, (0.0,) * n_out, "grid sizes"),
+        "SLT": g.declare(
+            g.fresh("SLT", "SLT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the right"
+        ),
+        "SRT": g.declare(
+            g.fresh("SRT", "SRT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the left"
+        ),
+        "SMU": g.declare(
+            g.fresh("SMU", "SMU"), "REAL", "state", n_lim, (0.0,) * n_lim, "term degrees at grid points"
+        ),
+        "VALID": g.declare(g.fresh("CVALID", "CVALID"), "BOOL", "state", None, False, "cache filled"),
+        "GOFF": _const(g, "GOFF", "INT", goff, "first grid point of each output"),
+        "LOFF": _const(g, "LOFF", "INT", loff, "first cache entry of each term"),
+    }
+    wx, wy = cache["SX"], cache["SY"]
     gt = _const(g, "GT", "INT", [gr.term for gr in groups], "term of each activated set")
     gmin = _const(g, "GMIN", "BOOL", [gr.is_min for gr in groups], "MIN activation (else PROD)")
     ga = g.array("GA", "REAL", n_groups)
@@ -111,12 +139,6 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     for i, gr in enumerate(groups):
         b.set(ga[i], gr.a)
         b.set(gw[i], gr.w)
-    live = g.array("LIVE", "BOOL", n_terms)  # a set of the term has a*w > 0
-    with b.for_(tt, 0, n_terms - 1) as tv:
-        b.set(live[tv], False)
-    gg = g.counter("G")
-    with b.for_(gg, 0, n_groups - 1) as gv, b.if_((ga[gv] * gw[gv]).gt(0.0)):
-        b.set(live[gt[gv]], True)
 
     tab = {
         "T0": _const(g, "OT0", "INT", out_t0),
@@ -155,8 +177,6 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     st = _method_state(g, methods)
     arrays = {
         "GX": g.array("GX", "REAL", max_pts + 2),
-        "LT": g.array("LT", "REAL", n_terms),
-        "RT": g.array("RT", "REAL", n_terms),
         "LL": g.array("LL", "REAL", max_groups),
         "LR": g.array("LR", "REAL", max_groups),
         "LA": g.array("LA", "REAL", max_groups),
@@ -169,12 +189,11 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
         "CUT": g.array("CUT", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
         "CV": g.array("CV", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
     }
-    if maxima:
-        arrays["MUT"] = g.array("MUT", "REAL", n_terms)
     gl = _gl_tables(g, max_groups) if probor else None
-    ctx = _Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw, live)
+    ctx = _Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw)
 
     o_ = v["O"]
+    _rebuild_cache(ctx, cache, rx, ry, n_pts, n_terms, n_out, tab)
     ov = Var(g.counter("OO"))
     with b.for_(ov.name, 0, n_out - 1):
         b.set(o_, ov)
@@ -182,7 +201,7 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
         b.set(v["AC"], tab["AC"][o_])
         b.set(v["LOW"], tab["LOW"][o_])
         b.set(v["HIGH"], tab["HIGH"][o_])
-        _grid(ctx, tab["P0"][o_], tab["P1"][o_])
+        b.set(v["NG"], cache["SNG"][o_])
         b.set(v["AREA"], 0.0)
         b.set(v["MOM"], 0.0)
         for name, (typ, init) in _STATE.items():
@@ -212,13 +231,13 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
                     b.set(j, jv)
                 with b.else_():
                     b.set(j, ng - 2 - jv)
+                gx = cache["SGX"]
+                gbase = cache["GOFF"][o_]
                 if maxima:
                     with b.if_(v["MC"].ge(METHODS["LM"])):
-                        _grid_point(
-                            ctx, arrays["GX"][j], tab["T0"][o_], tab["T1"][o_], tab["G0"][o_], tab["G1"][o_]
-                        )
+                        _grid_point(ctx, gx[gbase + j], j, cache, tab["G0"][o_], tab["G1"][o_])
                 with b.if_(j.ge(0).and_(j.le(ng - 2))):
-                    _interval_lines(ctx, arrays["GX"][j], arrays["GX"][j + 1], tab)
+                    _interval_lines(ctx, gx[gbase + j], gx[gbase + j + 1], j, cache, tab)
         _finish(ctx, value[o_], fired[o_])
     return value, fired
 
@@ -275,7 +294,6 @@ class _Ctx:
     gmin: Var
     ga: Var
     gw: Var
-    live: Var
     pass_: Var | None = None
     forward: Ex | None = None
 
@@ -328,21 +346,63 @@ def _gl_tables(g: Gen, n_groups: int) -> tuple[Var, Var, Var, Var]:
     )
 
 
-def _grid_point(c: _Ctx, x: Ex, t0: Ex, t1: Ex, g0: Ex, g1: Ex) -> None:
+def _rebuild_cache(
+    c: _Ctx,
+    cache: dict[str, Var],
+    rx: Var,
+    ry: Var,
+    n_pts: int,
+    n_terms: int,
+    n_out: int,
+    tab: dict[str, Var],
+) -> None:
+    """Compare the term points with the cached copy; when one differs, sort them again and
+    rebuild every output's grid, the terms' one-sided limits on each grid interval and their
+    degrees at each grid point (grid.build_grid: left/right/point)."""
+    g, b = c.g, c.g.b
+    changed = g.let(not_(cache["VALID"]), "CHANGED", "BOOL")
+    k = g.counter("K")
+    with b.for_(k, 0, n_pts - 1) as kv, b.if_(rx[kv].ne(cache["CX"][kv]).or_(ry[kv].ne(cache["CY"][kv]))):
+        b.set(changed, True)
+    with b.if_(changed):
+        with b.for_(k, 0, n_pts - 1) as kv:
+            for src, dst in ((rx, "CX"), (ry, "CY"), (rx, "SX"), (ry, "SY")):
+                b.set(cache[dst][kv], src[kv])
+        tt = g.counter("TT")
+        with b.for_(tt, 0, n_terms - 1) as tv:
+            T.sort_points(g, c.wx, c.wy, c.toff[tv], c.tlast[tv])
+        oo = g.counter("O")
+        gx, ng = c.a["GX"], c.v["NG"]
+        with b.for_(oo, 0, n_out - 1) as ov:
+            b.set(c.v["LOW"], tab["LOW"][ov])
+            b.set(c.v["HIGH"], tab["HIGH"][ov])
+            _grid(c, tab["P0"][ov], tab["P1"][ov])
+            b.set(cache["SNG"][ov], ng)
+            jj = g.counter("J")
+            with b.for_(jj, 0, ng - 1) as jv:
+                b.set(cache["SGX"][cache["GOFF"][ov] + jv], gx[jv])
+                with b.for_(tt, tab["T0"][ov], tab["T1"][ov]) as tv:
+                    at = cache["LOFF"][tv] + jv
+                    b.set(cache["SMU"][at], T.pwl_value(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], gx[jv]))
+                    b.set(cache["SLT"][at], 0.0)
+                    b.set(cache["SRT"][at], 0.0)
+                    with b.if_(jv.lt(ng - 1)):
+                        b.set(cache["SLT"][at], T.right_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], gx[jv]))
+                        b.set(
+                            cache["SRT"][at], T.left_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], gx[jv + 1])
+                        )
+        b.set(cache["VALID"], True)
+
+
+def _grid_point(c: _Ctx, x: Ex, j: Var, cache: dict[str, Var], g0: Ex, g1: Ex) -> None:
     """The accumulated degree exactly at a grid point (pwl.point_values): it can be the
     maximum at a vertical edge."""
     g, b, st = c.g, c.g.b, c.st
     xp = g.let(x, "XP")
-    mu = c.a["MUT"]
-    tt = g.counter("TT")
-    with b.for_(tt, t0, t1) as tv:
-        b.set(mu[tv], 0.0)
-        with b.if_(c.live[tv]):
-            b.set(mu[tv], T.pwl_value(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], xp))
     pv = g.let(0.0, "PV")
     gg = g.counter("G")
     with b.for_(gg, g0, g1) as gv, b.if_((c.ga[gv] * c.gw[gv]).gt(0.0)):
-        y = mu[c.gt[gv]]
+        y = g.let(cache["SMU"][cache["LOFF"][c.gt[gv]] + j], "MU")
         cc = g.temp(hint="PC")
         with b.if_(c.gmin[gv]):
             b.set(cc, c.gw[gv] * g.min_(c.ga[gv], y))
@@ -389,29 +449,22 @@ def _candidate(c: _Ctx, x: Ex) -> None:
             b.set(st["LASTX"], x)
 
 
-def _interval_lines(c: _Ctx, gx0: Ex, gx1: Ex, tab: dict[str, Var]) -> None:
+def _interval_lines(c: _Ctx, gx0: Ex, gx1: Ex, j: Var, cache: dict[str, Var], tab: dict[str, Var]) -> None:
     """The activated sets on one grid interval as lines (L, R, a, w, is_min), then the
     interval's pieces."""
     g, b, v, a = c.g, c.g.b, c.v, c.a
     o_ = v["O"]
     x0 = g.let(gx0, "X0")
     x1 = g.let(gx1, "X1")
-    tt = g.counter("TT")
-    lt_, rt_ = a["LT"], a["RT"]
-    with b.for_(tt, tab["T0"][o_], tab["T1"][o_]) as tv:
-        b.set(lt_[tv], 0.0)
-        b.set(rt_[tv], 0.0)
-        with b.if_(c.live[tv]):
-            b.set(lt_[tv], T.right_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], x0))
-            b.set(rt_[tv], T.left_limit(g, c.wx, c.wy, c.toff[tv], c.tlast[tv], x1))
     nl = v["NL"]
     b.set(nl, 0)
     gg = g.counter("G")
     with b.for_(gg, tab["G0"][o_], tab["G1"][o_]) as gv:
-        t_ = c.gt[gv]
-        with b.if_((c.ga[gv] * c.gw[gv]).gt(0.0).and_(lt_[t_].ne(0.0).or_(rt_[t_].ne(0.0)))):
-            b.set(a["LL"][nl], lt_[t_])
-            b.set(a["LR"][nl], rt_[t_])
+        at = g.let(cache["LOFF"][c.gt[gv]] + j, "AT", "INT")
+        lt_, rt_ = cache["SLT"][at], cache["SRT"][at]
+        with b.if_((c.ga[gv] * c.gw[gv]).gt(0.0).and_(lt_.ne(0.0).or_(rt_.ne(0.0)))):
+            b.set(a["LL"][nl], lt_)
+            b.set(a["LR"][nl], rt_)
             b.set(a["LA"][nl], c.ga[gv])
             b.set(a["LW"][nl], c.gw[gv])
             b.set(a["LMIN"][nl], c.gmin[gv])
