@@ -36,7 +36,7 @@ from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan
 
 #: -ffp-contract=off: no fused multiply-add, so that the C rounds like Python does.
-CFLAGS = ("-std=c99", "-O2", "-fPIC", "-shared", "-fvisibility=hidden", "-ffp-contract=off")
+CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-fvisibility=hidden", "-ffp-contract=off")
 
 _WRAPPER = """
 #include "{name}.c"
