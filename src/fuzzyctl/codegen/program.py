@@ -24,6 +24,7 @@ from dataclasses import dataclass, field
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen, Target
+from fuzzyctl.codegen.guard import check_known_fields
 from fuzzyctl.codegen.ir import Decl, Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
 from fuzzyctl.engine import shapes
@@ -220,6 +221,7 @@ class _Builder:
 
     def _check(self) -> None:
         g = self.g
+        check_known_fields(g, self.plan)
         for op in self.plan.outputs:
             if op.kind == "mamdani" and not op.exact:
                 raise g.refuse(
