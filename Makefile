@@ -1,11 +1,11 @@
 # Two commands do everything on a fresh machine (see README):
-#   make run   - create .venv, install, run the main job on a bundled example
+#   make run   - create .venv, install, simulate the container crane demo (CSV, PNG, HTML in build/sim)
 #   make test  - create .venv, install dev extras and system packages, run ruff, mypy, pytest
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run test lint typecheck pytest system-deps clean
+.PHONY: run docs-img test lint typecheck pytest system-deps clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -23,8 +23,11 @@ system-deps:
 	@bash scripts/system-deps.sh
 
 run: $(VENV)/.installed
-	$(BIN)/fuzzyctl check examples/figure7.fcl
-	$(BIN)/fuzzyctl eval examples/figure7.fcl --csv examples/figure7_inputs.csv --table
+	$(BIN)/fuzzyctl simulate examples/crane.toml --out-dir build/sim
+
+# The plot in the README: generated from the crane example, never drawn by hand.
+docs-img: $(VENV)/.installed
+	$(BIN)/fuzzyctl simulate examples/crane.toml --png docs/img/crane.png --no-csv --no-html
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check src tests benchmarks

@@ -6,4 +6,6 @@ from fuzzyctl.cli import (
     convert,  # noqa: F401
     lang,  # noqa: F401  (check, fmt)
     run,  # noqa: F401  (eval, explain)
+    serve,  # noqa: F401  (serve: the soft controller)
+    simulate,  # noqa: F401  (simulate)
 )

@@ -1,0 +1,107 @@
+"""``fuzzyctl serve CONFIG.toml``: run the soft controller (docs/runtime.md)."""
+
+from __future__ import annotations
+
+import signal
+import sys
+import threading
+import time
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from fuzzyctl.cli.app import app, err_console
+
+
+@app.command()
+def serve(
+    config: Annotated[Path, typer.Argument(help="the runtime configuration (TOML)", show_default=False)],
+    api: Annotated[bool, typer.Option("--api/--no-api", help="serve the HTTP/WebSocket API")] = True,
+    table: Annotated[
+        bool, typer.Option("--table/--no-table", help="live table (on a terminal); else one line per event")
+    ] = True,
+    duration: Annotated[
+        float | None, typer.Option("--duration", min=0, help="stop after this many seconds")
+    ] = None,
+    check: Annotated[bool, typer.Option("--check", help="check the configuration and exit")] = False,
+) -> None:
+    """Run fuzzy function blocks cyclically against field I/O (OPC UA, Modbus TCP, S7)."""
+    from rich.console import Console
+
+    from fuzzyctl.runtime import Runtime, load_config
+
+    cfg = load_config(config)
+    runtime = Runtime(cfg, api=api and cfg.api.enabled)
+    if check:
+        runtime.stop()
+        typer.echo(f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s)")
+        return
+    stop = threading.Event()
+
+    def on_signal(_signum: int, _frame: Any) -> None:
+        stop.set()
+
+    previous = signal.signal(signal.SIGTERM, on_signal)
+    console = Console(highlight=False)
+    runtime.start()
+    try:
+        if runtime.api_address is not None:
+            host, port = runtime.api_address
+            err_console.print(
+                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}",
+                markup=False,
+            )
+        deadline = None if duration is None else time.monotonic() + duration
+        live_table = table and console.is_terminal
+        last = _run(runtime, console, stop, deadline, live_table)
+    except KeyboardInterrupt:
+        last = None
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+        runtime.stop()
+    if last is not None:
+        _print_events(runtime, last)
+    if runtime.scheduler.error is not None:
+        raise RuntimeError(f"the cycle thread failed: {runtime.scheduler.error}")
+
+
+def _print_events(runtime: Any, after: int) -> int:
+    for e in runtime.events.since(after):
+        after = e.seq
+        print(f"{e.time} {e.level:<7} {e.kind:<16} {e.message}", file=sys.stdout, flush=True)
+    return after
+
+
+def _run(
+    runtime: Any, console: Any, stop: threading.Event, deadline: float | None, live_table: bool
+) -> int | None:
+    """Show the runtime until a signal, the deadline, or the cycle thread ends; returns the
+    last event printed (None with the live table)."""
+
+    def remaining() -> float:
+        return 0.25 if deadline is None else max(0.0, min(0.25, deadline - time.monotonic()))
+
+    def done() -> bool:
+        return (
+            stop.is_set()
+            or (deadline is not None and time.monotonic() >= deadline)
+            or not runtime.scheduler.alive
+        )
+
+    if live_table:
+        from rich.live import Live
+
+        from fuzzyctl.runtime.display import render
+
+        with Live(render(runtime), console=console, refresh_per_second=4, screen=False) as live:
+            while not done():
+                stop.wait(remaining())
+                live.update(render(runtime))
+        return None
+    last = 0
+    while True:
+        last = _print_events(runtime, last)
+        if done():
+            return last
+        stop.wait(remaining())

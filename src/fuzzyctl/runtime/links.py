@@ -1,0 +1,219 @@
+"""The process image and the I/O links that keep it up to date.
+
+A :class:`Link` owns one connector and runs on the runtime's I/O event loop: every
+``poll_interval`` it reads all the points bound to inputs (and parameters) of every
+instance into their :class:`InCell`, then writes every output cell to the field, as a
+PLC's process image is exchanged between cycles.  The cycle thread only reads and writes
+cells (plain attribute access, atomic under the GIL), so a slow or dead connection never
+delays a cycle.
+
+On a failure the link goes down, closes the connector and reconnects with exponential
+back-off from ``reconnect_min`` to ``reconnect_max``.  It is up again only after a
+complete exchange, so an instance that sees the link up also sees fresh inputs.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import contextlib
+import math
+import time
+from dataclasses import dataclass, field
+
+from fuzzyctl.io.base import Connector, LinkError, LinkState, Point
+from fuzzyctl.runtime.config import ConnectionConfig
+from fuzzyctl.runtime.events import EventLog
+
+__all__ = ["InCell", "Link", "OutCell"]
+
+
+class InCell:
+    """One input point in the process image: the last value read and when."""
+
+    __slots__ = ("stamp", "value")
+
+    def __init__(self) -> None:
+        self.value = math.nan
+        self.stamp = 0.0
+
+
+class OutCell:
+    """One output point: the value the cycle wants in the field (None: nothing yet)."""
+
+    __slots__ = ("sent", "value")
+
+    def __init__(self) -> None:
+        self.value: float | None = None
+        self.sent: float | None = None
+
+
+@dataclass
+class LinkCounters:
+    exchanges: int = 0
+    failures: int = 0
+    connects: int = 0
+    last_exchange_ms: float = 0.0
+    last_error: str | None = None
+    since: float = field(default_factory=time.monotonic)
+
+
+class Link:
+    """One connection and the cells bound to it."""
+
+    def __init__(self, name: str, connector: Connector, config: ConnectionConfig, events: EventLog) -> None:
+        self.name = name
+        self.connector = connector
+        self.config = config
+        self.events = events
+        self.state = LinkState.DOWN
+        self.counters = LinkCounters()
+        self._in: dict[Point, InCell] = {}
+        self._out: dict[Point, OutCell] = {}
+        self._mirror: dict[Point, OutCell] = {}
+
+    # --- bindings (before start)
+    def input(self, point: Point) -> InCell:
+        """The cell of an input point (shared when several bindings read the same point)."""
+        return self._in.setdefault(point, InCell())
+
+    def output(self, point: Point) -> OutCell:
+        """The cell of an output point, written every exchange."""
+        if point in self._out or point in self._mirror:
+            raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        return self._out.setdefault(point, OutCell())
+
+    def mirror(self, point: Point) -> OutCell:
+        """The cell of a parameter's mirror, written only when its value changes (so a
+        value a client writes is not overwritten before the runtime reads it)."""
+        if point in self._out or point in self._mirror:
+            raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        return self._mirror.setdefault(point, OutCell())
+
+    @property
+    def points(self) -> list[Point]:
+        return list({**self._in, **self._out, **self._mirror})
+
+    @property
+    def up(self) -> bool:
+        return self.state is LinkState.UP
+
+    # --- the exchange
+    async def exchange(self) -> None:
+        """Read every input point, write every output (and changed mirror)."""
+        t0 = time.perf_counter()
+        if self._in:
+            points = list(self._in)
+            values = await self.connector.read(points)
+            now = time.perf_counter()
+            for p, v in zip(points, values, strict=True):
+                in_cell = self._in[p]
+                in_cell.value, in_cell.stamp = v, now
+        out_points: list[Point] = []
+        out_values: list[float] = []
+        sent: list[OutCell] = []
+        for p, out_cell in self._out.items():
+            value = out_cell.value
+            if value is not None:
+                out_points.append(p)
+                out_values.append(value)
+                sent.append(out_cell)
+        for p, out_cell in self._mirror.items():
+            value = out_cell.value
+            if value is not None and value != out_cell.sent:
+                out_points.append(p)
+                out_values.append(value)
+                sent.append(out_cell)
+        if out_points:
+            await self.connector.write(out_points, out_values)
+            for out_cell, value in zip(sent, out_values, strict=True):
+                out_cell.sent = value
+        self.counters.exchanges += 1
+        self.counters.last_exchange_ms = (time.perf_counter() - t0) * 1e3
+
+    async def _connect(self) -> None:
+        await self.connector.connect()
+        ensure = getattr(self.connector, "ensure", None)
+        if ensure is not None:
+            await ensure(self.points)
+        for cell in self._mirror.values():
+            cell.sent = None  # a new peer has not seen our values
+        await self.exchange()
+
+    def _set_state(self, state: LinkState) -> None:
+        self.state = state
+        self.counters.since = time.monotonic()
+
+    async def run(self, stop: asyncio.Event) -> None:
+        """Connect, exchange every poll interval, reconnect with back-off, until ``stop``."""
+        cfg = self.config
+        delay = cfg.reconnect_min
+        attempt = 0
+        loop = asyncio.get_running_loop()
+        while not stop.is_set():
+            if self.state is not LinkState.UP:
+                attempt += 1
+                try:
+                    await self._connect()
+                # A protocol library may raise more than LinkError on a broken peer; any of
+                # them means "not connected", and the link must keep retrying.
+                except Exception as exc:
+                    self.counters.failures += 1
+                    self.counters.last_error = str(exc)
+                    await self.connector.close()
+                    self.events.emit(
+                        "link-retry",
+                        f"{self.name}: {describe(exc)}; next attempt in {delay:.3g} s",
+                        level="warning",
+                        link=self.name,
+                        attempt=attempt,
+                        delay=delay,
+                        error=describe(exc),
+                    )
+                    await _wait(stop, delay)
+                    delay = min(delay * 2, cfg.reconnect_max)
+                    continue
+                self.counters.connects += 1
+                self.counters.last_error = None
+                self._set_state(LinkState.UP)
+                self.events.emit(
+                    "link-up",
+                    f"{self.name}: connected to {self.connector.endpoint()}",
+                    link=self.name,
+                    endpoint=self.connector.endpoint(),
+                    attempts=attempt,
+                )
+                delay, attempt = cfg.reconnect_min, 0
+                continue
+            start = loop.time()
+            try:
+                await self.exchange()
+            except Exception as exc:  # as above: whatever broke, the link is down
+                self.counters.failures += 1
+                self.counters.last_error = describe(exc)
+                self._set_state(LinkState.DOWN)
+                self.events.emit(
+                    "link-lost",
+                    f"{self.name}: {describe(exc)}",
+                    level="error",
+                    link=self.name,
+                    error=describe(exc),
+                )
+                await self.connector.close()
+                continue
+            await _wait(stop, max(0.0, start + cfg.poll_interval - loop.time()))
+        await self.connector.close()
+        self._set_state(LinkState.CLOSED)
+
+
+def describe(exc: BaseException) -> str:
+    """An exception as a message (the type when it says nothing else)."""
+    text = str(exc)
+    return text if isinstance(exc, LinkError) and text else f"{type(exc).__name__}: {text}".rstrip(": ")
+
+
+async def _wait(stop: asyncio.Event, seconds: float) -> None:
+    if seconds <= 0:
+        await asyncio.sleep(0)
+        return
+    with contextlib.suppress(asyncio.TimeoutError):
+        await asyncio.wait_for(stop.wait(), seconds)

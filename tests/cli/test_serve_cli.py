@@ -1,0 +1,60 @@
+"""``fuzzyctl serve``: configuration check, errors without traceback, a timed run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from fuzzyctl.cli.app import main
+from tests.conftest import EXAMPLES
+
+
+def run(args: list[str], capsys: pytest.CaptureFixture[str]) -> tuple[int, str, str]:
+    code = main(args)
+    out, err = capsys.readouterr()
+    return code, out, err
+
+
+def test_serve_check_accepts_the_examples(capsys: pytest.CaptureFixture[str]) -> None:
+    code, out, _ = run(["serve", str(EXAMPLES / "serve" / "s7.toml"), "--check"], capsys)
+    assert code == 0 and "OK: 1 instance(s), 1 connection(s)" in out
+
+
+def test_serve_reports_config_errors_with_file_table_and_key(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    bad = tmp_path / "bad.toml"
+    bad.write_text('[instances.x]\nknowledge_base = "x.fcl"\nperiod = 120\n')
+    code, _, err = run(["serve", str(bad)], capsys)
+    assert code == 1
+    assert f"{bad}: [instances.x] period: Input should be less than or equal to 60" in err
+    assert "Traceback" not in err
+    code, _, err = run(["serve", str(tmp_path / "none.toml")], capsys)
+    assert code == 1 and "cannot read" in err
+
+
+def test_serve_runs_for_a_duration_and_prints_the_event_log(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "serve.toml"
+    cfg.write_text(
+        f"""
+[runtime]
+state_dir = "{tmp_path / "state"}"
+[connections.mb]
+type = "modbus-server"
+port = 0
+[instances.valve]
+knowledge_base = "{EXAMPLES / "fpltest.fpl"}"
+period = 0.01
+[instances.valve.inputs]
+Temp = {{ connection = "mb", address = 0 }}
+"""
+    )
+    code, out, _ = run(["serve", str(cfg), "--duration", "0.5", "--no-table", "--no-api"], capsys)
+    assert code == 0
+    kinds = [line.split()[2] for line in out.splitlines() if line.strip()]
+    assert kinds[0] == "runtime-start" and kinds[-1] == "runtime-stop"
+    assert "link-up" in kinds
+    assert (tmp_path / "state" / "events.jsonl").read_text().count("\n") == len(kinds)
