@@ -397,7 +397,7 @@ class _Builder:
                     for ch in cp.chained:
                         accu = plan.chained[ch].accu
                         target = bare[ch] if cp.term is None else chained[(ch, cp.term)]
-                        b.set(target, T.accumulate(g, accu, target, w * ah))
+                        T.accumulate_into(g, accu, target, T.mul(w, ah))
         return concl
 
     def _cond(
@@ -450,8 +450,8 @@ class _Builder:
         if op.kind == "degree":
             v = g.let(0.0, "Y")
             for _t, a, w, _act in contribs:
-                with b.if_((a * w).gt(0.0)):
-                    b.set(v, T.accumulate(g, op.accu or "MAX", v, w * a))
+                with b.if_(T.mul(w, a).gt(0.0)):
+                    T.accumulate_into(g, op.accu or "MAX", v, T.mul(w, a))
             return v, ex(True)
         if op.kind == "singleton":
             return self._singleton(op, contribs)
@@ -514,10 +514,10 @@ class _Builder:
         acc = {(t, i): g.let(0.0, "ACC") for t, es in enumerate(entries) for i in range(len(es))}
         for t, a, w, act in contribs:
             assert t is not None
-            with b.if_((a * w).gt(0.0)):
+            with b.if_(T.mul(w, a).gt(0.0)):
                 for i, (_x, y) in enumerate(entries[t]):
-                    c = w * T.tnorm(g, act, a, y)
-                    b.set(acc[(t, i)], T.accumulate(g, accu, acc[(t, i)], c))
+                    c = T.mul(w, T.tnorm(g, act, a, y))
+                    T.accumulate_into(g, accu, acc[(t, i)], c)
         used = sorted({t for t, _a, _w, _act in contribs if t is not None})
         keys = [(t, i) for t in used for i in range(len(entries[t]))]
         value = g.temp(hint="Y")
@@ -601,7 +601,7 @@ class _Builder:
         if op.accu is None:
             for t, a, w, _act in contribs:
                 assert t is not None
-                wt = g.let(w * a, "WT")
+                wt = g.let(T.mul(w, a), "WT")
                 zt = z(t)
                 with b.if_(wt.gt(0.0)):
                     b.set(num, num + wt * zt)
@@ -612,8 +612,8 @@ class _Builder:
                 assert t is not None
                 if t not in per:
                     per[t] = g.let(0.0, "WT")
-                with b.if_((a * w).gt(0.0)):
-                    b.set(per[t], T.accumulate(g, op.accu, per[t], w * a))
+                with b.if_(T.mul(w, a).gt(0.0)):
+                    T.accumulate_into(g, op.accu, per[t], T.mul(w, a))
             for t in sorted(per):
                 zt = z(t)
                 with b.if_(per[t].gt(0.0)):

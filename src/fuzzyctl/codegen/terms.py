@@ -54,6 +54,12 @@ def _tr(g: Gen, node: ast.expr, env: dict[str, Ex]) -> Ex:
         return Bin(_CMPOPS[type(node.ops[0])], _tr(g, node.left, env), _tr(g, node.comparators[0], env))
     if isinstance(node, ast.IfExp):
         t = g.temp()
+        if isinstance(node.orelse, ast.Name | ast.Constant):
+            # a plain alternative can be assigned first (shorter code, same value)
+            g.b.set(t, _tr(g, node.orelse, env))
+            with g.b.if_(_tr(g, node.test, env)):
+                g.b.set(t, _tr(g, node.body, env))
+            return t
         with g.b.if_(_tr(g, node.test, env)):
             g.b.set(t, _tr(g, node.body, env))
         with g.b.else_():
@@ -89,6 +95,24 @@ def accumulate(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
     if name == "PROBOR":
         return template(g, SNORMS["ASUM"].source, a, b)
     return snorm(g, name, a, b)
+
+
+def accumulate_into(g: Gen, name: str, target: Var | Index, value: ExLike) -> None:
+    """``target := accumulate(name, target, value)``; MAX as one IF (``a if a > b else b``
+    keeps ``a`` unless ``b`` is larger)."""
+    if name == "MAX":
+        v = _simple(g, value)
+        with g.b.if_(v.gt(target)):
+            g.b.set(target, v)
+        return
+    g.b.set(target, accumulate(g, name, target, value))
+
+
+def mul(w: Ex, x: ExLike) -> Ex:
+    """``w * x``, with a literal weight 1.0 left out (1.0 * x == x exactly)."""
+    if isinstance(w, Num) and w.value == 1.0:
+        return ex(x)
+    return w * ex(x)
 
 
 # --------------------------------------------------------------------------- hedges
