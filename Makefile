@@ -5,7 +5,7 @@ PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
 
-.PHONY: run docs-img test lint typecheck pytest system-deps clean
+.PHONY: run docs-img test fuzz lint typecheck pytest system-deps clean
 
 $(BIN)/python:
 	$(PYTHON) -m venv $(VENV)
@@ -39,6 +39,10 @@ pytest: $(VENV)/.installed-dev system-deps
 	$(BIN)/pytest
 
 test: lint typecheck pytest
+
+# Property tests with fresh random examples (make test replays a fixed set).
+fuzz: $(VENV)/.installed-dev system-deps
+	HYPOTHESIS_PROFILE=fuzz $(BIN)/pytest -q $$(grep -rl '@given' tests)
 
 clean:
 	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache

@@ -10,6 +10,13 @@ import os
 from pathlib import Path
 
 import pytest
+from hypothesis import settings
+
+# `make test` must give the same verdict on every run, so property tests replay a fixed
+# sequence of examples there; `make fuzz` draws fresh ones (and more of them) to hunt bugs.
+settings.register_profile("ci", derandomize=True, print_blob=True)
+settings.register_profile("fuzz", max_examples=1000, print_blob=True)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
 ROOT = Path(__file__).resolve().parent.parent
 SHARED = Path(os.environ.get("FUZZYCTL_SHARED", ROOT.parent / "shared")).resolve()

@@ -51,13 +51,16 @@ def knowledge_bases(draw: st.DrawFn) -> tuple[KnowledgeBase, bool]:
     out_pt = draw(st.booleans())
     intermediates = [] if out_pt else draw(st.lists(st.integers(14, 17), max_size=2, unique=True))
     variables = []
+    # Intermediate names are distinct: two slots under one name cannot be told apart in FCL
+    # (the reader keeps the label then; tested in test_xfuz_format).
+    intermediate_names = iter(draw(st.lists(NAMES, min_size=2, max_size=2, unique_by=str.lower)))
     for slot in sorted(inputs):
         low = draw(st.integers(-1000, 1000))
         variables.append(XVariable(slot, low, low + draw(st.integers(1, 1000))))
     for slot in sorted(outputs + intermediates):
         low = draw(st.integers(-1000, 1000))
         discr = draw(st.integers(3, 20))
-        name = draw(NAMES) if slot >= 14 else ""
+        name = next(intermediate_names) if slot >= 14 else ""
         variables.append(XVariable(slot, low, low + 2 * (discr - 1) + draw(st.integers(0, 500)), discr, name))
     mfs: list[XMembership] = []
     for slot in [*sorted(inputs), *sorted(outputs + intermediates)]:

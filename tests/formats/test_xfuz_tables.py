@@ -376,3 +376,30 @@ def test_xfuz_3_3_tables_to_fcl_text_and_back_give_the_same_words() -> None:
     again, diags = constants_from_model(parse_fcl(text))
     assert not [d for d in diags if d.is_error]
     assert again == manual_constants()
+
+
+def test_xfuz_two_intermediate_variables_under_one_name_keep_their_labels() -> None:
+    from fuzzyctl.formats.xfuz_tables import KnowledgeBase, XMembership, XRule, XVariable, encode_kb
+
+    kb = KnowledgeBase(
+        (
+            XVariable(0, 0, 10),
+            XVariable(8, 0, 20, 5),
+            XVariable(14, 0, 20, 5, "level"),
+            XVariable(15, 0, 20, 5, "LEVEL"),
+        ),
+        (
+            XMembership(0, "low", 0, 0, 0, 2, 6),
+            XMembership(1, "small", 8, 0, 0, 5, 10),
+            XMembership(2, "a", 14, 0, 0, 5, 10),
+            XMembership(3, "b", 15, 0, 0, 5, 10),
+        ),
+        (XRule(0, ((0, False),), (2, 3)), XRule(1, ((0, False),), (1,))),
+    )
+    esv, fa, rg = encode_kb(kb)
+    block, diags = model_from_constants(XfuzConstants(esv=esv, fa=fa, rg=rg))
+    assert not [d for d in diags if d.is_error]
+    dropped = [d for d in diags if d.code == "xfuz-name"]
+    assert len(dropped) == 1 and "LEVEL" in dropped[0].message and "already used" in dropped[0].message
+    local = [v.name for v in block.variables if v.kind is VarKind.LOCAL]
+    assert len(local) == 2 and len({n.lower() for n in local}) == 2 and "level" in local

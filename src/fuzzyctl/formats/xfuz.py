@@ -410,7 +410,18 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
     for v in kb.variables:
         label = v.label
         if v.kind is SlotKind.INTERMEDIATE and v.name and v.name != label:
-            if _IDENT.match(v.name):
+            taken = {w.label.lower() for w in kb.variables} | {n.lower() for n in names.values()}
+            if v.name.lower() in taken:
+                # Two slots under one name cannot both be referred to in FCL; keep the label.
+                diags.append(
+                    warning(
+                        f"{label}: name {v.name!r} is already used by another variable; "
+                        f"the variable is called {label} and the name is dropped",
+                        code="xfuz-name",
+                    )
+                )
+                names[v.slot] = label
+            elif _IDENT.match(v.name):
                 names[v.slot] = v.name
                 renamed.append((v.name, label))
             else:
