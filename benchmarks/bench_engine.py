@@ -128,7 +128,10 @@ def ours(model: str) -> dict[str, tuple[Callable[..., float], Callable[..., Any]
             py_single,
             lambda x1, x2: [py_single(u, v) for u, v in zip(x1.tolist(), x2.tolist(), strict=True)],
         ),
-        "fuzzyctl numpy": (lambda x1, x2: float(batch_of(py)(np.array([x1]), np.array([x2]))[0]), batch_of(py)),
+        "fuzzyctl numpy": (
+            lambda x1, x2: float(batch_of(py)(np.array([x1]), np.array([x2]))[0]),
+            batch_of(py),
+        ),
         "fuzzyctl native (C)": (single_of(native), batch_of(native)),
     }
 

@@ -44,3 +44,33 @@ def test_refusals_exit_1_naming_the_element(capsys: pytest.CaptureFixture[str]) 
     all_terms = shared_path("conformance", "fuzzylite", "mamdani", "AllTerms.fcl")
     assert main(["codegen", str(all_terms), "--lang", "c"]) == 1
     assert "output AllOutputTerms" in capsys.readouterr().err
+
+
+def test_one_function_block_per_fcl_block(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A file with two FUNCTION_BLOCKs gives two ST blocks (one text both parsers accept) and
+    two C pairs; --block picks one."""
+    from tests.codegen.test_st import tree_sitter_errors
+
+    two = tmp_path / "two.fcl"
+    two.write_text(
+        (S.EXAMPLES / "figure7.fcl").read_text() + "\n" + (S.EXAMPLES / "heater_extension.fcl").read_text()
+    )
+    assert main(["codegen", str(two), "-o", str(tmp_path / "two.st")]) == 0
+    text = (tmp_path / "two.st").read_text()
+    assert [line for line in text.splitlines() if line.startswith("FUNCTION_BLOCK")] == [
+        "FUNCTION_BLOCK Fuzzy_FB",
+        "FUNCTION_BLOCK heater",
+    ]
+    assert text.count("END_FUNCTION_BLOCK") == 2 and tree_sitter_errors(text) == []
+    assert main(["codegen", str(two), "--lang", "c", "-o", str(tmp_path / "c")]) == 0
+    assert sorted(p.name for p in (tmp_path / "c").iterdir()) == [
+        "Fuzzy_FB.c",
+        "Fuzzy_FB.h",
+        "heater.c",
+        "heater.h",
+    ]
+    assert main(["codegen", str(two), "--block", "heater"]) == 0
+    only = capsys.readouterr().out
+    assert "FUNCTION_BLOCK heater" in only and "Fuzzy_FB" not in only
+    assert main(["codegen", str(two), "--block", "nope"]) == 1
+    assert "nope" in capsys.readouterr().err

@@ -1,7 +1,12 @@
 """compile(model, backend="native") against the Python core (the specialised scalar path) to
-1e-12 of the output range: every example, every expressible conformance system and
-hypothesis-generated random systems; plus the cache, the fallback without a compiler, and the
-Controller interface (explain, reset, NC state)."""
+1e-12 of the output range: every example and hypothesis-generated random systems, each built
+through the backend into its own cached library; plus the cache, the fallback without a
+compiler, and the Controller interface (explain, reset, NC state).
+
+The conformance systems are checked to the same 1e-12 in tests/codegen/test_c.py, on the
+very C the backend compiles, built in one compiler run: one build per system here would cost
+a minute of compiling and prove nothing more (the backend adds only the batch wrapper, which
+the builds here exercise, and -O3 with -ffp-contract=off keeps IEEE arithmetic)."""
 
 from __future__ import annotations
 
@@ -41,9 +46,7 @@ def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
 
 
 def _files() -> list[tuple[str, Path]]:
-    out = [(f"examples/{p.name}", p) for p in S.example_files()]
-    out += [(rel, p) for rel, p in S.conformance_files() if rel not in S.NOT_EXPRESSIBLE_C]
-    return out
+    return [(f"examples/{p.name}", p) for p in S.example_files()]
 
 
 def _native_outputs(ctl: Controller, plan_inputs: list[str], data: np.ndarray) -> np.ndarray:
@@ -52,7 +55,7 @@ def _native_outputs(ctl: Controller, plan_inputs: list[str], data: np.ndarray) -
     return np.column_stack(cols) if cols else np.zeros((len(data), 0))
 
 
-def test_native_agrees_with_the_python_core_on_every_expressible_system() -> None:
+def test_native_agrees_with_the_python_core_on_every_example() -> None:
     files = _files()
     plans = [S.plan_of(p) for _rel, p in files]
     with ThreadPoolExecutor(max_workers=2) as pool:  # the compiler runs in parallel
