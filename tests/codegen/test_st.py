@@ -292,3 +292,13 @@ def test_refusals_name_the_element(tmp_path: Path) -> None:
         generate_st(fuzzyctl.load(src.replace("pressure", long)))
     with pytest.raises(CodegenError, match=r"unknown dialect"):
         generate_st(fuzzyctl.load(src), dialect="s5")
+
+
+def test_the_package_never_imports_the_test_parsers() -> None:
+    """blark (GPL) and tree-sitter check the output in tests only."""
+    from tests.conftest import ROOT
+
+    pattern = re.compile(r"^\s*(?:import|from)\s+(?:blark|tree_sitter)\b", re.M)
+    sources = list((ROOT / "src" / "fuzzyctl").rglob("*.py"))
+    assert len(sources) > 50
+    assert [str(p) for p in sources if pattern.search(p.read_text())] == []
