@@ -148,6 +148,10 @@ def _init(d: Decl) -> str:
     if d.init is None:
         return ""
     if isinstance(d.init, tuple):
+        if d.storage != "param" and not any(d.init):
+            # IEC 61131-3 initialises to 0 / FALSE anyway; long literal lists cost PLC
+            # editors (and Earley parsers) dearly.  Parameters stay explicit for the tuner.
+            return ""
         return " := [" + ", ".join(one(v) for v in d.init) + "]"
     return " := " + one(d.init)
 
