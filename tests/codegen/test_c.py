@@ -10,6 +10,7 @@ strictly and stays within 1e-4 of the range."""
 from __future__ import annotations
 
 import ctypes
+import re
 import shutil
 import subprocess
 from pathlib import Path
@@ -152,3 +153,41 @@ def test_float_build_compiles_strictly_and_stays_close(tmp_path: Path) -> None:
         err = S.max_error(plan, run(lib, plan, data), S.reference(plan, data))
         assert err <= 1e-4, (plan.name, err)
     assert "typedef float f0_real;" in (tmp_path / "f0.h").read_text()
+
+
+LIBM = re.compile(
+    r"\b(exp|log|log10|sqrt|fabs|sin|cos|tan|asin|acos|atan|sinh|cosh|tanh|floor|ceil|rint|pow|atan2|fmod)f?\s*\("
+)
+ALLOC = re.compile(r"\b(malloc|calloc|realloc|free|alloca)\s*\(")
+
+
+def test_no_allocation_no_mutable_globals_and_only_the_declared_libm(
+    compiled: tuple[ctypes.CDLL, list[tuple[str, Plan]]],
+) -> None:
+    """C99 for small targets: no heap, no state outside the instance struct, and libm only
+    for what the block uses - none for piecewise-linear systems, exp for smooth input terms,
+    sqrt for the exact CoA (the header comment lists them)."""
+    _lib, systems = compiled
+    used: dict[str, set[str]] = {}
+    for label, plan in systems:
+        header, source = render_c(build_program(plan, "c"))
+        code = re.sub(r"/\*.*?\*/", " ", source, flags=re.S)
+        assert not ALLOC.search(code + header), label
+        assert re.findall(r"#include\s+\S+", code) == [f'#include "{plan.name}.h"', "#include <math.h>"], (
+            label
+        )
+        assert re.findall(r"#include\s+\S+", header) == ["#include <stddef.h>"], label
+        # file-scope data is constant tables only
+        for line in code.splitlines():
+            if line and not line[0].isspace() and "=" in line and "(" not in line.split("=")[0]:
+                assert line.startswith("static const "), (label, line)
+        calls = {m.group(1) for m in LIBM.finditer(code)}
+        declared = re.search(r"/\* libm functions used: (.*?) \*/", source)
+        assert declared, label
+        listed = set() if declared.group(1) == "none" else set(declared.group(1).split(", "))
+        assert calls == listed, (label, calls, listed)
+        used[label] = calls
+    for name in ("figure7", "crane", "tank", "pendulum", "siemens_fpltest"):  # points and singletons
+        assert used[f"examples/{name}.fcl"] == set(), name
+    assert used["examples/heater_extension.fcl"] == {"sqrt"}  # CoA, points only
+    assert used["examples/dryer_chained.fcl"] == {"exp", "sqrt"}  # a Gaussian input term, CoA
