@@ -10,7 +10,10 @@ single  = mean latency of one evaluation through each library's public single-sa
 batch   = throughput over 100,000 random samples through the library's vectorised path
           (pyfuzzylite: numpy arrays as input values, best chunk size; scikit-fuzzy: array
           inputs; simpful has none: a loop), best of 3 repeats (slow peers: one, extrapolated)
-|err|   = largest difference from the exact centroid (fuzzyctl) over 1,000 samples
+|err|   = largest difference from the exact centroid (fuzzyctl numpy) over 1,000 samples
+fuzzyctl rows: python = the specialised scalar path (its batch: a loop of evaluate), numpy =
+          evaluate_batch (its single: a one-row batch), native = compile(backend="native"),
+          generated C built into a cached shared library (ctypes; one call per batch)
 Ratios are against pyfuzzylite, measured in this run.
 """
 
@@ -99,19 +102,38 @@ def throughput(
     return best
 
 
-def ours(model: str) -> tuple[Callable[..., float], Callable[..., Any], Any]:
-    ctl = fuzzyctl.compile(fuzzyctl.load(HERE / f"{model}.fcl"))
-    a, b = ctl.inputs
-    out = ctl.outputs[0]
-    evaluate = ctl.evaluate
+def ours(model: str) -> dict[str, tuple[Callable[..., float], Callable[..., Any]]]:
+    """fuzzyctl's three paths: the specialised Python of ``evaluate``, the numpy path of
+    ``evaluate_batch`` and the native backend (generated C in a shared library); each as
+    (single, batch).  The Python path's batch is a loop of ``evaluate``, the numpy path's
+    single evaluation a one-row batch."""
+    doc = fuzzyctl.load(HERE / f"{model}.fcl")
+    py = fuzzyctl.compile(doc)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no silent fallback: a missing compiler must show
+        native = fuzzyctl.compile(doc, backend="native")
+    a, b = py.inputs
+    out = py.outputs[0]
 
-    def single(x1: float, x2: float) -> float:
-        return evaluate({a: x1, b: x2})[out]
+    def single_of(ctl: Any) -> Callable[[float, float], float]:
+        evaluate = ctl.evaluate
+        return lambda x1, x2: evaluate({a: x1, b: x2})[out]
 
-    def batch(x1: np.ndarray, x2: np.ndarray) -> np.ndarray:
-        return ctl.evaluate_batch({a: x1, b: x2})[out]
+    def batch_of(ctl: Any) -> Callable[[np.ndarray, np.ndarray], np.ndarray]:
+        return lambda x1, x2: ctl.evaluate_batch({a: x1, b: x2})[out]
 
-    return single, batch, ctl
+    py_single = single_of(py)
+    return {
+        "fuzzyctl python (specialised)": (
+            py_single,
+            lambda x1, x2: [py_single(u, v) for u, v in zip(x1.tolist(), x2.tolist(), strict=True)],
+        ),
+        "fuzzyctl numpy": (
+            lambda x1, x2: float(batch_of(py)(np.array([x1]), np.array([x2]))[0]),
+            batch_of(py),
+        ),
+        "fuzzyctl native (C)": (single_of(native), batch_of(native)),
+    }
 
 
 def main() -> None:
@@ -143,14 +165,19 @@ def main() -> None:
 
     results: dict[str, dict[str, dict[str, float]]] = {}
     for model in ("tipper", "grid49"):
-        single, batch, _ctl = ours(model)
+        variants = ours(model)
         x1, x2 = samples(model, 1000, 7)
-        exact = batch(x1, x2)
-        results.setdefault("fuzzyctl (exact)", {})[model] = {
-            "single_s": latency(single, model, budget),
-            "batch_per_s": throughput(batch, model, 10 * budget, (4096, 16384, N_BATCH)),
-            "max_err": 0.0,
-        }
+        exact = variants["fuzzyctl numpy"][1](x1, x2)
+        for name, (single, batch) in variants.items():
+            got = np.asarray(batch(x1, x2), dtype=np.float64)
+            slow = name.startswith("fuzzyctl python")
+            results.setdefault(name, {})[model] = {
+                "single_s": latency(single, model, budget),
+                "batch_per_s": throughput(
+                    batch, model, (5 if slow else 10) * budget, (10_000,) if slow else (4096, 16384, N_BATCH)
+                ),
+                "max_err": float(np.max(np.abs(got - exact))),
+            }
         for name, build in libs.items():
             p_single, p_batch = build(model)
             errs = [
@@ -173,7 +200,7 @@ def main() -> None:
                 abs(ref_single(float(a), float(b)) - e)
                 for a, b, e in list(zip(x1, x2, exact, strict=True))[:100]
             )
-            results["fuzzyctl (exact)"][model]["vs_pyfuzzylite_200k"] = float(diff)
+            results["fuzzyctl numpy"][model]["vs_pyfuzzylite_200k"] = float(diff)
 
     base = results.get("pyfuzzylite 1000")
     print(
@@ -200,13 +227,26 @@ def main() -> None:
                     cells.append("-")
         cells += [f"{per['tipper']['max_err']:.2g}", f"{per['grid49']['max_err']:.2g}"]
         print("| " + " | ".join(cells) + " |")
-    if "vs_pyfuzzylite_200k" in results["fuzzyctl (exact)"]["tipper"]:
+    exact_row = results["fuzzyctl numpy"]
+    if "vs_pyfuzzylite_200k" in exact_row["tipper"]:
         print(
             "fuzzyctl vs pyfuzzylite at resolution 200,000: tipper "
-            f"{results['fuzzyctl (exact)']['tipper']['vs_pyfuzzylite_200k']:.2g}, grid49 "
-            f"{results['fuzzyctl (exact)']['grid49']['vs_pyfuzzylite_200k']:.2g} "
+            f"{exact_row['tipper']['vs_pyfuzzylite_200k']:.2g}, grid49 "
+            f"{exact_row['grid49']['vs_pyfuzzylite_200k']:.2g} "
             "(max |difference|, 100 samples)"
         )
+    nat = results["fuzzyctl native (C)"]
+    print("native (C) against the other paths (how many times faster):")
+    for name, per in results.items():
+        if name == "fuzzyctl native (C)":
+            continue
+        cells = []
+        for model in ("tipper", "grid49"):
+            cells.append(
+                f"{model}: single {per[model]['single_s'] / nat[model]['single_s']:,.1f}x, "
+                f"batch {nat[model]['batch_per_s'] / per[model]['batch_per_s']:,.1f}x"
+            )
+        print(f"  {name}: " + "; ".join(cells))
     if args.json:
         args.json.write_text(json.dumps(results, indent=1))
 

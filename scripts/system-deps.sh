@@ -5,6 +5,7 @@ set -euo pipefail
 NEEDED=(
   fuzzylite:fuzzylite  # fuzzylite 6.0 command: outside oracle for our FIS/FLL exports
   chromium:chromium    # the browser the studio tests drive (Playwright with executable_path)
+  cc:build-essential   # C compiler and headers: the generated C and the native backend
 )
 missing=()
 for entry in "${NEEDED[@]}"; do

@@ -52,9 +52,16 @@ def compile(
     """Turn a model into a :class:`~fuzzyctl.engine.Controller` (see ``fuzzyctl.engine``).
 
     ``block`` names the function block of a document (default: the first); ``backend`` is
-    ``"python"`` or ``"interpreted"``; ``compat="fuzzylite"`` etc. reproduces other tools'
-    semantics (default IEC 61131-7).  Raises
-    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
+    ``"python"``, ``"interpreted"`` or ``"native"`` (generated C compiled into a cached
+    shared library, see docs/codegen.md; without a C compiler it warns and uses the Python
+    path); ``compat="fuzzylite"`` etc. reproduces other tools' semantics (default
+    IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine
+    cannot evaluate."""
     from fuzzyctl.engine.compile import compile_block
 
+    if backend == "native":
+        from fuzzyctl.codegen.native import compile_native
+
+        plan = compile_block(model, block=block, backend="interpreted", **options).plan
+        return compile_native(plan)
     return compile_block(model, block=block, backend=backend, **options)

@@ -65,6 +65,28 @@ def test_simulate_json_and_runtime_option(tmp_path: Path, capsys: pytest.Capture
     assert siemens["quality"]["ise"] == pytest.approx(engine["quality"]["ise"], rel=0.05)
 
 
+def test_simulate_through_the_native_backend(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+):
+    monkeypatch.setenv("FUZZYCTL_CACHE_DIR", str(tmp_path / "cache"))
+    args = ["simulate", str(EXAMPLES / "crane.toml"), "--json", "--no-png", "--no-html", "--duration", "60"]
+    assert main([*args, "--csv", str(tmp_path / "a.csv")]) == 0
+    engine = json.loads(capsys.readouterr().out)
+    assert main([*args, "--csv", str(tmp_path / "b.csv"), "-r", "native"]) == 0
+    native = json.loads(capsys.readouterr().out)
+    assert native["runtime"] == "native" and list((tmp_path / "cache" / "native").glob("*.so"))
+    for key, value in engine["quality"].items():
+        if isinstance(value, float):
+            assert native["quality"][key] == pytest.approx(value, rel=1e-9, abs=1e-12), key
+        else:
+            assert native["quality"][key] == value, key
+    # without a compiler it refuses (exit 1, a message), it does not quietly run Python
+    monkeypatch.setenv("FUZZYCTL_CACHE_DIR", str(tmp_path / "empty"))
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-cc"))
+    assert main([*args, "--csv", str(tmp_path / "c.csv"), "-r", "native"]) == 1
+    assert "runtime 'native' cannot run here: no C compiler" in capsys.readouterr().err
+
+
 def _broken(tmp_path: Path, old: str, new: str) -> str:
     shutil.copy(EXAMPLES / "crane.fcl", tmp_path / "crane.fcl")
     text = (EXAMPLES / "crane.toml").read_text()

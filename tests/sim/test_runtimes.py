@@ -1,6 +1,7 @@
 """The same loop through the engine, the Siemens FUZZY block and the XFUZ block agrees:
 the blocks differ from the engine only by single-precision REALs (Siemens) and 16-bit
-words after rescaling (XFUZ), which is what the tolerances below allow."""
+words after rescaling (XFUZ), which is what the tolerances below allow.  Through the native
+backend (the generated C, double precision) the loop is the engine's to rounding."""
 
 from __future__ import annotations
 
@@ -13,6 +14,14 @@ from fuzzyctl.sim import make_runtime
 from fuzzyctl.sim.config import build_loop, load_config
 from fuzzyctl.sim.plc_runtimes import XfuzRuntime, _auto_factor
 from tests.conftest import EXAMPLES
+
+
+@pytest.fixture
+def native_cache(tmp_path, monkeypatch):
+    """Native builds go to a fresh cache (the user's is left alone, nothing is reused)."""
+    monkeypatch.setenv("FUZZYCTL_CACHE_DIR", str(tmp_path / "cache"))
+    return tmp_path / "cache"
+
 
 # example -> (duration s, signal, absolute tolerance siemens, xfuz)
 CASES = {
@@ -62,3 +71,39 @@ def test_unknown_or_missing_runtime():
     model = fuzzyctl.load(EXAMPLES / "crane.fcl")
     with pytest.raises(InputError, match="unknown controller runtime 'plc'"):
         make_runtime(model, "plc")
+
+
+@pytest.mark.parametrize("example", ["crane", "tank"])
+def test_native_loop_agrees_with_the_engine_loop(example, native_cache, monkeypatch):
+    from fuzzyctl.codegen.native import NativeController
+    from fuzzyctl.sim import config as sim_config
+
+    made = []
+
+    def spy(*args, **kwargs):
+        made.append(make_runtime(*args, **kwargs))
+        return made[-1]
+
+    monkeypatch.setattr(sim_config, "make_runtime", spy)
+    duration, signal, _tol_siemens, _tol_xfuz = CASES[example]
+    cfg = load_config(EXAMPLES / f"{example}.toml")
+    made.clear()  # loading checked the configuration with the engine
+    native = build_loop(cfg, runtime="native").run(duration)
+    # the loop really called the compiled C
+    assert [r.name for r in made] == ["native"] and isinstance(made[0].controller, NativeController)
+    assert made[0].controller.library.parent == native_cache / "native"
+    engine = build_loop(cfg, runtime="engine").run(duration)
+    assert native.names == engine.names
+    for name in engine.names:  # every recorded signal, the block's outputs included
+        ref = engine[name]
+        scale = max(1.0, float(np.max(np.abs(ref))))
+        assert np.max(np.abs(native[name] - ref)) <= 1e-9 * scale, name
+    # not trivially: the loop moved the controlled signal
+    assert np.ptp(engine[signal]) > 0
+
+
+def test_native_runtime_refuses_rather_than_falls_back(native_cache, monkeypatch):
+    model = fuzzyctl.load(EXAMPLES / "crane.fcl")
+    monkeypatch.setenv("CC", str(native_cache / "no-such-cc"))
+    with pytest.raises(InputError, match="runtime 'native' cannot run here: no C compiler"):
+        make_runtime(model, "native")

@@ -2,6 +2,7 @@
 
 from fuzzyctl.cli import (
     blocks,  # noqa: F401  (fuzzyctl blocks ...)
+    codegen,  # noqa: F401  (fuzzyctl codegen)
     convert,  # noqa: F401
     lang,  # noqa: F401  (check, fmt)
     run,  # noqa: F401  (eval, explain)

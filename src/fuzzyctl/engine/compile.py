@@ -70,7 +70,7 @@ def compile_block(
             raise FuzzyctlError(f"unknown compile option {bad[0]!r} (known: {', '.join(sorted(known))})")
         opts = dataclasses.replace(opts, **options)
     if backend not in ("python", "interpreted"):
-        raise FuzzyctlError(f"unknown backend {backend!r} (available: python, interpreted)")
+        raise FuzzyctlError(f"unknown backend {backend!r} (available: python, interpreted, native)")
     plan, diags = lower(fb, opts)
     if plan is None:
         path = getattr(model, "path", None) if isinstance(model, Document) else None

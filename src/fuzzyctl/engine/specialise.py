@@ -20,7 +20,7 @@ from typing import Any
 from fuzzyctl.engine import pwl, selection, shapes
 from fuzzyctl.engine.expr import eval_expr
 from fuzzyctl.engine.interp import Interpreter
-from fuzzyctl.engine.operators import SNORMS, TNORMS
+from fuzzyctl.engine.operators import SNORMS, SOURCE_HELPERS, TNORMS
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -65,6 +65,7 @@ class _Gen:
             "_am": pwl.area_moment,
             "_eval_expr": eval_expr,
             "_select": selection.select,
+            **SOURCE_HELPERS,  # the Hamacher templates call _ham_t / _ham_s
         }
         self.consts: dict[int, str] = {}
 

@@ -1,0 +1,314 @@
+"""Print a :class:`~fuzzyctl.codegen.ir.Program` as C99: a header with the instance struct and
+``NAME_init`` / ``NAME_step`` / ``NAME_batch``, and a source file.
+
+No allocation, no globals besides constant tables; libm only for what the block uses
+(``exp`` for smooth shapes, ``sqrt`` for CoA and some shapes/hedges, ``pow``/``log``/``cos``
+only where a shape, hedge or function term needs them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from fuzzyctl.codegen.ir import (
+    Assign,
+    Bin,
+    Bool,
+    Call,
+    Comment,
+    Decl,
+    Ex,
+    For,
+    If,
+    Index,
+    Int,
+    Neg,
+    Not,
+    Num,
+    Program,
+    Region,
+    Stmt,
+    Var,
+    While,
+    subexprs,
+)
+from fuzzyctl.codegen.names import check_c
+
+_PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
+_COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
+_FUNCS = {
+    "EXP": "exp",
+    "LN": "log",
+    "LOG": "log10",
+    "SQRT": "sqrt",
+    "ABS": "fabs",
+    "SIN": "sin",
+    "COS": "cos",
+    "TAN": "tan",
+    "ASIN": "asin",
+    "ACOS": "acos",
+    "ATAN": "atan",
+    "SINH": "sinh",
+    "COSH": "cosh",
+    "TANH": "tanh",
+    "FLOOR": "floor",
+    "CEIL": "ceil",
+    "RINT": "rint",
+    "POW": "pow",
+    "ATAN2": "atan2",
+    "FMOD": "fmod",
+}
+
+
+def libm_functions(prog: Program) -> list[str]:
+    """The libm functions the generated C calls (documented in its header)."""
+    return sorted({_FUNCS[f] for f in prog.uses if f in _FUNCS})
+
+
+class _C:
+    def __init__(self, prog: Program, single: bool) -> None:
+        self.prog = prog
+        self.single = single
+        self.real = f"{prog.name}_real"
+        self.fields = {d.name for d in prog.decls if d.storage in ("input", "output", "param", "state")}
+        self.consts = {d.name for d in prog.decls if d.storage == "const"}
+        self.lines: list[str] = []
+
+    # ------------------------------------------------------------------ expressions
+
+    def num(self, v: float) -> str:
+        if math.isnan(v):
+            return "NAN"
+        s = repr(float(v))
+        if "e" not in s and "." not in s:
+            s += ".0"
+        s = s + ("f" if self.single else "")
+        return f"({s})" if v < 0 else s
+
+    def name(self, n: str) -> str:
+        if n in self.consts:  # file-scope tables: unique per block (several blocks may share a unit)
+            return f"{self.prog.name}_{n}"
+        return f"fb->{n}" if n in self.fields else n
+
+    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
+        if isinstance(e, Num):
+            return self.num(e.value)
+        if isinstance(e, Int):
+            return str(e.value) if e.value >= 0 else f"({e.value})"
+        if isinstance(e, Bool):
+            return "1" if e.value else "0"
+        if isinstance(e, Var):
+            return self.name(e.name)
+        if isinstance(e, Index):
+            return f"{self.name(e.name)}[{self.ex(e.index)}]"
+        if isinstance(e, Neg):
+            return f"-{self.ex(e.operand, 6)}"
+        if isinstance(e, Not):
+            return f"!{self.ex(e.operand, 6)}"
+        if isinstance(e, Call):
+            if e.function == "NAN":
+                return "NAN"
+            if e.function == "TO_REAL":
+                return f"(({self.real}){self.ex(e.args[0])})"
+            fn = _FUNCS[e.function] + ("f" if self.single else "")
+            return f"{fn}({', '.join(self.ex(a) for a in e.args)})"
+        assert isinstance(e, Bin)
+        p = _PREC[e.op]
+        s = f"{self.ex(e.left, p)} {_COP.get(e.op, e.op)} {self.ex(e.right, p, True)}"
+        # operands keep the IR's tree exactly (floating point is not associative)
+        return f"({s})" if p < parent or (right and p == parent) else s
+
+    # ------------------------------------------------------------------ statements
+
+    def emit(self, s: str, ind: int) -> None:
+        self.lines.append("    " * ind + s)
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        for s in body:
+            if isinstance(s, Assign):
+                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)};", ind)
+            elif isinstance(s, Comment):
+                self.emit(f"/* {s.text} */", ind)
+            elif isinstance(s, Region):
+                self.emit(f"/* {s.name} */", ind)
+                self.stmts(s.body, ind)
+            elif isinstance(s, If):
+                for k, (cond, body) in enumerate(s.branches):
+                    kw = "if" if k == 0 else "} else if"
+                    self.emit(f"{kw} ({self.ex(cond)}) {{", ind)
+                    self.stmts(body, ind + 1)
+                if s.orelse:
+                    self.emit("} else {", ind)
+                    self.stmts(s.orelse, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, For):
+                v = s.var
+                cmp, inc = ("<=", "++") if s.step > 0 else (">=", "--")
+                self.emit(f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, While):
+                self.emit(f"while ({self.ex(s.cond)}) {{", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit("}", ind)
+
+
+def _ctype(d: Decl, real: str) -> str:
+    return {"REAL": real, "INT": "int", "BOOL": "unsigned char", "BYTE": "unsigned char"}[d.type]
+
+
+def _read_names(body: Sequence[Stmt]) -> set[str]:
+    """Names whose value is read somewhere (an assignment target itself is not a read)."""
+    out: set[str] = set()
+
+    def visit(e: Ex, top_target: bool) -> None:
+        for sub in subexprs(e):
+            if sub is e and top_target:
+                if isinstance(e, Index):
+                    visit(e.index, False)
+                continue
+            if isinstance(sub, Var | Index):
+                out.add(sub.name)
+
+    def rec(stmts: Sequence[Stmt]) -> None:
+        for s in stmts:
+            if isinstance(s, Assign):
+                visit(s.target, True)
+                visit(s.value, False)
+            elif isinstance(s, If):
+                for c, b in s.branches:
+                    visit(c, False)
+                    rec(b)
+                rec(s.orelse)
+            elif isinstance(s, For):
+                out.add(s.var)
+                visit(s.start, False)
+                visit(s.stop, False)
+                rec(s.body)
+            elif isinstance(s, While):
+                visit(s.cond, False)
+                rec(s.body)
+            elif isinstance(s, Region):
+                rec(s.body)
+
+    rec(body)
+    return out
+
+
+def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
+    """``(header, source)`` for ``prog``; ``single`` selects float instead of double."""
+    name = prog.name
+    check_c(name, "function block name")
+    for d in prog.decls:
+        if d.storage in ("input", "output"):
+            check_c(d.name, "variable")
+    r = _C(prog, single)
+    real = r.real
+    guard = f"FUZZYCTL_{name.upper()}_H"
+    h: list[str] = []
+    h.append(f"/* {name}.h - generated by fuzzyctl; do not edit (regenerate from the FCL). */")
+    for line in prog.header:
+        h.append(f"/* {line} */")
+    h += [f"#ifndef {guard}", f"#define {guard}", "", "#include <stddef.h>", ""]
+    h.append(f"typedef {'float' if single else 'double'} {real};")
+    h.append("")
+    h.append(
+        f"/* One instance of the function block: set the inputs, call {name}_step(), read the outputs. */"
+    )
+    h.append("typedef struct {")
+    for storage, title in (
+        ("input", "inputs"),
+        ("output", "outputs"),
+        ("param", "tunable parameters (initialised by init; may be changed between steps)"),
+        ("state", "internal state"),
+    ):
+        ds = prog.of(storage)  # type: ignore[arg-type]
+        if not ds:
+            continue
+        h.append(f"    /* {title} */")
+        for d in ds:
+            dim = f"[{d.size}]" if d.size is not None else ""
+            note = d.comment.split("\n")[0]
+            h.append(f"    {_ctype(d, real)} {d.name}{dim};" + (f" /* {note} */" if note else ""))
+    h.append(f"}} {name};")
+    h.append("")
+    n_in = len(prog.of("input")) - 1  # without ENABLE
+    outs = [d for d in prog.of("output") if d.name != "INFO"]
+    h.append(f"#define {name.upper()}_N_INPUTS {n_in}")
+    h.append(f"#define {name.upper()}_N_OUTPUTS {len(outs)}")
+    h.append("")
+    h.append("/* Set the parameters to the FCL's values, clear the state, ENABLE = 1. */")
+    h.append(f"void {name}_init({name} *fb);")
+    h.append(f"/* One evaluation (a PLC cycle); returns INFO: {prog.decl('INFO').comment}. */")
+    h.append(f"unsigned char {name}_step({name} *fb);")
+    h.append(
+        f"/* n evaluations in a row: in[i*{n_in} + k] is input k "
+        f"({', '.join(d.name for d in prog.of('input') if d.name != 'ENABLE')}) of row i,"
+    )
+    out_names = ", ".join(d.name for d in outs)
+    h.append(f"   out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row. */")
+    h.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out);")
+    h.append("")
+    h.append(f"#endif /* {guard} */")
+
+    c: list[str] = []
+    c.append(f"/* {name}.c - generated by fuzzyctl; do not edit (regenerate from the FCL). */")
+    libs = libm_functions(prog)
+    c.append(f"/* libm functions used: {', '.join(libs) if libs else 'none'} */")
+    c += [f'#include "{name}.h"', "#include <math.h>", ""]
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
+        c.append(f"static const {_ctype(d, real)} {r.name(d.name)}[{d.size}] = {{{vals}}};")
+    c.append("")
+    c.append(f"void {name}_init({name} *fb)")
+    c.append("{")
+    for d in prog.decls:
+        if d.storage not in ("input", "output", "param", "state"):
+            continue
+        if d.size is None:
+            one = d.init if isinstance(d.init, float | int | bool) else 0.0
+            if isinstance(one, bool) or d.type != "REAL":
+                c.append(f"    fb->{d.name} = {int(one)};")
+            else:
+                c.append(f"    fb->{d.name} = {r.num(float(one))};")
+        else:
+            values = d.init if isinstance(d.init, tuple) else (0.0,) * d.size
+            for i, val in enumerate(values):
+                c.append(f"    fb->{d.name}[{i}] = {r.num(val)};")
+    c.append("}")
+    c.append("")
+    c.append(f"unsigned char {name}_step({name} *fb)")
+    c.append("{")
+    read = _read_names(prog.body)
+    temps = prog.of("temp")
+    for d in temps:  # zero-initialised: keeps -Wmaybe-uninitialized quiet at any -O
+        if d.size is not None:
+            c.append(f"    {_ctype(d, real)} {d.name}[{d.size}] = {{0}};")
+        else:
+            c.append(f"    {_ctype(d, real)} {d.name} = 0;")
+    r.stmts(prog.body, 1)
+    c += r.lines
+    unread = [d.name for d in temps if d.name not in read]
+    for n in unread:  # assigned but never read: keeps -Wall -Wextra -Werror quiet
+        c.append(f"    (void){n};")
+    c.append("    return fb->INFO;")
+    c.append("}")
+    c.append("")
+    ins = [d.name for d in prog.of("input") if d.name != "ENABLE"]
+    c.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out)")
+    c.append("{")
+    c.append("    size_t i;")
+    c.append("    (void)in;")
+    c.append("    (void)out;")
+    c.append("    for (i = 0; i < n; i++) {")
+    for k, nm in enumerate(ins):
+        c.append(f"        fb->{nm} = ({real})in[i * {len(ins)} + {k}];")
+    c.append(f"        {name}_step(fb);")
+    for k, d in enumerate(outs):
+        c.append(f"        out[i * {len(outs)} + {k}] = (double)fb->{d.name};")
+    c.append("    }")
+    c.append("    return fb->INFO;")
+    c.append("}")
+    return "\n".join(h) + "\n", "\n".join(c) + "\n"

@@ -1,0 +1,199 @@
+"""Print a :class:`~fuzzyctl.codegen.ir.Program` as an IEC 61131-3 Structured Text
+FUNCTION_BLOCK in the portable subset: REAL (or LREAL), arrays with literal bounds, FOR loops
+over INT counters, IF instead of MIN/MAX/LIMIT, no ``**``, ``(* *)`` comments, upper-case
+keywords, identifiers of at most 24 characters checked against the reserved words of IEC,
+TwinCAT and SCL.  ``dialect="scl"`` adds Siemens TIA Portal conventions: ``#`` before block
+variables, ``REGION``, ``VERSION`` and ``BEGIN``.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from fuzzyctl.codegen.context import CodegenError
+from fuzzyctl.codegen.ir import (
+    Assign,
+    Bin,
+    Bool,
+    Call,
+    Comment,
+    Decl,
+    Ex,
+    For,
+    If,
+    Index,
+    Int,
+    Neg,
+    Not,
+    Num,
+    Program,
+    Region,
+    Stmt,
+    Var,
+    While,
+)
+from fuzzyctl.codegen.names import check_st
+
+_PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
+#: IEC 61131-3 standard functions (Table 22/23) the program may call.
+_FUNCS = {"EXP", "LN", "LOG", "SQRT", "ABS", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN"}
+
+
+def st_real(v: float) -> str:
+    """A REAL literal with the decimal point IEC requires (``1.0E-5``, never ``1e-05``)."""
+    if not math.isfinite(v):
+        raise CodegenError(f"the value {v} cannot be written in portable Structured Text")
+    s = repr(float(v)).upper()
+    mant, _, exp = s.partition("E")
+    if "." not in mant:
+        mant += ".0"
+    return mant + ("E" + exp if exp else "")
+
+
+class _ST:
+    def __init__(self, prog: Program, dialect: str, lreal: bool) -> None:
+        self.prog = prog
+        self.scl = dialect == "scl"
+        self.real = "LREAL" if lreal else "REAL"
+        self.lines: list[str] = []
+
+    def name(self, n: str) -> str:
+        return f"#{n}" if self.scl else n
+
+    def num(self, v: float) -> str:
+        s = st_real(v)
+        return f"({s})" if v < 0 else s
+
+    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
+        if isinstance(e, Num):
+            return self.num(e.value)
+        if isinstance(e, Int):
+            return str(e.value) if e.value >= 0 else f"({e.value})"
+        if isinstance(e, Bool):
+            return "TRUE" if e.value else "FALSE"
+        if isinstance(e, Var):
+            return self.name(e.name)
+        if isinstance(e, Index):
+            return f"{self.name(e.name)}[{self.ex(e.index)}]"
+        if isinstance(e, Neg):
+            return f"-{self.ex(e.operand, 6)}"
+        if isinstance(e, Not):
+            return f"NOT {self.ex(e.operand, 6)}"
+        if isinstance(e, Call):
+            if e.function == "TO_REAL":
+                return f"INT_TO_{self.real}({self.ex(e.args[0])})"
+            if e.function not in _FUNCS:
+                raise CodegenError(f"function {e.function} has no portable Structured Text equivalent")
+            return f"{e.function}({', '.join(self.ex(a) for a in e.args)})"
+        assert isinstance(e, Bin)
+        p = _PREC[e.op]
+        s = f"{self.ex(e.left, p)} {e.op} {self.ex(e.right, p, True)}"
+        return f"({s})" if p < parent or (right and p == parent) else s
+
+    def emit(self, s: str, ind: int) -> None:
+        self.lines.append("    " * ind + s)
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        for s in body:
+            if isinstance(s, Assign):
+                self.emit(f"{self.ex(s.target)} := {self.ex(s.value)};", ind)
+            elif isinstance(s, Comment):
+                self.emit(f"(* {_safe(s.text)} *)", ind)
+            elif isinstance(s, Region):
+                if self.scl:
+                    self.emit(f"REGION {_safe(s.name)}", ind)
+                    self.stmts(s.body, ind + 1)
+                    self.emit("END_REGION", ind)
+                else:
+                    self.emit(f"(* ---- {_safe(s.name)} *)", ind)
+                    self.stmts(s.body, ind)
+            elif isinstance(s, If):
+                for k, (cond, b) in enumerate(s.branches):
+                    self.emit(f"{'IF' if k == 0 else 'ELSIF'} {self.ex(cond)} THEN", ind)
+                    self.stmts(b, ind + 1) if b else self.emit(";", ind + 1)
+                if s.orelse:
+                    self.emit("ELSE", ind)
+                    self.stmts(s.orelse, ind + 1)
+                self.emit("END_IF;", ind)
+            elif isinstance(s, For):
+                by = "" if s.step == 1 else " BY -1"
+                self.emit(f"FOR {self.name(s.var)} := {self.ex(s.start)} TO {self.ex(s.stop)}{by} DO", ind)
+                self.stmts(s.body, ind + 1) if s.body else self.emit(";", ind + 1)
+                self.emit("END_FOR;", ind)
+            elif isinstance(s, While):
+                self.emit(f"WHILE {self.ex(s.cond)} DO", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit("END_WHILE;", ind)
+
+
+def _safe(text: str) -> str:
+    """Comment text that cannot close the comment."""
+    return text.replace("(*", "( *").replace("*)", "* )")
+
+
+def _type(d: Decl, real: str) -> str:
+    base = {"REAL": real, "INT": "INT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
+    return f"ARRAY[0..{d.size - 1}] OF {base}" if d.size is not None else base
+
+
+def _init(d: Decl) -> str:
+    def one(v: float | bool) -> str:
+        if d.type == "BOOL":
+            return "TRUE" if v else "FALSE"
+        if d.type in ("INT", "BYTE"):
+            return str(int(v))
+        return st_real(float(v))
+
+    if d.init is None:
+        return ""
+    if isinstance(d.init, tuple):
+        if d.storage != "param" and not any(d.init):
+            # IEC 61131-3 initialises to 0 / FALSE anyway; long literal lists cost PLC
+            # editors (and Earley parsers) dearly.  Parameters stay explicit for the tuner.
+            return ""
+        return " := [" + ", ".join(one(v) for v in d.init) + "]"
+    return " := " + one(d.init)
+
+
+def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
+    """One FUNCTION_BLOCK."""
+    check_st(prog.name, "function block name")
+    for d in prog.decls:
+        check_st(d.name, "variable" if d.storage in ("input", "output") else "identifier")
+    r = _ST(prog, dialect, lreal)
+    out: list[str] = []
+    for line in prog.header:
+        out.append(f"(* {_safe(line)} *)")
+    out.append(f"(* dialect: {dialect}; arithmetic in {r.real} *)")
+    if r.scl:
+        out.append(f'FUNCTION_BLOCK "{prog.name}"')
+        out.append("{ S7_Optimized_Access := 'TRUE' }")
+        out.append("VERSION : 0.1")
+    else:
+        out.append(f"FUNCTION_BLOCK {prog.name}")
+
+    def block(kw: str, decls: list[Decl], title: str | None = None) -> None:
+        if not decls:
+            return
+        out.append(kw)
+        if title:
+            out.append(f"    (* {_safe(title)} *)")
+        for d in decls:
+            for line in d.comment.split("\n") if d.comment and d.size is not None else []:
+                out.append(f"    (* {_safe(line)} *)")
+            note = f" (* {_safe(d.comment)} *)" if d.comment and d.size is None else ""
+            out.append(f"    {d.name} : {_type(d, r.real)}{_init(d)};{note}")
+        out.append("END_VAR")
+
+    block("VAR_INPUT", prog.of("input"))
+    block("VAR_OUTPUT", prog.of("output"))
+    block("VAR", prog.of("param"), "tunable parameters: may be changed online")
+    block("VAR", prog.of("state") + prog.of("const"), "internal state and tables: do not change")
+    block("VAR_TEMP", prog.of("temp"))
+    if r.scl:
+        out.append("BEGIN")
+    r.stmts(prog.body, 1 if r.scl else 0)
+    out += r.lines
+    out.append("END_FUNCTION_BLOCK")
+    return "\n".join(out) + "\n"
