@@ -8,8 +8,8 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl import model as m
+from fuzzyctl.fcl.identifiers import fcl_keywords
 from fuzzyctl.formats import convert, read_text
-from fuzzyctl.formats.fcl import fcl_keywords
 
 # IEC 61131-7 Table 7 keywords and the dialect words fcl.lark adds; written out here so a
 # broken keyword extraction cannot pass by testing an empty set.

@@ -116,7 +116,7 @@ def simulate(
         limits = "".join(f", |{k}| <= {v:g}" for k, v in cfg.quality.limits.items()) if cfg.quality else ""
         out.print(f"settling: |{q.signal} - setpoint| <= {q.band:g}{limits} from then on")
     for kind, path in result.files.items():
-        out.print(f"{kind}: {path}")
+        out.print(f"{kind}: {path}", soft_wrap=True)  # a path must stay copyable: never broken
 
 
 def _json_number(v: float | str) -> float | str | None:

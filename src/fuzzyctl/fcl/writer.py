@@ -10,7 +10,9 @@ from __future__ import annotations
 
 from collections.abc import Iterable
 
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.fcl import shapes
+from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.fcl.parser import number_text
 from fuzzyctl.model import (
     And,
@@ -42,6 +44,7 @@ from fuzzyctl.model import (
     ShapeMF,
     SingletonMF,
     SingletonsMF,
+    Span,
     Term,
     Unary,
     Variable,
@@ -281,7 +284,46 @@ def _options(o: OptionsBlock) -> list[str]:
     return [f"{INDENT}{o.keyword}", *body, f"{INDENT}{end}", ""]
 
 
+def unwritable_names(fb: FunctionBlock) -> list[Diagnostic]:
+    """Names FCL could not read back (a keyword such as ``if``, a space in a variable name,
+    ``a/b``): written as they are, they would give a file the parser rejects."""
+    found: list[Diagnostic] = []
+
+    def bad(what: str, name: str, span: Span | None) -> None:
+        found.append(
+            error(
+                f"{what} {name!r} cannot be written in FCL: it is not an identifier or it is an FCL keyword",
+                span,
+                code="fcl-write-name",
+                hint="rename it (`fuzzyctl convert` renames such names itself)",
+            )
+        )
+
+    if fb.name is not None and not fcl_block_name(fb.name):
+        bad("function block", fb.name, fb.span)
+    for v in fb.variables:
+        if not fcl_name(v.name):
+            bad("variable", v.name, v.span)
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in blocks:
+        for t in blk.terms:
+            if not fcl_term(t.name):
+                bad(f"term of {blk.variable}", t.name, t.span)
+    for rb in fb.rule_blocks:
+        if rb.name and not fcl_name(rb.name):
+            bad("rule block", rb.name, rb.span)
+        for r in rb.rules:
+            if r.label and not (r.label.isdigit() or fcl_name(r.label)):
+                bad(f"rule of {rb.name or 'the rule block'}", r.label, r.span)
+    return found
+
+
 def write_block(fb: FunctionBlock) -> str:
+    """FCL text of one function block; a name FCL could not read back is an error (all such
+    names are listed) rather than a file that does not load."""
+    problems = unwritable_names(fb)
+    if problems:
+        raise DiagnosticError(problems)
     out = [*_comment_lines(fb.comments, ""), "FUNCTION_BLOCK" + (f" {fb.name}" if fb.name else ""), ""]
     out.extend(_variables(fb))
     for f in fb.fuzzify:

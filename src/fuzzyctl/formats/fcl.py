@@ -13,10 +13,9 @@ import importlib.util
 import math
 import re
 from dataclasses import replace
-from functools import cache
-from importlib import resources
 from typing import Any
 
+from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.formats import Format, Loaded, Loss
 from fuzzyctl.formats._common import hedge_power, identifier
 from fuzzyctl.formats._lower import rename
@@ -68,35 +67,6 @@ def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule,
         w = float(rule.weight) * (1.0 if c.weight is None else float(c.weight))  # type: ignore[arg-type]
         conclusions.append(replace(c, weight=w))
     return replace(rule, weight=None, conclusions=tuple(conclusions))
-
-
-@cache
-def fcl_keywords() -> frozenset[str]:
-    """Upper-case words FCL reads as something other than a name: every keyword terminal of
-    the grammar (``fcl.lark``: ``IF: "IF"i``, ...), and ``NAN``/``INF``/``INFINITY``, which
-    the grammar reads as numbers wherever a number may stand."""
-    grammar = resources.files("fuzzyctl.fcl").joinpath("fcl.lark").read_text(encoding="utf-8")
-    words = re.findall(r'^[A-Z_]+\s*:\s*"([A-Za-z_]+)"i\s*$', grammar, re.MULTILINE)
-    return frozenset(w.upper() for w in words) | {"NAN", "INF", "INFINITY"}
-
-
-_FCL_ID = re.compile(r"[^\W\d]\w*")  # fcl.lark's ID: a Unicode letter or '_', then word characters
-
-
-def fcl_name(name: str) -> bool:
-    """True when FCL reads ``name`` back as one variable name: an identifier, no keyword
-    in any letter case (a variable ``if`` or ``Rule`` would end the statement)."""
-    return _FCL_ID.fullmatch(name) is not None and name.upper() not in fcl_keywords()
-
-
-def fcl_term(name: str) -> bool:
-    """Term names may be several words (ridderware JFuzzy's ``Rear Left``), each a name."""
-    return bool(name) and all(fcl_name(w) for w in name.split(" "))
-
-
-def _fcl_block_name(name: str) -> bool:
-    """fcl.lark's FB_NAME also takes hyphens inside (``FUNCTION_BLOCK tank-level``)."""
-    return all(fcl_name(w) for w in name.split("-"))
 
 
 def _labels(block: RuleBlock) -> RuleBlock:
@@ -208,7 +178,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         # names FCL cannot read back (MATLAB's "sugeno tipper", "a/b", a variable "if") are
         # renamed: not a loss
         fb, _renames = rename(fb, fcl_name, fcl_term)
-        if fb.name is not None and not _fcl_block_name(fb.name):
+        if fb.name is not None and not fcl_block_name(fb.name):
             fb = replace(fb, name=_fcl_identifier(fb.name, set()))
         taken: set[str] = set()
         fb = replace(

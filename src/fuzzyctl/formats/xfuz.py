@@ -43,6 +43,7 @@ from dataclasses import replace
 from typing import Any
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
+from fuzzyctl.fcl.identifiers import fcl_name
 from fuzzyctl.formats import Format, Loaded, Loss
 from fuzzyctl.formats.xfuz_tables import (
     ESV_SIZE,
@@ -357,7 +358,7 @@ def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
 # --------------------------------------------------------------------------- tables -> model
 
 
-_IDENT = re.compile(r"^[^\W\d]\w*$")
+
 
 
 def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
@@ -421,13 +422,13 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
                     )
                 )
                 names[v.slot] = label
-            elif _IDENT.match(v.name):
+            elif fcl_name(v.name):
                 names[v.slot] = v.name
                 renamed.append((v.name, label))
             else:
                 diags.append(
                     warning(
-                        f"{label}: name {v.name!r} is not an identifier; the variable is called {label}",
+                        f"{label}: name {v.name!r} cannot be an FCL name; renamed {label}",
                         code="xfuz-name",
                     )
                 )
@@ -446,11 +447,11 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
             continue
         regrouped |= mf.slot != last_slot and bool(terms[mf.slot])
         last_slot = mf.slot
-        tname = mf.name if mf.name and _IDENT.match(mf.name) else f"FA{mf.number}"
+        tname = mf.name if mf.name and fcl_name(mf.name) else f"FA{mf.number}"
         if tname != mf.name:
             diags.append(
                 warning(
-                    f"FA{mf.number}: name {mf.name!r} is not an identifier; the term is called {tname}",
+                    f"FA{mf.number}: name {mf.name!r} cannot be an FCL name; renamed {tname}",
                     code="xfuz-name",
                 )
             )
@@ -536,7 +537,7 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
 def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
     constants = read_tables(text, path=path)
     stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
-    block, diags = model_from_constants(constants, name=stem if _IDENT.match(stem) else "xfuz")
+    block, diags = model_from_constants(constants, name=stem if fcl_name(stem) else "xfuz")
     if not constants.out_pt or block.locals:
         diags.append(
             Diagnostic(
