@@ -302,7 +302,7 @@ def unwritable_names(fb: FunctionBlock) -> list[Diagnostic]:
     if fb.name is not None and not fcl_block_name(fb.name):
         bad("function block", fb.name, fb.span)
     for v in fb.variables:
-        if not fcl_name(v.name):
+        if not fcl_term(v.name):  # the parser reads several-word names (ridderware's fly.fcl)
             bad("variable", v.name, v.span)
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for blk in blocks:
