@@ -239,22 +239,9 @@ class _Builder:
 
     def _fuzzify(self) -> dict[tuple[int, int], Ex]:
         plan, g = self.plan, self.g
-        needed: set[tuple[int, int]] = set()
-
-        def collect(c: CondPlan) -> None:
-            if isinstance(c, CTerm) and "any" not in c.hedges:
-                needed.add((c.var, c.term))
-            elif isinstance(c, CNot):
-                collect(c.operand)
-            elif isinstance(c, CAnd | COr):
-                for o in c.operands:
-                    collect(o)
-
-        for r in plan.rules:
-            collect(r.condition)
         degrees: dict[tuple[int, int], Ex] = {}
         by_var: dict[int, list[int]] = {}
-        for var, term in sorted(needed):
+        for var, term in plan.terms_read():
             by_var.setdefault(var, []).append(term)
         pwl_terms: list[tuple[int, int, list[tuple[Ex, Ex]]]] = []
         smooth: dict[int, Params] = {}

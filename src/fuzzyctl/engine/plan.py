@@ -356,6 +356,24 @@ class Plan:
                 return i
         raise KeyError(name)
 
+    def terms_read(self) -> list[tuple[int, int]]:
+        """``(fuzzy input, term)`` pairs some rule condition reads, sorted: the only terms a
+        scalar evaluation needs to fuzzify (``any`` reads no term)."""
+        needed: set[tuple[int, int]] = set()
+
+        def collect(c: CondPlan) -> None:
+            if isinstance(c, CTerm) and "any" not in c.hedges:
+                needed.add((c.var, c.term))
+            elif isinstance(c, CNot):
+                collect(c.operand)
+            elif isinstance(c, CAnd | COr):
+                for o in c.operands:
+                    collect(o)
+
+        for r in self.rules:
+            collect(r.condition)
+        return sorted(needed)
+
     def to_dict(self) -> dict[str, Any]:
         """A JSON-ready view (dataclass names kept under ``"type"``)."""
         return _to_jsonable(self)  # type: ignore[no-any-return]

@@ -203,21 +203,8 @@ def specialise(plan: Plan) -> Fast:
     if any(inp.clamp is not None for inp in plan.inputs):
         g.emit(f"v = [{', '.join(f'v{i}' for i in range(len(plan.inputs)))}]")
     # ---- fuzzification: only the terms some condition reads
-    needed: set[tuple[int, int]] = set()
-
-    def collect(c: CondPlan) -> None:
-        if isinstance(c, CTerm) and "any" not in c.hedges:
-            needed.add((c.var, c.term))
-        elif isinstance(c, CNot):
-            collect(c.operand)
-        elif isinstance(c, CAnd | COr):
-            for o in c.operands:
-                collect(o)
-
-    for rp in plan.rules:
-        collect(rp.condition)
     degrees: dict[tuple[int, int], str] = {}
-    for var, term in sorted(needed):
+    for var, term in plan.terms_read():
         fi = plan.fuzzy_inputs[var]
         name = f"d{var}_{term}"
         g.term(fi.terms[term], f"v{fi.slot}", name)
