@@ -45,35 +45,6 @@ from fuzzyctl.engine.plan import (
     Slot,
 )
 
-FUNCTIONS = frozenset(
-    {
-        "sin",
-        "cos",
-        "tan",
-        "asin",
-        "acos",
-        "atan",
-        "sinh",
-        "cosh",
-        "tanh",
-        "exp",
-        "log",
-        "log10",
-        "sqrt",
-        "abs",
-        "fabs",
-        "floor",
-        "ceil",
-        "round",
-        "pow",
-        "min",
-        "max",
-        "atan2",
-        "fmod",
-        "sign",
-        "ln",
-    }
-)
 HEDGE_NAMES = frozenset(shapes.HEDGES)
 
 
