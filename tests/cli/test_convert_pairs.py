@@ -19,12 +19,12 @@ import pytest
 import fuzzyctl
 from fuzzyctl import formats
 from fuzzyctl.cli.app import main
-from tests.conftest import EXAMPLES, shared_path
+from tests.conftest import EXAMPLES, data_path
 
 SOURCES = {
     "figure7.fcl": EXAMPLES / "figure7.fcl",
-    "tippersg.fis": shared_path(
-        "conformance", "fuzzylite", "original", "takagi-sugeno", "matlab", "tippersg.fis"
+    "tippersg.fis": data_path(
+        "fuzzylite", "original", "takagi-sugeno", "matlab", "tippersg.fis"
     ),
 }
 WRITABLE = [f.name for f in formats.available() if f.write is not None]

@@ -1,7 +1,7 @@
 """The systems the code generators are checked on, and random inputs for them.
 
 * every FCL file in examples/ (all must be expressible in C and ST);
-* every conformance system (../shared/conformance) the engine evaluates, minus the ones the
+* every conformance system (tests/data/, vendored) the engine evaluates, minus the ones the
   C generator refuses (listed in :data:`NOT_EXPRESSIBLE_C` with the reason; a test checks
   the list is exactly what the generator refuses).
 """
@@ -18,7 +18,7 @@ import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.model import Document
-from tests.conftest import EXAMPLES, shared_path
+from tests.conftest import DATA, EXAMPLES
 
 #: Conformance systems the C generator refuses, and why (docs/codegen.md repeats this).
 NOT_EXPRESSIBLE_C = {
@@ -41,7 +41,7 @@ def example_files() -> list[Path]:
 
 def conformance_files() -> list[tuple[str, Path]]:
     """(relative name, path) of every conformance FCL the engine compiles."""
-    root = shared_path("conformance")
+    root = DATA
     out = []
     for p in sorted(root.rglob("*.fcl")):
         if "original" in p.parts:

@@ -8,7 +8,7 @@ import pytest
 
 from fuzzyctl.cli.app import main
 from tests.codegen import systems as S
-from tests.conftest import shared_path
+from tests.conftest import data_path
 
 FIG7 = str(S.EXAMPLES / "figure7.fcl")
 
@@ -38,10 +38,10 @@ def test_option_mismatches_are_usage_errors(tmp_path: Path) -> None:
 
 
 def test_refusals_exit_1_naming_the_element(capsys: pytest.CaptureFixture[str]) -> None:
-    dimmer = shared_path("conformance", "fuzzylite", "mamdani", "SimpleDimmer.fcl")
+    dimmer = data_path("fuzzylite", "mamdani", "SimpleDimmer.fcl")
     assert main(["codegen", str(dimmer), "--lang", "st"]) == 1
     assert "output Power: DEFAULT := nan" in capsys.readouterr().err
-    all_terms = shared_path("conformance", "fuzzylite", "mamdani", "AllTerms.fcl")
+    all_terms = data_path("fuzzylite", "mamdani", "AllTerms.fcl")
     assert main(["codegen", str(all_terms), "--lang", "c"]) == 1
     assert "output AllOutputTerms" in capsys.readouterr().err
 

@@ -1,4 +1,4 @@
-"""Every system of the real-world corpus (../shared/corpus) that the readers accept either
+"""Every system of the real-world corpus (extra suite ``corpus``) that the readers accept either
 compiles or is refused with diagnostics - never a crash - and the specialised, numpy and
 interpreted evaluators agree on it, with explanations available."""
 
@@ -8,10 +8,13 @@ import math
 import warnings
 
 import numpy as np
+import pytest
 
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from tests.conftest import shared_path
+
+pytestmark = pytest.mark.extra("corpus")
 
 
 def test_corpus_compiles_or_is_refused_and_the_evaluators_agree() -> None:

@@ -1,4 +1,4 @@
-"""The engine against fuzzylite's reference tables (../shared/conformance/fuzzylite/*.fld),
+"""The engine against fuzzylite's reference tables (tests/data/fuzzylite, vendored/*.fld),
 read through fuzzylite's FCL exports.
 
 With ``compat="fuzzylite"`` (WITH scales the degree, rules fire above 1e-6, Takagi-Sugeno
@@ -16,11 +16,11 @@ import numpy as np
 import pytest
 
 import fuzzyctl
-from tests.conftest import shared_path
+from tests.conftest import data_path
 
-FL = ("conformance", "fuzzylite")
+FL = ("fuzzylite",)
 FILES = sorted(
-    str(p.relative_to(shared_path(*FL))) for p in shared_path(*FL).rglob("*.fld") if "original" not in p.parts
+    str(p.relative_to(data_path(*FL))) for p in data_path(*FL).rglob("*.fld") if "original" not in p.parts
 )
 MAMDANI_TOL = 5e-4  # of the range
 TS_TOL = 1e-6
@@ -40,7 +40,7 @@ IEC_DIFFERS = {
 
 
 def _check(rel: str, compat: str) -> dict[str, float]:
-    fld = shared_path(*FL) / rel
+    fld = data_path(*FL) / rel
     options = {"hedges_carry_over": True} if compat == "fuzzylite" else {}
     c = fuzzyctl.compile(fuzzyctl.load(fld.with_suffix(".fcl")), compat=compat, **options)
     lines = fld.read_text().splitlines()
@@ -80,7 +80,7 @@ def test_iec_semantics_where_no_fuzzylite_deviation_applies(rel: str) -> None:
 def test_juggler_duplicate_terms_keep_the_first_and_warn() -> None:
     from fuzzyctl.engine.support import unsupported
 
-    doc = fuzzyctl.load(shared_path(*FL) / "takagi-sugeno" / "matlab" / "juggler.fcl")
+    doc = fuzzyctl.load(data_path(*FL) / "takagi-sugeno" / "matlab" / "juggler.fcl")
     assert any(d.code == "duplicate-term" for d in unsupported(doc.main))
 
 

@@ -1,7 +1,7 @@
-"""The engine against jFuzzyLogic 3.3's own outputs (../shared/conformance/jfuzzylogic).
+"""The engine against jFuzzyLogic 3.3's own outputs (tests/data/jfuzzylogic, vendored).
 
 Membership tables must agree exactly (1e-12); defuzzified grids within the error of
-jFuzzyLogic's 1000-point Riemann sum (README: 1e-3 x range), compiled with
+jFuzzyLogic's 1000-point Riemann sum (tests/data/CONFORMANCE.md: 1e-3 x range), compiled with
 ``compat="jfuzzylogic"`` (WITH weights the condition degree and every conclusion of its
 rule).  Where a file exceeds 1e-3 (vertical edges that fall on sample points: shashankrao,
 robot, up to 1.25e-3), the test proves the whole difference is that sum: jFuzzyLogic's
@@ -22,13 +22,13 @@ from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine.explain import Explanation, OutputTrace
 from fuzzyctl.engine.shapes import membership_np, pwl_value_np, sort_points
 from fuzzyctl.model import FunctionBlock, PointsMF, ShapeMF
-from tests.conftest import shared_path
+from tests.conftest import data_path
 
-JFL = Path("conformance/jfuzzylogic")
+JFL = Path("jfuzzylogic")
 RIEMANN = 1e-3  # of the output range (README)
 
-MEMBERSHIP = sorted(p.name for p in shared_path(*JFL.parts, "expected", "membership").glob("*.tsv"))
-GRIDS = sorted(p.name for p in shared_path(*JFL.parts, "expected", "grids").glob("*.tsv"))
+MEMBERSHIP = sorted(p.name for p in data_path(*JFL.parts, "expected", "membership").glob("*.tsv"))
+GRIDS = sorted(p.name for p in data_path(*JFL.parts, "expected", "grids").glob("*.tsv"))
 # jFuzzyLogic guesses a universe for gaussian outputs without RANGE; we require a RANGE.
 NEEDS_RANGE = {
     "fcl_QoS_LarsenQoSFewRules.tsv",
@@ -55,12 +55,12 @@ def _table(path: Path) -> tuple[list[str], list[str], np.ndarray]:
 
 @pytest.mark.parametrize("name", MEMBERSHIP)
 def test_membership_tables_exact(name: str) -> None:
-    comments, head, data = _table(shared_path(*JFL.parts, "expected", "membership", name))
+    comments, head, data = _table(data_path(*JFL.parts, "expected", "membership", name))
     m = re.search(r"source: (\S+)(?: variable (\S+))?(?: with (.*))?", comments[0])
     assert m is not None
     src, var = m.group(1), m.group(2) or head[0]
     extra = {k: float(v) for k, v in re.findall(r"(\w+)=([-\d.]+)", m.group(3) or "")}
-    c = fuzzyctl.compile(fuzzyctl.load(shared_path(*JFL.parts, src)))
+    c = fuzzyctl.compile(fuzzyctl.load(data_path(*JFL.parts, src)))
     for row in data:
         inputs = {n: 0.0 for n in c.inputs} | extra | {var: float(row[0])}
         degrees = {t.term: t.degree for t in c.explain(inputs).terms if t.variable == var}
@@ -72,14 +72,14 @@ def test_membership_tables_exact(name: str) -> None:
     "name",
     sorted(
         p.name
-        for p in shared_path(*JFL.parts, "tests").glob("junit_*.txt")
+        for p in data_path(*JFL.parts, "tests").glob("junit_*.txt")
         if p.name not in ("junit_tipper.txt", "junit_functions.txt")
     ),
 )
 def test_junit_rounded_tables(name: str) -> None:
     """jFuzzyLogic's own unit-test tables: round(100 * value)."""
-    _c, head, data = _table(shared_path(*JFL.parts, "tests", name))
-    c = fuzzyctl.compile(fuzzyctl.load(shared_path(*JFL.parts, "tests", name.replace(".txt", ".fcl"))))
+    _c, head, data = _table(data_path(*JFL.parts, "tests", name))
+    c = fuzzyctl.compile(fuzzyctl.load(data_path(*JFL.parts, "tests", name.replace(".txt", ".fcl"))))
     for row in data:
         degrees = {t.term: t.degree for t in c.explain({head[0]: row[0] / 100.0}).terms}
         for term, want in zip(head[1:], row[1:], strict=True):
@@ -118,10 +118,10 @@ def _riemann_centroid(fb: FunctionBlock, trace: Explanation, out: OutputTrace) -
 
 def _riemann_error(name: str) -> float:
     """Worst |emulated Riemann CoG - jFuzzyLogic| / range over the fired Mamdani CoG rows."""
-    comments, head, data = _table(shared_path(*JFL.parts, "expected", "grids", name))
+    comments, head, data = _table(data_path(*JFL.parts, "expected", "grids", name))
     src = re.search(r"source: (\S+)", comments[0])
     assert src is not None
-    doc = fuzzyctl.load(shared_path(*JFL.parts, src.group(1)))
+    doc = fuzzyctl.load(data_path(*JFL.parts, src.group(1)))
     fb = doc.blocks[0]
     c = fuzzyctl.compile(doc, compat="jfuzzylogic")
     worst, checked = 0.0, 0
@@ -139,10 +139,10 @@ def _riemann_error(name: str) -> float:
 
 
 def _grid(name: str, compat: str) -> tuple[float, float]:
-    comments, head, data = _table(shared_path(*JFL.parts, "expected", "grids", name))
+    comments, head, data = _table(data_path(*JFL.parts, "expected", "grids", name))
     src = re.search(r"source: (\S+)", comments[0])
     assert src is not None
-    c = fuzzyctl.compile(fuzzyctl.load(shared_path(*JFL.parts, src.group(1))), compat=compat)
+    c = fuzzyctl.compile(fuzzyctl.load(data_path(*JFL.parts, src.group(1))), compat=compat)
     inputs = {h: data[:, i] for i, h in enumerate(head) if h in c.inputs}
     got = c.evaluate_batch(inputs)
     worst_rel = 0.0
@@ -182,11 +182,11 @@ def test_iec_weights_differ_from_jfuzzylogic_where_documented(name: str) -> None
 
 @pytest.mark.parametrize("name", sorted(NEEDS_RANGE))
 def test_unbounded_outputs_without_range_are_reported(name: str) -> None:
-    comments, _h, _d = _table(shared_path(*JFL.parts, "expected", "grids", name))
+    comments, _h, _d = _table(data_path(*JFL.parts, "expected", "grids", name))
     src = re.search(r"source: (\S+)", comments[0])
     assert src is not None
     with pytest.raises(DiagnosticError, match="give a RANGE"):
-        fuzzyctl.compile(fuzzyctl.load(shared_path(*JFL.parts, src.group(1))))
+        fuzzyctl.compile(fuzzyctl.load(data_path(*JFL.parts, src.group(1))))
 
 
 @pytest.mark.parametrize(

@@ -1,5 +1,5 @@
-"""The real-world corpus and the conformance FCL files: load rate, the defects of the files
-that do not load, and write -> read round trips."""
+"""The real-world corpus (extra suite ``corpus``) and the vendored conformance FCL files: load
+rate, the defects of the files that do not load, and write -> read round trips."""
 
 from __future__ import annotations
 
@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 
 from fuzzyctl.fcl import load_file, load_text, write
-from tests.conftest import shared_path
+from tests.conftest import DATA, shared_path
 
 HERE = Path(__file__).resolve().parent.parent / "fcl"
 
@@ -28,6 +28,7 @@ def corpus() -> dict[str, object]:
     return {f.name: load_file(f) for f in files}
 
 
+@pytest.mark.extra("corpus")
 def test_corpus_load_rate_and_rejected_files(corpus: dict[str, object]) -> None:
     rejected = _rejected()
     loaded = [name for name, r in corpus.items() if r.ok]  # type: ignore[attr-defined]
@@ -44,6 +45,7 @@ def test_corpus_load_rate_and_rejected_files(corpus: dict[str, object]) -> None:
         assert keyword in first.message, (name, first.message)
 
 
+@pytest.mark.extra("corpus")
 def test_corpus_round_trip(corpus: dict[str, object]) -> None:
     for name, result in corpus.items():
         if not result.ok:  # type: ignore[attr-defined]
@@ -54,7 +56,7 @@ def test_corpus_round_trip(corpus: dict[str, object]) -> None:
 
 
 def test_conformance_fcl_files_load_and_round_trip() -> None:
-    files = sorted(shared_path("conformance").rglob("*.fcl"))
+    files = sorted(DATA.rglob("*.fcl"))
     assert len(files) > 90
     for f in files:
         result = load_file(f)

@@ -1,5 +1,5 @@
-"""Every readable file of ../shared/corpus and ../shared/conformance (FCL, FIS, FLL; identical
-files once) converted to every format that can be both written and read, the way
+"""Every readable file of the corpus (extra suite) and of the vendored conformance data (FCL,
+FIS, FLL; identical files once) converted to every format that can be both written and read, the way
 ``fuzzyctl convert`` does it (``formats.convert``).
 
 * A conversion without losses always writes a file that our reader of the target reads.
@@ -12,7 +12,6 @@ Counts per target are printed in the "conformance measurements" section."""
 
 from __future__ import annotations
 
-import hashlib
 from functools import cache
 from pathlib import Path
 
@@ -21,35 +20,21 @@ import pytest
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import available, convert, decode, get, read_text
 from fuzzyctl.model import Document
-from tests.conftest import SHARED
+from tests.extras import SOURCE_SETS, source_files
 
 TARGETS = [f.name for f in available() if f.write is not None and f.read is not None]
 LOSSY_MUST_READ = {"fcl", "fis", "fll", "json"}
 
 
-def _sources() -> list[Path]:
-    seen: set[str] = set()
-    out = []
-    for kind in ("fcl", "fis", "fll"):
-        for path in sorted((SHARED / "corpus" / kind).glob(f"*.{kind}")) + sorted(
-            (SHARED / "conformance").rglob(f"*.{kind}")
-        ):
-            digest = hashlib.sha1(path.read_bytes()).hexdigest()
-            if digest not in seen:
-                seen.add(digest)
-                out.append(path)
-    return out
-
-
-SOURCES = _sources()
+KINDS = ("fcl", "fis", "fll")
 
 
 @cache
-def _documents() -> list[tuple[Path, Document]]:
-    """The readable sources, parsed once for all targets (the unreadable ones are the
-    business of tests/formats/rejected.tsv and the FCL corpus test)."""
+def _documents(source: str) -> list[tuple[Path, Document]]:
+    """The readable files of a source set, parsed once for all targets (the unreadable ones
+    are the business of tests/formats/rejected.tsv and the FCL corpus test)."""
     out = []
-    for path in SOURCES:
+    for path in source_files(source, KINDS):
         try:
             out.append((path, get(path.suffix[1:]).read(decode(path.read_bytes()), str(path)).document))
         except DiagnosticError:
@@ -57,16 +42,22 @@ def _documents() -> list[tuple[Path, Document]]:
     return out
 
 
-def test_the_issue_formats_are_all_converted() -> None:
+@pytest.mark.parametrize("source", SOURCE_SETS)
+def test_the_issue_formats_are_all_converted(source: str) -> None:
     assert {"fcl", "fis", "fll", "json", "fpl", "xfuz"} <= set(TARGETS)
-    assert len(SOURCES) > 400 and len(_documents()) > 0.95 * len(SOURCES)
+    files = source_files(source, KINDS)
+    assert len(files) > {"corpus": 240, "vendored": 230}[source]
+    assert len(_documents(source)) > 0.95 * len(files)
 
 
+@pytest.mark.parametrize("source", SOURCE_SETS)
 @pytest.mark.parametrize("target", TARGETS)
-def test_every_conversion_reads_back(target: str, record_property: pytest.RecordProperty) -> None:
+def test_every_conversion_reads_back(
+    target: str, source: str, record_property: pytest.RecordProperty
+) -> None:
     problems = []
-    for path, document in _documents():
-        label = f"convert corpus -> {target}, files"
+    for path, document in _documents(source):
+        label = f"convert {source} -> {target}, files"
         try:
             text, losses = convert(document, target, lossy=True)
         except DiagnosticError as exc:

@@ -1,5 +1,6 @@
-"""Every .fis and .fll of the shared corpus loads, or is rejected at its real defect;
-written back, it reads again to the same model."""
+"""Every .fis and .fll of the shared corpus (extra suite ``corpus``) loads, or is rejected at
+its real defect; written back, it reads again to the same model (also the vendored
+fuzzylite files, in every clone)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,7 @@ import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import decode, get
-from tests.conftest import ROOT, shared_path
+from tests.conftest import DATA, ROOT, shared_path
 
 REJECTED = ROOT / "tests" / "formats" / "rejected.tsv"
 
@@ -24,6 +25,7 @@ def _files(kind: str) -> list[Path]:
     return sorted(shared_path("corpus", kind).glob(f"*.{kind}"))
 
 
+@pytest.mark.extra("corpus")
 @pytest.mark.parametrize("kind", ["fis", "fll"])
 def test_load_rate_and_rejections(kind: str, record_property: pytest.RecordProperty) -> None:
     rejected = {k: v for k, v in _rejected().items() if k.startswith(f"{kind}/")}
@@ -57,10 +59,11 @@ def test_load_rate_and_rejections(kind: str, record_property: pytest.RecordPrope
     assert not unexpected_loads, f"listed as broken but loaded: {sorted(unexpected_loads)}"
 
 
+@pytest.mark.parametrize("source", [pytest.param("corpus", marks=pytest.mark.extra("corpus")), "vendored"])
 @pytest.mark.parametrize("kind", ["fis", "fll"])
-def test_written_back_reads_to_the_same_model(kind: str) -> None:
+def test_written_back_reads_to_the_same_model(kind: str, source: str) -> None:
     fmt = get(kind)
-    files = _files(kind) + sorted(shared_path("conformance", "fuzzylite").rglob(f"*.{kind}"))
+    files = _files(kind) if source == "corpus" else sorted((DATA / "fuzzylite").rglob(f"*.{kind}"))
     same = lossy = written = 0
     for path in files:
         try:
@@ -79,7 +82,7 @@ def test_written_back_reads_to_the_same_model(kind: str) -> None:
         same += again.main == lowered.main
         written += 1
     print(
-        f"\n{kind} -> model -> {kind}: {written} files written and read back to the same text "
+        f"\n{source} {kind} -> model -> {kind}: {written} files written and read back to the same text "
         f"({same} to an identical model), {lossy} not expressible"
     )
     assert written >= 0.95 * (written + lossy)

@@ -1,7 +1,7 @@
 """Debian's ``fuzzylite`` command (fuzzylite 6.0) as an outside oracle for our writers and
 our engine.
 
-1. fuzzylite against fuzzylite: for every fuzzylite example (``../shared/conformance/fuzzylite``)
+1. fuzzylite against fuzzylite: for every fuzzylite example (``tests/data/fuzzylite``, vendored)
    we read the ``.fll``, write it as FLL and as FIS, and let fuzzylite evaluate the original
    and both exports on the same 40 random inputs: a wrong parameter order, hedge code,
    operator or weight would change its answers.
@@ -33,7 +33,6 @@ conformance README calls stale), and counted apart:
 
 from __future__ import annotations
 
-import hashlib
 import math
 import shutil
 import subprocess
@@ -50,7 +49,8 @@ from fuzzyctl.engine import shapes
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.formats import decode, get
 from fuzzyctl.model import FunctionBlock
-from tests.conftest import SHARED, shared_path
+from tests.conftest import DATA
+from tests.extras import real_files
 
 FUZZYLITE = shutil.which("fuzzylite")
 
@@ -97,9 +97,7 @@ def _tolerances(fb: FunctionBlock) -> np.ndarray:
     return np.array(tol)
 
 
-EXAMPLES = sorted(
-    p for p in shared_path("conformance", "fuzzylite").rglob("*.fll") if "original" not in p.parts
-)
+EXAMPLES = sorted(p for p in (DATA / "fuzzylite").rglob("*.fll") if "original" not in p.parts)
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: str(p.relative_to(p.parents[2])))
@@ -134,23 +132,6 @@ def test_fuzzylite_agrees_on_our_exports(path: Path, tmp_path: Path) -> None:
 
 
 # --------------------------------------------------------------------------- our engine vs fuzzylite
-
-
-def _sources() -> list[Path]:
-    seen: set[str] = set()
-    out = []
-    for kind in ("fll", "fis"):
-        for path in sorted((SHARED / "corpus" / kind).glob(f"*.{kind}")) + sorted(
-            (SHARED / "conformance").rglob(f"*.{kind}")
-        ):
-            digest = hashlib.sha1(path.read_bytes()).hexdigest()
-            if digest not in seen:
-                seen.add(digest)
-                out.append(path)
-    return out
-
-
-SOURCES = _sources()
 
 
 def _unreadable_by_fuzzylite6(fb: FunctionBlock, fmt: str) -> str | None:
@@ -198,7 +179,7 @@ def _maximum_ends(fb: FunctionBlock, name: str, data: dict[str, np.ndarray]) -> 
     return (ends[0] + ends[1]) / 2.0
 
 
-@pytest.mark.parametrize("source", SOURCES, ids=[str(p.relative_to(SHARED)) for p in SOURCES])
+@pytest.mark.parametrize("source", real_files("fll", "fis"))
 def test_our_engine_agrees_with_fuzzylite_on_our_exports(
     source: Path, tmp_path: Path, record_property: pytest.RecordProperty
 ) -> None:

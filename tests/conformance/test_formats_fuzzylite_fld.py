@@ -1,4 +1,4 @@
-"""fuzzylite's reference tables (../shared/conformance/fuzzylite/*.fld, 39 examples) through
+"""fuzzylite's reference tables (tests/data/fuzzylite, vendored/*.fld, 39 examples) through
 our FIS reader and through our FLL reader.
 
 Tolerances as the conformance README explains: Takagi-Sugeno outputs to 1e-6; integral
@@ -29,12 +29,12 @@ import pytest
 import fuzzyctl
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.formats import read_path
-from tests.conftest import shared_path
+from tests.conftest import data_path
 
-FL = ("conformance", "fuzzylite")
+FL = ("fuzzylite",)
 EXAMPLES = sorted(
-    str(p.relative_to(shared_path(*FL)).with_suffix(""))
-    for p in shared_path(*FL).rglob("*.fld")
+    str(p.relative_to(data_path(*FL)).with_suffix(""))
+    for p in data_path(*FL).rglob("*.fld")
     if "original" not in p.parts
 )
 MAMDANI_TOL = 5e-4  # of the output range
@@ -63,7 +63,7 @@ _EVALUATED: dict[tuple[str, Plan], dict[str, np.ndarray]] = {}
 
 def _errors(example: str, reader: str, compat: str, **options: float) -> dict[str, tuple[float, float]]:
     """Worst absolute error and tolerance per output."""
-    fld = shared_path(*FL) / f"{example}.fld"
+    fld = data_path(*FL) / f"{example}.fld"
     lines = fld.read_text().splitlines()
     head = lines[0].split()
     data = np.array([[float(v) for v in ln.split()] for ln in lines[1:] if ln.strip()])
@@ -125,4 +125,4 @@ def test_every_fld_is_covered() -> None:
     assert len(EXAMPLES) == 39
     for example in EXAMPLES:
         for reader in ("fis", "fll"):
-            assert Path(shared_path(*FL) / f"{example}.{reader}").exists()
+            assert Path(data_path(*FL) / f"{example}.{reader}").exists()

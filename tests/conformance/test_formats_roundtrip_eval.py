@@ -1,6 +1,6 @@
 """Round trips keep what a system computes: FIS -> model -> FIS, FLL -> model -> FLL and
-FCL -> FIS -> FCL over every file of ../shared/corpus and ../shared/conformance (identical
-files counted once), evaluated with the engine on random inputs.
+FCL -> FIS -> FCL over every file of the corpus (extra suite) and of the vendored conformance data
+(identical files counted once per set), evaluated with the engine on random inputs.
 
 For each file: read it (A), convert it (``Format.lower`` + ``write``) and read the result
 back (B; for FCL -> FIS -> FCL, B is the FIS and C the FCL written from it), then evaluate A
@@ -23,7 +23,6 @@ printed in the "conformance measurements" section.
 
 from __future__ import annotations
 
-import hashlib
 import math
 import re
 from pathlib import Path
@@ -36,27 +35,15 @@ from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.formats import decode, get
-from tests.conftest import SHARED
+from tests.extras import real_files
 
 TOLERANCE = 1e-9
 PATHS = {"fis": ("fis", ("fis",)), "fll": ("fll", ("fll",)), "fcl": ("fcl", ("fis", "fcl"))}
-
-
-def _files(kind: str) -> list[Path]:
-    seen: set[str] = set()
-    out = []
-    candidates = sorted((SHARED / "corpus" / kind).glob(f"*.{kind}")) + sorted(
-        (SHARED / "conformance").rglob(f"*.{kind}")
-    )
-    for path in candidates:
-        digest = hashlib.sha1(path.read_bytes()).hexdigest()
-        if digest not in seen:
-            seen.add(digest)
-            out.append(path)
-    return out
-
-
-CASES = [(kind, p) for kind in PATHS for p in _files(kind)]
+CASES = [
+    pytest.param(kind, p.values[0], marks=p.marks, id=f"{kind}:{p.id}")
+    for kind in PATHS
+    for p in real_files(kind)
+]
 
 
 def _normal(name: str) -> str:
@@ -129,7 +116,7 @@ def _worst(a: Controller, b: Controller, data: dict[str, np.ndarray]) -> float:
     return worst
 
 
-@pytest.mark.parametrize(("path", "source"), CASES, ids=[f"{k}:{p.relative_to(SHARED)}" for k, p in CASES])
+@pytest.mark.parametrize(("path", "source"), CASES)
 def test_round_trip_keeps_evaluation(path: str, source: Path, record_property: pytest.RecordProperty) -> None:
     kind, targets = PATHS[path]
     chain = " -> ".join([kind, *targets]) if path == "fcl" else f"{kind} -> model -> {kind}"

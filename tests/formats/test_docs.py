@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import doctest
 
+import pytest
+
 from tests.conftest import ROOT
 
 
-def test_formats_doc_examples() -> None:
+def test_formats_doc_examples(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.chdir(ROOT)  # the page names files relative to the checkout
     result = doctest.testfile(
         str(ROOT / "docs" / "formats.md"), module_relative=False, optionflags=doctest.ELLIPSIS
     )

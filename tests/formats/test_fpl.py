@@ -104,6 +104,7 @@ EXPECTED_FPLTEST = FunctionBlock(
 )
 
 
+@pytest.mark.extra("seeds")
 def test_siemens_1_3_fpltest_example_reads_as_printed() -> None:
     result = parse_fpl(fpltest_from_manual(), path="FPLTEST.fpl")
     assert result.document is not None
@@ -200,6 +201,7 @@ def test_siemens_1_3_errors_name_the_place(source: str, message: str, line: int,
     assert first.file == "bad.fpl"
 
 
+@pytest.mark.extra("seeds")
 def test_fpl_writer_round_trips_the_manual_example() -> None:
     doc = read_fpl(fpltest_from_manual())
     text = write_fpl(doc)
@@ -249,6 +251,7 @@ def test_fpl_writer_turns_triangles_and_trapezoids_into_points() -> None:
     assert back.term("z") == Term("z", pts((4, 0), (5, 1), (6, 1), (7, 0)))
 
 
+@pytest.mark.extra("seeds")
 def test_siemens_1_3_fpltest_reads_like_the_fcl_transcription() -> None:
     # examples/siemens_fpltest.fcl was written by hand (FCL issue) from the same listing;
     # the FPL carries MIN/MAX, which that FCL leaves out.

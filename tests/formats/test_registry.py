@@ -9,7 +9,7 @@ import pytest
 from fuzzyctl import formats
 from fuzzyctl.cli.app import main
 from fuzzyctl.diagnostics import FuzzyctlError
-from tests.conftest import shared_path
+from tests.conftest import data_path
 
 
 def test_builtin_formats_and_extensions() -> None:
@@ -27,7 +27,7 @@ def test_a_registered_format_is_used_by_convert(tmp_path: Path) -> None:
     fmt = formats.Format("demo", (".demo",), "test", write=lambda d: seen.append(d) or "ok\n")
     formats.register(fmt)
     try:
-        src = shared_path("conformance", "fuzzylite", "mamdani", "SimpleDimmer.fll")
+        src = data_path("fuzzylite", "mamdani", "SimpleDimmer.fll")
         assert main(["convert", str(src), str(tmp_path / "x.demo")]) == 0
         assert (tmp_path / "x.demo").read_text() == "ok\n" and seen
     finally:
@@ -37,7 +37,7 @@ def test_a_registered_format_is_used_by_convert(tmp_path: Path) -> None:
 def test_convert_refuses_losses_then_lists_them_with_lossy(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    src = shared_path("conformance", "fuzzylite", "mamdani", "SimpleDimmerChained.fll")
+    src = data_path("fuzzylite", "mamdani", "SimpleDimmerChained.fll")
     out = tmp_path / "out.fis"
     out.write_text("previous content\n")
     assert main(["convert", str(src), str(out)]) == 1
@@ -51,7 +51,7 @@ def test_convert_refuses_losses_then_lists_them_with_lossy(
 
 
 def test_convert_between_formats_keeps_the_model(tmp_path: Path) -> None:
-    src = shared_path("conformance", "fuzzylite", "takagi-sugeno", "octave", "linear_tip_calculator.fll")
+    src = data_path("fuzzylite", "takagi-sugeno", "octave", "linear_tip_calculator.fll")
     original = formats.read_path(src).document
     assert main(["convert", str(src), str(tmp_path / "a.json")]) == 0
     assert main(["convert", str(tmp_path / "a.json"), str(tmp_path / "b.txt"), "--to", "fll"]) == 0
@@ -59,7 +59,7 @@ def test_convert_between_formats_keeps_the_model(tmp_path: Path) -> None:
 
 
 def test_unavailable_and_bad_input_exit_codes(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
-    src = shared_path("conformance", "fuzzylite", "mamdani", "SimpleDimmer.fll")
+    src = data_path("fuzzylite", "mamdani", "SimpleDimmer.fll")
     code = main(["convert", str(src), str(tmp_path / "x.xyz")])
     assert code == 1 and "cannot tell the format" in capsys.readouterr().err
     broken = tmp_path / "broken.fis"
@@ -77,7 +77,7 @@ def test_write_atomic_replaces_whole_file(tmp_path: Path) -> None:
 
 def test_convert_formats_by_option_whatever_the_extensions(tmp_path: Path) -> None:
     """--from and --to override the extensions (a MATLAB FIS saved as .txt)."""
-    src = shared_path("conformance", "fuzzylite", "takagi-sugeno", "matlab", "tippersg.fis")
+    src = data_path("fuzzylite", "takagi-sugeno", "matlab", "tippersg.fis")
     renamed = tmp_path / "tipper.txt"
     renamed.write_bytes(src.read_bytes())
     assert main(["convert", str(renamed), str(tmp_path / "out.dat"), "--from", "fis", "--to", "fll"]) == 0

@@ -397,6 +397,7 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     shot(pg, "17-recorder-archive")
 
 
+@pytest.mark.extra("corpus")  # a real FIS file with OR rules
 def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
     pg = page
     fis = shared_path("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis")
