@@ -20,30 +20,15 @@ Layout of the generated block
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen, Target
 from fuzzyctl.codegen.guard import check_known_fields
-from fuzzyctl.codegen.ir import Decl, Ex, Index, Int, Num, Program, Var, ex, not_
+from fuzzyctl.codegen.ir import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
 from fuzzyctl.engine import shapes
-from fuzzyctl.engine.lower_terms import uses_x
-from fuzzyctl.engine.plan import (
-    CAnd,
-    CChained,
-    CDegree,
-    CNot,
-    CondPlan,
-    COr,
-    CTerm,
-    CTrue,
-    OutputPlan,
-    Plan,
-    PParam,
-    Slot,
-    TermPlan,
-)
+from fuzzyctl.engine.irrules import Contrib, Params, RuleBuilder, literal
+from fuzzyctl.engine.plan import OutputPlan, Plan, Slot, TermPlan
 
 #: INFO codes (modelled on the Siemens FUZZY block's INFO byte).
 INFO_OK = 0x00
@@ -52,56 +37,12 @@ INFO_DEFAULT = 0x02  # no rule fired for at least one output: DEFAULT or the pre
 INFO_DEGREE_RANGE = 0x31  # an input used as a degree (or WITH weight) is outside [0, 1]
 
 
-@dataclass
-class Params:
-    """A tunable parameter array being filled."""
+class _Builder(RuleBuilder):
+    """The PLC function block: rule evaluation from :class:`RuleBuilder`, constants as
+    tunable parameter arrays, the output geometry built at run time."""
 
-    g: Gen
-    name: str
-    what: str
-    values: list[float] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
-
-    def add(self, value: float, note: str) -> Index:
-        self.values.append(float(value))
-        self.notes.append(note)
-        return Var(self.name)[len(self.values) - 1]
-
-    def finish(self) -> None:
-        if not self.values:
-            self.g.names.discard(self.name.upper())
-            return
-        self.g.decls.append(_param_decl(self))
-
-
-def _param_decl(p: Params) -> Decl:
-    lines = [p.what] + [f"[{i}] {n}" for i, n in enumerate(p.notes)]
-    return Decl(p.name, "REAL", "param", len(p.values), tuple(p.values), "\n".join(lines))
-
-
-class _Builder:
     def __init__(self, plan: Plan, target: Target) -> None:
-        self.plan = plan
-        self.g = Gen(target)
-        self.inputs: list[Ex] = []
-        self.params: list[Params] = []
-
-    # ------------------------------------------------------------------ parameters
-
-    def new_params(self, hint: str, fallback: str, what: str) -> Params:
-        name = self.g.fresh(hint, fallback)
-        self.g.names.add(name.upper())
-        p = Params(self.g, name, what)
-        self.params.append(p)
-        return p
-
-    def pv(self, p: PParam, arr: Params | None, note: str) -> Ex:
-        """A parameter: an input's current value, a tunable entry, or a literal."""
-        if isinstance(p, Slot):
-            return self.inputs[p.index]
-        if arr is None:
-            return Num(p)
-        return arr.add(p, note)
+        super().__init__(plan, Gen(target))
 
     def pwl_points(self, t: TermPlan, xs: Params, ys: Params, where: str) -> list[tuple[Ex, Ex]]:
         """A piecewise-linear term as breakpoints (x, y) in the engine's order
@@ -178,14 +119,14 @@ class _Builder:
         with b.else_():
             b.set(info, Int(INFO_OK))
             degrees = self._fuzzify()
-            concl = self._rules(degrees, weights)
+            concl = self.rules(degrees, weights)
             values: dict[int, Ex] = {}
             exact = [oi for oi in plan.output_order if plan.outputs[oi].kind == "mamdani"]
             results: dict[int, tuple[Ex, Ex]] = {}
             if exact:
                 with b.region("defuzzify (exact, piecewise linear)"):
                     specs = [
-                        self._mamdani(plan.outputs[oi], self._contribs(plan.outputs[oi], concl))
+                        self._mamdani(plan.outputs[oi], self.contribs(plan.outputs[oi], concl))
                         for oi in exact
                     ]
                     vals, fireds = exact_outputs(g, specs)
@@ -205,7 +146,7 @@ class _Builder:
                             if op.no_change:
                                 b.set(outs[oi], prev[oi])
                             else:
-                                b.set(outs[oi], _literal(op.default if op.default is not None else 0.0))
+                                b.set(outs[oi], literal(op.default if op.default is not None else 0.0))
                     b.set(prev[oi], outs[oi])
                     values[oi] = outs[oi]
         for p in self.params:
@@ -259,43 +200,13 @@ class _Builder:
                 self._fuzzify_pwl(pwl_terms, degrees)
         for var, term_ids in by_var.items():
             fi = plan.fuzzy_inputs[var]
-            x = self.inputs[fi.slot]
             pp = smooth[var]
             if all(fi.terms[ti].kind in shapes.PWL_KINDS for ti in term_ids):
                 continue
             with g.b.region(f"fuzzify {fi.name}"):
                 for ti in term_ids:
-                    t = fi.terms[ti]
-                    where = f"term {fi.name}.{t.name}"
-                    if t.kind in shapes.PWL_KINDS:
-                        continue
-                    d: Ex
-                    if t.kind == "singleton":
-                        pos = self.pv(t.params[0], pp, f"{t.name} position")
-                        dv = g.temp(hint="MU")
-                        with g.b.if_(x.eq(pos)):
-                            g.b.set(dv, self.pv(t.height, None, ""))
-                        with g.b.else_():
-                            g.b.set(dv, 0.0)
-                        d = dv
-                    elif t.kind == "function":
-                        assert t.expr is not None
-                        d = g.let(T.expression(g, t.expr, self.inputs, _no_outputs, x, where), "MU")
-                    elif t.kind in shapes.SMOOTH_KINDS:
-                        ps = [
-                            self.pv(p, pp, f"{t.name} {name}")
-                            for p, name in zip(t.params, _param_names(t.kind, len(t.params)), strict=True)
-                        ]
-                        m: Ex = T.smooth(g, t.kind, ps, x, where)
-                        h = t.height
-                        d = (
-                            m
-                            if (not isinstance(h, Slot) and h == 1.0)
-                            else g.let(self.pv(h, None, "") * m, "MU")
-                        )
-                    else:
-                        raise g.refuse(where, f"{t.kind} terms on inputs")
-                    degrees[(var, ti)] = d
+                    if fi.terms[ti].kind not in shapes.PWL_KINDS:
+                        degrees[(var, ti)] = self.fuzzify_term(var, ti, pp)
         return degrees
 
     def _fuzzify_pwl(
@@ -335,117 +246,20 @@ class _Builder:
         for k, (v, ti, _p) in enumerate(terms):
             degrees[(v, ti)] = deg[k]
 
-    # ------------------------------------------------------------------ rules
-
-    def _rules(self, degrees: dict[tuple[int, int], Ex], weights: Params) -> list[list[tuple[Ex, Ex]]]:
-        """Rule degrees in plan order; returns per rule the (hedged degree, weight) of each
-        conclusion (``interp.run``)."""
-        plan, g = self.plan, self.g
-        b = g.b
-        opts = plan.options
-        chained: dict[tuple[int, int], Var] = {}
-        bare: dict[int, Var] = {}
-        for ci, chp in enumerate(plan.chained):
-            for ti in range(len(chp.terms)):
-                chained[(ci, ti)] = g.let(0.0, f"C{ci}_{ti}")
-            bare[ci] = g.let(0.0, f"CB{ci}")
-        normalised: set[int] = set()
-        concl: list[list[tuple[Ex, Ex]]] = [[] for _ in plan.rules]
-        with b.region("rules"):
-            for ri in plan.order:
-                rule = plan.rules[ri]
-                b.comment(f"RULE {rule.label}" + (f" (block {rule.block})" if rule.block else ""))
-                for ci in sorted(_chained_reads(rule.condition) - normalised):
-                    normalised.add(ci)
-                    if plan.chained[ci].accu == "NSUM" and plan.chained[ci].terms:
-                        top = g.let(1.0, "TOP")
-                        names = [chained[(ci, t)] for t in range(len(plan.chained[ci].terms))]
-                        for n in names:  # max([1.0, *accs])
-                            with b.if_(n.gt(top)):
-                                b.set(top, n)
-                        for n in names:
-                            b.set(n, n / top)
-                a = g.let(self._cond(rule.condition, degrees, chained, bare), f"R{ri}")
-                if opts.firing_threshold > 0.0:
-                    with b.if_(a.le(opts.firing_threshold)):
-                        b.set(a, 0.0)
-                carried: Ex = a
-                for cj, cp in enumerate(rule.conclusions):
-                    base = carried if opts.hedges_carry_over else a
-                    ah = T.hedged(g, base, cp.hedges, False) if cp.hedges else base
-                    if opts.hedges_carry_over:
-                        carried = ah
-                    w = (
-                        self.pv(cp.weight, weights, f"rule {rule.label} conclusion {cj + 1}")
-                        if (isinstance(cp.weight, Slot) or cp.weight != 1.0)
-                        else Num(1.0)
-                    )
-                    concl[ri].append((ah, w))
-                    for ch in cp.chained:
-                        accu = plan.chained[ch].accu
-                        target = bare[ch] if cp.term is None else chained[(ch, cp.term)]
-                        T.accumulate_into(g, accu, target, T.mul(w, ah))
-        return concl
-
-    def _cond(
-        self,
-        c: CondPlan,
-        degrees: dict[tuple[int, int], Ex],
-        chained: dict[tuple[int, int], Var],
-        bare: dict[int, Var],
-    ) -> Ex:
-        g = self.g
-        if isinstance(c, CTerm | CChained):
-            table: dict[tuple[int, int], Ex] = degrees if isinstance(c, CTerm) else dict(chained)
-            d = Num(1.0) if "any" in c.hedges else table[(c.var, c.term)]
-            return T.hedged(g, d, c.hedges, c.negated)
-        if isinstance(c, CDegree):
-            return self.inputs[c.slot] if c.slot is not None else bare[c.chained or 0]
-        if isinstance(c, CNot):
-            return g.let(1.0 - self._cond(c.operand, degrees, chained, bare), "N")
-        if isinstance(c, CAnd | COr):
-            acc = self._cond(c.operands[0], degrees, chained, bare)
-            for o in c.operands[1:]:
-                v = self._cond(o, degrees, chained, bare)
-                acc = (T.tnorm if isinstance(c, CAnd) else T.snorm)(g, c.op, acc, v)
-            return acc
-        assert isinstance(c, CTrue)
-        return Num(1.0)
-
     # ------------------------------------------------------------------ outputs
-
-    def _contribs(
-        self, op: OutputPlan, concl: list[list[tuple[Ex, Ex]]]
-    ) -> list[tuple[int | None, Ex, Ex, str]]:
-        """(term, degree, weight, act) with the weight placement of the options
-        (``interp._contribs``; the a*w > 0 filter is emitted where they are used)."""
-        out: list[tuple[int | None, Ex, Ex, str]] = []
-        for c in op.contributions:
-            ah, w = concl[c.rule][c.conclusion]
-            if self.plan.options.weight_before_activation and not (isinstance(w, Num) and w.value == 1.0):
-                out.append((c.term, self.g.let(ah * w, "AW"), ex(1.0), c.act))
-            else:
-                out.append((c.term, ah, w, c.act))
-        return out
 
     def _output(
         self, oi: int, op: OutputPlan, concl: list[list[tuple[Ex, Ex]]], values: dict[int, Ex]
     ) -> tuple[Ex, Ex]:
-        g = self.g
-        b = g.b
-        contribs = self._contribs(op, concl)
+        contribs = self.contribs(op, concl)
         if op.kind == "degree":
-            v = g.let(0.0, "Y")
-            for _t, a, w, _act in contribs:
-                with b.if_(T.mul(w, a).gt(0.0)):
-                    T.accumulate_into(g, op.accu or "MAX", v, T.mul(w, a))
-            return v, ex(True)
+            return self.degree_output(op, contribs)
         if op.kind == "singleton":
-            return self._singleton(op, contribs)
+            return self.singleton(op, contribs)
         assert op.kind == "ts"
-        return self._ts(op, contribs, values)
+        return self.ts(op, contribs, values)
 
-    def _mamdani(self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]]) -> ExactOutput:
+    def _mamdani(self, op: OutputPlan, contribs: list[Contrib]) -> ExactOutput:
         g = self.g
         assert op.low is not None and op.high is not None
         accu = op.accu or "MAX"
@@ -478,181 +292,12 @@ class _Builder:
                 groups.append(gr)
         return ExactOutput(op.name, op.method, accu, op.low, op.high, points, groups)
 
-    def _singleton(self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]]) -> tuple[Ex, Ex]:
-        g = self.g
-        b = g.b
-        accu = op.accu or "MAX"
-        sx = self.new_params(f"{op.name}_S", "OS", f"{op.name}: singleton positions")
-        sy = self.new_params(f"{op.name}_SY", "OSY", f"{op.name}: singleton degrees")
-        entries: list[list[tuple[Ex, Ex]]] = []
-        for term in op.terms:
-            if term.kind == "singleton":
-                entries.append([(self.pv(term.params[0], sx, term.name), Num(1.0))])
-            else:
-                es: list[tuple[Ex, Ex]] = []
-                for k in range(0, len(term.params), 2):
-                    es.append(
-                        (
-                            self.pv(term.params[k], sx, f"{term.name} x{k // 2}"),
-                            self.pv(term.params[k + 1], sy, f"{term.name} y{k // 2}"),
-                        )
-                    )
-                entries.append(es)
-        acc = {(t, i): g.let(0.0, "ACC") for t, es in enumerate(entries) for i in range(len(es))}
-        for t, a, w, act in contribs:
-            assert t is not None
-            with b.if_(T.mul(w, a).gt(0.0)):
-                for i, (_x, y) in enumerate(entries[t]):
-                    c = T.mul(w, T.tnorm(g, act, a, y))
-                    T.accumulate_into(g, accu, acc[(t, i)], c)
-        used = sorted({t for t, _a, _w, _act in contribs if t is not None})
-        keys = [(t, i) for t in used for i in range(len(entries[t]))]
-        value = g.temp(hint="Y")
-        fired = g.temp("BOOL", "FIRED")
-        total = g.let(0.0, "DEN")
-        for key in keys:
-            b.set(total, total + acc[key])
-        b.set(fired, total.gt(0.0))
-        if op.method == "COGS":
-            num = g.let(0.0, "NUM")
-            for key in keys:
-                b.set(num, num + entries[key[0]][key[1]][0] * acc[key])
-            with b.if_(fired):
-                b.set(value, num / total)
-            with b.else_():
-                b.set(value, 0.0)
-            return value, fired
-        # LM / RM / MoM over the positions reaching the largest degree (exact equality)
-        sup = g.let(0.0, "SUP")
-        for key in keys:
-            with b.if_(acc[key].gt(sup)):
-                b.set(sup, acc[key])
-        lm, rm, s, n = g.let(0.0, "LMX"), g.let(0.0, "RMX"), g.let(0.0, "SUM"), g.let(0, "CNT", "INT")
-        for idx, key in enumerate(keys):
-            x = entries[key[0]][key[1]][0]
-            with b.if_(acc[key].eq(sup).and_(sup.gt(0.0))):
-                with b.if_(n.eq(0).or_(x.lt(lm))):
-                    b.set(lm, x)
-                with b.if_(n.eq(0).or_(x.gt(rm))):
-                    b.set(rm, x)
-                # count each position once (the engine takes the set of positions)
-                dup: Ex = ex(False)
-                for k2 in keys[:idx]:
-                    x2 = entries[k2[0]][k2[1]][0]
-                    dup = dup.or_(acc[k2].eq(sup).and_(x2.eq(x)))
-                with b.if_(not_(dup)):
-                    b.set(s, s + x)
-                    b.set(n, n + 1)
-        with b.if_(fired.and_(n.gt(0))):
-            b.set(value, {"LM": lm, "RM": rm}.get(op.method, s / g.call("TO_REAL", n)))
-        with b.else_():
-            b.set(value, 0.0)
-        return value, fired
-
-    def _ts(
-        self, op: OutputPlan, contribs: list[tuple[int | None, Ex, Ex, str]], values: dict[int, Ex]
-    ) -> tuple[Ex, Ex]:
-        g = self.g
-        b = g.b
-        coef = self.new_params(f"{op.name}_Z", "OZ", f"{op.name}: Takagi-Sugeno values and coefficients")
-        zs: dict[int, Ex] = {}
-        n_in = len(self.plan.inputs)
-
-        def z(t: int) -> Ex:
-            if t not in zs:
-                term = op.terms[t]
-                where = f"term {op.name}.{term.name}"
-                if term.kind in ("singleton", "constant"):
-                    zs[t] = self.pv(term.params[0], coef, term.name)
-                elif term.kind == "linear":
-                    acc: Ex = Num(0.0)
-                    for i, c in enumerate(term.params[:n_in]):
-                        acc = (
-                            acc
-                            + self.pv(c, coef, f"{term.name} * {self.plan.inputs[i].name}") * self.inputs[i]
-                        )
-                    if len(term.params) > n_in:
-                        acc = acc + self.pv(term.params[n_in], coef, f"{term.name} constant")
-                    zs[t] = g.let(acc, "Z")
-                else:
-                    assert term.expr is not None
-                    if uses_x(term.expr):
-                        raise g.refuse(where, "a function of x on a Takagi-Sugeno output")
-                    zs[t] = g.let(
-                        T.expression(g, term.expr, self.inputs, lambda o: values[o], None, where), "Z"
-                    )
-            return zs[t]
-
-        num = g.let(0.0, "NUM")
-        den = g.let(0.0, "DEN")
-        if op.accu is None:
-            for t, a, w, _act in contribs:
-                assert t is not None
-                wt = g.let(T.mul(w, a), "WT")
-                zt = z(t)
-                with b.if_(wt.gt(0.0)):
-                    b.set(num, num + wt * zt)
-                    b.set(den, den + wt)
-        else:
-            per: dict[int, Var] = {}
-            for t, a, w, _act in contribs:
-                assert t is not None
-                if t not in per:
-                    per[t] = g.let(0.0, "WT")
-                with b.if_(T.mul(w, a).gt(0.0)):
-                    T.accumulate_into(g, op.accu, per[t], T.mul(w, a))
-            for t in sorted(per):
-                zt = z(t)
-                with b.if_(per[t].gt(0.0)):
-                    b.set(num, num + per[t] * zt)
-                    b.set(den, den + per[t])
-        fired = g.let(den.gt(0.0), "FIRED", "BOOL")
-        value = g.temp(hint="Y")
-        with b.if_(fired):
-            b.set(value, num / den if op.method == "WTAVER" else num)
-        with b.else_():
-            b.set(value, 0.0)
-        return value, fired
-
 
 def _weight_key(w: Ex) -> int:
     if isinstance(w, Num):
         return -1  # the literal 1.0 (no WITH)
     assert isinstance(w, Index) and isinstance(w.index, Int)
     return w.index.value
-
-
-def _no_outputs(_o: int) -> Ex:
-    raise AssertionError("input terms cannot read outputs")
-
-
-def _literal(v: float) -> Ex:
-    if math.isnan(v):
-        from fuzzyctl.codegen.ir import Call
-
-        return Call("NAN", ())
-    return Num(v)
-
-
-def _chained_reads(c: CondPlan) -> set[int]:
-    if isinstance(c, CChained):
-        return {c.var}
-    if isinstance(c, CNot):
-        return _chained_reads(c.operand)
-    if isinstance(c, CAnd | COr):
-        out: set[int] = set()
-        for o in c.operands:
-            out |= _chained_reads(o)
-        return out
-    return set()
-
-
-def _param_names(kind: str, n: int) -> list[str]:
-    from fuzzyctl.model import SHAPES
-
-    spec = SHAPES.get(kind)
-    names = list(spec.params) if spec is not None else []
-    return (names + [f"p{i}" for i in range(len(names), n)])[:n]
 
 
 def _info_comment() -> str:

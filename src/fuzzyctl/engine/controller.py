@@ -6,15 +6,17 @@ from __future__ import annotations
 import math
 import numbers
 from collections.abc import Callable, Mapping
-from typing import Any
-
-import numpy as np
-import numpy.typing as npt
+from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.engine import explain as explain_mod
-from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan
+
+if TYPE_CHECKING:  # numpy is imported when a batch is evaluated (cold start)
+    import numpy as np
+    import numpy.typing as npt
+
+    from fuzzyctl.engine import explain as explain_mod
+    from fuzzyctl.engine.interp import Interpreter
 
 _INF = math.inf
 
@@ -31,19 +33,55 @@ class Controller:
         self.name = plan.name
         self.inputs: tuple[str, ...] = tuple(i.name for i in plan.inputs)
         self.outputs: tuple[str, ...] = tuple(o.name for o in plan.outputs if o.is_output)
-        self._interp = Interpreter(plan)
         self._state: list[float | None] = [None] * len(plan.outputs)
         self._required = tuple(i.name for i in plan.inputs if i.default is None)
         self._degree = tuple(i.degree for i in plan.inputs)
-        self._fast: Callable[[list[float], list[float | None]], list[float]] | None = None
-        self._batch: Any = None
-        if specialise:
-            from fuzzyctl.engine.specialise import specialise as make_fast
+        self._specialise = specialise
+        self._interp_obj: Interpreter | None = None
+        # the generated evaluators, made on first use (None: not yet; False: the plan uses
+        # something the generator does not implement, the interpreter evaluates it)
+        self._fast_fn: Callable[[list[float], list[float | None]], list[float]] | None | bool = None
+        self._batch_fn: Any = None
 
-            self._fast = make_fast(plan)
-            from fuzzyctl.engine.batch import BatchEvaluator
+    @property
+    def _interp(self) -> Interpreter:
+        if self._interp_obj is None:
+            from fuzzyctl.engine.interp import Interpreter
 
-            self._batch = BatchEvaluator(plan)
+            self._interp_obj = Interpreter(self.plan)
+        return self._interp_obj
+
+    @property
+    def _fast(self) -> Callable[[list[float], list[float | None]], list[float]] | None:
+        """The generated scalar evaluator (:mod:`fuzzyctl.engine.render_py`), or None."""
+        if self._fast_fn is None:
+            self._fast_fn = False
+            if self._specialise:
+                from fuzzyctl.engine.fastprog import build_fast
+                from fuzzyctl.engine.irgen import CodegenError
+                from fuzzyctl.engine.render_py import specialise
+
+                try:
+                    self._fast_fn = specialise(build_fast(self.plan, "py"))
+                except CodegenError:
+                    pass
+        return self._fast_fn or None
+
+    @property
+    def _batch(self) -> Any:
+        """The generated numpy evaluator (:mod:`fuzzyctl.engine.render_np`), or None."""
+        if self._batch_fn is None:
+            self._batch_fn = False
+            if self._specialise:
+                from fuzzyctl.engine.fastprog import build_fast
+                from fuzzyctl.engine.irgen import CodegenError
+                from fuzzyctl.engine.render_np import vectorise
+
+                try:
+                    self._batch_fn = vectorise(build_fast(self.plan, "np"))
+                except CodegenError:
+                    pass
+        return self._batch_fn or None
 
     # ------------------------------------------------------------------ inputs
 
@@ -71,8 +109,9 @@ class Controller:
     def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
         """Evaluate once: ``{"temp": 20.0, ...} -> {"valve": 35.7, ...}``."""
         values = self._values(inputs)
-        if self._fast is not None:
-            res = self._fast(values, self._state)
+        fast = self._fast
+        if fast is not None:
+            res = fast(values, self._state)
         else:
             rec = self._interp.run(values, self._state)
             res = [o.value for o in rec.outputs]
@@ -88,6 +127,8 @@ class Controller:
     def explain(self, inputs: Mapping[str, Any]) -> explain_mod.Explanation:
         """Evaluate once and return every intermediate result (this counts as an evaluation:
         the NC state advances)."""
+        from fuzzyctl.engine import explain as explain_mod
+
         values = self._values(inputs)
         rec = self._interp.run(values, self._state)
         named = dict(zip(self.inputs, values, strict=True))
@@ -96,6 +137,8 @@ class Controller:
     def evaluate_batch(self, data: Any, *, chunk: int = 16384) -> dict[str, npt.NDArray[np.float64]]:
         """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
         arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays."""
+        import numpy as np
+
         columns = _columns(data)
         n = None
         arrays: list[npt.NDArray[np.float64]] = []
@@ -136,10 +179,13 @@ class Controller:
         return {k: v for k, v in result.items() if k in self.outputs}
 
     def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
-        if self._batch is not None:
-            outs: list[npt.NDArray[np.float64]] = self._batch.run(part, self._state)
-            return outs
+        import numpy as np
+
         m = len(part[0]) if part else 0
+        batch = self._batch
+        if batch is not None:
+            outs: list[npt.NDArray[np.float64]] = batch(part, self._state, m)
+            return outs
         res = [np.empty(m) for _ in self.plan.outputs]
         for r in range(m):
             rec = self._interp.run([float(a[r]) for a in part], self._state)
@@ -177,6 +223,8 @@ def _columns(data: Any) -> dict[str, Any]:
 
 
 def _column_array(name: str, col: Any) -> npt.NDArray[np.float64]:
+    import numpy as np
+
     raw = col.to_numpy() if hasattr(col, "to_numpy") else col
     try:
         arr = np.asarray(raw, dtype=np.float64)

@@ -223,7 +223,17 @@ class Interpreter:
         values: Sequence[float],
         outs: Sequence[float],
     ) -> OutputRecord:
-        contribs = self._contribs(op, concl)
+        return self.output_from(op, self._contribs(op, concl), values, outs)
+
+    def output_from(
+        self,
+        op: OutputPlan,
+        contribs: list[tuple[int | None, float, float, str]],
+        values: Sequence[float],
+        outs: Sequence[float],
+    ) -> OutputRecord:
+        """One output from its activated sets ``(term, degree, weight, act)`` (weight
+        placement applied, only sets with degree * weight > 0)."""
         if op.kind == "degree":
             v = 0.0
             for _t, a, w, _act in contribs:
