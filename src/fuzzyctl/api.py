@@ -1,15 +1,29 @@
 """The public facade: ``load()`` a fuzzy system from any supported format and
-``compile()`` it into something that evaluates."""
+``compile()`` it into something that evaluates.
+
+Both cache their work on disk, keyed by content (:mod:`fuzzyctl.cache`): a file read before
+is not parsed again (its document is unpickled), and a document compiled before is not
+lowered again (its plan is unpickled); the native backend finds its library by the plan.
+"""
 
 from __future__ import annotations
 
+import hashlib
+import os
+import pickle
+from collections import OrderedDict
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from fuzzyctl.model import Document, FunctionBlock
-
 if TYPE_CHECKING:
     from fuzzyctl.engine.controller import Controller
+    from fuzzyctl.engine.plan import Plan
+    from fuzzyctl.model import Document, FunctionBlock
+
+#: Backends of :func:`compile` (``auto``: native when possible, else python).
+BACKENDS = ("auto", "native", "python", "interpreted")
+#: Content keys of documents this process loaded (by identity; a few recent ones).
+_KEYS: OrderedDict[int, tuple[Document, str]] = OrderedDict()
 
 
 def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
@@ -19,23 +33,63 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     existing path is parsed as FCL unless ``format`` says otherwise.  Raises
     :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
     input is not valid."""
-    from fuzzyctl import formats
-    from fuzzyctl.diagnostics import DiagnosticError, error
-    from fuzzyctl.fcl import load_file, load_text
-
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        if fmt == "fcl":
-            return load_file(path).raise_for_errors()
-        return formats.read_path(path, fmt).document
+        return _load_path(path, fmt)
+    from fuzzyctl import formats
+    from fuzzyctl.diagnostics import DiagnosticError, error
+    from fuzzyctl.fcl import load_text
+
     if fmt not in (None, "fcl"):
         return formats.read_text(str(path_or_text), fmt).document
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
     return load_text(text).raise_for_errors()
+
+
+def _load_path(path: Path, fmt: str) -> Document:
+    from fuzzyctl import cache
+
+    key = None
+    if cache.enabled():
+        try:
+            data = path.read_bytes()
+        except OSError:
+            data = None  # the reader reports it
+        if data is not None:
+            key = content_key(data, fmt)
+            doc = _cached(f"documents/{key}.pickle")
+            from fuzzyctl.model import Document
+
+            if isinstance(doc, Document):
+                doc = Document(doc.blocks, str(path), doc.comments)
+                _remember(doc, key)
+                return doc
+    if fmt == "fcl":
+        from fuzzyctl.fcl import load_file
+
+        doc = load_file(path).raise_for_errors()
+    else:
+        from fuzzyctl import formats
+
+        doc = formats.read_path(path, fmt).document
+    if key is not None:
+        _store(f"documents/{key}.pickle", doc)
+        _remember(doc, key)
+    return doc
+
+
+def content_key(data: bytes, fmt: str) -> str:
+    """The cache key of a file's bytes read as ``fmt`` (with fuzzyctl's code fingerprint)."""
+    from fuzzyctl import cache
+
+    h = hashlib.sha256()
+    h.update(cache.code_fingerprint().encode() + b"\0" + fmt.encode() + b"\0")
+    h.update(data)
+    return h.hexdigest()[:32]
 
 
 def _looks_like_path(value: str) -> bool:
@@ -47,21 +101,84 @@ def _looks_like_path(value: str) -> bool:
 
 
 def compile(
-    model: Document | FunctionBlock, *, block: str | None = None, backend: str = "python", **options: Any
+    model: Document | FunctionBlock, *, block: str | None = None, backend: str | None = None, **options: Any
 ) -> Controller:
     """Turn a model into a :class:`~fuzzyctl.engine.Controller` (see ``fuzzyctl.engine``).
 
     ``block`` names the function block of a document (default: the first); ``backend`` is
-    ``"python"``, ``"interpreted"`` or ``"native"`` (generated C compiled into a cached
-    shared library, see docs/codegen.md; without a C compiler it warns and uses the Python
-    path); ``compat="fuzzylite"`` etc. reproduces other tools' semantics (default
-    IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine
-    cannot evaluate."""
-    from fuzzyctl.engine.compile import compile_block
+    ``"auto"`` (the default, or ``$FUZZYCTL_BACKEND``: native when a C compiler is present
+    and the C generator expresses the system, else python; a missing compiler is a one-line
+    notice), ``"native"`` (generated C compiled into a cached shared library, see
+    docs/codegen.md; without a C compiler it warns and uses the Python path), ``"python"``
+    (generated Python for single evaluations, numpy for batches) or ``"interpreted"`` (the
+    reference interpreter only); ``compat="fuzzylite"`` etc. reproduces other tools'
+    semantics (default IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError`
+    for what the engine cannot evaluate."""
+    backend = backend or os.environ.get("FUZZYCTL_BACKEND") or "auto"
+    if backend not in BACKENDS:
+        from fuzzyctl.diagnostics import FuzzyctlError
 
-    if backend == "native":
+        raise FuzzyctlError(f"unknown backend {backend!r} (available: {', '.join(BACKENDS)})")
+    plan = compile_plan(model, block=block, **options)
+    if backend in ("native", "auto"):
         from fuzzyctl.codegen.native import compile_native
 
-        plan = compile_block(model, block=block, backend="interpreted", **options).plan
-        return compile_native(plan)
-    return compile_block(model, block=block, backend=backend, **options)
+        return compile_native(plan, explicit=backend == "native")
+    from fuzzyctl.engine.controller import Controller
+
+    return Controller(plan, specialise=backend == "python")
+
+
+def compile_plan(model: Document | FunctionBlock, *, block: str | None = None, **options: Any) -> Plan:
+    """The lowered plan of ``model`` (``compile``'s first step), from the cache when the
+    document was loaded from a file this fuzzyctl has compiled before."""
+    from fuzzyctl import cache
+    from fuzzyctl.engine.compile import compile_block
+
+    doc_key = _KEYS.get(id(model))
+    key = None
+    if doc_key is not None and doc_key[0] is model and cache.enabled():
+        try:
+            spec = repr((doc_key[1], block, sorted(options.items())))
+        except Exception:  # pragma: no cover - unorderable options: no cache
+            spec = None
+        if spec is not None:
+            key = hashlib.sha256(spec.encode()).hexdigest()[:32]
+            plan = _cached(f"plans/{key}.pickle")
+            if plan is not None:
+                return plan  # type: ignore[no-any-return]
+    plan = compile_block(model, block=block, backend="interpreted", **options).plan
+    if key is not None:
+        _store(f"plans/{key}.pickle", plan)
+    return plan
+
+
+def _remember(doc: Document, key: str) -> None:
+    _KEYS[id(doc)] = (doc, key)
+    while len(_KEYS) > 32:
+        _KEYS.popitem(last=False)
+
+
+def _cached(rel: str) -> Any:
+    from fuzzyctl import cache
+
+    path = cache.cache_dir() / rel
+    try:
+        with open(path, "rb") as fh:
+            obj = pickle.load(fh)
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError, ValueError):
+        return None
+    cache.touch(path)
+    return obj
+
+
+def _store(rel: str, obj: Any) -> None:
+    from fuzzyctl import cache
+
+    path = cache.cache_dir() / rel
+    try:
+        data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+    except Exception:  # pragma: no cover - an unpicklable model: no cache
+        return
+    if cache.write_atomic(path, data):
+        cache.prune(path.parent, cache.limit_bytes(), keep=path)

@@ -3,16 +3,33 @@ embedded targets, and the native evaluation backend built on the C.
 
 * :func:`generate_st` - one FUNCTION_BLOCK per FCL function block (CODESYS, TwinCAT, SCL).
 * :func:`generate_c` - a header and a source file per function block.
-* :mod:`fuzzyctl.codegen.native` - ``compile(model, backend="native")``.
+* :mod:`fuzzyctl.codegen.native` - the native backend of ``compile()``.
 
-Everything is generated from :class:`~fuzzyctl.engine.plan.Plan` through one target-neutral
-program (:mod:`fuzzyctl.codegen.program`), so the three agree with the engine by
-construction and the tests check that they do.
+Everything is generated from :class:`~fuzzyctl.engine.plan.Plan` through target-neutral
+programs in one IR (:mod:`fuzzyctl.engine.ir`; the PLC block :mod:`fuzzyctl.codegen.program`,
+the evaluator :mod:`fuzzyctl.engine.fastprog`), so they agree with the engine by construction
+and the tests check that they do.  Importing the package is cheap (the generators load on
+first use).
 """
 
 from __future__ import annotations
 
-from fuzzyctl.codegen.api import generate_c, generate_st, lower_block
-from fuzzyctl.codegen.context import CodegenError
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from fuzzyctl.codegen.api import generate_c, generate_st, lower_block
+    from fuzzyctl.engine.irgen import CodegenError
 
 __all__ = ["CodegenError", "generate_c", "generate_st", "lower_block"]
+
+
+def __getattr__(name: str) -> Any:
+    if name == "CodegenError":
+        from fuzzyctl.engine.irgen import CodegenError
+
+        return CodegenError
+    if name in ("generate_c", "generate_st", "lower_block"):
+        from fuzzyctl.codegen import api
+
+        return getattr(api, name)
+    raise AttributeError(f"module 'fuzzyctl.codegen' has no attribute {name!r}")

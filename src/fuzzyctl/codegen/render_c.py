@@ -11,8 +11,10 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
-from fuzzyctl.codegen import c_helpers
-from fuzzyctl.codegen.ir import (
+from fuzzyctl.codegen import c_helpers, c_kernels
+from fuzzyctl.codegen.c_kernels import ACCU_CODES
+from fuzzyctl.codegen.context import CodegenError
+from fuzzyctl.engine.ir import (
     Assign,
     Bin,
     Bool,
@@ -24,10 +26,12 @@ from fuzzyctl.codegen.ir import (
     If,
     Index,
     Int,
+    Kernel,
     Neg,
     Not,
     Num,
     Program,
+    Pwl,
     Region,
     Stmt,
     Var,
@@ -35,6 +39,7 @@ from fuzzyctl.codegen.ir import (
     subexprs,
 )
 from fuzzyctl.codegen.names import check_c
+from fuzzyctl.engine.fastprog import FastProgram
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 _COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
@@ -330,3 +335,196 @@ def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
     c.append("    return fb->INFO;")
     c.append("}")
     return "\n".join(h) + "\n", "\n".join(c) + "\n"
+
+
+# --------------------------------------------------------------------------- the native evaluator
+
+
+class _Native(_C):
+    """The evaluator program of ``compile()`` (:mod:`fuzzyctl.engine.fastprog`) as C: one
+    ``fz_row`` per evaluation, called by a loop over columns.  No name of the model appears
+    (every variable is an ``FZ_`` identifier; comments are not printed)."""
+
+    def __init__(self, fp: FastProgram) -> None:
+        super().__init__(fp.program, False)
+        self.fp = fp
+        self.real = "double"
+        self.fields = set()
+        self.state = fp.state
+        self.pwl_funcs: dict[tuple[tuple[float, float], ...], str] = {}
+        self.max_lines = 1
+        self.uses_lines = False
+
+    def name(self, n: str) -> str:
+        if n in self.consts:
+            return f"fz_c_{n}"
+        if n == self.state:
+            return "prev"
+        return n
+
+    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
+        if isinstance(e, Pwl):
+            return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
+        return super().ex(e, parent, right)
+
+    def pwl_func(self, points: tuple[tuple[float, float], ...]) -> str:
+        if points not in self.pwl_funcs:
+            self.pwl_funcs[points] = f"fz_pwl{len(self.pwl_funcs)}"
+        return self.pwl_funcs[points]
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        for s in body:
+            if isinstance(s, Kernel):
+                self.kernel(s, ind)
+            elif isinstance(s, Comment):
+                continue
+            elif isinstance(s, Region):
+                self.stmts(s.body, ind)
+            elif isinstance(s, If):
+                for k, (cond, b) in enumerate(s.branches):
+                    self.emit(f"{'if' if k == 0 else '} else if'} ({self.ex(cond)}) {{", ind)
+                    self.stmts(b, ind + 1)
+                if s.orelse:
+                    self.emit("} else {", ind)
+                    self.stmts(s.orelse, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, For | While):
+                super().stmts([s], ind)  # loop bodies come back here
+            else:
+                super().stmts([s], ind)
+
+    def kernel(self, k: Kernel, ind: int) -> None:
+        if k.name == "HOLD":
+            self.hold(k, ind)
+        elif k.name == "AM_LINES":
+            x0, x1, accu, geom = k.data  # type: ignore[misc]
+            n = len(geom)
+            self.max_lines = max(self.max_lines, n)
+            self.uses_lines = True
+            ls = ", ".join(self.num(g[0]) for g in geom)
+            rs = ", ".join(self.num(g[1]) for g in geom)
+            mns = ", ".join("1" if g[2] else "0" for g in geom)
+            a_s = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
+            w_s = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
+            self.emit("{", ind)
+            self.emit(f"static const double L[{n}] = {{{ls}}}, R[{n}] = {{{rs}}};", ind + 1)
+            self.emit(f"static const unsigned char mn[{n}] = {{{mns}}};", ind + 1)
+            self.emit(f"const double a[{n}] = {{{a_s}}}, w[{n}] = {{{w_s}}};", ind + 1)
+            area, mom = (self.ex(o) for o in k.outs)
+            self.emit(
+                f"fz_am_lines({self.num(x0)}, {self.num(x1)}, {ACCU_CODES[accu]}, {n}, L, R, a, w, mn, "
+                f"&{area}, &{mom});",
+                ind + 1,
+            )
+            self.emit("}", ind)
+        else:
+            raise CodegenError(f"the native evaluator has no kernel {k.name}")
+
+    def hold(self, k: Kernel, ind: int) -> None:
+        oi, default, no_change, clamp = k.data  # type: ignore[misc]
+        out = self.ex(k.outs[0])
+        value, fired = k.args
+        if isinstance(fired, Bool) and fired.value:
+            if self.ex(value) != out:
+                self.emit(f"{out} = {self.ex(value)};", ind)
+        else:
+            alt = f"prev[{oi}]" if no_change else self.num(default)
+            self.emit(f"{out} = ({self.ex(fired)}) ? {self.ex(value)} : {alt};", ind)
+        if clamp is not None:
+            lo, hi = clamp
+            self.emit(f"if ({out} < {self.num(lo)}) {out} = {self.num(lo)};", ind)
+            self.emit(f"else if ({out} > {self.num(hi)}) {out} = {self.num(hi)};", ind)
+        self.emit(f"prev[{oi}] = {out};", ind)
+
+    def pwl_code(self) -> list[str]:
+        """One static function per breakpoint list (``shapes.pwl_value`` as an if-chain)."""
+        from fuzzyctl.engine.grid import left_limit, right_limit
+        from fuzzyctl.engine.shapes import pwl_value
+
+        out: list[str] = []
+        for pts, fname in self.pwl_funcs.items():
+            n = self.num
+            xs = sorted({q[0] for q in pts})
+            out.append(f"static inline double {fname}(double x)\n{{")
+            out.append(f"    if (x < {n(xs[0])}) return {n(pts[0][1])};")
+            for k, u in enumerate(xs):
+                pv = pwl_value(pts, u)
+                jump = left_limit(pts, u) != right_limit(pts, u) or pv != left_limit(pts, u)
+                if jump or k == 0:
+                    out.append(f"    if (x == {n(u)}) return {n(pv)};")
+                if k + 1 < len(xs):
+                    u1 = xs[k + 1]
+                    r0, l1 = right_limit(pts, u), left_limit(pts, u1)
+                    if r0 == l1:
+                        expr = n(r0)
+                    else:
+                        base = f"(x - {n(u)}) * {n((l1 - r0) / (u1 - u))}"
+                        expr = base if r0 == 0.0 else f"{n(r0)} + {base}"
+                    out.append(f"    if (x < {n(u1)}) return {expr};")
+            out.append(f"    if (x == {n(xs[-1])}) return {n(pwl_value(pts, xs[-1]))};")
+            out.append(f"    return {n(pts[-1][1])};\n}}\n")
+        return out
+
+
+def render_native(fp: FastProgram) -> str:
+    """One C file: ``fz_row`` (one evaluation), ``fz_eval``, ``fz_batch`` (a loop over
+    columns of rows) and ``fz_init`` (the NC state), exported for the native backend."""
+    prog = fp.program
+    r = _Native(fp)
+    r.stmts(prog.body, 1)
+    body = r.lines
+    c: list[str] = ["/* generated by fuzzyctl: the native evaluator; do not edit */"]
+    c += ["#include <math.h>", "#include <stddef.h>", "#define FZ_API __attribute__((visibility(\"default\")))", ""]
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        ctype = {"REAL": "double", "INT": "int", "BOOL": "unsigned char", "BYTE": "unsigned char"}[d.type]
+        vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
+        c.append(f"static const {ctype} fz_c_{d.name}[{d.size}] = {{{vals}}};")
+    helpers = helper_functions(prog)
+    c += c_helpers.render(set(helpers))
+    if r.uses_lines:
+        c.append(c_kernels.am_lines_code(r.max_lines))
+    c += r.pwl_code()
+    n_out = len(fp.outputs)
+    c.append("static inline void fz_row(double *restrict prev, const double *restrict in, double *restrict out)")
+    c.append("{")
+    for k, name in enumerate(fp.inputs):
+        c.append(f"    double {name} = in[{k}];")
+    for d in prog.of("output"):
+        c.append(f"    double {d.name} = 0;")
+    for d in prog.of("temp"):
+        ctype = _ctype(d, "double")
+        if d.size is not None:
+            c.append(f"    {ctype} {d.name}[{d.size}] = {{0}};")
+        else:
+            c.append(f"    {ctype} {d.name} = 0;")
+    c += body
+    for k, name in enumerate(fp.outputs):
+        c.append(f"    out[{k}] = {name};")
+    c.append("    (void)prev;")
+    c.append("}")
+    c.append("")
+    init = prog.decl(fp.state).init
+    assert isinstance(init, tuple)
+    c.append(f"FZ_API size_t fz_n_state(void) {{ return {len(init)}; }}")
+    c.append("FZ_API void fz_init(double *prev)\n{")
+    for i, v in enumerate(init):
+        c.append(f"    prev[{i}] = {r.num(v)};")
+    c.append("}")
+    c.append("FZ_API void fz_eval(double *prev, const double *in, double *out) { fz_row(prev, in, out); }")
+    n_in = max(1, len(fp.inputs))
+    c.append("/* n rows: input k of row i is cols[k][i], output k of row i goes to outs[k][i] */")
+    c.append("FZ_API void fz_batch(double *prev, size_t n, const double *const *cols, double *const *outs)\n{")
+    c.append(f"    double in[{n_in}] = {{0}}, out[{max(1, n_out)}];")
+    c.append("    size_t i;")
+    c.append("    for (i = 0; i < n; i++) {")
+    for k in range(len(fp.inputs)):
+        c.append(f"        in[{k}] = cols[{k}][i];")
+    c.append("        fz_row(prev, in, out);")
+    for k in range(n_out):
+        c.append(f"        outs[{k}][i] = out[{k}];")
+    c.append("    }")
+    c.append("    (void)cols;")
+    c.append("    (void)outs;")
+    c.append("}")
+    return "\n".join(c) + "\n"

@@ -170,13 +170,22 @@ class Controller:
             a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
             for i, a in enumerate(arrays)
         ]
-        result = {o.name: np.empty(n) for o in self.plan.outputs}
+        out = self._run_batch(n, full, chunk)
+        return {o.name: arr for o, arr in zip(self.plan.outputs, out, strict=True) if o.is_output}
+
+    def _run_batch(
+        self, n: int, columns: list[npt.NDArray[np.float64]], chunk: int
+    ) -> list[npt.NDArray[np.float64]]:
+        """Every plan output (in plan order) for ``n`` rows of validated input columns."""
+        import numpy as np
+
+        result = [np.empty(n) for _ in self.plan.outputs]
         for start in range(0, n, chunk):
-            part = [a[start : start + chunk] for a in full]
+            part = [a[start : start + chunk] for a in columns]
             out = self._batch_chunk(part)
-            for o, arr in zip(self.plan.outputs, out, strict=True):
-                result[o.name][start : start + chunk] = arr
-        return {k: v for k, v in result.items() if k in self.outputs}
+            for res, arr in zip(result, out, strict=True):
+                res[start : start + chunk] = arr
+        return result
 
     def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
         import numpy as np

@@ -215,10 +215,6 @@ class FastBuilder(RuleBuilder):
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         groups = merge(self.g, contribs, op.accu or "MAX")
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
-        if self.target == "c" and not (op.exact and op.grid is not None):
-            from fuzzyctl.engine.smoothprog import smooth_output
-
-            return smooth_output(self, op, groups)
         if self.target == "c":
             raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
         return self._whole_output("MAMDANI", oi, op, merged, {})

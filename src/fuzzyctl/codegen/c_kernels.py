@@ -1,0 +1,207 @@
+"""The kernels of the evaluator program (:mod:`fuzzyctl.engine.fastprog`) in C, for the
+native backend: the same algorithms as the scalar Python kernels (:mod:`fuzzyctl.engine.pwl`),
+written once here.
+
+``fz_am_lines`` is :func:`fuzzyctl.engine.pwl.interval_pieces` followed by
+:func:`~fuzzyctl.engine.pwl.area_moment`: on one grid interval every activated set is a line
+(clipped by MIN activation), the pieces between kinks, crossings (MAX) and the point where the
+sum reaches 1 (BSUM) are linear and integrated in closed form; under PROBOR a piece is a
+product of linear factors, integrated with Gauss-Legendre nodes exact for its degree.
+"""
+
+from __future__ import annotations
+
+from fuzzyctl.engine.pwl import gauss_legendre
+
+ACCU_CODES = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
+
+
+def gl_tables(max_lines: int) -> str:
+    """Gauss-Legendre nodes and weights on [0, 1] for PROBOR of 2..max_lines factors, with
+    the engine's node count ((n + 3) // 2 + 1)."""
+    offs, xs, ws = [0] * (max_lines + 2), [], []
+    counts = [0] * (max_lines + 2)
+    for n in range(2, max_lines + 1):
+        m = (n + 3) // 2 + 1
+        nodes, weights = gauss_legendre(m)
+        offs[n], counts[n] = len(xs), m
+        xs.extend(nodes)
+        ws.extend(weights)
+    xs = xs or [0.0]
+    ws = ws or [0.0]
+    return (
+        f"static const double fz_glx[{len(xs)}] = {{{', '.join(repr(v) for v in xs)}}};\n"
+        f"static const double fz_glw[{len(ws)}] = {{{', '.join(repr(v) for v in ws)}}};\n"
+        f"static const int fz_gln[{len(counts)}] = {{{', '.join(map(str, counts))}}};\n"
+        f"static const int fz_glo[{len(offs)}] = {{{', '.join(map(str, offs))}}};\n"
+    )
+
+
+AM_LINES = r"""
+/* pwl._value: the set of line i at t (exactly w*a at its kink) */
+static inline double fz_line(double L, double R, double a, double w, int mn, double kink, double t)
+{
+    double y;
+    if (mn) {
+        if (t == kink) return w * a;
+        y = L + (R - L) * t;
+        return w * (y >= a ? a : y);
+    }
+    return w * a * (L + (R - L) * t);
+}
+
+static inline void fz_piece(double xa, double xb, double v0, double v1, double *area, double *mom)
+{
+    double dx = xb - xa;
+    *area += 0.5 * dx * (v0 + v1);
+    *mom += dx * (xa * (2.0 * v0 + v1) + xb * (v0 + 2.0 * v1)) / 6.0;
+}
+
+static void fz_sort(double *v, int n)
+{
+    int i, j;
+    for (i = 1; i < n; i++) {
+        double k = v[i];
+        for (j = i - 1; j >= 0 && v[j] > k; j--) v[j + 1] = v[j];
+        v[j + 1] = k;
+    }
+}
+
+static inline double fz_probor(const double *p0, const double *p1, int n, double s)
+{
+    double acc = 0.0, c;
+    int k;
+    for (k = 0; k < n; k++) {
+        c = p0[k] + (p1[k] - p0[k]) * s;
+        acc = acc + c - acc * c;
+    }
+    return acc;
+}
+
+/* pwl._combine: the accumulated set between xa and xb from the lines' values at both ends */
+static void fz_combine(double xa, double xb, const double *p0, const double *p1, int n, int accu,
+                       double *area, double *mom)
+{
+    double cuts[FZ_MAXL * FZ_MAXL], s0 = 0.0, s1 = 0.0, v0, v1, xp, vp, xs, vs, d0, d1, y, dx;
+    int i, j, k, nc = 0;
+    if (n == 1) {
+        fz_piece(xa, xb, p0[0], p1[0], area, mom);
+        return;
+    }
+    if (accu == 1) {
+        for (i = 0; i < n; i++)
+            for (j = i + 1; j < n; j++) {
+                d0 = p0[i] - p0[j];
+                d1 = p1[i] - p1[j];
+                if (d0 * d1 < 0.0) cuts[nc++] = d0 / (d0 - d1);
+            }
+        v0 = p0[0];
+        v1 = p1[0];
+        for (k = 1; k < n; k++) {
+            if (p0[k] > v0) v0 = p0[k];
+            if (p1[k] > v1) v1 = p1[k];
+        }
+        if (!nc) {
+            fz_piece(xa, xb, v0, v1, area, mom);
+            return;
+        }
+        fz_sort(cuts, nc);
+        dx = xb - xa;
+        xp = xa;
+        vp = v0;
+        for (i = 0; i < nc; i++) {
+            xs = xa + cuts[i] * dx;
+            vs = p0[0] + (p1[0] - p0[0]) * cuts[i];
+            for (k = 1; k < n; k++) {
+                y = p0[k] + (p1[k] - p0[k]) * cuts[i];
+                if (y > vs) vs = y;
+            }
+            fz_piece(xp, xs, vp, vs, area, mom);
+            xp = xs;
+            vp = vs;
+        }
+        fz_piece(xp, xb, vp, v1, area, mom);
+        return;
+    }
+    if (accu == 4) {
+        int m = fz_gln[n], o = fz_glo[n], q;
+        double a = 0.0, mo = 0.0, f;
+        dx = xb - xa;
+        for (q = 0; q < m; q++) {
+            f = fz_probor(p0, p1, n, fz_glx[o + q]);
+            a += fz_glw[o + q] * f;
+            mo += fz_glw[o + q] * f * (xa + fz_glx[o + q] * dx);
+        }
+        *area += a * dx;
+        *mom += mo * dx;
+        return;
+    }
+    for (k = 0; k < n; k++) {
+        s0 += p0[k];
+        s1 += p1[k];
+    }
+    if (accu == 3 && (s0 - 1.0) * (s1 - 1.0) < 0.0) {
+        double s = (1.0 - s0) / (s1 - s0), xm = xa + s * (xb - xa);
+        fz_piece(xa, xm, s0 < 1.0 ? s0 : 1.0, 1.0, area, mom);
+        fz_piece(xm, xb, 1.0, s1 < 1.0 ? s1 : 1.0, area, mom);
+        return;
+    }
+    if (accu == 3) {
+        if (s0 > 1.0) s0 = 1.0;
+        if (s1 > 1.0) s1 = 1.0;
+    }
+    fz_piece(xa, xb, s0, s1, area, mom);
+}
+
+/* area and moment of the accumulated activated sets on [x0, x1] (pwl.interval_pieces) */
+static void fz_am_lines(double x0, double x1, int accu, int n, const double *L, const double *R,
+                        const double *a, const double *w, const unsigned char *mn, double *area,
+                        double *mom)
+{
+    double ll[FZ_MAXL], rr[FZ_MAXL], aa[FZ_MAXL], ww[FZ_MAXL], kink[FZ_MAXL];
+    double ts[FZ_MAXL + 2], p0[FZ_MAXL], p1[FZ_MAXL], dx = x1 - x0, t0, t1, xa, xb;
+    unsigned char mm[FZ_MAXL];
+    int i, m = 0, nt = 2, u;
+    *area = 0.0;
+    *mom = 0.0;
+    for (i = 0; i < n; i++) {
+        if (a[i] * w[i] > 0.0) {
+            ll[m] = L[i];
+            rr[m] = R[i];
+            aa[m] = a[i];
+            ww[m] = w[i];
+            mm[m] = mn[i];
+            m++;
+        }
+    }
+    if (!m) return;
+    ts[0] = 0.0;
+    ts[1] = 1.0;
+    for (i = 0; i < m; i++) {
+        kink[i] = -1.0;
+        if (mm[i] && (ll[i] - aa[i]) * (rr[i] - aa[i]) < 0.0) {
+            kink[i] = (aa[i] - ll[i]) / (rr[i] - ll[i]);
+            ts[nt++] = kink[i];
+        }
+    }
+    fz_sort(ts, nt);
+    for (i = 1, u = 1; i < nt; i++)
+        if (ts[i] != ts[u - 1]) ts[u++] = ts[i];
+    nt = u;
+    for (i = 0; i < m; i++) p0[i] = fz_line(ll[i], rr[i], aa[i], ww[i], mm[i], kink[i], 0.0);
+    for (u = 1; u < nt; u++) {
+        t0 = ts[u - 1];
+        t1 = ts[u];
+        xa = t0 > 0.0 ? x0 + t0 * dx : x0;
+        xb = t1 < 1.0 ? x0 + t1 * dx : x1;
+        for (i = 0; i < m; i++) p1[i] = fz_line(ll[i], rr[i], aa[i], ww[i], mm[i], kink[i], t1);
+        fz_combine(xa, xb, p0, p1, m, accu, area, mom);
+        for (i = 0; i < m; i++) p0[i] = p1[i];
+    }
+}
+"""
+
+
+def am_lines_code(max_lines: int) -> str:
+    """The ``fz_am_lines`` kernel for at most ``max_lines`` sets per interval."""
+    return f"#define FZ_MAXL {max(2, max_lines)}\n" + gl_tables(max(2, max_lines)) + AM_LINES
