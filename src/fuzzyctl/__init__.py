@@ -20,4 +20,11 @@ def __getattr__(name: str) -> Any:
         from fuzzyctl import api
 
         return getattr(api, name)
+    if not name.startswith("_"):  # a subpackage not imported yet (fuzzyctl.engine, ...)
+        import importlib
+
+        try:
+            return importlib.import_module(f"fuzzyctl.{name}")
+        except ModuleNotFoundError:
+            pass
     raise AttributeError(f"module 'fuzzyctl' has no attribute {name!r}")

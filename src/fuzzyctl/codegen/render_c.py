@@ -365,6 +365,8 @@ class _Native(_C):
     def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
         if isinstance(e, Pwl):
             return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
+        if isinstance(e, Call) and e.function == "IMOD":
+            return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
         return super().ex(e, parent, right)
 
     def pwl_func(self, points: tuple[tuple[float, float], ...]) -> str:

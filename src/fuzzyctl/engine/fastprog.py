@@ -141,15 +141,18 @@ class FastBuilder(RuleBuilder):
         state = g.declare("FZ_PREV", "REAL", "state", max(1, len(plan.outputs)), init or (0.0,))
         self.out_vars = [g.declare(f"FZ_OUT{oi}", "REAL", "output") for oi in range(len(plan.outputs))]
         degrees = self.fuzzify()
-        if _use_table(plan, self.target):
+        tabled: dict[int, list[Contrib]] | None = None
+        concl: list[list[tuple[Ex, Ex]]] = []
+        if _use_table(plan):
             from fuzzyctl.engine.ruletable import table_rules
 
-            concl = table_rules(self, degrees)
+            tabled = table_rules(self, degrees, sparse=self.target != "np")
         else:
             concl = self.rules(degrees, Literals(g, "", ""))
         values: dict[int, Ex] = {}
         for oi in plan.output_order:
-            self.output(oi, concl, values)
+            op = plan.outputs[oi]
+            self.output(oi, tabled[oi] if tabled is not None else self.contribs(op, concl), values)
         prog = Program(plan.name or "FUZZY", g.decls, b.root, [], g.uses)
         return FastProgram(prog, self.target, names, [v.name for v in self.out_vars], state.name, plan)
 
@@ -180,11 +183,11 @@ class FastBuilder(RuleBuilder):
 
     # ------------------------------------------------------------------ outputs
 
-    def output(self, oi: int, concl: list[list[tuple[Ex, Ex]]], values: dict[int, Ex]) -> None:
+    def output(self, oi: int, contribs: list[Contrib], values: dict[int, Ex]) -> None:
+        """Output ``oi`` from its activated sets, then DEFAULT / NC / lock-range."""
         op = self.plan.outputs[oi]
         g = self.g
         out = self.out_vars[oi]
-        contribs = self.contribs(op, concl)
         if op.kind == "degree":
             v, _fired = self.degree_output(op, contribs)
             g.b.set(out, v)
@@ -365,7 +368,7 @@ def _expr_outputs(e: ExprPlan) -> set[int]:
     return set()
 
 
-def _use_table(plan: Plan, target: FastTarget) -> bool:
+def _use_table(plan: Plan) -> bool:
     if len(plan.rules) < TABLE_THRESHOLD:
         return False
     from fuzzyctl.engine.ruletable import table_applies

@@ -277,7 +277,7 @@ def _minmax(s: If) -> tuple[str, Var | Index, Ex] | None:
     if cond.op not in ("<", ">"):
         return None
     target, value = body[0].target, body[0].value
-    if not (isinstance(cond.right, Var) and isinstance(target, Var) and cond.right.name == target.name):
+    if not _same(cond.right, target):
         return None
     if not _same(cond.left, value):
         return None

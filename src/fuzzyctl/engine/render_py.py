@@ -103,6 +103,8 @@ class _Py:
         if isinstance(e, Call):
             if e.function == "NAN":
                 return "_NAN"
+            if e.function == "IMOD":
+                return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
             return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
         if isinstance(e, Pwl):  # not at the top of an assignment: shapes.pwl_value
             from fuzzyctl.engine.shapes import pwl_value

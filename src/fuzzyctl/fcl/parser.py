@@ -10,6 +10,7 @@ syntax errors are translated into human messages by :mod:`fuzzyctl.fcl.errors`.
 from __future__ import annotations
 
 import math
+import os
 import textwrap
 import threading
 from collections.abc import Sequence
@@ -543,19 +544,65 @@ def _on_token(tok: Token) -> Token:
 
 @cache
 def _parser() -> Lark:
-    # The transformer is swapped per parse (see parse_source); lark builds its tables once.
-    base = Lark(_grammar(), parser="lalr", lexer="contextual")
-    callbacks = {name: _on_comment for name in _COMMENT_TYPES}
-    callbacks.update({t.name: _on_token for t in base.terminals if t.name not in (*_COMMENT_TYPES, "WS")})
-    return Lark(
-        _grammar(),
-        parser="lalr",
-        lexer="contextual",
+    """The one LALR parser of this process.  Its tables are computed once per grammar and
+    lark version and kept in the cache directory (lark's ``cache``); a process only loads
+    them.  The transformer is swapped per parse (see parse_source)."""
+    callbacks: dict[str, Any] = {name: _on_comment for name in _COMMENT_TYPES}
+    callbacks.update({name: _on_token for name in _terminal_names() if name not in (*_COMMENT_TYPES, "WS")})
+    return _lark(
         maybe_placeholders=True,
         lexer_callbacks=callbacks,
         transformer=_Builder(ParseState(Source(""))),
-        cache=False,
     )
+
+
+def _terminal_names() -> list[str]:
+    """The grammar's terminal names (for the lexer callbacks), kept beside the tables."""
+    import hashlib
+    import json
+
+    from lark import __version__ as lark_version
+
+    from fuzzyctl import cache as disk
+
+    key = hashlib.sha256((_grammar() + lark_version).encode()).hexdigest()[:24]
+    path = disk.cache_dir() / "lark" / f"fcl-terminals-{key}.json"
+    try:
+        names = json.loads(path.read_text())
+        if isinstance(names, list) and all(isinstance(n, str) for n in names):
+            return names
+    except (OSError, ValueError):
+        pass
+    names = [t.name for t in _lark().terminals]
+    disk.write_atomic(path, json.dumps(names).encode())
+    return names
+
+
+def _lark(**options: Any) -> Lark:
+    """A Lark parser of the FCL grammar, its analysed tables loaded from (or written to) the
+    on-disk cache; without a writable cache directory they are computed in memory."""
+    import hashlib
+
+    from lark import __version__ as lark_version
+
+    from fuzzyctl import cache as disk
+
+    grammar = _grammar()
+    opts: dict[str, Any] = {"parser": "lalr", "lexer": "contextual", **options}
+    spec = repr((sorted(options), options.get("maybe_placeholders")))
+    key = hashlib.sha256((grammar + lark_version + spec).encode()).hexdigest()[:24]
+    path = disk.cache_dir() / "lark" / f"fcl-{key}.cache"
+    if not path.exists():
+        # lark writes its cache file in place: write it elsewhere and rename it, so that
+        # another process never reads half a file
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
+            Lark(grammar, cache=str(tmp), **opts)
+            os.replace(tmp, path)
+        except OSError:
+            return Lark(grammar, **opts)
+    return Lark(grammar, cache=str(path), **opts)
 
 
 @dataclass
