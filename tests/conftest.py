@@ -28,6 +28,14 @@ settings.register_profile("ci", derandomize=True, print_blob=True)
 settings.register_profile("fuzz", max_examples=1000, print_blob=True)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
+# compile() picks the native backend by default, which compiles C for every new system: the
+# tests use the Python path unless they ask for native (tests/codegen/test_native.py and the
+# default-backend tests do), and keep their caches (native libraries, plans, the parser
+# tables) apart from the user's, across runs (keyed by content and fuzzyctl's code).
+os.environ.setdefault("FUZZYCTL_BACKEND", "python")
+os.environ.setdefault("FUZZYCTL_CACHE_DIR", str(Path.home() / ".cache" / "fuzzyctl-tests" / "cache"))
+os.environ.setdefault("FUZZYCTL_QUIET", "1")
+
 ROOT = Path(__file__).resolve().parent.parent
 EXAMPLES = ROOT / "examples"
 DATA = ROOT / "tests" / "data"

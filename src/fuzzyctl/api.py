@@ -114,16 +114,43 @@ def compile(
     reference interpreter only); ``compat="fuzzylite"`` etc. reproduces other tools'
     semantics (default IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError`
     for what the engine cannot evaluate."""
+    plan, key = _plan(model, block, options)
+    return _controller(plan, backend, key)
+
+
+def compile_path(
+    path: str | Path, *, block: str | None = None, backend: str | None = None, format: str | None = None, **options: Any
+) -> Controller:
+    """``compile(load(path), ...)``, answered from the caches without reading the model when
+    a file with this content was compiled with these options before (the quick start of
+    ``fuzzyctl eval``)."""
+    from fuzzyctl import cache
+
+    path = Path(path)
+    fmt = (format or "").lower() or (path.suffix.lower().lstrip(".") or "fcl")
+    if cache.enabled():
+        try:
+            key = _plan_key(content_key(path.read_bytes(), fmt), block, options)
+        except OSError:
+            key = None
+        plan = _cached(f"plans/{key}.pickle") if key is not None else None
+        if plan is not None:
+            return _controller(plan, backend, key)
+    return compile(load(path, format=fmt), block=block, backend=backend, **options)
+
+
+def _controller(plan: Plan, backend: str | None, key: str | None) -> Controller:
     backend = backend or os.environ.get("FUZZYCTL_BACKEND") or "auto"
     if backend not in BACKENDS:
         from fuzzyctl.diagnostics import FuzzyctlError
 
         raise FuzzyctlError(f"unknown backend {backend!r} (available: {', '.join(BACKENDS)})")
-    plan = compile_plan(model, block=block, **options)
     if backend in ("native", "auto"):
+        from fuzzyctl import cache
         from fuzzyctl.codegen.native import compile_native
 
-        return compile_native(plan, explicit=backend == "native")
+        hint = cache.cache_dir() / "plans" / f"{key}.lib" if key is not None and cache.enabled() else None
+        return compile_native(plan, explicit=backend == "native", hint=hint)
     from fuzzyctl.engine.controller import Controller
 
     return Controller(plan, specialise=backend == "python")
@@ -132,25 +159,33 @@ def compile(
 def compile_plan(model: Document | FunctionBlock, *, block: str | None = None, **options: Any) -> Plan:
     """The lowered plan of ``model`` (``compile``'s first step), from the cache when the
     document was loaded from a file this fuzzyctl has compiled before."""
+    return _plan(model, block, options)[0]
+
+
+def _plan(model: Document | FunctionBlock, block: str | None, options: dict[str, Any]) -> tuple[Plan, str | None]:
     from fuzzyctl import cache
     from fuzzyctl.engine.compile import compile_block
 
     doc_key = _KEYS.get(id(model))
     key = None
     if doc_key is not None and doc_key[0] is model and cache.enabled():
-        try:
-            spec = repr((doc_key[1], block, sorted(options.items())))
-        except Exception:  # pragma: no cover - unorderable options: no cache
-            spec = None
-        if spec is not None:
-            key = hashlib.sha256(spec.encode()).hexdigest()[:32]
+        key = _plan_key(doc_key[1], block, options)
+        if key is not None:
             plan = _cached(f"plans/{key}.pickle")
             if plan is not None:
-                return plan  # type: ignore[no-any-return]
+                return plan, key
     plan = compile_block(model, block=block, backend="interpreted", **options).plan
     if key is not None:
         _store(f"plans/{key}.pickle", plan)
-    return plan
+    return plan, key
+
+
+def _plan_key(doc_key: str, block: str | None, options: dict[str, Any]) -> str | None:
+    try:
+        spec = repr((doc_key, block, sorted(options.items())))
+    except TypeError:  # options that do not sort: no cache
+        return None
+    return hashlib.sha256(spec.encode()).hexdigest()[:32]
 
 
 def _remember(doc: Document, key: str) -> None:

@@ -10,9 +10,10 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from fuzzyctl.model import Span
+if TYPE_CHECKING:  # the model is imported by whoever makes a diagnostic with a span
+    from fuzzyctl.model import Span
 
 
 class Severity(StrEnum):
@@ -106,6 +107,11 @@ def has_errors(diagnostics: Iterable[Diagnostic]) -> bool:
 class FuzzyctlError(Exception):
     """Base of every error fuzzyctl raises on purpose.  The CLI prints these without a
     traceback; anything else reaching the CLI is a bug in fuzzyctl."""
+
+
+class CodegenError(FuzzyctlError):
+    """A code generator cannot express something in a system; the message names it (also
+    :mod:`fuzzyctl.codegen`'s and :mod:`fuzzyctl.engine.irgen`'s)."""
 
 
 class DiagnosticError(FuzzyctlError):

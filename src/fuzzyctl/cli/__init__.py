@@ -1,6 +1,23 @@
 """The ``fuzzyctl`` command.  Each command group lives in its own module and registers
-itself on :data:`app`; :func:`main` turns every error into a message and an exit code."""
+itself on :data:`app`; :func:`main` turns every error into a message and an exit code.
 
-from fuzzyctl.cli.app import app, main
+The console script starts in :mod:`fuzzyctl.cli.entry`, which answers the simplest
+``fuzzyctl eval`` invocations without importing the command framework (see
+:mod:`fuzzyctl.cli.quick`); importing this package imports nothing until used."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from fuzzyctl.cli.app import app, main
 
 __all__ = ["app", "main"]
+
+
+def __getattr__(name: str) -> Any:
+    if name in ("app", "main"):
+        from fuzzyctl.cli import app as app_module
+
+        return getattr(app_module, name)
+    raise AttributeError(f"module 'fuzzyctl.cli' has no attribute {name!r}")

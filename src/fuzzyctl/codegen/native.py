@@ -28,7 +28,6 @@ import hashlib
 import os
 import shutil
 import struct
-import subprocess
 import tempfile
 import threading
 import warnings
@@ -37,8 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzyctl import cache
-from fuzzyctl.codegen.context import CodegenError
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.diagnostics import CodegenError, FuzzyctlError
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan
 
@@ -158,13 +156,24 @@ def library_key(plan: Plan, cc: str) -> str:
     return h.hexdigest()[:32]
 
 
-def build(plan: Plan) -> Path:
-    """Compile (or find in the cache) the shared library of ``plan``."""
+def build(plan: Plan, hint: Path | None = None) -> Path:
+    """Compile (or find in the cache) the shared library of ``plan``.  ``hint`` is a file
+    naming the library of this plan, written here (it saves hashing a large plan)."""
+    out_dir = cache_dir() / "native"
+    if hint is not None:
+        try:
+            lib = out_dir / hint.read_text().strip()
+            if lib.suffix == ".so" and lib.parent == out_dir and lib.exists():
+                cache.touch(lib)
+                return lib
+        except OSError:
+            pass
     cc = compiler()
     if cc is None:
         raise NativeError("no C compiler found (set CC or install cc)")
-    out_dir = cache_dir() / "native"
     lib = out_dir / f"{library_key(plan, cc)}.so"
+    if hint is not None:
+        cache.write_atomic(hint, lib.name.encode())
     if lib.exists():
         cache.touch(lib)
         return lib
@@ -177,6 +186,8 @@ def build(plan: Plan) -> Path:
         os.close(fd)
         partial = Path(tmp_name)  # unique per build (threads share a pid)
         cmd = [cc, *CFLAGS, "-o", str(partial), str(Path(tmp, "fz_native.c")), "-lm"]
+        import subprocess
+
         res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
         if res.returncode != 0:
             partial.unlink(missing_ok=True)
@@ -362,12 +373,12 @@ def notice(message: str) -> None:
     print(f"fuzzyctl: {message}", file=sys.stderr)
 
 
-def compile_native(plan: Plan, *, explicit: bool = True) -> Controller:
+def compile_native(plan: Plan, *, explicit: bool = True, hint: Path | None = None) -> Controller:
     """A native controller for ``plan``, or the Python one when there is no compiler or the
     plan uses something the C generators cannot express: with a warning when native was
     asked for (``explicit``), a one-line notice for a missing compiler otherwise."""
     try:
-        return NativeController(plan, build(plan))
+        return NativeController(plan, build(plan, hint))
     except NativeError as exc:
         if explicit:
             warnings.warn(f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3)

@@ -7,7 +7,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.diagnostics import CodegenError
 from fuzzyctl.engine.ir import Builder, Decl, Ex, ExLike, Storage, Type, Var, ex
 
 #: "c" and "st": the PLC function block; "py", "np" and "c" also the evaluator of ``compile()``
@@ -19,8 +19,7 @@ PREFIX = "FZ_"
 MAX_IDENT = 24
 
 
-class CodegenError(FuzzyctlError):
-    """The block uses something the code generator cannot express; the message names it."""
+__all__ = ["MAX_IDENT", "PREFIX", "CodegenError", "Gen", "Target", "flat"]
 
 
 @dataclass

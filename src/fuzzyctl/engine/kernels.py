@@ -110,6 +110,9 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
     op = plan.outputs[oi]
     n_in = len(plan.inputs)
     n_out = len(plan.outputs)
+    smooth_cog = (
+        op.kind == "mamdani" and not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
+    )
 
     def f(*args: float) -> tuple[float, bool]:
         values: Sequence[float] = args[:n_in]
@@ -122,6 +125,13 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
             a, w = args[base + 2 * k], args[base + 2 * k + 1]
             if a * w > 0.0:
                 contribs.append((t, a, w, act))
+        if smooth_cog:  # the vectorised integration of a batch, on one row
+            import numpy as np
+
+            from fuzzyctl.engine.smooth_np import smooth_output
+
+            v, fired = smooth_output(plan, op, contribs, [np.array([x]) for x in values], [], 1)
+            return float(v[0]), bool(fired[0])
         rec = interp.output_from(op, contribs, values, outs)
         return rec.value, rec.fired
 

@@ -231,26 +231,36 @@ def _group(
     n_rules = len(grp.rules)
 
     def fire(r: Ex) -> None:
-        """Rule ``r`` of the group (its index in the group's tables)."""
+        """Rule ``r`` of the group (its index in the group's tables): its degree, added to its
+        slots (a degree at or below the firing threshold counts as 0, which changes no slot)."""
         base = g.let(r * nvars, "RB", "INT")
         d: Ex = deg[rt_v[base]]
         for k in range(1, nvars):
             d = T.tnorm(g, grp.op, d, deg[rt_v[base + k]])
         a = g.let(d * rw_v[r], "RD")
         threshold = plan.options.firing_threshold
+        if not sparse:  # one program for every sample (numpy): no branch on the degree
+            if threshold > 0.0:
+                with b.if_(a.le(threshold)):
+                    b.set(a, 0.0)
+            _add(r, a)
+            return
         with b.if_(a.gt(threshold)):
-            q = g.counter("Q")
-            with b.for_(q, so_v[r], so_v[r + 1] - 1) as qv:
-                s = g.let(ss_v[qv], "S", "INT")
-                val = g.let(sm_v[qv] * a, "V")
-                k_ = g.let(kind[s], "K", "INT")
-                with b.if_(k_.eq(1)):
-                    with b.if_(val.gt(acc[s])):
-                        b.set(acc[s], val)
-                with b.elif_(k_.eq(4)):
-                    b.set(acc[s], acc[s] + val - acc[s] * val)
-                with b.else_():
-                    b.set(acc[s], acc[s] + val)
+            _add(r, a)
+
+    def _add(r: Ex, a: Var) -> None:
+        q = g.counter("Q")
+        with b.for_(q, so_v[r], so_v[r + 1] - 1) as qv:
+            s = g.let(ss_v[qv], "S", "INT")
+            val = g.let(sm_v[qv] * a, "V")
+            k_ = g.let(kind[s], "K", "INT")
+            with b.if_(k_.eq(1)):
+                with b.if_(val.gt(acc[s])):
+                    b.set(acc[s], val)
+            with b.elif_(k_.eq(4)):
+                b.set(acc[s], acc[s] + val - acc[s] * val)
+            with b.else_():
+                b.set(acc[s], acc[s] + val)
 
     if not sparse or nvars == 0 or _code_limit(radix):
         with b.for_(g.counter("R"), 0, n_rules - 1) as rv:
