@@ -205,3 +205,87 @@ static void fz_am_lines(double x0, double x1, int accu, int n, const double *L, 
 def am_lines_code(max_lines: int) -> str:
     """The ``fz_am_lines`` kernel for at most ``max_lines`` sets per interval."""
     return f"#define FZ_MAXL {max(2, max_lines)}\n" + gl_tables(max(2, max_lines)) + AM_LINES
+
+
+#: Smooth sets in the native evaluator (fuzzyctl.engine.smooth_np locates kinks the same way).
+SMOOTH_SAMPLES = 8  # points per characteristic interval where the branch taken is compared
+SMOOTH_BISECTIONS = 40  # steps locating a kink
+SMOOTH_ROUNDS = 4  # kinks located between two samples at most
+SMOOTH_NODES = 8  # Gauss-Legendre nodes per piece between kinks
+
+SMOOTH_DRIVER = r"""
+/* CoG of a smooth accumulated set: the characteristic intervals are sampled, where the branch
+   the set takes changes (which set is the largest, whether it is clipped) the kink is located
+   by bisection, and every piece between kinks is integrated with a fixed Gauss-Legendre rule */
+static void {name}(const double *h, const double *w, double *value, unsigned char *fired)
+{{
+    static const double cuts[{nc}] = {{{cuts}}};
+    static const double glx[{ng}] = {{{glx}}}, glw[{ng}] = {{{glw}}};
+    double pts[{cap}], area = 0.0, mom = 0.0, code, c0, cx, cr, lo, hi, end, mid, cm, a, b, x, y, d;
+    int i, j, k, q, np = 0;
+    for (i = 0; i + 1 < {nc}; i++) {{
+        a = cuts[i];
+        b = cuts[i + 1];
+        pts[np++] = a;
+        {set}(a, h, w, &c0);
+        for (j = 1; j < {samples}; j++) {{
+            x = j + 1 < {samples} ? a + (b - a) * ((double)j / ({samples} - 1)) : b;
+            {set}(x, h, w, &cx);
+            if (cx != c0) {{
+                lo = a + (b - a) * ((double)(j - 1) / ({samples} - 1));
+                hi = x;
+                code = c0;
+                for (q = 0; q < {rounds} && np < {cap} - 1; q++) {{
+                    end = hi;
+                    for (k = 0; k < {bisections}; k++) {{
+                        mid = 0.5 * (lo + hi);
+                        {set}(mid, h, w, &cm);
+                        if (cm == code) lo = mid;
+                        else hi = mid;
+                    }}
+                    pts[np++] = 0.5 * (lo + hi);
+                    {set}(hi, h, w, &cr);
+                    if (cr == cx || !(hi < end)) break;
+                    lo = hi;
+                    hi = end;
+                    code = cr;
+                }}
+            }}
+            c0 = cx;
+        }}
+    }}
+    pts[np++] = cuts[{nc} - 1];
+    for (i = 0; i + 1 < np; i++) {{
+        d = pts[i + 1] - pts[i];
+        if (!(d > 0.0)) continue;
+        for (k = 0; k < {ng}; k++) {{
+            x = pts[i] + glx[k] * d;
+            y = {set}(x, h, w, &code) * glw[k] * d;
+            area += y;
+            mom += y * x;
+        }}
+    }}
+    *fired = area > 0.0;
+    *value = area > 0.0 ? mom / area : 0.0;
+}}
+"""
+
+
+def smooth_driver(name: str, set_fn: str, cuts: list[float], num: object) -> str:
+    """The C of one smooth output's CoG (``set_fn`` computes the set and its branch code)."""
+    nodes, weights = gauss_legendre(SMOOTH_NODES)
+    fmt = num  # the renderer's literal printer
+    cap = (len(cuts) - 1) * (SMOOTH_SAMPLES * SMOOTH_ROUNDS + 1) + 2
+    return SMOOTH_DRIVER.format(
+        name=name,
+        set=set_fn,
+        nc=len(cuts),
+        cuts=", ".join(fmt(c) for c in cuts),  # type: ignore[operator]
+        ng=SMOOTH_NODES,
+        glx=", ".join(repr(v) for v in nodes),
+        glw=", ".join(repr(v) for v in weights),
+        cap=cap,
+        samples=SMOOTH_SAMPLES,
+        rounds=SMOOTH_ROUNDS,
+        bisections=SMOOTH_BISECTIONS,
+    )

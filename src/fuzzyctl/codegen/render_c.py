@@ -40,6 +40,7 @@ from fuzzyctl.engine.ir import (
 )
 from fuzzyctl.codegen.names import check_c
 from fuzzyctl.engine.fastprog import FastProgram
+from fuzzyctl.engine.plan import OutputPlan
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 _COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
@@ -354,6 +355,8 @@ class _Native(_C):
         self.pwl_funcs: dict[tuple[tuple[float, float], ...], str] = {}
         self.max_lines = 1
         self.uses_lines = False
+        self.extra: list[str] = []  # functions the kernels need (smooth sets)
+        self.uses: set[str] = set()  # intrinsics they call
 
     def name(self, n: str) -> str:
         if n in self.consts:
@@ -419,8 +422,98 @@ class _Native(_C):
                 ind + 1,
             )
             self.emit("}", ind)
+        elif k.name == "SMOOTH":
+            n = len(k.args) // 2
+            name = self.smooth_functions(k)
+            hs = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
+            ws = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
+            value, fired = (self.ex(o) for o in k.outs)
+            self.emit("{", ind)
+            self.emit(f"const double h[{max(1, n)}] = {{{hs or '0.0'}}}, w[{max(1, n)}] = {{{ws or '0.0'}}};", ind + 1)
+            self.emit(f"{name}(h, w, &{value}, &{fired});", ind + 1)
+            self.emit("}", ind)
         else:
             raise CodegenError(f"the native evaluator has no kernel {k.name}")
+
+    def smooth_functions(self, k: Kernel) -> str:
+        """The set function and the quadrature driver of one smooth output."""
+        from fuzzyctl.engine import shapes
+
+        oi, sets = k.data  # type: ignore[misc]
+        op = self.fp.plan.outputs[oi]
+        assert op.low is not None and op.high is not None
+        idx = len(self.extra)
+        set_fn, driver = f"fz_set{idx}", f"fz_smooth{idx}"
+        cuts = sorted(
+            {
+                op.low,
+                op.high,
+                *(
+                    c
+                    for t in op.terms
+                    for c in shapes.characteristic_points(t.kind, [float(p) for p in t.params])  # type: ignore[arg-type]
+                    if op.low < c < op.high
+                ),
+            }
+        )
+        self.extra.append(self.set_function(set_fn, op, sets))
+        self.extra.append(c_kernels.smooth_driver(driver, set_fn, cuts, self.num))
+        return driver
+
+    def set_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
+        """``double name(double x, const double *h, const double *w, double *code)``: the
+        accumulated set at x (``interp.accumulated_function``) and a code of the branch it
+        took - under MAX 2k (+1 when clipped) for the largest set k, otherwise a sum of
+        2^k over the clipped sets (+0.5 where BSUM reaches 1)."""
+        from fuzzyctl.engine import irterms as T
+        from fuzzyctl.engine.irgen import Gen
+        from fuzzyctl.engine.ir import Index, Pwl
+
+        g = Gen("c")
+        x, hv, wv = Var("x"), Var("h"), Var("w")
+        accu = op.accu or "MAX"
+        acc = g.let(0.0, "ACC")
+        best = g.let(-1.0, "BEST")
+        code = g.let(0.0, "CODE")
+        for k, (t, act) in enumerate(sets):
+            term = op.terms[t]
+            where = f"term {op.name}.{term.name}"
+            if term.pwl is not None:
+                mu: Ex = g.let(Pwl(x, term.pwl), "MU")
+            else:
+                ps = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
+                mu = T.smooth(g, term.kind, ps, x, where)
+                if float(term.height) != 1.0:  # type: ignore[arg-type]
+                    mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
+            h, w = Index("h", Int(k)), Index("w", Int(k))
+            c = g.let(w * T.tnorm(g, act, h, mu), "C")
+            if accu == "MAX":
+                with g.b.if_(c.gt(best)):
+                    g.b.set(best, c)
+                    g.b.set(code, float(2 * k))
+                    if act == "MIN":
+                        with g.b.if_(h.lt(mu)):
+                            g.b.set(code, float(2 * k + 1))
+                T.accumulate_into(g, accu, acc, c)
+            else:
+                g.b.set(acc, T.accumulate(g, accu, acc, c))
+                if act == "MIN" and k < 52:
+                    with g.b.if_(h.lt(mu)):
+                        g.b.set(code, code + float(2**k))
+        if accu == "BSUM":
+            with g.b.if_(acc.ge(1.0)):
+                g.b.set(code, code + 0.5)
+        r = _Native(self.fp)
+        r.pwl_funcs = self.pwl_funcs  # one set of breakpoint functions per file
+        r.lines = []
+        r.stmts(g.b.root, 1)
+        out = [f"static double {name}(double x, const double *h, const double *w, double *code)", "{"]
+        for d in g.decls:
+            out.append(f"    {_ctype(d, 'double')} {d.name} = 0;")
+        out += r.lines
+        out += [f"    *code = {code.name};", f"    return {acc.name};", "}", ""]
+        self.uses.update(g.uses)
+        return "\n".join(out)
 
     def hold(self, k: Kernel, ind: int) -> None:
         oi, default, no_change, clamp = k.data  # type: ignore[misc]
@@ -483,10 +576,12 @@ def render_native(fp: FastProgram) -> str:
         vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
         c.append(f"static const {ctype} fz_c_{d.name}[{d.size}] = {{{vals}}};")
     helpers = helper_functions(prog)
+    helpers = c_helpers.closure(set(helpers) | {_HELPER_OF[f] for f in r.uses if f in _HELPER_OF})
     c += c_helpers.render(set(helpers))
     if r.uses_lines:
         c.append(c_kernels.am_lines_code(r.max_lines))
     c += r.pwl_code()
+    c += r.extra
     n_out = len(fp.outputs)
     c.append("static inline void fz_row(double *restrict prev, const double *restrict in, double *restrict out)")
     c.append("{")

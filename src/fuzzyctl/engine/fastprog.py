@@ -219,8 +219,23 @@ class FastBuilder(RuleBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         if self.target == "c":
-            raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
+            smooth_cog = not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
+            if not smooth_cog or any(t.kind == "function" for t in op.terms):
+                raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
+            return self._smooth_kernel(oi, merged)
         return self._whole_output("MAMDANI", oi, op, merged, {})
+
+    def _smooth_kernel(self, oi: int, contribs: list[Contrib]) -> tuple[Ex, Ex]:
+        """A smooth CoG in C: the set's kinks located, then a fixed Gauss-Legendre rule per
+        piece (:func:`fuzzyctl.codegen.render_c.smooth_code`)."""
+        g = self.g
+        value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
+        args: list[Ex] = []
+        for _t, a, w, _act in contribs:
+            args += [a, w]
+        sets = tuple((t, act) for t, _a, _w, act in contribs)
+        g.b.add(Kernel("SMOOTH", (value, fired), tuple(args), (oi, sets)))
+        return value, fired
 
     def _whole_output(
         self, kind: str, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
