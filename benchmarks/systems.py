@@ -76,9 +76,12 @@ def _combos(n: int, count: int) -> Iterator[tuple[int, ...]]:
 def _terms_fcl(shape: str) -> str:
     if shape == "triangle":
         return "".join(
-            f"        TERM {t} := TRIAN {c - THIRD!r} {c!r} {c + THIRD!r};\n" for t, c in zip(TERMS7, PEAKS7)
+            f"        TERM {t} := TRIAN {c - THIRD!r} {c!r} {c + THIRD!r};\n"
+            for t, c in zip(TERMS7, PEAKS7, strict=True)
         )
-    return "".join(f"        TERM {t} := GAUSS {c!r} {SIGMA!r};\n" for t, c in zip(TERMS7, PEAKS7))
+    return "".join(
+        f"        TERM {t} := GAUSS {c!r} {SIGMA!r};\n" for t, c in zip(TERMS7, PEAKS7, strict=True)
+    )
 
 
 def fcl(system: System) -> str:
@@ -87,7 +90,9 @@ def fcl(system: System) -> str:
     out.append("    VAR_INPUT\n" + "".join(f"        {v} : REAL;\n" for v in ins) + "    END_VAR\n")
     out.append("    VAR_OUTPUT\n        u : REAL;\n    END_VAR\n")
     for v in ins:
-        out.append(f"    FUZZIFY {v}\n        RANGE := (-1.0 .. 1.0);\n{_terms_fcl(system.shape)}    END_FUZZIFY\n")
+        out.append(
+            f"    FUZZIFY {v}\n        RANGE := (-1.0 .. 1.0);\n{_terms_fcl(system.shape)}    END_FUZZIFY\n"
+        )
     out.append(
         "    DEFUZZIFY u\n        RANGE := (-1.0 .. 1.0);\n"
         + _terms_fcl(system.shape)
@@ -95,7 +100,7 @@ def fcl(system: System) -> str:
     )
     out.append("    RULEBLOCK rules\n        AND : MIN;\n        ACT : MIN;\n        ACCU : MAX;\n")
     for k, (combo, o) in enumerate(system.rules()):
-        cond = " AND ".join(f"{v} IS {TERMS7[i]}" for v, i in zip(ins, combo))
+        cond = " AND ".join(f"{v} IS {TERMS7[i]}" for v, i in zip(ins, combo, strict=True))
         out.append(f"        RULE {k + 1} : IF {cond} THEN u IS {TERMS7[o]};\n")
     out.append("    END_RULEBLOCK\nEND_FUNCTION_BLOCK\n")
     return "".join(out)
@@ -104,9 +109,10 @@ def fcl(system: System) -> str:
 def _terms_fll(shape: str) -> str:
     if shape == "triangle":
         return "".join(
-            f"  term: {t} Triangle {c - THIRD!r} {c!r} {c + THIRD!r}\n" for t, c in zip(TERMS7, PEAKS7)
+            f"  term: {t} Triangle {c - THIRD!r} {c!r} {c + THIRD!r}\n"
+            for t, c in zip(TERMS7, PEAKS7, strict=True)
         )
-    return "".join(f"  term: {t} Gaussian {c!r} {SIGMA!r}\n" for t, c in zip(TERMS7, PEAKS7))
+    return "".join(f"  term: {t} Gaussian {c!r} {SIGMA!r}\n" for t, c in zip(TERMS7, PEAKS7, strict=True))
 
 
 def fll(system: System, resolution: int = 1000) -> str:
@@ -126,7 +132,7 @@ def fll(system: System, resolution: int = 1000) -> str:
         "  implication: Minimum\n  activation: General\n"
     )
     for combo, o in system.rules():
-        cond = " and ".join(f"{v} is {TERMS7[i]}" for v, i in zip(system.inputs, combo))
+        cond = " and ".join(f"{v} is {TERMS7[i]}" for v, i in zip(system.inputs, combo, strict=True))
         out.append(f"  rule: if {cond} then u is {TERMS7[o]}\n")
     return "".join(out)
 

@@ -119,7 +119,12 @@ def compile(
 
 
 def compile_path(
-    path: str | Path, *, block: str | None = None, backend: str | None = None, format: str | None = None, **options: Any
+    path: str | Path,
+    *,
+    block: str | None = None,
+    backend: str | None = None,
+    format: str | None = None,
+    **options: Any,
 ) -> Controller:
     """``compile(load(path), ...)``, answered from the caches without reading the model when
     a file with this content was compiled with these options before (the quick start of
@@ -162,7 +167,9 @@ def compile_plan(model: Document | FunctionBlock, *, block: str | None = None, *
     return _plan(model, block, options)[0]
 
 
-def _plan(model: Document | FunctionBlock, block: str | None, options: dict[str, Any]) -> tuple[Plan, str | None]:
+def _plan(
+    model: Document | FunctionBlock, block: str | None, options: dict[str, Any]
+) -> tuple[Plan, str | None]:
     from fuzzyctl import cache
     from fuzzyctl.engine.compile import compile_block
 

@@ -12,6 +12,7 @@ entry lives in its own subdirectory, kept under ``$FUZZYCTL_CACHE_MB`` megabytes
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import tempfile
@@ -73,10 +74,8 @@ def write_atomic(path: Path, data: bytes) -> bool:
 
 def touch(path: Path) -> None:
     """Mark an entry as used (least recently used entries go first)."""
-    try:
+    with contextlib.suppress(OSError):
         os.utime(path)
-    except OSError:
-        pass
 
 
 def prune(directory: Path, limit: int, keep: Path | None = None) -> None:

@@ -17,7 +17,7 @@ __all__ = ["app", "main"]
 
 def __getattr__(name: str) -> Any:
     if name in ("app", "main"):
-        from fuzzyctl.cli import app as app_module
+        import importlib
 
-        return getattr(app_module, name)
+        return getattr(importlib.import_module("fuzzyctl.cli.app"), name)
     raise AttributeError(f"module 'fuzzyctl.cli' has no attribute {name!r}")

@@ -19,7 +19,9 @@ ACCU_CODES = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
 def gl_tables(max_lines: int) -> str:
     """Gauss-Legendre nodes and weights on [0, 1] for PROBOR of 2..max_lines factors, with
     the engine's node count ((n + 3) // 2 + 1)."""
-    offs, xs, ws = [0] * (max_lines + 2), [], []
+    offs = [0] * (max_lines + 2)
+    xs: list[float] = []
+    ws: list[float] = []
     counts = [0] * (max_lines + 2)
     for n in range(2, max_lines + 1):
         m = (n + 3) // 2 + 1

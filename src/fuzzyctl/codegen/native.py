@@ -177,7 +177,7 @@ def build(plan: Plan, hint: Path | None = None) -> Path:
     if lib.exists():
         cache.touch(lib)
         return lib
-    kind, files = sources(plan)
+    _kind, files = sources(plan)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-build-") as tmp:
         for fname, text in files.items():
@@ -381,12 +381,18 @@ def compile_native(plan: Plan, *, explicit: bool = True, hint: Path | None = Non
         return NativeController(plan, build(plan, hint))
     except NativeError as exc:
         if explicit:
-            warnings.warn(f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3)
+            warnings.warn(
+                f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
+            )
         elif compiler() is None:
             notice("no C compiler (cc or $CC): evaluating with the Python path")
         else:
-            warnings.warn(f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3)
+            warnings.warn(
+                f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
+            )
     except CodegenError as exc:
         if explicit:
-            warnings.warn(f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3)
+            warnings.warn(
+                f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
+            )
     return Controller(plan, specialise=True)

@@ -119,23 +119,20 @@ class _Builder(RuleBuilder):
         with b.else_():
             b.set(info, Int(INFO_OK))
             degrees = self._fuzzify()
-            concl = self.rules(degrees, weights)
+            contribs = self._rule_section(degrees, weights)
             values: dict[int, Ex] = {}
             exact = [oi for oi in plan.output_order if plan.outputs[oi].kind == "mamdani"]
             results: dict[int, tuple[Ex, Ex]] = {}
             if exact:
                 with b.region("defuzzify (exact, piecewise linear)"):
-                    specs = [
-                        self._mamdani(plan.outputs[oi], self.contribs(plan.outputs[oi], concl))
-                        for oi in exact
-                    ]
+                    specs = [self._mamdani(plan.outputs[oi], contribs[oi]) for oi in exact]
                     vals, fireds = exact_outputs(g, specs)
                 for k, oi in enumerate(exact):
                     results[oi] = (vals[k], fireds[k])
             for oi in plan.output_order:
                 op = plan.outputs[oi]
                 with b.region(f"output {op.name}"):
-                    val, fired = results[oi] if oi in results else self._output(oi, op, concl, values)
+                    val, fired = results[oi] if oi in results else self._output(oi, op, contribs[oi], values)
                     if op.kind == "degree":
                         b.set(outs[oi], val)
                     else:
@@ -248,10 +245,22 @@ class _Builder(RuleBuilder):
 
     # ------------------------------------------------------------------ outputs
 
+    def _rule_section(self, degrees: dict[tuple[int, int], Ex], weights: Params) -> dict[int, list[Contrib]]:
+        """Each output's activated sets: one statement per rule, or above
+        :data:`~fuzzyctl.engine.fastprog.TABLE_THRESHOLD` rules a loop over constant tables
+        (:mod:`fuzzyctl.engine.ruletable`; weights are then table entries, not tunable)."""
+        from fuzzyctl.engine.fastprog import TABLE_THRESHOLD
+        from fuzzyctl.engine.ruletable import table_applies, table_rules
+
+        plan = self.plan
+        if len(plan.rules) >= TABLE_THRESHOLD and table_applies(plan):
+            return table_rules(self, degrees, sparse=False)  # type: ignore[arg-type]
+        concl = self.rules(degrees, weights)
+        return {oi: self.contribs(op, concl) for oi, op in enumerate(plan.outputs)}
+
     def _output(
-        self, oi: int, op: OutputPlan, concl: list[list[tuple[Ex, Ex]]], values: dict[int, Ex]
+        self, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
     ) -> tuple[Ex, Ex]:
-        contribs = self.contribs(op, concl)
         if op.kind == "degree":
             return self.degree_output(op, contribs)
         if op.kind == "singleton":

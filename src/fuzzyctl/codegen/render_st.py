@@ -133,7 +133,7 @@ def _safe(text: str) -> str:
 
 
 def _type(d: Decl, real: str) -> str:
-    base = {"REAL": real, "INT": "INT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
+    base = {"REAL": real, "INT": "INT", "DINT": "DINT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
     return f"ARRAY[0..{d.size - 1}] OF {base}" if d.size is not None else base
 
 
@@ -141,7 +141,7 @@ def _init(d: Decl) -> str:
     def one(v: float | bool) -> str:
         if d.type == "BOOL":
             return "TRUE" if v else "FALSE"
-        if d.type in ("INT", "BYTE"):
+        if d.type in ("INT", "DINT", "BYTE"):
             return str(int(v))
         return st_real(float(v))
 

@@ -3,6 +3,7 @@ the state an instance keeps between evaluations (DEFAULT := NC)."""
 
 from __future__ import annotations
 
+import contextlib
 import math
 import numbers
 from collections.abc import Callable, Mapping
@@ -40,7 +41,7 @@ class Controller:
         self._interp_obj: Interpreter | None = None
         # the generated evaluators, made on first use (None: not yet; False: the plan uses
         # something the generator does not implement, the interpreter evaluates it)
-        self._fast_fn: Callable[[list[float], list[float | None]], list[float]] | None | bool = None
+        self._fast_fn: Callable[[list[float], list[float | None]], list[float]] | bool | None = None
         self._batch_fn: Any = None
 
     @property
@@ -61,11 +62,9 @@ class Controller:
                 from fuzzyctl.engine.irgen import CodegenError
                 from fuzzyctl.engine.render_py import specialise
 
-                try:
+                with contextlib.suppress(CodegenError):  # the interpreter evaluates it
                     self._fast_fn = specialise(build_fast(self.plan, "py"))
-                except CodegenError:
-                    pass
-        return self._fast_fn or None
+        return self._fast_fn if callable(self._fast_fn) else None
 
     @property
     def _batch(self) -> Any:
@@ -77,10 +76,8 @@ class Controller:
                 from fuzzyctl.engine.irgen import CodegenError
                 from fuzzyctl.engine.render_np import vectorise
 
-                try:
+                with contextlib.suppress(CodegenError):  # the interpreter evaluates it
                     self._batch_fn = vectorise(build_fast(self.plan, "np"))
-                except CodegenError:
-                    pass
         return self._batch_fn or None
 
     # ------------------------------------------------------------------ inputs

@@ -40,6 +40,7 @@ So the 343 rules of a 3-input grid reach the integration as at most 7 sets, one 
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
@@ -109,13 +110,12 @@ class FastBuilder(RuleBuilder):
         self.g.b.add(Kernel("SELECT", outs, tuple(degrees), sel))
         return list(outs)
 
-    def function_term(self, expr: object, x: Ex | None, outputs: object, where: str) -> Ex:
+    def function_term(self, expr: object, x: Ex | None, outputs: Callable[[int], Ex], where: str) -> Ex:
         assert isinstance(expr, ENum | EInput | EOutput | EX | EUnary | EBinary | ECall)
         if self.target == "c":
-            return super().function_term(expr, x, outputs, where)  # type: ignore[arg-type]
+            return super().function_term(expr, x, outputs, where)
         refs = sorted(_expr_outputs(expr))
-        get = outputs  # type: ignore[assignment]
-        args = (x if x is not None else Num(0.0), *self.inputs, *(get(o) for o in refs))  # type: ignore[operator]
+        args = (x if x is not None else Num(0.0), *self.inputs, *(outputs(o) for o in refs))
         out = self.g.temp(hint="F")
         self.g.b.add(Kernel("EXPR", (out,), tuple(args), (expr, tuple(refs), len(self.plan.outputs))))
         return out
@@ -299,7 +299,11 @@ class FastBuilder(RuleBuilder):
         g = self.g
         b = g.b
         w = gr.w
-        scale = (lambda e: e) if isinstance(w, Num) and w.value == 1.0 else (lambda e: w * e)
+        one = isinstance(w, Num) and w.value == 1.0
+
+        def scale(e: Ex) -> Ex:
+            return e if one else w * e
+
         if gr.act != "MIN":
             fa, fm = grid.full[gr.term]
             b.set(area, area + scale(gr.a * fa))
@@ -353,7 +357,7 @@ def merge(g: Gen, contribs: list[Contrib], accu: str) -> list[Group]:
                 acc = g.let(members[0][0], "H")
                 for a, _w in members[1:]:
                     with g.b.if_(a.gt(acc)):
-                        g.b.set(acc, a)  # type: ignore[arg-type]
+                        g.b.set(acc, a)
             merged.append(Group(t, acc, members[0][1], act))
         else:
             total: Ex = _times(members[0])

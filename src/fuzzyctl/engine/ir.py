@@ -25,9 +25,10 @@ import math
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
-Type = Literal["REAL", "INT", "BOOL", "BYTE"]
+#: DINT: 32-bit integers (table indices of large rule bases; INT is 16-bit in Structured Text)
+Type = Literal["REAL", "INT", "DINT", "BOOL", "BYTE"]
 #: Storage classes: instance inputs/outputs, tunable parameters (static, initialised, meant to
 #: be changed online), internal state (static), constants (static, initialised, not to be
 #: changed) and temporaries (per evaluation).
@@ -258,7 +259,7 @@ class Kernel:
     name: str
     outs: tuple[Var | Index, ...]
     args: tuple[Ex, ...]
-    data: object = None
+    data: Any = None
 
 
 Stmt = Assign | If | For | While | Comment | Region | Kernel

@@ -71,9 +71,9 @@ class Gen:
     def array(self, hint: str, type_: Type, size: int, storage: Storage = "temp") -> Var:
         return self.declare(self.fresh(hint, hint), type_, storage, max(size, 1))
 
-    def counter(self, hint: str = "K") -> str:
-        """An INT loop counter."""
-        return self.declare(self.fresh(hint, hint), "INT", "temp").name
+    def counter(self, hint: str = "K", type_: Type = "INT") -> str:
+        """An INT (or DINT) loop counter."""
+        return self.declare(self.fresh(hint, hint), type_, "temp").name
 
     # ------------------------------------------------------------------ helpers
 

@@ -101,9 +101,7 @@ class RuleBuilder:
         self.params.append(p)
         return p
 
-    def function_term(
-        self, expr: object, x: Ex | None, outputs: Callable[[int], Ex], where: str
-    ) -> Ex:
+    def function_term(self, expr: object, x: Ex | None, outputs: Callable[[int], Ex], where: str) -> Ex:
         """The value of a function term (``engine.expr``): IR expressions (C only)."""
         from fuzzyctl.engine.plan import EX, EBinary, ECall, EInput, ENum, EOutput, EUnary
 
@@ -430,9 +428,7 @@ class RuleBuilder:
             b.set(value, 0.0)
         return value, fired
 
-    def _ts_value(
-        self, op: OutputPlan, t: int, values: dict[int, Ex], zs: dict[int, Ex], coef: Params
-    ) -> Ex:
+    def _ts_value(self, op: OutputPlan, t: int, values: dict[int, Ex], zs: dict[int, Ex], coef: Params) -> Ex:
         """z of a Takagi-Sugeno term (computed once per evaluation)."""
         if t in zs:
             return zs[t]

@@ -54,9 +54,7 @@ def am_lines(x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bo
     return f
 
 
-def _am_two(
-    x0: float, x1: float, g1: tuple[float, float, bool], g2: tuple[float, float, bool]
-) -> Kernel:
+def _am_two(x0: float, x1: float, g1: tuple[float, float, bool], g2: tuple[float, float, bool]) -> Kernel:
     """Two sets under MAX: one set alone needs no cutting beyond its own kink."""
 
     def f(a1: float, w1: float, a2: float, w2: float) -> tuple[float, float]:
@@ -120,7 +118,7 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         for k, o in enumerate(earlier):
             outs[o] = args[n_in + k]
         base = n_in + len(earlier)
-        contribs = []
+        contribs: list[tuple[int | None, float, float, str]] = []
         for k, (t, act) in enumerate(sets):
             a, w = args[base + 2 * k], args[base + 2 * k + 1]
             if a * w > 0.0:
@@ -130,7 +128,8 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
 
             from fuzzyctl.engine.smooth_np import smooth_output
 
-            v, fired = smooth_output(plan, op, contribs, [np.array([x]) for x in values], [], 1)
+            sets_1 = [(t or 0, a, w, act) for t, a, w, act in contribs]
+            v, fired = smooth_output(plan, op, sets_1, [np.array([x]) for x in values], [], 1)
             return float(v[0]), bool(fired[0])
         rec = interp.output_from(op, contribs, values, outs)
         return rec.value, rec.fired

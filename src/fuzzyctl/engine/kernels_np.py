@@ -132,7 +132,7 @@ def hold(oi: int, default: float, no_change: bool, clamp: tuple[float, float] | 
         if fired.all():
             if n:
                 state[oi] = float(value[-1])
-            return value
+            return np.asarray(value, dtype=np.float64)
         prev = state[oi]
         initial = prev if (no_change and prev is not None) else default
         if no_change:
@@ -163,17 +163,17 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         for k, o in enumerate(earlier):
             outs[o] = col(n, args[n_in + k])
         base = n_in + len(earlier)
-        contribs = [
+        contribs: list[tuple[int | None, Arr, Any, str]] = [
             (t, col(n, args[base + 2 * k]), args[base + 2 * k + 1], act) for k, (t, act) in enumerate(sets)
         ]
         if op.kind == "ts":
             return _ts(op, contribs, vals, outs, n)
         if op.exact and op.grid is not None and not (op.accu == "PROBOR" and op.method == "COA"):
-            groups = [(t, a, w, act == "MIN") for t, a, w, act in contribs]
+            groups = [(t or 0, a, w, act == "MIN") for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
         from fuzzyctl.engine.smooth_np import smooth_output
 
-        return smooth_output(plan, op, contribs, vals, outs, n)
+        return smooth_output(plan, op, [(t or 0, a, w, act) for t, a, w, act in contribs], vals, outs, n)
 
     return f
 
@@ -258,14 +258,10 @@ def _mamdani(op: OutputPlan, grid: GridPlan, groups: list[tuple[int, Arr, W, boo
                 ar, mo = a * fa, a * fm
             area += w * ar
             moment += w * mo
-        general = sorted(
-            set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]}
-        )
+        general = sorted(set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]})
         for j in general:
             lines = [
-                (grid.left[t][j], grid.right[t][j], a, w, mn)
-                for t, a, w, mn in groups
-                if t in grid.active[j]
+                (grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]
             ]
             if not lines:
                 continue

@@ -245,7 +245,7 @@ class _Np:
         if k.name == "HOLD":
             if mask is not None:
                 raise CodegenError("DEFAULT / NC under a condition")
-            oi, default, no_change, clamp = k.data  # type: ignore[misc]
+            oi, default, no_change, clamp = k.data
             value, fired = (self.ex(a) for a in k.args)
             fn = self.bind(kernels_np.hold(oi, default, no_change, clamp))
             self.emit(f"{self.ex(k.outs[0])} = {fn}(n, state, {value}, {fired})", ind)
@@ -310,7 +310,7 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
     r.stmts(prog.body, 2, None)
     body = r.lines
     head = [f"    {name} = v[{k}]" for k, name in enumerate(fp.inputs)]
-    for d in prog.of("temp"):
+    for d in prog.of("temp") + prog.of("output"):
         if d.size is not None:
             head.append(f"    {d.name} = [0.0] * {d.size}")
         else:

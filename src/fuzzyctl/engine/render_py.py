@@ -191,7 +191,7 @@ class _Py:
 
     def hold(self, k: Kernel, ind: int) -> None:
         """DEFAULT / NC / lock-range (``interp.run``)."""
-        oi, default, no_change, clamp = k.data  # type: ignore[misc]
+        oi, default, no_change, clamp = k.data
         out = self.ex(k.outs[0])
         value, fired = k.args
         if not (isinstance(fired, Bool) and fired.value):
@@ -229,7 +229,10 @@ def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
         if d.size is not None:
             zero = "0.0" if d.type == "REAL" else ("0" if d.type == "INT" else "False")
             head.append(f"    {d.name} = [{zero}] * {d.size}")
-    for name in needs_init(prog.body, {d.name for d in prog.of("temp") if d.size is None}):
+    scalars = {d.name for d in prog.of("temp") + prog.of("output") if d.size is None}
+    for name in needs_init(prog.body, scalars) + [
+        o for o in fp.outputs if o in scalars and not _assigned(prog.body, o)
+    ]:
         head.append(f"    {name} = 0.0")
     src = "def _fast(v, state):\n" + "\n".join(head + body) + f"\n    return [{', '.join(fp.outputs)}]\n"
     return src, r.env
@@ -242,6 +245,10 @@ def specialise(fp: FastProgram) -> Fast:
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn
+
+
+def _assigned(body: Sequence[Stmt], name: str) -> bool:
+    return name not in needs_init([*body, Assign(Var("_probe"), Var(name))], {name})
 
 
 def needs_init(body: Sequence[Stmt], scalars: set[str]) -> list[str]:

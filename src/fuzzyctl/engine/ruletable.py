@@ -25,6 +25,7 @@ program always loops over every rule (``sparse=False``).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -148,7 +149,7 @@ class _Tables:
 
     def ints(self, hint: str, values: list[int]) -> Var:
         init = tuple(float(v) for v in values) or (0.0,)
-        return self.g.declare(self.g.fresh(hint, hint), "INT", "const", len(init), init)
+        return self.g.declare(self.g.fresh(hint, hint), "DINT", "const", len(init), init)
 
     def reals(self, hint: str, values: list[float]) -> Var:
         init = tuple(values) or (0.0,)
@@ -218,7 +219,9 @@ def _group(
             rt.append(pos[(var, terms[var])])
             code += fi_terms[k].index(terms[var]) * strides[k]
         codes.append(code)
-    so, ss, sm = [], [], []
+    so: list[int] = []
+    ss: list[int] = []
+    sm: list[float] = []
     for ri in grp.rules:
         so.append(len(ss))
         for s, m in per_rule[ri]:
@@ -233,7 +236,7 @@ def _group(
     def fire(r: Ex) -> None:
         """Rule ``r`` of the group (its index in the group's tables): its degree, added to its
         slots (a degree at or below the firing threshold counts as 0, which changes no slot)."""
-        base = g.let(r * nvars, "RB", "INT")
+        base = g.let(r * nvars, "RB", "DINT")
         d: Ex = deg[rt_v[base]]
         for k in range(1, nvars):
             d = T.tnorm(g, grp.op, d, deg[rt_v[base + k]])
@@ -249,21 +252,20 @@ def _group(
             _add(r, a)
 
     def _add(r: Ex, a: Var) -> None:
-        q = g.counter("Q")
+        q = g.counter("Q", "DINT")
         with b.for_(q, so_v[r], so_v[r + 1] - 1) as qv:
-            s = g.let(ss_v[qv], "S", "INT")
+            s = g.let(ss_v[qv], "S", "DINT")
             val = g.let(sm_v[qv] * a, "V")
-            k_ = g.let(kind[s], "K", "INT")
-            with b.if_(k_.eq(1)):
-                with b.if_(val.gt(acc[s])):
-                    b.set(acc[s], val)
+            k_ = g.let(kind[s], "K", "DINT")
+            with b.if_(k_.eq(1)), b.if_(val.gt(acc[s])):
+                b.set(acc[s], val)
             with b.elif_(k_.eq(4)):
                 b.set(acc[s], acc[s] + val - acc[s] * val)
             with b.else_():
                 b.set(acc[s], acc[s] + val)
 
     if not sparse or nvars == 0 or _code_limit(radix):
-        with b.for_(g.counter("R"), 0, n_rules - 1) as rv:
+        with b.for_(g.counter("R", "DINT"), 0, n_rules - 1) as rv:
             fire(rv)
         return
     _sparse(fb, grp, pos, deg, fi_terms, strides, codes, fire, tab, n_rules)
@@ -284,7 +286,7 @@ def _sparse(
     fi_terms: list[list[int]],
     strides: list[int],
     codes: list[int],
-    fire: object,
+    fire: Callable[[Ex], None],
     tab: _Tables,
     n_rules: int,
 ) -> None:
@@ -314,28 +316,28 @@ def _sparse(
     nz = []
     for k in range(nvars):
         ts = fi_terms[k]
-        arr = g.array(f"NZ{k}", "INT", len(ts))
-        n = g.let(0, f"NZN{k}", "INT")
+        arr = g.array(f"NZ{k}", "DINT", len(ts))
+        n = g.let(0, f"NZN{k}", "DINT")
         for j, t in enumerate(ts):
             with b.if_(deg[pos[(grp.vars[k], t)]].gt(0.0)):
                 b.set(arr[n], j)
                 b.set(n, n + 1)
         nz.append((arr, n))
-    combos = g.let(nz[0][1], "NCMB", "INT")
+    combos = g.let(nz[0][1], "NCMB", "DINT")
     for _arr, n in nz[1:]:
         b.set(combos, combos * n)
-    fire_fn = fire  # type: ignore[assignment]
+    fire_fn = fire
     with b.if_(combos.lt(n_rules)):
         counters: list[Var] = []
 
         def nest(k: int, code: Ex) -> None:
             if k == nvars:
-                h = g.let(_mod(code, size), "HH", "INT")
+                h = g.let(_mod(code, size), "HH", "DINT")
                 go = g.let(True, "GO", "BOOL")
                 with b.while_(go):
                     with b.if_(hk[h].eq(code)):
-                        with b.for_(g.counter("J"), hf[h], hf[h] + hc[h] - 1) as jv:
-                            fire_fn(hr[jv])  # type: ignore[operator]
+                        with b.for_(g.counter("J", "DINT"), hf[h], hf[h] + hc[h] - 1) as jv:
+                            fire_fn(hr[jv])
                         b.set(go, False)
                     with b.elif_(hk[h].eq(-1)):
                         b.set(go, False)
@@ -343,14 +345,14 @@ def _sparse(
                         b.set(h, _mod(h + 1, size))
                 return
             arr, n = nz[k]
-            with b.for_(g.counter(f"C{k}"), 0, n - 1) as cv:
+            with b.for_(g.counter(f"C{k}", "DINT"), 0, n - 1) as cv:
                 counters.append(cv)
-                c = g.let(code + arr[cv] * strides[k], f"CODE{k}", "INT")
+                c = g.let(code + arr[cv] * strides[k], f"CODE{k}", "DINT")
                 nest(k + 1, c)
 
         nest(0, Int(0))
     with b.else_(), b.for_(g.counter("R"), 0, n_rules - 1) as rv:
-        fire_fn(rv)  # type: ignore[operator]
+        fire_fn(rv)
 
 
 def _mod(e: Ex, size: int) -> Ex:

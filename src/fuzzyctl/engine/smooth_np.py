@@ -119,9 +119,9 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
     stacked = []
     for kind, gs in by_kind.items():
         ps = [
-            np.array([float(op.terms[cs[g][0]].params[j]) for g in gs])[:, None]
+            np.array([float(op.terms[cs[g][0]].params[j]) for g in gs])[:, None]  # type: ignore[arg-type]
             for j in range(len(op.terms[cs[gs[0]][0]].params))
-        ]  # type: ignore[arg-type]
+        ]
         hs = np.array([float(op.terms[cs[g][0]].height) for g in gs])[:, None]  # type: ignore[arg-type]
         stacked.append((kind, np.array(gs), ps, hs))
 
@@ -160,6 +160,17 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         return acc, code
 
     return f
+
+
+def _membership(term: Any, vals: list[Arr], rows: Arr, x: Arr, r: Arr) -> Arr:
+    """A term that is not stacked (piecewise linear, function of x) at nodes ``x``."""
+    if term.kind == "function":
+        assert term.expr is not None
+        row_vals = [v[rows][r] if np.ndim(v) else v for v in vals]
+        got = np.asarray(eval_expr_np(term.expr, row_vals, [], x), dtype=np.float64)
+        return np.broadcast_to(got, x.shape)
+    params = [float(p) for p in term.params]
+    return shapes.membership_np(term.kind, params, float(term.height), x)
 
 
 def _kinked_intervals(f: Any, m: int, cuts: Arr) -> tuple[Arr, Arr, Arr]:
@@ -202,9 +213,7 @@ def _kinked_intervals(f: Any, m: int, cuts: Arr) -> tuple[Arr, Arr, Arr]:
     return px[:-1][keep], px[1:][keep], pr[:-1][keep]
 
 
-def integrate_rows(
-    f: Any, m: int, a: Arr, b: Arr, r: Arr, cuts: Sequence[float], rtol: float
-) -> tuple[Arr, Arr]:
+def integrate_rows(f: Any, m: int, a: Arr, b: Arr, r: Arr, cuts: Any, rtol: float) -> tuple[Arr, Arr]:
     """Area and moment of ``f`` for ``m`` rows from initial intervals ``(a, b)`` of rows ``r``
     (``quadrature.integrate`` with every row's intervals in one array)."""
     span = float(cuts[-1] - cuts[0])
@@ -258,7 +267,7 @@ def _rows(
     value = np.full(n, np.nan)
     fired = np.zeros(n, dtype=bool)
     for i in range(n):
-        cs = []
+        cs: list[tuple[int | None, float, float, str]] = []
         for t, a, w, act in contribs:
             ai = float(np.asarray(a)[i] if np.ndim(a) else a)
             wi = float(np.asarray(w)[i] if np.ndim(w) else w)
