@@ -7,6 +7,7 @@ and the system it runs.
   this file).
 * ``gauss343``: 3 inputs x 7 Gaussian terms, 343 rules (the full grid), 7 Gaussian output
   terms, MIN/MAX, centroid - the smooth worst case.
+* ``grid343``: the same with triangles (the scaling series 49, 343, 2,401, 10,000).
 * ``grid2401``: 4 inputs x 7 triangles, 2,401 rules (the full grid), 7 output triangles.
 * ``rules10k``: 8 inputs x 7 triangles, 10,000 distinct rules drawn at random (fixed seed)
   from the 7^8 grid, 7 output triangles.
@@ -54,6 +55,7 @@ class System:
 SYSTEMS = {
     "grid49": System("grid49", 2, "triangle", 49),
     "gauss343": System("gauss343", 3, "gaussian", 343),
+    "grid343": System("grid343", 3, "triangle", 343),
     "grid2401": System("grid2401", 4, "triangle", 2401),
     "rules10k": System("rules10k", 8, "triangle", 10_000),
 }

@@ -291,3 +291,94 @@ def smooth_driver(name: str, set_fn: str, cuts: list[float], num: object) -> str
         rounds=SMOOTH_ROUNDS,
         bisections=SMOOTH_BISECTIONS,
     )
+
+
+AM_MAX2 = r"""
+/* pieces of a polyline through (x0 + t dx, v) for ordered t: area and moment (batch._polyline_am) */
+static inline void fz_poly_am(double x0, double dx, const double *ts, const double *vs, int n,
+                              double *area, double *mom)
+{
+    double a = 0.0, tm = 0.0, d, s;
+    int k;
+    for (k = 0; k + 1 < n; k++) {
+        d = ts[k + 1] - ts[k];
+        s = vs[k] + vs[k + 1];
+        a += d * s;
+        tm += d * (ts[k] * (s + vs[k]) + ts[k + 1] * (s + vs[k + 1]));
+    }
+    a *= 0.5 * dx;
+    *area = a;
+    *mom = x0 * a + (dx * dx / 6.0) * tm;
+}
+
+/* one activated set on the interval: w * min(a, line) or w * a * line (batch._clipped_line_am) */
+static inline void fz_clipped_am(double x0, double dx, double L, double R, double a, double w, int mn,
+                                 double *area, double *mom)
+{
+    double ts[3], vs[3], tk, y;
+    if (!mn) {
+        ts[0] = 0.0; ts[1] = 1.0;
+        vs[0] = w * a * L; vs[1] = w * a * R;
+        fz_poly_am(x0, dx, ts, vs, 2, area, mom);
+        return;
+    }
+    tk = R != L ? (a - L) / (R - L) : 0.0;
+    tk = tk < 0.0 ? 0.0 : (tk > 1.0 ? 1.0 : tk);
+    ts[0] = 0.0; ts[1] = tk; ts[2] = 1.0;
+    y = L + (R - L) * tk;
+    vs[0] = w * (a < L ? a : L);
+    vs[1] = w * ((L - a) * (R - a) < 0.0 ? a : (a < y ? a : y));
+    vs[2] = w * (a < R ? a : R);
+    fz_poly_am(x0, dx, ts, vs, 3, area, mom);
+}
+
+/* two activated sets under MAX, exactly and without sorting (batch._max_of_two):
+   max = c1 + c2 - min(c1, c2), min(c1, c2) = min(H, p1, p2) is concave */
+static inline __attribute__((always_inline)) void fz_am_max2(
+    double x0, double x1, double L1, double R1, double h1, double w1, int mn1,
+    double L2, double R2, double h2, double w2, int mn2, double *area, double *mom)
+{
+    double dx = x1 - x0, a1, b1, a2, b2, a3, b3, P1, S1, P2, S2, H, t, pts[5], vals[5], v0, v1;
+    int k, hit;
+    if (!(h2 * w2 > 0.0)) { /* one set alone: no crossing */
+        fz_clipped_am(x0, dx, L1, R1, h1, w1, mn1, area, mom);
+        return;
+    }
+    if (!(h1 * w1 > 0.0)) {
+        fz_clipped_am(x0, dx, L2, R2, h2, w2, mn2, area, mom);
+        return;
+    }
+    fz_clipped_am(x0, dx, L1, R1, h1, w1, mn1, &a1, &b1);
+    fz_clipped_am(x0, dx, L2, R2, h2, w2, mn2, &a2, &b2);
+    if (mn1) { P1 = w1 * L1; S1 = w1 * (R1 - L1); } else { P1 = w1 * h1 * L1; S1 = w1 * h1 * (R1 - L1); }
+    if (mn2) { P2 = w2 * L2; S2 = w2 * (R2 - L2); } else { P2 = w2 * h2 * L2; S2 = w2 * h2 * (R2 - L2); }
+    H = HUGE_VAL;
+    if (mn1 && w1 * h1 < H) H = w1 * h1;
+    if (mn2 && w2 * h2 < H) H = w2 * h2;
+    t = S1 != S2 ? (P2 - P1) / (S1 - S2) : 0.0;
+    t = t != t ? 0.0 : (t < 0.0 ? 0.0 : (t > 1.0 ? 1.0 : t));
+    pts[0] = 0.0; pts[2] = t; pts[4] = 1.0;
+    int hits[2];
+    for (k = 0; k < 2; k++) {
+        double ta = k ? t : 0.0, tb = k ? 1.0 : t, ma, mb;
+        ma = P1 + S1 * ta; if (P2 + S2 * ta < ma) ma = P2 + S2 * ta;
+        mb = P1 + S1 * tb; if (P2 + S2 * tb < mb) mb = P2 + S2 * tb;
+        hit = (ma - H) * (mb - H) < 0.0;
+        hits[k] = hit;
+        pts[1 + 2 * k] = hit ? ta + (H - ma) / (mb - ma) * (tb - ta) : ta;
+    }
+    for (k = 0; k < 5; k++) {
+        if ((k == 1 && hits[0]) || (k == 3 && hits[1])) {
+            vals[k] = H; /* exactly H where min(p1, p2) crosses it */
+            continue;
+        }
+        v0 = P1 + S1 * pts[k];
+        v1 = P2 + S2 * pts[k];
+        v0 = v1 < v0 ? v1 : v0;
+        vals[k] = H < v0 ? H : v0;
+    }
+    fz_poly_am(x0, dx, pts, vals, 5, &a3, &b3);
+    *area = a1 + a2 - a3;
+    *mom = b1 + b2 - b3;
+}
+"""

@@ -358,6 +358,7 @@ class _Native(_C):
         self.pwl_funcs: dict[tuple[tuple[float, float], ...], str] = {}
         self.max_lines = 1
         self.uses_lines = False
+        self.uses_max2 = False
         self.extra: list[str] = []  # functions the kernels need (smooth sets)
         self.uses: set[str] = set()  # intrinsics they call
 
@@ -404,6 +405,16 @@ class _Native(_C):
     def kernel(self, k: Kernel, ind: int) -> None:
         if k.name == "HOLD":
             self.hold(k, ind)
+        elif k.name == "AM_LINES" and k.data[2] == "MAX" and len(k.data[3]) == 2:
+            x0, x1, _accu, geom = k.data
+            self.uses_max2 = True
+            area, mom = (self.ex(o) for o in k.outs)
+            lines = []
+            for i, (left, right, mn) in enumerate(geom):
+                a_, w_ = self.ex(k.args[2 * i]), self.ex(k.args[2 * i + 1])
+                lines.append(f"{self.num(left)}, {self.num(right)}, {a_}, {w_}, {1 if mn else 0}")
+            self.emit(f"fz_am_max2({self.num(x0)}, {self.num(x1)}, {lines[0]},", ind)
+            self.emit(f"           {lines[1]}, &{area}, &{mom});", ind)
         elif k.name == "AM_LINES":
             x0, x1, accu, geom = k.data
             n = len(geom)
@@ -585,6 +596,8 @@ def render_native(fp: FastProgram) -> str:
     c += c_helpers.render(set(helpers))
     if r.uses_lines:
         c.append(c_kernels.am_lines_code(r.max_lines))
+    if r.uses_max2:
+        c.append(c_kernels.AM_MAX2)
     c += r.pwl_code()
     c += r.extra
     n_out = len(fp.outputs)
