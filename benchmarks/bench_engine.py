@@ -175,7 +175,7 @@ def fuzzylite_cpp(system: str, rows: np.ndarray, work: Path) -> dict[str, Any] |
     fll.write_text(fll_text(system))
     fld = work / f"{system}.fld"
     n = min(1000, len(rows))
-    names = [ln.split(":", 1)[1].strip() for ln in fll.read_text().splitlines() if ln.startswith(("InputVariable:"))]
+    names = [ln.split(":", 1)[1].strip() for ln in fll.read_text().splitlines() if ln.startswith("InputVariable:")]
     with fld.open("w") as fh:
         fh.write(" ".join([*names, "u"]) + "\n")
         for r in rows[:n]:

@@ -71,7 +71,6 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     n_out = len(outs)
     methods = {o.method for o in outs}
     accus = {ACCUS[o.accu] for o in outs if len(o.groups) > 1}
-    maxima = bool(methods & {"LM", "RM", "MOM"})
     # ---- tables: terms and their points, activated sets, per-output data
     term_pts: list[list[tuple[Ex, Ex]]] = []
     out_t0, out_t1, out_p0, out_p1, out_g0, out_g1 = [], [], [], [], [], []
@@ -116,28 +115,7 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     goff = [sum(grid_size[:oi]) for oi in range(n_out)]
     loff = [sum(grid_size[term_out[t]] for t in range(u)) for u in range(n_terms)]
     n_lim = sum(grid_size[term_out[t]] for t in range(n_terms))
-    cache = {
-        "CX": g.declare(g.fresh("CX", "CX"), "REAL", "state", n_pts, (0.0,) * n_pts, "cached term points"),
-        "CY": g.declare(g.fresh("CY", "CY"), "REAL", "state", n_pts, (0.0,) * n_pts),
-        "SX": g.declare(g.fresh("SX", "SX"), "REAL", "state", n_pts, (0.0,) * n_pts, "sorted term points"),
-        "SY": g.declare(g.fresh("SY", "SY"), "REAL", "state", n_pts, (0.0,) * n_pts),
-        "SGX": g.declare(
-            g.fresh("SGX", "SGX"), "REAL", "state", sum(grid_size), (0.0,) * sum(grid_size), "grids"
-        ),
-        "SNG": g.declare(g.fresh("SNG", "SNG"), "INT", "state", n_out, (0.0,) * n_out, "grid sizes"),
-        "SLT": g.declare(
-            g.fresh("SLT", "SLT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the right"
-        ),
-        "SRT": g.declare(
-            g.fresh("SRT", "SRT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the left"
-        ),
-        "SMU": g.declare(
-            g.fresh("SMU", "SMU"), "REAL", "state", n_lim, (0.0,) * n_lim, "term degrees at grid points"
-        ),
-        "VALID": g.declare(g.fresh("CVALID", "CVALID"), "BOOL", "state", None, False, "cache filled"),
-        "GOFF": _const(g, "GOFF", "INT", goff, "first grid point of each output"),
-        "LOFF": _const(g, "LOFF", "INT", loff, "first cache entry of each term"),
-    }
+    cache = _cache(g, n_pts, grid_size, n_out, n_lim, goff, loff)
     wx, wy = cache["SX"], cache["SY"]
     gt = _const(g, "GT", "INT", [gr.term for gr in groups], "term of each activated set")
     gmin = _const(g, "GMIN", "BOOL", [gr.is_min for gr in groups], "MIN activation (else PROD)")
@@ -159,6 +137,18 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
         "LOW": _const(g, "OLOW", "REAL", [o.low for o in outs], "defuzzification range"),
         "HIGH": _const(g, "OHIGH", "REAL", [o.high for o in outs]),
     }
+    v, arrays, st, gl = _work_variables(g, methods, accus, max_pts, max_groups)
+    ctx = Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw)
+
+    _rebuild_cache(ctx, cache, rx, ry, n_pts, n_terms, n_out, tab)
+    _each_output(ctx, cache, tab, value, fired, n_out)
+    return value, fired
+
+
+def _work_variables(
+    g: Gen, methods: set[str], accus: set[int], max_pts: int, max_groups: int
+) -> tuple[dict[str, Var], dict[str, Var], dict[str, Var], tuple[Var, Var, Var, Var] | None]:
+    """The scratch variables and arrays of the defuzzification loop."""
     v: dict[str, Var] = {}
     scalars: tuple[tuple[str, Type], ...] = (
         ("O", "INT"),
@@ -197,10 +187,19 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
         "CV": g.array("CV", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
     }
     gl = _gl_tables(g, max_groups) if probor else None
-    ctx = Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw)
+    return v, arrays, st, gl
 
+
+def _each_output(
+    ctx: Ctx, cache: dict[str, Var], tab: dict[str, Var], value: Var, fired: Var, n_out: int
+) -> None:
+    """One loop over the outputs: each output's grid intervals in one to three passes (CoG
+    one, LM/RM/MoM two: the height, then where it is reached; CoA three: the total, then
+    from the left and from the right)."""
+    g, b, v, st = ctx.g, ctx.g.b, ctx.v, ctx.st
+    methods = ctx.methods
+    maxima = bool(methods & {"LM", "RM", "MOM"})
     o_ = v["O"]
-    _rebuild_cache(ctx, cache, rx, ry, n_pts, n_terms, n_out, tab)
     ov = Var(g.counter("OO"))
     with b.for_(ov.name, 0, n_out - 1):
         b.set(o_, ov)
@@ -246,7 +245,35 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
                 with b.if_(j.ge(0).and_(j.le(ng - 2))):
                     _interval_lines(ctx, gx[gbase + j], gx[gbase + j + 1], j, cache, tab)
         finish(ctx, value[o_], fired[o_])
-    return value, fired
+
+
+def _cache(
+    g: Gen, n_pts: int, grid_size: list[int], n_out: int, n_lim: int, goff: list[int], loff: list[int]
+) -> dict[str, Var]:
+    """The instance's copy of the output geometry (rebuilt when a term point changes)."""
+    cache = {
+        "CX": g.declare(g.fresh("CX", "CX"), "REAL", "state", n_pts, (0.0,) * n_pts, "cached term points"),
+        "CY": g.declare(g.fresh("CY", "CY"), "REAL", "state", n_pts, (0.0,) * n_pts),
+        "SX": g.declare(g.fresh("SX", "SX"), "REAL", "state", n_pts, (0.0,) * n_pts, "sorted term points"),
+        "SY": g.declare(g.fresh("SY", "SY"), "REAL", "state", n_pts, (0.0,) * n_pts),
+        "SGX": g.declare(
+            g.fresh("SGX", "SGX"), "REAL", "state", sum(grid_size), (0.0,) * sum(grid_size), "grids"
+        ),
+        "SNG": g.declare(g.fresh("SNG", "SNG"), "INT", "state", n_out, (0.0,) * n_out, "grid sizes"),
+        "SLT": g.declare(
+            g.fresh("SLT", "SLT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the right"
+        ),
+        "SRT": g.declare(
+            g.fresh("SRT", "SRT"), "REAL", "state", n_lim, (0.0,) * n_lim, "term limits from the left"
+        ),
+        "SMU": g.declare(
+            g.fresh("SMU", "SMU"), "REAL", "state", n_lim, (0.0,) * n_lim, "term degrees at grid points"
+        ),
+        "VALID": g.declare(g.fresh("CVALID", "CVALID"), "BOOL", "state", None, False, "cache filled"),
+        "GOFF": _const(g, "GOFF", "INT", goff, "first grid point of each output"),
+        "LOFF": _const(g, "LOFF", "INT", loff, "first cache entry of each term"),
+    }
+    return cache
 
 
 _STATE: dict[str, tuple[Type, float]] = {

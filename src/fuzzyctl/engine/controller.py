@@ -251,7 +251,7 @@ def _column_array(name: str, col: Any) -> npt.NDArray[np.float64]:
                 _number(name, v)
             except InputError as exc:
                 raise InputError(f"{exc} (row {i})") from None
-    bad = np.flatnonzero(~np.isfinite(arr))
-    if bad.size:
+    if arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):  # no temporary array
+        bad = np.flatnonzero(~np.isfinite(arr))
         raise InputError(f"input {name!r} must be finite (row {int(bad[0])}: {arr[bad[0]]})")
     return arr

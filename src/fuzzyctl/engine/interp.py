@@ -173,6 +173,15 @@ class Interpreter:
                     else:
                         chained_acc[ch][cp.term] = accumulate(accu, chained_acc[ch][cp.term], w * ah)
 
+        records = self._outputs(concl_degrees, values, state)
+        chained_final = [chained_value(i) for i in range(len(plan.chained))]
+        return Record(term_degrees, rule_degrees, concl_degrees, chained_final, records, cond_degrees)
+
+    def _outputs(
+        self, concl_degrees: list[list[tuple[float, float]]], values: Sequence[float], state: list[float | None]
+    ) -> list[OutputRecord]:
+        """Every output in dependency order, then DEFAULT / NC and lock-range."""
+        plan = self.plan
         out_values = [math.nan] * len(plan.outputs)
         records: list[OutputRecord | None] = [None] * len(plan.outputs)
         for oi in plan.output_order:
@@ -189,15 +198,7 @@ class Interpreter:
             state[oi] = rec.value
             out_values[oi] = rec.value
             records[oi] = rec
-        chained_final = [chained_value(i) for i in range(len(plan.chained))]
-        return Record(
-            term_degrees,
-            rule_degrees,
-            concl_degrees,
-            chained_final,
-            [r for r in records if r is not None],
-            cond_degrees,
-        )
+        return [r for r in records if r is not None]
 
     # ------------------------------------------------------------------ outputs
 

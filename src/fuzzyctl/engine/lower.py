@@ -65,30 +65,111 @@ def lower(fb: m.FunctionBlock, options: Options | None = None) -> tuple[Plan | N
 # --------------------------------------------------------------------------- the block
 
 
+@dataclasses.dataclass
+class _Block:
+    """What lowering one function block has found so far (shared by its phases)."""
+
+    ctx: _Ctx
+    inputs: list[InputPlan] = dataclasses.field(default_factory=list)
+    output_names: dict[str, int] = dataclasses.field(default_factory=dict)
+    block_ops: list[tuple[str, str, str, str | None]] = dataclasses.field(default_factory=list)
+    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]] = dataclasses.field(default_factory=dict)
+    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]] = dataclasses.field(default_factory=dict)
+    fuzzy_inputs: list[FuzzyInputPlan] = dataclasses.field(default_factory=list)
+    fuzzy_index: dict[str, int] = dataclasses.field(default_factory=dict)
+    chained: list[ChainedPlan] = dataclasses.field(default_factory=list)
+    chained_index: dict[str, int] = dataclasses.field(default_factory=dict)
+    chained_term_names: dict[str, list[str]] = dataclasses.field(default_factory=dict)
+    rules: list[RulePlan] = dataclasses.field(default_factory=list)
+    rule_deps: list[set[str]] = dataclasses.field(default_factory=list)
+    rule_concludes: list[set[str]] = dataclasses.field(default_factory=list)
+    selections: list[SelectionPlan] = dataclasses.field(default_factory=list)
+
+    def term_source(self, name: str) -> list[m.Term] | None:
+        fb = self.ctx.fb
+        db = fb.defuzzify_block(name)
+        if db is not None:
+            return _first_terms(self.ctx, name, db.terms)
+        fz = fb.fuzzify_block(name)
+        if fz is not None and name not in self.ctx.slots:
+            return _first_terms(self.ctx, name, fz.terms)
+        return None
+
+    def accu_for(self, name: str, db: m.DefuzzifyBlock | None) -> str | None:
+        ctx = self.ctx
+        if db is not None and db.accu is not None:
+            try:
+                return ops.resolve_accu(db.accu)
+            except KeyError:
+                ctx.err(f"DEFUZZIFY {name}: unknown accumulation {db.accu!r}", db.span, "accu-unknown")
+                return None
+        found: list[str] = []
+        for bi, _c in self.concluded_terms.get(name, []) + self.concluded_bare.get(name, []):
+            a = self.block_ops[bi][3]
+            if a is not None and a not in found:
+                found.append(a)
+        if len(found) > 1:
+            ctx.warn(
+                f"rule blocks concluding {name} disagree on ACCU ({', '.join(found)}); {found[0]} is used",
+                db.span if db else None,
+                "accu-disagree",
+            )
+        return found[0] if found else None
+
+
 def _lower(ctx: _Ctx) -> Plan | None:
+    """The phases of lowering, in order; each adds to the :class:`_Block`."""
+    b = _Block(ctx)
+    _variables(b)
+    _block_operators(b)
+    _concluded(b)
+    _fuzzified(b)
+    _chained(b)
+    _rules(b)
+    order = _rule_order(ctx, b.rule_deps, b.rule_concludes, b.rules)
+    outputs, output_order = _outputs(b)
+    if output_order is None or order is None:
+        return None
+    return Plan(
+        ctx.fb.name,
+        tuple(b.inputs),
+        tuple(b.fuzzy_inputs),
+        tuple(b.chained),
+        tuple(b.rules),
+        tuple(order),
+        tuple(outputs),
+        tuple(output_order),
+        ctx.options,
+        tuple(b.selections),
+    )
+
+
+def _variables(b: _Block) -> None:
+    ctx = b.ctx
     fb = ctx.fb
     seen_vars: set[str] = set()
     for v in fb.variables:
         if v.name in seen_vars:
             ctx.err(f"variable {v.name!r} is declared twice", v.span, "duplicate-variable")
         seen_vars.add(v.name)
-    inputs: list[InputPlan] = []
     for v in fb.inputs:
-        ctx.slots[v.name] = len(inputs)
+        ctx.slots[v.name] = len(b.inputs)
         default = (
             float(v.initial)
             if isinstance(v.initial, int | float) and not isinstance(v.initial, bool)
             else None
         )
-        inputs.append(InputPlan(v.name, default))
+        b.inputs.append(InputPlan(v.name, default))
     for v in fb.locals:
         if isinstance(v.initial, int | float) and not isinstance(v.initial, bool):
             ctx.constants[v.name] = float(v.initial)
-    output_names = {v.name: i for i, v in enumerate(fb.outputs)}
+    b.output_names.update({v.name: i for i, v in enumerate(fb.outputs)})
 
-    # ---- rule blocks: operators
-    block_ops: list[tuple[str, str, str, str | None]] = []
-    for rb in fb.rule_blocks:
+
+def _block_operators(b: _Block) -> None:
+    """Each rule block's AND/OR pair, activation and accumulation."""
+    ctx = b.ctx
+    for rb in ctx.fb.rule_blocks:
         try:
             and_op, or_op = ops.resolve_pair(rb.and_op, rb.or_op)
         except KeyError as exc:
@@ -111,15 +192,17 @@ def _lower(ctx: _Ctx) -> Plan | None:
                 ctx.err(
                     f"rule block {rb.name or ''}: unknown accumulation {rb.accu!r}", rb.span, "accu-unknown"
                 )
-        block_ops.append((and_op, or_op, act, accu))
+        b.block_ops.append((and_op, or_op, act, accu))
 
-    # ---- who is concluded, and how
-    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]] = {}
-    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]] = {}
+
+def _concluded(b: _Block) -> None:
+    """Who is concluded, and how."""
+    ctx = b.ctx
+    fb = ctx.fb
     for bi, rb in enumerate(fb.rule_blocks):
         for rule in rb.rules:
             for c in rule.conclusions:
-                target = concluded_bare if c.term is None else concluded_terms
+                target = b.concluded_bare if c.term is None else b.concluded_terms
                 target.setdefault(c.variable, []).append((bi, c))
                 var = fb.variable(c.variable)
                 if var is None:
@@ -135,25 +218,18 @@ def _lower(ctx: _Ctx) -> Plan | None:
                         "conclusion-on-input",
                     )
 
-    def term_source(name: str) -> list[m.Term] | None:
-        db = fb.defuzzify_block(name)
-        if db is not None:
-            return _first_terms(ctx, name, db.terms)
-        fz = fb.fuzzify_block(name)
-        if fz is not None and name not in ctx.slots:
-            return _first_terms(ctx, name, fz.terms)
-        return None
 
-    # ---- fuzzified inputs
-    fuzzy_inputs: list[FuzzyInputPlan] = []
-    fuzzy_index: dict[str, int] = {}
+def _fuzzified(b: _Block) -> None:
+    """The fuzzified inputs and their terms (lock-range on the input)."""
+    ctx = b.ctx
+    fb = ctx.fb
     for fz in fb.fuzzify:
         var = fb.variable(fz.variable)
         if var is None:
             ctx.err(f"FUZZIFY of undeclared variable {fz.variable!r}", fz.span, "undeclared-variable")
             continue
         if var.kind is not m.VarKind.INPUT:
-            if fz.variable not in concluded_terms and fz.variable not in concluded_bare:
+            if fz.variable not in b.concluded_terms and fz.variable not in b.concluded_bare:
                 ctx.err(
                     f"FUZZIFY {fz.variable}: {var.kind.value} variable never receives a value "
                     "(only inputs, or variables concluded by rules, can be used in conditions)",
@@ -167,61 +243,40 @@ def _lower(ctx: _Ctx) -> Plan | None:
                 ctx.err(
                     f"term {fz.variable}.{t.name}: {t.kind} is an output-only term", fz.span, "ts-on-input"
                 )
-        fuzzy_index[fz.variable] = len(fuzzy_inputs)
-        fuzzy_inputs.append(
+        b.fuzzy_index[fz.variable] = len(b.fuzzy_inputs)
+        b.fuzzy_inputs.append(
             FuzzyInputPlan(fz.variable, ctx.slots[fz.variable], tuple(t for t in terms if t is not None))
         )
         if fz.clamp:
             bounds = _clamp_bounds(ctx, fz.range or var.range, f"FUZZIFY {fz.variable}", fz.span)
             slot = ctx.slots[fz.variable]
-            inputs[slot] = dataclasses.replace(inputs[slot], clamp=bounds)
+            b.inputs[slot] = dataclasses.replace(b.inputs[slot], clamp=bounds)
 
-    # ---- chained variables: concluded by rules and read in conditions
+
+def _chained(b: _Block) -> None:
+    """Chained variables: concluded by rules and read in conditions."""
+    fb = b.ctx.fb
     referenced: list[str] = []
     for _rb, rule in fb.rules():
         if rule.condition is not None:
             _collect_vars(rule.condition, referenced)
-    chained_names = [n for n in dict.fromkeys(referenced) if n in concluded_terms or n in concluded_bare]
-    chained_index = {n: i for i, n in enumerate(chained_names)}
-    chained_term_names: dict[str, list[str]] = {}
+    chained_names = [n for n in dict.fromkeys(referenced) if n in b.concluded_terms or n in b.concluded_bare]
+    b.chained_index.update({n: i for i, n in enumerate(chained_names)})
     for n in chained_names:
-        src = term_source(n)
-        chained_term_names[n] = [t.name for t in src] if src is not None else []
-
-    def accu_for(name: str, db: m.DefuzzifyBlock | None) -> str | None:
-        if db is not None and db.accu is not None:
-            try:
-                return ops.resolve_accu(db.accu)
-            except KeyError:
-                ctx.err(f"DEFUZZIFY {name}: unknown accumulation {db.accu!r}", db.span, "accu-unknown")
-                return None
-        found: list[str] = []
-        for bi, _c in concluded_terms.get(name, []) + concluded_bare.get(name, []):
-            a = block_ops[bi][3]
-            if a is not None and a not in found:
-                found.append(a)
-        if len(found) > 1:
-            ctx.warn(
-                f"rule blocks concluding {name} disagree on ACCU ({', '.join(found)}); {found[0]} is used",
-                db.span if db else None,
-                "accu-disagree",
-            )
-        return found[0] if found else None
-
-    chained: list[ChainedPlan] = []
+        src = b.term_source(n)
+        b.chained_term_names[n] = [t.name for t in src] if src is not None else []
     for n in chained_names:
-        chained.append(
-            ChainedPlan(n, tuple(chained_term_names[n]), accu_for(n, fb.defuzzify_block(n)) or "MAX")
+        b.chained.append(
+            ChainedPlan(n, tuple(b.chained_term_names[n]), b.accu_for(n, fb.defuzzify_block(n)) or "MAX")
         )
 
-    # ---- rules
-    rules: list[RulePlan] = []
-    rule_deps: list[set[str]] = []
-    rule_concludes: list[set[str]] = []
-    selections: list[SelectionPlan] = []
-    for bi, rb in enumerate(fb.rule_blocks):
-        and_op, or_op, act, _accu = block_ops[bi]
-        first_rule = len(rules)
+
+def _rules(b: _Block) -> None:
+    """Every rule's condition, weight and conclusions; rule activation methods per block."""
+    ctx = b.ctx
+    for bi, rb in enumerate(ctx.fb.rule_blocks):
+        and_op, or_op, act, _accu = b.block_ops[bi]
+        first_rule = len(b.rules)
         for rule in rb.rules:
             deps: set[str] = set()
             cond = (
@@ -230,11 +285,11 @@ def _lower(ctx: _Ctx) -> Plan | None:
                     rule.condition,
                     and_op,
                     or_op,
-                    fuzzy_index,
-                    chained_index,
-                    chained_term_names,
-                    concluded_bare,
-                    inputs,
+                    b.fuzzy_index,
+                    b.chained_index,
+                    b.chained_term_names,
+                    b.concluded_bare,
+                    b.inputs,
                     deps,
                     rule.label,
                 )
@@ -248,30 +303,41 @@ def _lower(ctx: _Ctx) -> Plan | None:
                 if w_rule is not None:
                     conclusions = tuple(dataclasses.replace(c, weight=w_rule) for c in conclusions)
             for c in conclusions:
-                cp = _conclusion(ctx, c, rule.label, output_names, chained_index, term_source, inputs)
+                cp = _conclusion(ctx, c, rule.label, b.output_names, b.chained_index, b.term_source, b.inputs)
                 if cp is not None:
                     concls.append(cp)
-            weight = _rule_weight(ctx, rule, inputs)
+            weight = _rule_weight(ctx, rule, b.inputs)
             if cond is None or weight is None:
                 continue
-            rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls), weight))
-            rule_deps.append(deps)
-            rule_concludes.append({c.variable for c in rule.conclusions})
+            b.rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls), weight))
+            b.rule_deps.append(deps)
+            b.rule_concludes.append({c.variable for c in rule.conclusions})
         if rb.rule_activation is not None:
-            sel = _selection(ctx, rb, tuple(range(first_rule, len(rules))), rule_deps)
+            sel = _selection(ctx, rb, tuple(range(first_rule, len(b.rules))), b.rule_deps)
             if sel is not None:
                 for ri in sel.rules:
-                    rules[ri] = dataclasses.replace(rules[ri], selection=len(selections))
-                selections.append(sel)
+                    b.rules[ri] = dataclasses.replace(b.rules[ri], selection=len(b.selections))
+                b.selections.append(sel)
 
-    order = _rule_order(ctx, rule_deps, rule_concludes, rules)
 
-    # ---- outputs
+def _outputs(b: _Block) -> tuple[list[OutputPlan], list[int] | None]:
+    """The outputs (lock-range on the output) and their order (function terms read earlier
+    outputs)."""
+    ctx = b.ctx
+    fb = ctx.fb
     outputs: list[OutputPlan] = []
     output_deps: list[set[int]] = []
     for oi, var in enumerate(fb.outputs):
         op = _output(
-            ctx, var, oi, rules, output_names, concluded_terms, concluded_bare, accu_for, term_source
+            ctx,
+            var,
+            oi,
+            b.rules,
+            b.output_names,
+            b.concluded_terms,
+            b.concluded_bare,
+            b.accu_for,
+            b.term_source,
         )
         if op is None:
             continue
@@ -287,7 +353,7 @@ def _lower(ctx: _Ctx) -> Plan | None:
                 _expr_outputs(t.expr, deps_o)
         output_deps.append(deps_o)
     if any(d.is_error for d in ctx.diags):
-        return None
+        return outputs, None
     output_order = _topo(
         ctx,
         [(i, sorted(d)) for i, d in enumerate(output_deps)],
@@ -296,20 +362,7 @@ def _lower(ctx: _Ctx) -> Plan | None:
             + " -> ".join(outputs[i].name for i in cyc)
         ),
     )
-    if output_order is None or order is None:
-        return None
-    return Plan(
-        fb.name,
-        tuple(inputs),
-        tuple(fuzzy_inputs),
-        tuple(chained),
-        tuple(rules),
-        tuple(order),
-        tuple(outputs),
-        tuple(output_order),
-        ctx.options,
-        tuple(selections),
-    )
+    return outputs, output_order
 
 
 def _clamp_bounds(

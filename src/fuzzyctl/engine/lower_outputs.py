@@ -9,7 +9,7 @@ from fuzzyctl.engine import operators as ops
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.grid import build_grid
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
-from fuzzyctl.engine.plan import Contribution, OutputPlan, RulePlan, Slot
+from fuzzyctl.engine.plan import Contribution, OutputPlan, RulePlan, Slot, TermPlan
 
 METHOD_ALIASES = {
     "MM": "MOM",
@@ -101,41 +101,7 @@ def _output(
             no_change,
         )
     if ts_terms or (singletonish and method in ("WTAVER", "WTSUM")):
-        if not kinds <= shapes.TS_KINDS | {"singleton"}:
-            ctx.err(
-                f"DEFUZZIFY {var.name}: Takagi-Sugeno terms (constant, linear, function) "
-                "cannot be mixed with fuzzy sets",
-                db.span,
-                "mixed-terms",
-            )
-            return None
-        if method not in (None, "WTAVER", "WTSUM", "COGS", "COG"):
-            ctx.err(
-                f"DEFUZZIFY {var.name}: {method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
-                db.span,
-                "method-ts",
-            )
-            return None
-        for t in tps:
-            if t.kind == "linear" and len(t.params) > len(fb.inputs) + 1:
-                ctx.err(
-                    f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
-                    f"{len(fb.inputs)} inputs",
-                    db.span,
-                    "linear-arity",
-                )
-                return None
-        ts_accu = accu if accu is not None else ctx.options.ts_default_accu
-        return OutputPlan(
-            var.name,
-            "ts",
-            "WTSUM" if method == "WTSUM" else "WTAVER",
-            ts_accu,
-            tps,
-            tuple(contributions),
-            default,
-            no_change,
-        )
+        return _ts_output(ctx, var, db, tps, kinds, method, accu, contributions, default, no_change)
     if singletonish:
         if method == "COA":
             ctx.err(
@@ -154,47 +120,83 @@ def _output(
             "mixed-terms",
         )
         return None
+    return _mamdani_output(ctx, var, db, tps, kinds, method, accu, contributions, default, no_change)
+
+
+def _ts_output(
+    ctx: _Ctx,
+    var: m.Variable,
+    db: m.DefuzzifyBlock,
+    tps: tuple[TermPlan, ...],
+    kinds: set[str],
+    method: str | None,
+    accu: str | None,
+    contributions: list[Contribution],
+    default: float | None,
+    no_change: bool,
+) -> OutputPlan | None:
+    """A Takagi-Sugeno output (constant, linear, function terms; singletons under WTAVER)."""
+    fb = ctx.fb
+    if not kinds <= shapes.TS_KINDS | {"singleton"}:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: Takagi-Sugeno terms (constant, linear, function) "
+            "cannot be mixed with fuzzy sets",
+            db.span,
+            "mixed-terms",
+        )
+        return None
+    if method not in (None, "WTAVER", "WTSUM", "COGS", "COG"):
+        ctx.err(
+            f"DEFUZZIFY {var.name}: {method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
+            db.span,
+            "method-ts",
+        )
+        return None
+    for t in tps:
+        if t.kind == "linear" and len(t.params) > len(fb.inputs) + 1:
+            ctx.err(
+                f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
+                f"{len(fb.inputs)} inputs",
+                db.span,
+                "linear-arity",
+            )
+            return None
+    ts_accu = accu if accu is not None else ctx.options.ts_default_accu
+    return OutputPlan(
+        var.name,
+        "ts",
+        "WTSUM" if method == "WTSUM" else "WTAVER",
+        ts_accu,
+        tps,
+        tuple(contributions),
+        default,
+        no_change,
+    )
+
+
+def _mamdani_output(
+    ctx: _Ctx,
+    var: m.Variable,
+    db: m.DefuzzifyBlock,
+    tps: tuple[TermPlan, ...],
+    kinds: set[str],
+    method: str | None,
+    accu: str | None,
+    contributions: list[Contribution],
+    default: float | None,
+    no_change: bool,
+) -> OutputPlan | None:
+    """A Mamdani output: its method, universe, and the grid of a constant piecewise-linear one."""
     meth = method or "COG"
     if meth in ("COGS", "WTAVER", "WTSUM"):
         ctx.err(
             f"DEFUZZIFY {var.name}: {meth} needs singleton or Takagi-Sugeno terms", db.span, "method-terms"
         )
         return None
-    rng = db.range or var.range
-    if rng is not None:
-        low, high = float(rng.low), float(rng.high)
-        if not (math.isfinite(low) and math.isfinite(high) and low < high):
-            ctx.err(f"DEFUZZIFY {var.name}: RANGE must be finite with min < max", rng.span, "range-invalid")
-            return None
-    else:
-        lows, highs = [], []
-        for t in tps:
-            if not t.constant:
-                ctx.err(
-                    f"DEFUZZIFY {var.name}: term {t.name} has variable parameters; give a RANGE",
-                    db.span,
-                    "range-needed",
-                )
-                return None
-            lo, hi = shapes.support(
-                t.kind,
-                [float(p) for p in t.params if not isinstance(p, Slot)],
-                float(t.height) if not isinstance(t.height, Slot) else 1.0,
-            )
-            if not (math.isfinite(lo) and math.isfinite(hi)):
-                ctx.err(
-                    f"DEFUZZIFY {var.name}: term {t.name} ({t.kind}) is not zero outside a finite interval; "
-                    "give a RANGE",
-                    db.span,
-                    "range-needed",
-                )
-                return None
-            lows.append(lo)
-            highs.append(hi)
-        low, high = min(lows), max(highs)
-        if not low < high:
-            ctx.err(f"DEFUZZIFY {var.name}: the terms have no extent; give a RANGE", db.span, "range-needed")
-            return None
+    bounds = _universe(ctx, var, db, tps)
+    if bounds is None:
+        return None
+    low, high = bounds
     acc = accu or "MAX"
     acts = {c.act for c in contributions}
     exact = kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
@@ -205,3 +207,45 @@ def _output(
     return OutputPlan(
         var.name, "mamdani", meth, acc, tps, tuple(contributions), default, no_change, low, high, exact, grid
     )
+
+
+def _universe(
+    ctx: _Ctx, var: m.Variable, db: m.DefuzzifyBlock, tps: tuple[TermPlan, ...]
+) -> tuple[float, float] | None:
+    """[RANGE min, max], else the hull of the terms' supports."""
+    rng = db.range or var.range
+    if rng is not None:
+        low, high = float(rng.low), float(rng.high)
+        if not (math.isfinite(low) and math.isfinite(high) and low < high):
+            ctx.err(f"DEFUZZIFY {var.name}: RANGE must be finite with min < max", rng.span, "range-invalid")
+            return None
+        return low, high
+    lows, highs = [], []
+    for t in tps:
+        if not t.constant:
+            ctx.err(
+                f"DEFUZZIFY {var.name}: term {t.name} has variable parameters; give a RANGE",
+                db.span,
+                "range-needed",
+            )
+            return None
+        lo, hi = shapes.support(
+            t.kind,
+            [float(p) for p in t.params if not isinstance(p, Slot)],
+            float(t.height) if not isinstance(t.height, Slot) else 1.0,
+        )
+        if not (math.isfinite(lo) and math.isfinite(hi)):
+            ctx.err(
+                f"DEFUZZIFY {var.name}: term {t.name} ({t.kind}) is not zero outside a finite interval; "
+                "give a RANGE",
+                db.span,
+                "range-needed",
+            )
+            return None
+        lows.append(lo)
+        highs.append(hi)
+    low, high = min(lows), max(highs)
+    if not low < high:
+        ctx.err(f"DEFUZZIFY {var.name}: the terms have no extent; give a RANGE", db.span, "range-needed")
+        return None
+    return low, high
