@@ -153,7 +153,9 @@ def ours(path: Path, rows: np.ndarray, budget: float) -> dict[str, dict[str, Any
 # --------------------------------------------------------------------------- others
 
 
-def peer(python: str, lib: str, system: str, rows: np.ndarray, budget: float, work: Path) -> dict[str, Any] | None:
+def peer(
+    python: str, lib: str, system: str, rows: np.ndarray, budget: float, work: Path
+) -> dict[str, Any] | None:
     f = work / f"{system}-samples.npy"
     np.save(f, rows)
     cmd = [python, str(HERE / "peer_driver.py"), lib, system, str(f), "--budget", str(budget)]
@@ -175,12 +177,16 @@ def fuzzylite_cpp(system: str, rows: np.ndarray, work: Path) -> dict[str, Any] |
     fll.write_text(fll_text(system))
     fld = work / f"{system}.fld"
     n = min(1000, len(rows))
-    names = [ln.split(":", 1)[1].strip() for ln in fll.read_text().splitlines() if ln.startswith("InputVariable:")]
+    names = [
+        ln.split(":", 1)[1].strip() for ln in fll.read_text().splitlines() if ln.startswith("InputVariable:")
+    ]
     with fld.open("w") as fh:
         fh.write(" ".join([*names, "u"]) + "\n")
         for r in rows[:n]:
             fh.write(" ".join(repr(float(v)) for v in r) + " 0\n")
-    res = subprocess.run([exe, "benchmark", str(fll), str(fld), "3"], capture_output=True, text=True, timeout=3600)
+    res = subprocess.run(
+        [exe, "benchmark", str(fll), str(fld), "3"], capture_output=True, text=True, timeout=3600
+    )
     lines = [ln for ln in res.stdout.splitlines() if ln.startswith("fuzzylite")]
     if not lines:
         return None
@@ -232,7 +238,9 @@ def section_peers(args: argparse.Namespace, work: Path, results: dict[str, Any])
             if system in rec and "outputs" in rec[system]:
                 k = len(rec[system]["outputs"])
                 rec[system]["max_err"] = float(np.max(np.abs(rec[system]["outputs"] - exact[:k])))
-    results["peers"] = {k: {s: {m: v for m, v in r.items() if m != "outputs"} for s, r in d.items()} for k, d in table.items()}
+    results["peers"] = {
+        k: {s: {m: v for m, v in r.items() if m != "outputs"} for s, r in d.items()} for k, d in table.items()
+    }
     base = table.get("pyfuzzylite", {})
     print("\n## 1. Against the peers (ratios: x pyfuzzylite)\n")
     head = "| engine |" + "".join(f" {s} single | {s} batch/s |" for s in ("tipper", "grid49", "gauss343"))
@@ -256,7 +264,10 @@ def section_peers(args: argparse.Namespace, work: Path, results: dict[str, Any])
         if errs:
             print(f"  {name}: {errs}")
     nat, num = table["fuzzyctl native"], table["fuzzyctl python/numpy"]
-    print("native batch / numpy batch: " + ", ".join(f"{s} {nat[s]['batch_per_s'] / num[s]['batch_per_s']:.1f}x" for s in nat))
+    print(
+        "native batch / numpy batch: "
+        + ", ".join(f"{s} {nat[s]['batch_per_s'] / num[s]['batch_per_s']:.1f}x" for s in nat)
+    )
 
 
 def section_handwritten(args: argparse.Namespace, work: Path, results: dict[str, Any]) -> None:
@@ -281,12 +292,20 @@ def section_handwritten(args: argparse.Namespace, work: Path, results: dict[str,
     ctl.evaluate_batch(cols)
     threaded = (time.perf_counter() - t0) / len(rows)
     err = float(np.max(np.abs(got - out_hw)))
-    results["handwritten"] = {"hand_ns": per_hw * 1e9, "native_ns": best * 1e9, "native_threads_ns": threaded * 1e9, "max_diff": err}
+    results["handwritten"] = {
+        "hand_ns": per_hw * 1e9,
+        "native_ns": best * 1e9,
+        "native_threads_ns": threaded * 1e9,
+        "max_diff": err,
+    }
     print("\n## 2. Hand-written C (grid49, 1,000,000 rows, -O3)\n")
-    print(f"hand-written loop {per_hw * 1e9:.1f} ns/row; native evaluate_batch {best * 1e9:.1f} ns/row one thread "
-          "(CPU time) "
-          f"({best / per_hw:.2f}x the hand-written loop), {threaded * 1e9:.1f} ns/row on all cores; "
-          f"largest difference {err:.1g}")
+    print(
+        f"hand-written loop {per_hw * 1e9:.1f} ns/row; native evaluate_batch {best * 1e9:.1f} ns/row "
+        "one thread "
+        "(CPU time) "
+        f"({best / per_hw:.2f}x the hand-written loop), {threaded * 1e9:.1f} ns/row on all cores; "
+        f"largest difference {err:.1g}"
+    )
 
 
 def _subprocess_time(code: str, env: dict[str, str]) -> float:
@@ -315,25 +334,41 @@ def section_scaling(args: argparse.Namespace, work: Path, results: dict[str, Any
         nat = fuzzyctl.compile(doc, backend="native")
         names = list(py.inputs)
         x = samples(system, 20_000, len(names))
-        rec: dict[str, Any] = {"system": system, "rules": n_rules, "compile_cold_s": cold, "load_compile_warm_s": warm}
+        rec: dict[str, Any] = {
+            "system": system,
+            "rules": n_rules,
+            "compile_cold_s": cold,
+            "load_compile_warm_s": warm,
+        }
         for label, ctl in (("python", py), ("native", nat)):
-            rec[f"single_{label}_s"] = latency(lambda r, c=ctl: c.evaluate(dict(zip(names, r.tolist(), strict=True))), x, budget)
+            names = list(ctl.inputs)
+            rec[f"single_{label}_s"] = latency(
+                lambda r, c=ctl, names=names: c.evaluate(dict(zip(names, r.tolist(), strict=True))), x, budget
+            )
             rec[f"batch_{'numpy' if label == 'python' else label}_per_s"] = throughput(
-                lambda a, c=ctl: c.evaluate_batch({n: a[:, i] for i, n in enumerate(names)}), x, 3 * budget
+                lambda a, c=ctl, names=names: c.evaluate_batch({n: a[:, i] for i, n in enumerate(names)}),
+                x,
+                3 * budget,
             )
         if args.peers is not None:
-            got = peer(args.peers, "pyfuzzylite", system, x[:200], 0.3 if system == "rules10k" else budget, work)
+            got = peer(
+                args.peers, "pyfuzzylite", system, x[:200], 0.3 if system == "rules10k" else budget, work
+            )
             if got is not None:
                 rec["pyfuzzylite_import_s"] = got["build_s"]
                 rec["pyfuzzylite_single_s"] = got["single_s"]
         rows_out.append(rec)
     results["scaling"] = rows_out
     print("\n## 3. Scaling with the rule count\n")
-    print("| system | rules | single python | single native | batch numpy/s | batch native/s | compile cold (parse, lower, C) | load+compile warm | pyfuzzylite import | pyfuzzylite single |")
+    print(
+        "| system | rules | single python | single native | batch numpy/s | batch native/s "
+        "| compile cold (parse, lower, C) | load+compile warm | pyfuzzylite import | pyfuzzylite single |"
+    )
     print("|---|---|---|---|---|---|---|---|---|---|")
     for r in rows_out:
         print(
-            f"| {r['system']} | {r['rules']:,} | {r['single_python_s'] * 1e6:,.1f} us | {r['single_native_s'] * 1e6:,.1f} us | "
+            f"| {r['system']} | {r['rules']:,} | {r['single_python_s'] * 1e6:,.1f} us "
+            f"| {r['single_native_s'] * 1e6:,.1f} us | "
             f"{r['batch_numpy_per_s']:,.0f} | {r['batch_native_per_s']:,.0f} | {r['compile_cold_s']:.2f} s | "
             f"{r['load_compile_warm_s']:.3f} s | {r.get('pyfuzzylite_import_s', math.nan):.2f} s | "
             f"{r.get('pyfuzzylite_single_s', math.nan) * 1e3:,.2f} ms |"
@@ -360,9 +395,16 @@ def section_cold_start(args: argparse.Namespace, work: Path, results: dict[str, 
         return statistics.median(times)
 
     out = {
-        "eval grid49": median([exe, "eval", str(fcl_path("grid49", work)), "--set", "e=0.1", "--set", "de=0.2"]),
+        "eval grid49": median(
+            [exe, "eval", str(fcl_path("grid49", work)), "--set", "e=0.1", "--set", "de=0.2"]
+        ),
         "eval grid2401": median(
-            [exe, "eval", str(fcl_path("grid2401", work)), *sum((["--set", f"x{k}=0.1"] for k in range(1, 5)), [])]
+            [
+                exe,
+                "eval",
+                str(fcl_path("grid2401", work)),
+                *[a for k in range(1, 5) for a in ("--set", f"x{k}=0.1")],
+            ]
         ),
         "--help": median([exe, "--help"]),
         "python -c pass": median([sys.executable, "-c", "pass"]),
@@ -373,7 +415,9 @@ def section_cold_start(args: argparse.Namespace, work: Path, results: dict[str, 
         fll.write_text(fll_text("grid49"))
         fld = work / "one.fld"
         fld.write_text("e de\n0.1 0.2\n")
-        out["fuzzylite C++ (one row)"] = median([cpp, "-i", str(fll), "-of", "fld", "-d", str(fld), "-o", str(work / "o.fld")])
+        out["fuzzylite C++ (one row)"] = median(
+            [cpp, "-i", str(fll), "-of", "fld", "-d", str(fld), "-o", str(work / "o.fld")]
+        )
     results["cold_start"] = out
     print("\n## 4. Cold start (median of 10 runs, caches warm)\n")
     for k, v in out.items():
@@ -387,7 +431,8 @@ def section_memory(args: argparse.Namespace, work: Path, results: dict[str, Any]
         code = (
             "import resource, numpy as np, fuzzyctl; "
             f"c = fuzzyctl.compile(fuzzyctl.load({str(HERE / 'grid49.fcl')!r}), backend={backend!r}); "
-            f"rng = np.random.default_rng(0); x = {{'e': rng.uniform(-1, 1, {n}), 'de': rng.uniform(-1, 1, {n})}}; "
+            "rng = np.random.default_rng(0); "
+            f"x = {{'e': rng.uniform(-1, 1, {n}), 'de': rng.uniform(-1, 1, {n})}}; "
             "base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss; "
             "y = c.evaluate_batch(x); "
             "print(base, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss)"
@@ -396,7 +441,10 @@ def section_memory(args: argparse.Namespace, work: Path, results: dict[str, Any]
         before, after = (int(v) for v in res.stdout.split())
         out[backend] = {"peak_mb": after / 1024, "inputs_mb": before / 1024}
     results["memory"] = {"rows": n, **out}
-    print(f"\n## 5. Peak resident memory of a {n:,}-row batch (grid49; inputs {2 * n * 8 / 2**20:,.0f} MB, output {n * 8 / 2**20:,.0f} MB)\n")
+    print(
+        f"\n## 5. Peak resident memory of a {n:,}-row batch (grid49; inputs {2 * n * 8 / 2**20:,.0f} MB, "
+        f"output {n * 8 / 2**20:,.0f} MB)\n"
+    )
     for k, v in out.items():
         print(f"  {k}: peak {v['peak_mb']:,.0f} MB (with the inputs in memory: {v['inputs_mb']:,.0f} MB)")
 
@@ -406,15 +454,21 @@ def main() -> None:
     ap.add_argument("--quick", action="store_true", help="smaller budgets (rougher numbers)")
     ap.add_argument("--json", type=Path, help="also write the numbers as JSON")
     default_peers = ROOT / ".venv-peers" / "bin" / "python"
-    ap.add_argument("--peers", default=str(default_peers) if default_peers.exists() else None,
-                    help="python of the peers' virtual environment (default: .venv-peers)")
+    ap.add_argument(
+        "--peers",
+        default=str(default_peers) if default_peers.exists() else None,
+        help="python of the peers' virtual environment (default: .venv-peers)",
+    )
     ap.add_argument("--only", help="comma-separated sections: peers,handwritten,scaling,cold,memory")
     args = ap.parse_args()
     if args.peers is None:
         print("no .venv-peers: peers skipped (make .venv-peers)", file=sys.stderr)
     load0 = os.getloadavg()
-    print(f"python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores; numpy {np.__version__}; "
-          f"load average {load0[0]:.1f} {load0[1]:.1f} {load0[2]:.1f}")
+    print(
+        f"python {platform.python_version()} on {platform.machine()}, {os.cpu_count()} cores; "
+        f"numpy {np.__version__}; "
+        f"load average {load0[0]:.1f} {load0[1]:.1f} {load0[2]:.1f}"
+    )
     results: dict[str, Any] = {"load_start": load0}
     sections = {
         "peers": section_peers,

@@ -178,7 +178,10 @@ class Interpreter:
         return Record(term_degrees, rule_degrees, concl_degrees, chained_final, records, cond_degrees)
 
     def _outputs(
-        self, concl_degrees: list[list[tuple[float, float]]], values: Sequence[float], state: list[float | None]
+        self,
+        concl_degrees: list[list[tuple[float, float]]],
+        values: Sequence[float],
+        state: list[float | None],
     ) -> list[OutputRecord]:
         """Every output in dependency order, then DEFAULT / NC and lock-range."""
         plan = self.plan
