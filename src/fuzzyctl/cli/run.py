@@ -15,6 +15,7 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl.cli.app import app
+from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
     list[str] | None,
@@ -72,8 +73,21 @@ def eval_(
     ] = False,
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
+    dask_in: DaskOpt = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
 ) -> None:
-    """Evaluate a controller once (--set) or on every row of a CSV file (--csv)."""
+    """Evaluate a controller once (--set), on every row of a CSV file (--csv), or on a
+    directory/glob of Parquet/CSV files on Dask (--dask DATA -o DIR)."""
+    if dask_in is not None:
+        if set_ or csv_in is not None:
+            raise typer.BadParameter("use --dask alone, without --set or --csv", param_hint="--dask")
+        from fuzzyctl.cli import eval_dask
+
+        eval_dask.run(file, dask_in, output, block=block, compat=compat, workers=workers, scheduler=scheduler)
+        return
+    if workers is not None or scheduler is not None:
+        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
     ctl = _controller(file, block, compat)
     if csv_in is not None:
         if set_:
