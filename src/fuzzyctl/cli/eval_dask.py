@@ -21,11 +21,19 @@ DaskOpt = Annotated[
 ]
 WorkersOpt = Annotated[
     int | None,
-    typer.Option("--workers", help="With --dask: local worker processes (default: one per CPU; 0: this process).", show_default=False),
+    typer.Option(
+        "--workers",
+        help="With --dask: local worker processes (default: one per CPU; 0: this process).",
+        show_default=False,
+    ),
 ]
 SchedulerOpt = Annotated[
     str | None,
-    typer.Option("--scheduler", help="With --dask: an existing scheduler tcp://HOST:PORT (or $DASK_SCHEDULER_ADDRESS).", show_default=False),
+    typer.Option(
+        "--scheduler",
+        help="With --dask: an existing scheduler tcp://HOST:PORT (or $DASK_SCHEDULER_ADDRESS).",
+        show_default=False,
+    ),
 ]
 
 
@@ -57,8 +65,12 @@ def run(
     console = Console(stderr=True)
     try:
         with Progress(
-            TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(), TimeElapsedColumn(),
-            console=console, transient=True,
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=console,
+            transient=True,
         ) as progress:
             task = progress.add_task(f"scoring {source}", total=None)
 

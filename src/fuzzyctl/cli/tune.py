@@ -24,7 +24,7 @@ SchedulerOpt = Annotated[
     str | None,
     typer.Option(
         "--scheduler",
-        help="An existing Dask scheduler, tcp://HOST:PORT (default: $DASK_SCHEDULER_ADDRESS, else a local cluster).",
+        help="An existing Dask scheduler, tcp://HOST:PORT (default: $DASK_SCHEDULER_ADDRESS, else local).",
         show_default=False,
     ),
 ]
@@ -34,7 +34,9 @@ ValidationOpt = Annotated[
 ]
 ValidationDataOpt = Annotated[
     Path | None,
-    typer.Option("--validation-data", help="Validation (checking) rows from this file instead.", show_default=False),
+    typer.Option(
+        "--validation-data", help="Validation (checking) rows from this file instead.", show_default=False
+    ),
 ]
 
 
@@ -71,21 +73,33 @@ def _print_table(title: str, rows: list[tuple[str, float, float]] | list[tuple[s
 @app.command("learn")
 def learn(
     data: Annotated[Path, typer.Argument(help="CSV or Parquet file with a header row.", show_default=False)],
-    inputs: Annotated[str, typer.Option("--inputs", help="Input columns, comma-separated.", show_default=False)],
+    inputs: Annotated[
+        str, typer.Option("--inputs", help="Input columns, comma-separated.", show_default=False)
+    ],
     output: Annotated[str, typer.Option("--output", help="The output column.", show_default=False)],
-    out: Annotated[Path, typer.Option("-o", "--out", help="Write the learned system here (FCL).", show_default=False)],
+    out: Annotated[
+        Path, typer.Option("-o", "--out", help="Write the learned system here (FCL).", show_default=False)
+    ],
     method: Annotated[str, typer.Option("--method", help="grid (partition) or cluster (KMeans).")] = "grid",
     kind: Annotated[str, typer.Option("--type", help="tsk (Takagi-Sugeno) or mamdani (singletons).")] = "tsk",
     terms: Annotated[
         int | None,
-        typer.Option("--terms", help="Terms per input (grid; default 5/3/2 by input count) or clusters (default 10).", show_default=False),
+        typer.Option(
+            "--terms",
+            help="Terms per input (grid; default 5/3/2 by input count) or clusters (default 10).",
+            show_default=False,
+        ),
     ] = None,
     out_terms: Annotated[int, typer.Option("--out-terms", help="Output singletons of a Mamdani system.")] = 7,
-    and_op: Annotated[str, typer.Option("--and", help="AND operator: prod or min (PLC Basic level).")] = "prod",
+    and_op: Annotated[
+        str, typer.Option("--and", help="AND operator: prod or min (PLC Basic level).")
+    ] = "prod",
     validation: ValidationOpt = 0.2,
     validation_data: ValidationDataOpt = None,
     seed: SeedOpt = 0,
-    name: Annotated[str | None, typer.Option("--name", help="FUNCTION_BLOCK name (default: learned).")] = None,
+    name: Annotated[
+        str | None, typer.Option("--name", help="FUNCTION_BLOCK name (default: learned).")
+    ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the errors as JSON.")] = False,
 ) -> None:
     """Learn a fuzzy system from data: grid partition or clustering, consequents by least squares."""
@@ -121,38 +135,64 @@ def learn(
 
 @app.command("tune")
 def tune(
-    file: Annotated[Path, typer.Argument(help="The fuzzy system to tune (FCL, FIS, FLL or JSON).", show_default=False)],
-    out: Annotated[Path, typer.Option("-o", "--out", help="Write the tuned system here (FCL).", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="The fuzzy system to tune (FCL, FIS, FLL or JSON).", show_default=False)
+    ],
+    out: Annotated[
+        Path, typer.Option("-o", "--out", help="Write the tuned system here (FCL).", show_default=False)
+    ],
     data: Annotated[
-        Path | None, typer.Option("--data", help="CSV/Parquet of inputs and target outputs.", show_default=False)
+        Path | None,
+        typer.Option("--data", help="CSV/Parquet of inputs and target outputs.", show_default=False),
     ] = None,
     output: Annotated[
         str | None,
-        typer.Option("--output", help="Target column(s), comma-separated (default: every output in the data).", show_default=False),
+        typer.Option(
+            "--output",
+            help="Target column(s), comma-separated (default: every output in the data).",
+            show_default=False,
+        ),
     ] = None,
     plant_config: Annotated[
         Path | None,
-        typer.Option("--plant", help="A simulate configuration (TOML); cost and scenarios from its [tune] table.", show_default=False),
+        typer.Option(
+            "--plant",
+            help="A simulate configuration (TOML); cost and scenarios from its [tune] table.",
+            show_default=False,
+        ),
     ] = None,
     cost: Annotated[
         str | None,
-        typer.Option("--cost", help="Cost terms, e.g. settling_time=1,max:angle=0.5 (overrides [tune] cost).", show_default=False),
+        typer.Option(
+            "--cost",
+            help="Cost terms, e.g. settling_time=1,max:angle=0.5 (overrides [tune] cost).",
+            show_default=False,
+        ),
     ] = None,
     free: Annotated[
         str, typer.Option("--free", help="What moves: all, inputs, outputs, weights, VAR, VAR.TERM, -ITEM.")
     ] = "all",
     optimizer: Annotated[
         str | None,
-        typer.Option("--optimizer", help="cmaes, de, lsq or lbfgsb (default: lsq for data, cmaes for the plant).", show_default=False),
+        typer.Option(
+            "--optimizer",
+            help="cmaes, de, lsq or lbfgsb (default: lsq for data, cmaes for the plant).",
+            show_default=False,
+        ),
     ] = None,
-    budget: Annotated[int, typer.Option("--budget", help="Evaluations (simulations per scenario, or passes over the data).")] = 200,
+    budget: Annotated[
+        int, typer.Option("--budget", help="Evaluations (simulations per scenario, or passes over the data).")
+    ] = 200,
     seed: SeedOpt = 0,
     loss: Annotated[str, typer.Option("--loss", help="Data loss: rmse, mae or max.")] = "rmse",
     validation: ValidationOpt = 0.2,
     validation_data: ValidationDataOpt = None,
-    block: Annotated[str | None, typer.Option("--block", help="Function block to tune (default: the first).")] = None,
+    block: Annotated[
+        str | None, typer.Option("--block", help="Function block to tune (default: the first).")
+    ] = None,
     runtime: Annotated[
-        str | None, typer.Option("--runtime", help="Run the controller in the loop on: engine, siemens, xfuz, native.")
+        str | None,
+        typer.Option("--runtime", help="Run the controller in the loop on: engine, siemens, xfuz, native."),
     ] = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,

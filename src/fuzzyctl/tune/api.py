@@ -9,10 +9,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from fuzzyctl.diagnostics import FuzzyctlError, InputError
+from fuzzyctl.diagnostics import InputError
 from fuzzyctl.model import Document, FunctionBlock
 from fuzzyctl.tune import optimize, parallel, plant
-from fuzzyctl.tune.data import LOSSES, read_table, require, split
+from fuzzyctl.tune.data import LOSSES, Columns, read_table, require, split
 from fuzzyctl.tune.problems import DataProblem, PlantProblem
 from fuzzyctl.tune.space import Space, build_space
 
@@ -159,7 +159,11 @@ def _data_problem(
     cols = read_table(data)
     outs = [v.name for v in fb.outputs]
     targets = (
-        [output] if isinstance(output, str) else list(output) if output is not None else [o for o in outs if o in cols]
+        [output]
+        if isinstance(output, str)
+        else list(output)
+        if output is not None
+        else [o for o in outs if o in cols]
     )
     if not targets:
         raise InputError(f"{where}: no column names an output of {fb.name} ({', '.join(outs)}); use --output")
@@ -168,10 +172,11 @@ def _data_problem(
             raise InputError(f"--output {t!r} is not an output of {fb.name} (outputs: {', '.join(outs)})")
     needed = [v.name for v in fb.inputs if v.initial is None]
     require(cols, [*needed, *targets], where)
+    valid: Columns | None
     if validation_data is not None:
-        val = read_table(validation_data, what="validation data")
-        require(val, [*needed, *targets], str(validation_data))
-        train, valid = cols, val
+        valid = read_table(validation_data, what="validation data")
+        require(valid, [*needed, *targets], str(validation_data))
+        train = cols
     else:
         s = split(cols, validation, seed)
         train, valid = s.train, s.validation
@@ -225,18 +230,37 @@ def _result(
     blocks[index] = tuned
     new_doc = dataclasses.replace(doc, blocks=tuple(blocks))
     result = TuneResult(
-        new_doc, doc, index, kind, opt, seed, budget, outcome.evaluations, outcome.seconds, workers,
-        outcome.interrupted, outcome.message, cost_name, before, after, table, changes, outcome.history,
-        notes, problem,
+        new_doc,
+        doc,
+        index,
+        kind,
+        opt,
+        seed,
+        budget,
+        outcome.evaluations,
+        outcome.seconds,
+        workers,
+        outcome.interrupted,
+        outcome.message,
+        cost_name,
+        before,
+        after,
+        table,
+        changes,
+        outcome.history,
+        notes,
+        problem,
     )
     result.traces = (extra_before, extra_after)
     return result
 
 
-def _evaluate(problem: DataProblem | PlantProblem, fb: FunctionBlock) -> tuple[float, dict[str, float], list[Any]]:
+def _evaluate(
+    problem: DataProblem | PlantProblem, fb: FunctionBlock
+) -> tuple[float, dict[str, float], list[Any]]:
     """The cost, the report's rows and (plant) the traces of one system."""
     if isinstance(problem, DataProblem):
-        parts = [problem.task(fb, k) for k in problem.keys()]
+        parts = [problem.task(fb, k) for k in problem.task_keys()]
         return float(problem.combine(parts)), problem.scores(fb), []
     rows: dict[str, float] = {}
     traces = []

@@ -36,7 +36,10 @@ def read_table(source: str | Path | Mapping[str, Any] | Any, *, what: str = "dat
         elif hasattr(source, "column_names") and hasattr(source, "column"):  # pyarrow Table
             cols = {n: source.column(n).to_numpy(zero_copy_only=False) for n in source.column_names}
         elif hasattr(source, "columns"):
-            cols = {str(c): source[c].to_numpy() if hasattr(source[c], "to_numpy") else source[c] for c in source.columns}
+            cols = {
+                str(c): source[c].to_numpy() if hasattr(source[c], "to_numpy") else source[c]
+                for c in source.columns
+            }
         else:
             raise InputError(f"{what}: expected a CSV/Parquet path, a mapping of columns or a DataFrame")
     out: Columns = {}
@@ -65,7 +68,8 @@ def _read_file(path: Path) -> Any:
             return pq.read_table(path)
         return pacsv.read_csv(path)
     except (pa.ArrowInvalid, OSError) as exc:
-        raise InputError(f"{path}: cannot read it as {'Parquet' if path.suffix.lower() in ('.parquet', '.pq') else 'CSV'}: {exc}") from None
+        kind = "Parquet" if path.suffix.lower() in (".parquet", ".pq") else "CSV"
+        raise InputError(f"{path}: cannot read it as {kind}: {exc}") from None
 
 
 def _numeric(where: str, name: str, raw: Any) -> Arr:
@@ -82,7 +86,9 @@ def _numeric(where: str, name: str, raw: Any) -> Arr:
     arr = arr.reshape(-1)
     bad = np.flatnonzero(~np.isfinite(arr))
     if bad.size:
-        raise InputError(f"{where}: column {name!r}, row {int(bad[0]) + 1}: {arr[bad[0]]} is not a finite number")
+        raise InputError(
+            f"{where}: column {name!r}, row {int(bad[0]) + 1}: {arr[bad[0]]} is not a finite number"
+        )
     return arr
 
 
@@ -105,7 +111,7 @@ def split(cols: Columns, fraction: float, seed: int) -> Split:
     if not 0.0 <= fraction < 1.0 or math.isnan(fraction):
         raise InputError(f"validation fraction must be in [0, 1), got {fraction}")
     n = len(next(iter(cols.values())))
-    k = int(round(fraction * n))
+    k = round(fraction * n)
     if fraction == 0.0 or k == 0:
         return Split(cols, None)
     if n - k < 2:

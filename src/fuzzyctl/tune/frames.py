@@ -28,7 +28,9 @@ class Scorer:
     """A picklable recipe for a controller: the model and how to compile it.  Called on a
     pandas DataFrame it returns the frame with the outputs appended (or replaced)."""
 
-    def __init__(self, model: Document | FunctionBlock, *, block: str | None = None, **compile_options: Any) -> None:
+    def __init__(
+        self, model: Document | FunctionBlock, *, block: str | None = None, **compile_options: Any
+    ) -> None:
         import fuzzyctl
 
         self.model = model
@@ -54,16 +56,15 @@ class Scorer:
     def check_columns(self, columns: Any, where: str) -> None:
         missing = [c for c in self._required if c not in columns]
         if missing:
-            raise InputError(f"{where}: no column for input {missing[0]!r} (columns: {', '.join(map(str, columns))})")
+            raise InputError(
+                f"{where}: no column for input {missing[0]!r} (columns: {', '.join(map(str, columns))})"
+            )
 
     def __call__(self, frame: Any) -> Any:
         ctl = self.controller()
         ctl.reset()  # partitions are independent (see the module docstring)
         cols = {c: frame[c].to_numpy(dtype=np.float64) for c in self.inputs if c in frame.columns}
-        if len(frame) == 0:
-            out = {o: np.empty(0) for o in self.outputs}
-        else:
-            out = ctl.evaluate_batch(cols)
+        out = ctl.evaluate_batch(cols) if len(frame) else {o: np.empty(0) for o in self.outputs}
         result = frame.copy()
         for o in self.outputs:
             result[o] = out[o]
@@ -161,7 +162,8 @@ def score_to_parquet(
     for old in out.glob("part-*.parquet"):
         old.unlink()
     parts = ddf.to_delayed()
-    tasks = [dask.delayed(_write_part)(p, scorer, str(out), i) for i, p in enumerate(parts)]
+    delayed = dask.delayed  # type: ignore[attr-defined]
+    tasks = [delayed(_write_part)(p, scorer, str(out), i) for i, p in enumerate(parts)]
     total = 0
     if execu is None or getattr(execu, "client", None) is None:
         for i, t in enumerate(tasks):
@@ -173,7 +175,7 @@ def score_to_parquet(
 
     futures = execu.client.compute(tasks)
     try:
-        for done, fut in enumerate(as_completed(futures, loop=execu.client.loop), start=1):
+        for done, fut in enumerate(as_completed(futures, loop=execu.client.loop), start=1):  # type: ignore[no-untyped-call]
             total += int(fut.result())
             if progress:
                 progress(done, len(tasks))

@@ -36,7 +36,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.shapes import pwl_value_np
-from fuzzyctl.model import FunctionBlock
+from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 
 Arr = npt.NDArray[np.float64]
 PSlot = tuple[str, int, int, int] | tuple[str, int, int] | tuple[str, int]
@@ -305,23 +305,27 @@ def slot_map(fb: FunctionBlock, plan: Plan) -> dict[tuple[object, ...], PSlot] |
     """Model parameter keys (see :mod:`fuzzyctl.tune.space`) -> gradient keys of
     :func:`forward`; ``None`` when the plan's rules do not line up with the model's."""
     out: dict[tuple[object, ...], PSlot] = {}
-    fin = {fi.name: (k, {t.name: j for j, t in reversed(list(enumerate(fi.terms)))}) for k, fi in enumerate(plan.fuzzy_inputs)}
-    outs = {op.name: (k, {t.name: j for j, t in reversed(list(enumerate(op.terms)))}) for k, op in enumerate(plan.outputs)}
-    for blk in [*fb.fuzzify, *fb.defuzzify]:
-        table, side = (fin, "in") if blk.variable in fin else (outs, "out")
-        if blk.variable not in table:
+    sides: dict[str, tuple[str, int, list[str]]] = {}
+    for k, fi in enumerate(plan.fuzzy_inputs):
+        sides[fi.name] = ("in", k, [t.name for t in fi.terms])
+    for k, op in enumerate(plan.outputs):
+        sides.setdefault(op.name, ("out", k, [t.name for t in op.terms]))
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in blocks:
+        if blk.variable not in sides:
             continue
-        k, names = table[blk.variable]
+        side, k, names = sides[blk.variable]
+        first: dict[str, int] = {}
         for ti, t in enumerate(blk.terms):
-            j = names.get(t.name)
-            if j is None or blk.terms.index(next(x for x in blk.terms if x.name == t.name)) != ti:
+            first.setdefault(t.name, ti)
+            if first[t.name] != ti or t.name not in names:
                 continue  # a duplicate term name: the engine uses the first
+            j = names.index(t.name)
             npar = len(getattr(t.mf, "params", ())) or 2 * len(getattr(t.mf, "points", ())) or 1
             for p in range(npar):
                 out[("term", blk.variable, ti, p)] = (side, k, j, p)
     ri = 0
-    enabled = [rb for rb in fb.rule_blocks]
-    for bi, rb in enumerate(enabled):
+    for bi, rb in enumerate(fb.rule_blocks):
         if not rb.enabled:
             continue
         for r_idx, rule in enumerate(rb.rules):

@@ -149,10 +149,11 @@ def learn(
         raise InputError(f"{output!r} is both an input and the output")
     cols = read_table(data)
     require(cols, [*inputs, output], str(data) if isinstance(data, str | Path) else "data")
+    parts_val: Columns | None
     if validation_data is not None:
-        val = read_table(validation_data, what="validation data")
-        require(val, [*inputs, output], str(validation_data))
-        parts_train, parts_val = cols, val
+        parts_val = read_table(validation_data, what="validation data")
+        require(parts_val, [*inputs, output], str(validation_data))
+        parts_train = cols
     else:
         s = split(cols, validation, seed)
         parts_train, parts_val = s.train, s.validation
@@ -173,14 +174,16 @@ def learn(
         raise InputError(f"{n} training rows are too few for {n_terms} clusters")
 
     fuzz, antecedents = (
-        _grid(parts_train, inputs, n_terms) if method == "grid" else _clusters(parts_train, inputs, output, n_terms, seed)
+        _grid(parts_train, inputs, n_terms)
+        if method == "grid"
+        else _clusters(parts_train, inputs, output, n_terms, seed)
     )
     y = parts_train[output]
     y_lo, y_hi = float(np.min(y)), float(np.max(y))
     pad = 0.1 * (y_hi - y_lo) or 1.0
     out_range = Range(_sig(y_lo - pad, 6), _sig(y_hi + pad, 6))
     block_name = name or "learned"
-    variables = tuple(Variable(i, VarKind.INPUT) for i in inputs) + (Variable(output, VarKind.OUTPUT),)
+    variables = (*(Variable(i, VarKind.INPUT) for i in inputs), Variable(output, VarKind.OUTPUT))
     # Per-rule consequents first (Takagi-Sugeno, or zero-order for the Mamdani grouping).
     order = 1 if kind == "tsk" else 0
     fb = _assemble(block_name, variables, fuzz, antecedents, output, out_range, and_op, order, None)
@@ -189,7 +192,20 @@ def learn(
     if kind == "tsk":
         fb = _set_linear(fb, output, theta, len(inputs))
     else:
-        fb, note = _mamdani(fb, parts_train, inputs, output, theta, out_terms, out_range, antecedents, fuzz, variables, and_op, seed)
+        fb, note = _mamdani(
+            fb,
+            parts_train,
+            inputs,
+            output,
+            theta,
+            out_terms,
+            out_range,
+            antecedents,
+            fuzz,
+            variables,
+            and_op,
+            seed,
+        )
         notes.append(note)
     fb = _with_comment(fb, method, kind, inputs, output, n, and_op)
     doc = Document((fb,))
@@ -366,8 +382,16 @@ def _mamdani(
     names = _OUT_NAMES.get(k, tuple(f"o{j + 1}" for j in range(k)))
     terms = [Term(names[j], SingletonMF(_sig(float(start[j])))) for j in range(k)]
     fb2 = _assemble(
-        fb.name or "learned", variables, fuzz, antecedents, output, out_range, and_op, 0,
-        [names[a] for a in assign], terms,
+        fb.name or "learned",
+        variables,
+        fuzz,
+        antecedents,
+        output,
+        out_range,
+        and_op,
+        0,
+        [names[a] for a in assign],
+        terms,
     )
     phi, _ = _design(fb2, cols, inputs, output)
     used = phi.any(axis=0)
@@ -380,8 +404,16 @@ def _mamdani(
     rename = {names[int(j)]: names[r] for r, j in enumerate(order)}
     terms = [Term(names[r], SingletonMF(_sig(float(pos[int(j)])))) for r, j in enumerate(order)]
     fb3 = _assemble(
-        fb.name or "learned", variables, fuzz, antecedents, output, out_range, and_op, 0,
-        [rename[names[a]] for a in assign], terms,
+        fb.name or "learned",
+        variables,
+        fuzz,
+        antecedents,
+        output,
+        out_range,
+        and_op,
+        0,
+        [rename[names[a]] for a in assign],
+        terms,
     )
     return fb3, f"{len(antecedents)} rules share {k} output singletons"
 

@@ -74,7 +74,7 @@ class Evaluator:
     def costs(self, cands: Sequence[Arr]) -> list[float]:
         if self.evaluations and len(cands) > self.remaining():
             raise _Stop
-        keys = self.problem.keys()
+        keys = self.problem.task_keys()
         items = [(np.asarray(c, dtype=np.float64), k) for c in cands for k in keys]
         parts = self.execu.map("task", items)
         out = []
@@ -89,7 +89,7 @@ class Evaluator:
         """Residual vectors (data problems), each counted as one evaluation."""
         if self.evaluations and len(cands) > self.remaining():
             raise _Stop
-        keys = self.problem.keys()
+        keys = self.problem.task_keys()
         items = [(np.asarray(c, dtype=np.float64), k) for c in cands for k in keys]
         parts = self.execu.map("residuals", items)
         out = []
@@ -101,13 +101,21 @@ class Evaluator:
         return out
 
     def jacobian(self, u: Arr) -> Arr:
-        parts = self.execu.map("jacobian", [(np.asarray(u, dtype=np.float64), k) for k in self.problem.keys()])
+        parts = self.execu.map(
+            "jacobian", [(np.asarray(u, dtype=np.float64), k) for k in self.problem.task_keys()]
+        )
         return np.vstack([J for _r, J in parts])
 
     def outcome(self, u0: Arr, started: float, interrupted: bool, message: str) -> Outcome:
         best = self.best if self.best is not None else np.asarray(u0, dtype=np.float64)
         return Outcome(
-            best, self.best_cost, self.evaluations, self.history, interrupted, message, time.perf_counter() - started
+            best,
+            self.best_cost,
+            self.evaluations,
+            self.history,
+            interrupted,
+            message,
+            time.perf_counter() - started,
         )
 
 
@@ -145,7 +153,8 @@ def run(
         else:
             if not isinstance(problem, DataProblem):
                 raise FuzzyctlError(
-                    f"--optimizer {optimizer} needs data (--data): a closed-loop cost has no gradient; use cmaes or de"
+                    f"--optimizer {optimizer} needs data (--data): a closed-loop cost has no "
+                    "gradient; use cmaes or de"
                 )
             message = _lsq(ev, problem, u0, optimizer)
     except _Stop:
@@ -279,7 +288,9 @@ def _lsq(ev: Evaluator, problem: DataProblem, u0: Arr, optimizer: str) -> str:
             v[j] = v[j] + h if v[j] + h <= 1.0 else v[j] - h
             steps.append(v)
         rs = ev.residuals(steps)
-        return np.column_stack([(r - base) / (s[j] - u[j]) for j, (r, s) in enumerate(zip(rs, steps, strict=True))])
+        return np.column_stack(
+            [(r - base) / (s[j] - u[j]) for j, (r, s) in enumerate(zip(rs, steps, strict=True))]
+        )
 
     if optimizer == "lsq" and problem.loss == "rmse":
         res = least_squares(
@@ -303,6 +314,12 @@ def _lsq(ev: Evaluator, problem: DataProblem, u0: Arr, optimizer: str) -> str:
             g = J[k] * np.sign(r[k])
         return f, g
 
-    res = minimize(fun, np.clip(u0, 0.0, 1.0), jac=True, method="L-BFGS-B", bounds=[(0.0, 1.0)] * len(u0),
-                   options={"maxfun": ev.budget, "maxiter": ev.budget})
+    res = minimize(
+        fun,
+        np.clip(u0, 0.0, 1.0),
+        jac=True,
+        method="L-BFGS-B",
+        bounds=[(0.0, 1.0)] * len(u0),
+        options={"maxfun": ev.budget, "maxiter": ev.budget},
+    )
     return str(res.message)

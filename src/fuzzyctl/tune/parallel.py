@@ -9,6 +9,7 @@ order they were submitted, so the optimiser sees the same numbers whatever ran t
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import os
 from collections.abc import Callable, Sequence
@@ -68,10 +69,8 @@ class DaskExecutor:
 
     def close(self) -> None:
         if self._problem is not None:
-            try:
+            with contextlib.suppress(Exception):  # best effort on shutdown
                 self.client.cancel(self._problem)
-            except Exception:  # noqa: BLE001 - best effort on shutdown
-                pass
         self._problem = None
         if self.cluster is not None:
             self.client.close()

@@ -43,7 +43,17 @@ EFFORT_TERMS = ("effort", "effort_abs", "travel")
 #: Terms on any recorded signal: "ise:angle", "max:angle", ...
 SIGNAL_TERMS = ("ise", "iae", "max", "rms")
 DEFAULT_COST = {"iae": 1.0}
-_SCENARIO_KEYS = {"name", "weight", "duration", "setpoints", "disturbances", "plant", "noise", "seed", "quality"}
+_SCENARIO_KEYS = {
+    "name",
+    "weight",
+    "duration",
+    "setpoints",
+    "disturbances",
+    "plant",
+    "noise",
+    "seed",
+    "quality",
+}
 
 
 @dataclass(frozen=True)
@@ -103,8 +113,13 @@ def load_scenarios(
         raise InputError(f"{path}: [tune] must be a table")
     extra = sorted(set(table) - {"cost", "scenarios"})
     if extra:
-        raise InputError(f"{path}: [tune]: unknown key(s) {', '.join(map(repr, extra))} (allowed: cost, scenarios)")
-    weights = parse_cost(cost if cost is not None else table.get("cost"), "--cost" if cost is not None else f"{path}: [tune] cost")
+        raise InputError(
+            f"{path}: [tune]: unknown key(s) {', '.join(map(repr, extra))} (allowed: cost, scenarios)"
+        )
+    weights = parse_cost(
+        cost if cost is not None else table.get("cost"),
+        "--cost" if cost is not None else f"{path}: [tune] cost",
+    )
     if cfg.quality is None and any(t.split(":")[0] in QUALITY_TERMS and ":" not in t for t in weights):
         raise InputError(f"{path}: the cost uses quality figures but the file has no [quality] table")
     raw = table.get("scenarios", [])
@@ -117,7 +132,10 @@ def load_scenarios(
         where = f"{path}: [[tune.scenarios]] #{i + 1}"
         bad = sorted(set(s) - _SCENARIO_KEYS)
         if bad:
-            raise InputError(f"{where}: unknown key(s) {', '.join(map(repr, bad))} (allowed: {', '.join(sorted(_SCENARIO_KEYS))})")
+            raise InputError(
+                f"{where}: unknown key(s) {', '.join(map(repr, bad))} "
+                f"(allowed: {', '.join(sorted(_SCENARIO_KEYS))})"
+            )
         variant = _variant(cfg, s, where)
         weight = s.get("weight", 1.0)
         if isinstance(weight, bool) or not isinstance(weight, int | float) or weight < 0:

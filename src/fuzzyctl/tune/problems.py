@@ -34,7 +34,9 @@ def _plan(fb: FunctionBlock, compat: str) -> Plan:
     # no scalar specialisation for a system that is evaluated once.
     plan, diags = lower(fb, COMPAT_PROFILES[compat])
     if plan is None:  # candidates are valid by construction: this is a bug
-        raise FuzzyctlError("internal error: a tuning candidate does not compile: " + "; ".join(d.message for d in diags))
+        raise FuzzyctlError(
+            "internal error: a tuning candidate does not compile: " + "; ".join(d.message for d in diags)
+        )
     return plan
 
 
@@ -67,7 +69,7 @@ class DataProblem:
 
     # ------------------------------------------------------------------ tasks
 
-    def keys(self) -> list[int]:
+    def task_keys(self) -> list[int]:
         return list(range(max(1, -(-rows(self.train) // self.chunk_rows))))
 
     def _rows(self, cols: Columns, key: int) -> slice:
@@ -90,9 +92,7 @@ class DataProblem:
         _fb, plan = self.candidate_plan(cand)
         part = {k: v[sl] if sl is not None else v for k, v in cols.items()}
         n = rows(part)
-        vals = [
-            part[i.name] if i.name in part else np.full(n, float(i.default or 0.0)) for i in plan.inputs
-        ]
+        vals = [part[i.name] if i.name in part else np.full(n, float(i.default or 0.0)) for i in plan.inputs]
         outs = BatchEvaluator(plan).run(vals, [None] * len(plan.outputs))
         return {o.name: outs[k] for k, o in enumerate(plan.outputs) if o.name in self.outputs}
 
@@ -170,7 +170,7 @@ class PlantProblem:
     weights: dict[str, float]
     runtime: str | None = None
 
-    def keys(self) -> list[int]:
+    def task_keys(self) -> list[int]:
         return list(range(len(self.scenarios)))
 
     def model(self, cand: Candidate) -> Document:

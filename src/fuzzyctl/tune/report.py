@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fuzzyctl.model import FunctionBlock
+from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 from fuzzyctl.sim.loop import write_atomic
 
 if TYPE_CHECKING:
@@ -211,11 +211,17 @@ def _responses_mpl(fig: Any, r: TuneResult) -> None:
 def _moved_variables(r: TuneResult) -> list[str]:
     moved = []
     before = r.original.blocks[r.block_index]
-    for blk in [*before.fuzzify, *before.defuzzify]:
-        other = r.block.fuzzify_block(blk.variable) or r.block.defuzzify_block(blk.variable)
-        if other is not None and other.terms != blk.terms:
-            if any(hasattr(t.mf, "points") or getattr(t.mf, "kind", "") not in ("linear", "constant") for t in blk.terms):
-                moved.append(blk.variable)
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*before.fuzzify, *before.defuzzify]
+    for blk in blocks:
+        other: FuzzifyBlock | DefuzzifyBlock | None = r.block.fuzzify_block(
+            blk.variable
+        ) or r.block.defuzzify_block(blk.variable)
+        sets = any(
+            hasattr(t.mf, "points") or getattr(t.mf, "kind", "") not in ("linear", "constant")
+            for t in blk.terms
+        )
+        if other is not None and other.terms != blk.terms and sets:
+            moved.append(blk.variable)
     return moved
 
 
@@ -234,7 +240,9 @@ def _curves(fb: FunctionBlock, var: str) -> tuple[np.ndarray, list[tuple[str, np
     for op in plan.outputs:
         if op.name == var:
             terms = op.terms
-    xs_all = [float(p) for t in terms for p in (t.params[0::2] if t.kind in ("points", "singletons") else t.params)]
+    xs_all = [
+        float(p) for t in terms for p in (t.params[0::2] if t.kind in ("points", "singletons") else t.params)
+    ]
     lo, hi = (min(xs_all), max(xs_all)) if xs_all else (0.0, 1.0)
     pad = 0.05 * (hi - lo or 1.0)
     x = np.linspace(lo - pad, hi + pad, 600)
@@ -243,7 +251,7 @@ def _curves(fb: FunctionBlock, var: str) -> tuple[np.ndarray, list[tuple[str, np
         if t.kind in ("linear", "constant", "function"):
             continue
         if t.kind == "singleton":
-            out.append((t.name, np.array([float(t.params[0])]), True))  # type: ignore[arg-type]
+            out.append((t.name, np.array([float(t.params[0])]), True))
             continue
         out.append((t.name, membership_np(t.kind, t.params, t.height, x), False))
     return x, out
@@ -262,7 +270,9 @@ def _terms_mpl(fig: Any, r: TuneResult, moved: list[str]) -> None:
                     if fb is r.block:
                         ax.text(float(y[0]), 1.02, name, fontsize=7, ha="center", color=color)
                 else:
-                    ax.plot(x, y, style, color=color, alpha=alpha, lw=1.2, label=name if fb is r.block else None)
+                    ax.plot(
+                        x, y, style, color=color, alpha=alpha, lw=1.2, label=name if fb is r.block else None
+                    )
         ax.set_title(f"{var}: before (dashed) and after", fontsize=9)
         ax.set_ylim(-0.02, 1.12)
         ax.grid(True, alpha=0.3)
@@ -283,9 +293,13 @@ def _html(r: TuneResult) -> str:
     if r.kind == "data":
         fit = go.Figure()
         for label, o, y, b, a in _predictions(r):
-            fit.add_trace(go.Scatter(x=y, y=b, mode="markers", name=f"{o} {label} before", marker={"size": 4}))
+            fit.add_trace(
+                go.Scatter(x=y, y=b, mode="markers", name=f"{o} {label} before", marker={"size": 4})
+            )
             fit.add_trace(go.Scatter(x=y, y=a, mode="markers", name=f"{o} {label} after", marker={"size": 4}))
-        fit.update_layout(title="system output against target", xaxis_title="target", yaxis_title="output", height=480)
+        fit.update_layout(
+            title="system output against target", xaxis_title="target", yaxis_title="output", height=480
+        )
         figs.append(fit)
     else:
         before, after = r.traces
@@ -298,16 +312,22 @@ def _html(r: TuneResult) -> str:
             f.update_layout(title=f"{sc.name}: {signal}", xaxis_title="time [s]", height=360)
             figs.append(f)
     parts = [fig.to_html(include_plotlyjs=(k == 0), full_html=False) for k, fig in enumerate(figs)]
-    table = "".join(f"<tr><td>{html.escape(k)}</td><td>{_fmt(b)}</td><td>{_fmt(a)}</td></tr>" for k, b, a in r.table)
-    changes = "".join(f"<tr><td>{html.escape(k)}</td><td>{b:.6g}</td><td>{a:.6g}</td></tr>" for k, b, a in r.changes)
+    table = "".join(
+        f"<tr><td>{html.escape(k)}</td><td>{_fmt(b)}</td><td>{_fmt(a)}</td></tr>" for k, b, a in r.table
+    )
+    changes = "".join(
+        f"<tr><td>{html.escape(k)}</td><td>{b:.6g}</td><td>{a:.6g}</td></tr>" for k, b, a in r.changes
+    )
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'><title>tuning report</title>"
-        "<style>body{font-family:sans-serif;margin:2em}td,th{padding:2px 10px;border-bottom:1px solid #ddd}</style>"
+        "<style>body{font-family:sans-serif;margin:2em}"
+        "td,th{padding:2px 10px;border-bottom:1px solid #ddd}</style>"
         f"</head><body><h1>Tuning {html.escape(r.block.name or '')}</h1>"
         f"<p>{html.escape(r.optimizer)}, seed {r.seed}, {r.evaluations} evaluations: "
         f"{html.escape(r.cost_name)} {_fmt(r.before)} &rarr; {_fmt(r.after)}</p>"
         f"<table><tr><th></th><th>before</th><th>after</th></tr>{table}</table>"
-        f"<h2>Changed parameters</h2><table><tr><th>parameter</th><th>before</th><th>after</th></tr>{changes}</table>"
+        "<h2>Changed parameters</h2>"
+        f"<table><tr><th>parameter</th><th>before</th><th>after</th></tr>{changes}</table>"
         + "".join(parts)
         + "</body></html>"
     )

@@ -35,11 +35,9 @@ import numpy.typing as npt
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.model import (
     SHAPES,
-    Conclusion,
     DefuzzifyBlock,
     FunctionBlock,
     FuzzifyBlock,
-    Point,
     PointsMF,
     Range,
     Rule,
@@ -96,7 +94,7 @@ class SpaceError(FuzzyctlError):
 # A number in the model: ("term", variable, term index, parameter index) - for points and
 # SINGLETONS the parameter index is 2k for x_k -, ("with", rule block, rule, conclusion) or
 # ("rule", rule block, rule).
-SlotKey = tuple[str, str | int, int, int] | tuple[str, int, int]
+SlotKey = tuple[str | int, ...]
 
 
 @dataclass(frozen=True)
@@ -235,7 +233,9 @@ class Space:
                     return g
         raise KeyError(key)
 
-    def changes(self, u: Sequence[float] | Vector, *, digits: int | None = None) -> list[tuple[str, float, float]]:
+    def changes(
+        self, u: Sequence[float] | Vector, *, digits: int | None = None
+    ) -> list[tuple[str, float, float]]:
         """``(label, before, after)`` for every slot whose value changed."""
         vals = self.values(u)
         rows = []
@@ -258,12 +258,13 @@ def catalogue(fb: FunctionBlock) -> dict[SlotKey, Slot]:
     for blk in blocks:
         var = blk.variable
         for ti, t in enumerate(blk.terms):
-            for key, value, role, label in _term_slots(var, ti, t, inputs):
-                slots[key] = Slot(key, value, role, var, t.name, label)
+            for tkey, value, role, label in _term_slots(var, ti, t, inputs):
+                slots[tkey] = Slot(tkey, value, role, var, t.name, label)
+    key: SlotKey
     for bi, rb in enumerate(fb.rule_blocks):
         for ri, rule in enumerate(rb.rules):
             if isinstance(rule.weight, float | int):
-                key: SlotKey = ("rule", bi, ri)
+                key = ("rule", bi, ri)
                 slots[key] = Slot(key, float(rule.weight), "weight", None, None, f"rule {rule.label} weight")
             for ci, c in enumerate(rule.conclusions):
                 w = 1.0 if c.weight is None else c.weight
@@ -272,6 +273,11 @@ def catalogue(fb: FunctionBlock) -> dict[SlotKey, Slot]:
                     key = ("with", bi, ri, ci)
                     slots[key] = Slot(key, float(w), "weight", None, None, f"rule {rule.label} ({what}) WITH")
     return slots
+
+
+def _num(p: object) -> float:
+    assert isinstance(p, float | int)
+    return float(p)
 
 
 def _const(p: object) -> bool:
@@ -286,27 +292,27 @@ def _term_slots(
     if isinstance(mf, PointsMF | SingletonsMF):
         if all(_const(p.x) for p in mf.points):
             for k, p in enumerate(mf.points):
-                yield ("term", var, ti, 2 * k), float(p.x), "x", f"{base} point {k + 1} x"  # type: ignore[arg-type]
+                yield ("term", var, ti, 2 * k), _num(p.x), "x", f"{base} point {k + 1} x"
     elif isinstance(mf, SingletonMF):
         if _const(mf.value):
-            yield ("term", var, ti, 0), float(mf.value), "x", base  # type: ignore[arg-type]
+            yield ("term", var, ti, 0), _num(mf.value), "x", base
     elif isinstance(mf, ShapeMF):
         if not all(_const(p) for p in mf.params):
             return
         names = SHAPES[mf.kind].params if mf.kind in SHAPES else ()
         if mf.kind in ("constant", "linear"):
-            for k, p in enumerate(mf.params):
+            for k, c in enumerate(mf.params):
                 if mf.kind == "constant" or k >= len(inputs):
                     what = "constant"
                 else:
                     what = f"coefficient of {inputs[k]}"
-                yield ("term", var, ti, k), float(p), "coef", f"{base} {what}"  # type: ignore[arg-type]
+                yield ("term", var, ti, k), _num(c), "coef", f"{base} {what}"
             return
         for k in _ABSCISSAE.get(mf.kind, ()):
-            if math.isfinite(float(mf.params[k])):  # type: ignore[arg-type]
-                yield ("term", var, ti, k), float(mf.params[k]), "x", f"{base} {names[k]}"  # type: ignore[arg-type]
+            if math.isfinite(_num(mf.params[k])):
+                yield ("term", var, ti, k), _num(mf.params[k]), "x", f"{base} {names[k]}"
         for k in _SCALES.get(mf.kind, ()):
-            v = float(mf.params[k])  # type: ignore[arg-type]
+            v = _num(mf.params[k])
             if v != 0.0 and math.isfinite(v):
                 yield ("term", var, ti, k), v, "scale", f"{base} {names[k]}"
 
@@ -322,7 +328,9 @@ def _universe(fb: FunctionBlock, var: str, xs: Sequence[float]) -> tuple[float, 
     return (min(xs), max(xs)) if xs else (0.0, 0.0)
 
 
-def parse_free(spec: str | Sequence[str] | None, fb: FunctionBlock) -> tuple[set[tuple[str, str]], bool, list[str]]:
+def parse_free(
+    spec: str | Sequence[str] | None, fb: FunctionBlock
+) -> tuple[set[tuple[str, str]], bool, list[str]]:
     """``(variable, term)`` pairs and whether weights are free, from a specification like
     ``"all"``, ``"inputs,-angle"``, ``"distance.close,power"`` or ``"weights"``."""
     items: list[str] = []
@@ -355,7 +363,9 @@ def parse_free(spec: str | Sequence[str] | None, fb: FunctionBlock) -> tuple[set
             chosen, chosen_w = {(v, t)}, None
         else:
             known = ", ".join(["all", "inputs", "outputs", "weights", *every])
-            raise SpaceError(f"--free {raw!r}: not a variable or VARIABLE.TERM of this block (known: {known})")
+            raise SpaceError(
+                f"--free {raw!r}: not a variable or VARIABLE.TERM of this block (known: {known})"
+            )
         used.append(raw)
         if neg:
             terms -= chosen
@@ -378,7 +388,8 @@ def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all") -> 
     free_keys: list[SlotKey] = []
     variables = [b.variable for b in fb.fuzzify] + [b.variable for b in fb.defuzzify]
     # Terms whose parameters are variables (Refs) or whose kind has no tunable parameter.
-    for blk in [*fb.fuzzify, *fb.defuzzify]:
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in blocks:
         for ti, t in enumerate(blk.terms):
             if (blk.variable, t.name) in free_terms and not any(
                 k[0] == "term" and k[1] == blk.variable and k[2] == ti for k in slots
@@ -391,9 +402,7 @@ def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all") -> 
         by_value: dict[float, list[Slot]] = {}
         for s in xs_slots:
             by_value.setdefault(s.value, []).append(s)
-        is_free = [
-            lo < v < hi and any((var, s.term) in free_terms for s in by_value[v]) for v in values
-        ]
+        is_free = [lo < v < hi and any((var, s.term) in free_terms for s in by_value[v]) for v in values]
         # Runs of free breakpoints between fixed neighbours (or the universe's ends).
         i = 0
         while i < len(values):
@@ -450,11 +459,16 @@ def _coef_box(fb: FunctionBlock, s: Slot) -> tuple[float, float]:
     if rng is not None and rng.high > rng.low:
         big = rng.high - rng.low
     else:
-        consts = [abs(float(p)) for t in (out.terms if out else ()) if isinstance(t.mf, ShapeMF) for p in t.mf.params[-1:] if _const(p)]
+        consts = [
+            abs(_num(p))
+            for t in (out.terms if out else ())
+            if isinstance(t.mf, ShapeMF)
+            for p in t.mf.params[-1:]
+            if _const(p)
+        ]
         big = max([1.0, *consts])
-    key = s.key
-    assert key[0] == "term"
-    k = int(key[3])
+    assert s.key[0] == "term"
+    k = int(s.key[-1])
     inputs = [v.name for v in fb.inputs]
     width = 2.0 * big
     if "coefficient of" in s.label and k < len(inputs):
@@ -479,9 +493,9 @@ def apply_values(fb: FunctionBlock, values: dict[SlotKey, float]) -> FunctionBlo
     rule_w: dict[tuple[int, int], float] = {}
     for key, v in values.items():
         if key[0] == "term":
-            by_term.setdefault((str(key[1]), int(key[2])), {})[int(key[3])] = v  # type: ignore[misc]
+            by_term.setdefault((str(key[1]), int(key[2])), {})[int(key[3])] = v
         elif key[0] == "with":
-            withs[(int(key[1]), int(key[2]), int(key[3]))] = v  # type: ignore[misc]
+            withs[(int(key[1]), int(key[2]), int(key[3]))] = v
         else:
             rule_w[(int(key[1]), int(key[2]))] = v
 
