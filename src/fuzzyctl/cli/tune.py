@@ -41,13 +41,13 @@ ValidationDataOpt = Annotated[
 
 
 def _need_extra() -> None:
-    try:
-        import cma  # noqa: F401
-        import pyarrow  # noqa: F401
-    except ImportError:
+    import importlib.util
+
+    missing = [m for m in ("cma", "pyarrow", "distributed") if importlib.util.find_spec(m) is None]
+    if missing:
         from fuzzyctl.diagnostics import FuzzyctlError
 
-        raise FuzzyctlError("tuning needs the tune extra: pip install 'fuzzyctl[tune]'") from None
+        raise FuzzyctlError(f"this needs the tune extra ({', '.join(missing)}): pip install 'fuzzyctl[tune]'")
 
 
 def _fmt(v: float) -> str:
@@ -80,7 +80,7 @@ def learn(
     out: Annotated[
         Path, typer.Option("-o", "--out", help="Write the learned system here (FCL).", show_default=False)
     ],
-    method: Annotated[str, typer.Option("--method", help="grid (partition) or cluster (KMeans).")] = "grid",
+    method: Annotated[str, typer.Option("--method", help="grid (partition) or cluster (k-means).")] = "grid",
     kind: Annotated[str, typer.Option("--type", help="tsk (Takagi-Sugeno) or mamdani (singletons).")] = "tsk",
     terms: Annotated[
         int | None,
@@ -104,7 +104,7 @@ def learn(
 ) -> None:
     """Learn a fuzzy system from data: grid partition or clustering, consequents by least squares."""
     _need_extra()
-    from fuzzyctl.tune.learn import learn as run
+    from fuzzyctl.tune.learning import learn as run
 
     names = [s.strip() for s in inputs.split(",") if s.strip()]
     if not names:

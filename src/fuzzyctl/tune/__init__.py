@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from fuzzyctl.tune.api import TuneResult
-    from fuzzyctl.tune.learn import LearnResult
+    from fuzzyctl.tune.learning import LearnResult
 
 
 def tune(*args: Any, **kwargs: Any) -> TuneResult:
@@ -28,8 +28,8 @@ def tune(*args: Any, **kwargs: Any) -> TuneResult:
 
 
 def learn(*args: Any, **kwargs: Any) -> LearnResult:
-    """See :func:`fuzzyctl.tune.learn.learn`."""
-    from fuzzyctl.tune.learn import learn as _learn
+    """See :func:`fuzzyctl.tune.learning.learn`."""
+    from fuzzyctl.tune.learning import learn as _learn
 
     return _learn(*args, **kwargs)
 

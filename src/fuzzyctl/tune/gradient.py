@@ -235,7 +235,9 @@ def _accumulate(accu: str, items: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, 
         for key, d in g.items():
             _add(grad, key, d)
     if accu == "BSUM":
-        grad = {k: np.where(total < 1.0, d, 0.0) for k, d in grad.items()}
+        # min(1, s): at s == 1 exactly (a degree-1 plateau under weight 1, common) the
+        # left derivative, the one in the direction weights can move from 1
+        grad = {k: np.where(total <= 1.0, d, 0.0) for k, d in grad.items()}
         total = np.minimum(total, 1.0)
     return total, grad
 

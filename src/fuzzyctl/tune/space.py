@@ -236,14 +236,24 @@ class Space:
     def changes(
         self, u: Sequence[float] | Vector, *, digits: int | None = None
     ) -> list[tuple[str, float, float]]:
-        """``(label, before, after)`` for every slot whose value changed."""
+        """``(label, before, after)`` for every parameter that changed; a breakpoint shared
+        by several terms is one row naming all of them."""
         vals = self.values(u)
         rows = []
-        for key in self.free_keys:
-            after = vals[key] if digits is None else self._round(key, vals[key], digits)
-            before = self.slots[key].value
-            if after != before:
-                rows.append((self.slots[key].label, before, after))
+        for g in self.groups:
+            for keys in g.slots:
+                key = keys[0]
+                after = vals[key] if digits is None else self._round(key, vals[key], digits)
+                before = self.slots[key].value
+                if after == before:
+                    continue
+                labels = [self.slots[k].label for k in keys]
+                var = self.slots[key].variable
+                if len(labels) > 1 and var is not None:
+                    label = f"{var}: " + " = ".join(lb.removeprefix(f"{var}.") for lb in labels)
+                else:
+                    label = labels[0]
+                rows.append((label, before, after))
         return rows
 
 
@@ -292,7 +302,7 @@ def _term_slots(
     if isinstance(mf, PointsMF | SingletonsMF):
         if all(_const(p.x) for p in mf.points):
             for k, p in enumerate(mf.points):
-                yield ("term", var, ti, 2 * k), _num(p.x), "x", f"{base} point {k + 1} x"
+                yield ("term", var, ti, 2 * k), _num(p.x), "x", f"{base} point {k + 1}"
     elif isinstance(mf, SingletonMF):
         if _const(mf.value):
             yield ("term", var, ti, 0), _num(mf.value), "x", base

@@ -2,7 +2,8 @@
 
 * **grid partition**: N triangular terms per input forming a partition of unity (each
   term peaks where its neighbours reach 0; ramps at the ends), one rule per combination;
-* **clustering** (scikit-learn's KMeans on the standardised inputs and output, seeded):
+* **clustering** (scipy's k-means++ on the standardised inputs and output, seeded; the
+  best of five starts):
   one rule per cluster, a Gaussian term per input at the cluster centre with the spread of
   its members (floored at range / (2 K) so that no rule is a spike);
 
@@ -14,7 +15,7 @@ the closed form of :mod:`fuzzyctl.tune.gradient`.
 * ``kind="tsk"``: a first-order Takagi-Sugeno system, one ``Linear`` output term per rule,
   METHOD WTAVER (``numpy.linalg.lstsq``);
 * ``kind="mamdani"``: singleton outputs under CoGS: the per-rule optimum is grouped into
-  ``out_terms`` linguistic singletons (KMeans in one dimension), each rule concludes the
+  ``out_terms`` linguistic singletons (k-means in one dimension), each rule concludes the
   nearest one, and the singleton positions are refitted by bounded least squares
   (``scipy.optimize.lsq_linear``) within the output's RANGE.
 
@@ -28,6 +29,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -241,27 +243,35 @@ def _grid(cols: Columns, inputs: Sequence[str], n: int) -> tuple[list[FuzzifyBlo
 def _clusters(
     cols: Columns, inputs: Sequence[str], output: str, k: int, seed: int
 ) -> tuple[list[FuzzifyBlock], list[tuple[str, ...]]]:
-    try:
-        from sklearn.cluster import KMeans
-    except ImportError as exc:  # pragma: no cover - the tune extra brings scikit-learn
-        raise InputError("--method cluster needs scikit-learn: pip install 'fuzzyctl[tune]'") from exc
+    from scipy.cluster.vq import kmeans2
+
     names = [*inputs, output]
     X = np.column_stack([cols[c] for c in names])
     mean, std = X.mean(axis=0), X.std(axis=0)
     std[std == 0] = 1.0
-    km = KMeans(n_clusters=k, n_init=10, random_state=seed).fit((X - mean) / std)
-    centres = km.cluster_centers_ * std + mean
-    labels = km.labels_
+    Z = (X - mean) / std
+    # k-means++ from five seeds, the partition with the least within-cluster sum of squares
+    best: tuple[float, Arr, npt.NDArray[np.int_]] | None = None
+    for attempt in range(5):
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # "One of the clusters is empty": handled below
+            c, lab = kmeans2(Z, k, minit="++", seed=seed * 7919 + attempt)
+        sse = float(np.sum((Z - c[lab]) ** 2))
+        if best is None or sse < best[0]:
+            best = (sse, c, lab)
+    assert best is not None
+    centres = best[1] * std + mean
+    labels = best[2]
     order = np.lexsort(centres[:, ::-1].T)  # by the first input, then the next ...
     fuzz = []
     for d, i in enumerate(inputs):
         lo, hi = _sig(float(np.min(cols[i])), 6), _sig(float(np.max(cols[i])), 6)
         floor = (hi - lo) / (2.0 * k)
         ts = []
-        for rank, c in enumerate(order):
-            members = X[labels == c, d]
+        for rank, ci in enumerate(order):
+            members = X[labels == ci, d]
             sigma = max(float(np.std(members)) if len(members) > 1 else 0.0, floor)
-            mean_c = min(max(float(centres[c, d]), lo), hi)
+            mean_c = min(max(float(centres[ci, d]), lo), hi)
             ts.append(Term(f"c{rank + 1}", ShapeMF("gaussian", (_sig(mean_c), _sig(sigma)))))
         fuzz.append(FuzzifyBlock(i, tuple(ts), Range(lo, hi)))
     return fuzz, [tuple(f"c{r + 1}" for _ in inputs) for r in range(k)]
@@ -424,7 +434,7 @@ def _with_comment(
     import dataclasses
 
     what = "first-order Takagi-Sugeno" if kind == "tsk" else "Mamdani with singleton outputs (CoGS)"
-    how = "grid partition" if method == "grid" else "KMeans clustering"
+    how = "grid partition" if method == "grid" else "k-means clustering"
     text = (
         f"Learned by fuzzyctl learn from {n} rows: {what}, {how} of {', '.join(inputs)} -> {output}, "
         f"AND {and_op}, consequents by least squares."
