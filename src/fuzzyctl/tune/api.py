@@ -123,6 +123,10 @@ def tune(
     opt = optimizer or ("lsq" if kind == "data" else "cmaes")
     if opt not in optimize.OPTIMIZERS:
         raise InputError(f"--optimizer must be one of {', '.join(optimize.OPTIMIZERS)}, got {opt!r}")
+    if kind == "plant" and opt in ("lsq", "lbfgsb"):
+        raise InputError(
+            f"--optimizer {opt} needs data (--data): a closed-loop cost has no gradient; use cmaes or de"
+        )
     if budget is None:
         budget = 200
     problem: DataProblem | PlantProblem

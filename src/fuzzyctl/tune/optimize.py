@@ -232,8 +232,8 @@ def _de(ev: Evaluator, u0: Arr, seed: int, opts: dict[str, Any]) -> str:
 
     n = len(u0)
     # Population: 15 per parameter as scipy advises, fewer when the budget would otherwise
-    # allow less than ~5 generations.
-    mult = int(opts.get("popsize", max(1, min(15, ev.budget // (5 * n) if n else 15))))
+    # allow less than ~20 generations (at least 5 members).
+    mult = int(opts.get("popsize", max(1, min(15, ev.budget // (20 * n) if n else 15))))
     pop = max(5, mult * n)
     maxiter = max(0, ev.budget // pop - 1)
 
@@ -243,13 +243,22 @@ def _de(ev: Evaluator, u0: Arr, seed: int, opts: dict[str, Any]) -> str:
     def stop(intermediate_result: Any) -> bool:  # the name tells scipy the new signature
         return ev.remaining() < pop
 
+    # The first population: the system as written, half of the rest spread around it (a
+    # tenth of each range, as CMA-ES starts) and half anywhere in the box (Latin hypercube):
+    # a refinement of a working system with room for a global search.
+    rng = np.random.default_rng(seed)
+    near = (pop - 1) // 2
+    far = pop - 1 - near
+    strata = (rng.permuted(np.tile(np.arange(far), (n, 1)), axis=1).T + rng.random((far, n))) / max(far, 1)
+    init = np.vstack(
+        [np.clip(u0, 0.0, 1.0), np.clip(u0 + SIGMA0 * rng.standard_normal((near, n)), 0.0, 1.0), strata]
+    )
     res = differential_evolution(
         lambda x: math.inf,  # never called: every evaluation goes through mapper
         bounds=[(0.0, 1.0)] * n,
-        x0=np.clip(u0, 0.0, 1.0),
-        popsize=max(1, math.ceil(pop / max(n, 1))),
+        init=init,
         maxiter=maxiter,
-        rng=np.random.default_rng(seed),
+        rng=rng,
         workers=mapper,
         updating="deferred",
         polish=False,
