@@ -194,6 +194,14 @@ def tune(
         str | None,
         typer.Option("--runtime", help="Run the controller in the loop on: engine, siemens, xfuz, native."),
     ] = None,
+    keep_zero: Annotated[
+        bool | None,
+        typer.Option(
+            "--keep-zero/--move-zero",
+            help="Keep abscissae and singletons at 0 (default: yes with --plant, no with --data).",
+            show_default=False,
+        ),
+    ] = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
     report: Annotated[
@@ -247,6 +255,7 @@ def tune(
             workers=workers,
             scheduler=scheduler,
             runtime=runtime,
+            keep_zero=keep_zero,
             progress=tick,
         )
     result.write_fcl(out)

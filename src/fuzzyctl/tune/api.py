@@ -95,6 +95,7 @@ def tune(
     scheduler: str | None = None,
     client: Any = None,
     runtime: str | None = None,
+    keep_zero: bool | None = None,
     progress: optimize.Progress | None = None,
     options: dict[str, Any] | None = None,
 ) -> TuneResult:
@@ -107,7 +108,9 @@ def tune(
     data: least squares with the closed-form gradient where it holds) or ``"lbfgsb"``;
     ``budget`` evaluations (default 200); ``workers`` Dask worker processes on this machine
     (default: one per CPU; 0 runs in this process), or ``scheduler`` / ``client`` for an
-    existing cluster.  Ctrl-C stops the search and keeps the best candidate so far."""
+    existing cluster.  ``keep_zero`` (default: True against the plant, False against data)
+    keeps abscissae and singletons at 0 where they are: the loop's equilibrium.  Ctrl-C
+    stops the search and keeps the best candidate so far."""
     if (data is None) == (plant_config is None):
         raise InputError("give either data (--data) or a plant configuration (--plant)")
     if loss not in LOSSES:
@@ -118,8 +121,8 @@ def tune(
     except KeyError as exc:
         raise InputError(str(exc.args[0])) from None
     index = doc.blocks.index(fb)
-    space = build_space(fb, free)
     kind = "data" if data is not None else "plant"
+    space = build_space(fb, free, keep_zero=kind == "plant" if keep_zero is None else keep_zero)
     opt = optimizer or ("lsq" if kind == "data" else "cmaes")
     if opt not in optimize.OPTIMIZERS:
         raise InputError(f"--optimizer must be one of {', '.join(optimize.OPTIMIZERS)}, got {opt!r}")

@@ -388,8 +388,12 @@ def parse_free(
     return terms, weights, used
 
 
-def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all") -> Space:
-    """The free parameters of ``fb`` for a ``--free`` specification (see :func:`parse_free`)."""
+def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all", *, keep_zero: bool = False) -> Space:
+    """The free parameters of ``fb`` for a ``--free`` specification (see :func:`parse_free`).
+
+    ``keep_zero``: abscissae and singletons at exactly 0 stay there.  In a closed loop the
+    terms at zero error and the zero output make the equilibrium (no error, no action):
+    moving them moves where the loop settles."""
     slots = catalogue(fb)
     free_terms, free_weights, _ = parse_free(free, fb)
     notes: list[str] = []
@@ -412,7 +416,12 @@ def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all") -> 
         by_value: dict[float, list[Slot]] = {}
         for s in xs_slots:
             by_value.setdefault(s.value, []).append(s)
-        is_free = [lo < v < hi and any((var, s.term) in free_terms for s in by_value[v]) for v in values]
+        is_free = [
+            lo < v < hi
+            and not (keep_zero and v == 0.0)
+            and any((var, s.term) in free_terms for s in by_value[v])
+            for v in values
+        ]
         # Runs of free breakpoints between fixed neighbours (or the universe's ends).
         i = 0
         while i < len(values):
