@@ -122,6 +122,7 @@ def learn(
         validation_data=validation_data,
         seed=seed,
         name=name,
+        shape=shape,
     )
     result.write_fcl(out)
     if as_json:

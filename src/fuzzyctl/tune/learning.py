@@ -1,7 +1,8 @@
 """An initial fuzzy system from data (``fuzzyctl learn``), like MATLAB's ``genfis``:
 
 * **grid partition**: N triangular terms per input forming a partition of unity (each
-  term peaks where its neighbours reach 0; ramps at the ends), one rule per combination;
+  term peaks where its neighbours reach 0; ramps at the ends), or N Gaussians at the same
+  centres crossing at 0.5 (``shape="gauss"``), one rule per combination;
 * **clustering** (scipy's k-means++ on the standardised inputs and output, seeded; the
   best of five starts):
   one rule per cluster, a Gaussian term per input at the cluster centre with the spread of
@@ -67,6 +68,7 @@ from fuzzyctl.tune.data import Columns, read_table, require, rows, split
 Arr = npt.NDArray[np.float64]
 METHODS = ("grid", "cluster")
 KINDS = ("tsk", "mamdani")
+SHAPES = ("triangle", "gauss")
 _NAMES = {
     2: ("low", "high"),
     3: ("low", "medium", "high"),
@@ -134,6 +136,7 @@ def learn(
     validation_data: str | Path | Mapping[str, Any] | Any | None = None,
     seed: int = 0,
     name: str | None = None,
+    shape: str = "triangle",
 ) -> LearnResult:
     """Learn a fuzzy system mapping ``inputs`` to ``output`` from a table (CSV/Parquet path,
     mapping of columns or DataFrame); see the module docstring for the methods."""
@@ -141,6 +144,8 @@ def learn(
         raise InputError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
     if kind not in KINDS:
         raise InputError(f"--type must be one of {', '.join(KINDS)}, got {kind!r}")
+    if shape not in SHAPES:
+        raise InputError(f"--shape must be one of {', '.join(SHAPES)}, got {shape!r}")
     and_op = and_op.upper()
     if and_op not in ("MIN", "PROD"):
         raise InputError(f"--and must be MIN or PROD, got {and_op!r}")
@@ -176,7 +181,7 @@ def learn(
         raise InputError(f"{n} training rows are too few for {n_terms} clusters")
 
     fuzz, antecedents = (
-        _grid(parts_train, inputs, n_terms)
+        _grid(parts_train, inputs, n_terms, shape)
         if method == "grid"
         else _clusters(parts_train, inputs, output, n_terms, seed)
     )
@@ -218,7 +223,9 @@ def learn(
 # --------------------------------------------------------------------------- antecedents
 
 
-def _grid(cols: Columns, inputs: Sequence[str], n: int) -> tuple[list[FuzzifyBlock], list[tuple[str, ...]]]:
+def _grid(
+    cols: Columns, inputs: Sequence[str], n: int, shape: str = "triangle"
+) -> tuple[list[FuzzifyBlock], list[tuple[str, ...]]]:
     fuzz = []
     names_per_input = []
     for i in inputs:
@@ -227,7 +234,13 @@ def _grid(cols: Columns, inputs: Sequence[str], n: int) -> tuple[list[FuzzifyBlo
         centres[0], centres[-1] = lo, hi
         names = _names(n)
         ts = []
+        # Gaussians cross their neighbours at 0.5, as the triangles do (MATLAB genfis's
+        # default shape; not for the PLC blocks, which take points only).
+        sigma = _sig((centres[1] - centres[0]) / (2.0 * math.sqrt(2.0 * math.log(2.0))))
         for k, c in enumerate(centres):
+            if shape == "gauss":
+                ts.append(Term(names[k], ShapeMF("gaussian", (c, sigma))))
+                continue
             pts: list[tuple[float, float]] = []
             if k > 0:
                 pts.append((centres[k - 1], 0.0))

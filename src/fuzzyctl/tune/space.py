@@ -467,8 +467,8 @@ def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all", *, 
 
 def _coef_box(fb: FunctionBlock, s: Slot) -> tuple[float, float]:
     """Takagi-Sugeno coefficient box: the output's span S (its RANGE, else the largest
-    constant of its terms, at least 1), the constant within ``c +- 2 S``, the coefficient of
-    input i within ``c +- 2 S / span_i``."""
+    constant of its terms, at least 1), the constant within ``c +- 4 S``, the coefficient of
+    input i within ``c +- 4 S / span_i`` (a local model may be steep where rules overlap)."""
     assert s.variable is not None
     out = fb.defuzzify_block(s.variable)
     rng = out.range if out is not None else None
@@ -489,12 +489,12 @@ def _coef_box(fb: FunctionBlock, s: Slot) -> tuple[float, float]:
     assert s.key[0] == "term"
     k = int(s.key[-1])
     inputs = [v.name for v in fb.inputs]
-    width = 2.0 * big
+    width = 4.0 * big
     if "coefficient of" in s.label and k < len(inputs):
         name = inputs[k]
         xs = [sl.value for sl in catalogue_x(fb, name)]
         lo, hi = _universe(fb, name, xs)
-        width = 2.0 * big / (hi - lo) if hi > lo else 2.0 * big
+        width = 4.0 * big / (hi - lo) if hi > lo else 4.0 * big
     return s.value - width, s.value + width
 
 
