@@ -36,15 +36,21 @@ def pid_loop(w: object, load: object) -> object:
 
     pid = sim.PID(KP, ti=TI, low=-30.0, high=30.0)
     structure = sim.PIDLoop(pid, setpoint="w", measurement="y", drive="u")
-    return sim.Loop(sim.make_plant("fopdt", PLANT), structure, period=DT, setpoints={"w": w}, disturbances={"load": load})
+    return sim.Loop(
+        sim.make_plant("fopdt", PLANT), structure, period=DT, setpoints={"w": w}, disturbances={"load": load}
+    )
 
 
 def fuzzy_loop(doc: object, w: object, load: object) -> object:
     from fuzzyctl import sim
 
     fuzzy = sim.make_runtime(doc)  # type: ignore[arg-type]
-    structure = sim.FuzzyPI(fuzzy, {"e": "w - y", "de": "ddt(e)"}, output="du", drive="u", low=-30.0, high=30.0)
-    return sim.Loop(sim.make_plant("fopdt", PLANT), structure, period=DT, setpoints={"w": w}, disturbances={"load": load})
+    structure = sim.FuzzyPI(
+        fuzzy, {"e": "w - y", "de": "ddt(e)"}, output="du", drive="u", low=-30.0, high=30.0
+    )
+    return sim.Loop(
+        sim.make_plant("fopdt", PLANT), structure, period=DT, setpoints={"w": w}, disturbances={"load": load}
+    )
 
 
 def logs(seed: int = 0) -> dict[str, np.ndarray]:
@@ -79,7 +85,9 @@ def main() -> int:
 
     args.out.mkdir(parents=True, exist_ok=True)
     data = logs()
-    learned = fuzzyctl.learn(data, inputs=["e", "de"], output="du", kind="mamdani", out_terms=25, name="fuzzy_pi")
+    learned = fuzzyctl.learn(
+        data, inputs=["e", "de"], output="du", kind="mamdani", out_terms=25, name="fuzzy_pi"
+    )
     learned.write_fcl(args.out / "fuzzy_pi_learned.fcl")
     n_out = len(learned.block.defuzzify[0].terms)
     print(f"logged rows: {len(data['e'])}; learned {learned.rules} rules, {n_out} output singletons")
@@ -91,7 +99,9 @@ def main() -> int:
     w = profiles.steps([(5.0, 1.0)], before=0.0)
     load = profiles.steps([(100.0, -0.5)], before=0.0)
     rows = [("PI (Kp 5, Ti 16 s)", quality(pid_loop(w, load).run(200.0)))]  # type: ignore[attr-defined]
-    rows.append(("Mamdani fitted to the PI's logs", quality(fuzzy_loop(learned.document, w, load).run(200.0))))  # type: ignore[attr-defined]
+    rows.append(
+        ("Mamdani fitted to the PI's logs", quality(fuzzy_loop(learned.document, w, load).run(200.0)))
+    )  # type: ignore[attr-defined]
 
     if args.budget > 0:
         toml = args.out / "fuzzy_pi.toml"
@@ -102,9 +112,9 @@ def main() -> int:
                 duration = 200
                 [plant]
                 model = "fopdt"
-                gain = {PLANT['gain']}
-                time_constant = {PLANT['time_constant']}
-                dead_time = {PLANT['dead_time']}
+                gain = {PLANT["gain"]}
+                time_constant = {PLANT["time_constant"]}
+                dead_time = {PLANT["dead_time"]}
                 [controller]
                 structure = "fuzzy_pi"
                 file = "fuzzy_pi_learned.fcl"
@@ -136,7 +146,10 @@ def main() -> int:
         tuned = fuzzyctl.tune(learned.document, plant_config=toml, budget=args.budget, workers=0)
         tuned.write_fcl(args.out / "fuzzy_pi_tuned.fcl")
         rows.append(
-            (f"the same, tuned in closed loop ({tuned.evaluations} ev.)", quality(fuzzy_loop(tuned.document, w, load).run(200.0)))  # type: ignore[attr-defined]
+            (
+                f"the same, tuned in closed loop ({tuned.evaluations} ev.)",
+                quality(fuzzy_loop(tuned.document, w, load).run(200.0)),
+            )  # type: ignore[attr-defined]
         )
         print(f"closed-loop tuning on its own scenarios: IAE {tuned.before:.4g} -> {tuned.after:.4g}")
 

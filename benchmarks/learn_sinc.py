@@ -53,7 +53,10 @@ def case(
     tuned = fuzzyctl.tune(learned.document, data=train, output="y", validation=0.0, budget=budget, workers=0)
     t2 = time.perf_counter()
     rows = []
-    for label, doc, secs in (("learn", learned.document, t1 - t0), (f"learn + tune (lsq, {tuned.evaluations} ev.)", tuned.document, t2 - t1)):
+    for label, doc, secs in (
+        ("learn", learned.document, t1 - t0),
+        (f"learn + tune (lsq, {tuned.evaluations} ev.)", tuned.document, t2 - t1),
+    ):
         tr = rmse(doc, train, "y")
         ch = rmse(doc, check, "y") if check is not None else float("nan")
         rows.append(f"| {name} | {terms} {shape} | {label} | {tr:.5f} | {ch:.5f} | {secs:.1f} |")
@@ -69,14 +72,21 @@ def main() -> int:
     xc = x[:-1] + 0.1
     rows = []
     for terms, shape in ((5, "triangle"), (5, "gauss"), (9, "triangle"), (9, "gauss")):
-        rows += case("sin(x)/x", {"x": x, "y": sinc(x)}, {"x": xc, "y": sinc(xc)}, ["x"], terms, args.budget, shape)
+        rows += case(
+            "sin(x)/x", {"x": x, "y": sinc(x)}, {"x": xc, "y": sinc(xc)}, ["x"], terms, args.budget, shape
+        )
     xm = np.round(np.arange(0.0, 10.0001, 0.1), 10)
     xmc = xm[:-1] + 0.05
     f = lambda v: np.sin(2 * v) / np.exp(v / 5)  # noqa: E731
     for shape in ("triangle", "gauss"):
         rows += case(
-            "sin(2x)/exp(x/5) (MATLAB tunefis)", {"x": xm, "y": f(xm)}, {"x": xmc, "y": f(xmc)}, ["x"], 5,
-            args.budget, shape,
+            "sin(2x)/exp(x/5) (MATLAB tunefis)",
+            {"x": xm, "y": f(xm)},
+            {"x": xmc, "y": f(xmc)},
+            ["x"],
+            5,
+            args.budget,
+            shape,
         )
     g = np.linspace(-10, 10, 11)
     gx, gy = np.meshgrid(g, g)
@@ -89,8 +99,14 @@ def main() -> int:
     print("| function | terms per input | system | training RMSE | checking RMSE | seconds |")
     print("|---|---|---|---|---|---|")
     print("\n".join(rows))
-    print("\nreference: MATLAB tunefis doc, same data and 5 MFs: ANFIS training RMSE 0.0694086 (epoch 1), 0.0680259 (2), 0.066663 (3)")
-    print("reference: R package anfis, two-input sinc, 121 points, 5 MFs per input, 10 epochs: last training error 0.01916307")
+    print(
+        "\nreference: MATLAB tunefis doc, same data and 5 MFs: ANFIS training RMSE "
+        "0.0694086 (epoch 1), 0.0680259 (2), 0.066663 (3)"
+    )
+    print(
+        "reference: R package anfis, two-input sinc, 121 points, 5 MFs per input, 10 epochs: "
+        "last training error 0.01916307"
+    )
     return 0
 
 

@@ -44,16 +44,25 @@ def main() -> int:
             client.close()
             cluster.close()
         results[n] = (r, started)
-        print(f"{n} worker(s): {r.evaluations} evaluations in {r.seconds:.1f} s (cluster start {started:.1f} s)", flush=True)
+        print(
+            f"{n} worker(s): {r.evaluations} evaluations in {r.seconds:.1f} s "
+            f"(cluster start {started:.1f} s)",
+            flush=True,
+        )
     runs = list(results.values())
     first = runs[0][0]
     for r, _ in runs[1:]:
-        assert r.history == first.history and r.document == first.document, "results differ between worker counts"
+        assert r.history == first.history and r.document == first.document, (
+            "results differ between worker counts"
+        )
 
     scenarios, _ = plant.load_scenarios(toml)
     before_traces, after_traces = first.traces
     print(f"\nCMA-ES, seed {args.seed}, budget {args.budget}: cost {first.before:.2f} -> {first.after:.2f}")
-    print("\n| transport | settling s before | after | sway integral deg s before | after | largest sway deg before | after |")
+    print(
+        "\n| transport | settling s before | after | sway integral deg s before | after "
+        "| largest sway deg before | after |"
+    )
     print("|---|---|---|---|---|---|---|")
     for sc, tb, ta in zip(scenarios, before_traces, after_traces, strict=True):
         mb = plant.metrics(sc, tb, ["settling_time", "iae:angle", "max:angle"])

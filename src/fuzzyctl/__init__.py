@@ -7,10 +7,10 @@ The public entry points are :func:`fuzzyctl.load` and :func:`fuzzyctl.compile`; 
 
 from typing import Any
 
-from fuzzyctl.api import compile, load
+from fuzzyctl.api import compile, load, plot_terms
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "compile", "evaluate_dataframe", "learn", "load", "tune"]
+__all__ = ["__version__", "compile", "evaluate_dataframe", "learn", "load", "plot_terms", "tune"]
 
 
 def __getattr__(name: str) -> Any:

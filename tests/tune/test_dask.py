@@ -95,7 +95,21 @@ def test_eval_dask_cli_writes_parquet_partitions(dask_client: Any, tmp_path: Pat
     got = pd.concat(pd.read_parquet(p) for p in parts).sort_values("id")
     assert np.array_equal(got["power"].to_numpy(), ref)
     # CSV files by glob, in this process
-    assert main(["eval", crane, "--dask", str(tmp_path / "day*.csv"), "-o", str(tmp_path / "o2"), "--workers", "0"]) == 0
+    assert (
+        main(
+            [
+                "eval",
+                crane,
+                "--dask",
+                str(tmp_path / "day*.csv"),
+                "-o",
+                str(tmp_path / "o2"),
+                "--workers",
+                "0",
+            ]
+        )
+        == 0
+    )
     got = pd.concat(pd.read_parquet(p) for p in sorted((tmp_path / "o2").glob("*.parquet"))).sort_values("id")
     assert np.array_equal(got["power"].to_numpy(), ref)
 

@@ -72,7 +72,9 @@ CASES = [
 
 
 @pytest.mark.parametrize(("seed", "and_op", "accu", "kind"), CASES)
-def test_closed_form_matches_engine_and_finite_differences(seed: int, and_op: str, accu: str, kind: str) -> None:
+def test_closed_form_matches_engine_and_finite_differences(
+    seed: int, and_op: str, accu: str, kind: str
+) -> None:
     rng = np.random.default_rng(seed)
     fb = load_text(_system(rng, and_op, accu, kind)).raise_for_errors().main
     space = build_space(fb, "all,weights")
@@ -127,16 +129,22 @@ def test_crane_is_in_the_closed_form_class() -> None:
 def test_says_where_it_does_not_hold(change: str, reason: str) -> None:
     text = (EXAMPLES / "crane.fcl").read_text(encoding="utf-8")
     if reason == "area defuzzification":
-        text = text.replace("METHOD : CoGS;", "METHOD : CoG;").replace("TERM neg_high := -100;", "TERM neg_high := (-100, 1) (-50, 0);")
+        text = text.replace("METHOD : CoGS;", "METHOD : CoG;").replace(
+            "TERM neg_high := -100;", "TERM neg_high := (-100, 1) (-50, 0);"
+        )
         text = text.replace("TERM neg_medium := -50;", "TERM neg_medium := (-100, 0) (-50, 1) (0, 0);")
         text = text.replace("TERM zero := 0;", "TERM zero := (-50, 0) (0, 1) (50, 0);")
         text = text.replace("TERM pos_medium := 50;", "TERM pos_medium := (0, 0) (50, 1) (100, 0);")
         text = text.replace("TERM pos_high := 100;", "TERM pos_high := (50, 0) (100, 1);")
         text = text.replace("DEFAULT := 0;", "RANGE(-100..100); DEFAULT := 0;")
     elif reason == "OR":
-        text = text.replace("IF distance IS far AND angle IS neg_big", "IF distance IS far OR angle IS neg_big")
+        text = text.replace(
+            "IF distance IS far AND angle IS neg_big", "IF distance IS far OR angle IS neg_big"
+        )
     else:
-        text = text.replace("IF distance IS far AND angle IS neg_big", "IF distance IS very far AND angle IS neg_big")
+        text = text.replace(
+            "IF distance IS far AND angle IS neg_big", "IF distance IS very far AND angle IS neg_big"
+        )
     plan = fuzzyctl.compile(load_text(text).raise_for_errors()).plan
     why = gradient.unsupported(plan, ["power"])
     assert why is not None and reason in why

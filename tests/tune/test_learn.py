@@ -145,4 +145,6 @@ def test_cli_json_reports_both_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     assert main([*args, "--validation-data", str(check)]) == 0
     info = json.loads(capsys.readouterr().out)
     assert info["training rows"] == 100 and info["validation rows"] == 100
-    assert info["validation RMSE"] == pytest.approx(_rmse(fuzzyctl.load(out), surface(100, seed=11)), rel=1e-9)
+    assert info["validation RMSE"] == pytest.approx(
+        _rmse(fuzzyctl.load(out), surface(100, seed=11)), rel=1e-9
+    )

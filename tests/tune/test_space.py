@@ -59,7 +59,9 @@ def random_block(rng: np.random.Generator) -> FunctionBlock:
         ta = fuzz[0].terms[int(rng.integers(len(fuzz[0].terms)))].name
         tb = fuzz[1].terms[int(rng.integers(len(fuzz[1].terms)))].name
         w = float(rng.uniform(0.2, 1.0)) if rng.random() < 0.5 else None
-        rules.append(Rule(str(r + 1), _and(Is("a", ta), Is("b", tb)), (Conclusion("y", outs[r % 4].name, w),)))
+        rules.append(
+            Rule(str(r + 1), _and(Is("a", ta), Is("b", tb)), (Conclusion("y", outs[r % 4].name, w),))
+        )
     return FunctionBlock(
         "r",
         (Variable("a", VarKind.INPUT), Variable("b", VarKind.INPUT), Variable("y", VarKind.OUTPUT)),
@@ -116,7 +118,7 @@ def test_random_candidates_are_valid(seed: int) -> None:
                 for c in rule.conclusions:
                     assert c.weight is None or 0.0 <= float(c.weight) <= 1.0  # type: ignore[arg-type]
         ys = [float(t.mf.value) for t in cand.defuzzify[0].terms]  # type: ignore[union-attr, arg-type]
-        assert ys == sorted(ys) and -10.0 <= min(ys) and max(ys) <= 10.0
+        assert ys == sorted(ys) and min(ys) >= -10.0 and max(ys) <= 10.0
         fuzzyctl.compile(cand)  # and the engine takes it
 
 

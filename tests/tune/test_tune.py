@@ -42,11 +42,19 @@ def test_least_squares_recovers_the_known_optimum(crane_data: dict[str, object])
     assert "training RMSE power" in names and "validation RMSE power" in names
 
 
-@pytest.mark.parametrize(("optimizer", "loss"), [("cmaes", "rmse"), ("de", "mae"), ("lbfgsb", "max"), ("lbfgsb", "mae")])
+@pytest.mark.parametrize(
+    ("optimizer", "loss"), [("cmaes", "rmse"), ("de", "mae"), ("lbfgsb", "max"), ("lbfgsb", "mae")]
+)
 def test_every_optimizer_improves(crane_data: dict[str, object], optimizer: str, loss: str) -> None:
     r = fuzzyctl.tune(
-        crane_data["moved"], data=crane_data["cols"], free="power", optimizer=optimizer, loss=loss,
-        budget=40, workers=0, seed=1,
+        crane_data["moved"],
+        data=crane_data["cols"],
+        free="power",
+        optimizer=optimizer,
+        loss=loss,
+        budget=40,
+        workers=0,
+        seed=1,
     )
     assert r.after < r.before
     assert r.evaluations <= 40
@@ -60,7 +68,9 @@ def test_finite_differences_where_the_closed_form_does_not_hold(crane_data: dict
     text = write(crane_data["moved"]).replace(  # type: ignore[arg-type]
         "RULE 18 : IF distance IS zero AND angle IS zero", "RULE 18 : IF distance IS zero OR angle IS zero"
     )
-    r = fuzzyctl.tune(load_text(text).raise_for_errors(), data=crane_data["cols"], free="power", budget=25, workers=0)
+    r = fuzzyctl.tune(
+        load_text(text).raise_for_errors(), data=crane_data["cols"], free="power", budget=25, workers=0
+    )
     assert any("finite differences" in n and "OR" in n for n in r.notes)
     assert r.after < r.before
 
@@ -71,7 +81,12 @@ def test_ctrl_c_keeps_the_best_so_far(crane_data: dict[str, object], tmp_path: P
             raise KeyboardInterrupt
 
     r = fuzzyctl.tune(
-        crane_data["moved"], data=crane_data["cols"], optimizer="cmaes", budget=100, workers=0, progress=interrupt
+        crane_data["moved"],
+        data=crane_data["cols"],
+        optimizer="cmaes",
+        budget=100,
+        workers=0,
+        progress=interrupt,
     )
     assert r.interrupted and r.evaluations == 12
     best = min(h[1] for h in r.history)

@@ -94,6 +94,9 @@ def learn(
     and_op: Annotated[
         str, typer.Option("--and", help="AND operator: prod or min (PLC Basic level).")
     ] = "prod",
+    shape: Annotated[
+        str, typer.Option("--shape", help="Grid terms: triangle (points, PLC blocks) or gauss.")
+    ] = "triangle",
     validation: ValidationOpt = 0.2,
     validation_data: ValidationDataOpt = None,
     seed: SeedOpt = 0,

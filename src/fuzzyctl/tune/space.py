@@ -388,7 +388,9 @@ def parse_free(
     return terms, weights, used
 
 
-def build_space(fb: FunctionBlock, free: str | Sequence[str] | None = "all", *, keep_zero: bool = False) -> Space:
+def build_space(
+    fb: FunctionBlock, free: str | Sequence[str] | None = "all", *, keep_zero: bool = False
+) -> Space:
     """The free parameters of ``fb`` for a ``--free`` specification (see :func:`parse_free`).
 
     ``keep_zero``: abscissae and singletons at exactly 0 stay there.  In a closed loop the
