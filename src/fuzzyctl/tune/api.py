@@ -53,7 +53,7 @@ class TuneResult:
     def write_fcl(self, path: str | Path) -> Path:
         """The tuned document as FCL (comments kept, one added saying how it was tuned)."""
         from fuzzyctl.fcl import write
-        from fuzzyctl.sim.loop import write_atomic
+        from fuzzyctl.files import write_atomic
 
         path = Path(path)
         write_atomic(path, write(self.document))

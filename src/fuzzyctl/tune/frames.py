@@ -38,8 +38,8 @@ class Scorer:
         self.options = compile_options
         self.token = uuid.uuid4().hex
         ctl = fuzzyctl.compile(model, block=block, **compile_options)  # fail here, not on a worker
-        self.inputs: tuple[str, ...] = ctl.inputs
-        self.outputs: tuple[str, ...] = ctl.outputs
+        self.inputs: tuple[str, ...] = tuple(ctl.inputs)
+        self.outputs: tuple[str, ...] = tuple(ctl.outputs)
         self._required = tuple(i.name for i in ctl.plan.inputs if i.default is None)
 
     def controller(self) -> Any:

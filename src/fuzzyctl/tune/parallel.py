@@ -12,6 +12,8 @@ from __future__ import annotations
 import contextlib
 import logging
 import os
+import signal
+import threading
 from collections.abc import Callable, Sequence
 from typing import Any
 
@@ -63,7 +65,12 @@ class DaskExecutor:
         futures = [self.client.submit(_call, self._problem, method, c, k, pure=False) for c, k in items]
         try:
             return list(self.client.gather(futures))
-        except BaseException:
+        except BaseException as exc:
+            if isinstance(exc, KeyboardInterrupt):
+                # Cancelling leaves distributed's gather tasks with an exception nobody
+                # retrieves; asyncio would print each one ("Task exception was never
+                # retrieved ... AllExit") after the user asked to stop.
+                logging.getLogger("asyncio").setLevel(logging.CRITICAL)
             self.client.cancel(futures)
             raise
 
@@ -91,14 +98,28 @@ def local_cluster(workers: int) -> tuple[Any, Any]:
     """A LocalCluster of ``workers`` single-threaded worker processes on 127.0.0.1 (no
     dashboard) and a client of it."""
     distributed = _import_distributed()
-    cluster = distributed.LocalCluster(
-        n_workers=workers,
-        threads_per_worker=1,
-        processes=True,
-        host="127.0.0.1",
-        dashboard_address=None,
-        silence_logs=logging.ERROR,
-    )
+    # Ctrl-C in a terminal reaches the whole process group.  The worker processes start with
+    # SIGINT ignored (they inherit it), so that only this process stops - keeping the best
+    # candidate so far - instead of every worker dying with a traceback.
+    main = threading.current_thread() is threading.main_thread()
+    previous = signal.getsignal(signal.SIGINT) if main else None
+    if main:
+        signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        cluster = distributed.LocalCluster(
+            n_workers=workers,
+            threads_per_worker=1,
+            processes=True,
+            host="127.0.0.1",
+            # The scheduler's small HTTP server (health, metrics) on a free loopback port, so
+            # that two clusters never fight over 8787; no dashboard pages.
+            dashboard_address="127.0.0.1:0",
+            scheduler_kwargs={"dashboard": False},
+            silence_logs=logging.ERROR,
+        )
+    finally:
+        if main:
+            signal.signal(signal.SIGINT, previous)
     return distributed.Client(cluster, set_as_default=False), cluster
 
 

@@ -17,7 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
-from fuzzyctl.sim.loop import write_atomic
+from fuzzyctl.files import write_atomic
 
 if TYPE_CHECKING:
     from fuzzyctl.tune.api import TuneResult
