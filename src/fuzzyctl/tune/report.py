@@ -16,8 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 from fuzzyctl.files import write_atomic
+from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 
 if TYPE_CHECKING:
     from fuzzyctl.tune.api import TuneResult
