@@ -1,7 +1,9 @@
 """fuzzyctl: IEC 61131-7 fuzzy control for PLC engineers.
 
 The public entry points are :func:`fuzzyctl.load` and :func:`fuzzyctl.compile`; see
-``fuzzyctl.api``.  Importing the package is cheap: everything is imported when first used.
+``fuzzyctl.api``.  ``fuzzyctl.tune(...)``, ``fuzzyctl.learn(...)`` and
+``fuzzyctl.evaluate_dataframe(...)`` (docs/tune.md) are imported on first use.  Importing the
+package is cheap: everything is imported when first used (the start of a command matters).
 """
 
 from __future__ import annotations
@@ -9,20 +11,22 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from fuzzyctl.api import compile, load
+    from fuzzyctl.api import compile, load, plot_terms
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "compile", "load"]
+__all__ = ["__version__", "compile", "evaluate_dataframe", "learn", "load", "plot_terms", "tune"]
 
 
 def __getattr__(name: str) -> Any:
-    if name in ("compile", "load"):
-        from fuzzyctl import api
+    import importlib
 
-        return getattr(api, name)
+    if name in ("compile", "load", "plot_terms"):
+        return getattr(importlib.import_module("fuzzyctl.api"), name)
+    # Lazy: tuning pulls in scipy, cma and Dask, which plain evaluation does not need.
+    if name in ("tune", "learn", "evaluate_dataframe"):
+        module = importlib.import_module("fuzzyctl.tune")
+        return module if name == "tune" else getattr(module, name)
     if not name.startswith("_"):  # a subpackage not imported yet (fuzzyctl.engine, ...)
-        import importlib
-
         try:
             return importlib.import_module(f"fuzzyctl.{name}")
         except ModuleNotFoundError:

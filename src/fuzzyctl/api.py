@@ -16,8 +16,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
     from fuzzyctl.engine.controller import Controller
     from fuzzyctl.engine.plan import Plan
+    from fuzzyctl.engine.variables import VariableInfo
     from fuzzyctl.model import Document, FunctionBlock
 
 #: Backends of :func:`compile` (``auto``: native when possible, else python).
@@ -93,9 +97,12 @@ def content_key(data: bytes, fmt: str) -> str:
 
 
 def _looks_like_path(value: str) -> bool:
-    """Text holding a newline, ';' or ':=' is source; anything else is taken as a path (a
-    missing file is then reported as such, not parsed as FCL)."""
-    if "\n" in value or ";" in value or ":=" in value:
+    """Text holding a newline, ';' or ':=', starting with '{' or '[', or longer than any path
+    is source; anything else is taken as a path (a missing file is then reported as such,
+    not parsed as FCL)."""
+    if "\n" in value or ";" in value or ":=" in value or len(value) > 4096:
+        return False
+    if value.lstrip()[:1] in ("{", "["):  # JSON, a FIS section
         return False
     return "FUNCTION_BLOCK" not in value.upper() or Path(value).exists()
 
@@ -115,7 +122,10 @@ def compile(
     semantics (default IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError`
     for what the engine cannot evaluate."""
     plan, key = _plan(model, block, options)
-    return _controller(plan, backend, key)
+    from fuzzyctl.model import Document
+
+    fb = model.block(block) if isinstance(model, Document) else model
+    return _controller(plan, backend, key, fb)
 
 
 def compile_path(
@@ -144,7 +154,9 @@ def compile_path(
     return compile(load(path, format=fmt), block=block, backend=backend, **options)
 
 
-def _controller(plan: Plan, backend: str | None, key: str | None) -> Controller:
+def _controller(
+    plan: Plan, backend: str | None, key: str | None, model: FunctionBlock | None = None
+) -> Controller:
     backend = backend or os.environ.get("FUZZYCTL_BACKEND") or "auto"
     if backend not in BACKENDS:
         from fuzzyctl.diagnostics import FuzzyctlError
@@ -155,10 +167,10 @@ def _controller(plan: Plan, backend: str | None, key: str | None) -> Controller:
         from fuzzyctl.codegen.native import compile_native
 
         hint = cache.cache_dir() / "plans" / f"{key}.lib" if key is not None and cache.enabled() else None
-        return compile_native(plan, explicit=backend == "native", hint=hint)
+        return compile_native(plan, model, explicit=backend == "native", hint=hint)
     from fuzzyctl.engine.controller import Controller
 
-    return Controller(plan, specialise=backend == "python")
+    return Controller(plan, specialise=backend == "python", model=model)
 
 
 def compile_plan(model: Document | FunctionBlock, *, block: str | None = None, **options: Any) -> Plan:
@@ -224,3 +236,12 @@ def _store(rel: str, obj: Any) -> None:
         return
     if cache.write_atomic(path, data):
         cache.prune(path.parent, cache.limit_bytes(), keep=path)
+
+
+def plot_terms(variable: VariableInfo, *, points: int = 1001, ax: Axes | None = None) -> Figure:
+    """The membership functions of a variable as a labelled matplotlib Figure:
+    ``fuzzyctl.plot_terms(ctl.inputs["temp"]).savefig("temp.png")`` (as scikit-fuzzy's
+    ``view()`` or simpful's ``plot_variable``)."""
+    from fuzzyctl.engine.plot import plot_terms as draw
+
+    return draw(variable, points=points, ax=ax)

@@ -109,11 +109,6 @@ class FuzzyctlError(Exception):
     traceback; anything else reaching the CLI is a bug in fuzzyctl."""
 
 
-class CodegenError(FuzzyctlError):
-    """A code generator cannot express something in a system; the message names it (also
-    :mod:`fuzzyctl.codegen`'s and :mod:`fuzzyctl.engine.irgen`'s)."""
-
-
 class DiagnosticError(FuzzyctlError):
     """Raised when a file cannot be loaded; carries every diagnostic found."""
 

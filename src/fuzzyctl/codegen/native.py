@@ -33,12 +33,16 @@ import threading
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fuzzyctl import cache
-from fuzzyctl.diagnostics import CodegenError, FuzzyctlError
-from fuzzyctl.engine.controller import Controller
+from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.engine.controller import Controller, merge_inputs
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.escape import CodegenError
+
+if TYPE_CHECKING:
+    from fuzzyctl.model import FunctionBlock
 
 #: -ffp-contract=off: no fused multiply-add, so that the C rounds like Python does.
 CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-fvisibility=hidden", "-ffp-contract=off")
@@ -203,8 +207,8 @@ class NativeController(Controller):
     ``explain`` runs the Python interpreter on the same NC state (read from and written back
     to the native instance), so it stays consistent with ``evaluate``."""
 
-    def __init__(self, plan: Plan, library: Path) -> None:
-        super().__init__(plan, specialise=False)
+    def __init__(self, plan: Plan, library: Path, model: FunctionBlock | None = None) -> None:
+        super().__init__(plan, specialise=False, model=model)
         self.library = library
         lib = ctypes.CDLL(str(library))
         vp = ctypes.c_void_p
@@ -234,8 +238,8 @@ class NativeController(Controller):
         # (the evaluator's) and no output reads another (a NC value is then only copied)
         self._parallel = not self._plc and not _outputs_read(plan)
 
-    def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
-        values = self._values(inputs)
+    def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
+        values = self._values(merge_inputs(inputs, values_by_name))
         buf = self._in1
         for i, v in enumerate(values):
             buf[i] = v
@@ -245,21 +249,25 @@ class NativeController(Controller):
             return {n: out[k] for k, (n, _i) in enumerate(self._names)}
         return {n: out[i] for n, i in self._names}
 
-    def evaluate_reference(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+    def evaluate_reference(
+        self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
+    ) -> dict[str, float]:
         self._pull_state()
-        res = super().evaluate_reference(inputs)
+        res = super().evaluate_reference(inputs, **values_by_name)
         self._push_state()
         return res
 
-    def explain(self, inputs: Mapping[str, Any]) -> Any:
+    def explain(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> Any:
         self._pull_state()
-        res = super().explain(inputs)
+        res = super().explain(inputs, **values_by_name)
         self._push_state()
         return res
 
-    def _run_batch(self, n: int, columns: list[Any], chunk: int) -> list[Any]:
+    def _run_batch(self, full: list[Any], n: int, chunk: int) -> dict[str, Any]:
+        """One C call over the whole batch (one per thread when slices run in parallel)."""
         import numpy as np
 
+        columns = full
         columns = [np.ascontiguousarray(c, dtype=np.float64) for c in columns]
         n_cols = len(self._out_index) if self._plc else self._n_res
         outs = [np.empty(n) for _ in range(n_cols)]
@@ -270,13 +278,9 @@ class NativeController(Controller):
             self._call_batch(self._inst_p, 0, n, columns, outs)
         else:
             self._threaded(n, parts, columns, outs)
-        res = [np.full(n, np.nan) for _ in self.plan.outputs]
-        if self._plc:
-            for k, oi in enumerate(self._out_index):
-                res[oi] = outs[k]
-        else:
-            res = outs
-        return res
+        if self._plc:  # the PLC block's wrapper writes the declared outputs only
+            return {self.plan.outputs[oi].name: outs[k] for k, oi in enumerate(self._out_index)}
+        return {o.name: arr for o, arr in zip(self.plan.outputs, outs, strict=True) if o.is_output}
 
     def _call_batch(self, inst: Any, start: int, stop: int, columns: list[Any], outs: list[Any]) -> None:
         if stop <= start:
@@ -373,12 +377,14 @@ def notice(message: str) -> None:
     print(f"fuzzyctl: {message}", file=sys.stderr)
 
 
-def compile_native(plan: Plan, *, explicit: bool = True, hint: Path | None = None) -> Controller:
+def compile_native(
+    plan: Plan, model: FunctionBlock | None = None, *, explicit: bool = True, hint: Path | None = None
+) -> Controller:
     """A native controller for ``plan``, or the Python one when there is no compiler or the
     plan uses something the C generators cannot express: with a warning when native was
     asked for (``explicit``), a one-line notice for a missing compiler otherwise."""
     try:
-        return NativeController(plan, build(plan, hint))
+        return NativeController(plan, build(plan, hint), model)
     except NativeError as exc:
         if explicit:
             warnings.warn(
@@ -395,4 +401,4 @@ def compile_native(plan: Plan, *, explicit: bool = True, hint: Path | None = Non
             warnings.warn(
                 f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
             )
-    return Controller(plan, specialise=True)
+    return Controller(plan, specialise=True, model=model)

@@ -7,16 +7,15 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Literal
 
-from fuzzyctl.diagnostics import CodegenError
 from fuzzyctl.engine.ir import Builder, Decl, Ex, ExLike, Storage, Type, Var, ex
+from fuzzyctl.escape import MAX_IDENT_ST as MAX_IDENT
+from fuzzyctl.escape import CodegenError
 
 #: "c" and "st": the PLC function block; "py", "np" and "c" also the evaluator of ``compile()``
 Target = Literal["c", "st", "py", "np"]
 
 #: Every generated identifier starts with this prefix (user names never do: checked).
 PREFIX = "FZ_"
-#: Longest identifier the portable ST subset allows (and the C code keeps to).
-MAX_IDENT = 24
 
 
 __all__ = ["MAX_IDENT", "PREFIX", "CodegenError", "Gen", "Target", "flat"]

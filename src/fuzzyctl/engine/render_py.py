@@ -241,7 +241,8 @@ def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
 def specialise(fp: FastProgram) -> Fast:
     """Compile the rendered source into the function."""
     src, env = render_py(fp)
-    exec(compile(src, f"<fuzzyctl evaluator {fp.plan.name}>", "exec"), env)
+    # no model text reaches the source (FZ_ names, float literals; kernels are bound objects)
+    exec(compile(src, f"<fuzzyctl evaluator {fp.plan.name!r}>", "exec"), env)
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn
