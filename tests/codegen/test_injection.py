@@ -4,10 +4,11 @@ Every reader (FCL, FIS, FLL, JSON, FPL, XFUZ) is given a small system with a hos
 (comment terminators of C and ST, newlines, line splices, trigraphs, quotes, NUL, ``]]>``,
 ``${``, Unicode line separators and bidirectional controls, 20,000 characters) in each of
 its text fields in turn.  The reader may refuse it (a :class:`DiagnosticError`) or accept it;
-when it accepts, the generated C, Structured Text and the specialised
-Python must be the benign system's code token for token - whatever the hostile text did, it
-stayed inside a comment or was refused as a name (:class:`CodegenError`).  Then the issue's
-reproducer and every hostile label are built by the native backend and run."""
+when it accepts, the generated C, Structured Text and the evaluators of ``compile()``
+(Python, numpy, the native backend's C) must be the benign system's code token for token -
+whatever the hostile text did, it stayed inside a comment or was refused as a name
+(:class:`CodegenError`).  Then the issue's reproducer and every hostile label are built by
+the native backend and run."""
 
 from __future__ import annotations
 
@@ -20,16 +21,19 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from fuzzyctl.engine.specialise import specialise
 
 import fuzzyctl
+import fuzzyctl.formats.json  # used as fuzzyctl.formats.json (the registry imports it lazily)
 from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError, generate_c, generate_st, lower_block
 from fuzzyctl.codegen.native import NativeController
 from fuzzyctl.codegen.program import build_program
-from fuzzyctl.codegen.render_c import render_c
+from fuzzyctl.codegen.render_c import render_c, render_native
 from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.diagnostics import DiagnosticError
+from fuzzyctl.engine.fastprog import build_fast
+from fuzzyctl.engine.render_np import render_np
+from fuzzyctl.engine.render_py import render_py
 from fuzzyctl.model import Document
 from tests.codegen import hostile as H
 
@@ -118,7 +122,10 @@ def _code(doc: Document) -> dict[str, list[str] | None]:
         out["st"] = list(H.st_tokens(render_st(build_program(plan, "st"))))
     except CodegenError:
         out["st"] = None
-    out["python"] = specialise(plan).__source__.split()  # type: ignore[attr-defined]
+    # the evaluators of compile(): Python (single), numpy (batch), C (native backend)
+    out["python"] = render_py(build_fast(plan, "py"))[0].split()
+    out["numpy"] = render_np(build_fast(plan, "np"))[0].split()
+    out["native"] = list(H.c_tokens(render_native(build_fast(plan, "c"))))
     return out
 
 
@@ -180,6 +187,17 @@ def private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
     return tmp_path
 
 
+@pytest.mark.parametrize("target", ["py", "np", "c"])
+def test_evaluator_renderers_refuse_a_name_that_is_not_an_identifier(target: str) -> None:
+    """The evaluators of compile() print only the program's own names, each through the
+    target's identifier check: a name that got into the program some other way is refused."""
+    fp = build_fast(lower_block(_benign_fcl()), target)  # type: ignore[arg-type]
+    fp.inputs[0] = H.HOSTILE["c-close"]
+    render = {"py": render_py, "np": render_np, "c": render_native}[target]
+    with pytest.raises(CodegenError, match="generated name"):
+        render(fp)  # type: ignore[operator]
+
+
 def _labelled(labels: list[str]) -> Document:
     """The tank example with hostile rule labels, rule-block and term names (JSON: free text)."""
     data = fuzzyctl.formats.json.to_dict(fuzzyctl.load(Path(__file__).parents[2] / "examples" / "tank.fcl"))
@@ -194,7 +212,7 @@ def _labelled(labels: list[str]) -> Document:
 
 def test_native_backend_on_the_issue_reproducer(private_cache: Path) -> None:
     doc = _labelled([H.HOSTILE["issue-14"]])
-    reference = fuzzyctl.compile(doc)
+    reference = fuzzyctl.compile(doc, backend="python")  # the default may be native itself
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # a fallback to Python would hide a refused build
         native = fuzzyctl.compile(doc, backend="native")

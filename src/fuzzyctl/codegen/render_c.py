@@ -36,6 +36,7 @@ from fuzzyctl.engine.ir import (
     Stmt,
     Var,
     While,
+    identifiers,
     subexprs,
 )
 from fuzzyctl.engine.plan import OutputPlan
@@ -591,6 +592,10 @@ def render_native(fp: FastProgram) -> str:
     """One C file: ``fz_row`` (one evaluation), ``fz_eval``, ``fz_batch`` (a loop over
     columns of rows) and ``fz_init`` (the NC state), exported for the native backend."""
     prog = fp.program
+    # every name printed passes c_ident (they are the program's FZ_ names: a model name
+    # reaching here is refused, never printed)
+    for n in sorted(identifiers(prog) | {*fp.inputs, *fp.outputs, fp.state}):
+        c_ident(n, "generated name")
     r = _Native(fp)
     r.stmts(prog.body, 1)
     body = r.lines

@@ -419,6 +419,29 @@ def walk_exprs(stmts: Sequence[Stmt]) -> Iterator[Ex]:
             yield from s.args
 
 
+def _loop_vars(stmts: Sequence[Stmt]) -> Iterator[str]:
+    for s in stmts:
+        if isinstance(s, For):
+            yield s.var
+            yield from _loop_vars(s.body)
+        elif isinstance(s, If):
+            for _c, body in s.branches:
+                yield from _loop_vars(body)
+            yield from _loop_vars(s.orelse)
+        elif isinstance(s, While | Region):
+            yield from _loop_vars(s.body)
+
+
+def identifiers(prog: Program) -> set[str]:
+    """Every identifier of ``prog`` a renderer prints: declarations, loop variables and the
+    variables the statements use (each renderer passes them through its target's escaping
+    function, :mod:`fuzzyctl.escape`)."""
+    out = {d.name for d in prog.decls} | set(_loop_vars(prog.body))
+    for top in walk_exprs(prog.body):
+        out.update(e.name for e in subexprs(top) if isinstance(e, Var | Index))
+    return out
+
+
 def subexprs(e: Ex) -> Iterator[Ex]:
     yield e
     if isinstance(e, Index):

@@ -48,7 +48,8 @@ from fuzzyctl.engine.ir import (
     subexprs,
 )
 from fuzzyctl.engine.irgen import CodegenError
-from fuzzyctl.engine.render_py import lit
+from fuzzyctl.engine.render_py import check_names, lit
+from fuzzyctl.escape import py_str
 
 Batch = Callable[[list[Any], list[float | None], int], list[Any]]
 
@@ -304,6 +305,7 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
     """The source of ``_batch`` and the globals it needs."""
     r = _Np(fp)
     prog = fp.program
+    check_names(fp)
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
         r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
@@ -333,7 +335,7 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
 def vectorise(fp: FastProgram) -> Batch:
     """Compile the rendered source into the function."""
     src, env = render_np(fp)
-    exec(compile(src, f"<fuzzyctl batch evaluator {fp.plan.name!r}>", "exec"), env)
+    exec(compile(src, f"<fuzzyctl batch evaluator {py_str(fp.plan.name)}>", "exec"), env)
     fn: Batch = env["_batch"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn

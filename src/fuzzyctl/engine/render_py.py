@@ -4,8 +4,9 @@ exact float literals, IFs as Python ``if``, piecewise-linear memberships as if-c
 their breakpoints, kernels as calls of :mod:`fuzzyctl.engine.kernels`.
 
 The generated source is kept on the function (``__source__``) for inspection.  No name of the
-model reaches the source: every variable is an ``FZ_`` identifier of the program, and
-comments (which hold rule labels) are not printed.
+model reaches the source: every variable is an ``FZ_`` identifier of the program (each one
+checked by :func:`fuzzyctl.escape.py_ident`), and comments (which hold rule labels) are not
+printed.
 """
 
 from __future__ import annotations
@@ -36,7 +37,9 @@ from fuzzyctl.engine.ir import (
     Stmt,
     Var,
     While,
+    identifiers,
 )
+from fuzzyctl.escape import py_ident, py_str
 
 Fast = Callable[[list[float], list[float | None]], list[float]]
 
@@ -216,6 +219,7 @@ def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
     """The source of ``_fast`` and the globals it needs."""
     r = _Py(fp)
     prog = fp.program
+    check_names(fp)
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
         r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
@@ -241,11 +245,19 @@ def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
 def specialise(fp: FastProgram) -> Fast:
     """Compile the rendered source into the function."""
     src, env = render_py(fp)
-    # no model text reaches the source (FZ_ names, float literals; kernels are bound objects)
-    exec(compile(src, f"<fuzzyctl evaluator {fp.plan.name!r}>", "exec"), env)
+    # no model text reaches the source (FZ_ names checked by py_ident, float literals;
+    # kernels are bound objects)
+    exec(compile(src, f"<fuzzyctl evaluator {py_str(fp.plan.name)}>", "exec"), env)
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn
+
+
+def check_names(fp: FastProgram) -> None:
+    """Every name printed into the source passes :func:`fuzzyctl.escape.py_ident` (they are
+    the program's ``FZ_`` names: a model name reaching here is refused, never printed)."""
+    for name in sorted(identifiers(fp.program) | {*fp.inputs, *fp.outputs, fp.state}):
+        py_ident(name, "generated name")
 
 
 def _assigned(body: Sequence[Stmt], name: str) -> bool:

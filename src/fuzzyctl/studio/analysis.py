@@ -333,7 +333,7 @@ class ControllerCache:
             if key in self._items:
                 self._items.move_to_end(key)
                 return self._items[key]
-        controller = fuzzyctl.compile(fb)
+        controller = fuzzyctl.compile(fb, backend="python")  # recompiled on every edit: no C build
         with self._lock:
             self._items[key] = controller
             while len(self._items) > self.size:
