@@ -133,7 +133,7 @@ def ours(path: Path, rows: np.ndarray, budget: float) -> dict[str, dict[str, Any
     for label, backend in (("fuzzyctl python/numpy", "python"), ("fuzzyctl native", "native")):
         ctl = fuzzyctl.compile(doc, backend=backend)
         names = list(ctl.inputs)
-        o = ctl.outputs[0]
+        o = next(iter(ctl.outputs))
 
         def single(r: np.ndarray, ctl: Any = ctl, names: list[str] = names, o: str = o) -> float:
             return float(ctl.evaluate(dict(zip(names, r.tolist(), strict=True)))[o])
