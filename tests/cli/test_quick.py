@@ -7,6 +7,7 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -52,6 +53,21 @@ def test_everything_else_goes_to_the_full_command_line(
 ) -> None:
     assert try_quick(argv) is None
     assert capsys.readouterr().out == ""
+
+
+def test_an_output_without_a_value_goes_to_the_full_command_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Issue 14.6 (tests/cli/test_run.py): the full command line says why and exits 1."""
+    from tests.cli.test_run import NO_RULE_FIRES
+
+    src = tmp_path / "nan.fcl"
+    src.write_text(NO_RULE_FIRES)
+    for form in ([], ["--json"]):
+        assert try_quick(["eval", str(src), "--set", "x=8", *form]) is None
+        assert capsys.readouterr().out == ""
+        assert try_quick(["eval", str(src), "--set", "x=2", *form]) == 0  # the rule fires
+        assert "5" in capsys.readouterr().out
 
 
 def test_parse_only_the_simple_form() -> None:

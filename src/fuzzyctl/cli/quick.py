@@ -75,17 +75,19 @@ def try_quick(argv: list[str]) -> int | None:
         result = ctl.evaluate(values)
     except Exception:  # every error is reported by the full command line
         return None
+    if not all(math.isfinite(v) for v in result.values()):
+        return None  # an output without a value: the full command line says why and exits 1
     if as_json:
         import json
 
-        print(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
+        print(json.dumps(result))
         return 0
     from rich.console import Console
     from rich.table import Table
 
     table = Table(title=f"{ctl.name or file.name}", show_lines=False)
-    table.add_column("output")
-    table.add_column("value", justify="right")
+    table.add_column("output", overflow="fold")  # as cli/run.py's _print_outputs
+    table.add_column("value", justify="right", overflow="fold", no_wrap=False)
     for k, v in result.items():
         table.add_row(k, f"{v:.10g}")
     Console(highlight=False).print(table)
