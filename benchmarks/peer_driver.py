@@ -70,7 +70,10 @@ def build(lib: str, system: str) -> tuple[Any, Any]:
 
         return single, batch
     if lib == "skfuzzy" and system in ("tipper", "grid49"):
-        s, b, _ = models.build_skfuzzy(system, out_points=1201)
+        # one simulation each: after array inputs scikit-fuzzy refuses a single sample
+        # ("All antecedents must have input values!")
+        s, _b, _ = models.build_skfuzzy(system, out_points=1201)
+        _s, b, _ = models.build_skfuzzy(system, out_points=1201)
         return (lambda r: s(float(r[0]), float(r[1]))), (lambda rows: b(rows[:, 0], rows[:, 1]))
     if lib == "simpful" and system in ("tipper", "grid49"):
         s, _b, _ = models.build_simpful(system, subdivisions=1000)

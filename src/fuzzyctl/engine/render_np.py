@@ -335,7 +335,7 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
 def vectorise(fp: FastProgram) -> Batch:
     """Compile the rendered source into the function."""
     src, env = render_np(fp)
-    exec(compile(src, f"<fuzzyctl batch evaluator {py_str(fp.plan.name)}>", "exec"), env)
+    exec(compile(src, f"<fuzzyctl batch evaluator {py_str(fp.plan.name or '')}>", "exec"), env)
     fn: Batch = env["_batch"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn

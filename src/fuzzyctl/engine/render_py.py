@@ -247,7 +247,7 @@ def specialise(fp: FastProgram) -> Fast:
     src, env = render_py(fp)
     # no model text reaches the source (FZ_ names checked by py_ident, float literals;
     # kernels are bound objects)
-    exec(compile(src, f"<fuzzyctl evaluator {py_str(fp.plan.name)}>", "exec"), env)
+    exec(compile(src, f"<fuzzyctl evaluator {py_str(fp.plan.name or '')}>", "exec"), env)
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn
