@@ -45,6 +45,8 @@ from fuzzyctl.formats.xfuz_tables import (
 __all__ = ["XfuzFB", "XfuzSnapshot"]
 
 N_IN, N_OUT, N_RULES = 8, 6, 64
+DEGRE_FULL = 255
+"""DEGRE holds a rule's degree 0..1 as 0..255, rounded (2.3)."""
 _ARRAYS = {"INP": N_IN, "OUT": N_OUT, "I_SIM": N_IN, "O_CALC": N_OUT, "O_MAN": N_OUT, "O_DEF": N_OUT}
 _BITS = ("INIT", "MAN_AUTO", "CONT_ASK", "START", "REFRESH", "INHIB")
 _WORDS = ("T_OFB", "MONITOR", "COMMAND")
@@ -266,7 +268,7 @@ class XfuzFB:
         if not result.any_active and not self.COMMAND >> 8 & 1:
             info |= 1 << StatusBit.NO_ACTIVE_RULE
         self._info_status = info
-        self.DEGRE = [min(255, math.floor(255.0 * d + 0.5)) for d in result.degrees]
+        self.DEGRE = [min(DEGRE_FULL, math.floor(DEGRE_FULL * d + 0.5)) for d in result.degrees]
         self.DEGRE += [0] * (N_RULES - len(self.DEGRE))
 
     def _assign_outputs(self) -> None:

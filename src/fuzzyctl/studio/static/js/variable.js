@@ -2,6 +2,7 @@
 // questions, terms (insert, delete, rename, "insert N" evenly spread), points in a table
 // and draggable on the chart (singletons move as a line), zoom in five steps.
 import { state, on, fb, inputs, outputs, termBlock, range, changed, handles, localCurve, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status } from "./state.js";
+import { nameWarning } from "./names.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
 
 let current = null; // variable name
@@ -398,6 +399,8 @@ export function init() {
     renameVariable(current, name);
     current = name;
     changed("rename");
+    const warn = nameWarning("variable", name);
+    if (warn) status(warn, "warning");
   });
   $("#term-select").addEventListener("change", (e) => {
     term = +e.target.value;
@@ -414,6 +417,8 @@ export function init() {
     blk.terms[term].name = name;
     renameTerm(current, old, name);
     changed("rename");
+    const warn = nameWarning("term", name);
+    if (warn) status(warn, "warning");
   });
   $("#var-range-apply").addEventListener("click", setRange);
   $("#term-insert").addEventListener("click", insertTerm);
