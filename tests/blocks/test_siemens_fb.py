@@ -231,6 +231,11 @@ def test_siemens_3_2_fuzzy_ai_unipolar_bipolar_thermocouple() -> None:
         75.0,
         100.0,
     ]
+    # 3.2 note: a bipolar signal needs symmetric MIN/MAX; Pressure 50..100 is not, and the
+    # result says so (the value is the manual's formula all the same)
+    bipolar = fuzzy_ai(fb, 0, bipolar=True, input_nr=2)
+    assert bipolar.warning is not None and "MIN 50 and MAX 100 are not symmetric" in bipolar.warning
+    assert fuzzy_ai(fb, 0, input_nr=2).warning is None  # unipolar: no such constraint
     # FACTOR and OFFSET: 75 * 2 - 10 = 140, written as is (the FB clamps, not FUZZY_AI)
     assert fuzzy_ai(fb, 0, bipolar=True, factor=2.0, offset=-10.0, input_nr=2).value == 140.0
     assert fb.INPUT2 == 140.0

@@ -113,6 +113,19 @@ def test_always_is_only_read_back_when_it_is_the_writer_s_form() -> None:
     assert sum(r.condition is None for _rb, r in back.main.rules()) == 1
 
 
+def test_generated_c_computes_the_rule_without_if_part(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from fuzzyctl.codegen import generate_st
+
+    monkeypatch.setenv("FUZZYCTL_CACHE_DIR", str(tmp_path))
+    doc = biased()
+    assert "RULE bias" in generate_st(doc)
+    native = fuzzyctl.compile(doc, backend="native")  # the generated C, compiled
+    assert type(native).__name__ == "NativeController"
+    assert native.evaluate({"Temp": 9.0, "Pressure": 65.0})["Valve"] == pytest.approx(20.0)  # (75 - 25) / 2.5
+
+
 def test_xfuz_tables_hold_it_as_an_always_true_predicate() -> None:
     doc = biased()
     lowered, _losses = lower_xfuz(doc)
