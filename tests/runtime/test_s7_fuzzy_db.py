@@ -152,3 +152,51 @@ START_STOP = {{ connection = "cpu", db = 30, parameter = "START_STOP" }}
     assert get(data, "OUTPUT2") == -7.5 and get(data, "OUTPUT3") == 0.0 and data[49] == 0
     assert len(data) == DB_LENGTH
     assert_log_complete(rt, tmp_path / "events.jsonl")
+
+
+def test_a_command_written_right_after_our_mirror_is_not_lost(tmp_path: Path) -> None:
+    """The field changes START_STOP after serve wrote its mirror but before serve read the
+    mirror back: the read differs from what the field last held (our write), so it is a
+    command, even though it equals the value read before.  Driven by hand (no threads)."""
+    from fuzzyctl.io.base import LinkState
+
+    rt = make_runtime(
+        tmp_path,
+        f"""
+[connections.cpu]
+type = "s7"
+port = 1
+
+[instances.valve]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+
+[instances.valve.parameters]
+START_STOP = {{ connection = "cpu", db = 30, parameter = "START_STOP" }}
+""",
+    )
+    inst = rt.instances["valve"]
+    (p,) = inst.params
+    p.link.state = LinkState.UP
+    block = inst.adapter.block
+    assert block.START_STOP == 0xFFFF  # downloaded and enabled
+
+    def read(value: float, stamp: float) -> None:
+        p.cell.value, p.cell.stamp = value, stamp
+        inst._param_from_field(p)
+
+    read(0.0, 1.0)  # a fresh DB holds W#16#0: not a command
+    assert block.START_STOP == 0xFFFF
+    p.mirror.sent, p.mirror.last_send = 0xFFFF, (0xFFFF, 2.0)  # serve writes its mirror
+    read(0.0, 1.5)  # a read older than our write: still the fresh DB, not a command
+    assert block.START_STOP == 0xFFFF
+    read(0.0, 3.0)  # the program wrote 0 between our write (2.0) and this read: stop
+    assert block.START_STOP == 0
+    p.mirror.sent, p.mirror.last_send = 0, (0, 4.0)
+    read(0.0, 5.0)  # the echo of our mirror: nothing
+    assert block.START_STOP == 0
+    read(0x0123, 6.0)  # any word other than 0 starts it again
+    assert block.START_STOP == 0x0123
+    p.mirror.sent, p.mirror.last_send = 0x0123, (0x0123, 7.0)
+    read(0x0123, 8.0)
+    assert block.START_STOP == 0x0123
