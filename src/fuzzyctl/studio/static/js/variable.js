@@ -126,12 +126,13 @@ function render() {
     return;
   }
   if (term >= blk.terms.length) term = Math.max(0, blk.terms.length - 1);
-  $("#var-name").value = current;
+  // A field being typed in keeps its text when a check's report redraws the view.
+  if (document.activeElement !== $("#var-name")) $("#var-name").value = current;
   const [lo, hi] = range(current);
   if (document.activeElement !== $("#var-min")) $("#var-min").value = lo;
   if (document.activeElement !== $("#var-max")) $("#var-max").value = hi;
   $("#term-select").replaceChildren(...blk.terms.map((t, i) => el("option", { value: i, selected: i === term }, t.name)));
-  $("#term-name").value = blk.terms[term] ? blk.terms[term].name : "";
+  if (document.activeElement !== $("#term-name")) $("#term-name").value = blk.terms[term] ? blk.terms[term].name : "";
   const isOut = !isInput(current);
   $("#out-options").hidden = !isOut;
   if (isOut) {
@@ -394,8 +395,9 @@ export function init() {
   $("#var-name").addEventListener("change", (e) => {
     const name = e.target.value.trim();
     if (name === current) return;
-    if (!isIdentifier(name)) return status(`${name}: a name is a letter or _ followed by letters, digits or _`, "error"), render();
-    if (variableNames().includes(name)) return status(`${name} exists already`, "error"), render();
+    const refuse = (message) => ((e.target.value = current), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: a name is a letter or _ followed by letters, digits or _`);
+    if (variableNames().includes(name)) return refuse(`${name} exists already`);
     renameVariable(current, name);
     current = name;
     changed("rename");
@@ -412,8 +414,9 @@ export function init() {
     const name = e.target.value.trim();
     const old = blk.terms[term].name;
     if (name === old) return;
-    if (!isIdentifier(name)) return status(`${name}: not a valid term name`, "error"), render();
-    if (blk.terms.some((t) => t.name === name)) return status(`${current} has a term ${name} already`, "error"), render();
+    const refuse = (message) => ((e.target.value = old), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: not a valid term name`);
+    if (blk.terms.some((t) => t.name === name)) return refuse(`${current} has a term ${name} already`);
     blk.terms[term].name = name;
     renameTerm(current, old, name);
     changed("rename");
