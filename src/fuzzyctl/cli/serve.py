@@ -49,7 +49,8 @@ def serve(
         if runtime.api_address is not None:
             host, port = runtime.api_address
             err_console.print(
-                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}",
+                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}, "
+                f"read-only token in {runtime.read_token_path}",
                 markup=False,
             )
         deadline = None if duration is None else time.monotonic() + duration

@@ -65,8 +65,16 @@ class Link:
         self.connector = connector
         self.config = config
         self.events = events
-        self.state = LinkState.DOWN
+        self._state = LinkState.DOWN
+        self.up = False
+        """Whether the link is up: a plain attribute, read several times per instance and
+        cycle by the cycle thread."""
         self.counters = LinkCounters()
+        self.deadline = config.effective_deadline
+        self.last_exchange = 0.0
+        """``time.perf_counter()`` at the end of the last complete exchange: an instance
+        whose link has none for longer than ``deadline`` holds, before the protocol's timeout
+        declares the link lost (a frozen peer)."""
         self._in: dict[Point, InCell] = {}
         self._out: dict[Point, OutCell] = {}
         self._mirror: dict[Point, OutCell] = {}
@@ -94,8 +102,13 @@ class Link:
         return list({**self._in, **self._out, **self._mirror})
 
     @property
-    def up(self) -> bool:
-        return self.state is LinkState.UP
+    def state(self) -> LinkState:
+        return self._state
+
+    @state.setter
+    def state(self, state: LinkState) -> None:
+        self._state = state
+        self.up = state is LinkState.UP
 
     # --- the exchange
     async def exchange(self) -> None:
@@ -128,7 +141,8 @@ class Link:
             for out_cell, value in zip(sent, out_values, strict=True):
                 out_cell.sent = value
         self.counters.exchanges += 1
-        self.counters.last_exchange_ms = (time.perf_counter() - t0) * 1e3
+        self.last_exchange = end = time.perf_counter()
+        self.counters.last_exchange_ms = (end - t0) * 1e3
 
     async def _connect(self) -> None:
         await self.connector.connect()
