@@ -80,6 +80,11 @@ def _thread_cpu(thread: Any) -> float:
         return math.nan
 
 
+def _counts(inst: Any) -> tuple[int, int, int]:
+    stats = inst.task.stats
+    return stats.count, stats.overruns, stats.skipped
+
+
 def _start_abuse(url: str, seconds: float, token: str | None) -> subprocess.Popen[str]:
     """The abusive client in its own process (its work must not count as ours)."""
     cmd = [sys.executable, str(ROOT / "benchmarks" / "http_abuse.py"), url, "--mb", "500"]
@@ -127,7 +132,8 @@ def run(
             for i in range(n):
                 regs = [*float32_to_registers(temps[i]), *float32_to_registers(pressures[i])]
                 master.write_registers(i * 6, regs)
-            start_counts = {name: inst.task.stats.count for name, inst in rt.instances.items()}
+            # Counted over the measurement only (start-up has its own hiccups).
+            start_counts = {name: _counts(inst) for name, inst in rt.instances.items()}
             thread, io_thread = rt.scheduler._thread, rt._io_thread
             cpu0, io0, wall0 = _thread_cpu(thread), _thread_cpu(io_thread), time.perf_counter()
             if abuse and rt.api_address is not None:
@@ -136,6 +142,7 @@ def run(
                 abuser = _start_abuse(url, seconds, rt.token if abuse == "token" else None)
             time.sleep(seconds)
             cpu1, io1, wall1 = _thread_cpu(thread), _thread_cpu(io_thread), time.perf_counter()
+            end_counts = {name: _counts(inst) for name, inst in rt.instances.items()}
             outputs = []
             for i in range(n):
                 r = master.read_holding_registers(i * 6 + 4, count=2).registers
@@ -157,13 +164,14 @@ def run(
     overruns = skipped = 0
     counts = []
     for name, inst in rt.instances.items():
-        stats = inst.task.stats
-        _, jit, dur = inst.ring.ordered()  # the last 2000 cycles (20 s at 10 ms)
-        jitters += jit
-        durations += dur
-        overruns += stats.overruns
-        skipped += stats.skipped
-        counts.append(stats.count - start_counts[name])
+        starts, jit, dur = inst.ring.ordered()  # the last 2000 cycles (20 s at 10 ms)
+        kept = [i for i, t in enumerate(starts) if wall0 <= t <= wall1]  # those of the measurement
+        jitters += [jit[i] for i in kept]
+        durations += [dur[i] for i in kept]
+        (c0, o0, s0), (c1, o1, s1) = start_counts[name], end_counts[name]
+        overruns += o1 - o0
+        skipped += s1 - s0
+        counts.append(c1 - c0)
     expected = [
         float(np.float32(engine.evaluate({"Temp": t, "Pressure": p})["Valve"]))
         for t, p in zip(temps, pressures, strict=True)
@@ -178,7 +186,7 @@ def run(
         "seconds": seconds,
         "priority": priority,
         "abuse": abuse,
-        "cycles_total": sum(i.task.stats.count for i in rt.instances.values()),
+        "cycles_total": sum(counts),
         "cycles_min_per_instance": min(counts),
         "cycles_expected_per_instance": seconds / period,
         "jitter_p50": percentile(jitters, 50),

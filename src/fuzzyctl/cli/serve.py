@@ -45,6 +45,13 @@ def serve(
     previous = signal.signal(signal.SIGTERM, on_signal)
     console = Console(highlight=False)
     runtime.start()
+    prio = cfg.runtime.realtime_priority
+    if prio > 1:
+        # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
+        # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
+        from fuzzyctl.runtime.scheduler import set_fifo
+
+        set_fifo(prio - 1)
     try:
         if runtime.api_address is not None:
             host, port = runtime.api_address

@@ -54,7 +54,8 @@ class Runtime:
             log_path = (config.state_dir / name) if name else None
         else:
             log_path = Path(event_log) if event_log is not None else None
-        self.events = EventLog(log_path)
+        prio = config.runtime.realtime_priority
+        self.events = EventLog(log_path, thread_setup=(lambda: set_fifo(prio - 1)) if prio > 1 else None)
         self.api_enabled = config.api.enabled if api is None else api
         self._stop = threading.Event()
         self.clock = RuntimeClock(self._stop, config.runtime.spin)

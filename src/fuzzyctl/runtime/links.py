@@ -78,16 +78,20 @@ class Link:
         self._in: dict[Point, InCell] = {}
         self._out: dict[Point, OutCell] = {}
         self._mirror: dict[Point, OutCell] = {}
+        self._lists: tuple[list[Point], list[InCell], list[Point], list[OutCell], list[Point], list[OutCell]] | None
+        self._lists = None  # the bindings as parallel lists, made at the first exchange
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
         """The cell of an input point (shared when several bindings read the same point)."""
+        self._lists = None
         return self._in.setdefault(point, InCell())
 
     def output(self, point: Point) -> OutCell:
         """The cell of an output point, written every exchange."""
         if point in self._out or point in self._mirror:
             raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        self._lists = None
         return self._out.setdefault(point, OutCell())
 
     def mirror(self, point: Point) -> OutCell:
@@ -95,6 +99,7 @@ class Link:
         value a client writes is not overwritten before the runtime reads it)."""
         if point in self._out or point in self._mirror:
             raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        self._lists = None
         return self._mirror.setdefault(point, OutCell())
 
     @property
@@ -114,23 +119,30 @@ class Link:
     async def exchange(self) -> None:
         """Read every input point, write every output (and changed mirror)."""
         t0 = time.perf_counter()
-        if self._in:
-            points = list(self._in)
-            values = await self.connector.read(points)
+        lists = self._lists
+        if lists is None:
+            # Points hash slowly (pydantic models): walk parallel lists, not the dicts.
+            lists = self._lists = (
+                list(self._in), list(self._in.values()),
+                list(self._out), list(self._out.values()),
+                list(self._mirror), list(self._mirror.values()),
+            )  # fmt: skip
+        in_points, in_cells, out_points_all, out_cells, mirror_points, mirror_cells = lists
+        if in_points:
+            values = await self.connector.read(in_points)
             now = time.perf_counter()
-            for p, v in zip(points, values, strict=True):
-                in_cell = self._in[p]
+            for in_cell, v in zip(in_cells, values, strict=True):
                 in_cell.value, in_cell.stamp = v, now
         out_points: list[Point] = []
         out_values: list[float] = []
         sent: list[OutCell] = []
-        for p, out_cell in self._out.items():
+        for p, out_cell in zip(out_points_all, out_cells, strict=True):
             value = out_cell.value
             if value is not None:
                 out_points.append(p)
                 out_values.append(value)
                 sent.append(out_cell)
-        for p, out_cell in self._mirror.items():
+        for p, out_cell in zip(mirror_points, mirror_cells, strict=True):
             value = out_cell.value
             if value is not None and value != out_cell.sent:
                 out_points.append(p)
