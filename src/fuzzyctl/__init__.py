@@ -4,7 +4,7 @@ The public entry points are :func:`fuzzyctl.load` and :func:`fuzzyctl.compile`; 
 ``fuzzyctl.api``.
 """
 
-from fuzzyctl.api import compile, load
+from fuzzyctl.api import compile, load, plot_terms
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "compile", "load"]
+__all__ = ["__version__", "compile", "load", "plot_terms"]
