@@ -103,7 +103,7 @@ class CycleContext(NamedTuple):
     """What a block is told when the task calls it (immutable; a named tuple because the
     runtime makes ten thousand a second, and a frozen dataclass costs 5x as much)."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # the field hides tuple.index, which nobody calls here
     period: float
     scheduled: float
     start: float
@@ -117,7 +117,7 @@ class CycleContext(NamedTuple):
 class CycleRecord(NamedTuple):
     """Timing of one cycle.  ``skipped`` counts the releases lost before the next one."""
 
-    index: int
+    index: int  # type: ignore[assignment]  # (as in CycleContext)
     scheduled: float
     start: float
     end: float

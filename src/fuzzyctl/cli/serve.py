@@ -32,11 +32,20 @@ def serve(
     from fuzzyctl.runtime import Runtime, load_config
 
     cfg = load_config(config)
-    runtime = Runtime(cfg, api=api and cfg.api.enabled)
     if check:
+        from fuzzyctl.runtime import capacity
+
+        runtime = Runtime(cfg, api=False, event_log=None)
+        est = capacity.estimate(runtime)
         runtime.stop()
-        typer.echo(f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s)")
+        typer.echo(
+            f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s); "
+            f"the cycles need about {est.load:.0%} of one core (capacity {capacity.CAPACITY:.0%})"
+        )
+        for text in capacity.warnings(runtime, est):
+            err_console.print(f"warning: {text}", markup=False)
         return
+    runtime = Runtime(cfg, api=api and cfg.api.enabled)
     stop = threading.Event()
 
     def on_signal(_signum: int, _frame: Any) -> None:

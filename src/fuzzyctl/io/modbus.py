@@ -367,7 +367,8 @@ def _register_lists(server: Any, count: int) -> dict[str, list[int]] | None:
         return None
     out: dict[str, list[int]] = {}
     for name, block in tables.items():
-        if not (isinstance(block, tuple) and len(block) == 4 and block[0] == 0 and isinstance(block[2], list)):
+        ok = isinstance(block, tuple) and len(block) == 4 and block[0] == 0
+        if not ok or not isinstance(block[2], list):
             return None
         if len(block[2]) < count:
             return None

@@ -54,7 +54,11 @@ class EventLog:
     """Thread-safe, gap-free event log with an optional JSON-lines file."""
 
     def __init__(
-        self, path: Path | None = None, *, keep: int = 100_000, thread_setup: Callable[[], object] | None = None
+        self,
+        path: Path | None = None,
+        *,
+        keep: int = 100_000,
+        thread_setup: Callable[[], object] | None = None,
     ) -> None:
         self._lock = threading.Lock()
         self._events: deque[Event] = deque(maxlen=keep)

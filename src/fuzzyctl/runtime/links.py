@@ -47,6 +47,9 @@ class OutCell:
         self.sent: float | None = None
 
 
+_Lists = tuple[list[Point], list[InCell], list[Point], list[OutCell], list[Point], list[OutCell]]
+
+
 @dataclass
 class LinkCounters:
     exchanges: int = 0
@@ -78,8 +81,7 @@ class Link:
         self._in: dict[Point, InCell] = {}
         self._out: dict[Point, OutCell] = {}
         self._mirror: dict[Point, OutCell] = {}
-        self._lists: tuple[list[Point], list[InCell], list[Point], list[OutCell], list[Point], list[OutCell]] | None
-        self._lists = None  # the bindings as parallel lists, made at the first exchange
+        self._lists: _Lists | None = None  # the bindings as parallel lists, made at the first exchange
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
