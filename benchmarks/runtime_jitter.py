@@ -8,6 +8,7 @@ times and overruns; checks that every instance cycled and computed the engine's 
     python benchmarks/runtime_jitter.py --instances 50 --period 0.005 --seconds 10
     python benchmarks/runtime_jitter.py --priority 50 --abuse anonymous   # 500 MB PUTs meanwhile
     python benchmarks/runtime_jitter.py --table 50,100,200 --seconds 20   # docs/runtime.md's table
+    python benchmarks/runtime_jitter.py --floor --priority 50 --seconds 10 # the machine alone
 
 No assertion on time: the numbers depend on the machine (and on what else runs on it).
 """
@@ -212,6 +213,30 @@ def run(
     }
 
 
+def floor(seconds: float, priority: int, step: float = 0.001) -> dict[str, Any]:
+    """What the machine gives any thread: a bare thread (no interpreter lock shared with
+    anything) waking every ``step`` at ``priority`` (SCHED_FIFO; 0 normal).  The runtime's
+    jitter cannot be better than this, whatever it does."""
+    if priority:
+        os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(priority))
+    late: list[float] = []
+    due = time.perf_counter()
+    end = due + seconds
+    while due < end:
+        due += step
+        wait = due - time.perf_counter()
+        if wait > 0:
+            time.sleep(wait)
+        late.append(time.perf_counter() - due)
+    return {
+        "floor_p50": percentile(late, 50),
+        "floor_p99": percentile(late, 99),
+        "floor_max": max(late),
+        "priority": priority,
+        "loadavg": os.getloadavg()[0],
+    }
+
+
 def report(r: dict[str, Any]) -> str:
     ms = 1e3
     prio = f", SCHED_FIFO {r['priority']}" if r["priority"] else ", normal priority"
@@ -243,18 +268,21 @@ def table(instances: list[int], period: float, seconds: float, priority: int) ->
     rows = []
     for prio in (0, priority):
         for n in instances:
+            # The machine's own floor just before, in a process of its own (10 s).
+            cmd = [sys.executable, __file__, "--floor", "--seconds", "10", "--priority", str(prio)]
+            bare = json.loads(subprocess.run(cmd, capture_output=True, text=True, check=True).stdout)
             cmd = [sys.executable, __file__, "--instances", str(n), "--period", str(period)]
             cmd += ["--seconds", str(seconds), "--priority", str(prio), "--json"]
             out = subprocess.run(cmd, capture_output=True, text=True, check=True).stdout
-            r = json.loads(out.strip().splitlines()[-1])
+            r = json.loads(out.strip().splitlines()[-1]) | bare
             print(report(r), file=sys.stderr, flush=True)
             rows.append(r)
     ms = 1e3
     print(
         "| instances | priority | load avg | jitter p50 | p99 | p99.9 | max | overruns | skipped "
-        "| cycles run / due | cycle thread CPU | outputs right |"
+        "| cycles run / due | cycle thread CPU | outputs right | bare thread p99 / max |"
     )
-    print("|---|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for r in rows:
         print(
             f"| {r['instances']} | {'FIFO ' + str(r['priority']) if r['priority'] else 'normal'} "
@@ -262,7 +290,8 @@ def table(instances: list[int], period: float, seconds: float, priority: int) ->
             f"| **{r['jitter_p99'] * ms:.3f} ms** "
             f"| {r['jitter_p999'] * ms:.3f} ms | {r['jitter_max'] * ms:.3f} ms | **{r['overruns']}** "
             f"| {r['skipped']} | {r['cycles_per_second'] / r['cycles_per_second_due'] * 100:.1f} % "
-            f"| {r['cpu_load_cycles'] * 100:.0f} % | {r['instances'] - r['outputs_wrong']}/{r['instances']} |"
+            f"| {r['cpu_load_cycles'] * 100:.0f} % | {r['instances'] - r['outputs_wrong']}/{r['instances']} "
+            f"| {r['floor_p99'] * ms:.3f} / {r['floor_max'] * ms:.1f} ms |"
         )
     return 0
 
@@ -286,8 +315,12 @@ def main(argv: list[str] | None = None) -> int:
         metavar="N,N,..",
         help="run these instance counts at normal priority and at --priority (default 50), print a table",
     )
+    ap.add_argument("--floor", action="store_true", help="only the machine's floor: a bare thread's lateness")
     ap.add_argument("--json", action="store_true")
     args = ap.parse_args(argv)
+    if args.floor:
+        print(json.dumps(floor(args.seconds, args.priority)))
+        return 0
     if args.table:
         return table(args.table, args.period, args.seconds, args.priority or 50)
     r = run(args.instances, args.period, args.seconds, args.priority, args.abuse)
