@@ -40,7 +40,7 @@ def serve(
         runtime.stop()
         typer.echo(
             f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s); "
-            f"the cycles need about {est.load:.0%} of one core (capacity {capacity.CAPACITY:.0%})"
+            f"the cycles need about {est.load:.1%} of one core (capacity {capacity.CAPACITY:.0%})"
         )
         for text in capacity.warnings(runtime, est):
             err_console.print(f"warning: {text}", markup=False)

@@ -66,11 +66,18 @@ class ApiProcess:
     def start(self, wait: bool = True) -> None:
         """Start the process; with ``wait``, until it serves (FuzzyctlError if it cannot)."""
         self._spawn()
-        if wait and not self._ready.wait(START_TIMEOUT):
-            self.stop()
-            raise FuzzyctlError(f"the API process did not start within {START_TIMEOUT:g} s")
-        if wait and self.proc is not None and self.proc.poll() is not None:
-            raise FuzzyctlError(f"the API process ended at start (exit code {self.proc.returncode})")
+        if wait:
+            self.wait_ready()
+
+    def wait_ready(self) -> None:
+        """Until the process serves; FuzzyctlError when it does not within START_TIMEOUT."""
+        deadline = time.monotonic() + START_TIMEOUT
+        while not self._ready.wait(0.1):
+            proc = self.proc
+            if proc is not None and proc.poll() is not None and self.restarts == 0:
+                raise FuzzyctlError(f"the API process ended at start (exit code {proc.returncode})")
+            if time.monotonic() > deadline:
+                raise FuzzyctlError(f"the API process did not start within {START_TIMEOUT:g} s")
 
     def _spawn(self) -> None:
         ours, theirs = socket.socketpair(socket.AF_UNIX, socket.SOCK_STREAM)

@@ -6,11 +6,12 @@ included) a few hundred times in a tight loop, in CPU time (so that a busy machi
 inflate it), and adds up ``cycle time / period`` over the instances: the fraction of one
 core the cycles need on *this* machine.  The capacity is
 the same estimate for the largest configuration of ``benchmarks/runtime_jitter.py`` that
-kept the jitter p99 under 2 ms with no overrun at SCHED_FIFO (docs/runtime.md, "Timing"):
-both are measured in the same units on the same kind of machine, so the comparison holds
-on a faster or slower one.  In a running runtime a cycle costs about twice the tight-loop
-time (caches emptied by other work between releases), and the thread also sleeps and wakes:
-that is in the calibration, not in the estimate.
+kept the jitter p99 under 2 ms at SCHED_FIFO (docs/runtime.md, "Timing"):
+both are fractions of one core measured the same way, so the comparison carries over,
+roughly, to a faster or slower machine (not its own stalls: see the docs).  In a running
+runtime a cycle costs about twice the tight-loop time (caches emptied by other work
+between releases), and the thread also sleeps and wakes: that is in the calibration, not
+in the estimate.
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ if TYPE_CHECKING:
 __all__ = ["CAPACITY", "CapacityEstimate", "estimate", "warnings"]
 
 CAPACITY = 0.30
-"""Estimated load (fraction of one core, as :func:`estimate` computes it) at which 100
-FPLTEST instances at 10 ms kept p99 < 2 ms with no overrun under SCHED_FIFO on the
-project's 2-core machine (docs/runtime.md, "Timing")."""
+"""The estimated load (fraction of one core, as :func:`estimate` computes it) up to which
+the jitter p99 stayed under 2 ms at SCHED_FIFO on the project's loaded 2-core machine:
+50 FPLTEST instances at 10 ms (24 %) did in every run, 100 (47 %) only in calm minutes
+(docs/runtime.md, "Timing"); 30 % is about 60 instances."""
 
 BUDGET = 10_000  # cycles timed per repetition in all (about a second at most)
 
@@ -73,8 +75,8 @@ def warnings(runtime: Runtime, est: CapacityEstimate) -> list[str]:
     out = []
     if est.load > CAPACITY:
         out.append(
-            f"the cycles need about {est.load:.0%} of one core (estimated); the runtime was measured "
-            f"to hold {CAPACITY:.0%} with jitter p99 < 2 ms and no overrun (docs/runtime.md, Timing): "
+            f"the cycles need about {est.load:.1%} of one core (estimated); the runtime was measured "
+            f"to keep jitter p99 < 2 ms up to {CAPACITY:.0%} (docs/runtime.md, Timing): "
             "expect more jitter and overruns; use fewer instances per runtime or longer periods"
         )
     if not runtime.config.runtime.realtime_priority and est.load > 0.05:

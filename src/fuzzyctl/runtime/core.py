@@ -241,6 +241,8 @@ class Runtime:
             sock.setblocking(False)
             self._api_socket = sock
             self.api_address = sock.getsockname()[:2]
+            # Started first: its imports take seconds, they overlap with the rest of the start.
+            self._start_api(sock)
         self.started = True
         self.events.emit(
             "runtime-start",
@@ -256,8 +258,12 @@ class Runtime:
         self._io_ready.wait(30)
         if self._io_error is not None:
             raise FuzzyctlError(f"the I/O loop failed to start: {self._io_error}")
-        if self._api_socket is not None:
-            self._start_api(self._api_socket)
+        if self.api_process is not None:
+            try:
+                self.api_process.wait_ready()
+            except BaseException:
+                self.stop()
+                raise
         sys.setswitchinterval(self.config.runtime.switch_interval)
         gc.collect()
         gc.freeze()  # startup objects out of the collector's way: shorter pauses in the cycle thread
@@ -292,11 +298,7 @@ class Runtime:
         self.api_process = ApiProcess(
             Service(self), sock, settings, emit=self.events.emit, thread_setup=below_cycles
         )
-        try:
-            self.api_process.start()
-        except BaseException:
-            self.stop()
-            raise
+        self.api_process.start(wait=False)
 
     def _scheduler_started(self, problem: str | None) -> None:
         if problem is not None:
