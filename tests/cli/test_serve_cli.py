@@ -82,7 +82,7 @@ def test_serve_check_warns_when_the_cycles_exceed_the_measured_capacity(
     assert code == 0 and load > CAPACITY
     assert "warning: the cycles need about" in err and "expect more jitter and overruns" in err
     assert "realtime_priority is 0" not in err
-    code, out, err = run(["serve", str(config(40, 0.001, 0)), "--check"], capsys)
+    code, out, err = run(["serve", str(config(5, 0.001, 0)), "--check"], capsys)
     assert "realtime_priority is 0" in err
     code, out, err = run(["serve", str(config(1, 0.1, 50)), "--check"], capsys)
     assert code == 0 and "OK: 1 instance(s)" in out and not err
