@@ -403,7 +403,16 @@ class Runtime:
         try:
             kb = self.prepare_download(name, text, format, origin)
         except FuzzyctlError as exc:
-            detail = exc.render() if isinstance(exc, DiagnosticError) else str(exc)
+            if isinstance(exc, DiagnosticError):
+                # Places and messages, no source excerpts: rendering those splits the whole
+                # (possibly megabytes of) text once per diagnostic, holding the interpreter.
+                shown = [
+                    f"{d.location()}: {d.severity.value}: {d.message[:300]}" for d in exc.diagnostics[:20]
+                ]
+                more = len(exc.diagnostics) - len(shown)
+                detail = "\n".join(shown + ([f"... {more} more"] if more > 0 else []))
+            else:
+                detail = str(exc)
             self.events.emit(
                 "download-refused",
                 f"{name}: download refused: {detail.splitlines()[0] if detail else exc}",

@@ -156,6 +156,7 @@ class RpcServer:
             self._on_closed(problem)
 
     def _slow_loop(self) -> None:
+        self._thread_setup()  # it parses and builds while holding the lock: not preemptible either
         while (item := self._slow.get()) is not None:
             self._handle(*item)
 
