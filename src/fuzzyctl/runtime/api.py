@@ -285,6 +285,22 @@ def _errors(exc: RequestValidationError) -> list[dict[str, Any]]:
     ]
 
 
+# The front door has checked the token already; this declares it in the OpenAPI
+# description (the lock in /api/v1/docs).
+_bearer = HTTPBearer(auto_error=False, description="the write token, or the read-only token for reading")
+
+
+def _documented(_creds: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)]) -> None:
+    return None
+
+
+Token = Annotated[None, Depends(_documented)]
+InstanceName = Annotated[
+    str, Path(description="instance name (the [instances.<name>] table)", max_length=200)
+]
+PointName = Annotated[str, Path(description="an input or output name", max_length=64)]
+
+
 def create_app(backend: Backend, settings: ApiSettings) -> Any:
     """The API (an ASGI app: FastAPI behind :class:`~fuzzyctl.webguard.Guard`)."""
     app = FastAPI(
@@ -295,19 +311,6 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
         docs_url=f"{API_PREFIX}/docs",
         redoc_url=None,
     )
-    # The front door has checked the token already; this declares it in the OpenAPI
-    # description (the lock in /api/v1/docs).
-    bearer = HTTPBearer(auto_error=False, description="the write token, or the read-only token for reading")
-
-    def documented(_creds: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]) -> None:
-        return None
-
-    Token = Annotated[None, Depends(documented)]
-    InstanceName = Annotated[
-        str, Path(description="instance name (the [instances.<name>] table)", max_length=200)
-    ]
-    PointName = Annotated[str, Path(description="an input or output name", max_length=64)]
-    live_clients = 0
 
     @app.exception_handler(RequestValidationError)
     async def _invalid_request(_request: Request, exc: RequestValidationError) -> JSONResponse:
@@ -320,8 +323,25 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
             body["diagnostics"] = exc.diagnostics
         return JSONResponse(body, status_code=exc.status)
 
-    # --- reading -------------------------------------------------------------------
+    _reading(app, backend)
+    _writing(app, backend)
+    _live(app, backend, settings)
 
+    def max_body(_method: str, path: str) -> int:
+        return settings.max_body if path.endswith("/knowledge_base") else SMALL_BODY
+
+    return Guard(
+        app,
+        hosts=settings.hosts,
+        origins=settings.origins,
+        origin_on_reads=True,
+        max_body=max_body,
+        authorize=authorizer(settings),
+        json_only=lambda path: path.startswith(API_PREFIX),
+    )
+
+
+def _reading(app: FastAPI, backend: Backend) -> None:
     @app.get(f"{API_PREFIX}/health", response_model=Health, tags=["read"])
     async def health() -> Any:
         """Liveness: the runtime answers (no token needed)."""
@@ -370,8 +390,8 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
         """The event log, oldest first; page with ``after`` = the last seq you have."""
         return await backend.call("events", after=after, limit=limit, kinds=kind)
 
-    # --- writing -------------------------------------------------------------------
 
+def _writing(app: FastAPI, backend: Backend) -> None:
     @app.put(f"{API_PREFIX}/instances/{{name}}/start_stop", tags=["write"])
     async def start_stop(name: InstanceName, body: StartStopBody, _: Token) -> Any:
         """Siemens: START_STOP = 16#FFFF or 0.  XFUZ: START = 1 or 0."""
@@ -416,7 +436,9 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
         stop, transfer, restart; XFUZ: REFRESH), atomically between two cycles."""
         return await backend.call("download", name=name, text=body.text, format=body.format)
 
-    # --- live ----------------------------------------------------------------------
+
+def _live(app: FastAPI, backend: Backend, settings: ApiSettings) -> None:
+    clients = [0]  # WebSocket clients now
 
     @app.websocket(f"{API_PREFIX}/live")
     async def live(
@@ -430,15 +452,14 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
         """Pushes ``{"type": "snapshot", "time", "instances": {name: detail}, "events": [...]}``
         ``rate`` times a second (at most 20).  Messages from the client are ignored (text or
         binary); the token is the Authorization header or ``?token=``."""
-        nonlocal live_clients
-        if live_clients >= settings.live_clients_max:
+        if clients[0] >= settings.live_clients_max:
             await ws.close(code=1013)  # try again later (refused at the handshake)
             return
-        live_clients += 1
+        clients[0] += 1
         try:
             await _stream(ws, rate, instances, events)
         finally:
-            live_clients -= 1
+            clients[0] -= 1
 
     async def _stream(ws: WebSocket, rate: float, instances: str | None, events: bool) -> None:
         wanted = [n for n in (instances or "").split(",") if n]
@@ -479,16 +500,3 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
                 receiver.cancel()
                 with contextlib.suppress(BaseException):
                     await receiver
-
-    def max_body(method: str, path: str) -> int:
-        return settings.max_body if path.endswith("/knowledge_base") else SMALL_BODY
-
-    return Guard(
-        app,
-        hosts=settings.hosts,
-        origins=settings.origins,
-        origin_on_reads=True,
-        max_body=max_body,
-        authorize=authorizer(settings),
-        json_only=lambda path: path.startswith(API_PREFIX),
-    )
