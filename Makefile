@@ -50,8 +50,9 @@ lint: $(VENV)/.installed-dev
 typecheck: $(VENV)/.installed-dev
 	$(BIN)/mypy
 
+# both cores (pytest-xdist); the last line says which extra suites (tests/extras.py) ran
 pytest: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
-	$(BIN)/pytest
+	$(BIN)/pytest -n auto $(PYTEST_ARGS)
 
 test: lint typecheck pytest
 

@@ -23,7 +23,7 @@ import numpy.typing as npt
 from fuzzyctl.diagnostics import InputError
 
 #: Bytes of CSV per batch: large enough for throughput, small enough for bounded memory.
-BLOCK_BYTES = 4 << 20
+BLOCK_BYTES = 1 << 20
 PARQUET_ROWS = 131_072
 FORMATS = ("csv", "parquet", "jsonl")
 

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl.cli.app import app
+from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
     list[str] | None,
@@ -108,8 +109,24 @@ def eval_(
     ] = "nan",
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
+    dask_in: DaskOpt = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
 ) -> None:
-    """Evaluate a controller once (--set) or on every row of a data file (--data)."""
+    """Evaluate a controller once (--set), on every row of a data file (--data), or on a
+    directory/glob of Parquet/CSV files on Dask (--dask DATA -o DIR)."""
+    if dask_in is not None:
+        if set_ or data is not None:
+            raise typer.BadParameter("use --dask alone, without --set or --data", param_hint="--dask")
+        from fuzzyctl.cli import eval_dask
+
+        out_dir = Path(output) if output not in (None, "-") else None
+        eval_dask.run(
+            file, dask_in, out_dir, block=block, compat=compat, workers=workers, scheduler=scheduler
+        )
+        return
+    if workers is not None or scheduler is not None:
+        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
     if data is not None and set_:
         raise typer.BadParameter("use either --set or --data", param_hint="--set")
     if data is None and output is not None:

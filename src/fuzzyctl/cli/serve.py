@@ -30,21 +30,28 @@ def serve(
     from rich.console import Console
 
     from fuzzyctl.runtime import Runtime, load_config
+    from fuzzyctl.runtime.config import ConfigError
 
-    cfg = load_config(config)
     if check:
+        from fuzzyctl.runtime.core import check_config
+
+        checked, problems = check_config(config)
+        if problems:
+            raise ConfigError(problems)
+        assert checked is not None
         from fuzzyctl.runtime import capacity
 
-        runtime = Runtime(cfg, api=False, event_log=None)
-        est = capacity.estimate(runtime)
+        runtime = Runtime(checked, api=False, event_log=None)
+        est = capacity.estimate(runtime)  # times the cycles: a runtime that is then dropped
         runtime.stop()
         typer.echo(
-            f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s); "
+            f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s); "
             f"the cycles need about {est.load:.1%} of one core (capacity {capacity.CAPACITY:.0%})"
         )
         for text in capacity.warnings(runtime, est):
             err_console.print(f"warning: {text}", markup=False)
         return
+    cfg = load_config(config)
     runtime = Runtime(cfg, api=api and cfg.api.enabled)
     stop = threading.Event()
 
