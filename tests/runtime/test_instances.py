@@ -343,3 +343,33 @@ T_OFB = {{ connection = "mb", address = 5, type = "int16" }}
     finally:
         rt.stop()
     assert not any(e.kind == "error" for e in rt.events.since(0))
+
+
+def test_an_internal_error_in_one_instance_puts_it_safe_and_the_others_run_on(tmp_path: Path) -> None:
+    two = SIEMENS_SERVER + f"""
+[instances.other]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+"""
+    rt = make_runtime(tmp_path, two)
+    valve, other = rt.instances["valve"], rt.instances["other"]
+
+    def broken(period: float) -> None:
+        raise ZeroDivisionError("a bug")
+
+    try:
+        rt.start()
+        mb = master(rt)
+        mb.write_registers(0, [*float32_to_registers(9.0), *float32_to_registers(65.0)])
+        wait_until(lambda: valve.snapshot()["state"] == "run", 10)
+        valve.adapter.execute = broken  # type: ignore[method-assign]
+        wait_until(lambda: valve.snapshot()["state"] == "safe", 10)
+        r = mb.read_holding_registers(10, count=3).registers
+        assert float32_from_registers(r[0], r[1]) == 12.5 and r[2] == INFO_BLOCK_FAULT
+        assert "internal error: ZeroDivisionError: a bug" in valve.snapshot()["error"]
+        cycles = other.task.stats.count
+        wait_until(lambda: other.task.stats.count > cycles + 10, 10)  # the cycle thread lives on
+        assert rt.scheduler.alive and other.snapshot()["state"] == "run"
+        mb.close()
+    finally:
+        rt.stop()

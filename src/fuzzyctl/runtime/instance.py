@@ -216,7 +216,13 @@ class Instance:
             try:
                 self._cycle(ctx.start, ctx.period)
             except Exception as exc:  # a bug in one instance must not stop the others
-                self._block_fault(f"internal error: {type(exc).__name__}: {exc}", ctx.start)
+                try:
+                    self._block_fault(f"internal error: {type(exc).__name__}: {exc}", ctx.start)
+                except Exception:  # not even the status can be read: the safe values at least
+                    for o in self.outputs:
+                        if o.safe is not None and o.key not in STATUS_KEYS:
+                            for cell in o.cells:
+                                cell.value = o.safe
 
     def _cycle(self, now: float, period: float) -> None:
         adapter = self.adapter
