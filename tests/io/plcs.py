@@ -64,7 +64,8 @@ class ModbusPLC:
             await self._server.serve_forever(background=True)
             return int(self._server.transport.sockets[0].getsockname()[1])
 
-        self.port = self._lt.run(go())
+        # Building a server (asyncua: its whole standard address space) is slow on a loaded machine.
+        self.port = self._lt.run(go(), timeout=60.0)
 
     def stop(self) -> None:
         if self._server is not None:
@@ -168,7 +169,8 @@ class OpcUaPLC:
             self._server = server
             return int(server.bserver._server.sockets[0].getsockname()[1])
 
-        self.port = self._lt.run(go())
+        # Building a server (asyncua: its whole standard address space) is slow on a loaded machine.
+        self.port = self._lt.run(go(), timeout=60.0)
 
     def stop(self) -> None:
         if self._server is not None:
