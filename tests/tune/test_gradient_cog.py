@@ -22,9 +22,13 @@ from fuzzyctl.tune.space import Space, build_space
 # excluded entries (a kink of the engine's output within the step) per case, filled by the
 # test and reported in docs/tune.md
 EXCLUDED: dict[int, float] = {}
+#: of which the closed form and the difference estimate disagree
+DISAGREE: dict[int, float] = {}
 
 
-def _system(rng: np.random.Generator, and_op: str, act: str, accu: str, n_rules: int = 12) -> str:
+def _system(
+    rng: np.random.Generator, and_op: str, act: str, accu: str, n_rules: int = 12, method: str = "CoG"
+) -> str:
     c = np.sort(rng.uniform(-10, 10, 5))
     e = np.sort(rng.uniform(-5, 5, 4))
     p = np.sort(rng.uniform(-18, 18, 7))
@@ -56,7 +60,7 @@ DEFUZZIFY z
   TERM o2 := TRAPE {f[1]} {f[2]} {f[3]} {f[5]};
   TERM o3 := ({f[3]}, 0) ({f[4]}, 0.7) ({f[5]}, 0.4) ({f[6]}, 0);
   TERM o4 := ({f[5]}, 0) ({f[6]}, 1);
-  METHOD : CoG;
+  METHOD : {method};
   ACCU : {accu};
   DEFAULT := 0;
 END_DEFUZZIFY
@@ -70,12 +74,14 @@ END_FUNCTION_BLOCK
 
 
 CASES = [
-    (0, "MIN", "MIN", "MAX", "iec"),
-    (1, "PROD", "PROD", "SUM", "iec"),
-    (2, "MIN", "MIN", "BSUM", "iec"),
-    (3, "PROD", "MIN", "MAX", "jfuzzylogic"),  # WITH before activation
-    (4, "MIN", "PROD", "MAX", "iec"),
-    (5, "PROD", "MIN", "SUM", "iec"),
+    (0, "MIN", "MIN", "MAX", "iec", "CoG"),
+    (1, "PROD", "PROD", "SUM", "iec", "CoG"),
+    (2, "MIN", "MIN", "BSUM", "iec", "CoG"),
+    (3, "PROD", "MIN", "MAX", "jfuzzylogic", "CoG"),  # WITH before activation
+    (4, "MIN", "PROD", "MAX", "iec", "CoG"),
+    (5, "PROD", "MIN", "SUM", "iec", "CoG"),
+    (6, "MIN", "MIN", "MAX", "iec", "CoA"),
+    (7, "PROD", "PROD", "BSUM", "iec", "CoA"),
 ]
 
 
@@ -90,12 +96,12 @@ def _jacobian(
     return J
 
 
-@pytest.mark.parametrize(("seed", "and_op", "act", "accu", "compat"), CASES)
-def test_cog_closed_form_matches_engine_and_finite_differences(
-    seed: int, and_op: str, act: str, accu: str, compat: str
+@pytest.mark.parametrize(("seed", "and_op", "act", "accu", "compat", "method"), CASES)
+def test_area_closed_form_matches_engine_and_finite_differences(
+    seed: int, and_op: str, act: str, accu: str, compat: str, method: str
 ) -> None:
     rng = np.random.default_rng(100 + seed)
-    fb = load_text(_system(rng, and_op, act, accu)).raise_for_errors().main
+    fb = load_text(_system(rng, and_op, act, accu, method=method)).raise_for_errors().main
     space = build_space(fb, "all,weights")
     u = np.clip(space.initial() + rng.normal(0, 0.02, space.size), 0.0, 1.0)
     cand = space.decode(u)
@@ -123,24 +129,34 @@ def test_cog_closed_form_matches_engine_and_finite_differences(
     smap = gradient.slot_map(cand, plan)
     assert smap is not None
     J = _jacobian(space, smap, grad, u, n)
+    # slopes on the two steps next to u (inside the box: u-h..u..u+h; at a bound the two
+    # steps inside it), the derivative at u extrapolated to second order from them
     h = 1e-6
-    fwd, bwd = np.empty_like(J), np.empty_like(J)
+    s1, s2, est = np.empty_like(J), np.empty_like(J), np.empty_like(J)
     for j in range(space.size):
-        up, um = u.copy(), u.copy()
-        up[j] = min(1.0, u[j] + h)
-        um[j] = max(0.0, u[j] - h)
-        yp, ym = engine(space.decode(up)), engine(space.decode(um))
-        fwd[:, j] = (yp - y0) / (up[j] - u[j]) if up[j] > u[j] else np.nan
-        bwd[:, j] = (y0 - ym) / (u[j] - um[j]) if um[j] < u[j] else np.nan
-    central = np.where(np.isnan(fwd), bwd, np.where(np.isnan(bwd), fwd, 0.5 * (fwd + bwd)))
+        side = -1.0 if u[j] + h > 1.0 else (1.0 if u[j] - h < 0.0 else 0.0)
+        steps = [-1.0, 0.0, 1.0] if side == 0.0 else [side * k for k in (0.0, 1.0, 2.0)]
+        ys = []
+        for k in steps:
+            v = u.copy()
+            v[j] = u[j] + k * h
+            ys.append(y0 if k == 0.0 else engine(space.decode(v)))
+        if side < 0.0:
+            ys, steps = ys[::-1], steps[::-1]
+        a, b = (ys[1] - ys[0]) / h, (ys[2] - ys[1]) / h
+        s1[:, j], s2[:, j] = a, b
+        at = steps.index(0.0)
+        est[:, j] = 0.5 * (a + b) if at == 1 else (a - 0.5 * (b - a) if at == 0 else b + 0.5 * (b - a))
 
     def tol(d: np.ndarray) -> np.ndarray:
         return 1e-4 * np.maximum(1.0, np.abs(d))
 
-    # a kink of the engine's output within the step: forward and backward differ
-    kink = np.abs(fwd - bwd) > tol(central)
-    bad = (np.abs(J - central) > tol(central)) & ~kink
+    # a kink of the engine's output within the steps: the two slopes differ
+    kink = np.abs(s2 - s1) > tol(est)
+    bad = (np.abs(J - est) > tol(est)) & ~kink
     EXCLUDED[seed] = float(kink.mean())
+    DISAGREE[seed] = float((kink & (np.abs(J - est) > tol(est))).mean())
+    assert DISAGREE[seed] < 0.002  # even at the kinks the two mostly agree
     assert not bad.any(), f"{bad.sum()} of {bad.size} derivatives differ outside kinks"
     assert kink.mean() < 0.02, f"{kink.mean():.2%} of the entries are at kinks"
     # every kind of parameter has a nonzero derivative somewhere: output points, WITH, inputs
@@ -154,7 +170,7 @@ def test_where_the_cog_closed_form_does_not_hold() -> None:
     rng = np.random.default_rng(7)
     text = _system(rng, "MIN", "MIN", "MAX")
     for old, new, reason in [
-        ("METHOD : CoG;", "METHOD : CoA;", "COA"),
+        ("METHOD : CoG;", "METHOD : LM;", "LM"),
         ("ACCU : MAX;", "ACCU : PROBOR;", "PROBOR"),
         (re.search(r"TERM o4 := \(\S+, 0\)", text)[0], "", "vertical edge"),  # type: ignore[index]
         ("TERM o1 := TRIAN", "TERM o1 := GAUSS 0 3; TERM o9 := TRIAN", "shape gaussian"),
@@ -168,9 +184,10 @@ def test_where_the_cog_closed_form_does_not_hold() -> None:
         assert why is not None and reason in why, (reason, why)
 
 
-def test_tuning_a_mamdani_cog_system_uses_the_closed_form() -> None:
+@pytest.mark.parametrize("method", ["CoG", "CoA"])
+def test_tuning_a_mamdani_system_uses_the_closed_form(method: str) -> None:
     rng = np.random.default_rng(11)
-    truth = load_text(_system(rng, "MIN", "MIN", "MAX", n_rules=9)).raise_for_errors().main
+    truth = load_text(_system(rng, "MIN", "MIN", "MAX", n_rules=9, method=method)).raise_for_errors().main
     x, y = rng.uniform(-10, 10, 300), rng.uniform(-5, 5, 300)
     z = fuzzyctl.compile(truth).evaluate_batch({"x": x, "y": y})["z"]
     space = build_space(truth, "z")

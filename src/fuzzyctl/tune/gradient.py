@@ -8,8 +8,8 @@ maximal in every MAX accumulation) the output of a system with
 * conditions that are ANDs (MIN or PROD) of ``variable IS term``,
 * singleton outputs under CoGS (accumulation MAX, SUM or BSUM), Takagi-Sugeno outputs
   (constant, linear or singleton terms) under WTAVER / WTSUM, or Mamdani outputs with
-  points/triangle/trapezoid terms under COG (activation MIN or PROD, accumulation MAX, SUM
-  or BSUM: :mod:`fuzzyctl.tune.gradient_cog`),
+  points/triangle/trapezoid terms under COG or COA (activation MIN or PROD, accumulation
+  MAX, SUM or BSUM: :mod:`fuzzyctl.tune.gradient_cog`),
 
 is a rational function of the parameters, and its gradient follows by the chain rule:
 
@@ -22,7 +22,7 @@ is a rational function of the parameters, and its gradient follows by the chain 
 
 Where it does not hold (:func:`unsupported` says why): on the boundaries between pieces
 (a sample exactly on a breakpoint, ties in MIN/MAX: a set of measure zero, where the
-one-sided derivative is used), for Mamdani outputs by COA, LM, RM, MOM or with PROBOR/NSUM
+one-sided derivative is used), for Mamdani outputs by LM, RM, MOM or with PROBOR/NSUM
 or smooth terms, for OR, NOT, hedges,
 chained rule blocks, other norms, fuzzylite's rule activation methods and firing
 threshold, and for other shapes.  There the tuner falls back to finite differences of the
@@ -316,8 +316,8 @@ def _clamped(op: OutputPlan, y: Arr, grad: Grad) -> tuple[Arr, Grad]:
 
 
 def _mamdani(oi: int, op: OutputPlan, plan: Plan, fired: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, Grad]:
-    """COG of a Mamdani output (:mod:`fuzzyctl.tune.gradient_cog`) chained with the rules'
-    degrees; NaN where the set is empty."""
+    """COG or COA of a Mamdani output (:mod:`fuzzyctl.tune.gradient_cog`) chained with the
+    rules' degrees; NaN where the set is empty."""
     weights = [float(c.weight) for c in op.contributions]  # type: ignore[arg-type]
     res = gradient_cog.cog_partials(
         op, [a for a, _g in fired], weights, plan.options.weight_before_activation, n

@@ -1,4 +1,5 @@
-"""Closed-form derivatives of a Mamdani output defuzzified by centre of gravity (COG).
+"""Closed-form derivatives of a Mamdani output defuzzified by centre of gravity (COG) or
+of area (COA).
 
 The engine integrates the accumulated set exactly (:mod:`fuzzyctl.engine.pwl`,
 :mod:`fuzzyctl.engine.batch`): on the output grid (the range cut at every term point) each
@@ -31,7 +32,15 @@ u^2 dx`` (``u`` measured from the grid interval's start) times constants.  Activ
 of one term that MAX accumulation merges (``max_k w min(a_k, mu) = w min(max_k a_k, mu)``)
 pass the derivative to the rule of largest degree.
 
-Where it does not hold (:func:`unsupported`): other methods (COA, LM, RM, MOM), PROBOR and
+COA: ``x*`` with ``int_low^x* f = M0 / 2``, so ``f(x*) dx* = dM0 / 2 - int_low^x* df``,
+the same integrals up to ``x*``.
+
+A WITH weight alone moves ``f`` only where no other set ties with its set (two rules of
+equal degree clipping two terms at one level, merged sets below the second largest
+degree): there the derivative from below is given, the direction a weight at its bound 1
+can move.
+
+Where it does not hold (:func:`unsupported`): other methods (LM, RM, MOM), PROBOR and
 NSUM, other shapes, vertical edges inside the range (the moving jump would add a term),
 and at a tie - a degree exactly equal to a plateau of a term (the derivative from below,
 the direction a degree of 1 can move, is given), two sets exactly equal on a whole piece.
@@ -47,6 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
+from fuzzyctl.engine.batch import _coa  # the engine's bisector: the same x* to the last bit
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
 
 Arr = npt.NDArray[np.float64]
@@ -74,8 +84,8 @@ def _term_unsupported(t: TermPlan, low: float, high: float) -> str | None:
 
 def unsupported(op: OutputPlan) -> str | None:
     """Why the closed form does not apply to the Mamdani output ``op`` (``None``: it does)."""
-    if op.method != "COG":
-        return f"{op.name}: {op.method} of a Mamdani output (closed form for COG only)"
+    if op.method not in ("COG", "COA"):
+        return f"{op.name}: {op.method} of a Mamdani output (closed form for COG and COA only)"
     accu = op.accu or "MAX"
     if accu not in ACCUS:
         return f"{op.name}: COG with ACCU {accu} (closed form for MAX, SUM, BSUM)"
@@ -295,8 +305,18 @@ class _Sums:
 
 
 def _interval(
-    j: int, op: OutputPlan, groups: list[_Group], idx: list[int], accu: str, sums: _Sums, n: int
-) -> None:
+    j: int,
+    op: OutputPlan,
+    groups: list[_Group],
+    idx: list[int],
+    accu: str,
+    sums: _Sums,
+    n: int,
+    upto: Arr | None = None,
+) -> tuple[Arr, Arr]:
+    """Add the interval's moments and their derivatives to ``sums``; with ``upto``, only the
+    integrals from the interval's start to ``upto`` (the moments of ``sums`` are then
+    meaningless).  Returns the cuts (x) and the accumulated degree there."""
     grid = op.grid
     assert grid is not None
     x0, x1 = grid.xs[j], grid.xs[j + 1]
@@ -310,6 +330,9 @@ def _interval(
     ]
     T, V = _cuts(lines, accu, n, levels)  # type: ignore[arg-type]
     U = T * dx
+    X = x0 + U
+    if upto is not None:
+        U = np.minimum(U, np.maximum(upto - x0, 0.0)[:, None])
     ua, ub = U[:, :-1], U[:, 1:]
     i0 = ub - ua
     i1 = i0 * (ua + ub) / 2.0
@@ -358,44 +381,99 @@ def _interval(
                 sums.p0[key], sums.p1[key] = np.zeros(n), np.zeros(n)
             sums.p0[key] += e0
             sums.p1[key] += x0 * e0 + e1
+    return X, V
+
+
+def _accumulate(
+    op: OutputPlan, groups: list[_Group], accu: str, n: int, upto: Arr | None = None
+) -> tuple[_Sums, list[tuple[Arr, Arr]]]:
+    grid = op.grid
+    assert grid is not None
+    z = np.zeros((len(groups), n))
+    sums = _Sums(np.zeros(n), np.zeros(n), z.copy(), z.copy(), z.copy(), z.copy(), {}, {})
+    pieces = []
+    for j in range(len(grid.xs) - 1):
+        idx = [g for g, grp in enumerate(groups) if grp.term in grid.active[j]]
+        if idx:
+            pieces.append(_interval(j, op, groups, idx, accu, sums, n, upto))
+    return sums, pieces
+
+
+def _bisector(pieces: list[tuple[Arr, Arr]]) -> tuple[Arr, Arr]:
+    """The engine's centre of area of the pieces, and the accumulated degree there."""
+    x0 = np.concatenate([X[:, :-1] for X, _V in pieces], axis=1)
+    x1 = np.concatenate([X[:, 1:] for X, _V in pieces], axis=1)
+    v0 = np.concatenate([V[:, :-1] for _X, V in pieces], axis=1)
+    v1 = np.concatenate([V[:, 1:] for _X, V in pieces], axis=1)
+    xc, _fired = _coa(x0, x1, v0, v1)
+    inside = (x0 <= xc[:, None]) & (xc[:, None] <= x1) & (x1 > x0)
+    with np.errstate(all="ignore"):
+        at = v0 + (v1 - v0) * (xc[:, None] - x0) / (x1 - x0)
+    return xc, np.where(inside, at, 0.0).max(axis=1, initial=0.0)
 
 
 def cog_partials(
     op: OutputPlan, degrees: Sequence[Arr], weights: Sequence[float], before: bool, n: int
 ) -> CogPartials:
-    """COG of the Mamdani output ``op`` (for which :func:`unsupported` is None) and its
-    partial derivatives, given each rule's degree (``degrees``, rule weight included) and
-    each contribution's WITH weight; ``before``: the weight scales the degree before
-    activation (``Options.weight_before_activation``)."""
-    grid = op.grid
-    assert grid is not None
+    """COG (or COA) of the Mamdani output ``op`` (for which :func:`unsupported` is None)
+    and its partial derivatives, given each rule's degree (``degrees``, rule weight
+    included) and each contribution's WITH weight; ``before``: the weight scales the degree
+    before activation (``Options.weight_before_activation``).
+
+    COA: ``x*`` with ``int_low^x* f = M0 / 2``, so ``f(x*) dx* = dM0 / 2 - int_low^x* df``
+    (no derivative where ``f(x*) = 0``: a gap exactly halving the area)."""
     accu = op.accu or "MAX"
     groups = _groups(op, degrees, weights, before, n)
-    G = len(groups)
-    z = np.zeros((G, n))
-    sums = _Sums(np.zeros(n), np.zeros(n), z.copy(), z.copy(), z.copy(), z.copy(), {}, {})
-    for j in range(len(grid.xs) - 1):
-        idx = [g for g, grp in enumerate(groups) if grp.term in grid.active[j]]
-        if idx:
-            _interval(j, op, groups, idx, accu, sums, n)
+    sums, pieces = _accumulate(op, groups, accu, n)
     fired = sums.m0 > 0.0
     safe = np.where(fired, sums.m0, 1.0)
-    y = sums.m1 / safe
+    if op.method == "COA" and pieces:
+        y, height = _bisector(pieces)
+        part, _p = _accumulate(op, groups, accu, n, upto=y)
+        ok = fired & (height > 0.0)
+        h = np.where(ok, height, 1.0)
 
-    def dy(d0: Arr, d1: Arr) -> Arr:
-        return np.asarray(np.where(fired, (d1 - y * d0) / safe, 0.0), dtype=np.float64)
+        def dy(full: Arr, upto: Arr) -> Arr:
+            return np.asarray(np.where(ok, (0.5 * full - upto) / h, 0.0), dtype=np.float64)
 
+        d_a, d_w = (
+            [dy(sums.a0[g], part.a0[g]) for g in range(len(groups))],
+            [dy(sums.w0[g], part.w0[g]) for g in range(len(groups))],
+        )
+        d_term = {key: dy(sums.p0[key], part.p0[key]) for key in sums.p0}
+    else:
+        y = sums.m1 / safe
+
+        def dq(d0: Arr, d1: Arr) -> Arr:
+            return np.asarray(np.where(fired, (d1 - y * d0) / safe, 0.0), dtype=np.float64)
+
+        d_a = [dq(sums.a0[g], sums.a1[g]) for g in range(len(groups))]
+        d_w = [dq(sums.w0[g], sums.w1[g]) for g in range(len(groups))]
+        d_term = {key: dq(sums.p0[key], sums.p1[key]) for key in sums.p0}
+    d_deg, d_wt = _to_contributions(op, groups, degrees, weights, d_a, d_w, n)
+    return CogPartials(np.where(fired, y, np.nan), d_deg, d_wt, d_term)
+
+
+def _to_contributions(
+    op: OutputPlan,
+    groups: list[_Group],
+    degrees: Sequence[Arr],
+    weights: Sequence[float],
+    d_a: list[Arr],
+    d_w: list[Arr],
+    n: int,
+) -> tuple[list[Arr], list[Arr]]:
+    """Derivatives of the activated sets -> of each contribution's degree and weight."""
     d_deg = [np.zeros(n) for _ in op.contributions]
-    d_w = [np.zeros(n) for _ in op.contributions]
+    d_wt = [np.zeros(n) for _ in op.contributions]
     for g, grp in enumerate(groups):
-        da, dw = dy(sums.a0[g], sums.a1[g]), dy(sums.w0[g], sums.w1[g])
+        da, dw = d_a[g], d_w[g]
         for k, ci in enumerate(grp.members):
             mask = grp.pick == k if len(grp.members) > 1 else np.ones(n, dtype=bool)
             if grp.scaled:  # a = degree * weight
                 d_deg[ci] = np.where(mask, da * weights[ci], 0.0)
-                d_w[ci] = np.where(mask, dw * degrees[op.contributions[ci].rule], 0.0)
+                d_wt[ci] = np.where(mask, dw * degrees[op.contributions[ci].rule], 0.0)
             else:
                 d_deg[ci] = np.where(mask, da, 0.0)
-                d_w[ci] = np.where(mask, dw, 0.0)
-    d_term = {key: dy(sums.p0[key], sums.p1[key]) for key in sums.p0}
-    return CogPartials(np.where(fired, y, np.nan), d_deg, d_w, d_term)
+                d_wt[ci] = np.where(mask, dw, 0.0)
+    return d_deg, d_wt
