@@ -296,7 +296,9 @@ def _selection(lines: Sequence[Line], accu: str, tm: Arr) -> tuple[list[Bool], l
 class _Sums:
     m0: Arr
     m1: Arr
-    a0: Arr  # (groups, n): dM0/da, dM1/da, dM0/dw, dM1/dw (scaled: d/da from below)
+    # (groups, n): dM0/da, dM1/da; dM0/dw, dM1/dw from below (for a scaled group, whose a is
+    # degree * weight: d/da from below, which the weight's derivative is made of)
+    a0: Arr
     a1: Arr
     w0: Arr
     w1: Arr
