@@ -275,7 +275,7 @@ class _Builder(RuleBuilder):
         xs = self.new_params(f"{op.name}_X", "OX", f"{op.name}: term points x (sorted at run time)")
         ys = self.new_params(f"{op.name}_Y", "OY", f"{op.name}: term points degree")
         points = [self.pwl_points(t, xs, ys, t.name) for t in op.terms]
-        # what MAX accumulation lets combine before integrating (engine batch._merge):
+        # what MAX accumulation lets combine before integrating (engine fastprog.merge):
         # max_k w*min(a_k, mu) = w*min(max_k a_k, mu) for one weight, and (w*a)*mu for PROD
         groups: list[Group] = []
         merged: dict[tuple[int, bool, int], Group] = {}

@@ -2,7 +2,7 @@
 of area (COA).
 
 The engine integrates the accumulated set exactly (:mod:`fuzzyctl.engine.pwl`,
-:mod:`fuzzyctl.engine.batch`): on the output grid (the range cut at every term point) each
+:mod:`fuzzyctl.engine.kernels_np`): on the output grid (the range cut at every term point) each
 term is linear; MIN activation adds a kink where a term crosses the rule's degree, MAX
 accumulation adds the crossings of activated sets, BSUM the crossings of their sum with 1.
 Between two consecutive cuts the accumulated set ``f`` is linear, and
@@ -56,7 +56,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.engine.batch import _coa  # the engine's bisector: the same x* to the last bit
+from fuzzyctl.engine.kernels_np import _coa  # the engine's bisector: the same x* to the last bit
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
 
 Arr = npt.NDArray[np.float64]
@@ -219,7 +219,7 @@ def _cuts(
     lines: Sequence[Line], accu: str, n: int, levels: Sequence[tuple[float, float, Arr]] = ()
 ) -> tuple[Arr, Arr]:
     """The cuts of one grid interval (``t`` in [0, 1], sorted per row) and the accumulated
-    degree there - the engine's candidates (:func:`fuzzyctl.engine.batch._interval`) and
+    degree there - the engine's candidates (:func:`fuzzyctl.engine.kernels_np._interval`) and
     where a term ``(L, R, level)`` of ``levels`` crosses a level."""
     zeros, ones = np.zeros(n), np.ones(n)
     cands = [zeros, ones]
