@@ -23,7 +23,7 @@ from fastapi.staticfiles import StaticFiles
 from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
 from fuzzyctl.model import Document, FunctionBlock
-from fuzzyctl.studio import analysis, online
+from fuzzyctl.studio import analysis, api_editing, online
 from fuzzyctl.studio.project import (
     PathError,
     ProjectDir,
@@ -261,7 +261,13 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         report = analysis.check_text(text)
         ranges = analysis.display_ranges(fb, settings_of(body))
         return _clean(
-            {"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()}
+            {
+                "text": text,
+                "ranges": ranges,
+                "curves": analysis.curves(fb, ranges),
+                "fcl_losses": analysis.fcl_losses(document),
+                **report.to_dict(),
+            }
         )
 
     @app.post("/api/parse")
@@ -473,5 +479,6 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
     def index() -> FileResponse:
         return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
 
+    app.include_router(api_editing.router(cache))
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     return app

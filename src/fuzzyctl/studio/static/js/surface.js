@@ -112,9 +112,10 @@ function draw() {
   const title = f.value === null || f.value === undefined ? "" : `${$("#sf-anim").value} = ${fmt(f.value)}`;
   plot($("#sf-chart"), traces, {
     scene: {
-      xaxis: { title: { text: s.x }, range: [xl, xh] },
-      yaxis: { title: { text: s.y }, range: [yl, yh] },
-      zaxis: { title: { text: s.z }, range: [zl, zh] },
+      // few ticks, kept apart from the corner where the X and Y labels would meet
+      xaxis: { title: { text: s.x }, range: [xl, xh], nticks: 6, tickfont: { size: 11 } },
+      yaxis: { title: { text: s.y }, range: [yl, yh], nticks: 6, tickfont: { size: 11 } },
+      zaxis: { title: { text: s.z }, range: [zl, zh], nticks: 6, tickfont: { size: 11 } },
       camera: camera(),
       aspectmode: "cube",
     },
@@ -149,6 +150,12 @@ async function toggleAnimation() {
   }, 250);
 }
 
+/** The angle of one rotation step: 5 to 45 degrees (manual 6.6); the speed follows. */
+function rotationStep() {
+  const v = Math.round(+$("#sf-rot-step").value || 10);
+  return Math.max(5, Math.min(45, v));
+}
+
 function toggleRotation() {
   const button = $("#sf-rotate");
   if (rotating) {
@@ -160,7 +167,7 @@ function toggleRotation() {
   button.textContent = "Stop";
   rotating = setInterval(() => {
     const slider = $("#sf-rot");
-    slider.value = (+slider.value + 10) % 360;
+    slider.value = (+slider.value + rotationStep()) % 360;
     Plotly.relayout($("#sf-chart"), { "scene.camera": camera() });
   }, 200);
 }
@@ -179,6 +186,7 @@ export function init() {
   });
   for (const id of ["#sf-rot", "#sf-elev"]) $(id).addEventListener("input", () => data && Plotly.relayout($("#sf-chart"), { "scene.camera": camera() }));
   $("#sf-rotate").addEventListener("click", toggleRotation);
+  $("#sf-rot-step").addEventListener("change", (e) => (e.target.value = rotationStep()));
   $("#sf-animate").addEventListener("click", toggleAnimation);
   $("#sf-trajectory").addEventListener("change", draw);
   on("model", () => {

@@ -54,13 +54,13 @@ export function confirmDialog(title, content, buttons) {
 }
 
 /** Fill a list with diagnostics; each item leads to the element it concerns. */
-export function fillDiagnostics(list, diagnostics) {
+export function fillDiagnostics(list, diagnostics, { onClick = goTo } = {}) {
   list.replaceChildren();
   for (const d of diagnostics) {
-    const where = d.line ? `${d.line}:${d.column}` : "";
+    const where = d.line ? `${d.line}${d.column ? ":" + d.column : ""}` : "";
     const item = el("li", { class: d.severity, tabindex: "0", title: d.element || "" }, `${d.severity}${where ? " " + where : ""}: ${d.message}`);
-    item.addEventListener("click", () => goTo(d));
-    item.addEventListener("keydown", (e) => e.key === "Enter" && goTo(d));
+    item.addEventListener("click", () => onClick(d));
+    item.addEventListener("keydown", (e) => e.key === "Enter" && onClick(d));
     list.append(item);
   }
 }
@@ -88,6 +88,11 @@ export function plot(node, traces, layout = {}, config = {}) {
     showlegend: false,
   };
   return Plotly.react(node, traces, { ...base, ...layout }, { displaylogo: false, responsive: true, ...config });
+}
+
+/** Axis ticks that never collide: plotly picks at most ``n`` ticks. */
+export function ticks(n = 6) {
+  return { nticks: n, automargin: true };
 }
 
 export const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];

@@ -1,0 +1,112 @@
+// Rules as the editors see them: a rule in the model's JSON form, read as cells of a table
+// (one term per input and per output, each input term possibly negated) when it is that
+// simple, else as text; helpers shared by the table, the matrix and the text editor.
+import { fb, inputs, outputs } from "./state.js";
+
+/** A rule as cells ``{ins: {input: term}, neg: {input: true}, outs: {output: term}}``, or
+ * null when a table cannot show it (OR, parentheses, hedges, an input twice, a WITH
+ * weight, a degree condition).  An empty condition gives empty ``ins`` (a rule without
+ * an IF part). */
+export function cells(rule) {
+  const ins = {};
+  const neg = {};
+  const outs = {};
+  const inputNames = new Set(inputs().map((v) => v.name));
+  const outputNames = new Set(outputs().map((v) => v.name));
+  const literal = (c) => {
+    if (c.type === "not" && c.operand.type === "is") return { ...c.operand, negated: !c.operand.negated };
+    return c;
+  };
+  const plain = (c) => c.type === "is" && !(c.hedges && c.hedges.length) && inputNames.has(c.variable) && !(c.variable in ins);
+  const cond = rule.condition;
+  const parts = !cond ? [] : cond.type === "and" ? cond.operands : [cond];
+  for (const raw of parts) {
+    const c = literal(raw);
+    if (!plain(c)) return null;
+    ins[c.variable] = c.term;
+    if (c.negated) neg[c.variable] = true;
+  }
+  for (const c of rule.conclusions) {
+    if (c.term === null || (c.weight !== null && c.weight !== undefined) || (c.hedges && c.hedges.length) || !outputNames.has(c.variable) || c.variable in outs) return null;
+    outs[c.variable] = c.term;
+  }
+  if (rule.weight !== null && rule.weight !== undefined) return null;
+  return { ins, neg, outs };
+}
+
+/** Write table cells back into ``rule`` (inputs and outputs in declaration order). */
+export function fromCells(rule, view) {
+  const parts = inputs()
+    .filter((v) => view.ins[v.name])
+    .map((v) => ({ type: "is", variable: v.name, term: view.ins[v.name], negated: !!(view.neg && view.neg[v.name]), hedges: [] }));
+  rule.condition = parts.length === 0 ? null : parts.length === 1 ? parts[0] : { type: "and", operands: parts };
+  rule.conclusions = outputs()
+    .filter((v) => view.outs[v.name])
+    .map((v) => ({ variable: v.name, term: view.outs[v.name], weight: null, hedges: [] }));
+}
+
+/** A rule is part of the knowledge base when it concludes something (and, until rules
+ * without an IF part are carried through FCL, when it has a condition). */
+export function complete(rule) {
+  return !!rule.condition && rule.conclusions.length > 0;
+}
+
+function paramText(p) {
+  return p && typeof p === "object" ? p.name : String(p);
+}
+
+export function conditionText(c, parent = 0) {
+  if (!c) return "";
+  if (c.type === "is") return [c.variable, "IS", ...(c.negated ? ["NOT"] : []), ...(c.hedges || []), c.term].join(" ");
+  if (c.type === "degree") return c.variable;
+  if (c.type === "not") {
+    const inner = c.operand;
+    return `NOT ${inner.type === "and" || inner.type === "or" || inner.type === "not" ? `(${conditionText(inner)})` : conditionText(inner, 3)}`;
+  }
+  const own = c.type === "and" ? 2 : 1;
+  const text = c.operands
+    .map((o) => {
+      const t = conditionText(o, own);
+      const other = o.type === "and" ? 2 : o.type === "or" ? 1 : 9;
+      return other <= own ? `(${t})` : t;
+    })
+    .join(c.type === "and" ? " AND " : " OR ");
+  return text;
+}
+
+export function conclusionText(c) {
+  let text = c.variable;
+  if (c.term !== null && c.term !== undefined) text += " IS " + [...(c.hedges || []), c.term].join(" ");
+  if (c.weight !== null && c.weight !== undefined) text += ` WITH ${paramText(c.weight)}`;
+  return text;
+}
+
+export function conclusionsText(rule) {
+  return rule.conclusions.map(conclusionText).join(", ");
+}
+
+/** ``IF ... THEN ...`` as the FCL text writes it. */
+export function ruleText(rule) {
+  return `IF ${conditionText(rule.condition)} THEN ${conclusionsText(rule)}`;
+}
+
+export function nextLabel(block) {
+  const numbers = block.rules.map((r) => parseInt(r.label, 10)).filter(Number.isFinite);
+  return String((numbers.length ? Math.max(...numbers) : 0) + 1);
+}
+
+export function termOptions(name) {
+  const b = fb();
+  const blk = b.fuzzify.find((f) => f.variable === name) || b.defuzzify.find((d) => d.variable === name);
+  return blk ? blk.terms.map((t) => t.name) : [];
+}
+
+export function blankRule(block) {
+  return { label: nextLabel(block), condition: null, conclusions: [], weight: null };
+}
+
+/** The rule (block index, rule index) of a diagnostic's element, or null. */
+export function ruleOf(element) {
+  const m = /^rule:(\d+):(\d+)$/.exec(element || "");
+  return m ? { block: +m[1], rule: +m[2] } : null;
+}
