@@ -1,14 +1,17 @@
 """Helpers for the studio's browser tests: switch views, wait for the check, read the
-recorder's reading line, open files, read the 3D display and the FCL text."""
+recorder's reading line, open files, fill rule cells, read the 3D display and the FCL
+text, and take the screenshots docs/studio.md shows."""
 
 from __future__ import annotations
 
+import os
 from typing import Any
 
 from tests.conftest import ROOT
 
 CHROMIUM = "/usr/bin/chromium"
 ARTIFACTS = ROOT / "test-artifacts" / "studio"
+DOCS_IMG = ROOT / "docs" / "img" / "studio"
 ARGS = [
     "--headless",
     "--no-sandbox",
@@ -23,9 +26,33 @@ RECORDED = (
 )
 
 
-def shot(pg: Any, name: str) -> None:
+def shot(pg: Any, name: str, *, doc: bool = False) -> None:
+    """A screenshot in test-artifacts/studio/; ``doc``: one of docs/studio.md's pictures,
+    also written to docs/img/studio/ when FUZZYCTL_STUDIO_DOCS is set (`make docs-img`)."""
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     pg.screenshot(path=str(ARTIFACTS / f"{name}.png"))
+    if doc and os.environ.get("FUZZYCTL_STUDIO_DOCS"):
+        DOCS_IMG.mkdir(parents=True, exist_ok=True)
+        pg.screenshot(path=str(DOCS_IMG / f"{name}.png"))
+
+
+def rule_mode(pg: Any, mode: str) -> None:
+    """The rule view as matrix, rows (Table), columns (Siemens) or text."""
+    tab(pg, "rules")
+    pg.click(f'#view-rules .segmented [data-mode="{mode}"]')
+    pg.wait_for_function(f"document.querySelector('#view-rules').dataset.mode === '{mode}'")
+
+
+def set_cell(pg: Any, rule: int, var: str, term: str) -> None:
+    """Pick ``term`` in the rule table's cell of rule index ``rule`` and ``var``."""
+    pg.click(f'#rule-table td.cell[data-rule="{rule}"][data-var="{var}"]')
+    pg.select_option(f'#rule-table select[data-rule="{rule}"][data-var="{var}"]', term)
+    pg.wait_for_selector(f'#rule-table td.cell[data-rule="{rule}"][data-var="{var}"]:not(:has(select))')
+
+
+def cell_text(pg: Any, rule: int, var: str) -> str:
+    text: str = pg.inner_text(f'#rule-table td.cell[data-rule="{rule}"][data-var="{var}"]')
+    return text.strip()
 
 
 def tab(pg: Any, view: str) -> None:

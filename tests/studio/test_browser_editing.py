@@ -18,7 +18,19 @@ import pytest
 
 import fuzzyctl
 from tests.conftest import shared_path
-from tests.studio.browser import fcl_text, new_project, open_file, reading, settle, shot, surface_z, tab
+from tests.studio.browser import (
+    cell_text,
+    fcl_text,
+    new_project,
+    open_file,
+    reading,
+    rule_mode,
+    set_cell,
+    settle,
+    shot,
+    surface_z,
+    tab,
+)
 
 
 def points(pg: Any) -> list[float]:
@@ -108,10 +120,10 @@ def test_variable_editor(page: Any) -> None:
     assert "extra" not in term_names(pg)
 
     # a rule uses zero; renaming the term renames it in the rule
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     pg.click("#rule-append")
-    pg.select_option('select[data-rule="0"][data-var="input1"]', "zero")
-    pg.select_option('select[data-rule="0"][data-var="output1"]', "p_large")
+    set_cell(pg, 0, "input1", "zero")
+    set_cell(pg, 0, "output1", "p_large")
     settle(pg)
     tab(pg, "variable")
     pg.select_option("#var-select", "input1")
@@ -164,7 +176,7 @@ def test_variable_editor(page: Any) -> None:
         pg.mouse.move(box["x"] + x0 + (x40 - x0) * k / 8, box["y"] + y)
     pg.mouse.up()
     settle(pg)
-    moved = points(pg)[0]
+    moved = float(pg.input_value("#param-0"))
     assert 38 <= moved <= 42, moved
     assert f"TERM zero := {moved:g};" in fcl_text(pg).replace(".0;", ";")
     shot(pg, "12-singleton-dragged")
@@ -173,11 +185,11 @@ def test_variable_editor(page: Any) -> None:
 def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     pg = page
     new_project(pg, "table", 2, 1)
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     for j, (a, y) in enumerate([("n_big", "n_large"), ("zero", "zero"), ("p_big", "p_large")]):
         pg.click("#rule-append")
-        pg.select_option(f'select[data-rule="{j}"][data-var="input1"]', a)
-        pg.select_option(f'select[data-rule="{j}"][data-var="output1"]', y)
+        set_cell(pg, j, "input1", a)
+        set_cell(pg, j, "output1", y)
     # insert a blank rule before the second one: an incomplete rule is not FCL yet
     pg.click('#rule-table th[data-rule="1"]')
     pg.click("#rule-insert")
@@ -227,10 +239,11 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     )
     pg.fill("#code-input", "\n".join(fixed))
     pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
-    tab(pg, "rules")
-    assert pg.input_value('select[data-rule="1"][data-var="input2"]') == "zero"
-    assert pg.input_value('select[data-rule="1"][data-var="output1"]') == "p_small"
-    assert "OR" in pg.inner_text("#rule-table td.text-rule")
+    rule_mode(pg, "rows")
+    assert cell_text(pg, 1, "input2") == "zero"
+    assert cell_text(pg, 1, "output1") == "p_small"
+    assert pg.input_value('#rule-table input[data-rule="2"][data-part="if"]') == "input1 IS zero OR input2 IS zero"
+    assert cell_text(pg, 2, "output1") == "zero"  # its THEN part is still a cell
     # the conformance level follows the model: the OR rule (without an OR operator in its
     # rule block) lifts it above Basic, and the panel says why
     assert pg.inner_text("#level-badge") == "level: Extension"
@@ -244,7 +257,7 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
 def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> None:
     pg = page
     new_project(pg, "three", 3, 1)
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     table = [
         ("n_big", "n_big", "n_big", "n_large"),
         ("p_big", "zero", "zero", "p_small"),
@@ -254,7 +267,7 @@ def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> N
     for j, (a, b, c, y) in enumerate(table):
         pg.click("#rule-append")
         for var, term in (("input1", a), ("input2", b), ("input3", c), ("output1", y)):
-            pg.select_option(f'select[data-rule="{j}"][data-var="{var}"]', term)
+            set_cell(pg, j, var, term)
     settle(pg)
     ctl = fuzzyctl.compile(fuzzyctl.load(fcl_text(pg)))
 
@@ -366,13 +379,14 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     assert pg.inner_text("#rec-sig-Temp") == "Temp: Minimum"
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
-    # more than 500 samples: the archive is full and the oldest records are gone
+    # more than 450 samples: the archive is full and the oldest records are gone
     pg.wait_for_function("document.querySelector('#rec-chart').layout.xaxis.range[0] >= 60", timeout=20000)
     pg.click("#rec-stop")
     values = reading(pg, 75)
     assert values["Temp"] == 0  # the range minimum
     scroll = pg.locator("#rec-scroll")
-    assert scroll.is_enabled() and scroll.get_attribute("max") == "349"  # 500 - 150 - 1
+    # the archive: three display lengths (45 s) of 0.1 s records, 450 - 150 - 1 positions
+    assert scroll.is_enabled() and scroll.get_attribute("max") == "299"
     # scroll to the oldest record of the archive
     pg.eval_on_selector("#rec-scroll", "(e) => { e.value = 0; e.dispatchEvent(new Event('input')); }")
     first = reading(pg, 0)
@@ -421,8 +435,8 @@ def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
     assert info.value.suggested_filename.endswith(".fll")
 
     # keyboard: Alt+digit picks a view, arrows move along the tabs, Ctrl+S saves
-    pg.keyboard.press("Alt+3")
-    assert pg.is_visible("#view-rules")
+    pg.keyboard.press("Alt+4")
+    assert pg.is_visible("#view-ruleviewer")
     pg.keyboard.press("ArrowRight")
     assert pg.is_visible("#view-text")
     assert pg.evaluate("document.activeElement.dataset.view") == "text"

@@ -534,7 +534,7 @@ function setArchive(value) {
   $("#rec-archive").value = rec().archive;
   $("#rec-archive").min = length();
   $("#rec-archive").max = Math.min(9999, 3 * length());
-  $("#rec-sampling").textContent = `sampling time ${fmt(length() / POINTS, 4)} s, archive ${archiveRecords()} records`;
+  $("#rec-sampling").textContent = `sampling time ${Number((length() / POINTS).toPrecision(4))} s, archive ${archiveRecords()} records`;
 }
 
 function layout() {

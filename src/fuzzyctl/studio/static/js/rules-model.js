@@ -3,20 +3,14 @@
 // simple, else as text; helpers shared by the table, the matrix and the text editor.
 import { fb, inputs, outputs } from "./state.js";
 
-/** A rule as cells ``{ins: {input: term}, neg: {input: true}, outs: {output: term}}``, or
- * null when a table cannot show it (OR, parentheses, hedges, an input twice, a WITH
- * weight, a degree condition).  An empty condition gives empty ``ins`` (a rule without
- * an IF part). */
-export function cells(rule) {
+/** The IF part as cells ``{ins: {input: term}, neg: {input: true}}``, or null when a
+ * table cannot show it (OR, parentheses, hedges, an input twice, a degree condition).  An
+ * empty condition gives empty ``ins`` (a rule without an IF part). */
+export function conditionCells(rule) {
   const ins = {};
   const neg = {};
-  const outs = {};
   const inputNames = new Set(inputs().map((v) => v.name));
-  const outputNames = new Set(outputs().map((v) => v.name));
-  const literal = (c) => {
-    if (c.type === "not" && c.operand.type === "is") return { ...c.operand, negated: !c.operand.negated };
-    return c;
-  };
+  const literal = (c) => (c.type === "not" && c.operand.type === "is" ? { ...c.operand, negated: !c.operand.negated } : c);
   const plain = (c) => c.type === "is" && !(c.hedges && c.hedges.length) && inputNames.has(c.variable) && !(c.variable in ins);
   const cond = rule.condition;
   const parts = !cond ? [] : cond.type === "and" ? cond.operands : [cond];
@@ -26,23 +20,49 @@ export function cells(rule) {
     ins[c.variable] = c.term;
     if (c.negated) neg[c.variable] = true;
   }
+  return { ins, neg };
+}
+
+/** The THEN part as cells ``{outs: {output: term}}``, or null (a WITH weight, a hedge,
+ * an output twice, a bare variable). */
+export function conclusionCells(rule) {
+  const outs = {};
+  const outputNames = new Set(outputs().map((v) => v.name));
   for (const c of rule.conclusions) {
     if (c.term === null || (c.weight !== null && c.weight !== undefined) || (c.hedges && c.hedges.length) || !outputNames.has(c.variable) || c.variable in outs) return null;
     outs[c.variable] = c.term;
   }
-  if (rule.weight !== null && rule.weight !== undefined) return null;
-  return { ins, neg, outs };
+  return { outs };
 }
 
-/** Write table cells back into ``rule`` (inputs and outputs in declaration order). */
-export function fromCells(rule, view) {
+/** A rule as cells ``{ins, neg, outs}``, or null when either part needs text or the rule
+ * has a rule weight (MATLAB / fuzzylite). */
+export function cells(rule) {
+  if (rule.weight !== null && rule.weight !== undefined) return null;
+  const c = conditionCells(rule);
+  const o = conclusionCells(rule);
+  return c && o ? { ...c, ...o } : null;
+}
+
+/** Write IF cells back into ``rule`` (inputs in declaration order). */
+export function setCondition(rule, view) {
   const parts = inputs()
     .filter((v) => view.ins[v.name])
     .map((v) => ({ type: "is", variable: v.name, term: view.ins[v.name], negated: !!(view.neg && view.neg[v.name]), hedges: [] }));
   rule.condition = parts.length === 0 ? null : parts.length === 1 ? parts[0] : { type: "and", operands: parts };
+}
+
+/** Write THEN cells back into ``rule`` (outputs in declaration order). */
+export function setConclusions(rule, view) {
   rule.conclusions = outputs()
     .filter((v) => view.outs[v.name])
     .map((v) => ({ variable: v.name, term: view.outs[v.name], weight: null, hedges: [] }));
+}
+
+/** Write table cells back into ``rule``. */
+export function fromCells(rule, view) {
+  setCondition(rule, view);
+  setConclusions(rule, view);
 }
 
 /** A rule is part of the knowledge base when it concludes something (and, until rules

@@ -9,8 +9,8 @@ import { post } from "./api.js";
 import { $, el } from "./ui.js";
 
 const NS = "http://www.w3.org/2000/svg";
-const W = 132;
-const H = 40;
+let W = 132; // a cell's size: as wide as the view allows (MATLAB's columns fill the window)
+let H = 40;
 const values = {};
 let inFlight = false;
 let again = false;
@@ -122,6 +122,9 @@ function totalCell(o) {
 function draw(view) {
   const ins = inputs();
   const outs = outputs();
+  const room = ($("#rv-grid").clientWidth || 1000) - 330 - 70 - 20;
+  W = Math.round(Math.max(120, Math.min(280, room / Math.max(1, ins.length + outs.length))));
+  H = view.rules.length <= 12 ? 56 : 40;
   const onlyFired = $("#rv-filter").value === "fired";
   const table = el("table", { class: "rv-table", id: "rv-table" });
   table.append(el("thead", {}, el("tr", {}, el("th", {}, "Rule"), ...ins.map((v) => el("th", {}, `${v.name}`)), el("th", {}, "degree"), ...outs.map((v) => el("th", {}, v.name)))));

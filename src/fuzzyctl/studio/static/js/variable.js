@@ -63,7 +63,7 @@ function labels(blk, lo, hi, view) {
       let level = 0;
       while (placed.some((p) => p.level === level && Math.abs(p.x - x) < span * 0.07)) level++;
       placed.push({ x, level });
-      return { x, y: 1.05 + 0.075 * (level % 3), text: t.name, showarrow: false, font: { color: COLORS[i % COLORS.length], size: i === term ? 14 : 12 }, xanchor: "center" };
+      return { x, y: 1.04 + 0.065 * Math.min(level, 4), text: t.name, showarrow: false, font: { color: COLORS[i % COLORS.length], size: i === term ? 14 : 12 }, xanchor: "center" };
     })
     .filter(Boolean);
 }
@@ -103,7 +103,7 @@ function renderChart() {
   });
   plot(node, traces, {
     xaxis: { range: view, fixedrange: true, zeroline: false, title: { text: current }, nticks: 10 },
-    yaxis: { range: [-0.04, 1.28], fixedrange: true, title: { text: "degree of membership" }, tickvals: [0, 0.25, 0.5, 0.75, 1] },
+    yaxis: { range: [-0.04, 1.33], fixedrange: true, title: { text: "degree of membership" }, tickvals: [0, 0.25, 0.5, 0.75, 1] },
     dragmode: false,
     hovermode: false,
     annotations: labels(blk, lo, hi, view),
