@@ -17,7 +17,7 @@ from typing import Any
 import pytest
 
 import fuzzyctl
-from tests.conftest import shared_path
+from tests.conftest import data_path, shared_path
 from tests.studio.browser import (
     cell_text,
     fcl_text,
@@ -411,19 +411,45 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     shot(pg, "17-recorder-archive")
 
 
-@pytest.mark.extra("corpus")  # a real FIS file with OR rules
-def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
+# A FIS file with OR rules, imported and exported, then the keyboard: the real-world one
+# of the corpus (an extra suite) and the MATLAB tipper vendored from fuzzylite (every clone).
+IMPORTS = [
+    pytest.param(
+        ("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis"),
+        {"len": 40.0, "wid": 20.0, "n": 30.0},
+        "PL",
+        marks=pytest.mark.extra("corpus"),
+        id="corpus",
+    ),
+    pytest.param(
+        ("data", "fuzzylite", "mamdani", "matlab", "tipper.fis"),
+        {"service": 3.0, "food": 7.0},
+        "tip",
+        id="vendored",
+    ),
+]
+
+
+@pytest.mark.parametrize(("where", "point", "output"), IMPORTS)
+def test_import_export_and_keyboard(
+    page: Any, browser_project: Path, where: tuple[str, ...], point: dict[str, float], output: str
+) -> None:
     pg = page
-    fis = shared_path("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis")
+    fis = shared_path(*where[1:]) if where[0] == "corpus" else data_path(*where[1:])
     pg.set_input_files("#import-file", str(fis))
     pg.wait_for_function("document.querySelector('#status').textContent.includes('imported')")
     assert "(fis)" in pg.inner_text("#status")
     settle(pg)
-    assert pg.locator("#diagram .node.input").count() == 3
+    assert pg.locator("#diagram .node.input").count() == len(point)
     ref = fuzzyctl.compile(fuzzyctl.load(fis))
-    point = {"len": 40.0, "wid": 20.0, "n": 30.0}
     imported = fuzzyctl.compile(fuzzyctl.load(fcl_text(pg)))
     assert imported.evaluate(point) == pytest.approx(ref.evaluate(point))
+    # the OR rules are text fields of the rule table, not greyed-out text
+    rule_mode(pg, "rows")
+    conditions = pg.evaluate(
+        "[...document.querySelectorAll('#rule-table input[data-part=\"if\"]')].map((e) => e.value)"
+    )
+    assert any(" OR " in c for c in conditions)
     # export as FLL: the downloaded file computes the same
     pg.click("#btn-export")
     pg.select_option("#export-format", "fll")
@@ -442,23 +468,24 @@ def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
     assert pg.evaluate("document.activeElement.dataset.view") == "text"
     pg.keyboard.press("Control+s")
     pg.wait_for_selector("#dlg-saveas[open]")
-    pg.fill("#saveas-path", "imported.fcl")
+    name = f"imported-{where[0]}.fcl"
+    pg.fill("#saveas-path", name)
     pg.keyboard.press("Enter")
-    pg.wait_for_function("document.querySelector('#status').textContent.includes('saved imported.fcl')")
-    again = fuzzyctl.compile(fuzzyctl.load(browser_project / "imported.fcl"))
+    pg.wait_for_function(f"document.querySelector('#status').textContent.includes('saved {name}')")
+    again = fuzzyctl.compile(fuzzyctl.load(browser_project / name))
     assert again.evaluate(point) == pytest.approx(ref.evaluate(point))
     # a change, then Save (no dialog: the project has its file now)
     tab(pg, "variable")
-    pg.select_option("#var-select", "PL")
+    pg.select_option("#var-select", output)
     pg.select_option("#out-method", "MOM")
     settle(pg)
     assert pg.inner_text("#project-name").startswith("●")  # unsaved changes
     pg.click("#btn-save")
     pg.wait_for_function("!document.querySelector('#project-name').textContent.startsWith('●')")
-    block = fuzzyctl.load(browser_project / "imported.fcl").main.defuzzify_block("PL")
+    block = fuzzyctl.load(browser_project / name).main.defuzzify_block(output)
     assert block is not None and block.method == "MOM"
     # Tab reaches the buttons of the menu bar in order
     pg.focus("#btn-new")
     pg.keyboard.press("Tab")
     assert pg.evaluate("document.activeElement.id") == "btn-open"
-    shot(pg, "18-imported")
+    shot(pg, f"18-imported-{where[0]}")

@@ -257,6 +257,13 @@ def display_ranges(fb: FunctionBlock, settings: dict[str, Any] | None = None) ->
     return out
 
 
+def views(document: Document, settings: dict[str, Any] | None) -> dict[str, Any]:
+    """What the editors draw of a document just opened or imported, so that the browser
+    needs no second check: display ranges, term curves, what FCL cannot write."""
+    ranges = display_ranges(document.main, settings)
+    return {"ranges": ranges, "curves": curves(document.main, ranges), "fcl_losses": fcl_losses(document)}
+
+
 def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[str, Any]]:
     """How each term of each input and output looks, for the editors: ``{"points":
     [[x, mu], ...]}`` (exact for piecewise-linear terms, 201 samples for smooth ones,

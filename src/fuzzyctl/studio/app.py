@@ -177,7 +177,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
                 "sha256": None,
                 "document": analysis.document_to_json(document),
                 "settings": settings,
-                "ranges": analysis.display_ranges(document.main, settings),
+                **analysis.views(document, settings),
                 **report.to_dict(),
             }
         return {
@@ -186,7 +186,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
             "sha256": sha256(text),
             "document": analysis.document_to_json(document),
             "settings": settings,
-            "ranges": analysis.display_ranges(document.main, settings),
+            **analysis.views(document, settings),
             **report.to_dict(),
         }
 
@@ -350,7 +350,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
                 "document": analysis.document_to_json(document),
                 "settings": settings,
                 "text": text,
-                "ranges": analysis.display_ranges(document.main, settings),
+                **analysis.views(document, settings),
                 "warnings": [d.to_dict() for d in loaded.diagnostics],
                 **report.to_dict(),
             }

@@ -49,9 +49,11 @@ async function parse(text) {
   editor.paint(result.diagnostics);
   fillDiagnostics($("#rule-diags"), result.diagnostics.map((d) => ({ ...d, element: null })), { onClick: (d) => d.line && editor.goToLine(d.line) });
   $("#rules-text").dataset.ok = String(result.ok);
+  $("#rules-text").dataset.parsed = String(+($("#rules-text").dataset.parsed || 0) + 1);
   if (!result.ok) return;
   host.block().rules = result.rules;
-  changed("rules-text");
+  // the whole model is checked after a pause in typing: its parse would hold up the next line's
+  changed("rules-text", { delay: 1000 });
 }
 
 export function render() {

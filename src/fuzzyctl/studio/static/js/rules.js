@@ -2,7 +2,7 @@
 // the same rules - the matrix of two inputs, the table with one row per rule, the Siemens
 // table with one column per rule, and the rules as text - with append, insert blank,
 // delete and compress.  Every view edits the model; the check follows.
-import { state, on, fb, changed, status, withoutSpans } from "./state.js";
+import { state, on, fb, changed, status, bodyWithoutRules } from "./state.js";
 import { post } from "./api.js";
 import { $, el, fillDiagnostics } from "./ui.js";
 import { complete, blankRule, ruleText } from "./rules-model.js";
@@ -27,9 +27,7 @@ function block() {
 /** The request body for reading rule lines: the model without any rules (the server reads
  * the lines in the function block with this rule block alone). */
 function parseBody(extra) {
-  const doc = withoutSpans(state.doc);
-  for (const b of doc.blocks) for (const r of b.rule_blocks) r.rules = [];
-  return { document: doc, block: state.block, ...extra };
+  return bodyWithoutRules(extra);
 }
 
 async function parseLines(textValue) {

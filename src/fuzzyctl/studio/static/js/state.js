@@ -64,12 +64,12 @@ let again = false; // the model changed while it was
 /** Something in the model changed: views redraw now, the check runs shortly after.  One
  * check is in flight at a time; changes meanwhile are checked together when it returns
  * (a 500-rule model takes a while to check, edits must not queue up behind each other). */
-export function changed(what = "model", { quiet = false } = {}) {
+export function changed(what = "model", { quiet = false, delay = 150 } = {}) {
   state.dirty = true;
   if (!quiet) emit("model", what);
   emit("dirty", true);
   clearTimeout(timer);
-  timer = setTimeout(recheck, 150);
+  timer = setTimeout(recheck, delay);
 }
 
 export async function recheck() {
@@ -94,6 +94,7 @@ export async function recheck() {
     state.report = report;
     state.textError = null;
     emit("report", report);
+    document.body.dataset.checks = String(+(document.body.dataset.checks || 0) + 1); // for tests and timing
   } catch (err) {
     if (mine !== seq || again) return;
     state.report = { ok: false, diagnostics: [{ severity: "error", message: err.message, element: null }], level: null, ranges: (state.report || {}).ranges || {}, curves: (state.report || {}).curves || {} };
@@ -103,6 +104,13 @@ export async function recheck() {
     emit("checking", false);
     if (again) recheck();
   }
+}
+
+/** The request body of the editors that read text in the edited function block (rule
+ * lines, a term): the model without rules or source positions, small however many rules. */
+export function bodyWithoutRules(extra = {}) {
+  const doc = { ...state.doc, blocks: state.doc.blocks.map((b) => ({ ...b, rule_blocks: b.rule_blocks.map((rb) => ({ ...rb, rules: [] })) })) };
+  return { document: withoutSpans(doc), block: state.block, ...extra };
 }
 
 /** A copy of the model without source positions: they point into the file as it was
@@ -150,11 +158,13 @@ export function load(result, { path = result.path, sha = result.sha256 } = {}) {
   state.path = path;
   state.sha = sha;
   state.dirty = false;
-  state.report = { ok: result.ok, diagnostics: result.diagnostics || [], level: result.level, features: result.features || [], text: result.text, ranges: result.ranges || {}, curves: {} };
+  state.report = { ok: result.ok, diagnostics: result.diagnostics || [], level: result.level, features: result.features || [], text: result.text, ranges: result.ranges || {}, curves: result.curves || {}, fcl_losses: result.fcl_losses || [] };
   emit("loaded", result);
   emit("model", "all");
   emit("dirty", false);
-  recheck();
+  // an opened or imported file comes checked, with its curves; a new project is checked now
+  if (result.curves) emit("report", state.report);
+  else recheck();
 }
 
 // --- new terms ----------------------------------------------------------------------

@@ -26,7 +26,9 @@ export function kindLabel(kind) {
 /** Every kind the picker offers, inputs first the fuzzy sets, outputs also the
  * Takagi-Sugeno ones. */
 export function kinds(isOutput) {
-  const shapeKinds = Object.keys(SHAPES).filter((k) => isOutput || (k !== "constant" && k !== "linear"));
+  // cosine_half is jFuzzyLogic's COSINE with a variable half-width; with numbers it is a
+  // cosine, and FCL writes it as one
+  const shapeKinds = Object.keys(SHAPES).filter((k) => k !== "cosine_half" && (isOutput || (k !== "constant" && k !== "linear")));
   return ["points", "singleton", ...(isOutput ? ["singletons"] : []), ...shapeKinds, "function"];
 }
 

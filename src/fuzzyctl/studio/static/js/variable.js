@@ -4,7 +4,7 @@
 // trapezoid, Gaussian, bell, sigmoid ... and expressions - with a field per parameter,
 // the term as FCL text, handles to drag on the chart (singletons and spikes as lines),
 // every curve labelled, zoom in five steps.
-import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status, withoutSpans } from "./state.js";
+import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status, bodyWithoutRules } from "./state.js";
 import { post } from "./api.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
 import { SHAPES, kindOf, kindLabel, kinds, handles, placeOf, convert, paramName, readParam, paramText, positions, rescale, localCurve } from "./terms.js";
@@ -400,11 +400,9 @@ async function applyFcl() {
   const { t } = selected();
   const input = $("#term-fcl");
   if (!t || !input.value.trim()) return;
-  const doc = withoutSpans(state.doc);
-  for (const b of doc.blocks) for (const r of b.rule_blocks) r.rules = [];
   let result;
   try {
-    result = await post("/api/term/parse", { document: doc, block: state.block, variable: current, text: input.value });
+    result = await post("/api/term/parse", bodyWithoutRules({ variable: current, text: input.value }));
   } catch (err) {
     fillDiagnostics($("#term-fcl-diags"), [{ severity: "error", message: err.message }]);
     input.classList.add("bad");
