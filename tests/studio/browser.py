@@ -77,8 +77,11 @@ def reading(pg: Any, index: int) -> dict[str, float]:
     return values
 
 
-def open_file(pg: Any, path: str) -> None:
+def open_file(pg: Any, path: str, *, discard: bool = False) -> None:
+    """File > Open; ``discard``: the project open has unsaved changes, answer Discard."""
     pg.click("#btn-open")
+    if discard:
+        pg.click("#confirm-discard")
     pg.select_option("#open-list", path)
     pg.click("#open-ok")
     pg.wait_for_function(f"document.querySelector('#project-name').textContent.includes('{path}')")

@@ -87,9 +87,19 @@ def _labels(lines: list[str]) -> tuple[list[str], list[int]]:
     prefixes: list[str] = []
     rule_lines: list[int] = []
     position = 0
+    closing: str | None = None  # the end of a comment that spans lines
     for i, line in enumerate(lines):
-        if not line.strip() or _COMMENT_LINE.match(line):
+        stripped = line.strip()
+        if closing is not None:
             prefixes.append("")
+            if closing in line:
+                closing = None
+            continue
+        if not stripped or _COMMENT_LINE.match(line):
+            prefixes.append("")
+            for start, end in (("(*", "*)"), ("/*", "*/")):
+                if stripped.startswith(start) and end not in stripped[2:]:
+                    closing = end
             continue
         position += 1
         rule_lines.append(i + 1)
@@ -146,17 +156,25 @@ def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]
     end = max(i for i, line in enumerate(written) if line.strip().upper() == "END_RULEBLOCK")
     typed = text.replace("\r\n", "\n").replace("\r", "\n").split("\n")
     prefixes, rule_lines = _labels(typed)
-    # a line is cached as typed: the label a prefix gives is set when it is taken out, so
-    # inserting a line above (which renumbers the rest) re-reads only the new line
-    keys = [(context, line) for line in typed]
-    known = {i: _LINES.get(keys[i - 1]) for i in rule_lines}
+    # a rule is cached as typed, with the comment lines before it (they become its
+    # comments); the label a prefix gives is set when it is taken out, so inserting a line
+    # above (which renumbers the rest) re-reads only the new line
+    leads: dict[int, range] = {}
+    previous = 0
+    for i in rule_lines:
+        leads[i] = range(previous, i - 1)  # 0-based indices of the lines before rule line i
+        previous = i
+    keys = {i: (context, "\n".join(typed[k] for k in (*leads[i], i - 1))) for i in rule_lines}
+    known = {i: _LINES.get(keys[i]) for i in rule_lines}
     missing = [i for i in rule_lines if known[i] is None]
     diagnostics: list[dict[str, Any]] = []
     syntax_error = False
     if missing:
-        # the lines not read before, each at its own line number (blank lines between)
+        # the rules not read before (and their comments), each at its own line number
         inserted = ["" for _ in typed]
         for i in missing:
+            for k in leads[i]:
+                inserted[k] = typed[k]
             inserted[i - 1] = prefixes[i - 1] + typed[i - 1]
         placed = _Placed("\n".join([*written[:end], *inserted, *written[end:]]), end + 1, prefixes)
         report = analysis.check_text(placed.text)
@@ -168,7 +186,7 @@ def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]
             parsed = report.parsed.main.rule_blocks[0].rules
             for i, rule in zip(missing, parsed, strict=True):
                 value = (strip_spans(encode(rule)), [d for d in found if d["line"] == i])
-                _LINES.put(keys[i - 1], value)
+                _LINES.put(keys[i], value)
                 known[i] = value
     for i in rule_lines:
         cached = known[i]

@@ -321,7 +321,10 @@ async function sample() {
       if (session !== running) return; // stopped meanwhile: the recording ended at Stop
       res.t.forEach((t, i) => push(t, Object.fromEntries(Object.entries(res.values).map(([name, vs]) => [name, vs[i]]))));
     } else if (source() === "sim") {
-      const res = await post("/api/sim/step", { id: sim.id, seconds: n * dt() });
+      // never past the configuration's duration: the run ends at the display's right edge
+      const reached = archive.length ? archive[archive.length - 1].t : 0;
+      const seconds = Math.min(n * dt(), Math.max(sim.info.period || 0.01, (sim.info.duration || Infinity) - reached));
+      const res = await post("/api/sim/step", { id: sim.id, seconds });
       if (session !== running) return;
       const rows = res.rows;
       const count = rows.t.length;

@@ -18,10 +18,15 @@ export function setHost(h) {
   host = h;
 }
 
+/** The block's rules as lines; a rule's comments stand on the lines before it (the parser
+ * attaches them to it again). */
 export function textOf(block) {
-  return block.rules
-    .map((r, i) => (r.label === String(i + 1) ? ruleText(r) : `RULE ${r.label} : ${ruleText(r)}`) + ";")
-    .join("\n");
+  const lines = [];
+  block.rules.forEach((r, i) => {
+    for (const c of r.comments || []) lines.push(...c.split("\n"));
+    lines.push((r.label === String(i + 1) ? ruleText(r) : `RULE ${r.label} : ${ruleText(r)}`) + ";");
+  });
+  return lines.join("\n");
 }
 
 /** The check's diagnostics about this block's rules, on the lines of those rules. */
