@@ -65,7 +65,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
         set_cell(pg, label, "temp", t)
         set_cell(pg, label, "output1", out)
     settle(pg)
-    shot(pg, "02-rule-table")
+    shot(pg, "02-rule-table", doc=True)
     pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
     text = fcl_text(pg)
     assert "RULE 1 : IF temp IS neg THEN output1 IS n_large;" in text
@@ -339,7 +339,7 @@ params = {{ MAN_AUTO = 1, START = 1 }}
             "document.querySelector('#online-badge').textContent.includes('lost')", timeout=15000
         )
         assert pg.is_disabled("#on-start")
-        shot(pg, "19-connection-lost")
+        shot(pg, "19-connection-lost", doc=True)
         # the failed heartbeat requests are the browser's console errors this test expects
         errors: list[str] = request.node.console_errors
         errors[:] = [e for e in errors if "502" not in e]

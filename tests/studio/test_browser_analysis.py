@@ -112,7 +112,7 @@ def test_rotation_explain_and_rule_viewer(page: Any, browser_project: Path) -> N
     assert chart["y"] + chart["height"] <= 900 and chart["y"] < rules["y"]
     first = pg.inner_text("#ex-rules tbody tr:first-child")
     assert "IF distance IS far AND angle IS neg_big THEN power IS pos_medium" in first
-    shot(pg, "16-explain", doc=True)
+    shot(pg, "29-explain", doc=True)
 
     # the rule viewer: each rule's degree, the outputs at the bottom, moved by the sliders
     tab(pg, "ruleviewer")

@@ -93,7 +93,7 @@ def test_panes_diagram_busy_numbers_gutter(page: Any) -> None:
         "import('/static/js/state.js').then((m) => [m.fmt(4.476e-13), m.fmt(29.99312), m.fmt(0.0071784),"
         " m.fmt(12.5, 4, 200), m.fmt(-0.00001, 4, 200), m.fmt(123456789), m.num(-4), m.num(0.1 + 0.2)])"
     )
-    assert formatted == ["0.000", "29.99", "0.007178", "12.50", "0.00", "1.235e+8", "-4", "0.3"]
+    assert formatted == ["0.000", "29.99", "0.007178", "12.5", "0.0", "1.235e+8", "-4", "0.3"]
 
     # the FCL text: line numbers, and the line of a diagnostic marked in the gutter
     text = fcl_text(pg)
@@ -117,7 +117,8 @@ def test_what_the_editors_do_not_edit_is_shown_and_kept(page: Any, browser_proje
     beyond = pg.inner_text("#beyond-list")
     assert "local variables (VAR): wetness" in beyond
     assert "hedge" in beyond
-    assert "Open" in pg.inner_text("#model-summary")  # the features beyond Basic, by level
+    assert "Conformance level Open" in pg.inner_text("#model-summary")
+    assert "hedges" in pg.inner_text("#level-detail")  # among the features of that level
     # kept: an edit elsewhere and a save leave the local variable, its rules and hedges
     tab(pg, "variable")
     pg.select_option("#var-select", "load")

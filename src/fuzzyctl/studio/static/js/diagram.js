@@ -7,6 +7,7 @@
 import { state, on, emit, fb, inputs, outputs, diagnosticsFor, changed, termNames, evenTerms, range, status, num } from "./state.js";
 import { $, el, COLORS } from "./ui.js";
 import { kindOf } from "./terms.js";
+import { cells, termOptions } from "./rules-model.js";
 import { relayout } from "./panes.js";
 
 const NS = "http://www.w3.org/2000/svg";
@@ -40,6 +41,36 @@ function sparkline(parent, name, x, y, w, h) {
   });
 }
 
+/** A rule block of two inputs drawn small as its matrix: a cell per pair of terms,
+ * coloured by the output term its rule concludes (the Rules view's colours). */
+function miniMatrix(parent, rb, x, y, w, h) {
+  const ins = inputs();
+  const outs = outputs();
+  if (ins.length !== 2 || !outs.length) return;
+  const rowsT = termOptions(ins[0].name);
+  const colsT = termOptions(ins[1].name);
+  const outT = termOptions(outs[0].name);
+  if (!rowsT.length || !colsT.length || !outT.length) return;
+  const size = Math.min(w / colsT.length, h / rowsT.length);
+  const palette = ["#2166ac", "#4393c3", "#92c5de", "#d1e5f0", "#f7f7f7", "#fddbc7", "#f4a582", "#d6604d", "#b2182b"];
+  const colour = (t) => {
+    const i = outT.indexOf(t);
+    return i < 0 ? null : palette[outT.length === 1 ? 4 : Math.round((i * (palette.length - 1)) / (outT.length - 1))];
+  };
+  const filled = new Map();
+  for (const r of rb.rules) {
+    const c = cells(r);
+    if (!c || Object.keys(c.ins).length !== 2 || !c.outs[outs[0].name]) continue;
+    filled.set(`${c.ins[ins[0].name]}\u0000${c.ins[ins[1].name]}`, c.outs[outs[0].name]);
+  }
+  rowsT.forEach((a, i) =>
+    colsT.forEach((b, j) => {
+      const t = filled.get(`${a}\u0000${b}`);
+      parent.append(svg("rect", { x: x + j * size, y: y + i * size, width: size - 1, height: size - 1, fill: (t && colour(t)) || "#eef2f6", class: "mini-cell" }));
+    }),
+  );
+}
+
 function marks(g, id, x, y, w) {
   // a variable's box also carries the diagnostics of its terms
   const diags = id.startsWith("var:") ? [...diagnosticsFor(id), ...diagnosticsFor(`term:${id.slice(4)}`)] : diagnosticsFor(id);
@@ -50,13 +81,14 @@ function marks(g, id, x, y, w) {
   g.append(svg("title", {}, diags.map((d) => `${d.severity}: ${d.message}`).join("\n")));
 }
 
-function box(parent, { x, y, w, h, label, lines, kind, id, onOpen, spark }) {
+function box(parent, { x, y, w, h, label, lines, kind, id, onOpen, spark, rb }) {
   const sparkH = Math.max(26, h - 50 - 17 * lines.length);
   const g = svg("g", { class: `node ${kind}`, tabindex: "0", role: "button", "aria-label": `${kind} ${label}`, "data-id": id });
   g.append(svg("rect", { x, y, width: w, height: h, rx: 7, class: "box" }));
   g.append(svg("text", { x: x + 12, y: y + 22, class: "label" }, label));
   lines.forEach((line, i) => g.append(svg("text", { x: x + 12, y: y + 42 + i * 17, class: "sub" }, line)));
   if (spark) sparkline(g, spark, x + 12, y + h - sparkH - 8, w - 24, sparkH);
+  if (kind === "rules" && rb) miniMatrix(g, rb, x + 12, y + h - sparkH - 8, w - 24, sparkH);
   marks(g, id, x, y, w);
   g.addEventListener("click", onOpen);
   g.addEventListener("keydown", (e) => (e.key === "Enter" || e.key === " ") && (e.preventDefault(), onOpen()));
@@ -105,8 +137,10 @@ function renderDiagram() {
     const mid = y + BOX_H / 2;
     ins.forEach((v, k) => wire(root, 10 + BOX_W, column(ins.length, k) + BOX_H / 2, ruleX, mid));
     outs.forEach((v, k) => wire(root, ruleX + ruleW, mid, W - 10 - BOX_W, column(outs.length, k) + BOX_H / 2));
-    const ops = [rb.and_op && `AND ${rb.and_op}`, rb.or_op && `OR ${rb.or_op}`, rb.act && `ACT ${rb.act}`, rb.accu && `ACCU ${rb.accu}`].filter(Boolean).join(" · ");
-    box(root, { x: ruleX, y, w: ruleW, h: BOX_H, label: "If … Then", lines: [`${rb.name || "rules"}: ${rb.rules.length} rule(s)${rb.enabled === false ? " (disabled)" : ""}`, ops || "operators: IEC defaults"], kind: "rules", id: `ruleblock:${i}`, onOpen: () => emit("show", { view: "rules", target: { block: i, rule: null } }) });
+    const ops = [rb.and_op && `AND ${rb.and_op}`, rb.or_op && `OR ${rb.or_op}`, rb.act && `ACT ${rb.act}`, rb.accu && `ACCU ${rb.accu}`].filter(Boolean);
+    // the operators on one line, or two when they would not fit the box
+    const opLines = !ops.length ? ["operators: IEC defaults"] : ops.join(" · ").length * 7.2 < ruleW - 24 ? [ops.join(" · ")] : [ops.slice(0, 2).join(" · "), ops.slice(2).join(" · ")];
+    box(root, { x: ruleX, y, w: ruleW, h: BOX_H, rb, label: "If … Then", lines: [`${rb.name || "rules"}: ${rb.rules.length} rule(s)${rb.enabled === false ? " (disabled)" : ""}`, ...opLines], kind: "rules", id: `ruleblock:${i}`, onOpen: () => emit("show", { view: "rules", target: { block: i, rule: null } }) });
   });
   ins.forEach((v, k) => {
     const blk = b.fuzzify.find((f) => f.variable === v.name);
@@ -194,8 +228,7 @@ function renderSummary() {
   const beyond = beyondEditors(state.doc, b);
   host.append(el("h3", {}, "Also in the model (kept)"));
   host.append(beyond.length ? el("ul", { id: "beyond-list" }, ...beyond.map((x) => el("li", {}, x))) : el("p", { class: "hint", id: "beyond-list" }, "Nothing beyond what the editors show."));
-  const features = ((state.report && state.report.features) || []).filter((f) => f.level !== "Basic");
-  if (features.length) host.append(el("h3", {}, `Beyond Basic level (${state.report.level})`), el("ul", { class: "kept" }, ...features.map((f) => el("li", {}, `${f.level}: ${f.element} — ${f.detail}`))));
+  if (state.report && state.report.level) host.append(el("p", { class: "hint" }, `Conformance level ${state.report.level}: the Check panel lists the features that need it.`));
   const losses = (state.report && state.report.fcl_losses) || [];
   if (losses.length) host.append(el("h3", { class: "losses" }, "Saving as FCL drops"), el("ul", { class: "losses", id: "fcl-losses" }, ...losses.map((l) => el("li", {}, l))));
 }

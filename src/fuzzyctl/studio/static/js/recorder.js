@@ -6,7 +6,7 @@
 // one.  Sources: test signals (off line; the outputs read "???" while a curve drives an
 // input, manual 6.7), a simulated process (issue 9: the display holds the whole run and
 // the recorder stops at its end), a running runtime.
-import { state, on, inputs, outputs, range, body, fmt, num, status, isInput } from "./state.js";
+import { state, on, inputs, outputs, range, body, fmt, num, niceTicks, status, isInput } from "./state.js";
 import { post, del } from "./api.js";
 import { $, el, plot, openDialog, COLORS } from "./ui.js";
 import { setTrajectory } from "./surface.js";
@@ -396,13 +396,13 @@ function draw() {
   });
   const sel = r.curves[selectedCurve] || r.curves[0];
   const [lo, hi] = sel ? scale(sel) : [0, 1];
-  const ticks = [0, 0.25, 0.5, 0.75, 1];
+  const ticks = niceTicks(lo, hi, 5); // round values of the selected curve's scale
   const stopped = !running;
   const reading = stopped && archive.length ? readingRecord() : null;
   const shapes = reading ? [{ type: "line", x0: reading.t, x1: reading.t, y0: -0.02, y1: 1.02, line: { color: "#333", width: 1.5 } }] : [];
   plot($("#rec-chart"), traces, {
     xaxis: { range: [t0, t0 + length()], title: { text: "time [s]" } },
-    yaxis: { range: [-0.03, 1.03], tickvals: ticks, ticktext: ticks.map((f) => num(lo + f * (hi - lo))), title: { text: sel ? `${sel}${unitOf(sel) ? ` [${unitOf(sel)}]` : ""}${rec().shared ? " (shared axis)" : ""}` : "" } },
+    yaxis: { range: [-0.03, 1.03], tickvals: ticks.map((v) => (v - lo) / (hi - lo)), ticktext: ticks.map((v) => num(v)), title: { text: sel ? `${sel}${unitOf(sel) ? ` [${unitOf(sel)}]` : ""}${rec().shared ? " (shared axis)" : ""}` : "" } },
     shapes,
     margin: { l: 60, r: 15, t: 10, b: 40 },
   }, { staticPlot: true });

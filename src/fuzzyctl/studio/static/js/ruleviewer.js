@@ -98,7 +98,7 @@ function outputCell(name, concls) {
       const fill = polygon(set.x.map((x, i) => [x, set.y[i]]), s, "fill-out");
       if (fill) root.append(fill);
     }
-    if (set && set.spikes) for (const [x, y] of set.spikes) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), class: "fill-out", stroke: "#5b8fd0", "stroke-width": 4 }));
+    if (set && set.spikes) for (const [x, y] of set.spikes) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), class: "spike-out" }));
     if (curve && curve.points) root.append(polyline(curve.points, s));
     else if (curve && curve.singleton !== undefined) root.append(svg("line", { x1: s.sx(curve.singleton), x2: s.sx(curve.singleton), y1: s.sy(0), y2: s.sy(1), class: "mf" }));
     text += `${text ? ", " : ""}${c.term} ${deg(c.degree * c.weight)}`;
@@ -114,7 +114,7 @@ function totalCell(o) {
     const fill = polygon(o.breakpoints, s, "fill-out");
     if (fill) root.append(fill);
   }
-  for (const [x, y] of o.singletons || []) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), stroke: "#5b8fd0", "stroke-width": 4 }));
+  for (const [x, y] of o.singletons || []) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), class: "spike-out" }));
   if (o.value !== null && o.value !== undefined) root.append(svg("line", { x1: s.sx(o.value), x2: s.sx(o.value), y1: 0, y2: H, class: "value-line" }));
   return el("td", { class: "rv-total", "data-var": o.name, "data-value": o.value ?? "" }, root, el("div", { class: "num", id: `rv-value-${o.name}` }, `${o.name} = ${fmtVar(o.name, o.value)}`));
 }
@@ -166,6 +166,8 @@ async function refresh() {
     last = await post("/api/ruleview", body({ inputs: point }), { quiet: true });
     draw(last);
     $("#view-ruleviewer").dataset.outputs = JSON.stringify(Object.fromEntries(last.outputs.map((o) => [o.name, o.value])));
+    // the result stays in view beside the sliders too (the bottom row may be scrolled away)
+    $("#rv-result").textContent = last.outputs.map((o) => `${o.name} = ${fmtVar(o.name, o.value)}`).join(",  ");
   } catch (err) {
     status(err.message, "error");
   } finally {
@@ -196,6 +198,7 @@ function renderInputs() {
     number.addEventListener("change", () => Number.isFinite(parseFloat(number.value)) && setValue(v.name, parseFloat(number.value)));
     row.append(el("label", {}, `${v.name} `, slider, number));
   }
+  row.append(el("span", { class: "sep" }), el("strong", { id: "rv-result", class: "num" }, ""));
 }
 
 function valueAt(event, svgNode) {

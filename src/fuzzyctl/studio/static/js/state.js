@@ -237,14 +237,14 @@ export function isIdentifier(name) {
 /** A number as an engineer reads it: fixed decimals, four significant digits, no
  * exponent between 0.001 and 100000, and 0 for what is 0 at that resolution
  * (``4.476e-13`` is ``0.000``).  With ``span`` (the variable's range width) the decimals
- * resolve 1/10000 of the range, so every value of one variable has the same decimals. */
+ * resolve 1/1000 of the range, so every value of one variable has the same decimals. */
 export function fmt(v, digits = 4, span = null) {
   if (v === null || v === undefined || Number.isNaN(v)) return "—";
   if (typeof v !== "number") return String(v);
   if (!Number.isFinite(v)) return v > 0 ? "∞" : "−∞";
   const a = Math.abs(v);
   let decimals;
-  if (span && span > 0) decimals = Math.ceil(-Math.log10(span / 10000));
+  if (span && span > 0) decimals = Math.ceil(-Math.log10(span / 1000));
   else if (a < 1e-9) decimals = 3;
   else if (a >= 1e5 || a < 1e-3) return v.toExponential(digits - 1);
   else decimals = digits - 1 - Math.floor(Math.log10(a));
@@ -266,6 +266,19 @@ export function fmtVar(name, v, unit = null) {
   const [lo, hi] = range(name);
   const text = fmt(v, 4, hi - lo);
   return unit ? `${text} ${unit}` : text;
+}
+
+/** Round tick values for an axis over [lo, hi]: steps of 1, 2, 2.5 or 5 times a power of
+ * ten, about ``n`` of them. */
+export function niceTicks(lo, hi, n = 5) {
+  const span = hi - lo;
+  if (!(span > 0)) return [lo];
+  const raw = span / n;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 2.5, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
+  const out = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) out.push(Number(v.toPrecision(12)));
+  return out;
 }
 
 /** A degree of membership: three decimals. */
