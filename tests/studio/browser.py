@@ -60,9 +60,25 @@ def tab(pg: Any, view: str) -> None:
     pg.wait_for_selector(f"#view-{view}:not([hidden])")
 
 
+def checks(pg: Any) -> int:
+    """How many checks of the model have come back so far."""
+    return int(pg.get_attribute("body", "data-checks") or "0")
+
+
+def checked(pg: Any) -> None:
+    """Wait until the check of the model has seen every change made so far."""
+    pg.wait_for_function(
+        "document.body.dataset.changes === undefined"
+        " || document.body.dataset.changes === document.body.dataset.checkedChanges",
+        timeout=60000,
+    )
+
+
 def settle(pg: Any) -> None:
-    """Wait for the pending check of the model."""
-    pg.wait_for_timeout(400)
+    """Wait for the pending check of the model (an edit that reaches the server first, as
+    the rule and term fields do, has 300 ms to come back and make its change)."""
+    pg.wait_for_timeout(300)
+    checked(pg)
 
 
 def reading(pg: Any, index: int) -> dict[str, float]:

@@ -48,7 +48,10 @@ def parse(client: TestClient, doc: dict[str, Any], text: str) -> dict[str, Any]:
 
 def test_rule_lines_are_read_by_the_fcl_parser(client: TestClient) -> None:
     doc = crane(client)
-    text = "IF distance IS far OR NOT angle IS zero THEN power IS zero WITH 0.5\n\n// a comment\nRULE 1 : IF angle IS zero THEN power IS pos_high"
+    text = (
+        "IF distance IS far OR NOT angle IS zero THEN power IS zero WITH 0.5\n\n// a comment\n"
+        "RULE 1 : IF angle IS zero THEN power IS pos_high"
+    )
     out = parse(client, doc, text)
     assert out["ok"] and out["lines"] == [1, 4]
     first, second = out["rules"]
@@ -59,7 +62,15 @@ def test_rule_lines_are_read_by_the_fcl_parser(client: TestClient) -> None:
     source = (EXAMPLES / "crane.fcl").read_text()
     start = source.index("RULE 1 :")
     end = source.index("END_RULEBLOCK")
-    fcl = source[:start] + "RULE 2 : " + text.split("\n")[0] + ";\n" + text.split("\n")[3] + ";\n" + source[end:]
+    fcl = (
+        source[:start]
+        + "RULE 2 : "
+        + text.split("\n")[0]
+        + ";\n"
+        + text.split("\n")[3]
+        + ";\n"
+        + source[end:]
+    )
     expected = fuzzyctl.load(fcl).main.rule_blocks[0].rules
     assert strip(out["rules"]) == [strip(encode(r)) for r in expected]
     assert out["rules"][1]["comments"] == ["// a comment"]
@@ -79,7 +90,10 @@ def test_rule_lines_are_read_by_the_fcl_parser(client: TestClient) -> None:
 
 def test_comments_stay_with_their_rules(client: TestClient) -> None:
     doc = crane(client)
-    text = "(* the first rule,\n   two lines of comment *)\nIF angle IS zero THEN power IS zero\n// the second\nIF angle IS neg_big THEN power IS neg_high"
+    text = (
+        "(* the first rule,\n   two lines of comment *)\nIF angle IS zero THEN power IS zero\n"
+        "// the second\nIF angle IS neg_big THEN power IS neg_high"
+    )
     out = parse(client, doc, text)
     assert out["lines"] == [3, 5]
     assert [r["label"] for r in out["rules"]] == ["1", "2"]
@@ -124,7 +138,9 @@ def test_a_term_typed_as_fcl(client: TestClient, text: str, kind: str, params: l
 
 def test_a_wrong_term_names_its_column(client: TestClient) -> None:
     doc = crane(client)
-    r = client.post("/api/term/parse", json={"document": doc, "variable": "angle", "text": "(0, 0) (5, 1) (3"}).json()
+    r = client.post(
+        "/api/term/parse", json={"document": doc, "variable": "angle", "text": "(0, 0) (5, 1) (3"}
+    ).json()
     assert not r["ok"] and r["mf"] is None
     assert r["diagnostics"][0]["line"] == 1 and r["diagnostics"][0]["column"] >= 15
     r = client.post("/api/term/parse", json={"document": doc, "variable": "power", "text": "12.5"}).json()
@@ -165,7 +181,11 @@ def test_rule_viewer_sets_are_the_activated_terms() -> None:
         # the literals carry the term degrees the engine explains
         for lit in row["literals"]:
             assert lit["degree"] == pytest.approx(
-                next(t.degree for t in explanation.terms if (t.variable, t.term) == (lit["variable"], lit["term"]))
+                next(
+                    t.degree
+                    for t in explanation.terms
+                    if (t.variable, t.term) == (lit["variable"], lit["term"])
+                )
             )
     assert checked > 100
     ctl.reset()

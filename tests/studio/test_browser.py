@@ -222,7 +222,15 @@ def test_online_monitoring_and_download(
     # not connected: the state is in the menu bar, every command is disabled with a reason
     tab(pg, "online")
     assert pg.inner_text("#online-badge") == "● off line"
-    for button in ("#on-start", "#on-stop", "#on-auto", "#on-manual", "#on-force", "#on-release", "#on-download"):
+    for button in (
+        "#on-start",
+        "#on-stop",
+        "#on-auto",
+        "#on-manual",
+        "#on-force",
+        "#on-release",
+        "#on-download",
+    ):
         assert pg.is_disabled(button)
         assert "not connected" in (pg.get_attribute(button, "title") or "")
     assert "not connected" in pg.inner_text("#on-reason")

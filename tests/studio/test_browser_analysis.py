@@ -40,11 +40,15 @@ def test_recorder_defaults_shared_axis_and_test_signals(page: Any, browser_proje
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
     # the recorder stops by itself at the end of the run, with all of it in view
-    pg.wait_for_function("document.querySelector('#status').textContent.includes('run is complete')", timeout=60000)
+    pg.wait_for_function(
+        "document.querySelector('#status').textContent.includes('run is complete')", timeout=60000
+    )
     assert pg.get_attribute("#view-recorder", "data-running") == "false"
     assert pg.evaluate("document.querySelector('#rec-chart').layout.xaxis.range") == [0, duration]
     position, target = trace(pg, "position"), trace(pg, "target")
-    assert position["x"][0] == pytest.approx(0, abs=0.6) and position["x"][-1] == pytest.approx(duration, abs=0.6)
+    assert position["x"][0] == pytest.approx(0, abs=0.6) and position["x"][-1] == pytest.approx(
+        duration, abs=0.6
+    )
     # each curve on its own range: the target (30 m) and the position near it are apart
     assert abs(position["y"][-1] - target["y"][-1]) > 0.1
     # curves of one quantity (metres) share one axis: now they meet
@@ -52,7 +56,10 @@ def test_recorder_defaults_shared_axis_and_test_signals(page: Any, browser_proje
     position, target = trace(pg, "position"), trace(pg, "target")
     assert abs(position["y"][-1] - target["y"][-1]) < 0.01
     pg.click('#rec-curves input[type="radio"] >> nth=4')  # the position's curve labels the axis
-    assert pg.evaluate("document.querySelector('#rec-chart').layout.yaxis.title.text") == "position [m] (shared axis)"
+    assert (
+        pg.evaluate("document.querySelector('#rec-chart').layout.yaxis.title.text")
+        == "position [m] (shared axis)"
+    )
     assert "m" in pg.inner_text("#rec-cur-4")
     shot(pg, "27-recorder-shared-axis", doc=True)
 
@@ -68,7 +75,9 @@ def test_recorder_defaults_shared_axis_and_test_signals(page: Any, browser_proje
     ctl = fuzzyctl.compile(fuzzyctl.load(browser_project / "crane.fcl"))
     expect = ctl.evaluate({"distance": 8, "angle": 0})["power"]
     pg.wait_for_selector('#rec-outputs-now [data-output="power"][data-value]')
-    assert float(pg.get_attribute('#rec-outputs-now [data-output="power"]', "data-value") or "nan") == pytest.approx(expect)
+    assert float(
+        pg.get_attribute('#rec-outputs-now [data-output="power"]', "data-value") or "nan"
+    ) == pytest.approx(expect)
     # ... and "???" as soon as a curve drives one (manual 6.7)
     pg.click("#rec-sig-distance")
     pg.select_option("#sig-kind", "triangle")
@@ -125,11 +134,14 @@ def test_rotation_explain_and_rule_viewer(page: Any, browser_project: Path) -> N
     ctl.reset()
     expect = ctl.evaluate({"distance": 5, "angle": -3})["power"]
     pg.wait_for_function(
-        f"Math.abs(JSON.parse(document.querySelector('#view-ruleviewer').dataset.outputs || '{{}}').power - {expect}) < 1e-9"
+        "Math.abs(JSON.parse(document.querySelector('#view-ruleviewer').dataset.outputs || '{}').power"
+        f" - {expect}) < 1e-9"
     )
     ctl.reset()
     explanation = ctl.explain({"distance": 5, "angle": -3})
-    degrees = pg.evaluate("[...document.querySelectorAll('#rv-table tbody tr:not(.total) td.deg')].map((e) => e.textContent)")
+    degrees = pg.evaluate(
+        "[...document.querySelectorAll('#rv-table tbody tr:not(.total) td.deg')].map((e) => e.textContent)"
+    )
     assert degrees == [f"{r.degree:.3f}" for r in explanation.rules]
     assert pg.locator("#rv-table tr.fired").count() == sum(1 for r in explanation.rules if r.degree > 0)
     # a click in the distance column moves the input there

@@ -242,7 +242,10 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     rule_mode(pg, "rows")
     assert cell_text(pg, 1, "input2") == "zero"
     assert cell_text(pg, 1, "output1") == "p_small"
-    assert pg.input_value('#rule-table input[data-rule="2"][data-part="if"]') == "input1 IS zero OR input2 IS zero"
+    assert (
+        pg.input_value('#rule-table input[data-rule="2"][data-part="if"]')
+        == "input1 IS zero OR input2 IS zero"
+    )
     assert cell_text(pg, 2, "output1") == "zero"  # its THEN part is still a cell
     # the conformance level follows the model: the OR rule (without an OR operator in its
     # rule block) lifts it above Basic, and the panel says why
@@ -411,8 +414,8 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     shot(pg, "17-recorder-archive")
 
 
-# A FIS file with OR rules, imported and exported, then the keyboard: the real-world one
-# of the corpus (an extra suite) and the MATLAB tipper vendored from fuzzylite (every clone).
+# A FIS file imported and exported, then the keyboard: the real-world one of the corpus (an
+# extra suite) and MATLAB's tipper with its OR rules, vendored from fuzzylite (every clone).
 IMPORTS = [
     pytest.param(
         ("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis"),
@@ -435,7 +438,7 @@ def test_import_export_and_keyboard(
     page: Any, browser_project: Path, where: tuple[str, ...], point: dict[str, float], output: str
 ) -> None:
     pg = page
-    fis = shared_path(*where[1:]) if where[0] == "corpus" else data_path(*where[1:])
+    fis = shared_path(*where) if where[0] == "corpus" else data_path(*where[1:])
     pg.set_input_files("#import-file", str(fis))
     pg.wait_for_function("document.querySelector('#status').textContent.includes('imported')")
     assert "(fis)" in pg.inner_text("#status")
@@ -444,12 +447,13 @@ def test_import_export_and_keyboard(
     ref = fuzzyctl.compile(fuzzyctl.load(fis))
     imported = fuzzyctl.compile(fuzzyctl.load(fcl_text(pg)))
     assert imported.evaluate(point) == pytest.approx(ref.evaluate(point))
-    # the OR rules are text fields of the rule table, not greyed-out text
+    # the rules are editable: cells, and the OR rules text fields (not greyed-out text)
     rule_mode(pg, "rows")
+    assert pg.locator("#rule-table tbody tr").count() == len(ref.plan.rules)
     conditions = pg.evaluate(
         "[...document.querySelectorAll('#rule-table input[data-part=\"if\"]')].map((e) => e.value)"
     )
-    assert any(" OR " in c for c in conditions)
+    assert any(" OR " in c for c in conditions) == (where[0] == "data")  # the corpus file has none
     # export as FLL: the downloaded file computes the same
     pg.click("#btn-export")
     pg.select_option("#export-format", "fll")

@@ -19,6 +19,7 @@ from fuzzyctl.model import And, Conclusion, Is, Not, Or
 from tests.studio.browser import (
     ARTIFACTS,
     cell_text,
+    checked,
     fcl_text,
     new_project,
     open_file,
@@ -88,11 +89,23 @@ def test_matrix_columns_and_table_edit_one_model(page: Any, browser_project: Pat
     pg.focus('#rule-table td.cell[data-rule="1"][data-var="distance"]')
     pg.keyboard.press("ArrowRight")
     pg.keyboard.press("ArrowDown")
-    assert pg.evaluate("document.activeElement.dataset.rule + ' ' + document.activeElement.dataset.var") == "2 angle"
+    assert (
+        pg.evaluate("document.activeElement.dataset.rule + ' ' + document.activeElement.dataset.var")
+        == "2 angle"
+    )
     pg.keyboard.press("Enter")
     pg.wait_for_selector('#rule-table select[data-rule="2"][data-var="angle"]')
     pg.keyboard.press("Escape")
     assert cell_text(pg, 2, "angle") == "zero"
+
+
+def applied(pg: Any, action: Any) -> None:
+    """Do ``action`` (Enter in a rule's text field) and wait until the parser's rule is in
+    the model and checked."""
+    before = int(pg.get_attribute("#rule-table", "data-applied") or "0")
+    action()
+    pg.wait_for_function(f"+(document.querySelector('#rule-table').dataset.applied || 0) > {before}")
+    checked(pg)
 
 
 TYPED = """IF input1 IS n_big OR input2 IS p_big THEN output1 IS n_large, output2 IS zero
@@ -107,7 +120,7 @@ def test_text_editor_reads_rules_with_the_fcl_parser(page: Any) -> None:
     rule_mode(pg, "text")
     pg.fill("#rules-input", TYPED)
     pg.wait_for_function("document.querySelector('#rules-text').dataset.ok === 'true'")
-    settle(pg)
+    checked(pg)  # the model's check follows a pause in typing
     rules = fuzzyctl.load(fcl_text(pg)).main.rule_blocks[0].rules
     assert [r.label for r in rules] == ["1", "2", "7", "4"]
     first, second, third, fourth = rules
@@ -137,17 +150,19 @@ def test_text_editor_reads_rules_with_the_fcl_parser(page: Any) -> None:
     assert "error 4:" in pg.inner_text("#rule-diags")
     pg.fill("#rules-input", TYPED)
     pg.wait_for_function("document.querySelector('#rules-text').dataset.ok === 'true'")
+    checked(pg)
 
     # the table: the OR rule's IF part is a text field, its THEN part two cells
     rule_mode(pg, "rows")
     condition = '#rule-table input[data-rule="0"][data-part="if"]'
     assert pg.input_value(condition) == "input1 IS n_big OR input2 IS p_big"
     assert cell_text(pg, 0, "output1") == "n_large" and cell_text(pg, 0, "output2") == "zero"
-    assert pg.input_value('#rule-table input[data-rule="1"][data-part="then"]') == "output1 IS p_small WITH 0.5"
+    assert (
+        pg.input_value('#rule-table input[data-rule="1"][data-part="then"]') == "output1 IS p_small WITH 0.5"
+    )
     # edited there: read by the same parser; a mistake is refused with its message
     pg.fill(condition, "input1 IS n_big OR (input2 IS p_big AND NOT input1 IS zero)")
-    pg.press(condition, "Enter")
-    settle(pg)
+    applied(pg, lambda: pg.press(condition, "Enter"))
     rule = fuzzyctl.load(fcl_text(pg)).main.rule_blocks[0].rules[0]
     assert rule.condition == Or(
         (Is("input1", "n_big"), And((Is("input2", "p_big"), Not(Is("input1", "zero")))))
@@ -162,15 +177,20 @@ def test_text_editor_reads_rules_with_the_fcl_parser(page: Any) -> None:
     field = '#rule-table input[data-rule="3"][data-part="if"]'
     assert pg.input_value(field) == "input1 IS zero"
     pg.fill(field, "input1 IS zero OR input1 IS p_small")
-    pg.press(field, "Enter")
-    settle(pg)
+    applied(pg, lambda: pg.press(field, "Enter"))
     assert "RULE 4 : IF input1 IS zero OR input1 IS p_small THEN output1 IS zero;" in fcl_text(pg)
 
 
 def big_rule_base(path: Path, rules: int = 500) -> None:
     """Three inputs of eight triangles, one singleton output, ``rules`` AND rules."""
     names = ["nb", "nm", "ns", "ze", "ps", "pm", "pb", "px"]
-    lines = ["FUNCTION_BLOCK big", "    VAR_INPUT", "        e : REAL;", "        de : REAL;", "        load : REAL;"]
+    lines = [
+        "FUNCTION_BLOCK big",
+        "    VAR_INPUT",
+        "        e : REAL;",
+        "        de : REAL;",
+        "        load : REAL;",
+    ]
     lines += ["    END_VAR", "    VAR_OUTPUT", "        u : REAL;", "    END_VAR"]
     for v in ("e", "de", "load"):
         lines.append(f"    FUZZIFY {v}")
@@ -185,7 +205,8 @@ def big_rule_base(path: Path, rules: int = 500) -> None:
     for k, (a, b, c) in enumerate(itertools.islice(itertools.product(range(8), repeat=3), rules)):
         out = names[min(7, (a + b + c) // 3)]
         lines.append(
-            f"        RULE {k + 1} : IF e IS {names[a]} AND de IS {names[b]} AND load IS {names[c]} THEN u IS {out};"
+            f"        RULE {k + 1} : IF e IS {names[a]} AND de IS {names[b]} AND load IS {names[c]}"
+            f" THEN u IS {out};"
         )
     lines += ["    END_RULEBLOCK", "END_FUNCTION_BLOCK", ""]
     path.write_text("\n".join(lines))
@@ -232,7 +253,9 @@ def test_500_rules_open_and_edit(page: Any, browser_project: Path) -> None:
     pg.eval_on_selector("#rules-input", f"(e) => {{ e.setSelectionRange({second - 2}, {second}); }}")
     start = time.monotonic()
     pg.keyboard.insert_text("px")
-    pg.wait_for_function(f"+document.querySelector('#rules-text').dataset.parsed > {parsed + 1}", timeout=60000)
+    pg.wait_for_function(
+        f"+document.querySelector('#rules-text').dataset.parsed > {parsed + 1}", timeout=60000
+    )
     timings["text_next_read_s"] = time.monotonic() - start
     assert pg.get_attribute("#rules-text", "data-ok") == "true"
     tab(pg, "text")  # the FCL text follows when the check of the whole model is back

@@ -16,10 +16,12 @@ import pytest
 import fuzzyctl
 from fuzzyctl.model import SHAPES, PointsMF, ShapeMF
 from tests.conftest import data_path
-from tests.studio.browser import fcl_text, settle, shot, tab
+from tests.studio.browser import checked, fcl_text, settle, shot, tab
 
 # cosine_half is only a kind of its own with a variable half-width (else FCL writes a cosine)
-FUZZY_KINDS = [k for k in SHAPES if k not in ("constant", "linear", "cosine_half")] + ["points", "singleton"]
+# (points and singletons first: they go to input terms; an output cannot mix singletons with
+# fuzzy sets)
+FUZZY_KINDS = ["points", "singleton"] + [k for k in SHAPES if k not in ("constant", "linear", "cosine_half")]
 
 
 def import_allterms(pg: Any) -> Any:
@@ -31,7 +33,9 @@ def import_allterms(pg: Any) -> Any:
 
 
 def params(pg: Any) -> list[str]:
-    values: list[str] = pg.evaluate("[...document.querySelectorAll('#term-params input')].map((e) => e.value)")
+    values: list[str] = pg.evaluate(
+        "[...document.querySelectorAll('#term-params input')].map((e) => e.value)"
+    )
     return values
 
 
@@ -46,12 +50,17 @@ def test_every_term_kind_is_editable(page: Any) -> None:
         mf = term.mf
         if isinstance(mf, ShapeMF):
             assert pg.input_value("#term-kind") == mf.kind
-            names = pg.evaluate("[...document.querySelectorAll('#term-params label')].map((e) => e.textContent)")
+            names = pg.evaluate(
+                "[...document.querySelectorAll('#term-params label')].map((e) => e.textContent)"
+            )
             assert names == [*SHAPES[mf.kind].params, "height"]
             assert [float(v) for v in params(pg)] == [*mf.params, mf.height]
         else:
             assert isinstance(mf, PointsMF) and pg.input_value("#term-kind") == "points"
-            xs = pg.evaluate("[...document.querySelectorAll('#points-table input[aria-label$=\" x\"]')].map((e) => +e.value)")
+            xs = pg.evaluate(
+                "[...document.querySelectorAll('#points-table input[aria-label$=\" x\"]')]"
+                ".map((e) => +e.value)"
+            )
             assert xs == [p.x for p in mf.points]
     # every curve carries its name
     labels = pg.evaluate("document.querySelector('#mf-chart').layout.annotations.map((a) => a.text)")
@@ -64,14 +73,16 @@ def test_every_term_kind_is_editable(page: Any) -> None:
     pg.press("#param-1", "Enter")
     pg.wait_for_function(
         "(() => { const c = document.querySelector('#mf-chart').data.find((t) => t.name === 'I');"
-        " const i = c.x.findIndex((x) => x > 3.3); return Math.abs(c.y[i] - Math.exp(-((c.x[i] - 3) ** 2) / 0.32)) < 1e-9; })()"
+        " const i = c.x.findIndex((x) => x > 3.3);"
+        " return Math.abs(c.y[i] - Math.exp(-((c.x[i] - 3) ** 2) / 0.32)) < 1e-9; })()"
     )
     # the bell's centre dragged from 4 to 5 along the axis
     pg.select_option("#term-select", label="M")
     box = pg.locator("#mf-chart").bounding_box()
     x4, x5, y1 = pg.evaluate(
         "(() => { const l = document.querySelector('#mf-chart')._fullLayout;"
-        " return [l.xaxis.l2p(4) + l.xaxis._offset, l.xaxis.l2p(5) + l.xaxis._offset, l.yaxis.l2p(1) + l.yaxis._offset]; })()"
+        " return [l.xaxis.l2p(4) + l.xaxis._offset, l.xaxis.l2p(5) + l.xaxis._offset,"
+        " l.yaxis.l2p(1) + l.yaxis._offset]; })()"
     )
     pg.mouse.move(box["x"] + x4, box["y"] + y1)
     pg.mouse.down()
@@ -86,7 +97,9 @@ def test_every_term_kind_is_editable(page: Any) -> None:
     pg.select_option("#term-select", label="E")
     pg.fill("#term-fcl", "TRAPE 1 1.5 2 2.5")
     pg.press("#term-fcl", "Enter")
-    pg.wait_for_function("document.querySelector('#param-1') && document.querySelector('#param-1').value === '1.5'")
+    pg.wait_for_function(
+        "document.querySelector('#param-1') && document.querySelector('#param-1').value === '1.5'"
+    )
     assert params(pg) == ["1", "1.5", "2", "2.5", "1"]
     pg.fill("#term-fcl", "TRAPE 1 2")
     pg.press("#term-fcl", "Enter")
@@ -99,13 +112,14 @@ def test_every_term_kind_is_editable(page: Any) -> None:
     wanted: dict[tuple[str, str], str] = {}
     for kind, name in zip(FUZZY_KINDS, terms, strict=False):
         variable = "AllInputTerms" if len(wanted) < len(fb.fuzzify[0].terms) else "AllOutputTerms"
-        pg.select_option("#var-select", variable)
+        if pg.input_value("#var-select") != variable:
+            pg.select_option("#var-select", variable)
         pg.select_option("#term-select", label=name)
         pg.select_option("#term-kind", kind)
-        pg.wait_for_function(f"document.querySelector('#term-kind').value === '{kind}'")
         wanted[(variable, name)] = kind
+    checked(pg)  # the check of the model after the last change
     assert len(wanted) == len(FUZZY_KINDS)
-    pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
+    assert pg.inner_text("#check-badge").startswith("OK")
     edited = fuzzyctl.load(fcl_text(pg)).main
     for (variable, name), kind in wanted.items():
         block = edited.fuzzify_block(variable) or edited.defuzzify_block(variable)
@@ -117,6 +131,15 @@ def test_every_term_kind_is_editable(page: Any) -> None:
     # placed where the term was: the new shape's parameters lie in the variable's range
     for (variable, name), _kind in wanted.items():
         block = edited.fuzzify_block(variable) or edited.defuzzify_block(variable)
-        assert block is not None and (term := block.term(name)) is not None
-        if isinstance(term.mf, ShapeMF) and term.mf.kind in ("triangle", "trapezoid", "rectangle", "gaussian"):
-            assert all(-1 <= float(p) <= 7.5 for p in term.mf.params if isinstance(p, float) and math.isfinite(p))
+        assert block is not None
+        term = block.term(name)
+        assert term is not None
+        if isinstance(term.mf, ShapeMF) and term.mf.kind in (
+            "triangle",
+            "trapezoid",
+            "rectangle",
+            "gaussian",
+        ):
+            assert all(
+                -1 <= float(p) <= 7.5 for p in term.mf.params if isinstance(p, float) and math.isfinite(p)
+            )

@@ -191,6 +191,8 @@ async function applyText(input) {
   r.conclusions = parsed.conclusions;
   changed("rules");
   host.render();
+  const table = document.querySelector("#rule-table");
+  table.dataset.applied = String(+(table.dataset.applied || 0) + 1); // for tests
   status(`rule ${r.label}: ${ruleText(r)}`);
 }
 

@@ -64,8 +64,12 @@ let again = false; // the model changed while it was
 /** Something in the model changed: views redraw now, the check runs shortly after.  One
  * check is in flight at a time; changes meanwhile are checked together when it returns
  * (a 500-rule model takes a while to check, edits must not queue up behind each other). */
+let changes = 0; // model changes so far; a check reports which of them it saw
 export function changed(what = "model", { quiet = false, delay = 150 } = {}) {
   state.dirty = true;
+  changes++;
+  document.body.dataset.changes = String(changes);
+  if (inFlight) again = true; // the check under way is of the model before this change
   if (!quiet) emit("model", what);
   emit("dirty", true);
   clearTimeout(timer);
@@ -81,6 +85,7 @@ export async function recheck() {
   inFlight = true;
   again = false;
   const mine = ++seq;
+  const seen = changes;
   emit("checking", true);
   try {
     const request = body();
@@ -94,7 +99,9 @@ export async function recheck() {
     state.report = report;
     state.textError = null;
     emit("report", report);
-    document.body.dataset.checks = String(+(document.body.dataset.checks || 0) + 1); // for tests and timing
+    // for tests and timing: how many checks came back, and up to which change they saw
+    document.body.dataset.checks = String(+(document.body.dataset.checks || 0) + 1);
+    document.body.dataset.checkedChanges = String(seen);
   } catch (err) {
     if (mine !== seq || again) return;
     state.report = { ok: false, diagnostics: [{ severity: "error", message: err.message, element: null }], level: null, ranges: (state.report || {}).ranges || {}, curves: (state.report || {}).curves || {} };

@@ -198,7 +198,15 @@ function renderTerm() {
   renderParams(t);
   renderPoints(t);
   const fcl = serverCurve(t.name).fcl;
-  if (document.activeElement !== $("#term-fcl") && fcl !== undefined && !$("#term-fcl").classList.contains("bad")) $("#term-fcl").value = fcl;
+  const field = $("#term-fcl");
+  const key = `${current}\u0000${t.name}`;
+  if (field.dataset.term !== key) {
+    // another term: its own text, whatever was typed for the last one
+    field.dataset.term = key;
+    field.classList.remove("bad");
+    $("#term-fcl-diags").replaceChildren();
+    field.value = fcl ?? "";
+  } else if (document.activeElement !== field && fcl !== undefined && !field.classList.contains("bad")) field.value = fcl;
 }
 
 function render() {
