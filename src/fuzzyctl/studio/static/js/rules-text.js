@@ -31,10 +31,16 @@ export function textOf(block) {
 
 /** The check's diagnostics about this block's rules, on the lines of those rules. */
 function reportDiagnostics() {
+  const lineOf = [];
+  let line = 0;
+  for (const r of host.block().rules) {
+    for (const c of r.comments || []) line += c.split("\n").length;
+    lineOf.push(++line);
+  }
   const out = [];
   for (const d of (state.report && state.report.diagnostics) || []) {
     const at = ruleOf(d.element);
-    if (at && at.block === host.blockIndex()) out.push({ ...d, line: at.rule + 1, column: null });
+    if (at && at.block === host.blockIndex() && lineOf[at.rule]) out.push({ ...d, line: lineOf[at.rule], column: null });
   }
   return out;
 }
@@ -87,5 +93,16 @@ export function init() {
 }
 
 export function focusLine(line) {
+  editor.goToLine(line);
+}
+
+/** Go to the line of rule ``index`` (the comment lines before each rule counted). */
+export function focusRule(index) {
+  let line = 0;
+  host.block().rules.forEach((r, i) => {
+    if (i > index) return;
+    for (const c of r.comments || []) line += c.split("\n").length;
+    line += 1;
+  });
   editor.goToLine(line);
 }

@@ -234,6 +234,11 @@ export function shown() {
 export function focus(target) {
   rb = target.block || 0;
   selectedRule = target.rule;
+  if (mode === "text" && selectedRule !== null) {
+    render();
+    text.focusRule(selectedRule);
+    return;
+  }
   if (mode === "matrix" || mode === null) mode = "rows";
   render();
   if (selectedRule !== null) {

@@ -80,7 +80,7 @@ async function refresh() {
     if (mine !== seq) return; // a newer request is under way: its answer is the one to show
     data = answer;
     frame = 0;
-    draw();
+    await draw();
     $("#sf-chart").dataset.fixed = JSON.stringify(fixed);
     $("#sf-note").textContent = `${s.z} over ${s.x} and ${s.y}; click a point to explain it.`;
     emit("surface", data);
@@ -110,7 +110,7 @@ function draw() {
   const [yl, yh] = range(s.y);
   const [zl, zh] = range(s.z);
   const title = f.value === null || f.value === undefined ? "" : `${$("#sf-anim").value} = ${fmt(f.value)}`;
-  plot($("#sf-chart"), traces, {
+  return plot($("#sf-chart"), traces, {
     scene: {
       // few ticks, kept apart from the corner where the X and Y labels would meet
       xaxis: { title: { text: s.x }, range: [xl, xh], nticks: 6, tickfont: { size: 11 } },
@@ -168,7 +168,7 @@ function toggleRotation() {
   rotating = setInterval(() => {
     const slider = $("#sf-rot");
     slider.value = (+slider.value + rotationStep()) % 360;
-    Plotly.relayout($("#sf-chart"), { "scene.camera": camera() });
+    if (window.Plotly) Plotly.relayout($("#sf-chart"), { "scene.camera": camera() });
   }, 200);
 }
 
@@ -184,7 +184,7 @@ export function init() {
     settings().points = Math.max(5, Math.min(80, parseInt(e.target.value, 10) || 31));
     schedule();
   });
-  for (const id of ["#sf-rot", "#sf-elev"]) $(id).addEventListener("input", () => data && Plotly.relayout($("#sf-chart"), { "scene.camera": camera() }));
+  for (const id of ["#sf-rot", "#sf-elev"]) $(id).addEventListener("input", () => data && window.Plotly && Plotly.relayout($("#sf-chart"), { "scene.camera": camera() }));
   $("#sf-rotate").addEventListener("click", toggleRotation);
   $("#sf-rot-step").addEventListener("change", (e) => (e.target.value = rotationStep()));
   $("#sf-animate").addEventListener("click", toggleAnimation);

@@ -72,7 +72,7 @@ function renderChart() {
   const node = chart();
   const blk = current ? termBlock(current) : null;
   if (!blk) {
-    Plotly.purge(node);
+    if (window.Plotly) Plotly.purge(node);
     return;
   }
   const [lo, hi] = range(current);
