@@ -1,7 +1,7 @@
 // The 3D graphic display (manual 6.6): two inputs on X and Y, an output on Z, the other
 // inputs as family parameters, rotation, the 4D animation of a third input in steps of
 // N %, and the trajectory of the last simulated loop over the surface (issue 9).
-import { state, on, emit, inputs, outputs, range, body, fmt, status } from "./state.js";
+import { state, on, emit, inputs, outputs, range, body, fmt, num, niceTicks, status } from "./state.js";
 import { post } from "./api.js";
 import { $, el, plot } from "./ui.js";
 
@@ -97,6 +97,14 @@ function camera() {
   return { eye: { x: r * Math.cos(el_) * Math.cos(az), y: r * Math.cos(el_) * Math.sin(az), z: r * Math.sin(el_) } };
 }
 
+/** Round ticks inside the range: the ends of X and Y meet at the corners of the floor, where
+ * their labels would stand on each other. */
+function innerTicks(lo, hi) {
+  const span = hi - lo;
+  const values = niceTicks(lo, hi, 5).filter((v) => v > lo + span * 0.04 && v < hi - span * 0.04);
+  return { tickvals: values, ticktext: values.map((v) => num(v)) };
+}
+
 function draw() {
   if (!data) return;
   const s = settings();
@@ -113,8 +121,8 @@ function draw() {
   return plot($("#sf-chart"), traces, {
     scene: {
       // few ticks, kept apart from the corner where the X and Y labels would meet
-      xaxis: { title: { text: s.x }, range: [xl, xh], nticks: 6, tickfont: { size: 11 } },
-      yaxis: { title: { text: s.y }, range: [yl, yh], nticks: 6, tickfont: { size: 11 } },
+      xaxis: { title: { text: s.x }, range: [xl, xh], ...innerTicks(xl, xh), tickfont: { size: 11 } },
+      yaxis: { title: { text: s.y }, range: [yl, yh], ...innerTicks(yl, yh), tickfont: { size: 11 } },
       zaxis: { title: { text: s.z }, range: [zl, zh], nticks: 6, tickfont: { size: 11 } },
       camera: camera(),
       aspectmode: "cube",

@@ -4,7 +4,7 @@
 // trapezoid, Gaussian, bell, sigmoid ... and expressions - with a field per parameter,
 // the term as FCL text, handles to drag on the chart (singletons and spikes as lines),
 // every curve labelled, zoom in five steps.
-import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status, bodyWithoutRules } from "./state.js";
+import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, num, status, bodyWithoutRules } from "./state.js";
 import { post } from "./api.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
 import { SHAPES, kindOf, kindLabel, kinds, handles, placeOf, convert, paramName, readParam, paramText, positions, rescale, localCurve } from "./terms.js";
@@ -339,7 +339,7 @@ async function setRange() {
   // the new range shows at once; the check confirms it
   if (state.report) state.report.ranges = { ...state.report.ranges, [current]: [lo, hi] };
   changed("range");
-  status(`${current}: range ${fmt(lo)} … ${fmt(hi)}${adjust ? ", membership functions adjusted" : ""}`);
+  status(`${current}: range ${num(lo)} … ${num(hi)}${adjust ? ", membership functions adjusted" : ""}`);
 }
 
 function insertTerm() {
@@ -384,7 +384,7 @@ async function insertN() {
   point = 0;
   const lost = blankMissingTerms(current);
   changed("terms");
-  status(`${n} terms spread over ${fmt(lo)} … ${fmt(hi)}${lost ? `; ${lost} rule(s) referred to the old terms` : ""}`);
+  status(`${n} terms spread over ${num(lo)} … ${num(hi)}${lost ? `; ${lost} rule(s) referred to the old terms` : ""}`);
 }
 
 function changeKind(kind) {
