@@ -383,7 +383,9 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
     # more than 450 samples: the archive is full and the oldest records are gone
-    pg.wait_for_function("document.querySelector('#rec-chart').layout.xaxis.range[0] >= 60", timeout=20000)
+    pg.wait_for_function(
+        "(document.querySelector('#rec-chart').layout?.xaxis.range[0] ?? 0) >= 60", timeout=30000
+    )
     pg.click("#rec-stop")
     values = reading(pg, 75)
     assert values["Temp"] == 0  # the range minimum

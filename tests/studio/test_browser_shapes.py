@@ -63,6 +63,7 @@ def test_every_term_kind_is_editable(page: Any) -> None:
             )
             assert xs == [p.x for p in mf.points]
     # every curve carries its name
+    pg.wait_for_function("document.querySelector('#mf-chart').layout")
     labels = pg.evaluate("document.querySelector('#mf-chart').layout.annotations.map((a) => a.text)")
     assert sorted(labels) == sorted(t.name for t in fb.fuzzify[0].terms)
     shot(pg, "23-every-shape", doc=True)

@@ -135,6 +135,7 @@ export function openPicker(td) {
   const close = (apply) => {
     if (done) return;
     done = true;
+    const t0 = performance.now();
     if (apply && picker.value !== current) {
       const now = side === "if" ? conditionCells(block.rules[j]) : conclusionCells(block.rules[j]);
       let value = picker.value;
@@ -163,6 +164,8 @@ export function openPicker(td) {
       head.classList.toggle("incomplete", !complete(block.rules[j]));
       head.title = complete(block.rules[j]) ? ruleText(block.rules[j]) : "incomplete: needs an IF and a THEN part";
     }
+    // the browser's time for the edit: the model changed, the cell drawn again (for tests)
+    document.querySelector("#rule-table").dataset.editMs = (performance.now() - t0).toFixed(1);
   };
   picker.addEventListener("change", () => close(true));
   picker.addEventListener("blur", () => close(null));
