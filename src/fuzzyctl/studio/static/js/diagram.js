@@ -121,8 +121,8 @@ function renderDiagram() {
   // boxes (and the terms drawn in them) grow with the space there is
   const W = Math.max(640, host.clientWidth || 1000);
   const avail = Math.max(300, host.clientHeight || 500);
-  const BOX_W = Math.round(Math.max(200, Math.min(340, W * 0.27)));
-  const BOX_H = Math.round(Math.max(96, Math.min(170, (avail - 70) / rows - GAP)));
+  const BOX_W = Math.round(Math.max(200, Math.min(360, W * 0.29)));
+  const BOX_H = Math.round(Math.max(96, Math.min(210, (avail - 70) / rows - GAP)));
   const H = Math.max(avail, rows * (BOX_H + GAP) + 70);
   const root = svg("svg", { viewBox: `0 0 ${W} ${H}`, width: W, height: H, role: "group", "aria-label": `function block ${b.name}` });
   const column = (n, k) => 50 + ((H - 60 - n * (BOX_H + GAP)) / 2) + k * (BOX_H + GAP);
@@ -130,7 +130,7 @@ function renderDiagram() {
   const bottom = column(rows, rows - 1) + BOX_H + 16;
   root.append(svg("rect", { x: BOX_W + 40, y: top, width: W - 2 * BOX_W - 80, height: bottom - top, rx: 12, class: "fb" }));
   root.append(svg("text", { x: W / 2, y: top + 24, "text-anchor": "middle", class: "fb-name" }, `FUNCTION_BLOCK ${b.name || ""}`));
-  const ruleW = Math.round(Math.max(220, Math.min(300, W * 0.22)));
+  const ruleW = Math.round(Math.max(170, Math.min(320, W - 2 * BOX_W - 110)));
   const ruleX = (W - ruleW) / 2;
   blocks.forEach((rb, i) => {
     const y = column(blocks.length, i);
