@@ -199,3 +199,14 @@ def test_what_fcl_cannot_write_is_listed(client: TestClient) -> None:
     assert any("lock-range" in loss for loss in r["fcl_losses"])
     opened = client.post("/api/open", json={"path": "crane.fcl"}).json()
     assert opened["fcl_losses"] == [] and set(opened["curves"]) == {"distance", "angle", "power"}
+
+
+def test_an_expression_term_is_read_too(client: TestClient) -> None:
+    """A term given by an expression (jFuzzyLogic FUNCTION, a Takagi-Sugeno output) has no
+    parameter fields: it is written and read as FCL."""
+    doc = crane(client)
+    r = client.post(
+        "/api/term/parse", json={"document": doc, "variable": "power", "text": "FUNCTION 2 * distance + 1"}
+    ).json()
+    assert r["ok"] and r["mf"]["type"] == "function"
+    assert r["mf"]["expr"]["type"] == "binary" and r["mf"]["expr"]["op"] == "+"
