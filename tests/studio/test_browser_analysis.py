@@ -101,6 +101,14 @@ def test_rotation_explain_and_rule_viewer(page: Any, browser_project: Path) -> N
     # the rotation step of the manual: 5 to 45 degrees
     tab(pg, "surface")
     pg.wait_for_function("document.querySelector('#sf-chart').data")
+    # tick labels of X and Y stay off the floor's corners, where they would stand on each other
+    scene = pg.evaluate("document.querySelector('#sf-chart').layout.scene")
+    for axis, name in (("xaxis", "distance"), ("yaxis", "angle")):
+        lo, hi = scene[axis]["range"]
+        ticks = scene[axis]["tickvals"]
+        assert scene[axis]["title"]["text"] == name
+        assert 2 <= len(ticks) <= 6
+        assert all(lo + 0.04 * (hi - lo) < t < hi - 0.04 * (hi - lo) for t in ticks), (axis, lo, hi, ticks)
     pg.fill("#sf-rot-step", "60")
     pg.press("#sf-rot-step", "Tab")
     assert pg.input_value("#sf-rot-step") == "45"

@@ -40,6 +40,17 @@ def width(pg: Any, selector: str) -> float:
 def test_panes_diagram_busy_numbers_gutter(page: Any) -> None:
     pg = page
     assert pg.is_hidden("#loading")  # the loading indicator is gone once the studio is ready
+    # ... and shows while the project is read (the server's answer is held back here)
+    waiting: list[Any] = []
+    pg.route("**/api/info", lambda route: waiting.append(route))
+    pg.reload(wait_until="domcontentloaded")
+    pg.wait_for_function("document.querySelector('#loading-text').textContent.includes('Reading the project')")
+    assert pg.is_visible("#loading") and pg.is_visible("#loading .spinner")
+    for route in waiting:
+        route.continue_()
+    pg.unroute("**/api/info")
+    pg.wait_for_selector("body[data-ready=true]")
+    assert pg.is_hidden("#loading")
     # the busy bar shows while a request is under way (the check is held back here)
     held: list[Any] = []
     hold = [True]
