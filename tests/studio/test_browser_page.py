@@ -44,7 +44,7 @@ def test_panes_diagram_busy_numbers_gutter(page: Any) -> None:
     waiting: list[Any] = []
     pg.route("**/api/info", lambda route: waiting.append(route))
     pg.reload(wait_until="domcontentloaded")
-    pg.wait_for_function("document.querySelector('#loading-text').textContent.includes('Reading the project')")
+    pg.wait_for_function("document.querySelector('#loading-text').textContent.includes('Reading')")
     assert pg.is_visible("#loading") and pg.is_visible("#loading .spinner")
     for route in waiting:
         route.continue_()
