@@ -220,7 +220,7 @@ function render() {
     return;
   }
   if (term >= blk.terms.length) term = Math.max(0, blk.terms.length - 1);
-  $("#var-name").value = current;
+  if (document.activeElement !== $("#var-name")) $("#var-name").value = current; // not while typed in
   const [lo, hi] = range(current);
   if (document.activeElement !== $("#var-min")) $("#var-min").value = lo;
   if (document.activeElement !== $("#var-max")) $("#var-max").value = hi;
