@@ -42,6 +42,15 @@ def pick_in_matrix(pg: Any, row: str, col: str, term: str) -> None:
     pg.wait_for_selector("#rule-matrix:not(:has(select))")
 
 
+def cut_cells(pg: Any, selector: str) -> list[str]:
+    """The cells whose text does not fit (names cut, as the old dropdowns did)."""
+    cut: list[str] = pg.evaluate(
+        f"[...document.querySelectorAll({selector!r})]"
+        ".filter((e) => e.scrollWidth > e.clientWidth + 1).map((e) => e.textContent)"
+    )
+    return cut
+
+
 def test_matrix_columns_and_table_edit_one_model(page: Any, browser_project: Path) -> None:
     pg = page
     open_file(pg, "crane.fcl")
@@ -55,6 +64,13 @@ def test_matrix_columns_and_table_edit_one_model(page: Any, browser_project: Pat
         assert isinstance(a, Is) and isinstance(b, Is)
         assert matrix_cell(pg, a.term, b.term) == rule.conclusions[0].term
     assert "25 of 25 rule(s) in this matrix" in pg.inner_text("#matrix-note")
+    assert (
+        pg.locator("#rule-matrix td").count() == 25
+        and cut_cells(pg, "#rule-matrix td, #rule-matrix th") == []
+    )
+    # the whole matrix is in view: no horizontal scrolling
+    pane = "document.querySelector('#rules-matrix')"
+    assert pg.evaluate(f"{pane}.scrollWidth <= {pane}.clientWidth")
     shot(pg, "20-rule-matrix", doc=True)
     # a cell changes its rule; a blanked cell removes it; a pick in an empty cell adds one
     pick_in_matrix(pg, "far", "zero", "pos_high")
@@ -76,10 +92,12 @@ def test_matrix_columns_and_table_edit_one_model(page: Any, browser_project: Pat
     rule_mode(pg, "columns")
     assert pg.locator("#rule-table th.rule-head").count() == 25
     assert cell_text(pg, 0, "distance") == "far" and cell_text(pg, 0, "power") == "pos_medium"
+    assert cut_cells(pg, "#rule-table td.cell") == []
     shot(pg, "21-rule-columns", doc=True)
     # the table with one row per rule; an input cell offers NOT term
     rule_mode(pg, "rows")
     assert pg.locator("#rule-table tbody tr").count() == 25
+    assert cut_cells(pg, "#rule-table td.cell") == []
     set_cell(pg, 0, "angle", "NOT neg_big")
     assert cell_text(pg, 0, "angle") == "NOT neg_big"
     settle(pg)
