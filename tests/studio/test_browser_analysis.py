@@ -157,4 +157,7 @@ def test_rotation_explain_and_rule_viewer(page: Any, browser_project: Path) -> N
     assert cell is not None
     pg.mouse.click(cell["x"] + cell["width"] * 0.75, cell["y"] + cell["height"] / 2)
     pg.wait_for_function("+document.querySelector('#rv-in-distance').value > 10")
+    # ... to a value as an engineer writes it: a thousandth of the range (24 -> 0.01)
+    clicked = pg.input_value("#rv-in-distance")
+    assert len(clicked.partition(".")[2]) <= 2, clicked
     shot(pg, "28-rule-viewer", doc=True)

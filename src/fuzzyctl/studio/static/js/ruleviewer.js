@@ -4,7 +4,7 @@
 // accumulated sets with the defuzzified values.  Inputs are set with the sliders, or by
 // clicking / dragging in an input's column.  Everything is computed by the engine
 // (/api/ruleview); the drawing clips nothing itself but the input terms' fill.
-import { state, on, inputs, outputs, range, body, fmtVar, deg, status } from "./state.js";
+import { state, on, inputs, outputs, range, body, fmt, fmtVar, deg, status } from "./state.js";
 import { post } from "./api.js";
 import { $, el } from "./ui.js";
 
@@ -176,9 +176,12 @@ async function refresh() {
   }
 }
 
-function setValue(name, v) {
+/** Set input ``name``; ``snap``: a value from the slider or the mouse, rounded to a
+ * thousandth of the range (what the number field then shows, not 14.1132). */
+function setValue(name, v, snap = false) {
   const [lo, hi] = range(name);
-  values[name] = Math.max(lo, Math.min(hi, v));
+  const clamped = Math.max(lo, Math.min(hi, v));
+  values[name] = snap ? parseFloat(fmt(clamped, 4, hi - lo)) : clamped;
   const slider = $(`#rv-slider-${CSS.escape(name)}`);
   const number = $(`#rv-in-${CSS.escape(name)}`);
   if (slider) slider.value = values[name];
@@ -194,7 +197,7 @@ function renderInputs() {
     if (!(v.name in values) || values[v.name] < lo || values[v.name] > hi) values[v.name] = (lo + hi) / 2;
     const slider = el("input", { type: "range", min: lo, max: hi, step: (hi - lo) / 500, value: values[v.name], id: `rv-slider-${v.name}`, "aria-label": `${v.name} slider` });
     const number = el("input", { type: "number", step: "any", value: Number(values[v.name].toPrecision(6)), size: 8, id: `rv-in-${v.name}`, "aria-label": v.name });
-    slider.addEventListener("input", () => setValue(v.name, parseFloat(slider.value)));
+    slider.addEventListener("input", () => setValue(v.name, parseFloat(slider.value), true));
     number.addEventListener("change", () => Number.isFinite(parseFloat(number.value)) && setValue(v.name, parseFloat(number.value)));
     row.append(el("label", {}, `${v.name} `, slider, number));
   }
@@ -218,12 +221,12 @@ export function init() {
     e.preventDefault();
     dragging = node;
     const [name, v] = valueAt(e, node);
-    setValue(name, v);
+    setValue(name, v, true);
   });
   window.addEventListener("pointermove", (e) => {
     if (!dragging) return;
     const [name, v] = valueAt(e, dragging);
-    setValue(name, v);
+    setValue(name, v, true);
   });
   window.addEventListener("pointerup", () => (dragging = null));
   $("#rv-filter").addEventListener("change", () => last && draw(last));
