@@ -210,3 +210,22 @@ def test_an_expression_term_is_read_too(client: TestClient) -> None:
     ).json()
     assert r["ok"] and r["mf"]["type"] == "function"
     assert r["mf"]["expr"]["type"] == "binary" and r["mf"]["expr"]["op"] == "+"
+
+
+def test_a_rule_without_if_part_is_typed_as_fcl_writes_it(client: TestClient, tmp_path: Path) -> None:
+    """IF ALWAYS THEN (fcl/no_if.py, Siemens 1.5) reads back as a rule without an IF part,
+    as the FCL text of a whole block does; ALWAYS inside a condition is refused (it is no
+    variable of the model)."""
+    doc = crane(client)
+    out = parse(client, doc, "IF ALWAYS THEN power IS zero\nIF angle IS zero THEN power IS zero")
+    assert out["ok"], out["diagnostics"]
+    assert out["rules"][0]["condition"] is None and out["rules"][1]["condition"]["type"] == "is"
+    # the FCL text of the whole block reads the same line the same way
+    text = (EXAMPLES / "crane.fcl").read_text()
+    text = text.replace("VAR_INPUT", "VAR_INPUT\n    ALWAYS : REAL := 1.0;", 1)
+    text = text.replace("END_RULEBLOCK", "RULE 99 : IF ALWAYS THEN power IS zero;\nEND_RULEBLOCK", 1)
+    (tmp_path / "always.fcl").write_text(text)
+    rules = fuzzyctl.load(tmp_path / "always.fcl").main.rule_blocks[0].rules
+    assert rules[-1].label == "99" and rules[-1].condition is None
+    bad = parse(client, doc, "IF ALWAYS AND angle IS zero THEN power IS zero")
+    assert not bad["ok"] and "ALWAYS stands alone" in bad["diagnostics"][0]["message"]

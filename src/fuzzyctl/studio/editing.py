@@ -24,8 +24,9 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.fcl.no_if import always_name
 from fuzzyctl.formats.json import encode
-from fuzzyctl.model import Document, FunctionBlock, SingletonMF, Term
+from fuzzyctl.model import Degree, Document, FunctionBlock, SingletonMF, Term, Variable, VarKind
 from fuzzyctl.studio import analysis
 
 _LABELLED = re.compile(r"^\s*RULE\s+(\w+)\s*:", re.IGNORECASE)
@@ -140,6 +141,17 @@ class _LineCache:
 _LINES = _LineCache()
 
 
+def _mentions(condition: Any, name: str) -> bool:
+    """Whether a condition (JSON form) reads variable ``name``."""
+    if isinstance(condition, dict):
+        if condition.get("variable") == name:
+            return True
+        return any(_mentions(v, name) for v in condition.values())
+    if isinstance(condition, list):
+        return any(_mentions(v, name) for v in condition)
+    return False
+
+
 def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]:
     """The rules of ``text`` (one per line) as rule block ``rule_block`` of ``fb``:
     ``{"ok", "rules", "lines", "diagnostics"}``; ``rules`` is None when a line has an
@@ -150,7 +162,17 @@ def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]
     if not 0 <= rule_block < len(fb.rule_blocks):
         raise FuzzyctlError(f"rule block {rule_block}: the function block has {len(fb.rule_blocks)}")
     block = fb.rule_blocks[rule_block]
-    skeleton = replace(fb, rule_blocks=(replace(block, rules=(), comments=()),), options=())
+    # a rule without an IF part (Siemens 1.5) is typed as FCL writes it, IF ALWAYS THEN:
+    # the lines are read with that always-1 input declared, and turned back into rules
+    # without a condition (fcl/no_if.py)
+    always = always_name(fb)
+    declared = Variable(always, VarKind.INPUT, "REAL", 1.0)
+    skeleton = replace(
+        fb,
+        variables=(*fb.variables, declared),
+        rule_blocks=(replace(block, rules=(), comments=()),),
+        options=(),
+    )
     written = analysis.fcl_text(Document((skeleton,))).split("\n")
     context = hashlib.sha256("\n".join(written).encode("utf-8")).hexdigest()
     end = max(i for i, line in enumerate(written) if line.strip().upper() == "END_RULEBLOCK")
@@ -185,7 +207,14 @@ def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]
         else:
             parsed = report.parsed.main.rule_blocks[0].rules
             for i, rule in zip(missing, parsed, strict=True):
-                value = (strip_spans(encode(rule)), [d for d in found if d["line"] == i])
+                own = [d for d in found if d["line"] == i]
+                if isinstance(rule.condition, Degree) and rule.condition.variable == always:
+                    rule = replace(rule, condition=None)
+                elif rule.condition is not None and _mentions(encode(rule.condition), always):
+                    message = f"{always} stands alone (IF {always} THEN: a rule without an IF part)"
+                    own.append({"severity": "error", "message": message, "line": i, "column": None})
+                    diagnostics.append(own[-1])
+                value = (strip_spans(encode(rule)), own)
                 _LINES.put(keys[i], value)
                 known[i] = value
     for i in rule_lines:

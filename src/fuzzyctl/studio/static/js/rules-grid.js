@@ -8,7 +8,7 @@
 import { state, inputs, outputs, changed, status } from "./state.js";
 import { el } from "./ui.js";
 import { escape } from "./code.js";
-import { conditionCells, conclusionCells, setCondition, setConclusions, complete, conditionText, conclusionsText, ruleText, termOptions, ruleOf } from "./rules-model.js";
+import { conditionCells, conclusionCells, setCondition, setConclusions, complete, conditionText, conclusionsText, ruleText, termOptions, ruleOf, alwaysName } from "./rules-model.js";
 
 let host = null; // {block(), blockIndex(), selected(), select(j, focus), parseRule(text, field), render(), orientation}
 
@@ -44,7 +44,7 @@ function textHtml(rule, j, side, span) {
 function headHtml(rule, j, selected) {
   const cls = `rule-head${j === selected ? " selected" : ""}${complete(rule) ? "" : " incomplete"}`;
   const weight = rule.weight !== null && rule.weight !== undefined ? ` <span class="hint" title="rule weight (MATLAB / fuzzylite): multiplies the condition degree">×${attr(typeof rule.weight === "object" ? rule.weight.name : rule.weight)}</span>` : "";
-  const title = complete(rule) ? ruleText(rule) : "incomplete: needs an IF and a THEN part";
+  const title = complete(rule) ? ruleText(rule) : "incomplete: needs a THEN part";
   return `<th scope="${host.orientation === "rows" ? "row" : "col"}" class="${cls}" tabindex="0" data-rule="${j}" title="${attr(title)}">${escape(rule.label)}${weight}</th>`;
 }
 
@@ -162,7 +162,7 @@ export function openPicker(td) {
     const head = document.querySelector(`#rule-table th.rule-head[data-rule="${j}"]`);
     if (head) {
       head.classList.toggle("incomplete", !complete(block.rules[j]));
-      head.title = complete(block.rules[j]) ? ruleText(block.rules[j]) : "incomplete: needs an IF and a THEN part";
+      head.title = complete(block.rules[j]) ? ruleText(block.rules[j]) : "incomplete: needs a THEN part";
     }
     // the browser's time for the edit: the model changed, the cell drawn again (for tests)
     document.querySelector("#rule-table").dataset.editMs = (performance.now() - t0).toFixed(1);
@@ -186,7 +186,7 @@ async function applyText(input) {
   const j = +input.dataset.rule;
   const r = host.block().rules[j];
   const side = input.dataset.part;
-  const condition = side === "if" ? input.value : conditionText(r.condition);
+  const condition = side === "if" ? input.value.trim() || alwaysName() : r.condition ? conditionText(r.condition) : alwaysName();
   const conclusions = side === "then" ? input.value : conclusionsText(r);
   const parsed = await host.parseRule(`RULE ${r.label} : IF ${condition} THEN ${conclusions}`, input);
   if (!parsed) return;

@@ -65,10 +65,22 @@ export function fromCells(rule, view) {
   setConclusions(rule, view);
 }
 
-/** A rule is part of the knowledge base when it concludes something (and, until rules
- * without an IF part are carried through FCL, when it has a condition). */
+/** A rule is part of the knowledge base once it has a THEN part; without an IF part it acts
+ * with degree 1 (S7 manual 1.5: "as if the conditions of the IF part were fully
+ * fulfilled").  An IF part alone has no influence. */
 export function complete(rule) {
-  return !!rule.condition && rule.conclusions.length > 0;
+  return rule.conclusions.length > 0;
+}
+
+/** The name FCL gives the always-1 input of the rules without an IF part (fcl/no_if.py:
+ * ``ALWAYS``, or ``ALWAYS_2``... when a name of the function block takes it). */
+export function alwaysName() {
+  const b = fb();
+  const taken = new Set([b.name || "", ...b.variables.map((v) => v.name), ...b.rule_blocks.map((r) => r.name || "")].map((n) => n.toUpperCase()));
+  for (const blk of [...b.fuzzify, ...b.defuzzify]) for (const t of blk.terms) taken.add(t.name.toUpperCase());
+  let name = "ALWAYS";
+  for (let n = 2; taken.has(name); n++) name = `ALWAYS_${n}`;
+  return name;
 }
 
 function paramText(p) {
@@ -105,9 +117,15 @@ export function conclusionsText(rule) {
   return rule.conclusions.map(conclusionText).join(", ");
 }
 
-/** ``IF ... THEN ...`` as the FCL text writes it. */
+/** ``IF ... THEN ...`` to read; a rule without an IF part says what it does. */
 export function ruleText(rule) {
-  return `IF ${conditionText(rule.condition)} THEN ${conclusionsText(rule)}`;
+  return `${rule.condition ? `IF ${conditionText(rule.condition)}` : "(no IF part: degree 1)"} THEN ${conclusionsText(rule)}`;
+}
+
+/** ``IF ... THEN ...`` as the FCL text writes it (a rule without an IF part: ``IF ALWAYS
+ * THEN``), for the text editors: the parser reads it back. */
+export function ruleLine(rule) {
+  return `IF ${rule.condition ? conditionText(rule.condition) : alwaysName()} THEN ${conclusionsText(rule)}`;
 }
 
 export function nextLabel(block) {

@@ -6,7 +6,7 @@
 import { state, changed } from "./state.js";
 import { $, fillDiagnostics } from "./ui.js";
 import { CodeEditor } from "./code.js";
-import { ruleText, ruleOf } from "./rules-model.js";
+import { ruleLine, ruleOf } from "./rules-model.js";
 
 let host = null; // {block(), blockIndex(), parse(text) -> result}
 let editor = null;
@@ -24,7 +24,7 @@ export function textOf(block) {
   const lines = [];
   block.rules.forEach((r, i) => {
     for (const c of r.comments || []) lines.push(...c.split("\n"));
-    lines.push((r.label === String(i + 1) ? ruleText(r) : `RULE ${r.label} : ${ruleText(r)}`) + ";");
+    lines.push((r.label === String(i + 1) ? ruleLine(r) : `RULE ${r.label} : ${ruleLine(r)}`) + ";");
   });
   return lines.join("\n");
 }

@@ -127,7 +127,15 @@ function renderDiagnostics(blk) {
   const diags = state.report ? state.report.diagnostics.filter((d) => d.element && (d.element === `ruleblock:${rb}` || d.element.startsWith(`rule:${rb}:`))) : [];
   fillDiagnostics($("#rule-diags"), diags);
   const incomplete = blk.rules.filter((r) => !complete(r)).length;
-  if (incomplete) $("#rule-diags").prepend(el("li", { class: "note" }, `${incomplete} incomplete rule(s) (no IF or no THEN part): not part of the knowledge base until complete, not saved.`));
+  if (incomplete) $("#rule-diags").prepend(el("li", { class: "note" }, `${incomplete} incomplete rule(s) (no THEN part): not part of the knowledge base until complete, not saved.`));
+  noIfNote(blk);
+}
+
+/** Rules with a THEN part only (manual 1.5): say what they do and how FCL holds them. */
+function noIfNote(blk) {
+  const labels = blk.rules.filter((r) => !r.condition && r.conclusions.length).map((r) => r.label);
+  if (!labels.length) return;
+  $("#rule-diags").prepend(el("li", { class: "note", "data-no-if": labels.join(",") }, `rule(s) ${labels.join(", ")}: no IF part, acting with degree 1 (manual 1.5); saved in FCL as "IF ALWAYS THEN", ALWAYS an unconnected input := 1.0.`));
 }
 
 function markSelected() {

@@ -6,6 +6,7 @@
 // every curve labelled, zoom in five steps.
 import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, num, status, bodyWithoutRules } from "./state.js";
 import { post } from "./api.js";
+import { nameWarning } from "./names.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
 import { SHAPES, kindOf, kindLabel, kinds, handles, placeOf, convert, paramName, readParam, paramText, positions, rescale, localCurve } from "./terms.js";
 
@@ -220,7 +221,8 @@ function render() {
     return;
   }
   if (term >= blk.terms.length) term = Math.max(0, blk.terms.length - 1);
-  if (document.activeElement !== $("#var-name")) $("#var-name").value = current; // not while typed in
+  // A field being typed in keeps its text when a check's report redraws the view.
+  if (document.activeElement !== $("#var-name")) $("#var-name").value = current;
   const [lo, hi] = range(current);
   if (document.activeElement !== $("#var-min")) $("#var-min").value = lo;
   if (document.activeElement !== $("#var-max")) $("#var-max").value = hi;
@@ -556,11 +558,14 @@ export function init() {
   $("#var-name").addEventListener("change", (e) => {
     const name = e.target.value.trim();
     if (name === current) return;
-    if (!isIdentifier(name)) return status(`${name}: a name is a letter or _ followed by letters, digits or _`, "error"), render();
-    if (variableNames().includes(name)) return status(`${name} exists already`, "error"), render();
+    const refuse = (message) => ((e.target.value = current), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: a name is a letter or _ followed by letters, digits or _`);
+    if (variableNames().includes(name)) return refuse(`${name} exists already`);
     renameVariable(current, name);
     current = name;
     changed("rename");
+    const warn = nameWarning("variable", name);
+    if (warn) status(warn, "warning");
   });
   $("#term-select").addEventListener("change", (e) => {
     term = +e.target.value;
@@ -574,11 +579,14 @@ export function init() {
     const name = e.target.value.trim();
     const old = blk.terms[term].name;
     if (name === old) return;
-    if (!isIdentifier(name)) return status(`${name}: not a valid term name`, "error"), render();
-    if (blk.terms.some((t) => t.name === name)) return status(`${current} has a term ${name} already`, "error"), render();
+    const refuse = (message) => ((e.target.value = old), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: not a valid term name`);
+    if (blk.terms.some((t) => t.name === name)) return refuse(`${current} has a term ${name} already`);
     blk.terms[term].name = name;
     renameTerm(current, old, name);
     changed("rename");
+    const warn = nameWarning("term", name);
+    if (warn) status(warn, "warning");
   });
   $("#term-kind").addEventListener("change", (e) => changeKind(e.target.value));
   $("#term-fcl").addEventListener("keydown", (e) => e.key === "Enter" && (e.preventDefault(), applyFcl()));
