@@ -41,6 +41,12 @@ class LoadResult:
 
 def check_source(source: Source) -> LoadResult:
     """Parse and check decoded text; never raises for bad input."""
+    from fuzzyctl.limits import check_text
+
+    try:
+        check_text(source.text, source.path, "fcl")
+    except DiagnosticError as exc:  # over the size limit: said, not parsed
+        return LoadResult(None, exc.diagnostics, source)
     parsed = parse_source(source)
     diagnostics = list(parsed.diagnostics)
     if parsed.document is not None and not has_errors(diagnostics):

@@ -1,0 +1,117 @@
+"""Limits on what fuzzyctl reads, so that no input can take unbounded time or memory.
+
+* :func:`max_input_bytes` - the largest model file read: 1 MiB for the text formats (FCL,
+  FIS, FLL, FPL, XFUZ; 3.6 times the largest real FCL file we know of, 290 KB, and what the
+  slowest reader, FCL, parses in under 5 s), 12 MiB for JSON (which spells out every span:
+  that 290 KB FCL file is 6 MB of JSON).  ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for
+  every format.  A larger file is refused before it is read, with a diagnostic saying the
+  size and the limit.
+* :data:`MAX_DIAGNOSTICS_SHOWN` - how many diagnostics the CLI prints per file; the rest
+  are summarised as "N more".
+* :data:`MAX_NESTING` - how deep conditions, expressions and JSON may nest (a rule with
+  more than that many parentheses or NOTs is refused with its place, never a
+  RecursionError).
+* :data:`MAX_DIGITS` - the longest number literal read (Python refuses to convert
+  integers over 4300 digits; a literal that long is an error with its place).
+
+The limits are documented in docs/limits.md.
+"""
+# MAX_DIAGNOSTICS_SHOWN lives in fuzzyctl.diagnostics (the renderer uses it); re-exported here.
+
+from __future__ import annotations
+
+import os
+import stat
+from pathlib import Path
+
+from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, DiagnosticError, error
+
+DEFAULT_MAX_INPUT_BYTES = 1024 * 1024
+#: Formats whose files are larger for the same system (read by a C parser, so faster).
+FORMAT_MAX_INPUT_BYTES = {"json": 12 * 1024 * 1024}
+MAX_NESTING = 200
+MAX_DIGITS = 400
+
+
+__all__ = [
+    "DEFAULT_MAX_INPUT_BYTES",
+    "MAX_DIAGNOSTICS_SHOWN",
+    "MAX_DIGITS",
+    "MAX_NESTING",
+    "check_text",
+    "max_input_bytes",
+    "read_input",
+    "too_large",
+]
+
+
+def max_input_bytes(format: str | None = None) -> int:
+    """The size limit of a model file of ``format`` in bytes (``FUZZYCTL_MAX_INPUT_BYTES``
+    when set, else :data:`DEFAULT_MAX_INPUT_BYTES` or the format's own)."""
+    value = os.environ.get("FUZZYCTL_MAX_INPUT_BYTES", "")
+    try:
+        limit = int(value)
+    except ValueError:
+        limit = 0
+    if limit > 0:
+        return limit
+    return FORMAT_MAX_INPUT_BYTES.get((format or "").lower(), DEFAULT_MAX_INPUT_BYTES)
+
+
+def _mib(n: int) -> str:
+    return f"{n / (1024 * 1024):.1f} MiB" if n >= 1024 * 1024 else f"{n} bytes"
+
+
+def too_large(size: int, path: str | None, format: str | None = None) -> DiagnosticError:
+    limit = max_input_bytes(format)
+    what = f"{format.upper()} files" if format else "model files"
+    return DiagnosticError(
+        [
+            error(
+                f"the file is {_mib(size)}, over the {_mib(limit)} limit for {what}",
+                file=path,
+                code="too-large",
+                hint="set FUZZYCTL_MAX_INPUT_BYTES to read larger files",
+            )
+        ]
+    )
+
+
+def _unreadable(exc: OSError, name: str) -> DiagnosticError:
+    return DiagnosticError([error(f"cannot read: {exc.strerror or exc}", file=name, code="unreadable")])
+
+
+def read_input(path: str | os.PathLike[str], format: str | None = None) -> bytes:
+    """The bytes of a model file, or :class:`DiagnosticError` for a missing file, a
+    directory, an unreadable file or one over :func:`max_input_bytes` (checked before
+    reading; a pipe or device is read up to the limit and no further)."""
+    p = Path(path)
+    name = str(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise DiagnosticError([error("no such file", file=name, code="no-file")]) from None
+    except OSError as exc:
+        raise _unreadable(exc, name) from None
+    if stat.S_ISDIR(st.st_mode):
+        what = f"an {format.upper()} file" if format else "a model file"
+        raise DiagnosticError([error(f"is a directory, not {what}", file=name, code="is-directory")])
+    limit = max_input_bytes(format)
+    if stat.S_ISREG(st.st_mode) and st.st_size > limit:
+        raise too_large(st.st_size, name, format)
+    try:
+        with p.open("rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError as exc:
+        raise _unreadable(exc, name) from None
+    if len(data) > limit:
+        raise too_large(len(data), name, format)
+    return data
+
+
+def check_text(text: str, path: str | None = None, format: str | None = None) -> None:
+    """Refuse source text over the size limit of ``format`` (in UTF-8 bytes; the encoding is
+    only measured when the length leaves a doubt)."""
+    limit = max_input_bytes(format)
+    if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8", "surrogatepass")) > limit):
+        raise too_large(len(text.encode("utf-8", "surrogatepass")), path, format)
