@@ -1,16 +1,16 @@
 """Limits on what fuzzyctl reads, so that no input can take unbounded time or memory.
 
-* :func:`max_input_bytes` - the largest model file read: 1 MiB for the text formats (FCL,
-  FIS, FLL, FPL, XFUZ; 3.6 times the largest real FCL file we know of, 290 KB, and what the
-  slowest reader, FCL, parses in under 5 s), 12 MiB for JSON (which spells out every span:
-  that 290 KB FCL file is 6 MB of JSON).  ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for
-  every format.  A larger file is refused before it is read, with a diagnostic saying the
-  size and the limit.
+* :func:`max_input_bytes` - the largest model file read: 8 MiB for the text formats (FCL,
+  FIS, FLL, FPL, XFUZ; a 10,000-rule FCL system is 1.4 MB, the largest real FCL file we
+  know of 290 KB), 96 MiB for JSON (which spells out every span: that 10,000-rule system is
+  43.5 MB of JSON).  ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for every format.  A
+  larger file is refused before it is read, with a diagnostic saying the size and the
+  limit; reading time is linear in the size below it.
 * :data:`MAX_DIAGNOSTICS_SHOWN` - how many diagnostics the CLI prints per file; the rest
   are summarised as "N more".
-* :data:`MAX_NESTING` - how deep conditions, expressions and JSON may nest (a rule with
-  more than that many parentheses or NOTs is refused with its place, never a
-  RecursionError).
+* :data:`MAX_NESTING` - how deep conditions and expressions may nest (a rule with more
+  than that many nested NOTs, ANDs in ORs or parentheses is refused with its place, never
+  a RecursionError); JSON may nest :data:`MAX_JSON_DEPTH` levels.
 * :data:`MAX_DIGITS` - the longest number literal read (Python refuses to convert
   integers over 4300 digits; a literal that long is an error with its place).
 
@@ -20,16 +20,32 @@ The limits are documented in docs/limits.md.
 
 from __future__ import annotations
 
+import math
 import os
 import stat
 from pathlib import Path
 
-from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, DiagnosticError, error
+from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, Diagnostic, DiagnosticError, error
+from fuzzyctl.model import (
+    And,
+    Binary,
+    Call,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Not,
+    Or,
+    Range,
+    Unary,
+)
 
-DEFAULT_MAX_INPUT_BYTES = 1024 * 1024
+DEFAULT_MAX_INPUT_BYTES = 8 * 1024 * 1024
 #: Formats whose files are larger for the same system (read by a C parser, so faster).
-FORMAT_MAX_INPUT_BYTES = {"json": 12 * 1024 * 1024}
-MAX_NESTING = 200
+FORMAT_MAX_INPUT_BYTES = {"json": 12 * DEFAULT_MAX_INPUT_BYTES}
+MAX_NESTING = 100
+MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
 MAX_DIGITS = 400
 
 
@@ -37,8 +53,12 @@ __all__ = [
     "DEFAULT_MAX_INPUT_BYTES",
     "MAX_DIAGNOSTICS_SHOWN",
     "MAX_DIGITS",
+    "MAX_JSON_DEPTH",
     "MAX_NESTING",
+    "check_document",
     "check_text",
+    "depth",
+    "expr_depth",
     "max_input_bytes",
     "read_input",
     "too_large",
@@ -115,3 +135,78 @@ def check_text(text: str, path: str | None = None, format: str | None = None) ->
     limit = max_input_bytes(format)
     if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8", "surrogatepass")) > limit):
         raise too_large(len(text.encode("utf-8", "surrogatepass")), path, format)
+
+
+def depth(node: object) -> int:
+    """How deep a condition or an expression nests (``a IS b``: 1, ``NOT (a IS b)``: 2; a
+    chain ``x + y + z`` counts each operator), computed without recursion so that any tree
+    can be measured."""
+    deepest = 0
+    stack = [(node, 1)]
+    while stack:
+        item, level = stack.pop()
+        deepest = max(deepest, level)
+        if isinstance(item, Not | Unary):
+            stack.append((item.operand, level + 1))
+        elif isinstance(item, And | Or):
+            stack.extend((o, level + 1) for o in item.operands)
+        elif isinstance(item, Binary):
+            stack.append((item.left, level + 1))
+            stack.append((item.right, level + 1))
+        elif isinstance(item, Call):
+            stack.extend((a, level + 1) for a in item.args)
+    return deepest
+
+
+expr_depth = depth
+
+
+def check_document(document: Document, path: str | None = None) -> list[Diagnostic]:
+    """What every reader refuses, whatever the format says: a rule condition or function
+    term nesting deeper than :data:`MAX_NESTING` (it would overflow the stack of every later
+    step) and a RANGE with a NaN bound (``RANGE := (nan .. 100)``: no value is inside it)."""
+    out: list[Diagnostic] = []
+    for fb in document.blocks:
+        for owner, rng in _ranges(fb):
+            if math.isnan(rng.low) or math.isnan(rng.high):
+                out.append(
+                    error(
+                        f"{owner}: RANGE ({rng.low:g} .. {rng.high:g}) has a bound that is not a number",
+                        rng.span,
+                        code="range-nan",
+                        file=path,
+                    )
+                )
+        for _block, rule in fb.rules():
+            if rule.condition is not None and (d := depth(rule.condition)) > MAX_NESTING:
+                out.append(
+                    error(
+                        f"rule {rule.label}: the condition nests {d} levels deep "
+                        f"(the limit is {MAX_NESTING})",
+                        rule.span,
+                        code="too-deep",
+                        file=path,
+                    )
+                )
+        blocks: tuple[FuzzifyBlock | DefuzzifyBlock, ...] = (*fb.fuzzify, *fb.defuzzify)
+        for block in blocks:
+            for term in block.terms:
+                mf = term.mf
+                if isinstance(mf, FunctionMF) and (d := depth(mf.expr)) > MAX_NESTING:
+                    out.append(
+                        error(
+                            f"term {term.name}: the function nests {d} levels deep "
+                            f"(the limit is {MAX_NESTING})",
+                            term.span,
+                            code="too-deep",
+                            file=path,
+                        )
+                    )
+    return out
+
+
+def _ranges(fb: FunctionBlock) -> list[tuple[str, Range]]:
+    out = [(f"variable {v.name}", v.range) for v in fb.variables if v.range is not None]
+    out += [(f"FUZZIFY {b.variable}", b.range) for b in fb.fuzzify if b.range is not None]
+    out += [(f"DEFUZZIFY {b.variable}", b.range) for b in fb.defuzzify if b.range is not None]
+    return out

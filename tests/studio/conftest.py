@@ -50,6 +50,7 @@ def studio(browser_project: Path) -> Iterator[str]:
 @pytest.fixture(scope="session")
 def browser() -> Iterator[Any]:
     import playwright.sync_api as sync_api  # a dev dependency: missing is a failure
+
     if not Path(CHROMIUM).exists():
         pytest.fail(f"{CHROMIUM} missing: `make test` installs Debian's chromium (scripts/system-deps.sh)")
     with sync_api.sync_playwright() as p:

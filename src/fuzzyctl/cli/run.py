@@ -52,6 +52,28 @@ def _parse_sets(pairs: list[str] | None) -> dict[str, float]:
     return values
 
 
+def _why_not_finite(ctl: Any, inputs: dict[str, float], result: dict[str, float]) -> list[str]:
+    """One line per output that is not a finite number, with the reason (issue 14.6: such a
+    value is never printed as if it were a result, the command exits 1)."""
+    bad = [k for k, v in result.items() if not math.isfinite(v)]
+    if not bad:
+        return []
+    fired: dict[str, bool] = {}
+    try:  # the explanation tells "no rule fired" from "the arithmetic overflowed"
+        fired = {o.name: o.fired for o in ctl.explain(inputs).outputs}
+    except Exception:  # the reason is a courtesy: the value alone is enough to refuse
+        fired = {}
+    lines = []
+    for k in bad:
+        v = _fmt(result[k])
+        if fired.get(k) is False:
+            why = "no rule fired and its DEFAULT is not a number"
+        else:
+            why = "the inputs take the computation beyond the floating-point range"
+        lines.append(f"output {k!r} is {v}: {why}")
+    return lines
+
+
 def _fmt(v: float) -> str:
     return repr(float(v)) if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
 
@@ -82,9 +104,12 @@ def eval_(
         return
     if output is not None:
         raise typer.BadParameter("--output needs --csv", param_hint="--output")
-    result = ctl.evaluate(_parse_sets(set_))
+    inputs = _parse_sets(set_)
+    result = ctl.evaluate(inputs)
+    problems = _why_not_finite(ctl, inputs, result)
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
+        _refuse_not_finite(problems)
         return
     from rich.console import Console
     from rich.table import Table
@@ -95,6 +120,16 @@ def eval_(
     for k, v in result.items():
         table.add_row(k, f"{v:.10g}")
     Console(highlight=False).print(table)
+    _refuse_not_finite(problems)
+
+
+def _refuse_not_finite(problems: list[str]) -> None:
+    if problems:
+        from fuzzyctl.cli.app import err_console
+
+        for line in problems:
+            err_console.print(f"error: {line}", markup=False)
+        raise typer.Exit(1)
 
 
 def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False) -> None:
@@ -144,7 +179,8 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
         for start in range(0, n, CHUNK_ROWS):
             part = {h: cols[i, start : start + CHUNK_ROWS] for i, h in enumerate(header)}
             try:
-                out = ctl.evaluate_batch(part)
+                with np.errstate(all="ignore"):  # overflow is reported below, row by row
+                    out = ctl.evaluate_batch(part)
             except InputError as exc:
                 raise InputError(f"{path}: {exc} (data rows from {start + 1})") from None
             for k, v in out.items():
@@ -157,6 +193,31 @@ def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False)
     for r, row in enumerate(body):
         writer.writerow(row + [_fmt(results[o][r]) for o in out_names])
     text = buf.getvalue()
+    bad = [r for r in range(n) if not all(math.isfinite(results[o][r]) for o in out_names)]
+    problems = []
+    if bad:
+        first = bad[0]
+        row_inputs = {h: float(cols[i, first]) for i, h in enumerate(header)}
+        detail = _why_not_finite(ctl, row_inputs, {o: float(results[o][first]) for o in out_names})
+        problems = [
+            f"{path}:{first + 2}: {detail[0] if detail else 'an output is not a number'}"
+            + (f" ({len(bad)} rows have outputs that are not finite numbers)" if len(bad) > 1 else "")
+        ]
+    _write_csv_result(ctl, path, output, as_table, rows, body, out_names, results, text)
+    _refuse_not_finite(problems)
+
+
+def _write_csv_result(
+    ctl: Any,
+    path: Path,
+    output: Path | None,
+    as_table: bool,
+    rows: list[list[str]],
+    body: list[list[str]],
+    out_names: list[str],
+    results: dict[str, Any],
+    text: str,
+) -> None:
     if output is None and as_table:
         from rich.console import Console
         from rich.table import Table

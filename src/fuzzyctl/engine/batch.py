@@ -43,6 +43,7 @@ Arr = npt.NDArray[np.float64]
 W = Any  # a weight: float or array
 Result = tuple[Arr, npt.NDArray[np.bool_]]  # (values, fired)
 
+
 class BatchEvaluator:
     """Evaluates a plan on columns of samples."""
 

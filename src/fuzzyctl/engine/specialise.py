@@ -94,7 +94,9 @@ class _Gen:
     def term(self, t: TermPlan, x: str, out: str, ind: int = 1) -> None:
         if t.pwl is not None:
             self.pwl_chain(t.pwl, x, out, ind)
-        elif t.kind == "gaussian" and t.constant:
+        elif t.kind == "gaussian" and t.constant and 1e-150 <= abs(float(t.params[1])) <= 1e150:  # type: ignore[arg-type]
+            # a width whose square underflows to 0 or overflows would raise in Python: then
+            # shapes.membership, which gives the IEEE value as numpy and the C do
             m, sd = (float(p) for p in t.params if not isinstance(p, Slot))
             h = float(t.height) if not isinstance(t.height, Slot) else 1.0
             d = self.tmp()

@@ -41,7 +41,7 @@ class LoadResult:
 
 def check_source(source: Source) -> LoadResult:
     """Parse and check decoded text; never raises for bad input."""
-    from fuzzyctl.limits import check_text
+    from fuzzyctl.limits import check_document, check_text
 
     try:
         check_text(source.text, source.path, "fcl")
@@ -49,6 +49,8 @@ def check_source(source: Source) -> LoadResult:
         return LoadResult(None, exc.diagnostics, source)
     parsed = parse_source(source)
     diagnostics = list(parsed.diagnostics)
+    if parsed.document is not None and not has_errors(diagnostics):
+        diagnostics.extend(check_document(parsed.document, source.path))
     if parsed.document is not None and not has_errors(diagnostics):
         diagnostics.extend(run_checks(parsed.document, CheckContext(source.path)))
     return LoadResult(parsed.document, diagnostics, source, parsed.spellings)

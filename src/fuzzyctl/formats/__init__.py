@@ -157,13 +157,17 @@ def decode(data: bytes) -> str:
 
 def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
     """Parse ``text`` as ``format``."""
-    from fuzzyctl.limits import check_text
+    from fuzzyctl.limits import check_document, check_text
 
     fmt = get(format)
     if fmt.read is None:
         raise FuzzyctlError(f"format {fmt.name!r} can be written but not read")
     check_text(text, path, fmt.name)
-    return fmt.read(text, path)
+    loaded = fmt.read(text, path)
+    too_deep = check_document(loaded.document, path)
+    if too_deep:  # refused here, before anything walks the trees recursively
+        raise DiagnosticError(too_deep, text)
+    return loaded
 
 
 def read_path(path: str | Path, format: str | None = None) -> Loaded:
