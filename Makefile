@@ -5,6 +5,9 @@
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
+# pyfuzzylite, scikit-fuzzy and simpful pin numpy < 2: the tests and benchmarks drive them in a
+# venv of their own, never in .venv (which has the numpy users get)
+PEERS  := .venv-peers
 
 .PHONY: run simulate docs-img test fuzz lint typecheck pytest system-deps clean
 STUDIO_PORT ?= 8770
@@ -20,6 +23,11 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install -q -e '.[dev]'
 	touch $@ $(VENV)/.installed
+
+$(PEERS)/.installed: tests/peers/requirements.txt
+	$(PYTHON) -m venv $(PEERS)
+	$(PEERS)/bin/python -m pip install -q -r tests/peers/requirements.txt
+	touch $@
 
 system-deps:
 	@bash scripts/system-deps.sh
@@ -42,8 +50,9 @@ lint: $(VENV)/.installed-dev
 typecheck: $(VENV)/.installed-dev
 	$(BIN)/mypy
 
-pytest: $(VENV)/.installed-dev system-deps
-	$(BIN)/pytest
+# both cores (pytest-xdist); the last line says which extra suites (tests/extras.py) ran
+pytest: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
+	$(BIN)/pytest -n auto $(PYTEST_ARGS)
 
 test: lint typecheck pytest
 
@@ -52,11 +61,11 @@ test: lint typecheck pytest
 # when ../shared is there, the real-world corpus (make test runs a fixed sample of 100).
 FUZZ_MUTANTS ?= 3000
 FUZZ_SEED ?= $(shell date +%s)
-fuzz: $(VENV)/.installed-dev system-deps
+fuzz: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/pytest -q $$(grep -rl '@given' tests)
 	$(BIN)/python -m tests.fuzz.campaign --mutants $(FUZZ_MUTANTS) --seed $(FUZZ_SEED) \
 		$$($(BIN)/python -c 'import tests.extras as e; print("--corpus" if e.suite("corpus").available else "")' 2>/dev/null) \
 		--save build/fuzz-failures
 
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) $(PEERS) .pytest_cache .mypy_cache .ruff_cache

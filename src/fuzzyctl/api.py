@@ -9,7 +9,11 @@ from typing import TYPE_CHECKING, Any
 from fuzzyctl.model import Document, FunctionBlock
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
     from fuzzyctl.engine.controller import Controller
+    from fuzzyctl.engine.variables import VariableInfo
 
 
 def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
@@ -65,6 +69,15 @@ def compile(
     if backend == "native":
         from fuzzyctl.codegen.native import compile_native
 
-        plan = compile_block(model, block=block, backend="interpreted", **options).plan
-        return compile_native(plan)
+        reference = compile_block(model, block=block, backend="interpreted", **options)
+        return compile_native(reference.plan, reference.model)
     return compile_block(model, block=block, backend=backend, **options)
+
+
+def plot_terms(variable: VariableInfo, *, points: int = 1001, ax: Axes | None = None) -> Figure:
+    """The membership functions of a variable as a labelled matplotlib Figure:
+    ``fuzzyctl.plot_terms(ctl.inputs["temp"]).savefig("temp.png")`` (as scikit-fuzzy's
+    ``view()`` or simpful's ``plot_variable``)."""
+    from fuzzyctl.engine.plot import plot_terms as draw
+
+    return draw(variable, points=points, ax=ax)

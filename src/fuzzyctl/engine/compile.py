@@ -75,4 +75,4 @@ def compile_block(
     if plan is None:
         path = getattr(model, "path", None) if isinstance(model, Document) else None
         raise DiagnosticError([dataclasses.replace(d, file=d.file or path) for d in diags])
-    return Controller(plan, specialise=backend == "python")
+    return Controller(plan, specialise=backend == "python", model=fb)
