@@ -58,7 +58,7 @@ test: lint typecheck pytest
 
 # Property tests with fresh random examples (make test replays a fixed set), then the
 # mutation fuzzer (issue 14.5) on FUZZ_MUTANTS mutants of the examples, the vendored files and,
-# when ../shared is there, the real-world corpus (make test runs a fixed sample of 100).
+# when ../shared is there, the real-world corpus (make test runs a fixed sample of 80).
 FUZZ_MUTANTS ?= 3000
 FUZZ_SEED ?= $(shell date +%s)
 fuzz: $(VENV)/.installed-dev $(PEERS)/.installed system-deps

@@ -274,3 +274,26 @@ def test_api_errors_are_project_errors() -> None:
         except FuzzyctlError:
             continue
         pytest.fail(f"{_name} loaded")
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+def test_a_subnormal_vertex_is_zero_not_a_nan_centroid(backend: str) -> None:
+    """Found by the fuzzer: ``Triangle 1e-320 15 20`` next to a term ending at 0 made a piece
+    1e-320 wide whose slope overflowed - NaN in batches, a compile error in the generated
+    code.  A subnormal parameter is 0: the same centroid as with 0, on every path."""
+    root = Path(__file__).resolve().parents[2]
+    text = (root / "tests/data/fuzzylite/original/mamdani/matlab/tipper1.fll").read_text()
+    assert "term: average Triangle 10.000 15.000 20.000" in text
+    tiny = fuzzyctl.compile(
+        fuzzyctl.load(text.replace("Triangle 10.000 15.000", "Triangle 1e-320 15.000"), format="fll"),
+        backend=backend,
+    )
+    zero = fuzzyctl.compile(
+        fuzzyctl.load(text.replace("Triangle 10.000 15.000", "Triangle 0 15.000"), format="fll"),
+        backend="interpreted",
+    )
+    for service in (0.0, 3.0, 10.0):
+        one = tiny.evaluate({"service": service})["tip"]
+        many = float(tiny.evaluate_batch({"service": np.array([service])})["tip"][0])
+        assert one == pytest.approx(zero.evaluate({"service": service})["tip"], rel=1e-12)
+        assert many == pytest.approx(one, rel=1e-12)

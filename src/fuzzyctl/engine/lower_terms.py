@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -96,6 +97,10 @@ def _param(ctx: _Ctx, p: m.Param, where: str, allow_infinite: bool = False) -> P
     if math.isnan(v) or (math.isinf(v) and not allow_infinite):
         ctx.err(f"{where}: parameter {v} is not a finite number", None, "param-not-finite")
         return None
+    if v != 0.0 and abs(v) < sys.float_info.min:
+        # a subnormal number (1e-320) is 0 for any shape, but a piece that wide divides to
+        # inf: the centroid became NaN on one backend and a compile error on another
+        return 0.0
     return v
 
 
