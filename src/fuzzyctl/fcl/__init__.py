@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, has_errors
 from fuzzyctl.fcl.checks import CheckContext, register_provider, run_checks
+from fuzzyctl.fcl.no_if import without_if_parts
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source, decode, read_source
 from fuzzyctl.fcl.writer import write
@@ -49,11 +50,14 @@ def check_source(source: Source) -> LoadResult:
         return LoadResult(None, exc.diagnostics, source)
     parsed = parse_source(source)
     diagnostics = list(parsed.diagnostics)
-    if parsed.document is not None and not has_errors(diagnostics):
-        diagnostics.extend(check_document(parsed.document, source.path))
-    if parsed.document is not None and not has_errors(diagnostics):
-        diagnostics.extend(run_checks(parsed.document, CheckContext(source.path)))
-    return LoadResult(parsed.document, diagnostics, source, parsed.spellings)
+    document = parsed.document
+    if document is not None and not has_errors(diagnostics):
+        diagnostics.extend(check_document(document, source.path))
+    if document is not None and not has_errors(diagnostics):
+        document, notes = without_if_parts(document)  # IF ALWAYS THEN: Siemens 1.5 rules
+        diagnostics.extend(notes)
+        diagnostics.extend(run_checks(document, CheckContext(source.path)))
+    return LoadResult(document, diagnostics, source, parsed.spellings)
 
 
 def load_text(text: str, path: str | None = None) -> LoadResult:
