@@ -100,7 +100,7 @@ def _looks_like_path(value: str) -> bool:
     """Text holding a newline, ';' or ':=', starting with '{' or '[', or longer than any path
     is source; anything else is taken as a path (a missing file is then reported as such,
     not parsed as FCL)."""
-    if "\n" in value or ";" in value or ":=" in value or len(value) > 4096:
+    if any(c in value for c in "\n\r\0;") or ":=" in value or len(value) > 4096:
         return False
     if value.lstrip()[:1] in ("{", "["):  # JSON, a FIS section
         return False

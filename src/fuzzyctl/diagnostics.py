@@ -52,15 +52,12 @@ class Diagnostic:
         text = f"{self.location()}: {self.severity.value}: {self.message}"
         line = self.source_line
         if line is None and source is not None and self.span is not None:
-            lines = source.splitlines()
-            if 1 <= self.span.line <= len(lines):
-                line = lines[self.span.line - 1]
+            line = source_line(source, self.span.line)
         if line is not None and self.span is not None:
-            shown = line.expandtabs(1).rstrip("\r\n")
-            caret_col = max(self.span.column - 1, 0)
             width = 1
             if self.span.end_line == self.span.line and self.span.end_column:
                 width = max(self.span.end_column - self.span.column, 1)
+            shown, caret_col, width = _window(line.expandtabs(1).rstrip("\r\n"), self.span.column - 1, width)
             text += f"\n    {shown}\n    {' ' * caret_col}^{'~' * (width - 1)}"
         if self.hint:
             text += f"\n    hint: {self.hint}"
@@ -76,6 +73,71 @@ class Diagnostic:
             "message": self.message,
             "hint": self.hint,
         }
+
+
+#: How many diagnostics :meth:`DiagnosticError.render` and the CLI print for one file; the
+#: rest are counted in a last line ("... and N more").
+MAX_DIAGNOSTICS_SHOWN = 20
+#: Widest source line shown under a diagnostic (a window around the column).
+MAX_LINE_SHOWN = 120
+
+_LINES: tuple[str, list[str]] | None = None
+
+
+def source_line(source: str, number: int) -> str | None:
+    """Line ``number`` (1-based; lines end at ``\\n`` as every reader counts them) of
+    ``source``.  The text is split once and kept for the next call with the same text, so
+    rendering many diagnostics of one file is linear, not quadratic."""
+    global _LINES
+    cached = _LINES
+    if cached is None or cached[0] is not source:
+        cached = (source, source.split("\n"))
+        _LINES = cached
+    lines = cached[1]
+    return lines[number - 1] if 1 <= number <= len(lines) else None
+
+
+def _window(line: str, col: int, width: int) -> tuple[str, int, int]:
+    """At most :data:`MAX_LINE_SHOWN` characters of ``line`` around column ``col`` (0-based),
+    the caret column in that window and the underline width that fits in it."""
+    col = max(col, 0)
+    if len(line) <= MAX_LINE_SHOWN:
+        return line, col, width
+    start = max(0, min(col - MAX_LINE_SHOWN // 3, len(line) - MAX_LINE_SHOWN))
+    piece = line[start : start + MAX_LINE_SHOWN]
+    prefix = "..." if start > 0 else ""
+    suffix = "..." if start + MAX_LINE_SHOWN < len(line) else ""
+    caret = col - start + len(prefix)
+    return prefix + piece + suffix, caret, max(1, min(width, MAX_LINE_SHOWN - (col - start)))
+
+
+def select_shown(
+    diagnostics: Sequence[Diagnostic], limit: int = MAX_DIAGNOSTICS_SHOWN
+) -> tuple[list[Diagnostic], list[Diagnostic]]:
+    """``(shown, left out)``: at most ``limit`` diagnostics, errors chosen first, the shown
+    ones in file order."""
+    items = list(diagnostics)
+    if len(items) <= limit:
+        return items, []
+    errors = [i for i, d in enumerate(items) if d.is_error]
+    others = [i for i, d in enumerate(items) if not d.is_error]
+    kept = set((errors + others)[:limit])
+    return [d for i, d in enumerate(items) if i in kept], [d for i, d in enumerate(items) if i not in kept]
+
+
+def more_line(rest: Sequence[Diagnostic]) -> str:
+    """The last line after a capped list: how many were left out, and how many errors."""
+    n_err = sum(1 for d in rest if d.is_error)
+    return f"... and {len(rest)} more diagnostic(s) not shown ({n_err} error(s), {len(rest) - n_err} other)"
+
+
+def render_all(
+    diagnostics: Sequence[Diagnostic], source: str | None = None, limit: int = MAX_DIAGNOSTICS_SHOWN
+) -> list[str]:
+    """The rendered diagnostics (at most ``limit``, see :func:`select_shown`) and, when some
+    were left out, a last line counting them."""
+    shown, rest = select_shown(diagnostics, limit)
+    return [d.render(source) for d in shown] + ([more_line(rest)] if rest else [])
 
 
 def error(
@@ -118,8 +180,9 @@ class DiagnosticError(FuzzyctlError):
         first = next((d for d in self.diagnostics if d.is_error), None)
         super().__init__(first.render(source) if first else "invalid input")
 
-    def render(self) -> str:
-        return "\n".join(d.render(self.source) for d in self.diagnostics)
+    def render(self, limit: int = MAX_DIAGNOSTICS_SHOWN) -> str:
+        """Every diagnostic (at most ``limit`` of them, then a line counting the others)."""
+        return "\n".join(render_all(self.diagnostics, self.source, limit))
 
 
 class InputError(FuzzyctlError, ValueError):

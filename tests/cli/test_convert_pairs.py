@@ -23,9 +23,7 @@ from tests.conftest import EXAMPLES, data_path
 
 SOURCES = {
     "figure7.fcl": EXAMPLES / "figure7.fcl",
-    "tippersg.fis": data_path(
-        "fuzzylite", "original", "takagi-sugeno", "matlab", "tippersg.fis"
-    ),
+    "tippersg.fis": data_path("fuzzylite", "original", "takagi-sugeno", "matlab", "tippersg.fis"),
 }
 WRITABLE = [f.name for f in formats.available() if f.write is not None]
 

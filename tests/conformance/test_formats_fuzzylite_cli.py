@@ -61,6 +61,7 @@ def _fuzzylite_installed() -> None:
     if FUZZYLITE is None:
         pytest.fail("the fuzzylite command is missing: `make test` installs the apt package fuzzylite")
 
+
 SAMPLES = 40
 
 
@@ -151,8 +152,10 @@ def _known_output_deviation(fb: FunctionBlock, block: m.DefuzzifyBlock, fmt: str
         return "Tsukamoto defuzzification of fuzzylite 6.0"
     if fmt == "fis" and "Type='hybrid'" in text and (block.method or "") in {"WTAVER", "WTSUM"}:
         return "fuzzylite's FIS importer: one DefuzzMethod for every output of a hybrid FIS"
-    if fmt == "fis" and not text.startswith("%") and any(
-        h for _b, r in fb.rules() for c in r.conclusions for h in c.hedges
+    if (
+        fmt == "fis"
+        and not text.startswith("%")
+        and any(h for _b, r in fb.rules() for c in r.conclusions for h in c.hedges)
     ):
         return "Octave hedge codes read as fuzzylite's"
     if fb.name == "Laundry":

@@ -431,8 +431,13 @@ def test_power_hedges_and_comparison_functions() -> None:
     fb = _one_input({"a": single(0.0)}, [rule("1", is_("x", "up", hedges=["pow:3"]), then("y", "a"))])
     assert fuzzyctl.compile(fb).explain({"x": 5.0}).rule("1").degree == pytest.approx(0.125)
     # fuzzylite's Function as a fuzzy set of x: 1 on [0, 0.5), 0.5 at 0.5, 0 beyond (a step)
-    step = m.FunctionMF(m.Binary("+", m.Call("lt", (m.Name("x"), m.Num(0.5))),
-                                 m.Binary("*", m.Num(0.5), m.Call("eq", (m.Name("x"), m.Num(0.5))))))
+    step = m.FunctionMF(
+        m.Binary(
+            "+",
+            m.Call("lt", (m.Name("x"), m.Num(0.5))),
+            m.Binary("*", m.Num(0.5), m.Call("eq", (m.Name("x"), m.Num(0.5)))),
+        )
+    )
     fb = mamdani({"v": {"up": RAMP_UP}}, {"s": step}, [rule("1", is_("v", "up"), then("y", "s"))], rng=(0, 1))
     c = fuzzyctl.compile(fb)
     assert c.plan.outputs[0].kind == "mamdani" and not c.plan.outputs[0].exact  # quadrature

@@ -348,11 +348,14 @@ T_OFB = {{ connection = "mb", address = 5, type = "int16" }}
 
 
 def test_an_internal_error_in_one_instance_puts_it_safe_and_the_others_run_on(tmp_path: Path) -> None:
-    two = SIEMENS_SERVER + f"""
+    two = (
+        SIEMENS_SERVER
+        + f"""
 [instances.other]
 knowledge_base = "{FPLTEST_FCL}"
 period = 0.01
 """
+    )
     rt = make_runtime(tmp_path, two)
     valve, other = rt.instances["valve"], rt.instances["other"]
 

@@ -62,7 +62,7 @@ def check(
     from rich.console import Console
     from rich.table import Table
 
-    from fuzzyctl.diagnostics import DiagnosticError, Severity
+    from fuzzyctl.diagnostics import DiagnosticError, Severity, more_line, select_shown
     from fuzzyctl.fcl import conformance
 
     if conformance_statement:
@@ -107,9 +107,12 @@ def check(
         typer.echo(json.dumps(report, indent=2, default=str))
         raise typer.Exit(EXIT_OK if result.ok else EXIT_ERRORS)
 
-    for d in result.diagnostics:
+    shown, rest = select_shown(result.diagnostics)
+    for d in shown:
         style = {Severity.ERROR: "red", Severity.WARNING: "yellow", Severity.NOTE: "cyan"}[d.severity]
         err_console.print(d.render(result.source.text), style=style, markup=False, highlight=False)
+    if rest:
+        err_console.print(more_line(rest), markup=False, highlight=False)
     if not result.ok or doc is None:
         errors = sum(1 for d in result.diagnostics if d.is_error)
         err_console.print(f"{file}: {errors} error(s)", markup=False)

@@ -112,9 +112,13 @@ class Controller:
         ``{"valve": 35.7, ...}``.  Values are real numbers (numpy scalars and 0-d arrays too)."""
         values = self._values(merge_inputs(inputs, values_by_name))
         fast = self._fast
+        res: list[float] | None = None
         if fast is not None:
-            res = fast(values, self._state)
-        else:
+            try:
+                res = fast(values, self._state)
+            except ArithmeticError:  # Python raises where numpy and C give inf/NaN: take the IEEE value
+                res = None
+        if res is None:
             rec = self._interp.run(values, self._state)
             res = [o.value for o in rec.outputs]
         plan = self.plan

@@ -18,7 +18,7 @@ import numpy as np
 from fuzzyctl.engine import pwl, quadrature, selection, shapes
 from fuzzyctl.engine.expr import eval_expr, eval_expr_np
 from fuzzyctl.engine.grid import build_grid
-from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np, clamp
+from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np, clamp, fsum
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -278,11 +278,11 @@ class Interpreter:
         num = [wt * z_of(t, wt) for t, wt in items]
         den = [wt for _t, wt in items]
         rec.weights = [(op.terms[t].name, wt, z_of(t, wt)) for t, wt in items]
-        total = math.fsum(den)
+        total = fsum(den)
         if not total > 0.0:
             return rec
         rec.fired = True
-        rec.value = math.fsum(num) / total if op.method == "WTAVER" else math.fsum(num)
+        rec.value = fsum(num) / total if op.method == "WTAVER" else fsum(num)
         return rec
 
     def _singleton(
@@ -305,16 +305,16 @@ class Interpreter:
                 pos[(t, i)] = x
         rec = OutputRecord(math.nan, False)
         rec.points = sorted((pos[k], v) for k, v in acc.items())
-        total = math.fsum(v for _x, v in rec.points)
+        total = fsum(v for _x, v in rec.points)
         if not total > 0.0:
             return rec
         rec.fired = True
         if op.method == "COGS":
-            rec.value = math.fsum(x * v for x, v in rec.points) / total
+            rec.value = fsum(x * v for x, v in rec.points) / total
         else:
             sup = max(v for _x, v in rec.points)
             xs = sorted({x for x, v in rec.points if v == sup})
-            rec.value = {"LM": xs[0], "RM": xs[-1], "MOM": math.fsum(xs) / len(xs)}[op.method]
+            rec.value = {"LM": xs[0], "RM": xs[-1], "MOM": fsum(xs) / len(xs)}[op.method]
         return rec
 
     def _exact(
@@ -395,7 +395,7 @@ def ts_value(
     if term.kind == "linear":
         cs = [pv(p, values) for p in term.params]
         n = len(values)
-        v = math.fsum(c * x for c, x in zip(cs[:n], values, strict=False))
+        v = fsum(c * x for c, x in zip(cs[:n], values, strict=False))
         return v + (cs[n] if len(cs) > n else 0.0)
     assert term.expr is not None
     return eval_expr(term.expr, values, outs)

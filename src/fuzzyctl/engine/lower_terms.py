@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+import sys
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 
@@ -96,6 +97,10 @@ def _param(ctx: _Ctx, p: m.Param, where: str, allow_infinite: bool = False) -> P
     if math.isnan(v) or (math.isinf(v) and not allow_infinite):
         ctx.err(f"{where}: parameter {v} is not a finite number", None, "param-not-finite")
         return None
+    if v != 0.0 and abs(v) < sys.float_info.min:
+        # a subnormal number (1e-320) is 0 for any shape, but a piece that wide divides to
+        # inf: the centroid became NaN on one backend and a compile error on another
+        return 0.0
     return v
 
 
@@ -217,6 +222,9 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
     return tp
 
 
+_WIDTH_MIN, _WIDTH_MAX = 1e-150, 1e150
+
+
 def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> None:
     if not tp.constant:
         return
@@ -226,8 +234,12 @@ def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> No
         bad = "needs a <= b <= c"
     elif tp.kind == "trapezoid" and not (p[0] <= p[1] <= p[2] <= p[3]):
         bad = "needs a <= b <= c <= d"
-    elif tp.kind in ("gaussian", "gaussian2") and (p[1] == 0.0 or (tp.kind == "gaussian2" and p[3] == 0.0)):
-        bad = "needs a nonzero standard deviation"
+    elif tp.kind in ("gaussian", "gaussian2") and not all(
+        _WIDTH_MIN <= abs(sd) <= _WIDTH_MAX for sd in (p[1::2] if tp.kind == "gaussian2" else p[1:2])
+    ):
+        # 2 sd^2 must be a normal number: 0 or inf there makes exp(-d^2 / 2 sd^2) 0/0 at the
+        # centre (NaN, or a ZeroDivisionError in Python) where the shape means 1
+        bad = f"needs a standard deviation between {_WIDTH_MIN:g} and {_WIDTH_MAX:g} in size"
     elif (tp.kind == "bell" and p[1] == 0.0) or (tp.kind in ("cosine", "spike") and p[1] == 0.0):
         bad = "needs a nonzero width"
     elif tp.kind in ("sshape", "zshape") and not p[0] < p[1]:

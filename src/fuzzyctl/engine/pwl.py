@@ -20,6 +20,7 @@ from functools import cache
 
 import numpy as np
 
+from fuzzyctl.engine.operators import fsum
 from fuzzyctl.engine.plan import GridPlan
 
 #: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
@@ -97,8 +98,8 @@ def _combine(xa: float, xb: float, p0: list[float], p1: list[float], accu: str, 
             xp, vp = xs, vs
         out.append((xp, xb, vp, max(p1), None))
         return
-    s0 = math.fsum(p0)
-    s1 = math.fsum(p1)
+    s0 = fsum(p0)
+    s1 = fsum(p1)
     if accu in ("SUM", "NSUM"):
         out.append((xa, xb, s0, s1, None))
     elif accu == "BSUM":
@@ -182,7 +183,7 @@ def area_moment(pieces: Sequence[Piece]) -> tuple[float, float]:
         a, mo = piece_area_moment(p)
         areas.append(a)
         moments.append(mo)
-    return math.fsum(areas), math.fsum(moments)
+    return fsum(areas), fsum(moments)
 
 
 def _partial_area(p: Piece, s: float) -> float:
@@ -280,7 +281,7 @@ def maxima(
     mom = (
         plateau_mom / plateau_len
         if plateau_len > 0.0
-        else (math.fsum(isolated) / len(isolated) if isolated else math.nan)
+        else (fsum(isolated) / len(isolated) if isolated else math.nan)
     )
     return sup, lm, rm, mom
 

@@ -17,6 +17,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from fuzzyctl.engine.operators import fsum
 from fuzzyctl.engine.shapes import FloatArray
 
 _XGK = np.array(
@@ -191,7 +192,7 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         return sup, lm, rm, mom
     if not points:  # pragma: no cover - the top node itself is always a candidate peak
         points = [float(xs[int(np.argmax(ys))])]
-    return sup, points[0], points[-1], math.fsum(points) / len(points)
+    return sup, points[0], points[-1], fsum(points) / len(points)
 
 
 def _golden(f: Integrand, lo: float, hi: float, x0: float, y0: float) -> tuple[float, float]:

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from fuzzyctl.engine.operators import fsum
 from fuzzyctl.engine.plan import SelectionPlan
 
 Arr = npt.NDArray[np.float64]
@@ -119,7 +120,7 @@ def select(sel: SelectionPlan, degrees: Sequence[float]) -> list[float]:
             out[j] = degrees[j]
         return out
     if sel.method == "PROPORTIONAL":
-        total = math.fsum(a for a in degrees if a > 0.0)
+        total = fsum(a for a in degrees if a > 0.0)
         return [a / total if total > 0.0 and a > 0.0 else 0.0 for a in degrees]
     compare = COMPARISONS[sel.comparison]
     return [a if compare(a, sel.threshold) else 0.0 for a in degrees]

@@ -360,13 +360,26 @@ def membership(kind: str, params: Sequence[float], height: float, x: float) -> f
             if xi == x and yi > best:
                 best = yi
         return best * float(height)
-    return float(height) * _smooth(kind, params, x)
+    try:
+        return float(height) * _smooth(kind, params, x)
+    except (ArithmeticError, ValueError):
+        if kind not in SMOOTH_KINDS:
+            raise
+        # Python raises where IEEE arithmetic (numpy, the generated C) gives inf or NaN
+        # (a power or an exponential overflowing at x = 1e20, a zero width): take the numpy
+        # value, so that every backend gives the same degree.
+        return float(membership_np(kind, params, height, np.array([x]))[0])
 
 
 def membership_np(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -> FloatArray:
     """Vectorised :func:`membership`; every parameter may be a float or an array broadcasting
     against ``x`` (parameters given by input variables)."""
     x = np.asarray(x, dtype=np.float64)
+    with np.errstate(all="ignore"):  # overflow gives inf, 0/0 NaN: the IEEE values, no warning
+        return _membership_np(kind, params, height, x)
+
+
+def _membership_np(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -> FloatArray:
     if kind in PWL_KINDS:
         if all(np.ndim(p) == 0 for p in params) and np.ndim(height) == 0:
             pts = pwl_points(kind, [float(p) for p in params], float(height))
@@ -542,9 +555,16 @@ def power_of(name: str) -> float | None:
 def hedge_function(name: str) -> Callable[[float], float]:
     """The scalar function of a hedge name (``HEDGES`` or ``"pow:p"``)."""
     p = power_of(name)
-    if p is not None:
-        return lambda x: float(max(x, 0.0) ** p)
-    return HEDGES[name]
+    f = (lambda x: float(max(x, 0.0) ** p)) if p is not None else HEDGES[name]
+
+    def hedge(x: float) -> float:
+        try:
+            return f(x)
+        except (ArithmeticError, ValueError):  # the IEEE value, as in hedge_np and the C
+            with np.errstate(all="ignore"):
+                return float(hedge_np(name, np.float64(x)))
+
+    return hedge
 
 
 def hedge_np(name: str, x: Any) -> Any:
@@ -604,8 +624,10 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
             s, e = p
             r = e - s
             return e + (-1.0 if s < e else 1.0) * math.sqrt(max(r * r - (y * r / h) ** 2, 0.0))
-    except (ValueError, ZeroDivisionError):
-        return math.nan if y != h else math.inf
+    except (ArithmeticError, ValueError):
+        # log(0), a division by zero: the IEEE value of the numpy path (whose sign follows the
+        # slope), so that every backend agrees
+        return float(tsukamoto_np(kind, params, height, np.float64(y)))
     raise ValueError(f"{kind} is not monotonic")
 
 

@@ -42,9 +42,17 @@ class LoadResult:
 
 def check_source(source: Source) -> LoadResult:
     """Parse and check decoded text; never raises for bad input."""
+    from fuzzyctl.limits import check_document, check_text
+
+    try:
+        check_text(source.text, source.path, "fcl")
+    except DiagnosticError as exc:  # over the size limit: said, not parsed
+        return LoadResult(None, exc.diagnostics, source)
     parsed = parse_source(source)
     diagnostics = list(parsed.diagnostics)
     document = parsed.document
+    if document is not None and not has_errors(diagnostics):
+        diagnostics.extend(check_document(document, source.path))
     if document is not None and not has_errors(diagnostics):
         document, notes = without_if_parts(document)  # IF ALWAYS THEN: Siemens 1.5 rules
         diagnostics.extend(notes)

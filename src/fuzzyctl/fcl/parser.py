@@ -464,10 +464,21 @@ class _Builder(Transformer[Token, Any]):
         return tuple(c for c in children if isinstance(c, Conclusion))
 
     def rule(self, children: list[Any]) -> Rule:
+        from fuzzyctl.limits import MAX_NESTING, depth
+
         label: Token = children[1]
-        condition = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
+        condition: Condition | None = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
         conclusions = next(c for c in children if isinstance(c, tuple))
-        return Rule(str(label), condition, conclusions, _outer(children))
+        span = _outer(children)
+        if (d := depth(condition)) > MAX_NESTING:
+            # refused here: every later step walks conditions recursively
+            self.state.error(
+                f"rule {label}: the condition nests {d} levels deep (the limit is {MAX_NESTING})",
+                span or _tok_span(label),
+                "too-deep",
+            )
+            condition = None
+        return Rule(str(label), condition, conclusions, span)
 
     def rule_block(self, children: list[Any]) -> RuleBlock:
         name = next((str(c) for c in children if isinstance(c, Token) and c.type == "ID"), None)
@@ -539,6 +550,10 @@ def _on_token(tok: Token) -> Token:
     if _ACTIVE:
         state = _ACTIVE[-1]
         state.prev_token, state.last_token = state.last_token, tok
+        if tok.type == "NUMBER" and tok[-1:].isdigit() and not math.isfinite(_number(tok)):
+            # 1e400 or 5001 digits: Python reads it as inf, which the file did not say
+            shown = tok if len(tok) <= 24 else f"{tok[:20]}... ({len(tok)} characters)"
+            state.error(f"the number {shown} is too large (beyond 1.8e308)", _tok_span(tok), "number-range")
     return tok
 
 

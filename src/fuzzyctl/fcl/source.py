@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
-from pathlib import Path
 
 from fuzzyctl.diagnostics import DiagnosticError, error
 
@@ -19,8 +18,9 @@ class Source:
     encoding: str = "utf-8"
 
     def line(self, number: int) -> str:
-        lines = self.text.splitlines()
-        return lines[number - 1] if 1 <= number <= len(lines) else ""
+        from fuzzyctl.diagnostics import source_line
+
+        return source_line(self.text, number) or ""
 
 
 def decode(data: bytes, path: str | None = None) -> Source:
@@ -37,17 +37,8 @@ def decode(data: bytes, path: str | None = None) -> Source:
 
 
 def read_source(path: str | os.PathLike[str]) -> Source:
-    """Read and decode a file; a missing file or a directory is a diagnostic, not a crash."""
-    p = Path(path)
-    name = str(path)
-    if not p.exists():
-        raise DiagnosticError([error("no such file", file=name, code="no-file")])
-    if p.is_dir():
-        raise DiagnosticError([error("is a directory, not an FCL file", file=name, code="is-directory")])
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise DiagnosticError(
-            [error(f"cannot read: {exc.strerror or exc}", file=name, code="unreadable")]
-        ) from exc
-    return decode(data, name)
+    """Read and decode a file; a missing file, a directory or a file over the size limit
+    (:func:`fuzzyctl.limits.max_input_bytes`) is a diagnostic, not a crash."""
+    from fuzzyctl.limits import read_input
+
+    return decode(read_input(path, "fcl"), str(path))

@@ -164,16 +164,26 @@ def decode(data: bytes) -> str:
 
 def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
     """Parse ``text`` as ``format``."""
+    from fuzzyctl.limits import check_document, check_text
+
     fmt = get(format)
     if fmt.read is None:
         raise FuzzyctlError(f"format {fmt.name!r} can be written but not read")
-    return fmt.read(text, path)
+    check_text(text, path, fmt.name)
+    loaded = fmt.read(text, path)
+    too_deep = check_document(loaded.document, path)
+    if too_deep:  # refused here, before anything walks the trees recursively
+        raise DiagnosticError(too_deep, text)
+    return loaded
 
 
 def read_path(path: str | Path, format: str | None = None) -> Loaded:
-    """Read a file, choosing the format by ``format`` or by the file's extension."""
+    """Read a file, choosing the format by ``format`` or by the file's extension; a missing
+    or unreadable file, or one over the size limit, is a :class:`DiagnosticError`."""
+    from fuzzyctl.limits import read_input
+
     fmt = get(format) if format else for_path(path)
-    data = Path(path).read_bytes()
+    data = read_input(path, fmt.name)
     return read_text(decode(data), fmt.name, path=str(path))
 
 

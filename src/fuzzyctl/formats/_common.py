@@ -40,7 +40,20 @@ def parse_number(text: str) -> float:
         return -math.inf
     if lowered == "nan":
         return math.nan
-    return float(lowered)  # raises ValueError: the caller reports where
+    value = float(lowered)  # raises ValueError: the caller reports where
+    if math.isinf(value):  # 1e400, 5001 digits: not the infinity the file would spell inf
+        raise ValueError(f"{text.strip()[:24]} is too large (beyond 1.8e308)")
+    return value
+
+
+def parse_count(text: str) -> int:
+    """A count (``NumMFs=3``, ``NumRules=9``): a whole number from 0 to 10**9; ValueError
+    for anything else (``Infinity``, ``NaN``, ``2.5``, ``-1``, 5001 digits), which the caller
+    reports with its place."""
+    value = parse_number(text)
+    if not (math.isfinite(value) and 0 <= value <= 1e9 and value == int(value)):
+        raise ValueError(f"not a count: {text!r}")
+    return int(value)
 
 
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")

@@ -7,6 +7,7 @@ binary ``+ - * / %`` and ``^`` (right-associative, binds tighter than unary minu
 
 from __future__ import annotations
 
+import math
 import re
 
 from fuzzyctl.formats._common import fmt_number
@@ -30,12 +31,13 @@ class ExprError(ValueError):
 def _tokens(text: str) -> list[tuple[str, str, int]]:
     out: list[tuple[str, str, int]] = []
     pos = 0
-    while pos < len(text):
-        if text[pos:].strip() == "":
-            break
+    end = len(text.rstrip())  # linear: no rescanning of the rest of the text per token
+    while pos < end:
         m = _TOKEN.match(text, pos)
         if m is None or m.end() == pos:
-            start = pos + len(text[pos:]) - len(text[pos:].lstrip())
+            start = pos
+            while start < end and text[start].isspace():
+                start += 1
             raise ExprError(f"unexpected character {text[start]!r} in expression", start)
         kind = m.lastgroup or "op"
         out.append((kind, m.group(kind), m.start(kind)))
@@ -44,9 +46,13 @@ def _tokens(text: str) -> list[tuple[str, str, int]]:
 
 
 def parse_expr(text: str) -> Expr:
-    """Parse an infix expression; raises :class:`ExprError`."""
+    """Parse an infix expression; raises :class:`ExprError` (also for one nesting deeper than
+    :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike)."""
+    from fuzzyctl.limits import MAX_NESTING, expr_depth
+
     tokens = _tokens(text)
     index = 0
+    depth = 0
 
     def peek() -> tuple[str, str, int] | None:
         return tokens[index] if index < len(tokens) else None
@@ -67,7 +73,11 @@ def parse_expr(text: str) -> Expr:
     def primary() -> Expr:
         kind, value, pos = take()
         if kind == "num":
-            return Num(float(value))
+            number = float(value)
+            if math.isinf(number):  # 1e400, 5001 digits: not an infinity the file spelt
+                shown = value if len(value) <= 24 else f"{value[:20]}... ({len(value)} characters)"
+                raise ExprError(f"the number {shown} is too large (beyond 1.8e308)", pos)
+            return Num(number)
         if kind == "name":
             nxt = peek()
             if nxt is not None and nxt[1] == "(":
@@ -90,6 +100,17 @@ def parse_expr(text: str) -> Expr:
         raise ExprError(f"unexpected {value!r} in expression", pos)
 
     def expression(min_power: int) -> Expr:
+        nonlocal depth
+        depth += 1
+        try:
+            if depth > MAX_NESTING:
+                pos = (peek() or ("", "", len(text)))[2]
+                raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", pos)
+            return _operators(min_power)
+        finally:
+            depth -= 1
+
+    def _operators(min_power: int) -> Expr:
         left = primary()
         while True:
             tok = peek()
@@ -106,6 +127,8 @@ def parse_expr(text: str) -> Expr:
     leftover = peek()
     if leftover is not None:
         raise ExprError(f"unexpected {leftover[1]!r} after the expression", leftover[2])
+    if expr_depth(result) > MAX_NESTING:  # a long chain a + b + c ... is a deep tree too
+        raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", 0)
     return result
 
 
@@ -170,7 +193,17 @@ _CONSTANTS = {"pi": 3.141592653589793, "e": 2.718281828459045, "inf": float("inf
 
 def eval_constant(expr: Expr) -> float:
     """The value of an expression made of numbers and the constants ``pi``, ``e``, ``Inf``,
-    ``NaN`` (MATLAB evaluates a FIS ``Range=[-pi/4 pi/4]``); raises ValueError otherwise."""
+    ``NaN`` (MATLAB evaluates a FIS ``Range=[-pi/4 pi/4]``); raises ValueError otherwise
+    (division by zero and overflow included: MATLAB would give Inf, a range of Inf is no
+    use either)."""
+    try:
+        return _eval_constant(expr)
+    except ArithmeticError as exc:
+        raise ValueError(f"the value cannot be computed ({exc})") from None
+
+
+def _eval_constant(expr: Expr) -> float:
+    eval_constant = _eval_constant
     if isinstance(expr, Num):
         return expr.value
     if isinstance(expr, Name):

@@ -249,10 +249,9 @@ def prepare(
         defuzzify.append(replace(d, default=default, method=method))
     # An input singleton is the triangle (v, v, v): degree 1 exactly at v, 0 elsewhere, in our
     # engine, MATLAB's trimf and fuzzylite's Triangle alike.
-    fuzzify = tuple(
-        replace(f, terms=tuple(_singleton_as_triangle(t) for t in f.terms)) for f in fb.fuzzify
-    )
+    fuzzify = tuple(replace(f, terms=tuple(_singleton_as_triangle(t) for t in f.terms)) for f in fb.fuzzify)
     fb = replace(fb, rule_blocks=tuple(new_blocks), fuzzify=fuzzify, defuzzify=tuple(defuzzify))
+
     def valid(name: str) -> bool:
         return is_identifier(name) and name not in reserved
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field, replace
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Format, Loaded
-from fuzzyctl.formats._common import Reporter, parse_number, power_hedge, unique_name
+from fuzzyctl.formats._common import Reporter, parse_count, parse_number, power_hedge, unique_name
 from fuzzyctl.formats._expr import ExprError, eval_constant, names_in, parse_expr
 from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.model import (
@@ -194,9 +194,11 @@ def _numbers(text: str, rep: Reporter, line: int, what: str) -> list[float]:
         except ValueError:
             try:  # MATLAB evaluates entries such as -pi/4
                 out.append(eval_constant(parse_expr(part)))
-            except (ValueError, ZeroDivisionError):
+            except (ValueError, ZeroDivisionError) as exc:
+                # the entry, shortened (it may be 5001 digits or 1000 parentheses), and why
+                shown = part if len(part) <= 40 else f"{part[:30]}... ({len(part)} characters)"
                 raise rep.fail(
-                    f"{what}: expected numbers, found {text.strip()!r}", line, code="fis-number"
+                    f"{what}: expected numbers, found {shown!r} ({exc})", line, code="fis-number"
                 ) from None
     return out
 
@@ -356,10 +358,10 @@ def _variable(
     declared = section.get("NumMFs")
     if declared is not None:
         try:
-            count = int(parse_number(declared[0]))
+            count = parse_count(declared[0])
         except ValueError:
             raise rep.fail(
-                f"NumMFs must be a number, found {declared[0]!r}", declared[1], code="fis-number"
+                f"NumMFs must be a whole number, found {declared[0]!r}", declared[1], code="fis-number"
             ) from None
         if count != len(var.terms):
             rep.warning(
@@ -390,6 +392,8 @@ def _flag(section: _Section, key: str, rep: Reporter) -> bool:
 
 def _hedges(code: float, dialect: str, rep: Reporter, line: int) -> tuple[int, tuple[str, ...], bool]:
     """Term index (1-based, 0 for "any"), hedges, negation of one rule entry."""
+    if not math.isfinite(code) or abs(code) > 1e9:
+        raise rep.fail(f"rule entry {code:g} is not a term number", line, code="fis-rule")
     negated = code < 0
     magnitude = abs(code)
     index = math.floor(magnitude + 1e-9)
@@ -602,10 +606,10 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         if entry is None:
             return None
         try:
-            return int(parse_number(entry[0]))
+            return parse_count(entry[0])
         except ValueError:
             raise rep.fail(
-                f"{key} must be a number, found {entry[0]!r}", entry[1], code="fis-number"
+                f"{key} must be a whole number, found {entry[0]!r}", entry[1], code="fis-number"
             ) from None
 
     for key, found in (("NumInputs", len(inputs_s)), ("NumOutputs", len(outputs_s))):

@@ -227,7 +227,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                 Loss(f"input {f.variable!r}", "FIS cannot clamp an input to its range (lock-range)")
             )
             f = replace(f, clamp=False)
-        fuzzify.append(with_range(fb, f, losses, 'FIS'))  # type: ignore[arg-type]
+        fuzzify.append(with_range(fb, f, losses, "FIS"))  # type: ignore[arg-type]
     fb = replace(fb, fuzzify=tuple(fuzzify))
     for d in fb.defuzzify:
         accu = point_accumulation(fb, d) if is_point_output(d) else None
@@ -257,7 +257,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                     kept.append(t)
                 else:
                     losses.append(Loss(f"term {t.name!r} of {d.variable!r}", problem))
-        defuzzify.append(with_range(fb, replace(d, terms=tuple(kept)), losses, 'FIS'))  # type: ignore[arg-type]
+        defuzzify.append(with_range(fb, replace(d, terms=tuple(kept)), losses, "FIS"))  # type: ignore[arg-type]
     fb = replace(fb, defuzzify=tuple(defuzzify))
     for f in fb.fuzzify:
         for t in f.terms:
@@ -351,9 +351,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         losses.append(Loss("aggregation", "FIS has no NSUM"))
     # what is written anyway (--lossy) says the nearest FIS aggregation
     accu_values = {"SUM" if a == "NSUM" else a for a in accu_values}
-    fb = replace(
-        fb, defuzzify=tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify)
-    )
+    fb = replace(fb, defuzzify=tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify))
     methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
     if len(methods) > 1:
         losses.append(

@@ -219,6 +219,7 @@ class _RuleParser:
         self.line = line
         self.rep = rep
         self.variables = variables
+        self.depth = 0  # parentheses open (bounded: the descent recurses)
 
     def fail(self, message: str) -> Exception:
         return self.rep.fail(f"rule: {message}", self.line, code="fll-rule")
@@ -285,8 +286,14 @@ class _RuleParser:
 
     def atom(self) -> Condition | bool:
         if self.peek() == "(":
+            from fuzzyctl.limits import MAX_NESTING
+
             self.take("(")
+            self.depth += 1
+            if self.depth > MAX_NESTING:
+                raise self.fail(f"the condition nests more than {MAX_NESTING} parentheses deep")
             inner = self.disjunction()
+            self.depth -= 1
             self.expect(")")
             return inner
         name = self.take("a variable")

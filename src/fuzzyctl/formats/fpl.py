@@ -235,6 +235,7 @@ class _Parser:
         self.rulebases: list[_RuleBase] = []
         self.connects: list[tuple[str, Span, str, Span]] = []
         self.project: str | None = None
+        self.depth = 0  # parentheses open in a condition (the descent recurses: bounded)
 
     # -- token helpers
     @property
@@ -495,8 +496,14 @@ class _Parser:
     def parse_subcondition(self) -> Condition:
         tok = self.tok
         if tok.kind == "punct" and tok.text == "(":
+            from fuzzyctl.limits import MAX_NESTING
+
             self.advance()
+            self.depth += 1
+            if self.depth > MAX_NESTING:  # the descent recurses: bounded before the stack is
+                self.fail(f"the condition nests more than {MAX_NESTING} parentheses deep")
             inner = self.parse_condition()
+            self.depth -= 1
             if not (self.tok.kind == "punct" and self.tok.text == ")"):
                 self.fail(f"expected ')', found {self.describe(self.tok)}")
             self.advance()

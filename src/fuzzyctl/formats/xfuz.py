@@ -225,7 +225,7 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
     sizes = {"ESV": ESV_SIZE, "FA": FA_SIZE, "RG": RG_SIZE}
     tables: dict[str, list[int]] = {name: [0] * size for name, size in sizes.items()}
     seen: dict[tuple[str, str], int] = {}
-    for lineno, row in enumerate(csv.reader(io.StringIO(text)), start=1):
+    for lineno, row in _csv_rows(text, path, diags):
         if not row or not "".join(row).strip() or row[0].lstrip().startswith("#"):
             continue
         cells = [c.strip() for c in row]
@@ -275,6 +275,24 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
                 error(f"table {cells[0]!r} is not CONST, ESV, FA or RG", span, code="xfuz-csv", file=path)
             )
     return _finish(consts, tables, diags, text, path)
+
+
+def _csv_rows(text: str, path: str | None, diags: list[Diagnostic]) -> Iterator[tuple[int, list[str]]]:
+    """(line, cells) of each CSV row; any line ending (LF, CRLF, CR alone) ends a row, and
+    what the csv module refuses (a field over its 131,072 characters, a NUL) is an error at
+    its line instead of an exception."""
+    normalised = text.replace("\r\n", "\n").replace("\r", "\n")
+    reader = csv.reader(io.StringIO(normalised, newline="\n"))
+    while True:
+        start = reader.line_num + 1
+        try:
+            row = next(reader)
+        except StopIteration:
+            return
+        except csv.Error as exc:
+            diags.append(error(f"not a CSV row: {exc}", Span(start, 1), code="xfuz-csv", file=path))
+            continue
+        yield start, row
 
 
 def read_tables(text: str, *, path: str | None = None) -> XfuzConstants:

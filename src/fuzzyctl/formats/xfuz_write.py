@@ -12,6 +12,7 @@ from dataclasses import dataclass, replace
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
 from fuzzyctl.formats.xfuz_tables import (
     DISCR_MAX,
+    MAX_RULES,
     OPEN_HIGH,
     OPEN_LOW,
     KnowledgeBase,
@@ -510,6 +511,8 @@ def _dnf(cond: Condition | None, or_is_max: bool) -> list[Conjunct] | None:
             if part is None:
                 return None
             out = [a + b for a in out for b in part]
+            if len(out) > MAX_RULES:  # more than the tables hold (and exponential to build)
+                raise _TooMany
         return out
     if isinstance(cond, Or) and or_is_max:
         alternatives: list[Conjunct] = []
@@ -518,8 +521,14 @@ def _dnf(cond: Condition | None, or_is_max: bool) -> list[Conjunct] | None:
             if part is None:
                 return None
             alternatives += part
+            if len(alternatives) > MAX_RULES:
+                raise _TooMany
         return alternatives
     return None
+
+
+class _TooMany(Exception):
+    """A condition whose OR-of-ANDs form has more rules than the RG table holds."""
 
 
 def _extent(terms: tuple[Term, ...]) -> Range | None:
@@ -644,7 +653,11 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     rules: list[Rule] = []
     for rule in rb.rules:
         label = f"rule {rule.label!r}"
-        conjuncts = _dnf(rule.condition, or_is_max)
+        try:
+            conjuncts = _dnf(rule.condition, or_is_max)
+        except _TooMany:
+            losses.append((label, f"as ANDs of 'v IS [NOT] t' it needs more than {MAX_RULES} rules"))
+            continue
         if conjuncts is None:
             losses.append(
                 (label, "XFUZ rules are ANDs of 'v IS [NOT] t' (OR only as MAX, no hedges or degrees)")

@@ -1,0 +1,361 @@
+"""Large and pathological inputs: every reader must accept or refuse a 10 MB file in under
+5 s and 500 MB (issue 14, point 4).
+
+For each format (FCL, FIS, FLL, JSON, FPL, XFUZ) the script writes files of the requested
+size in several shapes - a valid system with very many rules, a file with an error on every
+line, random garbage, one single enormous line, deep nesting - and runs the CLI on each in a
+fresh process (``fuzzyctl.load`` inside the CLI's error boundary, which prints the
+diagnostics as the CLI does; FCL also through ``fuzzyctl check``), printing wall and CPU
+time, peak resident memory (of that process) and the exit code.
+Files over the size limit (``FUZZYCTL_MAX_INPUT_BYTES``, default 8 MiB) are refused up
+front, so the script also runs each shape just under the limit.
+
+usage: python benchmarks/large_inputs.py [--mb 10] [--formats fcl,fis,...] [--shapes ...]
+exit status 1 when a case breaks the goal (time, memory, or an exit code other than 0/1).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import random
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+GOAL_S, GOAL_MB = 5.0, 500.0
+
+
+def _repeat(head: str, unit: Callable[[int], str], tail: str, size: int) -> str:
+    parts, n, k = [head], len(head) + len(tail), 0
+    while n < size:
+        s = unit(k)
+        parts.append(s)
+        n += len(s)
+        k += 1
+    parts.append(tail)
+    return "".join(parts)
+
+
+def _garbage(size: int, seed: int = 1) -> str:
+    rng = random.Random(seed)
+    alphabet = "abcdefXYZ_0123456789 ();:=,.*/-+[]{}'\"\n\t"
+    return "".join(rng.choice(alphabet) for _ in range(min(size, 1 << 16))) * max(1, size >> 16)
+
+
+FCL_HEAD = """FUNCTION_BLOCK big
+VAR_INPUT a : REAL; b : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY a TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY
+FUZZIFY b TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY
+DEFUZZIFY y TERM lo := 0; TERM hi := 1; METHOD : COGS; DEFAULT := 0; END_DEFUZZIFY
+RULEBLOCK r
+AND : MIN;
+"""
+FCL_TAIL = "END_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+
+
+def fcl(shape: str, size: int) -> str:
+    if shape == "valid":
+        return _repeat(
+            FCL_HEAD, lambda k: f"RULE {k} : IF a IS lo AND b IS hi THEN y IS lo;\n", FCL_TAIL, size
+        )
+    if shape == "errors":
+        return _repeat(FCL_HEAD, lambda k: f"RULE {k} : IF a IS nothing THEN y IS ;\n", FCL_TAIL, size)
+    if shape == "one-line":
+        return _repeat(
+            FCL_HEAD.replace("\n", " "), lambda k: "RULE 1 : IF a IS lo THEN y IS lo; ", FCL_TAIL, size
+        )
+    if shape == "deep":
+        depth = size // 2
+        return (
+            FCL_HEAD + "RULE 1 : IF " + "(" * depth + "a IS lo" + ")" * depth + " THEN y IS lo;\n" + FCL_TAIL
+        )
+    if shape == "not":
+        return FCL_HEAD + "RULE 1 : IF " + "NOT " * (size // 4) + "a IS lo THEN y IS lo;\n" + FCL_TAIL
+    return _garbage(size)
+
+
+FIS_HEAD = """[System]
+Name='big'
+Type='mamdani'
+NumInputs=1
+NumOutputs=1
+NumRules={n}
+AndMethod='min'
+OrMethod='max'
+ImpMethod='min'
+AggMethod='max'
+DefuzzMethod='centroid'
+[Input1]
+Name='a'
+Range=[0 1]
+NumMFs=2
+MF1='lo':'trimf',[0 0 1]
+MF2='hi':'trimf',[0 1 1]
+[Output1]
+Name='y'
+Range=[0 1]
+NumMFs=2
+MF1='lo':'trimf',[0 0 1]
+MF2='hi':'trimf',[0 1 1]
+[Rules]
+"""
+
+
+def fis(shape: str, size: int) -> str:
+    if shape == "valid":
+        return _repeat(
+            FIS_HEAD.format(n=size // 14), lambda k: f"{k % 2 + 1}, {k % 2 + 1} (1) : 1\n", "", size
+        )
+    if shape == "errors":
+        return _repeat(FIS_HEAD.format(n=3), lambda k: f"{k} x, y (1) : 9\n", "", size)
+    if shape == "one-line":
+        return FIS_HEAD.format(n=1) + "1, 1 (1) : 1 " + "1 " * (size // 2) + "\n"
+    if shape == "deep":
+        d = size // 2
+        return (
+            FIS_HEAD.format(n=1).replace("[0 0 1]", "[" + "(" * d + "0" + ")" * d + " 0 1]", 1)
+            + "1, 1 (1) : 1\n"
+        )
+    if shape == "not":
+        return FIS_HEAD.format(n=1).replace("NumRules=1", "NumRules=" + "9" * 5001)
+    return _garbage(size)
+
+
+FLL_HEAD = """Engine: big
+InputVariable: a
+  range: 0 1
+  term: lo Triangle 0 0 1
+  term: hi Triangle 0 1 1
+OutputVariable: y
+  range: 0 1
+  default: 0
+  aggregation: Maximum
+  defuzzifier: Centroid 100
+  term: lo Triangle 0 0 1
+  term: hi Triangle 0 1 1
+RuleBlock: r
+  conjunction: Minimum
+  implication: Minimum
+"""
+
+
+def fll(shape: str, size: int) -> str:
+    if shape == "valid":
+        return _repeat(FLL_HEAD, lambda k: "  rule: if a is lo then y is hi\n", "", size)
+    if shape == "errors":
+        return _repeat(FLL_HEAD, lambda k: f"  rule: if a is nothing{k} then y is\n", "", size)
+    if shape == "one-line":
+        return FLL_HEAD + "  rule: if " + "a is lo and " * (size // 12) + "a is lo then y is hi\n"
+    if shape == "deep":
+        d = size // 2
+        return FLL_HEAD + "  rule: if " + "(" * d + "a is lo" + ")" * d + " then y is hi\n"
+    if shape == "not":
+        return FLL_HEAD + "  rule: if " + "not " * (size // 4) + "a is lo then y is hi\n"
+    return _garbage(size)
+
+
+def _json_doc() -> dict[str, object]:
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
+    import fuzzyctl
+    from fuzzyctl.formats import json as fj
+
+    return fj.to_dict(fuzzyctl.load(FCL_HEAD + "RULE 1 : IF a IS lo THEN y IS lo;\n" + FCL_TAIL))
+
+
+def jsonf(shape: str, size: int) -> str:
+    doc = _json_doc()
+    if shape == "valid":
+        rules = doc["blocks"][0]["rule_blocks"][0]["rules"]  # type: ignore[index]
+        one = json.dumps(rules[0])
+        rules.extend([rules[0]] * (size // len(one)))
+        return json.dumps(doc)
+    if shape == "errors":
+        doc["blocks"][0]["rule_blocks"][0]["rules"] = [{"label": 1, "bogus": k} for k in range(size // 30)]  # type: ignore[index]
+        return json.dumps(doc)
+    if shape == "one-line":
+        return json.dumps(doc) + " " * size
+    if shape == "deep":
+        d = size // 2
+        return "[" * d + "]" * d
+    if shape == "not":
+        cond: dict[str, object] = {"type": "is", "variable": "a", "term": "lo"}
+        text = json.dumps(cond)
+        depth = size // 32
+        text = '{"type": "not", "operand": ' * depth + text + "}" * depth
+        base = json.dumps(doc)
+        marker = json.dumps(doc["blocks"][0]["rule_blocks"][0]["rules"][0]["condition"])  # type: ignore[index]
+        return base.replace(marker, text, 1)
+    return _garbage(size)
+
+
+FPL_HEAD = """PROJECT big
+VAR a
+TYPE float
+MIN 0.0
+MAX 1.0
+MEMBER lo
+POINTS 0.0,1.0 1.0,0.0
+END
+MEMBER hi
+POINTS 0.0,0.0 1.0,1.0
+END
+END
+VAR y
+TYPE float
+MIN 0.0
+MAX 1.0
+MEMBER lo
+POINTS 0.0,1.0 0.01,1.0
+END
+END
+FUZZY r
+"""
+FPL_TAIL = "END\nCONNECT\nFROM a\nTO r\nEND\nCONNECT\nFROM r\nTO y\nEND\nEND\n"
+
+
+def fpl(shape: str, size: int) -> str:
+    if shape == "valid":
+        return _repeat(FPL_HEAD, lambda k: f"RULE R{k}\nIF (a is lo)\nTHEN y = lo\nEND\n", FPL_TAIL, size)
+    if shape == "errors":
+        return _repeat(FPL_HEAD, lambda k: f"RULE R{k}\nIF (a is nothing)\nTHEN y = \nEND\n", FPL_TAIL, size)
+    if shape == "one-line":
+        return (
+            FPL_HEAD
+            + "RULE R1 IF "
+            + "(a is lo) AND " * (size // 14)
+            + "(a is lo) THEN y = lo END\n"
+            + FPL_TAIL
+        )
+    if shape == "deep":
+        d = size // 2
+        return FPL_HEAD + "RULE R1\nIF " + "(" * d + "a is lo" + ")" * d + "\nTHEN y = lo\nEND\n" + FPL_TAIL
+    if shape == "not":
+        return FPL_HEAD + "RULE R1\nIF " + "NOT " * (size // 4) + "(a is lo)\nTHEN y = lo\nEND\n" + FPL_TAIL
+    return _garbage(size)
+
+
+def xfuz(shape: str, size: int) -> str:
+    head = "table,index,value,note\nCONST,OP_ET,0,\n"
+    if shape == "valid":
+        return _repeat(head, lambda k: f"FA,{k % 576},{k % 100},note {k}\n", "", size)
+    if shape == "errors":
+        return _repeat(head, lambda k: f"XX,{k},not-a-number,\n", "", size)
+    if shape == "one-line":
+        return head + "FA,0,1," + "n" * size + "\n"
+    if shape == "deep":
+        return "\r".join(f"FA,{k % 576},1," for k in range(size // 10))  # CR-only line ends
+    if shape == "not":
+        return head + "FA,0," + "9" * 5001 + ",\n"
+    return _garbage(size)
+
+
+FORMATS: dict[str, tuple[str, Callable[[str, int], str]]] = {
+    "fcl": (".fcl", fcl),
+    "fis": (".fis", fis),
+    "fll": (".fll", fll),
+    "json": (".json", jsonf),
+    "fpl": (".fpl", fpl),
+    "xfuz": (".csv.xfuz", xfuz),
+}
+SHAPES = ("valid", "errors", "garbage", "one-line", "deep", "not")
+
+
+# The child: fuzzyctl.load() inside the CLI's error boundary (diagnostics printed as the CLI
+# prints them, exit 1 on a refusal, 3 on anything else); FCL also goes through `check`.
+_CHILD = """
+import sys
+from fuzzyctl.cli.app import main
+if sys.argv[1] == "check":
+    sys.exit(main(["check", sys.argv[2]]))
+import fuzzyctl
+from fuzzyctl.diagnostics import DiagnosticError
+try:
+    fuzzyctl.load(sys.argv[2])
+except DiagnosticError as exc:
+    sys.stderr.write(exc.render())
+    sys.exit(1)
+except Exception as exc:
+    sys.stderr.write(repr(exc)[:2000])
+    sys.exit(3)
+"""
+
+
+def run_case(path: Path, mode: str, timeout: float) -> tuple[float, float, float, int | None]:
+    """(wall seconds, CPU seconds, peak RSS in MB, exit code or None on timeout) of a fresh
+    process reading ``path`` (``mode``: load or check)."""
+    start = time.perf_counter()
+    proc = subprocess.Popen(
+        [sys.executable, "-c", _CHILD, mode, str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+    )
+    deadline = start + timeout
+    while True:
+        pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+        if pid:
+            wall = time.perf_counter() - start
+            cpu = usage.ru_utime + usage.ru_stime
+            return wall, cpu, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
+        if time.perf_counter() > deadline:
+            proc.kill()
+            _pid, _status, usage = os.wait4(proc.pid, 0)
+            cpu = usage.ru_utime + usage.ru_stime
+            return time.perf_counter() - start, cpu, usage.ru_maxrss / 1024, None
+        time.sleep(0.01)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--mb", type=float, default=10.0, help="size of each file in MB (default 10)")
+    ap.add_argument("--formats", default=",".join(FORMATS))
+    ap.add_argument("--shapes", default=",".join(SHAPES))
+    ap.add_argument("--timeout", type=float, default=60.0)
+    ap.add_argument(
+        "--under-limit", action="store_true", help="also run each shape just under the size limit"
+    )
+    args = ap.parse_args()
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
+    from fuzzyctl.limits import max_input_bytes
+
+    sizes = [int(args.mb * 1_000_000)]
+    if args.under_limit:
+        sizes.append(-1)  # each format's own limit, minus 4 KiB
+    failed = 0
+    print(
+        f"goal: < {GOAL_S} s and < {GOAL_MB} MB; exit 0 (accepted) or 1 (refused); "
+        f"machine: {os.cpu_count()} cores"
+    )
+    print(
+        f"load average: {os.getloadavg()[0]:.1f} (the goal is judged on CPU time when the machine is shared)"
+    )
+    print(f"{'format':6} {'shape':9} {'mode':5} {'MB':>6} {'wall s':>7} {'CPU s':>6} {'RSS MB':>7} exit")
+    with tempfile.TemporaryDirectory() as tmp:
+        for fmt in args.formats.split(","):
+            ext, make = FORMATS[fmt]
+            for shape in args.shapes.split(","):
+                for size in sizes:
+                    path = Path(tmp) / f"{fmt}-{shape}{ext}"
+                    size = size if size > 0 else max_input_bytes(fmt) - 4096
+                    path.write_text(make(shape, size), encoding="utf-8")
+                    mb = path.stat().st_size / 1e6
+                    for mode in ("load", "check") if fmt == "fcl" else ("load",):
+                        wall, cpu, rss, code = run_case(path, mode, args.timeout)
+                        ok = code in (0, 1) and cpu < GOAL_S and rss < GOAL_MB
+                        failed += not ok
+                        shown = "hung" if code is None else str(code)
+                        flag = "" if ok else "   <-- over the goal"
+                        print(
+                            f"{fmt:6} {shape:9} {mode:5} {mb:6.1f} {wall:7.2f} {cpu:6.2f} {rss:7.0f} "
+                            f"{shown}{flag}",
+                            flush=True,
+                        )
+                    path.unlink()
+    return 1 if failed else 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,212 @@
+"""Limits on what fuzzyctl reads, so that no input can take unbounded time or memory.
+
+* :func:`max_input_bytes` - the largest model file read: 8 MiB for the text formats (FCL,
+  FIS, FLL, FPL, XFUZ; a 10,000-rule FCL system is 1.4 MB, the largest real FCL file we
+  know of 290 KB), 96 MiB for JSON (which spells out every span: that 10,000-rule system is
+  43.5 MB of JSON).  ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for every format.  A
+  larger file is refused before it is read, with a diagnostic saying the size and the
+  limit; reading time is linear in the size below it.
+* :data:`MAX_DIAGNOSTICS_SHOWN` - how many diagnostics the CLI prints per file; the rest
+  are summarised as "N more".
+* :data:`MAX_NESTING` - how deep conditions and expressions may nest (a rule with more
+  than that many nested NOTs, ANDs in ORs or parentheses is refused with its place, never
+  a RecursionError); JSON may nest :data:`MAX_JSON_DEPTH` levels.
+* :data:`MAX_DIGITS` - the longest number literal read (Python refuses to convert
+  integers over 4300 digits; a literal that long is an error with its place).
+
+The limits are documented in docs/limits.md.
+"""
+# MAX_DIAGNOSTICS_SHOWN lives in fuzzyctl.diagnostics (the renderer uses it); re-exported here.
+
+from __future__ import annotations
+
+import math
+import os
+import stat
+from pathlib import Path
+
+from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, Diagnostic, DiagnosticError, error
+from fuzzyctl.model import (
+    And,
+    Binary,
+    Call,
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FunctionMF,
+    FuzzifyBlock,
+    Not,
+    Or,
+    Range,
+    Unary,
+)
+
+DEFAULT_MAX_INPUT_BYTES = 8 * 1024 * 1024
+#: Formats whose files are larger for the same system (read by a C parser, so faster).
+FORMAT_MAX_INPUT_BYTES = {"json": 12 * DEFAULT_MAX_INPUT_BYTES}
+MAX_NESTING = 100
+MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
+MAX_DIGITS = 400
+
+
+__all__ = [
+    "DEFAULT_MAX_INPUT_BYTES",
+    "MAX_DIAGNOSTICS_SHOWN",
+    "MAX_DIGITS",
+    "MAX_JSON_DEPTH",
+    "MAX_NESTING",
+    "check_document",
+    "check_text",
+    "depth",
+    "expr_depth",
+    "max_input_bytes",
+    "read_input",
+    "too_large",
+]
+
+
+def max_input_bytes(format: str | None = None) -> int:
+    """The size limit of a model file of ``format`` in bytes (``FUZZYCTL_MAX_INPUT_BYTES``
+    when set, else :data:`DEFAULT_MAX_INPUT_BYTES` or the format's own)."""
+    value = os.environ.get("FUZZYCTL_MAX_INPUT_BYTES", "")
+    try:
+        limit = int(value)
+    except ValueError:
+        limit = 0
+    if limit > 0:
+        return limit
+    return FORMAT_MAX_INPUT_BYTES.get((format or "").lower(), DEFAULT_MAX_INPUT_BYTES)
+
+
+def _mib(n: int) -> str:
+    return f"{n / (1024 * 1024):.1f} MiB" if n >= 1024 * 1024 else f"{n} bytes"
+
+
+def too_large(size: int, path: str | None, format: str | None = None) -> DiagnosticError:
+    limit = max_input_bytes(format)
+    what = f"{format.upper()} files" if format else "model files"
+    return DiagnosticError(
+        [
+            error(
+                f"the file is {_mib(size)}, over the {_mib(limit)} limit for {what}",
+                file=path,
+                code="too-large",
+                hint="set FUZZYCTL_MAX_INPUT_BYTES to read larger files",
+            )
+        ]
+    )
+
+
+def _unreadable(exc: OSError, name: str) -> DiagnosticError:
+    return DiagnosticError([error(f"cannot read: {exc.strerror or exc}", file=name, code="unreadable")])
+
+
+def read_input(path: str | os.PathLike[str], format: str | None = None) -> bytes:
+    """The bytes of a model file, or :class:`DiagnosticError` for a missing file, a
+    directory, an unreadable file or one over :func:`max_input_bytes` (checked before
+    reading; a pipe or device is read up to the limit and no further)."""
+    p = Path(path)
+    name = str(path)
+    try:
+        st = p.stat()
+    except FileNotFoundError:
+        raise DiagnosticError([error("no such file", file=name, code="no-file")]) from None
+    except OSError as exc:
+        raise _unreadable(exc, name) from None
+    if stat.S_ISDIR(st.st_mode):
+        what = f"an {format.upper()} file" if format else "a model file"
+        raise DiagnosticError([error(f"is a directory, not {what}", file=name, code="is-directory")])
+    limit = max_input_bytes(format)
+    if stat.S_ISREG(st.st_mode) and st.st_size > limit:
+        raise too_large(st.st_size, name, format)
+    try:
+        with p.open("rb") as handle:
+            data = handle.read(limit + 1)
+    except OSError as exc:
+        raise _unreadable(exc, name) from None
+    if len(data) > limit:
+        raise too_large(len(data), name, format)
+    return data
+
+
+def check_text(text: str, path: str | None = None, format: str | None = None) -> None:
+    """Refuse source text over the size limit of ``format`` (in UTF-8 bytes; the encoding is
+    only measured when the length leaves a doubt)."""
+    limit = max_input_bytes(format)
+    if len(text) > limit or (len(text) * 4 > limit and len(text.encode("utf-8", "surrogatepass")) > limit):
+        raise too_large(len(text.encode("utf-8", "surrogatepass")), path, format)
+
+
+def depth(node: object) -> int:
+    """How deep a condition or an expression nests (``a IS b``: 1, ``NOT (a IS b)``: 2; a
+    chain ``x + y + z`` counts each operator), computed without recursion so that any tree
+    can be measured."""
+    deepest = 0
+    stack = [(node, 1)]
+    while stack:
+        item, level = stack.pop()
+        deepest = max(deepest, level)
+        if isinstance(item, Not | Unary):
+            stack.append((item.operand, level + 1))
+        elif isinstance(item, And | Or):
+            stack.extend((o, level + 1) for o in item.operands)
+        elif isinstance(item, Binary):
+            stack.append((item.left, level + 1))
+            stack.append((item.right, level + 1))
+        elif isinstance(item, Call):
+            stack.extend((a, level + 1) for a in item.args)
+    return deepest
+
+
+expr_depth = depth
+
+
+def check_document(document: Document, path: str | None = None) -> list[Diagnostic]:
+    """What every reader refuses, whatever the format says: a rule condition or function
+    term nesting deeper than :data:`MAX_NESTING` (it would overflow the stack of every later
+    step) and a RANGE with a NaN bound (``RANGE := (nan .. 100)``: no value is inside it)."""
+    out: list[Diagnostic] = []
+    for fb in document.blocks:
+        for owner, rng in _ranges(fb):
+            if math.isnan(rng.low) or math.isnan(rng.high):
+                out.append(
+                    error(
+                        f"{owner}: RANGE ({rng.low:g} .. {rng.high:g}) has a bound that is not a number",
+                        rng.span,
+                        code="range-nan",
+                        file=path,
+                    )
+                )
+        for _block, rule in fb.rules():
+            if rule.condition is not None and (d := depth(rule.condition)) > MAX_NESTING:
+                out.append(
+                    error(
+                        f"rule {rule.label}: the condition nests {d} levels deep "
+                        f"(the limit is {MAX_NESTING})",
+                        rule.span,
+                        code="too-deep",
+                        file=path,
+                    )
+                )
+        blocks: tuple[FuzzifyBlock | DefuzzifyBlock, ...] = (*fb.fuzzify, *fb.defuzzify)
+        for block in blocks:
+            for term in block.terms:
+                mf = term.mf
+                if isinstance(mf, FunctionMF) and (d := depth(mf.expr)) > MAX_NESTING:
+                    out.append(
+                        error(
+                            f"term {term.name}: the function nests {d} levels deep "
+                            f"(the limit is {MAX_NESTING})",
+                            term.span,
+                            code="too-deep",
+                            file=path,
+                        )
+                    )
+    return out
+
+
+def _ranges(fb: FunctionBlock) -> list[tuple[str, Range]]:
+    out = [(f"variable {v.name}", v.range) for v in fb.variables if v.range is not None]
+    out += [(f"FUZZIFY {b.variable}", b.range) for b in fb.fuzzify if b.range is not None]
+    out += [(f"DEFUZZIFY {b.variable}", b.range) for b in fb.defuzzify if b.range is not None]
+    return out
