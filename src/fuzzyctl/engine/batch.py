@@ -10,7 +10,6 @@ from typing import Any
 from fuzzyctl.engine.plan import Plan
 
 
-
 class BatchEvaluator:
     """``BatchEvaluator(plan).run(columns, state)`` -> one array per plan output."""
 
