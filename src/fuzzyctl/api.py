@@ -56,13 +56,16 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
 
 def _load_path(path: Path, fmt: str) -> Document:
     from fuzzyctl import cache
+    from fuzzyctl.diagnostics import DiagnosticError
 
     key = None
     if cache.enabled():
+        from fuzzyctl.limits import read_input
+
         try:
-            data = path.read_bytes()
-        except OSError:
-            data = None  # the reader reports it
+            data: bytes | None = read_input(path, fmt)  # the size limit holds for cached files too
+        except DiagnosticError:
+            data = None  # the reader reports it with its place
         if data is not None:
             key = content_key(data, fmt)
             doc = _cached(f"documents/{key}.pickle")
