@@ -12,13 +12,14 @@ if TYPE_CHECKING:
     from fuzzyctl.engine.controller import Controller
 
 
-def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
+def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = False) -> Document:
     """Read a fuzzy system from a file path or from source text.
 
     ``format`` (``"fcl"``, ...) overrides detection by file extension; text that is not an
-    existing path is parsed as FCL unless ``format`` says otherwise.  Raises
-    :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
-    input is not valid."""
+    existing path is parsed as FCL unless ``format`` says otherwise.  ``strict``: refuse, as
+    a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7).
+    Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
+    when the input is not valid."""
     from fuzzyctl import formats
     from fuzzyctl.diagnostics import DiagnosticError, error
     from fuzzyctl.fcl import load_file, load_text
@@ -28,14 +29,14 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
         path = Path(path_or_text)
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
         if fmt == "fcl":
-            return load_file(path).raise_for_errors()
+            return load_file(path, strict=strict).raise_for_errors()
         return formats.read_path(path, fmt).document
     if fmt not in (None, "fcl"):
         return formats.read_text(str(path_or_text), fmt).document
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
-    return load_text(text).raise_for_errors()
+    return load_text(text, strict=strict).raise_for_errors()
 
 
 def _looks_like_path(value: str) -> bool:
@@ -55,9 +56,14 @@ def compile(
     ``"python"``, ``"interpreted"`` or ``"native"`` (generated C compiled into a cached
     shared library, see docs/codegen.md; without a C compiler it warns and uses the Python
     path); ``compat="fuzzylite"`` etc. reproduces other tools' semantics (default
-    IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine
-    cannot evaluate."""
+    IEC 61131-7).  ``strict=True`` refuses what a strict IEC 61131-7 reading refuses and the
+    engine otherwise settles with a warning: an output without RANGE whose terms do not fall
+    to 0, identifiers that are Table 7 keywords.  Raises
+    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
     from fuzzyctl.engine.compile import compile_block
+
+    if options.get("strict"):
+        _refuse_reserved(model)
 
     if backend == "native":
         from fuzzyctl.codegen.native import compile_native
@@ -65,3 +71,13 @@ def compile(
         plan = compile_block(model, block=block, backend="interpreted", **options).plan
         return compile_native(plan)
     return compile_block(model, block=block, backend=backend, **options)
+
+
+def _refuse_reserved(model: Document | FunctionBlock) -> None:
+    from fuzzyctl.diagnostics import DiagnosticError, has_errors
+    from fuzzyctl.fcl.reserved import check_reserved_words
+
+    doc = model if isinstance(model, Document) else Document((model,))
+    found = check_reserved_words(doc, doc.path, strict=True)
+    if has_errors(found):
+        raise DiagnosticError(found)

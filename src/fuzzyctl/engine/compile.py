@@ -72,7 +72,9 @@ def compile_block(
     if backend not in ("python", "interpreted"):
         raise FuzzyctlError(f"unknown backend {backend!r} (available: python, interpreted, native)")
     plan, diags = lower(fb, opts)
+    path = getattr(model, "path", None) if isinstance(model, Document) else None
     if plan is None:
-        path = getattr(model, "path", None) if isinstance(model, Document) else None
         raise DiagnosticError([dataclasses.replace(d, file=d.file or path) for d in diags])
-    return Controller(plan, specialise=backend == "python")
+    controller = Controller(plan, specialise=backend == "python")
+    controller.warnings = tuple(dataclasses.replace(d, file=d.file or path) for d in diags)
+    return controller

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.diagnostics import InputError
+from fuzzyctl.diagnostics import Diagnostic, InputError
 from fuzzyctl.engine import explain as explain_mod
 from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan
@@ -35,6 +35,9 @@ class Controller:
         self._state: list[float | None] = [None] * len(plan.outputs)
         self._required = tuple(i.name for i in plan.inputs if i.default is None)
         self._degree = tuple(i.degree for i in plan.inputs)
+        #: what compiling decided with a warning (a universe taken from the terms, a term
+        #: defined twice, ...): :class:`~fuzzyctl.diagnostics.Diagnostic` objects
+        self.warnings: tuple[Diagnostic, ...] = ()
         self._fast: Callable[[list[float], list[float | None]], list[float]] | None = None
         self._batch: Any = None
         if specialise:

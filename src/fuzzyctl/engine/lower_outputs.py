@@ -98,8 +98,20 @@ def _output(
         return None
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
-    if method in ("COGS", "WTAVER", "WTSUM") and kinds <= shapes.TSUKAMOTO_KINDS:
+    if (
+        method in ("COGS", "WTAVER", "WTSUM")
+        and kinds <= shapes.TSUKAMOTO_KINDS
+        and all(t.kind != "points" or (t.pwl is not None and shapes.monotone(t.pwl)) for t in tps)
+        and ctx.options.emulate is None
+    ):
         # Tsukamoto: a weighted average of where each monotonic term reaches its degree
+        if "points" in kinds:
+            ctx.warn(
+                f"DEFUZZIFY {var.name}: {method} over monotonic point terms is Tsukamoto inference "
+                "(jfuzzyqt): each rule contributes where its term reaches the rule's degree",
+                db.span,
+                "tsukamoto-points",
+            )
         ts_accu = accu if accu is not None else ctx.options.ts_default_accu
         return OutputPlan(
             var.name,

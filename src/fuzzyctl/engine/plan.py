@@ -340,6 +340,10 @@ class Options:
     span_universe: bool = False
     #: jFuzzyLogic: a RANGE on the VAR declaration line is ignored (only DEFUZZIFY's counts)
     ignore_declared_range: bool = False
+    #: ``"jfuzzylogic"``: the plan is evaluated by :mod:`fuzzyctl.engine.jfl`, which reproduces
+    #: jFuzzyLogic 3.3 (its 1000-point defuzzification and the rest, docs/engine.md); the
+    #: code generators refuse such a plan
+    emulate: str | None = None
 
 
 @dataclass(frozen=True)

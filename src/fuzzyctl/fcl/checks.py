@@ -13,6 +13,8 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
+from fuzzyctl.fcl.jfl import check_jfuzzylogic
+from fuzzyctl.fcl.reserved import check_reserved_words
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     Condition,
@@ -529,6 +531,23 @@ def _names(e: object) -> set[str]:
     return out
 
 
+def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+    """Identifiers that are IEC 61131-7 Table 7 keywords (:mod:`fuzzyctl.fcl.reserved`)."""
+    return check_reserved_words(doc, ctx.file, bool(ctx.options.get("strict")))
+
+
 register_provider("declarations", check_declarations)
 register_provider("rules", check_rules)
 register_provider("functions", check_functions)
+
+
+def check_jfl(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+    """Under ``compat="jfuzzylogic"``: what jFuzzyLogic 3.3 would reject or read differently
+    (:mod:`fuzzyctl.fcl.jfl`)."""
+    if ctx.options.get("compat") != "jfuzzylogic":
+        return []
+    return check_jfuzzylogic(doc, ctx.file, ctx.options.get("parsed"))
+
+
+register_provider("reserved", check_reserved)
+register_provider("jfuzzylogic", check_jfl)

@@ -15,7 +15,8 @@ import net.sourceforge.jFuzzyLogic.rule.Variable;
  * (the first function block, syntax errors counted) and evaluates the rows in order on that one
  * function block (DEFAULT := NC state carries over).  Output per job: "## job N", then
  * JflOracle's lines: "# LOAD_ERROR ..." or "# syntax_errors=N", the header and one CSV row of
- * %.17g values (nan, ERR:<message>) per input row.
+ * %.17g values (nan, ERR:<message>) per input row.  An INPUTS.csv whose header is "*=V" means
+ * one evaluation with every input variable set to V.
  */
 public class JflBatch {
     public static void main(String[] args) throws Exception {
@@ -54,11 +55,26 @@ public class JflBatch {
         out.println(String.join(",", outNames));
         BufferedReader r = new BufferedReader(new FileReader(csv));
         String[] inNames = r.readLine().trim().split(",");
+        if (inNames.length == 1 && inNames[0].startsWith("*=")) {
+            // one evaluation with every input variable (a variable without defuzzifier) set to a value
+            List<String> all = new ArrayList<String>();
+            for (Variable v : fb.variablesSorted()) if (!v.isOutput()) all.add(v.getName());
+            String value = inNames[0].substring(2);
+            r.close();
+            StringWriter sw = new StringWriter();
+            sw.write(String.join(",", all) + "\n");
+            for (int j = 0; j < all.size(); j++) sw.write((j > 0 ? "," : "") + value);
+            sw.write(all.isEmpty() ? "-\n" : "\n");
+            r = new BufferedReader(new StringReader(sw.toString()));
+            inNames = r.readLine().trim().split(",");
+            if (all.isEmpty()) { inNames = new String[0]; }
+        }
         String line;
         while ((line = r.readLine()) != null) {
             line = line.trim();
             if (line.isEmpty()) continue;
             String[] cells = line.split(",");
+            if (inNames.length == 0) cells = new String[0];
             StringBuilder sb = new StringBuilder();
             try {
                 for (int j = 0; j < inNames.length; j++) fb.setVariable(inNames[j].trim(), Double.parseDouble(cells[j].trim()));
