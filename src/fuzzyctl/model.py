@@ -402,12 +402,18 @@ class And:
 
     operands: tuple[Condition, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
+    grouped: bool = field(default=False, compare=False, repr=False)
+    """Written in parentheses of its own.  IEC 61131-7 binds AND tighter than OR, so
+    ``a OR b AND c`` and ``a OR (b AND c)`` are the same tree; jFuzzyLogic reads AND and OR
+    left to right, so its profile needs to know which one was written."""
 
 
 @dataclass(frozen=True)
 class Or:
     operands: tuple[Condition, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
+    grouped: bool = field(default=False, compare=False, repr=False)
+    """Written in parentheses of its own (see :attr:`And.grouped`)."""
 
 
 Condition: TypeAlias = Is | Degree | Not | And | Or

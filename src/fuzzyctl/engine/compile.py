@@ -28,8 +28,14 @@ COMPAT_PROFILES: dict[str, Options] = {
     "pyfuzzylite": Options(
         weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"
     ),
-    # jFuzzyLogic 3.3: WITH scales the condition degree
-    "jfuzzylogic": Options(weight_before_activation=True, weight_whole_rule=True),
+    # jFuzzyLogic 3.3, reproduced by engine/jfl.py (docs/engine.md, "jfuzzylogic profile")
+    "jfuzzylogic": Options(
+        weight_before_activation=True,
+        weight_whole_rule=True,
+        span_universe=True,
+        ignore_declared_range=True,
+        emulate="jfuzzylogic",
+    ),
 }
 
 

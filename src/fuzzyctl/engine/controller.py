@@ -40,6 +40,13 @@ class Controller:
         self.warnings: tuple[Diagnostic, ...] = ()
         self._fast: Callable[[list[float], list[float | None]], list[float]] | None = None
         self._batch: Any = None
+        self._jfl: Any = None
+        if plan.options.emulate == "jfuzzylogic":
+            # another tool's arithmetic (1000-point sets, ...): one evaluator serves every path
+            from fuzzyctl.engine.jfl import JflEvaluator
+
+            self._jfl = JflEvaluator(plan)
+            specialise = False
         if specialise:
             from fuzzyctl.engine.specialise import specialise as make_fast
 
@@ -74,7 +81,9 @@ class Controller:
     def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
         """Evaluate once: ``{"temp": 20.0, ...} -> {"valve": 35.7, ...}``."""
         values = self._values(inputs)
-        if self._fast is not None:
+        if self._jfl is not None:
+            res = [float(v[0]) for v in self._jfl.run([[v] for v in values], self._state, 1)]
+        elif self._fast is not None:
             res = self._fast(values, self._state)
         else:
             rec = self._interp.run(values, self._state)
@@ -85,6 +94,8 @@ class Controller:
     def evaluate_reference(self, inputs: Mapping[str, Any]) -> dict[str, float]:
         """Evaluate through the interpreter (the unspecialised path), for cross-checks."""
         values = self._values(inputs)
+        if self._jfl is not None:
+            return self.evaluate(inputs)
         rec = self._interp.run(values, self._state)
         return {o.name: r.value for o, r in zip(self.plan.outputs, rec.outputs, strict=True) if o.is_output}
 
@@ -92,7 +103,11 @@ class Controller:
         """Evaluate once and return every intermediate result (this counts as an evaluation:
         the NC state advances)."""
         values = self._values(inputs)
-        rec = self._interp.run(values, self._state)
+        rec = (
+            self._jfl.record(values, self._state)
+            if self._jfl is not None
+            else self._interp.run(values, self._state)
+        )
         named = dict(zip(self.inputs, values, strict=True))
         return explain_mod.build(self.plan, named, rec)
 
@@ -139,6 +154,9 @@ class Controller:
         return {k: v for k, v in result.items() if k in self.outputs}
 
     def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
+        if self._jfl is not None:
+            got: list[npt.NDArray[np.float64]] = self._jfl.run(part, self._state, len(part[0]) if part else 1)
+            return got
         if self._batch is not None:
             outs: list[npt.NDArray[np.float64]] = self._batch.run(part, self._state)
             return outs

@@ -96,6 +96,8 @@ def _output(
     if not tps:
         ctx.err(f"DEFUZZIFY {var.name} has no terms", db.span, "no-terms")
         return None
+    if ctx.options.emulate == "jfuzzylogic" and not _jfl_terms_fit(ctx, var, db, method, kinds):
+        return None
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
     if (
@@ -291,3 +293,32 @@ def _consts(params: tuple[PParam, ...]) -> list[float]:
 
 def _const(p: PParam) -> float:
     return float(p) if not isinstance(p, Slot) else 1.0
+
+
+#: jFuzzyLogic's discrete terms (a HashMap of points) and the methods that take them
+_JFL_DISCRETE = {"singleton", "singletons", "function"}
+_JFL_DISCRETE_METHODS = {"COGS", "COGF"}
+
+
+def _jfl_terms_fit(
+    ctx: _Ctx, var: m.Variable, db: m.DefuzzifyBlock, method: str | None, kinds: set[str]
+) -> bool:
+    """jFuzzyLogic accumulates singleton and FUNCTION terms only into COGS/COGF (discrete)
+    and every other term only into COG/COA/LM/RM/MM (sampled); METHOD defaults to COG.  It
+    throws as soon as a rule concludes a term of the other sort, so its profile refuses."""
+    meth = (db.method or "COG").upper()
+    discrete = meth in _JFL_DISCRETE_METHODS
+    wrong = sorted(kinds - _JFL_DISCRETE) if discrete else sorted(kinds & (_JFL_DISCRETE | {"function_of_x"}))
+    if meth not in {"COG", "COA", "LM", "RM", "MM", "MOM", *_JFL_DISCRETE_METHODS}:
+        ctx.err(f"DEFUZZIFY {var.name}: jFuzzyLogic has no METHOD {db.method}", db.span, "jfl-method")
+        return False
+    if wrong:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: jFuzzyLogic cannot accumulate {', '.join(wrong)} terms with METHOD "
+            f"{meth}{'' if db.method else ' (its default)'}: "
+            + ("COGS and COGF take singletons and FUNCTION terms" if discrete else "use COGS for singletons"),
+            db.span,
+            "jfl-method",
+        )
+        return False
+    return True

@@ -302,18 +302,22 @@ def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> No
 
 def _first_terms(ctx: _Ctx, var: str, terms: Iterable[m.Term]) -> list[m.Term]:
     """Terms in declaration order; a repeated name keeps its first definition (as fuzzylite
-    C++ does) and is reported."""
-    seen: dict[str, m.Term] = {}
+    C++ does; jFuzzyLogic, and its profile, the last) and is reported."""
+    last = ctx.options.emulate == "jfuzzylogic"
+    seen: dict[str, int] = {}
     out: list[m.Term] = []
     for t in terms:
         if t.name in seen:
             ctx.warn(
-                f"term {t.name!r} of {var} is defined twice; the first definition is used",
+                f"term {t.name!r} of {var} is defined twice; the {'last' if last else 'first'} "
+                "definition is used",
                 t.span,
                 "duplicate-term",
             )
+            if last:
+                out[seen[t.name]] = t
             continue
-        seen[t.name] = t
+        seen[t.name] = len(out)
         out.append(t)
     return out
 

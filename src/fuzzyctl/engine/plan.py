@@ -216,6 +216,8 @@ class RulePlan:
     conclusions: tuple[ConclusionPlan, ...]
     weight: PParam = 1.0
     selection: int | None = None  # index into Plan.selections
+    #: the rule block's own accumulation, applied as this rule is evaluated (jFuzzyLogic profile)
+    accu: str | None = None
 
 
 @dataclass(frozen=True)

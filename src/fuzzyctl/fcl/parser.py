@@ -446,6 +446,8 @@ class _Builder(Transformer[Token, Any]):
 
     def group(self, children: list[Any]) -> Condition:
         inner: Condition = children[0]
+        if isinstance(inner, And | Or):
+            inner = replace(inner, grouped=True)  # for jFuzzyLogic's left-to-right reading
         return inner
 
     def and_condition(self, children: list[Any]) -> And:
