@@ -130,7 +130,8 @@ def _parse(body: str) -> Answer:
     outputs = rest[0].split(",") if rest and rest[0] else []
     rows: list[list[float | str]] = []
     for ln in rest[1:]:
-        rows.append([c if c.startswith("ERR:") else _float(c) for c in ln.split(",")])
+        cells = ln.split(",") if outputs else []
+        rows.append([c if c.startswith("ERR:") else _float(c) for c in cells])
     return Answer(None, syntax, outputs, rows)
 
 

@@ -306,6 +306,14 @@ def _jfl_terms_fit(
     """jFuzzyLogic accumulates singleton and FUNCTION terms only into COGS/COGF (discrete)
     and every other term only into COG/COA/LM/RM/MM (sampled); METHOD defaults to COG.  It
     throws as soon as a rule concludes a term of the other sort, so its profile refuses."""
+    if "singletons" in kinds:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: jFuzzyLogic 3.3 cannot load SINGLETONS terms (its parser fails on "
+            "them: 'Unknown (or unimplemented) option : VALUE_REAL')",
+            db.span,
+            "jfl-singletons",
+        )
+        return False
     meth = (db.method or "COG").upper()
     discrete = meth in _JFL_DISCRETE_METHODS
     wrong = sorted(kinds - _JFL_DISCRETE) if discrete else sorted(kinds & (_JFL_DISCRETE | {"function_of_x"}))

@@ -8,8 +8,11 @@ read), and why.  Each rule below was read in jFuzzyLogic's grammar (``fcl/Fcl.g`
 live jFuzzyLogic on the corpus (``tests/conformance/test_jfl_corpus.py``): a file gets a
 ``jfl-rejects`` warning exactly when jFuzzyLogic does not load it cleanly.
 
-``jfl-differs`` warnings name what jFuzzyLogic loads but reads differently from IEC 61131-7
-and which the ``jfuzzylogic`` profile of the engine reproduces (docs/engine.md).
+``jfl-fails`` warnings name what jFuzzyLogic loads but then throws on at every evaluation
+(names differing only in case, which it keeps apart); ``jfl-differs`` what it loads but reads
+differently from IEC 61131-7 (a RANGE on the declaration line, a variable declared without a
+FUZZIFY/DEFUZZIFY block), which the ``jfuzzylogic`` profile of the engine reproduces where it
+can (docs/engine.md).
 """
 
 from __future__ import annotations
@@ -77,11 +80,10 @@ class _Found:
         out = []
         for (code, reason), spans in self.reasons.items():
             more = f" ({len(spans) - 1} more like it)" if len(spans) > 1 else ""
-            prefix = (
-                "jFuzzyLogic 3.3 would reject this file: "
-                if code == "jfl-rejects"
-                else "jFuzzyLogic 3.3 reads this differently: "
-            )
+            prefix = {
+                "jfl-rejects": "jFuzzyLogic 3.3 would reject this file: ",
+                "jfl-fails": "jFuzzyLogic 3.3 loads this file but cannot evaluate it: ",
+            }.get(code, "jFuzzyLogic 3.3 reads this differently: ")
             out.append(warning(prefix + reason + more, spans[0], code=code, file=self.file))
         return out
 
@@ -97,6 +99,13 @@ def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> li
         for d in parsed.diagnostics:
             if d.code in ("missing-semicolon", "paren-conclusion"):
                 found.add("jfl-rejects", f"its grammar has no such form ({d.message})", d.span)
+            elif d.code == "case-mismatch":
+                found.add(
+                    "jfl-fails",
+                    f"its names are case-sensitive: {d.message.split(':')[0]} is another name, and "
+                    "evaluating the rule throws (NullPointerException)",
+                    d.span,
+                )
         for spelling in sorted(parsed.spellings):
             s = lookup(spelling)
             if spelling not in ("SINGLETONS", "FUNCTION") and (s is None or s.dialect != JFL):
@@ -142,6 +151,15 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
     for item in (fb.name,):
         if item and not _ID.fullmatch(item):
             found.add(rejects, f"function block name {item!r} is not one of its identifiers", fb.span)
+    with_terms = {b.variable for b in (*fb.fuzzify, *fb.defuzzify)}
+    for v in fb.variables:
+        if v.name not in with_terms:
+            found.add(
+                "jfl-differs",
+                f"{v.name} has no FUZZIFY or DEFUZZIFY block: jFuzzyLogic ignores VAR declarations, so "
+                "it has no such variable (setting or reading it fails)",
+                v.span,
+            )
     defined: set[str] = set()
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for block in sorted(blocks, key=lambda b: b.span.line if b.span else 0):
@@ -172,6 +190,8 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
                         "(it only knows variables from those blocks)",
                         t.span,
                     )
+            if isinstance(t.mf, SingletonsMF):
+                found.add(rejects, f"term {t.name}: its parser fails on SINGLETONS terms", t.span)
             if isinstance(t.mf, ShapeMF) and t.mf.height != 1.0:
                 found.add(rejects, f"term {t.name}: its shapes have no height parameter", t.span)
             if isinstance(t.mf, FunctionMF):
