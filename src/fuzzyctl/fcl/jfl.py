@@ -148,10 +148,9 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
         if v.data_type.upper() != "REAL":
             found.add(rejects, f"its only data type is REAL ({v.name} : {v.data_type})", v.span)
         _name(v.name, "variable", v.span, found)
-    for item in (fb.name,):
-        if item and not _ID.fullmatch(item):
-            found.add(rejects, f"function block name {item!r} is not one of its identifiers", fb.span)
-    with_terms = {b.variable for b in (*fb.fuzzify, *fb.defuzzify)}
+    if fb.name and not _ID.fullmatch(fb.name):
+        found.add(rejects, f"function block name {fb.name!r} is not one of its identifiers", fb.span)
+    with_terms = {b.variable for b in fb.fuzzify} | {b.variable for b in fb.defuzzify}
     for v in fb.variables:
         if v.name not in with_terms:
             found.add(
