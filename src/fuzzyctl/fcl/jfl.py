@@ -110,7 +110,7 @@ def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> li
             s = lookup(spelling)
             if spelling not in ("SINGLETONS", "FUNCTION") and (s is None or s.dialect != JFL):
                 found.add("jfl-rejects", f"its grammar has no shape {spelling}", None)
-    for m in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d", _code(text)):
+    for m in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d|\d\.(?![\d.])", _code(text)):
         line = text.count("\n", 0, m.start()) + 1
         found.add("jfl-rejects", "its lexer reads a number only with digits before '.' and '..' "
                   "between spaces", Span(line, 1))  # fmt: skip

@@ -46,6 +46,7 @@ from fuzzyctl.model import (
     Term,
     Unary,
     VarKind,
+    implied_operators,
 )
 
 # Defuzzification methods whose output terms act as points (a weighted average of term
@@ -235,7 +236,12 @@ def prepare(
                 losses.append(Loss(label, "a condition on a local variable cannot be written"))
                 continue
             rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses, running_hedges))
-        new_blocks.append(replace(block, rules=tuple(rules)))
+        # Table 3: a block that declares one operator evaluates with its pair; FIS and FLL
+        # have no such rule (an absent one is MIN/MAX or "none"), so both are written
+        and_op, or_op = block.and_op, block.or_op
+        if (and_op is None) != (or_op is None):
+            and_op, or_op = implied_operators(and_op, or_op)
+        new_blocks.append(replace(block, rules=tuple(rules), and_op=and_op, or_op=or_op))
 
     # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
     defuzzify = []
