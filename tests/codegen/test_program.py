@@ -100,7 +100,7 @@ def test_the_jfuzzylogic_profile_is_not_generated() -> None:
     """That profile reproduces jFuzzyLogic's 1000-point arithmetic for cross-checks."""
     fb = _block("COGS", "MAX", SINGLETONS, ())
     plan = fuzzyctl.compile(fb, backend="interpreted", compat="jfuzzylogic").plan
-    with pytest.raises(CodegenError, match="jfuzzylogic profile .* iec profile"):
+    with pytest.raises(CodegenError, match=r"jfuzzylogic profile .* iec profile"):
         build_program(plan, "c")
 
 
