@@ -5,6 +5,9 @@
 PYTHON ?= python3
 VENV   := .venv
 BIN    := $(VENV)/bin
+# pyfuzzylite, scikit-fuzzy and simpful pin numpy < 2: the tests and benchmarks drive them in a
+# venv of their own, never in .venv (which has the numpy users get)
+PEERS  := .venv-peers
 
 .PHONY: run simulate docs-img test fuzz lint typecheck pytest system-deps clean
 STUDIO_PORT ?= 8770
@@ -20,6 +23,11 @@ $(VENV)/.installed: pyproject.toml | $(BIN)/python
 $(VENV)/.installed-dev: pyproject.toml | $(BIN)/python
 	$(BIN)/python -m pip install -q -e '.[dev]'
 	touch $@ $(VENV)/.installed
+
+$(PEERS)/.installed: tests/peers/requirements.txt
+	$(PYTHON) -m venv $(PEERS)
+	$(PEERS)/bin/python -m pip install -q -r tests/peers/requirements.txt
+	touch $@
 
 system-deps:
 	@bash scripts/system-deps.sh
@@ -42,14 +50,15 @@ lint: $(VENV)/.installed-dev
 typecheck: $(VENV)/.installed-dev
 	$(BIN)/mypy
 
-pytest: $(VENV)/.installed-dev system-deps
-	$(BIN)/pytest
+# both cores (pytest-xdist); the last line says which extra suites (tests/extras.py) ran
+pytest: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
+	$(BIN)/pytest -n auto $(PYTEST_ARGS)
 
 test: lint typecheck pytest
 
 # Property tests with fresh random examples (make test replays a fixed set).
-fuzz: $(VENV)/.installed-dev system-deps
+fuzz: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/pytest -q $$(grep -rl '@given' tests)
 
 clean:
-	rm -rf $(VENV) .pytest_cache .mypy_cache .ruff_cache
+	rm -rf $(VENV) $(PEERS) .pytest_cache .mypy_cache .ruff_cache

@@ -9,7 +9,11 @@ from typing import TYPE_CHECKING, Any
 from fuzzyctl.model import Document, FunctionBlock
 
 if TYPE_CHECKING:
+    from matplotlib.axes import Axes
+    from matplotlib.figure import Figure
+
     from fuzzyctl.engine.controller import Controller
+    from fuzzyctl.engine.variables import VariableInfo
 
 
 def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = False) -> Document:
@@ -40,9 +44,12 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
 
 
 def _looks_like_path(value: str) -> bool:
-    """Text holding a newline, ';' or ':=' is source; anything else is taken as a path (a
-    missing file is then reported as such, not parsed as FCL)."""
-    if "\n" in value or ";" in value or ":=" in value:
+    """Text holding a newline, ';' or ':=', starting with '{' or '[', or longer than any path
+    is source; anything else is taken as a path (a missing file is then reported as such,
+    not parsed as FCL)."""
+    if "\n" in value or ";" in value or ":=" in value or len(value) > 4096:
+        return False
+    if value.lstrip()[:1] in ("{", "["):  # JSON, a FIS section
         return False
     return "FUNCTION_BLOCK" not in value.upper() or Path(value).exists()
 
@@ -68,8 +75,8 @@ def compile(
     if backend == "native":
         from fuzzyctl.codegen.native import compile_native
 
-        plan = compile_block(model, block=block, backend="interpreted", **options).plan
-        return compile_native(plan)
+        reference = compile_block(model, block=block, backend="interpreted", **options)
+        return compile_native(reference.plan, reference.model)
     return compile_block(model, block=block, backend=backend, **options)
 
 
@@ -81,3 +88,12 @@ def _refuse_reserved(model: Document | FunctionBlock) -> None:
     found = check_reserved_words(doc, doc.path, strict=True)
     if has_errors(found):
         raise DiagnosticError(found)
+
+
+def plot_terms(variable: VariableInfo, *, points: int = 1001, ax: Axes | None = None) -> Figure:
+    """The membership functions of a variable as a labelled matplotlib Figure:
+    ``fuzzyctl.plot_terms(ctl.inputs["temp"]).savefig("temp.png")`` (as scikit-fuzzy's
+    ``view()`` or simpful's ``plot_variable``)."""
+    from fuzzyctl.engine.plot import plot_terms as draw
+
+    return draw(variable, points=points, ax=ax)

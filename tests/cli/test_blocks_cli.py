@@ -96,9 +96,44 @@ def test_blocks_xfuz_runs_one_row_per_cycle(tmp_path: Path, capsys: pytest.Captu
     assert [r["O3_CALC"] for r in got] == ["0", "8", "8", "4", "4"]
     assert {r["STATUS"] for r in got} == {"0"} and [r["time"] for r in got][:2] == ["0.0", "0.01"]
     code, out, err = run(["blocks", "xfuz", str(EXAMPLES / "xfuz_3_3.xfuz"), str(path), "--json"], capsys)
-    assert code == 0
+    assert code == 1  # the run ends in the block's error state: said, and not exit 0
+    assert "ERROR = 1, STATUS bits 9" in err
     first = json.loads(out)[1]
     assert first["STATUS"] == 512 and first["STATUS_BITS"] == "9" and first["ERROR"] == 1  # as printed
+
+
+def test_the_bundled_xfuz_example_runs_without_options(capsys: pytest.CaptureFixture[str]) -> None:
+    """examples/xfuz_debit.xfuz is the manual's 3.3 example with Ouverture on 6 points, which
+    its span rule allows: Pression 0, Température -50 gives 8 (7.83 by hand); 20, 10 gives 3
+    (3.38) - tests/blocks/test_xfuz_block.py computes both from the manual's formulas."""
+    code, out, err = run(
+        ["blocks", "xfuz", str(EXAMPLES / "xfuz_debit.xfuz"), str(EXAMPLES / "xfuz.csv")], capsys
+    )
+    assert code == 0, err
+    got = rows(out)
+    assert [r["OUT3"] for r in got] == ["8", "8", "3", "3"]
+    assert {r["ERROR"] for r in got} == {"0"}
+
+
+def test_siemens_run_ending_in_an_error_state_exits_non_zero(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from fuzzyctl.blocks.siemens import FuzzyFB
+
+    path = samples(tmp_path, "Temp,Pressure\n9,65\n")
+    original = FuzzyFB.execute
+
+    def failing(self: FuzzyFB) -> int:  # INFO 11: no valid application (manual, Table 3-7)
+        original(self)
+        self.INFO = 0x11
+        return 0x11
+
+    FuzzyFB.execute = failing  # type: ignore[method-assign]
+    try:
+        code, out, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(path)], capsys)
+    finally:
+        FuzzyFB.execute = original  # type: ignore[method-assign]
+    assert code == 1 and "INFO 11" in err and "cycle,Valve,INFO,ENO" in out
 
 
 def test_blocks_xfuz_from_fcl_accepts_variable_names(

@@ -58,3 +58,50 @@ Temp = {{ connection = "mb", address = 0 }}
     assert kinds[0] == "runtime-start" and kinds[-1] == "runtime-stop"
     assert "link-up" in kinds
     assert (tmp_path / "state" / "events.jsonl").read_text().count("\n") == len(kinds)
+
+
+def test_serve_check_reports_every_problem_of_the_file_in_one_pass(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """Problems of different kinds in different tables - schema, connection, binding,
+    knowledge base - all in one run, as docs/runtime.md promises."""
+    (tmp_path / "kb.fcl").write_text((EXAMPLES / "siemens_fpltest.fcl").read_text())
+    bad = tmp_path / "bad.toml"
+    bad.write_text(
+        """
+[runtime]
+realtime_priority = 500
+[connections.cpu]
+type = "s7"
+host = "127.0.0.1"
+rack = "zero"
+[connections.cpu2]
+type = "s7"
+host = "127.0.0.1"
+[instances.valve]
+knowledge_base = "kb.fcl"
+period = -1
+[instances.valve2]
+knowledge_base = "kb.fcl"
+period = 0.1
+[instances.valve2.inputs]
+Pressur = { connection = "cpu2", db = 10, offset = 4 }
+[instances.valve2.outputs]
+Valve = { connection = "nowhere", db = 10, offset = 8 }
+[instances.other]
+knowledge_base = "missing.fcl"
+period = 0.1
+"""
+    )
+    code, _, err = run(["serve", str(bad), "--check"], capsys)
+    assert code == 1
+    for expected in (
+        "[runtime] realtime_priority",
+        "[connections.cpu] rack",
+        "[instances.valve] period",
+        "[instances.valve2.outputs.Valve] connection: no connection 'nowhere'",
+        "[instances.valve2.inputs] Pressur: 'Pressur' is not an input",
+        "[instances.other] knowledge_base",
+    ):
+        assert expected in err, (expected, err)
+    assert "Traceback" not in err

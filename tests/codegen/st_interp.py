@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -95,8 +96,17 @@ class Translation:
 
 
 def translate(source: str, name: str | None = None) -> Translation:
-    """Parse ``source`` with blark and translate one FUNCTION_BLOCK into Python."""
-    return _Translator(source, name).result
+    """Parse ``source`` with blark and translate one FUNCTION_BLOCK into Python.
+
+    blark's Earley parser needs ~12 ms per line, so translations are cached on disk, keyed by
+    the text, the block name, blark's version and this file (tests/diskcache.py)."""
+    from importlib.metadata import version
+
+    from tests.diskcache import cached
+
+    key = (source, name, version("blark"), Path(__file__).read_bytes())
+    result: Translation = cached("blark-st", key, lambda: _Translator(source, name).result)
+    return result
 
 
 class _Translator:

@@ -23,6 +23,7 @@ from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.render_c import render_c
 from fuzzyctl.engine.plan import Plan
 from tests.codegen import systems as S
+from tests.diskcache import cached_dir
 
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]
 N = 10_000
@@ -37,35 +38,46 @@ def _cc() -> str:
 
 
 def build_library(plans: list[Plan], out: Path, single: bool = False) -> ctypes.CDLL:
-    """All plans in one shared library, compiled in one strict cc invocation."""
-    sources = []
+    """All plans in one shared library, compiled in one strict cc invocation (cached on disk
+    by the generated text and the compiler: tests/diskcache.py)."""
+    files: dict[str, str] = {}
     sizes = ["#include <stddef.h>"]
     for plan in plans:
         header, source = render_c(build_program(plan, "c"), single=single)
-        (out / f"{plan.name}.h").write_text(header)
-        (out / f"{plan.name}.c").write_text(source)
-        sources.append(str(out / f"{plan.name}.c"))
+        files[f"{plan.name}.h"] = header
+        files[f"{plan.name}.c"] = source
         sizes.append(f'#include "{plan.name}.h"')
     sizes += [f"size_t {p.name}_size(void) {{ return sizeof({p.name}); }}" for p in plans]
-    (out / "sizes.c").write_text("\n".join(sizes) + "\n")
-    # two strict compiler runs side by side (2 cores), one link
-    halves = [sources[0::2], [*sources[1::2], str(out / "sizes.c")]]
-    objs = [out / "part0.o", out / "part1.o"]
-    procs = []
-    for part, obj in zip(halves, objs, strict=True):
-        unit = out / f"{obj.stem}.c"
-        unit.write_text("".join(f'#include "{Path(src).name}"\n' for src in part))
-        cmd = [_cc(), *STRICT, "-O1", "-ffp-contract=off", "-fPIC", "-c", "-o", str(obj), str(unit)]
-        procs.append(subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True))
-    for p in procs:
-        _out, err = p.communicate()
-        assert p.returncode == 0, err[:4000]
-    lib = out / "systems.so"
-    res = subprocess.run(
-        [_cc(), "-shared", "-o", str(lib), *map(str, objs), "-lm"], capture_output=True, text=True
-    )
-    assert res.returncode == 0, res.stderr[:4000]
-    return ctypes.CDLL(str(lib))
+    files["sizes.c"] = "\n".join(sizes) + "\n"
+    sources = [f"{p.name}.c" for p in plans]
+    compiler = subprocess.run([_cc(), "--version"], capture_output=True, text=True).stdout
+
+    def build(where: Path) -> None:
+        for name, text in files.items():
+            (where / name).write_text(text)
+        # two strict compiler runs side by side (2 cores), one link
+        halves = [sources[0::2], [*sources[1::2], "sizes.c"]]
+        objs = [where / "part0.o", where / "part1.o"]
+        procs = []
+        for part, obj in zip(halves, objs, strict=True):
+            unit = where / f"{obj.stem}.c"
+            unit.write_text("".join(f'#include "{src}"\n' for src in part))
+            cmd = [_cc(), *STRICT, "-O1", "-ffp-contract=off", "-fPIC", "-c", "-o", str(obj), str(unit)]
+            procs.append(subprocess.Popen(cmd, stderr=subprocess.PIPE, text=True))
+        for p in procs:
+            _out, err = p.communicate()
+            assert p.returncode == 0, err[:4000]
+        res = subprocess.run(
+            [_cc(), "-shared", "-o", str(where / "systems.so"), *map(str, objs), "-lm"],
+            capture_output=True,
+            text=True,
+        )
+        assert res.returncode == 0, res.stderr[:4000]
+
+    built = cached_dir("c-systems", (files, STRICT, compiler), build)
+    for name in files:  # the sources next to the test's other files, for a human to read
+        shutil.copy(built / name, out / name)
+    return ctypes.CDLL(str(built / "systems.so"))
 
 
 def run(lib: ctypes.CDLL, plan: Plan, data: np.ndarray) -> np.ndarray:

@@ -4,20 +4,18 @@ activation methods (``RuleBlock.rule_activation``), defaults with lock-previous,
 ``FunctionMF.argument``.
 
 Random systems are built twice from the same draws - as a model in Python and as FLL text
-that pyfuzzylite 8 parses itself - and evaluated on the same input sequence (the state of
-lock-previous carries from one sample to the next).  Takagi-Sugeno outputs agree to 1e-9,
-Mamdani centroids within pyfuzzylite's resolution (2e5 divisions: 1e-5 of the range).  The
-same systems check that the interpreter, the specialised scalar path and the numpy batch
-path agree to 1e-9.
+that pyfuzzylite 8 parses itself (in its own venv: tests/peers) - and evaluated on the same
+input sequence (the state of lock-previous carries from one sample to the next).
+Takagi-Sugeno outputs agree to 1e-9, Mamdani centroids within pyfuzzylite's resolution
+(2e5 divisions: 1e-5 of the range).  The same systems check that the interpreter, the
+specialised scalar path and the numpy batch path agree to 1e-9.
 """
 
 from __future__ import annotations
 
 import math
-import warnings
 from typing import Any
 
-import fuzzylite as fl
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -27,6 +25,7 @@ import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, InputError
 from fuzzyctl.engine.support import unsupported
+from tests import peers
 from tests.engine.randsys import sorted_floats
 
 RES = 200_000
@@ -191,16 +190,7 @@ def _pyfuzzylite_activation(activation: str | None) -> str:
 
 
 def _pyfuzzylite(text: str, names: list[str], rows: list[list[float]]) -> list[float]:
-    engine = fl.FllImporter().from_string(text)
-    out = []
-    for row in rows:
-        for name, value in zip(names, row, strict=True):
-            engine.input_variable(name).value = value
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            engine.process()
-        out.append(float(np.asarray(engine.output_variable("y").value).reshape(-1)[-1]))
-    return out
+    return [r[0] for r in peers.pyfuzzylite_fll(text, names, rows, ["y"])]
 
 
 def _three_paths(

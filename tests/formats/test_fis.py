@@ -3,12 +3,18 @@
 from __future__ import annotations
 
 import math
+import re
+from pathlib import Path
 
+import numpy as np
 import pytest
 
+import fuzzyctl
+from fuzzyctl import formats
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import fis, get
 from fuzzyctl.model import And, Conclusion, Is, Or, PointsMF, ShapeMF
+from tests.conftest import DATA, EXAMPLES
 
 HEADER = """[System]
 Name='t'
@@ -160,3 +166,39 @@ def test_points_become_trimf_or_discretemf() -> None:
     odd = Term("o", PointsMF((Point(0.0, 0.2), Point(1.0, 1.0), Point(3.0, 0.0))))
     assert _mf_text(tri) == "'t':'trimf',[0 1 3]"
     assert _mf_text(odd) == "'o':'discretemf',[0 0.2 1 1 3 0]"
+
+
+@pytest.mark.parametrize(
+    "source",
+    [*sorted((DATA / "fuzzylite").rglob("*.fis")), EXAMPLES / "tipper.fis"],
+    ids=lambda p: p.name,
+)
+def test_fis_to_fcl_uses_basic_level_forms(source: Path) -> None:
+    """Triangles and trapezoids become IEC point lists and ranges move into FUZZIFY/DEFUZZIFY
+    (not jFuzzyLogic's declaration-line RANGE); the FCL computes what the FIS computes."""
+    from fuzzyctl.formats import convert, read_text
+
+    document = formats.read_path(source).document
+    try:
+        text, losses = convert(document, "fcl")
+    except formats.LossError as exc:  # FCL cannot say it: reported, element by element
+        assert exc.losses
+        text, losses = convert(document, "fcl", lossy=True)
+        assert not re.search(r"\b(TRIAN|TRAPE)\b", text)
+        return
+    assert not losses
+    assert not re.search(r"\b(TRIAN|TRAPE|TRIANGLE|TRAPEZOID)\b", text), text
+    assert not re.search(r":\s*REAL\s*;\s*RANGE", text), "RANGE on a declaration line is Open level"
+    back = read_text(text, "fcl").document
+    a, b = fuzzyctl.compile(document), fuzzyctl.compile(back)
+    rng = np.random.default_rng(5)
+    data = {}
+    for name in a.inputs:
+        info = a.inputs[name]
+        low, high = info.range or (0.0, 1.0)
+        data[name] = rng.uniform(low - 0.1 * (high - low), high + 0.1 * (high - low), 60)
+    # FCL may rename what it cannot read (LDL-Level -> LDL_Level): match by position
+    renamed = {new: data[old] for old, new in zip(a.inputs, b.inputs, strict=True)}
+    got = b.evaluate_batch(renamed)
+    for (name, want), other in zip(a.evaluate_batch(data).items(), b.outputs, strict=True):
+        assert np.allclose(got[other], want, rtol=0, atol=1e-9, equal_nan=True), name

@@ -5,7 +5,7 @@ Exit codes: 0 success, 1 the input has errors, 2 usage error, 3 internal error (
 from __future__ import annotations
 
 import sys
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
@@ -13,8 +13,36 @@ from rich.console import Console
 from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 
+if TYPE_CHECKING:
+    from rich.table import Table
+
+
+def _plain_help() -> None:
+    """typer 0.29 prints ``<bool>`` after every flag (as if it took a value) and required
+    arguments as ``{file}`` in the usage line; our help shows flags bare and arguments as
+    FILE, as click and every Unix tool do (tests/cli/test_help.py reads every --help)."""
+    from typer import core
+
+    def display_type_rich(self: Any, ctx: Any) -> str | None:
+        if getattr(self, "is_flag", False) or getattr(self, "is_bool_flag", False):
+            return None
+        return original(self, ctx)
+
+    def usage_name(self: Any) -> str:
+        name = str(self.display_name_raw).upper()
+        name = name if self.required else f"[{name}]"
+        return name + ("..." if self.nargs != 1 else "")
+
+    original = core.TyperOption.display_type_rich
+    core.TyperOption.display_type_rich = display_type_rich  # type: ignore[method-assign]
+    core.TyperArgument._usage_display_name = usage_name  # type: ignore[method-assign]
+
+
+_plain_help()
+
 app = typer.Typer(
     name="fuzzyctl",
+    rich_markup_mode="markdown",  # paragraphs reflow: docstrings wrapped at 100 columns read as prose
     help="IEC 61131-7 fuzzy control: check, run, convert and generate code for FCL programs.",
     no_args_is_help=True,
     add_completion=False,
@@ -24,6 +52,25 @@ app = typer.Typer(
 err_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
+
+
+def record_table(title: str, figures: dict[str, str], width: int) -> Table:
+    """Named figures as one row with a column each when that fits ``width``, else as
+    name/value rows: numbers are never cut short on a narrow terminal."""
+    from rich.table import Table
+
+    wide = sum(max(len(k), len(v)) + 3 for k, v in figures.items()) + 1
+    table = Table(title=title)
+    if wide <= width:
+        for name in figures:
+            table.add_column(name, justify="right", overflow="fold")
+        table.add_row(*figures.values())
+        return table
+    table.add_column("figure", overflow="fold")
+    table.add_column("value", justify="right", overflow="fold")
+    for name, value in figures.items():
+        table.add_row(name, value)
+    return table
 
 
 def _version(value: bool) -> None:

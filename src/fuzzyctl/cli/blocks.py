@@ -176,6 +176,11 @@ def siemens(
         row.update({"INFO": f"{info:02X}", "ENO": int(fb.ENO)})
         out_rows.append(row)
     _emit(out_rows, ["cycle", *fb.output_names, "INFO", "ENO"], output, as_json)
+    if out_rows and fb.INFO not in (0x00, 0x01):  # 01: stopped by START_STOP, as asked
+        err_console.print(
+            f"error: the block ended with INFO {fb.INFO:02X} (ENO 0): see docs/blocks.md", markup=False
+        )
+        raise typer.Exit(1)
 
 
 @blocks_app.command("xfuz")
@@ -293,6 +298,14 @@ def xfuz(
     if degre:
         columns += [f"DEGRE{k}" for k in range(max(1, len(fb.kb.rules)))]
     _emit(out_rows, columns, output, as_json)
+    if out_rows and out_rows[-1]["ERROR"]:
+        bits = out_rows[-1]["STATUS_BITS"] or "none"
+        err_console.print(
+            f"error: the block ended in its error state (ERROR = 1, STATUS bits {bits}); "
+            "see docs/blocks.md, STATUS",
+            markup=False,
+        )
+        raise typer.Exit(1)
 
 
 @blocks_app.command("check")

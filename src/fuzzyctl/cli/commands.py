@@ -9,4 +9,5 @@ from fuzzyctl.cli import (
     serve,  # noqa: F401  (serve: the soft controller)
     simulate,  # noqa: F401  (simulate)
     studio,  # noqa: F401  (studio: the browser configuration tool)
+    tune,  # noqa: F401  (learn, tune: design from data and from the plant)
 )

@@ -4,9 +4,7 @@ data check list, print it in canonical form."""
 from __future__ import annotations
 
 import json
-import os
 import sys
-import tempfile
 from pathlib import Path
 from typing import Annotated
 
@@ -121,18 +119,18 @@ def check(
     out.print(f"Conformance level needed: {lvl}", markup=False)
     if feats:
         table = Table(title="Features beyond the Basic level (Table 8)", title_justify="left")
-        table.add_column("level")
-        table.add_column("table")
-        table.add_column("language element")
-        table.add_column("detail")
+        table.add_column("level", overflow="fold")
+        table.add_column("table", overflow="fold")
+        table.add_column("language element", overflow="fold")
+        table.add_column("detail", overflow="fold")
         for f in feats:
             table.add_row(str(f.level), f.table, f.element, f.detail)
         out.print(table)
     if checklist:
         for fb in doc.blocks:
             table = Table(title=f"Data check list (Table 11): {fb.name or '(unnamed)'}", title_justify="left")
-            table.add_column("technical data")
-            table.add_column("this file", justify="right")
+            table.add_column("technical data", overflow="fold")
+            table.add_column("this file", justify="right", overflow="fold")
             for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb)):
                 table.add_row(row.item, row.value)
             out.print(table)
@@ -175,17 +173,6 @@ def fmt(
     if target is None:
         sys.stdout.write(text)
         return
-    write_atomically(target, text)
+    from fuzzyctl.files import write_atomic
 
-
-def write_atomically(path: Path, text: str) -> None:
-    """Write ``text`` to ``path`` through a temporary file, so ``path`` is never half-written."""
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    write_atomic(target, text)

@@ -2,24 +2,24 @@
 
 from __future__ import annotations
 
-import csv
-import io
 import json
 import math
-import os
-import sys
-import tempfile
 from pathlib import Path
 from typing import Annotated, Any
 
 import typer
 
 from fuzzyctl.cli.app import app
+from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
     list[str] | None,
     typer.Option(
-        "--set", "-s", help="An input value, NAME=VALUE (repeat for each input).", show_default=False
+        "--set",
+        "-s",
+        help="An input value, NAME=VALUE (repeat for each input).",
+        show_default=False,
+        metavar="NAME=VALUE",
     ),
 ]
 BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to run (default: the first).")]
@@ -34,8 +34,6 @@ StrictOpt = Annotated[
         "do not fall to 0, names that are reserved keywords.",
     ),
 ]
-PROGRESS_ROWS = 100_000  # show a progress bar from this many rows on
-CHUNK_ROWS = 50_000
 
 
 def _controller(file: Path, block: str | None, compat: str, strict: bool = False) -> Any:
@@ -72,29 +70,101 @@ def _fmt(v: float) -> str:
 def eval_(
     file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
     set_: SetOpt = None,
-    csv_in: Annotated[
-        Path | None, typer.Option("--csv", help="Evaluate every row of a CSV file (header = input names).")
+    data: Annotated[
+        str | None,
+        typer.Option(
+            "--data",
+            "--csv",
+            metavar="FILE",
+            help="Evaluate every row of a CSV or Parquet file ('-': CSV on stdin). Every column is "
+            "kept; the header names the inputs.",
+            show_default=False,
+        ),
     ] = None,
     output: Annotated[
-        Path | None, typer.Option("--output", "-o", help="Write the CSV result here (atomically).")
+        str | None,
+        typer.Option(
+            "--output",
+            "-o",
+            metavar="FILE",
+            help="Write the rows here, atomically: .csv, .parquet or .jsonl by extension ('-': stdout).",
+            show_default=False,
+        ),
     ] = None,
-    as_json: Annotated[bool, typer.Option("--json", help="Print the outputs as JSON.")] = False,
-    as_table: Annotated[
-        bool, typer.Option("--table", help="With --csv and no -o: print a table, not CSV.")
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print the outputs as JSON (with --data: JSON lines).")
     ] = False,
+    as_table: Annotated[
+        bool, typer.Option("--table", help="With --data and no -o: print a table, not CSV.")
+    ] = False,
+    delimiter: Annotated[
+        str | None,
+        typer.Option(
+            "--delimiter",
+            help="CSV delimiter: a character or 'tab' (default: what the header uses).",
+            show_default=False,
+        ),
+    ] = None,
+    decimal: Annotated[
+        str | None,
+        typer.Option(
+            "--decimal", help="Decimal mark of the CSV numbers: '.' (default) or ','.", show_default=False
+        ),
+    ] = None,
+    on_error: Annotated[
+        str,
+        typer.Option(
+            "--on-error",
+            help="An empty, NaN or infinite input cell: 'nan' gives NaN outputs for its row and a "
+            "count; 'fail' stops there.",
+        ),
+    ] = "nan",
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
+    dask_in: DaskOpt = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
 ) -> None:
-    """Evaluate a controller once (--set) or on every row of a CSV file (--csv)."""
-    ctl = _controller(file, block, compat, strict)
-    if csv_in is not None:
-        if set_:
-            raise typer.BadParameter("use either --set or --csv", param_hint="--set")
-        _eval_csv(ctl, csv_in, output, as_table)
+    """Evaluate a controller once (--set), on every row of a data file (--data), or on a
+    directory/glob of Parquet/CSV files on Dask (--dask DATA -o DIR)."""
+    if dask_in is not None:
+        if set_ or data is not None:
+            raise typer.BadParameter("use --dask alone, without --set or --data", param_hint="--dask")
+        from fuzzyctl.cli import eval_dask
+
+        out_dir = Path(output) if output not in (None, "-") else None
+        eval_dask.run(
+            file, dask_in, out_dir, block=block, compat=compat, workers=workers, scheduler=scheduler
+        )
         return
-    if output is not None:
-        raise typer.BadParameter("--output needs --csv", param_hint="--output")
+    if workers is not None or scheduler is not None:
+        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
+    if data is not None and set_:
+        raise typer.BadParameter("use either --set or --data", param_hint="--set")
+    if data is None and output is not None:
+        raise typer.BadParameter("--output needs --data", param_hint="--output")
+    if decimal not in (None, ".", ","):
+        raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
+    if as_json and as_table:
+        raise typer.BadParameter("use either --json or --table", param_hint="--table")
+    ctl = _controller(file, block, compat, strict)
+    if data is not None:
+        from fuzzyctl.cli.app import err_console
+        from fuzzyctl.cli.eval_data import evaluate_file
+
+        evaluate_file(
+            ctl,
+            data,
+            output,
+            out_format="jsonl" if as_json and output in (None, "-") else None,
+            delimiter=delimiter,
+            decimal=decimal,
+            on_error=on_error,
+            as_table=as_table and output is None,
+            warn=lambda text: err_console.print(f"warning: {text}", markup=False),
+        )
+        return
     result = ctl.evaluate(_parse_sets(set_))
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
@@ -103,95 +173,11 @@ def eval_(
     from rich.table import Table
 
     table = Table(title=f"{ctl.name or file.name}", show_lines=False)
-    table.add_column("output")
-    table.add_column("value", justify="right")
+    table.add_column("output", overflow="fold")
+    table.add_column("value", justify="right", overflow="fold", no_wrap=False)
     for k, v in result.items():
         table.add_row(k, f"{v:.10g}")
     Console(highlight=False).print(table)
-
-
-def _eval_csv(ctl: Any, path: Path, output: Path | None, as_table: bool = False) -> None:
-    import numpy as np
-
-    from fuzzyctl.diagnostics import FuzzyctlError, InputError
-
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        raise FuzzyctlError(f"{path}: empty CSV file (expected a header naming the inputs)")
-    header = [h.strip() for h in rows[0]]
-    body = [r for r in rows[1:] if any(cell.strip() for cell in r)]
-    unknown = [h for h in header if h not in ctl.inputs]
-    if unknown:
-        raise InputError(f"{path}: column {unknown[0]!r} is not an input (inputs: {', '.join(ctl.inputs)})")
-    missing = [
-        n
-        for n, spec in zip(ctl.inputs, ctl.plan.inputs, strict=True)
-        if n not in header and spec.default is None
-    ]
-    if missing:
-        raise InputError(f"{path}: no column for input {missing[0]!r}")
-    cols = np.empty((len(header), len(body)))
-    for r, row in enumerate(body):
-        if len(row) != len(header):
-            raise InputError(f"{path}:{r + 2}: expected {len(header)} cells, got {len(row)}")
-        for c, cell in enumerate(row):
-            try:
-                v = float(cell)
-            except ValueError:
-                raise InputError(
-                    f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a number"
-                ) from None
-            if not math.isfinite(v):
-                raise InputError(
-                    f"{path}:{r + 2}: column {header[c]!r}: {cell.strip()!r} is not a finite number"
-                )
-            cols[c, r] = v
-    n = len(body)
-    results: dict[str, Any] = {o: np.empty(n) for o in ctl.outputs}
-    show = n >= PROGRESS_ROWS and sys.stderr.isatty()
-    from rich.progress import Progress
-
-    with Progress(disable=not show, transient=True) as progress:
-        task = progress.add_task(f"evaluating {path.name}", total=n)
-        for start in range(0, n, CHUNK_ROWS):
-            part = {h: cols[i, start : start + CHUNK_ROWS] for i, h in enumerate(header)}
-            try:
-                out = ctl.evaluate_batch(part)
-            except InputError as exc:
-                raise InputError(f"{path}: {exc} (data rows from {start + 1})") from None
-            for k, v in out.items():
-                results[k][start : start + CHUNK_ROWS] = v
-            progress.advance(task, min(CHUNK_ROWS, n - start))
-    buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    out_names = [o for o in ctl.outputs if o not in header]
-    writer.writerow(rows[0] + out_names)
-    for r, row in enumerate(body):
-        writer.writerow(row + [_fmt(results[o][r]) for o in out_names])
-    text = buf.getvalue()
-    if output is None and as_table:
-        from rich.console import Console
-        from rich.table import Table
-
-        tab = Table(title=f"{ctl.name or ''}: {path.name}")
-        for h in rows[0] + out_names:
-            tab.add_column(h, justify="right")
-        for r, row in enumerate(body):
-            tab.add_row(*row, *(f"{results[o][r]:.10g}" for o in out_names))
-        Console(highlight=False).print(tab)
-        return
-    if output is None:
-        sys.stdout.write(text)
-        return
-    fd, tmp = tempfile.mkstemp(prefix=f".{output.name}.", dir=output.parent if str(output.parent) else ".")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, output)
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
 
 
 @app.command()
@@ -224,20 +210,20 @@ def explain(
 
     con = Console(highlight=False)
     inputs = Table(title="inputs")
-    inputs.add_column("input")
-    inputs.add_column("value", justify="right")
+    inputs.add_column("input", overflow="fold")
+    inputs.add_column("value", justify="right", overflow="fold")
     for k, v in e.inputs.items():
         inputs.add_row(k, f"{v:.10g}")
     con.print(inputs)
     terms = Table(title="fuzzification (degree of each term)")
     for col in ("variable", "term", "degree"):
-        terms.add_column(col, justify="right" if col == "degree" else "left")
+        terms.add_column(col, justify="right" if col == "degree" else "left", overflow="fold")
     for t in (*e.terms, *e.chained):
         terms.add_row(t.variable, t.term, f"{t.degree:.6g}")
     con.print(terms)
     rules = Table(title="rules (condition degree, then each conclusion)")
     for col in ("block", "rule", "degree", "conclusion", "weight"):
-        rules.add_column(col, justify="right" if col in ("degree", "weight") else "left")
+        rules.add_column(col, justify="right" if col in ("degree", "weight") else "left", overflow="fold")
     for r in e.rules:
         concl = ", ".join(f"{c.variable} IS {c.term}" if c.term else c.variable for c in r.conclusions)
         weights = ", ".join(f"{c.weight:g}" for c in r.conclusions)
@@ -246,7 +232,7 @@ def explain(
     con.print(rules)
     outs = Table(title="outputs")
     for col in ("output", "value", "method", "accumulation", "fired"):
-        outs.add_column(col, justify="right" if col == "value" else "left")
+        outs.add_column(col, justify="right" if col == "value" else "left", overflow="fold")
     for o in e.outputs:
         outs.add_row(
             o.name,
@@ -260,7 +246,7 @@ def explain(
         if o.kind == "ts" and o.weights:
             ts = Table(title=f"{o.name}: Takagi-Sugeno terms")
             for col in ("term", "weight", "z"):
-                ts.add_column(col, justify="left" if col == "term" else "right")
+                ts.add_column(col, justify="left" if col == "term" else "right", overflow="fold")
             for name, w, z in o.weights:
                 ts.add_row(name, f"{w:.6g}", f"{z:.6g}")
             con.print(ts)

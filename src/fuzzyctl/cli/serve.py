@@ -30,13 +30,21 @@ def serve(
     from rich.console import Console
 
     from fuzzyctl.runtime import Runtime, load_config
+    from fuzzyctl.runtime.config import ConfigError
 
+    if check:
+        from fuzzyctl.runtime.core import check_config
+
+        checked, problems = check_config(config)
+        if problems:
+            raise ConfigError(problems)
+        assert checked is not None
+        typer.echo(
+            f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s)"
+        )
+        return
     cfg = load_config(config)
     runtime = Runtime(cfg, api=api and cfg.api.enabled)
-    if check:
-        runtime.stop()
-        typer.echo(f"{config}: OK: {len(runtime.instances)} instance(s), {len(runtime.links)} connection(s)")
-        return
     stop = threading.Event()
 
     def on_signal(_signum: int, _frame: Any) -> None:

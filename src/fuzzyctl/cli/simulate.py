@@ -9,7 +9,7 @@ from typing import Annotated
 
 import typer
 
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import app, record_table
 
 
 @app.command("simulate")
@@ -31,10 +31,14 @@ def simulate(
         Path | None,
         typer.Option("--out-dir", "-o", help="Directory for the CSV, PNG and HTML (default: current)."),
     ] = None,
-    csv: Annotated[Path | None, typer.Option("--csv", help="CSV path (default: OUT_DIR/<name>.csv).")] = None,
-    png: Annotated[Path | None, typer.Option("--png", help="PNG path (default: OUT_DIR/<name>.png).")] = None,
+    csv: Annotated[
+        Path | None, typer.Option("--csv", help="CSV path (default: OUT_DIR/CONFIG-NAME.csv).")
+    ] = None,
+    png: Annotated[
+        Path | None, typer.Option("--png", help="PNG path (default: OUT_DIR/CONFIG-NAME.png).")
+    ] = None,
     html: Annotated[
-        Path | None, typer.Option("--html", help="HTML path (default: OUT_DIR/<name>.html).")
+        Path | None, typer.Option("--html", help="HTML path (default: OUT_DIR/CONFIG-NAME.html).")
     ] = None,
     no_csv: Annotated[bool, typer.Option("--no-csv", help="Do not write the CSV.")] = False,
     no_png: Annotated[bool, typer.Option("--no-png", help="Do not write the PNG.")] = False,
@@ -43,10 +47,10 @@ def simulate(
         bool, typer.Option("--json", help="Print the quality figures and files as JSON.")
     ] = False,
 ) -> None:
-    """Simulate a closed loop; print its quality figures, write CSV + PNG + HTML."""
+    """Simulate a closed loop; print its quality figures and write CSV, PNG and HTML (all three
+    into the current directory unless options name which; --json writes only what is named)."""
     from rich.console import Console
     from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
-    from rich.table import Table
 
     from fuzzyctl.sim.config import load_config
     from fuzzyctl.sim.experiment import simulate as run
@@ -74,14 +78,7 @@ def simulate(
 
         result = run(cfg, runtime=runtime, cycle=cycle, duration=duration, progress=tick)
 
-    base = out_dir if out_dir is not None else Path.cwd()
-    stem = config.stem
-    write_outputs(
-        result,
-        csv=None if no_csv else (csv or base / f"{stem}.csv"),
-        png=None if no_png else (png or base / f"{stem}.png"),
-        html=None if no_html else (html or base / f"{stem}.html"),
-    )
+    write_outputs(result, **_targets(config, out_dir, csv, png, html, no_csv, no_png, no_html, as_json))
     q = result.quality
     if as_json:
         doc = {
@@ -99,24 +96,43 @@ def simulate(
         f"{cfg.title}: {result.runtime}, cycle {result.cycle:g} s, {result.trace['t'][-1]:g} s simulated"
     )
     if q is not None:
-        table = Table(title=f"quality of {q.signal} (setpoint {q.setpoint:g})")
-        for name in ("ISE", "IAE", "ITAE", "overshoot", "overshoot %", "settling time", "final error"):
-            table.add_column(name, justify="right")
         settle = "never" if math.isinf(q.settling_time) else f"{q.settling_time:.2f} s"
-        table.add_row(
-            f"{q.ise:.4g}",
-            f"{q.iae:.4g}",
-            f"{q.itae:.4g}",
-            f"{q.overshoot:.3g}",
-            f"{q.overshoot_percent:.2f}",
-            settle,
-            f"{q.final_error:.3g}",
-        )
-        out.print(table)
+        figures = {
+            "ISE": f"{q.ise:.4g}",
+            "IAE": f"{q.iae:.4g}",
+            "ITAE": f"{q.itae:.4g}",
+            "overshoot": f"{q.overshoot:.3g}",
+            "overshoot %": f"{q.overshoot_percent:.2f}",
+            "settling time": settle,
+            "final error": f"{q.final_error:.3g}",
+        }
+        out.print(record_table(f"quality of {q.signal} (setpoint {q.setpoint:g})", figures, out.width))
         limits = "".join(f", |{k}| <= {v:g}" for k, v in cfg.quality.limits.items()) if cfg.quality else ""
         out.print(f"settling: |{q.signal} - setpoint| <= {q.band:g}{limits} from then on")
     for kind, path in result.files.items():
         out.print(f"{kind}: {path}", soft_wrap=True)  # a path must stay copyable: never broken
+
+
+def _targets(
+    config: Path,
+    out_dir: Path | None,
+    csv: Path | None,
+    png: Path | None,
+    html: Path | None,
+    no_csv: bool,
+    no_png: bool,
+    no_html: bool,
+    as_json: bool,
+) -> dict[str, Path | None]:
+    """Only what was asked: files named with --csv/--png/--html are written, and no others
+    unless --out-dir asks for all of them; with none of those options a run writes all three
+    into the current directory, except with --json (scripts that parse the figures)."""
+    named = {"csv": csv, "png": png, "html": html}
+    skip = {"csv": no_csv, "png": no_png, "html": no_html}
+    if out_dir is None and (any(named.values()) or as_json):
+        return {k: (None if skip[k] else v) for k, v in named.items()}
+    base = out_dir if out_dir is not None else Path()
+    return {k: None if skip[k] else (v or base / f"{config.stem}.{k}") for k, v in named.items()}
 
 
 def _json_number(v: float | str) -> float | str | None:

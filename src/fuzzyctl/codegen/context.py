@@ -8,18 +8,15 @@ from dataclasses import dataclass, field
 from typing import Literal
 
 from fuzzyctl.codegen.ir import Builder, Decl, Ex, ExLike, Storage, Type, Var, ex
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.escape import MAX_IDENT_ST as MAX_IDENT
+from fuzzyctl.escape import CodegenError
 
 Target = Literal["c", "st"]
 
 #: Every generated identifier starts with this prefix (user names never do: checked).
 PREFIX = "FZ_"
-#: Longest identifier the portable ST subset allows (and the C code keeps to).
-MAX_IDENT = 24
 
-
-class CodegenError(FuzzyctlError):
-    """The block uses something the code generator cannot express; the message names it."""
+__all__ = ["MAX_IDENT", "PREFIX", "CodegenError", "Gen", "Target", "flat"]
 
 
 @dataclass

@@ -32,8 +32,9 @@ from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.render_c import render_c
 from fuzzyctl.diagnostics import FuzzyctlError
-from fuzzyctl.engine.controller import Controller
+from fuzzyctl.engine.controller import Controller, merge_inputs
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.model import FunctionBlock
 
 #: -ffp-contract=off: no fused multiply-add, so that the C rounds like Python does.
 CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-fvisibility=hidden", "-ffp-contract=off")
@@ -124,8 +125,8 @@ class NativeController(Controller):
     ``explain`` runs the Python interpreter on the same NC state (read from and written back
     to the native instance), so it stays consistent with ``evaluate``."""
 
-    def __init__(self, plan: Plan, library: Path) -> None:
-        super().__init__(plan, specialise=False)
+    def __init__(self, plan: Plan, library: Path, model: FunctionBlock | None = None) -> None:
+        super().__init__(plan, specialise=False, model=model)
         self.library = library
         lib = ctypes.CDLL(str(library))
         lib.fz_sizeof.restype = ctypes.c_size_t
@@ -146,8 +147,8 @@ class NativeController(Controller):
         self._names = [plan.outputs[i].name for i in self._out_index]
         self._batch_fn = lib.fz_batch
 
-    def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
-        values = self._values(inputs)
+    def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
+        values = self._values(merge_inputs(inputs, values_by_name))
         buf = self._in1
         for i, v in enumerate(values):
             buf[i] = v
@@ -155,15 +156,17 @@ class NativeController(Controller):
         out = self._out1
         return {n: out[k] for k, n in enumerate(self._names)}
 
-    def evaluate_reference(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+    def evaluate_reference(
+        self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
+    ) -> dict[str, float]:
         self._pull_state()
-        res = super().evaluate_reference(inputs)
+        res = super().evaluate_reference(inputs, **values_by_name)
         self._push_state()
         return res
 
-    def explain(self, inputs: Mapping[str, Any]) -> Any:
+    def explain(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> Any:
         self._pull_state()
-        res = super().explain(inputs)
+        res = super().explain(inputs, **values_by_name)
         self._push_state()
         return res
 
@@ -178,8 +181,10 @@ class NativeController(Controller):
             res[oi] = out[:, k].copy()
         return res
 
-    def evaluate_batch(self, data: Any, *, chunk: int = 1 << 20) -> dict[str, npt.NDArray[np.float64]]:
-        return super().evaluate_batch(data, chunk=chunk)
+    def evaluate_batch(
+        self, data: Any, *, chunk: int = 1 << 20, on_invalid: str = "raise"
+    ) -> dict[str, npt.NDArray[np.float64]]:
+        return super().evaluate_batch(data, chunk=chunk, on_invalid=on_invalid)
 
     def reset(self) -> None:
         super().reset()
@@ -198,13 +203,13 @@ class NativeController(Controller):
         return f"NativeController({self.name!r}, inputs={list(self.inputs)}, outputs={list(self.outputs)})"
 
 
-def compile_native(plan: Plan) -> Controller:
+def compile_native(plan: Plan, model: FunctionBlock | None = None) -> Controller:
     """A native controller for ``plan``, or the Python one (with a warning) when there is no
     compiler or the plan uses something the C generator cannot express."""
     try:
-        return NativeController(plan, build(plan))
+        return NativeController(plan, build(plan), model)
     except (CodegenError, NativeError) as exc:
         warnings.warn(
             f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
         )
-        return Controller(plan, specialise=True)
+        return Controller(plan, specialise=True, model=model)

@@ -33,7 +33,7 @@ from fuzzyctl.codegen.ir import (
     Var,
     While,
 )
-from fuzzyctl.codegen.names import check_st
+from fuzzyctl.escape import st_comment, st_ident
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 #: IEC 61131-3 standard functions (Table 22/23) the program may call.
@@ -99,14 +99,14 @@ class _ST:
             if isinstance(s, Assign):
                 self.emit(f"{self.ex(s.target)} := {self.ex(s.value)};", ind)
             elif isinstance(s, Comment):
-                self.emit(f"(* {_safe(s.text)} *)", ind)
+                self.emit(_comment(s.text), ind)
             elif isinstance(s, Region):
                 if self.scl:
-                    self.emit(f"REGION {_safe(s.name)}", ind)
+                    self.emit(f"REGION {st_comment(s.name)}", ind)  # the title runs to the line's end
                     self.stmts(s.body, ind + 1)
                     self.emit("END_REGION", ind)
                 else:
-                    self.emit(f"(* ---- {_safe(s.name)} *)", ind)
+                    self.emit(_comment(f"---- {s.name}"), ind)
                     self.stmts(s.body, ind)
             elif isinstance(s, If):
                 for k, (cond, b) in enumerate(s.branches):
@@ -127,9 +127,10 @@ class _ST:
                 self.emit("END_WHILE;", ind)
 
 
-def _safe(text: str) -> str:
-    """Comment text that cannot close the comment."""
-    return text.replace("(*", "( *").replace("*)", "* )")
+def _comment(text: str) -> str:
+    """An ST comment: every comment of the generated block is made here, from model text
+    escaped by :func:`fuzzyctl.escape.st_comment`."""
+    return f"(* {st_comment(text)} *)"
 
 
 def _type(d: Decl, real: str) -> str:
@@ -158,14 +159,14 @@ def _init(d: Decl) -> str:
 
 def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
     """One FUNCTION_BLOCK."""
-    check_st(prog.name, "function block name")
+    st_ident(prog.name, "function block name")
     for d in prog.decls:
-        check_st(d.name, "variable" if d.storage in ("input", "output") else "identifier")
+        st_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
     r = _ST(prog, dialect, lreal)
     out: list[str] = []
     for line in prog.header:
-        out.append(f"(* {_safe(line)} *)")
-    out.append(f"(* dialect: {dialect}; arithmetic in {r.real} *)")
+        out.append(_comment(line))
+    out.append(_comment(f"dialect: {dialect}; arithmetic in {r.real}"))
     if r.scl:
         out.append(f'FUNCTION_BLOCK "{prog.name}"')
         out.append("{ S7_Optimized_Access := 'TRUE' }")
@@ -178,11 +179,11 @@ def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -
             return
         out.append(kw)
         if title:
-            out.append(f"    (* {_safe(title)} *)")
+            out.append(f"    {_comment(title)}")
         for d in decls:
             for line in d.comment.split("\n") if d.comment and d.size is not None else []:
-                out.append(f"    (* {_safe(line)} *)")
-            note = f" (* {_safe(d.comment)} *)" if d.comment and d.size is None else ""
+                out.append(f"    {_comment(line)}")
+            note = f" {_comment(d.comment)}" if d.comment and d.size is None else ""
             out.append(f"    {d.name} : {_type(d, r.real)}{_init(d)};{note}")
         out.append("END_VAR")
 

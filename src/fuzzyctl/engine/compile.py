@@ -81,6 +81,6 @@ def compile_block(
     path = getattr(model, "path", None) if isinstance(model, Document) else None
     if plan is None:
         raise DiagnosticError([dataclasses.replace(d, file=d.file or path) for d in diags])
-    controller = Controller(plan, specialise=backend == "python")
+    controller = Controller(plan, specialise=backend == "python", model=fb)
     controller.warnings = tuple(dataclasses.replace(d, file=d.file or path) for d in diags)
     return controller

@@ -3,8 +3,10 @@ the state an instance keeps between evaluations (DEFAULT := NC)."""
 
 from __future__ import annotations
 
+import difflib
 import math
 import numbers
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
@@ -15,6 +17,8 @@ from fuzzyctl.diagnostics import Diagnostic, InputError
 from fuzzyctl.engine import explain as explain_mod
 from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.engine.variables import VariableMap, inputs_of, outputs_of
+from fuzzyctl.model import FunctionBlock
 
 _INF = math.inf
 
@@ -26,11 +30,14 @@ class Controller:
     without DEFAULT): :meth:`reset` forgets them.  Batch rows are successive evaluations of
     the same instance, in order, as a PLC cycle would see them."""
 
-    def __init__(self, plan: Plan, *, specialise: bool = True) -> None:
+    def __init__(self, plan: Plan, *, specialise: bool = True, model: FunctionBlock | None = None) -> None:
         self.plan = plan
         self.name = plan.name
-        self.inputs: tuple[str, ...] = tuple(i.name for i in plan.inputs)
-        self.outputs: tuple[str, ...] = tuple(o.name for o in plan.outputs if o.is_output)
+        #: the function block compiled (None when built from a plan alone)
+        self.model = model
+        #: name -> range and terms of each input / output, in declaration order
+        self.inputs: VariableMap = inputs_of(plan, model)
+        self.outputs: VariableMap = outputs_of(plan, model)
         self._interp = Interpreter(plan)
         self._state: list[float | None] = [None] * len(plan.outputs)
         self._required = tuple(i.name for i in plan.inputs if i.default is None)
@@ -58,6 +65,7 @@ class Controller:
     # ------------------------------------------------------------------ inputs
 
     def _values(self, inputs: Mapping[str, Any]) -> list[float]:
+        _check_names(inputs, self.inputs)
         values: list[float] = []
         for i, spec in enumerate(self.plan.inputs):
             if spec.name in inputs:
@@ -70,17 +78,14 @@ class Controller:
             if self._degree[i] and not 0.0 <= v <= 1.0:
                 raise InputError(f"input {spec.name!r} is used as a degree and must be in [0, 1], got {v}")
             values.append(v)
-        if len(inputs) > len(values) or any(k not in self.inputs for k in inputs):
-            unknown = [k for k in inputs if k not in self.inputs]
-            if unknown:
-                raise InputError(f"unknown input {unknown[0]!r} (inputs: {', '.join(self.inputs)})")
         return values
 
     # ------------------------------------------------------------------ evaluation
 
-    def evaluate(self, inputs: Mapping[str, Any]) -> dict[str, float]:
-        """Evaluate once: ``{"temp": 20.0, ...} -> {"valve": 35.7, ...}``."""
-        values = self._values(inputs)
+    def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
+        """Evaluate once: ``evaluate({"temp": 20.0, ...})`` or ``evaluate(temp=20.0, ...)`` ->
+        ``{"valve": 35.7, ...}``.  Values are real numbers (numpy scalars and 0-d arrays too)."""
+        values = self._values(merge_inputs(inputs, values_by_name))
         if self._jfl is not None:
             res = [float(v[0]) for v in self._jfl.run([[v] for v in values], self._state, 1)]
         elif self._fast is not None:
@@ -91,18 +96,22 @@ class Controller:
         plan = self.plan
         return {plan.outputs[i].name: res[i] for i in range(len(res)) if plan.outputs[i].is_output}
 
-    def evaluate_reference(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+    def evaluate_reference(
+        self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
+    ) -> dict[str, float]:
         """Evaluate through the interpreter (the unspecialised path), for cross-checks."""
-        values = self._values(inputs)
-        if self._jfl is not None:
-            return self.evaluate(inputs)
+        if self._jfl is not None:  # that profile has one evaluator
+            return self.evaluate(inputs, **values_by_name)
+        values = self._values(merge_inputs(inputs, values_by_name))
         rec = self._interp.run(values, self._state)
         return {o.name: r.value for o, r in zip(self.plan.outputs, rec.outputs, strict=True) if o.is_output}
 
-    def explain(self, inputs: Mapping[str, Any]) -> explain_mod.Explanation:
+    def explain(
+        self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
+    ) -> explain_mod.Explanation:
         """Evaluate once and return every intermediate result (this counts as an evaluation:
-        the NC state advances)."""
-        values = self._values(inputs)
+        the NC state advances); ``.plot()`` draws it."""
+        values = self._values(merge_inputs(inputs, values_by_name))
         rec = (
             self._jfl.record(values, self._state)
             if self._jfl is not None
@@ -111,18 +120,24 @@ class Controller:
         named = dict(zip(self.inputs, values, strict=True))
         return explain_mod.build(self.plan, named, rec)
 
-    def evaluate_batch(self, data: Any, *, chunk: int = 16384) -> dict[str, npt.NDArray[np.float64]]:
+    def evaluate_batch(
+        self, data: Any, *, chunk: int = 16384, on_invalid: str = "raise"
+    ) -> dict[str, npt.NDArray[np.float64]]:
         """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
-        arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays."""
+        arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays.
+
+        ``on_invalid``: ``"raise"`` (default) refuses a NaN or infinite input with the row;
+        ``"nan"`` gives NaN outputs for such rows, skips them (the NC state carries over them
+        from the previous valid row) and warns with their count (:class:`InvalidRowsWarning`)."""
+        if on_invalid not in ("raise", "nan"):
+            raise ValueError(f"on_invalid must be 'raise' or 'nan', not {on_invalid!r}")
         columns = _columns(data)
+        _check_names(columns, self.inputs)
         n = None
-        arrays: list[npt.NDArray[np.float64]] = []
-        for name in columns:
-            if name not in self.inputs:
-                raise InputError(f"unknown input {name!r} (inputs: {', '.join(self.inputs)})")
+        arrays: list[npt.NDArray[np.float64] | None] = []
         for i, spec in enumerate(self.plan.inputs):
             if spec.name in columns:
-                arr = _column_array(spec.name, columns[spec.name])
+                arr = _column_array(spec.name, columns[spec.name], finite=on_invalid == "raise")
             elif spec.default is not None:
                 arr = None
             else:
@@ -133,18 +148,33 @@ class Controller:
                 elif len(arr) != n:
                     raise InputError(f"input {spec.name!r} has {len(arr)} values, expected {n}")
                 if self._degree[i]:
-                    bad = np.flatnonzero((arr < 0.0) | (arr > 1.0))
+                    bad = np.flatnonzero((arr < 0.0) | (arr > 1.0))  # NaN compares False: kept
                     if bad.size:
                         raise InputError(
                             f"input {spec.name!r} is used as a degree and must be in [0, 1] "
                             f"(row {int(bad[0])}: {arr[bad[0]]})"
                         )
-            arrays.append(arr)  # type: ignore[arg-type]
+            arrays.append(arr)
         n = n or 0
         full = [
             a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
             for i, a in enumerate(arrays)
         ]
+        if on_invalid == "nan":
+            valid = np.logical_and.reduce([np.isfinite(a) for a in full]) if full else np.ones(n, bool)
+            n_bad = int(n - np.count_nonzero(valid))
+            if n_bad:
+                warnings.warn(InvalidRowsWarning(n_bad, n), stacklevel=2)
+                kept = self._run_batch([a[valid] for a in full], n - n_bad, chunk)
+                out = {k: np.full(n, np.nan) for k in kept}
+                for k, v in kept.items():
+                    out[k][valid] = v
+                return out
+        return self._run_batch(full, n, chunk)
+
+    def _run_batch(
+        self, full: list[npt.NDArray[np.float64]], n: int, chunk: int
+    ) -> dict[str, npt.NDArray[np.float64]]:
         result = {o.name: np.empty(n) for o in self.plan.outputs}
         for start in range(0, n, chunk):
             part = [a[start : start + chunk] for a in full]
@@ -176,7 +206,40 @@ class Controller:
         return f"Controller({self.name!r}, inputs={list(self.inputs)}, outputs={list(self.outputs)})"
 
 
+class InvalidRowsWarning(UserWarning):
+    """Rows of a batch with a NaN or infinite input got NaN outputs (``on_invalid="nan"``)."""
+
+    def __init__(self, rows: int, total: int) -> None:
+        super().__init__(f"{rows} of {total} rows have a NaN or infinite input: their outputs are NaN")
+        self.rows = rows
+        self.total = total
+
+
+def merge_inputs(inputs: Mapping[str, Any] | None, by_name: dict[str, Any]) -> Mapping[str, Any]:
+    if inputs is None:
+        return by_name
+    if not isinstance(inputs, Mapping):
+        raise InputError(f"inputs must be a mapping of names to values, not {type(inputs).__name__}")
+    if by_name:
+        both = sorted(set(inputs) & set(by_name))
+        if both:
+            raise InputError(f"input {both[0]!r} given twice (in the mapping and as a keyword)")
+        return {**inputs, **by_name}
+    return inputs
+
+
+def _check_names(given: Mapping[str, Any], known: Mapping[str, Any]) -> None:
+    """Unknown names first: a misspelt input would otherwise be reported as a missing one."""
+    for name in given:
+        if name not in known:
+            close = difflib.get_close_matches(str(name), list(known), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else f" (inputs: {', '.join(known)})"
+            raise InputError(f"unknown input {name!r}{hint}")
+
+
 def _number(name: str, raw: Any) -> float:
+    if isinstance(raw, np.ndarray) and raw.ndim == 0:
+        raw = raw.item()
     if isinstance(raw, float):
         v = raw
     elif isinstance(raw, numbers.Real):
@@ -197,7 +260,7 @@ def _columns(data: Any) -> dict[str, Any]:
     raise InputError("batch data must map input names to columns (a dict of arrays or a DataFrame)")
 
 
-def _column_array(name: str, col: Any) -> npt.NDArray[np.float64]:
+def _column_array(name: str, col: Any, finite: bool = True) -> npt.NDArray[np.float64]:
     raw = col.to_numpy() if hasattr(col, "to_numpy") else col
     try:
         arr = np.asarray(raw, dtype=np.float64)
@@ -218,7 +281,7 @@ def _column_array(name: str, col: Any) -> npt.NDArray[np.float64]:
                 _number(name, v)
             except InputError as exc:
                 raise InputError(f"{exc} (row {i})") from None
-    bad = np.flatnonzero(~np.isfinite(arr))
+    bad = np.flatnonzero(~np.isfinite(arr)) if finite else np.zeros(0, int)
     if bad.size:
         raise InputError(f"input {name!r} must be finite (row {int(bad[0])}: {arr[bad[0]]})")
     return arr

@@ -6,13 +6,16 @@ from __future__ import annotations
 import dataclasses
 import math
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from fuzzyctl.engine import pwl
 from fuzzyctl.engine.interp import OutputRecord, Record
 from fuzzyctl.engine.plan import Plan
+
+if TYPE_CHECKING:
+    from matplotlib.figure import Figure
 
 
 @dataclass(frozen=True)
@@ -83,6 +86,12 @@ class Explanation:
 
     def rule(self, label: str, block: str | None = None) -> RuleTrace:
         return next(r for r in self.rules if r.label == label and (block is None or r.block == block))
+
+    def plot(self) -> Figure:
+        """The accumulated output sets and values as a matplotlib Figure."""
+        from fuzzyctl.engine.plot import explanation_figure
+
+        return explanation_figure(self)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (NaN becomes None)."""

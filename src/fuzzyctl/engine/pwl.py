@@ -34,7 +34,7 @@ Line = tuple[float, float, float, float, bool]
 @cache
 def gauss_legendre(n: int) -> tuple[tuple[float, ...], tuple[float, ...]]:
     """Nodes and weights on [0, 1]."""
-    x, w = np.polynomial.legendre.leggauss(n)  # type: ignore[no-untyped-call]
+    x, w = np.polynomial.legendre.leggauss(n)
     return tuple(float(v) for v in (x + 1.0) / 2.0), tuple(float(v) for v in w / 2.0)
 
 

@@ -158,8 +158,8 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         return top, math.nan, math.nan, math.nan
     # smooth peaks between nodes
     peaks: list[tuple[float, float]] = []
-    for i in np.flatnonzero(ys >= top * (1.0 - 1e-6)):
-        i = int(i)
+    for index in np.flatnonzero(ys >= top * (1.0 - 1e-6)):
+        i = int(index)
         if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
             continue
         peaks.append(
@@ -190,8 +190,7 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         mom = sum((r - l_) * 0.5 * (l_ + r) for l_, r in runs) / length if length > 0 else 0.5 * (lm + rm)
         return sup, lm, rm, mom
     if not points:  # pragma: no cover - the top node itself is always a candidate peak
-        i = int(np.argmax(ys))
-        points = [float(xs[i])]
+        points = [float(xs[int(np.argmax(ys))])]
     return sup, points[0], points[-1], math.fsum(points) / len(points)
 
 

@@ -36,6 +36,7 @@ from fuzzyctl.engine.plan import (
     Slot,
     TermPlan,
 )
+from fuzzyctl.escape import py_str
 
 Fast = Callable[[list[float], list[float | None]], list[float]]
 
@@ -104,7 +105,7 @@ class _Gen:
             self.emit(f"{out} = _eval_expr({self.obj(t.expr)}, v, (), {x})", ind)
         else:
             params = "[" + ", ".join(self.param(p) for p in t.params) + "]"
-            self.emit(f"{out} = _m({t.kind!r}, {params}, {self.param(t.height)}, {x})", ind)
+            self.emit(f"{out} = _m({py_str(t.kind)}, {params}, {self.param(t.height)}, {x})", ind)
 
     def pwl_chain(self, pts: tuple[tuple[float, float], ...], x: str, out: str, ind: int) -> None:
         xs = sorted({p[0] for p in pts})
@@ -281,7 +282,8 @@ def specialise(plan: Plan) -> Fast:
     g.emit("return outs")
     src = "def _fast(v, state):\n" + "\n".join(g.lines) + "\n"
     env = dict(g.env)
-    exec(compile(src, f"<fuzzyctl specialised {plan.name}>", "exec"), env)
+    # only generated names, float literals and py_str() text reach the source: no model text
+    exec(compile(src, f"<fuzzyctl specialised {plan.name!r}>", "exec"), env)
     fn: Fast = env["_fast"]
     fn.__source__ = src  # type: ignore[attr-defined]
     return fn

@@ -17,13 +17,12 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
-import os
-import tempfile
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
+from fuzzyctl.files import write_atomic
 from fuzzyctl.model import Document
 
 
@@ -195,20 +194,6 @@ class LossError(FuzzyctlError):
             f"{format} cannot express {len(self.losses)} element(s) of this model "
             f"(use --lossy to convert anyway):\n{lines}"
         )
-
-
-def write_atomic(path: str | Path, text: str) -> None:
-    """Write a file so that readers see the old content or the new one, never a part."""
-    target = Path(path)
-    directory = target.parent if str(target.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as out:
-            out.write(text)
-        os.replace(tmp, target)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 __all__ = [

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import importlib
 import importlib.util
+import itertools
 import math
 import re
 from dataclasses import replace
@@ -26,10 +27,14 @@ from fuzzyctl.model import (
     Document,
     FunctionBlock,
     Is,
+    MembershipFunction,
     Not,
     Or,
+    Point,
+    PointsMF,
     Rule,
     RuleBlock,
+    ShapeMF,
 )
 
 _POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
@@ -126,6 +131,48 @@ def _fcl_identifier(name: str, taken: set[str]) -> str:
     return candidate
 
 
+def _as_points(mf: MembershipFunction) -> MembershipFunction:
+    """A triangle or trapezoid with numeric, finite vertices as the IEC point list it is
+    (Basic level, Table 8; the engine evaluates both the same); anything else unchanged."""
+    if not isinstance(mf, ShapeMF) or mf.kind not in ("triangle", "trapezoid"):
+        return mf
+    values = (*mf.params, mf.height)
+    if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
+        return mf
+    h = float(mf.height)  # type: ignore[arg-type]
+    xs = [float(v) for v in mf.params]  # type: ignore[arg-type]
+    ys = [0.0, h, 0.0] if mf.kind == "triangle" else [0.0, h, h, 0.0]
+    if any(b < a for a, b in itertools.pairwise(xs)):
+        return mf  # not a well-formed shape: keep what the source said
+    return PointsMF(tuple(Point(x, y) for x, y in zip(xs, ys, strict=True)))
+
+
+def _basic_level(fb: FunctionBlock) -> FunctionBlock:
+    """Say things the way strict IEC 61131-7 tools read them where that is the same thing:
+    point lists for triangles and trapezoids, and a variable's RANGE inside its FUZZIFY /
+    DEFUZZIFY block rather than on its declaration line (jFuzzyLogic's Open-level form)."""
+    ranges = {v.name: v.range for v in fb.variables if v.range is not None}
+    fuzzify = tuple(
+        replace(
+            f,
+            range=f.range or ranges.get(f.variable),
+            terms=tuple(replace(t, mf=_as_points(t.mf)) for t in f.terms),
+        )
+        for f in fb.fuzzify
+    )
+    defuzzify = tuple(
+        replace(
+            d,
+            range=d.range or ranges.get(d.variable),
+            terms=tuple(replace(t, mf=_as_points(t.mf)) for t in d.terms),
+        )
+        for d in fb.defuzzify
+    )
+    in_blocks = {f.variable for f in fuzzify} | {d.variable for d in defuzzify}
+    variables = tuple(replace(v, range=None) if v.name in in_blocks else v for v in fb.variables)
+    return replace(fb, variables=variables, fuzzify=fuzzify, defuzzify=defuzzify)
+
+
 def lower(document: Document) -> tuple[Document, list[Loss]]:
     """Rewrite what FCL says differently, report what it cannot say at all."""
     losses: list[Loss] = []
@@ -174,7 +221,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rule_blocks.append(replace(block, rules=tuple(rules), enabled=True, rule_activation=None))
         fuzzify = tuple(replace(f, clamp=False) for f in fb.fuzzify)
         defuzzify = tuple(replace(d, clamp=False) for d in fb.defuzzify)
-        fb = replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify)
+        fb = _basic_level(replace(fb, rule_blocks=tuple(rule_blocks), fuzzify=fuzzify, defuzzify=defuzzify))
         # names FCL cannot read back (MATLAB's "sugeno tipper", "a/b", a variable "if") are
         # renamed: not a loss
         fb, _renames = rename(fb, fcl_name, fcl_term)

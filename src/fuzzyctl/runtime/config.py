@@ -156,6 +156,8 @@ class Config:
     connections: dict[str, ConnectionConfig]
     instances: dict[str, InstanceConfig]
     state_dir: Path = field(default_factory=Path)
+    #: with ``partial=True``: what was wrong (the rest of the file is here, valid)
+    problems: tuple[str, ...] = ()
 
     def where(self, table: str, key: str | None = None) -> str:
         return _where(self.path, table, key)
@@ -214,19 +216,22 @@ def _binding(
     return BindingConfig(connection=conn_name, point=point, safe=None if safe is None else float(safe))
 
 
-def load_config(path: str | Path) -> Config:
-    """Read and validate a configuration file; raises :class:`ConfigError`."""
+def load_config(path: str | Path, *, partial: bool = False) -> Config:
+    """Read and validate a configuration file; raises :class:`ConfigError` (``partial``: see
+    :func:`parse_config`)."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ConfigError([f"{path}: cannot read: {exc.strerror or exc}"]) from exc
-    return parse_config(text, path)
+    return parse_config(text, path, partial=partial)
 
 
-def parse_config(text: str, path: str | Path = "<config>") -> Config:
+def parse_config(text: str, path: str | Path = "<config>", *, partial: bool = False) -> Config:
     """Validate configuration text (``path`` names it in messages and anchors relative
-    paths)."""
+    paths).  ``partial=True`` (``serve --check``) never raises for a problem of one table:
+    the Config holds every valid table and ``problems`` lists the rest, so that every
+    problem of a file is reported in one pass."""
     path = Path(path)
     try:
         raw = tomllib.loads(text)
@@ -250,7 +255,10 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
             {"connections": raw.get("connections", {}), "instances": raw.get("instances", {})}
         )
     except ValidationError as exc:
-        raise ConfigError(problems + _pydantic_problems(path, "", exc)) from exc
+        problems += _pydantic_problems(path, "", exc)
+        if not partial:
+            raise ConfigError(problems) from exc
+        return Config(path, runtime_cfg, api_cfg, {}, {}, problems=tuple(problems))
     base = path.resolve().parent
 
     connections: dict[str, ConnectionConfig] = {}
@@ -327,7 +335,7 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
                 problems.append(
                     f"{_where(path, tname, f'expose[{i}]')}: {conn_name!r} is not an opcua-server connection"
                 )
-        if len(problems) > n_before:
+        if len(problems) > n_before and not partial:  # partial: check what is valid of it
             continue
         kb = Path(t.knowledge_base)
         instances[name] = InstanceConfig(
@@ -349,11 +357,11 @@ def parse_config(text: str, path: str | Path = "<config>") -> Config:
         )
     if not top.instances:
         problems.append(f"{path}: no [instances.<name>] table: nothing to run")
-    if problems:
+    if problems and not partial:
         raise ConfigError(problems)
     if runtime_cfg.state_dir is None:
         state_dir = Path.home() / ".local" / "state" / "fuzzyctl"
     else:
         sd = Path(runtime_cfg.state_dir).expanduser()
         state_dir = sd if sd.is_absolute() else base / sd
-    return Config(path, runtime_cfg, api_cfg, connections, instances, state_dir)
+    return Config(path, runtime_cfg, api_cfg, connections, instances, state_dir, problems=tuple(problems))

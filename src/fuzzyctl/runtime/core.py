@@ -131,12 +131,16 @@ class Runtime:
             except InputError as exc:
                 problems.append(f"{where(f'{t}.params', key)}: {exc}")
         for name, b in icfg.inputs.items():
+            if b.connection not in self.links:
+                continue  # a connection with its own problem, reported with it (serve --check)
             try:
                 inst.bind_input(name, self.links[b.connection], self.links[b.connection].input(b.point))
             except (InputError, LinkError) as exc:
                 problems.append(f"{where(f'{t}.inputs', name)}: {exc}")
         exposed_outputs: dict[str, list[tuple[Link, Any]]] = {}
         for name, bindings in icfg.outputs.items():
+            if any(b.connection not in self.links for b in bindings):
+                continue
             try:
                 targets = [
                     (self.links[b.connection], self.links[b.connection].output(b.point)) for b in bindings
@@ -145,12 +149,16 @@ class Runtime:
             except LinkError as exc:
                 problems.append(f"{where(f'{t}.outputs', name)}: {exc}")
         for name, b in icfg.parameters.items():
+            if b.connection not in self.links:
+                continue
             link = self.links[b.connection]
             try:
                 inst.bind_param(name, link, link.input(b.point), link.mirror(b.point))
             except (InputError, LinkError) as exc:
                 problems.append(f"{where(f'{t}.parameters', name)}: {exc}")
         for server_name in icfg.expose:
+            if server_name not in self.links:
+                continue
             try:
                 self._expose(inst, self.links[server_name], exposed_outputs)
             except (InputError, LinkError) as exc:
@@ -402,3 +410,21 @@ class Runtime:
                 "points": len(link.points),
             }
         return out
+
+
+def check_config(path: str | Path) -> tuple[Config | None, list[str]]:
+    """Every problem of a configuration file in one pass (``fuzzyctl serve --check``): its
+    tables, then the instances that could be built from the valid tables (knowledge bases,
+    bindings against them); nothing is started."""
+    from fuzzyctl.runtime.config import load_config
+
+    try:
+        config = load_config(path, partial=True)
+    except ConfigError as exc:  # not readable or not TOML
+        return None, exc.problems
+    problems = list(config.problems)
+    try:
+        Runtime(config, api=False, event_log=None).stop()
+    except ConfigError as exc:
+        problems += [p for p in exc.problems if p not in problems]
+    return config, problems

@@ -45,7 +45,7 @@ def render(runtime: Runtime, *, events: int = 8, max_instances: int = 40) -> Gro
         ("overruns", "right"),
         ("links", "left"),
     ):
-        inst_table.add_column(col, justify=justify)  # type: ignore[arg-type]
+        inst_table.add_column(col, justify=justify, overflow="fold")  # type: ignore[arg-type]
     shown = list(runtime.instances.values())
     for inst in shown[:max_instances]:
         s = inst.snapshot()
@@ -73,7 +73,7 @@ def render(runtime: Runtime, *, events: int = 8, max_instances: int = 40) -> Gro
 
     link_table = Table(title="connections", expand=True, header_style="bold")
     for col in ("connection", "type", "endpoint", "state", "exchange ms", "failures", "last error"):
-        link_table.add_column(col)
+        link_table.add_column(col, overflow="fold")
     for name, info in runtime.links_state().items():
         link_table.add_row(
             name,

@@ -53,6 +53,7 @@ _TOP = {
     "integrator",
     "quality",
     "plot",
+    "tune",  # cost and scenarios for fuzzyctl tune (fuzzyctl.tune.plant); simulate ignores it
 }
 _CONTROLLER = {
     "direct": {"inputs", "outputs"},

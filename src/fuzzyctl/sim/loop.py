@@ -16,8 +16,6 @@ end that shows the loop as it runs) or at once (``loop.run(duration)`` -> :class
 from __future__ import annotations
 
 import math
-import os
-import tempfile
 from collections.abc import Callable, Iterator, Mapping
 from pathlib import Path
 from typing import Any
@@ -26,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.diagnostics import InputError
+from fuzzyctl.files import write_atomic
 from fuzzyctl.sim.integrate import FixedStep, Integrator
 from fuzzyctl.sim.plant import Plant
 from fuzzyctl.sim.profiles import Profile
@@ -84,23 +83,6 @@ class Trace:
         data = np.array([[float(x) for x in line.split(",")] for line in text[1:] if line], dtype=np.float64)
         data = data.reshape(-1, len(names))
         return cls({n: data[:, i] for i, n in enumerate(names)})
-
-
-def write_atomic(path: Path, content: str | bytes) -> None:
-    """Write a file through a temporary file in the same directory and ``os.replace``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(content.encode() if isinstance(content, str) else content)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; an output file is an ordinary file
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 class Loop:

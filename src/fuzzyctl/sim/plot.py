@@ -7,7 +7,8 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from fuzzyctl.sim.loop import Trace, write_atomic
+from fuzzyctl.files import write_atomic
+from fuzzyctl.sim.loop import Trace
 
 
 def default_panels(trace: Trace, *, first: Sequence[str] = (), drives: Sequence[str] = ()) -> list[list[str]]:

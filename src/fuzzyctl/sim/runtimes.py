@@ -37,8 +37,8 @@ class EngineRuntime:
 
         self.controller = fuzzyctl.compile(model, block=block)
         self.name = "engine"
-        self.inputs = self.controller.inputs
-        self.outputs = self.controller.outputs
+        self.inputs = tuple(self.controller.inputs)
+        self.outputs = tuple(self.controller.outputs)
 
     def evaluate(self, inputs: Mapping[str, float]) -> dict[str, float]:
         return self.controller.evaluate(inputs)
@@ -67,8 +67,8 @@ class NativeRuntime(EngineRuntime):
             raise InputError(f"controller runtime 'native' cannot run here: {exc}") from exc
         self.controller = NativeController(plan, library)
         self.name = "native"
-        self.inputs = self.controller.inputs
-        self.outputs = self.controller.outputs
+        self.inputs = tuple(self.controller.inputs)
+        self.outputs = tuple(self.controller.outputs)
 
 
 def make_runtime(

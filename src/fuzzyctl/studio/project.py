@@ -11,12 +11,12 @@ import hashlib
 import json
 import os
 import re
-import tempfile
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
 from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.files import write_atomic
 from fuzzyctl.model import Document, FunctionBlock, OptionsBlock
 
 STUDIO_KEYWORD = "STUDIO"
@@ -88,31 +88,9 @@ def sha256(text: str) -> str:
 
 
 def save_atomically(path: Path, text: str) -> None:
-    """Write ``text`` so that ``path`` holds the old or the new content after a crash,
-    never a part: a temporary file in the same directory, fsync, rename, fsync of the
-    directory (so the rename itself is on the disk)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
-            handle.flush()
-            os.fsync(handle.fileno())
-        if path.exists():
-            os.chmod(tmp, path.stat().st_mode & 0o777)
-        else:
-            umask = os.umask(0)
-            os.umask(umask)
-            os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    dir_fd = os.open(path.parent, os.O_RDONLY)
-    try:
-        os.fsync(dir_fd)
-    finally:
-        os.close(dir_fd)
+    """Write ``text`` so that ``path`` holds the old or the new content after a crash, never a
+    part (fsync of the file and of the directory: fuzzyctl.files)."""
+    write_atomic(path, text, durable=True)
 
 
 # ---------------------------------------------------------------------------- settings

@@ -1,0 +1,286 @@
+"""``fuzzyctl learn`` and ``fuzzyctl tune``: a fuzzy system from data, and tuning against
+data or the closed loop (docs/tune.md)."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+
+from fuzzyctl.cli.app import app
+
+WorkersOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--workers",
+        help="Dask worker processes on this machine (default: one per CPU; 0: run in this process).",
+        show_default=False,
+    ),
+]
+SchedulerOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--scheduler",
+        help="An existing Dask scheduler, tcp://HOST:PORT (default: $DASK_SCHEDULER_ADDRESS, else local).",
+        show_default=False,
+    ),
+]
+SeedOpt = Annotated[int, typer.Option("--seed", help="Random seed (splits, optimisers, clustering).")]
+ValidationOpt = Annotated[
+    float, typer.Option("--validation", help="Fraction of the rows kept for validation (0: none).")
+]
+ValidationDataOpt = Annotated[
+    Path | None,
+    typer.Option(
+        "--validation-data", help="Validation (checking) rows from this file instead.", show_default=False
+    ),
+]
+
+
+def _need_extra() -> None:
+    import importlib.util
+
+    missing = [m for m in ("cma", "pyarrow", "distributed") if importlib.util.find_spec(m) is None]
+    if missing:
+        from fuzzyctl.diagnostics import FuzzyctlError
+
+        raise FuzzyctlError(f"this needs the tune extra ({', '.join(missing)}): pip install 'fuzzyctl[tune]'")
+
+
+def _fmt(v: float) -> str:
+    return "inf" if math.isinf(v) else f"{v:.6g}"
+
+
+def _print_table(title: str, rows: list[tuple[str, float, float]] | list[tuple[str, float]]) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=title)
+    table.add_column("")
+    if rows and len(rows[0]) == 3:
+        table.add_column("before", justify="right")
+        table.add_column("after", justify="right")
+    else:
+        table.add_column("value", justify="right")
+    for row in rows:
+        table.add_row(row[0], *(_fmt(float(v)) for v in row[1:]))
+    Console(highlight=False).print(table)
+
+
+@app.command("learn")
+def learn(
+    data: Annotated[Path, typer.Argument(help="CSV or Parquet file with a header row.", show_default=False)],
+    inputs: Annotated[
+        str, typer.Option("--inputs", help="Input columns, comma-separated.", show_default=False)
+    ],
+    output: Annotated[str, typer.Option("--output", help="The output column.", show_default=False)],
+    out: Annotated[
+        Path, typer.Option("-o", "--out", help="Write the learned system here (FCL).", show_default=False)
+    ],
+    method: Annotated[str, typer.Option("--method", help="grid (partition) or cluster (k-means).")] = "grid",
+    kind: Annotated[str, typer.Option("--type", help="tsk (Takagi-Sugeno) or mamdani (singletons).")] = "tsk",
+    terms: Annotated[
+        int | None,
+        typer.Option(
+            "--terms",
+            help="Terms per input (grid; default 5/3/2 by input count) or clusters (default 10).",
+            show_default=False,
+        ),
+    ] = None,
+    out_terms: Annotated[int, typer.Option("--out-terms", help="Output singletons of a Mamdani system.")] = 7,
+    and_op: Annotated[
+        str, typer.Option("--and", help="AND operator: prod or min (PLC Basic level).")
+    ] = "prod",
+    shape: Annotated[
+        str, typer.Option("--shape", help="Grid terms: triangle (points, PLC blocks) or gauss.")
+    ] = "triangle",
+    validation: ValidationOpt = 0.2,
+    validation_data: ValidationDataOpt = None,
+    seed: SeedOpt = 0,
+    name: Annotated[
+        str | None, typer.Option("--name", help="FUNCTION_BLOCK name (default: learned).")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the errors as JSON.")] = False,
+) -> None:
+    """Learn a fuzzy system from data: grid partition or clustering, consequents by least squares."""
+    _need_extra()
+    from fuzzyctl.tune.learning import learn as run
+
+    names = [s.strip() for s in inputs.split(",") if s.strip()]
+    if not names:
+        raise typer.BadParameter("name at least one input column", param_hint="--inputs")
+    result = run(
+        data,
+        inputs=names,
+        output=output,
+        method=method,
+        kind=kind,
+        terms=terms,
+        out_terms=out_terms,
+        and_op=and_op,
+        validation=validation,
+        validation_data=validation_data,
+        seed=seed,
+        name=name,
+        shape=shape,
+    )
+    result.write_fcl(out)
+    if as_json:
+        typer.echo(json.dumps({"file": str(out), "rules": result.rules, **result.scores}))
+        return
+    rows = [(k, v) for k, v in result.scores.items() if not k.endswith("rows")]
+    _print_table(f"{out}: {result.kind} by {result.method}, {result.rules} rules", rows)
+    for note in result.notes:
+        typer.echo(note)
+
+
+@app.command("tune")
+def tune(
+    file: Annotated[
+        Path, typer.Argument(help="The fuzzy system to tune (FCL, FIS, FLL or JSON).", show_default=False)
+    ],
+    out: Annotated[
+        Path, typer.Option("-o", "--out", help="Write the tuned system here (FCL).", show_default=False)
+    ],
+    data: Annotated[
+        Path | None,
+        typer.Option("--data", help="CSV/Parquet of inputs and target outputs.", show_default=False),
+    ] = None,
+    output: Annotated[
+        str | None,
+        typer.Option(
+            "--output",
+            help="Target column(s), comma-separated (default: every output in the data).",
+            show_default=False,
+        ),
+    ] = None,
+    plant_config: Annotated[
+        Path | None,
+        typer.Option(
+            "--plant",
+            help="A simulate configuration (TOML); cost and scenarios from its [tune] table.",
+            show_default=False,
+        ),
+    ] = None,
+    cost: Annotated[
+        str | None,
+        typer.Option(
+            "--cost",
+            help="Cost terms, e.g. settling_time=1,max:angle=0.5 (overrides [tune] cost).",
+            show_default=False,
+        ),
+    ] = None,
+    free: Annotated[
+        str, typer.Option("--free", help="What moves: all, inputs, outputs, weights, VAR, VAR.TERM, -ITEM.")
+    ] = "all",
+    optimizer: Annotated[
+        str | None,
+        typer.Option(
+            "--optimizer",
+            help="cmaes, de, lsq or lbfgsb (default: lsq for data, cmaes for the plant).",
+            show_default=False,
+        ),
+    ] = None,
+    budget: Annotated[
+        int, typer.Option("--budget", help="Evaluations (simulations per scenario, or passes over the data).")
+    ] = 200,
+    seed: SeedOpt = 0,
+    loss: Annotated[str, typer.Option("--loss", help="Data loss: rmse, mae or max.")] = "rmse",
+    validation: ValidationOpt = 0.2,
+    validation_data: ValidationDataOpt = None,
+    block: Annotated[
+        str | None, typer.Option("--block", help="Function block to tune (default: the first).")
+    ] = None,
+    runtime: Annotated[
+        str | None,
+        typer.Option("--runtime", help="Run the controller in the loop on: engine, siemens, xfuz, native."),
+    ] = None,
+    keep_zero: Annotated[
+        bool | None,
+        typer.Option(
+            "--keep-zero/--move-zero",
+            help="Keep abscissae and singletons at 0 (default: yes with --plant, no with --data).",
+            show_default=False,
+        ),
+    ] = None,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
+    report: Annotated[
+        Path | None, typer.Option("--report", help="Write a report directory (Markdown, JSON, PNG, HTML).")
+    ] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
+) -> None:
+    """Tune a fuzzy system against data or a closed-loop cost (Ctrl-C keeps the best so far)."""
+    _need_extra()
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from fuzzyctl.tune.api import tune as run
+
+    if budget < 1:
+        raise typer.BadParameter(f"must be at least 1, got {budget}", param_hint="--budget")
+    if workers is not None and scheduler is not None:
+        raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
+    if (data is None) == (plant_config is None):
+        raise typer.BadParameter("give either --data or --plant", param_hint="--data")
+    console = Console(stderr=True)
+    with Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("best {task.fields[best]}"),
+        TimeElapsedColumn(),
+        console=console,
+        transient=True,
+        disable=as_json,
+    ) as progress:
+        task = progress.add_task(f"tuning {file.name}", total=budget, best="-")
+
+        def tick(done: int, total: int, best: float) -> None:
+            progress.update(task, completed=done, total=total, best=_fmt(best))
+
+        result = run(
+            file,
+            data=data,
+            output=[s.strip() for s in output.split(",")] if output else None,
+            plant_config=plant_config,
+            cost=cost,
+            free=free,
+            optimizer=optimizer,
+            budget=budget,
+            seed=seed,
+            loss=loss,
+            validation=validation,
+            validation_data=validation_data,
+            block=block,
+            workers=workers,
+            scheduler=scheduler,
+            runtime=runtime,
+            keep_zero=keep_zero,
+            progress=tick,
+        )
+    result.write_fcl(out)
+    files: dict[str, Any] = {"fcl": str(out)}
+    if report is not None:
+        files.update({k: str(v) for k, v in result.write_report(report).items()})
+    if as_json:
+        from fuzzyctl.tune.report import as_dict
+
+        typer.echo(json.dumps({**as_dict(result), "files": files}))
+        return
+    status = " (interrupted: best so far kept)" if result.interrupted else ""
+    _print_table(
+        f"{result.cost_name}: {_fmt(result.before)} -> {_fmt(result.after)}{status}",
+        [(k, b, a) for k, b, a in result.table],
+    )
+    if result.changes:
+        _print_table(f"{len(result.changes)} parameter(s) changed", list(result.changes))
+    for note in result.notes:
+        typer.echo(f"note: {note}")
+    where = "this process" if result.workers == 0 else f"{result.workers} Dask worker(s)"
+    typer.echo(f"{result.evaluations} evaluations on {where} in {result.seconds:.1f} s; wrote {out}")
+    if report is not None:
+        typer.echo(f"report: {report / 'report.md'}")

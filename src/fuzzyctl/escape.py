@@ -1,0 +1,342 @@
+"""The one place where text from a model becomes part of generated source.
+
+A model file is untrusted input: a rule label, a block name or a term name may hold
+``*/``, ``(*``, a newline, a quote, a NUL or a bidirectional-override character.  Every
+string that reaches generated code goes through exactly one function of this module per
+target, which either makes it inert or refuses it:
+
+========================  =====================================================================
+target                    functions
+========================  =====================================================================
+C                         :func:`c_comment` (body of ``/* */``), :func:`c_string` (a literal),
+                          :func:`c_ident` (refuses what is not a plain identifier)
+IEC 61131-3 ST / SCL      :func:`st_comment` (body of ``(* *)``, also an SCL ``REGION`` title),
+                          :func:`st_string` (a literal), :func:`st_ident` (refuses)
+XML (PLCopen TC6)         :func:`xml_text`, :func:`xml_attr`, :func:`xml_comment`
+Python                    :func:`py_str` (a literal), :func:`py_ident` (refuses)
+========================  =====================================================================
+
+Comment bodies are one line of printable ASCII: ``*/``, ``/*``, ``(*``, ``*)`` and ``??``
+(trigraphs) are split by a space, every other character outside ``' '..'~'`` (newlines,
+NUL, U+2028, bidirectional controls - the "Trojan Source" trick - and any non-ASCII
+letter) is written as ``<U+XXXX>``, and the body is cut to :data:`MAX_COMMENT` characters.
+Identifiers are never rewritten (that could merge two names): what is not an identifier of
+the target is refused with :class:`CodegenError` naming it.
+
+This module imports nothing of fuzzyctl but the error base class, so the engine (Python
+source of the specialised path), the code generators and the PLCopen writer share it.
+"""
+
+from __future__ import annotations
+
+import re
+
+from fuzzyctl.diagnostics import FuzzyctlError
+
+#: Longest comment body written (longer text is cut and ends with ``...``).
+MAX_COMMENT = 500
+#: Longest identifier the portable ST subset allows (and the C code keeps to).
+MAX_IDENT_ST = 24
+#: C99 guarantees 63 significant characters of an internal identifier.
+MAX_IDENT_C = 63
+
+
+class CodegenError(FuzzyctlError):
+    """The block uses something the code generator cannot express; the message names it."""
+
+
+# --------------------------------------------------------------------------- comments
+
+_PRINTABLE = re.compile(r"[^\x20-\x7e]")
+# '*' next to '/' or to a parenthesis could open or close a C or ST comment; '??' starts a
+# C trigraph ('??/' is a backslash).  A space between them makes every one inert.
+_OPENERS = re.compile(r"\*(?=[/)])|[/(](?=\*)|\?(?=\?)")
+
+
+def _one_line(text: str, limit: int) -> str:
+    text = _PRINTABLE.sub(lambda m: f"<U+{ord(m.group()):04X}>", str(text))
+    text = _OPENERS.sub(lambda m: m.group() + " ", text)
+    if len(text) > limit:
+        text = text[: limit - 3].rstrip("\\") + "..."
+    return text
+
+
+def c_comment(text: str) -> str:
+    """``text`` as the body of a C ``/* ... */`` comment: one line that cannot end the
+    comment, open another one, splice a line (no newline, no trigraph) or hide code from a
+    reader (no control or bidirectional characters)."""
+    return _one_line(text, MAX_COMMENT)
+
+
+def st_comment(text: str) -> str:
+    """``text`` as the body of a Structured Text ``(* ... *)`` comment (and of an SCL
+    ``REGION`` title, which runs to the end of the line): one line of printable ASCII with
+    no ``(*``, ``*)``, ``/*`` or ``*/``."""
+    return _one_line(text, MAX_COMMENT)
+
+
+# --------------------------------------------------------------------------- string literals
+
+
+def c_string(text: str) -> str:
+    """A C99 string literal (quotes included) holding the UTF-8 bytes of ``text``: every
+    byte outside printable ASCII, the quote, the backslash and ``?`` (trigraphs) are octal
+    escapes, which unlike ``\\x`` never swallow a following digit."""
+    out = []
+    for b in str(text).encode("utf-8", "surrogatepass"):
+        ch = chr(b)
+        if 0x20 <= b <= 0x7E and ch not in '"\\?':
+            out.append(ch)
+        else:
+            out.append(f"\\{b:03o}")
+    return '"' + "".join(out) + '"'
+
+
+def st_string(text: str) -> str:
+    """An IEC 61131-3 STRING literal (quotes included): ``$`` escapes for ``$``, the quote
+    and control characters, ``$hh`` for every other byte outside printable ASCII (Latin-1
+    when it fits, ``?`` otherwise: a STRING is single-byte)."""
+    named = {"$": "$$", "'": "$'", "\n": "$N", "\r": "$R", "\t": "$T", "\f": "$P"}
+    out = []
+    for ch in str(text):
+        if ch in named:
+            out.append(named[ch])
+        elif " " <= ch <= "~":
+            out.append(ch)
+        else:
+            code = ord(ch) if ord(ch) < 256 else ord("?")
+            out.append(f"${code:02X}")
+    return "'" + "".join(out) + "'"
+
+
+def py_str(text: str) -> str:
+    """A Python string literal (quotes included) equal to ``text``: ``repr`` of an exact
+    ``str`` always is one, whatever the text holds."""
+    return str.__repr__(str(text))
+
+
+# --------------------------------------------------------------------------- XML
+
+# Characters XML 1.0 cannot hold at all (not even as a character reference).
+_XML_INVALID = re.compile("[^\t\n\r\x20-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+_XML_TEXT = {"&": "&amp;", "<": "&lt;", ">": "&gt;"}
+_XML_ATTR = {**_XML_TEXT, '"': "&quot;", "'": "&apos;", "\t": "&#9;", "\n": "&#10;", "\r": "&#13;"}
+
+
+def _xml_valid(text: str) -> str:
+    return _XML_INVALID.sub("\ufffd", str(text))
+
+
+def xml_text(text: str) -> str:
+    """``text`` as XML character data: ``& < >`` escaped (so no ``]]>`` either) and the
+    characters XML 1.0 forbids (NUL, most C0 controls, lone surrogates, U+FFFE/U+FFFF)
+    replaced by U+FFFD."""
+    valid = _xml_valid(text)
+    return "".join(_XML_TEXT.get(ch, ch) for ch in valid).replace("\r", "&#13;")
+
+
+def xml_attr(text: str) -> str:
+    """``text`` as the value of an XML attribute in either quote: also ``" '`` escaped and
+    tab / newline / carriage return as character references (an attribute value's
+    whitespace would otherwise be normalised to spaces)."""
+    return "".join(_XML_ATTR.get(ch, ch) for ch in _xml_valid(text))
+
+
+def xml_comment(text: str) -> str:
+    """``text`` as the body of ``<!-- ... -->``: no ``--`` and no trailing ``-``."""
+    body = _xml_valid(text).replace("--", "- -").replace("--", "- -")
+    return body + " " if body.endswith("-") else body
+
+
+# --------------------------------------------------------------------------- identifiers
+
+# IEC 61131-3 (3rd edition) keywords, elementary types and standard function names
+_IEC = """
+ACTION END_ACTION ARRAY OF AT CASE ELSE END_CASE CONFIGURATION END_CONFIGURATION CONSTANT
+DO END_FOR END_IF END_REPEAT END_WHILE EN ENO EXIT FALSE FOR FROM FUNCTION END_FUNCTION
+FUNCTION_BLOCK END_FUNCTION_BLOCK IF ELSIF INITIAL_STEP END_STEP INTERVAL NON_RETAIN ON
+PRIORITY PROGRAM END_PROGRAM READ_ONLY READ_WRITE REPEAT RESOURCE END_RESOURCE RETAIN RETURN
+SINGLE STEP STRUCT END_STRUCT TASK THEN TO BY TRANSITION END_TRANSITION TRUE TYPE END_TYPE
+UNTIL VAR END_VAR VAR_ACCESS VAR_CONFIG VAR_EXTERNAL VAR_GLOBAL VAR_INPUT VAR_IN_OUT
+VAR_OUTPUT VAR_TEMP WHILE WITH AND OR XOR NOT MOD CLASS END_CLASS METHOD END_METHOD
+INTERFACE END_INTERFACE PROPERTY END_PROPERTY NAMESPACE END_NAMESPACE USING EXTENDS
+IMPLEMENTS THIS SUPER ABSTRACT FINAL OVERRIDE PUBLIC PRIVATE PROTECTED INTERNAL REF REF_TO
+NULL CONTINUE VAR_STAT
+BOOL BYTE WORD DWORD LWORD SINT INT DINT LINT USINT UINT UDINT ULINT REAL LREAL TIME LTIME
+DATE LDATE TIME_OF_DAY TOD LTOD DATE_AND_TIME DT LDT STRING WSTRING CHAR WCHAR ANY ANY_NUM
+ANY_REAL ANY_INT ANY_BIT ANY_DATE ANY_STRING ANY_ELEMENTARY ANY_MAGNITUDE ANY_DERIVED
+ABS SQRT LN LOG EXP SIN COS TAN ASIN ACOS ATAN ATAN2 EXPT MOVE ADD SUB MUL DIV GT GE EQ LE LT
+NE SEL MAX MIN LIMIT MUX SHL SHR ROR ROL LEN LEFT RIGHT MID CONCAT INSERT DELETE REPLACE FIND
+TRUNC ROUND CEIL FLOOR R_TRIG F_TRIG TON TOF TP CTU CTD CTUD SR RS
+"""
+# Beckhoff TwinCAT 3 / CODESYS additions
+_TWINCAT = """
+POINTER POINTER_TO REFERENCE REFERENCE_TO __NEW __DELETE __ISVALIDREF __QUERYINTERFACE
+__QUERYPOINTER __TRY __CATCH __FINALLY __ENDTRY JMP CAL CALC CALCN RET RETC RETCN LD LDN ST
+STN S R ADR ADRINST BITADR SIZEOF INDEXOF UNION END_UNION VAR_INST PERSISTENT XSIZE
+__SYSTEM PRAGMA QUERYINTERFACE UXINT XINT XWORD BIT
+"""
+# Siemens SCL (TIA Portal) additions
+_SCL = """
+BEGIN ORGANIZATION_BLOCK END_ORGANIZATION_BLOCK DATA_BLOCK END_DATA_BLOCK TITLE VERSION
+AUTHOR FAMILY NAME KNOW_HOW_PROTECT REGION END_REGION GOTO BLOCK_DB BLOCK_FB BLOCK_FC
+BLOCK_SDB BLOCK_SFB BLOCK_SFC COUNTER TIMER S5TIME VARIANT VOID DB FB FC OB SFB SFC UDT
+DINT_TO_REAL INT_TO_REAL REAL_TO_INT NORM_X SCALE_X OK
+"""
+
+RESERVED: frozenset[str] = frozenset((_IEC + _TWINCAT + _SCL).split())
+
+# C keywords and the library names the generated code uses
+C_KEYWORDS: frozenset[str] = frozenset(
+    [
+        "auto",
+        "break",
+        "case",
+        "char",
+        "const",
+        "continue",
+        "default",
+        "do",
+        "double",
+        "else",
+        "enum",
+        "extern",
+        "float",
+        "for",
+        "goto",
+        "if",
+        "inline",
+        "int",
+        "long",
+        "register",
+        "restrict",
+        "return",
+        "short",
+        "signed",
+        "sizeof",
+        "static",
+        "struct",
+        "switch",
+        "typedef",
+        "union",
+        "unsigned",
+        "void",
+        "volatile",
+        "while",
+        "_Bool",
+        "_Complex",
+        "_Imaginary",
+        "bool",
+        "true",
+        "false",
+        "NULL",
+        "NAN",
+        "INFINITY",
+        "main",
+        "exp",
+        "log",
+        "sqrt",
+        "pow",
+        "fabs",
+        "cos",
+        "sin",
+        "tan",
+        "size_t",
+    ]
+)
+
+
+_IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+_PY_KEYWORDS = frozenset(
+    [
+        "False",
+        "None",
+        "True",
+        "and",
+        "as",
+        "assert",
+        "async",
+        "await",
+        "break",
+        "class",
+        "continue",
+        "def",
+        "del",
+        "elif",
+        "else",
+        "except",
+        "finally",
+        "for",
+        "from",
+        "global",
+        "if",
+        "import",
+        "in",
+        "is",
+        "lambda",
+        "nonlocal",
+        "not",
+        "or",
+        "pass",
+        "raise",
+        "return",
+        "try",
+        "while",
+        "with",
+        "yield",
+        "match",
+        "case",
+        "type",
+        "_",
+    ]
+)
+# Object-like macros of <math.h> and <stddef.h>: a member of that name would be rewritten by
+# the preprocessor.
+_C_MACRO = re.compile(r"(M_|FP_|HUGE_VAL|MATH_ERR|math_errhandling|INFINITY$|NAN$|NULL$|offsetof$)")
+
+
+def st_ident(name: str, what: str) -> str:
+    """``name`` when it is an identifier of portable ST (IEC letters, digits and single inner
+    underscores, at most :data:`MAX_IDENT_ST` characters, no reserved word of IEC 61131-3,
+    TwinCAT or SCL); else :class:`CodegenError` naming ``what``."""
+    shown = _shown(name)
+    if not isinstance(name, str) or not _IDENT.match(name) or "__" in name or name.endswith("_"):
+        raise CodegenError(
+            f"{what} {shown} is not a portable IEC 61131-3 identifier "
+            "(letters, digits, single inner underscores)"
+        )
+    if len(name) > MAX_IDENT_ST:
+        raise CodegenError(f"{what} {shown} is longer than {MAX_IDENT_ST} characters (portable ST limit)")
+    if name.upper() in RESERVED:
+        raise CodegenError(f"{what} {shown} is a reserved word in IEC 61131-3, TwinCAT or SCL")
+    return name
+
+
+def c_ident(name: str, what: str) -> str:
+    """``name`` when it is a C identifier that cannot clash with the language, the C library
+    macros or the generated code's own names; else :class:`CodegenError` naming ``what``."""
+    shown = _shown(name)
+    if not isinstance(name, str) or not _IDENT.match(name):
+        raise CodegenError(f"{what} {shown} is not a C identifier")
+    if len(name) > MAX_IDENT_C:
+        raise CodegenError(f"{what} {shown} is longer than {MAX_IDENT_C} characters")
+    if name in C_KEYWORDS or _C_MACRO.match(name):
+        raise CodegenError(f"{what} {shown} is a C keyword or a name the generated code uses")
+    if name.startswith("__") or (name[0] == "_" and name[1:2].isupper()):
+        raise CodegenError(f"{what} {shown} is reserved to the C implementation")
+    return name
+
+
+def py_ident(name: str, what: str) -> str:
+    """``name`` when it is a plain ASCII Python identifier and no keyword; else
+    :class:`CodegenError`."""
+    if not isinstance(name, str) or not _IDENT.match(name) or name in _PY_KEYWORDS:
+        raise CodegenError(f"{what} {_shown(name)} is not a plain Python identifier")
+    return name
+
+
+def _shown(name: object) -> str:
+    """A name quoted for an error message: ``repr``, cut, so a hostile name cannot flood a
+    terminal or hide control characters in it."""
+    text = repr(name)
+    return text if len(text) <= 60 else text[:57] + "..."

@@ -1,0 +1,340 @@
+"""Closed-form derivatives of a system's outputs with respect to its parameters.
+
+On each piece of the engine's piecewise-linear structure (each sample inside one linear
+segment of every term it reads, the same operand minimal in every MIN, the same rule
+maximal in every MAX accumulation) the output of a system with
+
+* input terms given by points, triangles, trapezoids (linear pieces) or Gaussians,
+* conditions that are ANDs (MIN or PROD) of ``variable IS term``,
+* singleton outputs under CoGS (accumulation MAX, SUM or BSUM), or Takagi-Sugeno outputs
+  (constant, linear or singleton terms) under WTAVER / WTSUM,
+
+is a rational function of the parameters, and its gradient follows by the chain rule:
+
+    CoGS / WTAVER: y = sum(mu_t z_t) / sum(mu_t),   dy/dmu_t = (z_t - y) / sum(mu),
+                   dy/dz_t = mu_t / sum(mu)
+    linear piece:  mu = y_k + (y_k+1 - y_k) (x - x_k) / (x_k+1 - x_k),
+                   dmu/dx_k = (y_k+1 - y_k) (x - x_k+1) / (x_k+1 - x_k)^2,
+                   dmu/dx_k+1 = -(y_k+1 - y_k) (x - x_k) / (x_k+1 - x_k)^2
+    MIN / MAX: the derivative of the operand that is selected; PROD: the product rule.
+
+Where it does not hold (:func:`unsupported` says why): on the boundaries between pieces
+(a sample exactly on a breakpoint, ties in MIN/MAX: a set of measure zero, where the
+one-sided derivative is used), for Mamdani outputs defuzzified by area (COG/COA of clipped
+sets: piecewise rational in the breakpoints, not implemented here), for OR, NOT, hedges,
+chained rule blocks, other norms, fuzzylite's rule activation methods and firing
+threshold, and for other shapes.  There the tuner falls back to finite differences of the
+engine's outputs.  Samples where no rule fires take the DEFAULT value (derivative 0).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
+from fuzzyctl.engine.shapes import pwl_value_np
+from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
+
+Arr = npt.NDArray[np.float64]
+PSlot = tuple[str, int, int, int] | tuple[str, int, int] | tuple[str, int]
+Grad = dict[PSlot, Arr]
+
+_PIECE_KINDS = {"points": None, "triangle": (0, 1, 2), "trapezoid": (0, 1, 2, 3)}
+
+
+def _term_unsupported(t: TermPlan) -> str | None:
+    if not t.constant:
+        return f"term {t.name}: parameters given by variables"
+    if t.kind in _PIECE_KINDS:
+        if t.pwl is None or not all(np.isfinite(x) for x, _ in t.pwl):
+            return f"term {t.name}: infinite vertices"
+        return None
+    if t.kind == "gaussian":
+        return None
+    return f"term {t.name}: shape {t.kind}"
+
+
+def _cond_unsupported(c: CondPlan) -> str | None:
+    if isinstance(c, CTrue):
+        return None
+    if isinstance(c, CTerm):
+        return "hedges or IS NOT in a condition" if c.hedges or c.negated else None
+    if isinstance(c, CAnd):
+        if c.op not in ("MIN", "PROD"):
+            return f"AND {c.op}"
+        for o in c.operands:
+            why = _cond_unsupported(o)
+            if why:
+                return why
+        return None
+    return f"condition {type(c).__name__[1:].upper()}"
+
+
+def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
+    """Why the closed form does not apply to ``outputs`` of ``plan`` (``None``: it does)."""
+    if plan.chained:
+        return "chained rule blocks (local variables)"
+    if plan.selections:
+        return "rule activation methods (fuzzylite)"
+    if plan.options.firing_threshold > 0.0:
+        return "a firing threshold"
+    for fi in plan.fuzzy_inputs:
+        for t in fi.terms:
+            why = _term_unsupported(t)
+            if why:
+                return f"{fi.name}: {why}"
+    for r in plan.rules:
+        why = _cond_unsupported(r.condition)
+        if why:
+            return f"rule {r.label}: {why}"
+        if not isinstance(r.weight, float | int):
+            return f"rule {r.label}: weight given by a variable"
+        for cp in r.conclusions:
+            if cp.hedges or not isinstance(cp.weight, float | int):
+                return f"rule {r.label}: hedged conclusion or WITH given by a variable"
+    for name in outputs:
+        op = next((o for o in plan.outputs if o.name == name), None)
+        if op is None:
+            return f"no output {name}"
+        if op.kind == "singleton":
+            if op.method != "COGS" or (op.accu or "MAX") not in ("MAX", "SUM", "BSUM"):
+                return f"{name}: {op.method} with ACCU {op.accu}"
+            if any(t.kind != "singleton" or not t.constant for t in op.terms):
+                return f"{name}: SINGLETONS terms"
+        elif op.kind == "ts":
+            if op.method not in ("WTAVER", "WTSUM") or (op.accu or "MAX") not in ("MAX", "SUM"):
+                return f"{name}: {op.method} with ACCU {op.accu}"
+            if any(t.kind not in ("constant", "linear", "singleton") or not t.constant for t in op.terms):
+                return f"{name}: function or Tsukamoto terms"
+        else:
+            return f"{name}: {op.kind} output (area defuzzification is piecewise rational: not implemented)"
+    return None
+
+
+def _add(g: Grad, key: PSlot, v: Arr) -> None:
+    g[key] = g[key] + v if key in g else v
+
+
+def _scale(g: Grad, s: Arr | float) -> Grad:
+    return {k: v * s for k, v in g.items()}
+
+
+def _term_degree(var: int, ti: int, t: TermPlan, x: Arr) -> tuple[Arr, Grad]:
+    grad: Grad = {}
+    if t.kind == "gaussian":
+        m, s = float(t.params[0]), float(t.params[1])  # type: ignore[arg-type]
+        h = float(t.height)  # type: ignore[arg-type]
+        d = x - m
+        mu = h * np.exp(-(d * d) / (2.0 * s * s))
+        grad[("in", var, ti, 0)] = mu * d / (s * s)
+        grad[("in", var, ti, 1)] = mu * d * d / (s * s * s)
+        return mu, grad
+    assert t.pwl is not None
+    mu = pwl_value_np(t.pwl, x)
+    h = float(t.height)  # type: ignore[arg-type]
+    p = [float(v) for v in t.params]  # type: ignore[arg-type]
+    if t.kind == "points":
+        xs, ys, idx = p[0::2], [y * h for y in p[1::2]], list(range(0, len(p), 2))
+    else:
+        idx = list(_PIECE_KINDS[t.kind] or ())
+        xs = [p[i] for i in idx]
+        ys = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
+    for k in range(len(xs) - 1):
+        x0, x1 = xs[k], xs[k + 1]
+        if not x0 < x1:
+            continue
+        dy = ys[k + 1] - ys[k]
+        if dy == 0.0:
+            continue
+        inside = (x0 < x) & (x < x1)
+        span2 = (x1 - x0) ** 2
+        _add(grad, ("in", var, ti, idx[k]), np.where(inside, dy * (x - x1) / span2, 0.0))
+        _add(grad, ("in", var, ti, idx[k + 1]), np.where(inside, -dy * (x - x0) / span2, 0.0))
+    return mu, grad
+
+
+def _condition(c: CondPlan, degrees: dict[tuple[int, int], tuple[Arr, Grad]], n: int) -> tuple[Arr, Grad]:
+    if isinstance(c, CTrue):
+        return np.ones(n), {}
+    if isinstance(c, CTerm):
+        return degrees[(c.var, c.term)]
+    assert isinstance(c, CAnd)
+    parts = [_condition(o, degrees, n) for o in c.operands]
+    vals = np.stack([np.broadcast_to(v, (n,)) for v, _ in parts])
+    grad: Grad = {}
+    if c.op == "MIN":
+        pick = np.argmin(vals, axis=0)
+        for k, (_v, g) in enumerate(parts):
+            sel = pick == k
+            for key, d in g.items():
+                _add(grad, key, np.where(sel, d, 0.0))
+        return vals.min(axis=0), grad
+    total = np.prod(vals, axis=0)
+    for k, (_v, g) in enumerate(parts):
+        others = np.prod(np.delete(vals, k, axis=0), axis=0) if len(parts) > 1 else np.ones(n)
+        for key, d in g.items():
+            _add(grad, key, d * others)
+    return total, grad
+
+
+def forward(plan: Plan, vals: Sequence[Arr], outputs: Sequence[str]) -> dict[str, tuple[Arr, Grad]]:
+    """Values (NaN where no rule fires) and gradients of ``outputs`` at the samples ``vals``
+    (one array per input of ``plan``, in its order), for a plan :func:`unsupported` accepts.
+
+    Gradient keys: ``("in", fuzzy input, term, parameter)``, ``("out", output, term,
+    parameter)``, ``("rule", rule)`` (rule weight), ``("with", rule, conclusion)``."""
+    n = len(vals[0]) if vals else 0
+    vals = [
+        np.asarray(v, dtype=np.float64) if i.clamp is None else np.clip(v, *i.clamp)
+        for i, v in zip(plan.inputs, vals, strict=True)
+    ]
+    degrees: dict[tuple[int, int], tuple[Arr, Grad]] = {}
+    for var, fi in enumerate(plan.fuzzy_inputs):
+        for ti, t in enumerate(fi.terms):
+            degrees[(var, ti)] = _term_degree(var, ti, t, vals[fi.slot])
+    fired_rules: list[tuple[Arr, Grad]] = []
+    for ri, r in enumerate(plan.rules):
+        a, g = _condition(r.condition, degrees, n)
+        w = float(r.weight)  # type: ignore[arg-type]
+        g = _scale(g, w)
+        g[("rule", ri)] = np.asarray(a, dtype=np.float64)
+        fired_rules.append((a * w, g))
+    result: dict[str, tuple[Arr, Grad]] = {}
+    for oi, op in enumerate(plan.outputs):
+        if op.name in outputs:
+            result[op.name] = _output(oi, op, plan, fired_rules, vals, n)
+    return result
+
+
+def _contributions(op: OutputPlan, fired: list[tuple[Arr, Grad]]) -> list[tuple[int, Arr, Grad]]:
+    out = []
+    for c in op.contributions:
+        a, g = fired[c.rule]
+        w = float(c.weight)  # type: ignore[arg-type]
+        gg = _scale(g, w)
+        gg[("with", c.rule, c.conclusion)] = a
+        assert c.term is not None
+        out.append((c.term, a * w, gg))
+    return out
+
+
+def _accumulate(accu: str, items: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, Grad]:
+    vals = np.stack([np.broadcast_to(v, (n,)) for v, _ in items])
+    grad: Grad = {}
+    if accu == "MAX":
+        pick = np.argmax(vals, axis=0)
+        for k, (_v, g) in enumerate(items):
+            for key, d in g.items():
+                _add(grad, key, np.where(pick == k, d, 0.0))
+        return vals.max(axis=0), grad
+    total = vals.sum(axis=0)
+    for _v, g in items:
+        for key, d in g.items():
+            _add(grad, key, d)
+    if accu == "BSUM":
+        # min(1, s): at s == 1 exactly (a degree-1 plateau under weight 1, common) the
+        # left derivative, the one in the direction weights can move from 1
+        grad = {k: np.where(total <= 1.0, d, 0.0) for k, d in grad.items()}
+        total = np.minimum(total, 1.0)
+    return total, grad
+
+
+def _output(
+    oi: int, op: OutputPlan, plan: Plan, fired: list[tuple[Arr, Grad]], vals: Sequence[Arr], n: int
+) -> tuple[Arr, Grad]:
+    contribs = _contributions(op, fired)
+    per_term: dict[int, list[tuple[Arr, Grad]]] = {}
+    for t, v, g in contribs:
+        per_term.setdefault(t, []).append((v, g))
+    items: list[tuple[int, Arr, Grad]]
+    if op.kind == "ts" and op.accu is None:
+        items = [(t, v, g) for t, v, g in contribs]
+    else:
+        accu = op.accu or "MAX"
+        items = [(t, *_accumulate(accu, lst, n)) for t, lst in sorted(per_term.items())]
+    m = len(plan.inputs)
+    zs: dict[int, tuple[Arr, Grad]] = {}
+    for t, _v, _g in items:
+        if t in zs:
+            continue
+        term = op.terms[t]
+        params = [float(p) for p in term.params]  # type: ignore[arg-type]
+        zg: Grad = {}
+        if term.kind == "linear":
+            z = np.zeros(n)
+            for i, c in enumerate(params[:m]):
+                z = z + c * vals[i]
+                zg[("out", oi, t, i)] = vals[i]
+            if len(params) > m:
+                z = z + params[m]
+                zg[("out", oi, t, m)] = np.ones(n)
+        else:
+            z = np.full(n, params[0])
+            zg[("out", oi, t, 0)] = np.ones(n)
+        zs[t] = (z, zg)
+    total = np.zeros(n)
+    num = np.zeros(n)
+    for t, v, _g in items:
+        total = total + v
+        num = num + v * zs[t][0]
+    fired_rows = total > 0.0
+    safe = np.where(fired_rows, total, 1.0)
+    average = op.method != "WTSUM"
+    y = num / safe if average else num
+    grad: Grad = {}
+    for t, v, g in items:
+        z, zg = zs[t]
+        dy_dv = (z - y) / safe if average else z
+        for key, d in g.items():
+            _add(grad, key, dy_dv * d)
+        dy_dz = v / safe if average else v
+        for key, d in zg.items():
+            _add(grad, key, dy_dz * d)
+    grad = {k: np.where(fired_rows, d, 0.0) for k, d in grad.items()}
+    y = np.where(fired_rows, y, np.nan)
+    if op.clamp is not None:
+        lo, hi = op.clamp
+        inside = (y >= lo) & (y <= hi)
+        grad = {k: np.where(inside, d, 0.0) for k, d in grad.items()}
+        y = np.where(np.isnan(y), y, np.clip(y, lo, hi))
+    return y, grad
+
+
+def slot_map(fb: FunctionBlock, plan: Plan) -> dict[tuple[object, ...], PSlot] | None:
+    """Model parameter keys (see :mod:`fuzzyctl.tune.space`) -> gradient keys of
+    :func:`forward`; ``None`` when the plan's rules do not line up with the model's."""
+    out: dict[tuple[object, ...], PSlot] = {}
+    sides: dict[str, tuple[str, int, list[str]]] = {}
+    for k, fi in enumerate(plan.fuzzy_inputs):
+        sides[fi.name] = ("in", k, [t.name for t in fi.terms])
+    for k, op in enumerate(plan.outputs):
+        sides.setdefault(op.name, ("out", k, [t.name for t in op.terms]))
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in blocks:
+        if blk.variable not in sides:
+            continue
+        side, k, names = sides[blk.variable]
+        first: dict[str, int] = {}
+        for ti, t in enumerate(blk.terms):
+            first.setdefault(t.name, ti)
+            if first[t.name] != ti or t.name not in names:
+                continue  # a duplicate term name: the engine uses the first
+            j = names.index(t.name)
+            npar = len(getattr(t.mf, "params", ())) or 2 * len(getattr(t.mf, "points", ())) or 1
+            for p in range(npar):
+                out[("term", blk.variable, ti, p)] = (side, k, j, p)
+    ri = 0
+    for bi, rb in enumerate(fb.rule_blocks):
+        if not rb.enabled:
+            continue
+        for r_idx, rule in enumerate(rb.rules):
+            if ri >= len(plan.rules) or plan.rules[ri].label != rule.label:
+                return None
+            out[("rule", bi, r_idx)] = ("rule", ri)
+            for ci in range(len(rule.conclusions)):
+                out[("with", bi, r_idx, ci)] = ("with", ri, ci)
+            ri += 1
+    return out if ri == len(plan.rules) else None
