@@ -87,6 +87,7 @@ def compare_corpus(files: list[Path]) -> tuple[Stats, list[str], list[str]]:
             o.name: max(1.0, o.high - o.low) if o.low is not None and o.high is not None else 1.0
             for o in ctl.plan.outputs
         }
+        method = {o.name: o.method for o in ctl.plan.outputs}
         for k, out in enumerate(answer.outputs):
             for i, row in enumerate(answer.rows):
                 want, mine = row[k], float(got[out][i])
@@ -96,7 +97,7 @@ def compare_corpus(files: list[Path]) -> tuple[Stats, list[str], list[str]]:
                     err = 0.0 if math.isnan(want) and math.isnan(mine) else math.inf
                 else:
                     err = abs(mine - want) / scale[out]
-                st.add(err, f"{name} {out} row {i} ours {mine!r} jfl {want!r}")
+                st.add(err, f"{name} {out} row {i} ours {mine!r} jfl {want!r}", method[out])
     refused_but_clean = [
         f.name for f, a in zip(ours_refuse, answers[len(ctls) :], strict=True) if a.clean
     ]

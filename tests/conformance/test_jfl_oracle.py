@@ -172,7 +172,10 @@ def test_fresh_random_systems_agree(seed: int) -> None:
     systems = jfl_agreement.systems(1, seed)
     stats = jfl_agreement.compare(systems)
     for family, s in stats.items():
-        assert s.within_1e9 == s.samples, (family, seed, s.failures)
+        # beyond 1e-9 only one-step ties of MM/LM/RM/COA (a 1-ulp libm difference deciding
+        # which samples reach the maximum; docs/engine.md), and rarely
+        assert s.unexplained == 0, (family, seed, s.failures)
+        assert s.ties <= 0.02 * s.samples, (family, seed, s.ties)
 
 
 # ------------------------------------------------------------------ the corpus
