@@ -69,7 +69,7 @@ def compare_corpus(files: list[Path]) -> tuple[Stats, list[str], list[str]]:
         jobs.append(Job(f, [{k: v for k, v in r.items() if k in known} for r in rows], outs))
         ctls.append((ctl, rows))
         names.append(f.name)
-    answers = jfl_oracle.run(jobs + [Job(f) for f in ours_refuse])
+    answers = jfl_oracle.run(jobs + [Job(f) for f in ours_refuse], cache=True)
     cannot: list[str] = []
     st = Stats()
     for (ctl, rows), answer, name in zip(ctls, answers, names, strict=False):

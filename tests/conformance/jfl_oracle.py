@@ -4,7 +4,10 @@ One JVM runs many (model, rows) jobs: ``tests/conformance/jfl/JflBatch.java`` do
 job what the oracle's own driver (``jfl MODEL INPUTS``) does - it calls that driver's loader -
 and is compiled once into ``~/.cache/fuzzyctl-tests/jfl/<hash>`` (keyed by its source and the
 oracle jar).  Without ``javac`` each job runs through ``jfl`` itself (slower, same answers).
-Nothing about the answers is cached: every call asks jFuzzyLogic.
+``run(jobs, cache=True)`` (the fixed sets: the corpus, the seed-0 systems) keeps each job's
+answer under ``~/.cache/fuzzyctl-tests/jfl/answers/``, keyed by the job (model text, rows,
+outputs), JflBatch.java and the oracle jar: jFuzzyLogic is deterministic, so a cached answer
+is the answer it gave to that very question.  Fresh random systems always ask it live.
 """
 
 from __future__ import annotations
@@ -78,8 +81,37 @@ def _jars() -> str:
     return os.pathsep.join(str(TOOLS / j) for j in JARS)
 
 
-def run(jobs: list[Job]) -> list[Answer]:
-    """Ask jFuzzyLogic; one answer per job, in order."""
+def run(jobs: list[Job], cache: bool = False) -> list[Answer]:
+    """Ask jFuzzyLogic; one answer per job, in order (``cache``: see the module's doc)."""
+    if not cache:
+        return [_parse(body) for body in _ask(jobs)]
+    keys = [_key(job) for job in jobs]
+    bodies: list[str | None] = [
+        (CACHE / "answers" / k).read_text(encoding="utf-8") if (CACHE / "answers" / k).exists() else None
+        for k in keys
+    ]
+    missing = [i for i, b in enumerate(bodies) if b is None]
+    if missing:
+        (CACHE / "answers").mkdir(parents=True, exist_ok=True)
+        for i, body in zip(missing, _ask([jobs[i] for i in missing]), strict=True):
+            bodies[i] = body
+            tmp = CACHE / "answers" / f"{keys[i]}.{os.getpid()}"
+            tmp.write_text(body, encoding="utf-8")
+            os.replace(tmp, CACHE / "answers" / keys[i])  # atomic: parallel workers
+    return [_parse(b) for b in bodies if b is not None]
+
+
+def _key(job: Job) -> str:
+    jar = TOOLS / JARS[0]
+    model = job.fcl.read_bytes() if isinstance(job.fcl, Path) else job.fcl.encode()
+    h = hashlib.sha1((HERE / "JflBatch.java").read_bytes())
+    h.update(f"{jar.stat().st_size}:{jar.stat().st_mtime_ns}\0".encode())
+    h.update(model + b"\0" + _csv(job).encode() + b"\0" + ",".join(job.outputs or ["-"]).encode())
+    return h.hexdigest()
+
+
+def _ask(jobs: list[Job]) -> list[str]:
+    """jFuzzyLogic's raw answer to each job."""
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-jfl-") as tmp:
         d = Path(tmp)
         lines = []
@@ -110,7 +142,7 @@ def run(jobs: list[Job]) -> list[Answer]:
                 body = "\n".join(ln for ln in res.stdout.splitlines() if not ln.startswith("# fb="))
                 chunks.append(f"{i}\n{body}")
     assert len(chunks) == len(jobs), got if cp is not None else chunks
-    return [_parse(c.partition("\n")[2]) for c in chunks]
+    return [c.partition("\n")[2] for c in chunks]
 
 
 def _csv(job: Job) -> str:

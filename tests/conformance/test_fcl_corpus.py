@@ -73,7 +73,7 @@ def test_no_engine_runs_the_rejected_files() -> None:
     it refuses to load them or throws at every evaluation (as rejected.tsv says)."""
     names = sorted(_rejected())
     answers = jfl_oracle.run(
-        [Job(shared_path("corpus", "fcl", n), all_inputs=0.0) for n in names]
+        [Job(shared_path("corpus", "fcl", n), all_inputs=0.0) for n in names], cache=True
     )
     for name, answer in zip(names, answers, strict=True):
         ran = answer.load_error is None and any(
@@ -93,7 +93,7 @@ def test_jfuzzylogic_profile_warns_exactly_where_jfuzzylogic_refuses(corpus: dic
     loaded = {
         shared_path("corpus", "fcl", name): d for name, d in checks.items() if not any(x.is_error for x in d)
     }
-    answers = jfl_oracle.run([Job(f) for f in loaded])
+    answers = jfl_oracle.run([Job(f) for f in loaded], cache=True)
     missed, false = [], []
     for (f, diags), answer in zip(loaded.items(), answers, strict=True):
         warned = [d for d in diags if d.code == "jfl-rejects"]

@@ -42,7 +42,7 @@ PER_FAMILY = 3  # the fixed set: 3 systems of ~50 rows per behaviour, one JVM
 @pytest.fixture(scope="module")
 def fixed() -> tuple[list[System], list[Answer]]:
     systems = jfl_agreement.systems(PER_FAMILY, seed=0)
-    return systems, jfl_oracle.run([Job(s.text, s.rows, s.outputs) for s in systems])
+    return systems, jfl_oracle.run([Job(s.text, s.rows, s.outputs) for s in systems], cache=True)
 
 
 def _agreement(systems: list[System], answers: list[Answer]) -> dict[str, Stats]:
@@ -191,7 +191,8 @@ def test_corpus_files_both_run_agree() -> None:
     assert stats.systems >= 150 and stats.samples >= 3000
     assert stats.within_1e9 == stats.samples, stats.failures
     files = [f for f in jfl_corpus.corpus_files() if f.name in refused]
-    for f, answer in zip(files, jfl_oracle.run([Job(f, all_inputs=1.0) for f in files]), strict=True):
+    answers = jfl_oracle.run([Job(f, all_inputs=1.0) for f in files], cache=True)
+    for f, answer in zip(files, answers, strict=True):
         cells = [v for row in answer.rows for v in row]
         assert cells and all(isinstance(v, str) for v in cells), (f.name, answer)
     # and `check --compat jfuzzylogic` says why jFuzzyLogic cannot run the others

@@ -120,3 +120,43 @@ def test_explain_shows_the_sampled_set() -> None:
     assert len(out.breakpoints) == 1000 and out.breakpoints[0][0] == 0.0
     assert max(v for _x, v in out.breakpoints) == 0.5  # clipped at the rule's degree
     assert out.value == ctl.evaluate({"a": 0.5, "b": 0.0, "c": 0.0})["y"]
+
+
+def test_with_scales_every_conclusion_of_the_rule() -> None:
+    # RULE 1 concludes twice; WITH 0.5 scales both in jFuzzyLogic, only the one it follows
+    # in IEC (5.4.3: the weighting factor belongs to the conclusion)
+    text = HEAD.replace("VAR_OUTPUT y : REAL; END_VAR", "VAR_OUTPUT y : REAL; z : REAL; END_VAR")
+    text += "DEFUZZIFY z TERM one := 1; TERM zero := 0; METHOD : COGS; DEFAULT := -1; END_DEFUZZIFY\n"
+    text += (
+        "RULEBLOCK r\nACCU : MAX;\nRULE 1 : IF a IS t THEN y IS one WITH 0.5, z IS one;\n"
+        "RULE 2 : IF b IS t THEN y IS zero, z IS zero;\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+    )
+    inputs = {"a": 0.8, "b": 0.4, "c": 0.0}
+    jfl = fuzzyctl.compile(fuzzyctl.load(text), compat="jfuzzylogic").evaluate(inputs)
+    iec = fuzzyctl.compile(fuzzyctl.load(text)).evaluate(inputs)
+    assert jfl["y"] == pytest.approx(0.4 / 0.8) and jfl["z"] == pytest.approx(0.4 / 0.8)
+    assert iec["y"] == pytest.approx(0.4 / 0.8) and iec["z"] == pytest.approx(0.8 / 1.2)
+
+
+def test_a_range_on_the_var_line_is_ignored() -> None:
+    # y's terms span 0..2; RANGE (0 .. 10) on the VAR line would move the 1000 samples
+    text = HEAD.replace("y : REAL;", "y : REAL; RANGE := (0 .. 10);").replace(
+        "TERM one := 1; TERM zero := 0; METHOD : COGS;", "TERM up := (0, 0) (2, 1); METHOD : COG;"
+    )
+    text += "RULEBLOCK r\nRULE 1 : IF a IS t THEN y IS up;\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+    got = fuzzyctl.compile(fuzzyctl.load(text), compat="jfuzzylogic").evaluate({"a": 1.0, "b": 0, "c": 0})
+    xs = np.cumsum(np.r_[0.0, np.full(999, 0.002)])  # min 0, step (2 - 0) / 1000, as jFuzzyLogic
+    mu = xs / 2
+    assert got["y"] == pytest.approx(float((xs * mu).sum() / mu.sum()), abs=1e-12)
+
+
+def test_a_vertical_edge_takes_the_value_reached_from_the_left() -> None:
+    rising = "TERM t := (0, 0.25) (1, 0.25) (1, 1) (2, 0); END_FUZZIFY\nFUZZIFY b"
+    text = HEAD.replace("TERM t := (0, 0) (1, 1); END_FUZZIFY\nFUZZIFY b", rising, 1)
+    text += "RULEBLOCK r\nRULE 1 : IF a IS t THEN y IS one;\nRULE 2 : IF b IS t THEN y IS zero;\n"
+    text += "END_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+    inputs = {"a": 1.0, "b": 0.5, "c": 0.0}
+    jfl = fuzzyctl.compile(fuzzyctl.load(text), compat="jfuzzylogic").evaluate(inputs)["y"]
+    iec = fuzzyctl.compile(fuzzyctl.load(text)).evaluate(inputs)["y"]
+    assert jfl == pytest.approx(0.25 / 0.75)  # a IS t = 0.25, reached from the left
+    assert iec == pytest.approx(1.0 / 1.5)  # IEC: the upper value (docs/engine.md)
