@@ -21,12 +21,13 @@ import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from tests import diskcache
 from tests.extras import extra_path
 
 HERE = Path(__file__).resolve().parent / "jfl"
 TOOLS = extra_path("jfl_oracle", "tools", "jfuzzylogic")
 JARS = ("jfuzzylogic-3.3-oracle.jar", "antlrworks-1.2.jar")
-CACHE = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "fuzzyctl-tests" / "jfl"
+CACHE = diskcache.CACHE / "jfl"  # $FUZZYCTL_TEST_CACHE or ~/.cache/fuzzyctl-tests
 
 
 @dataclass

@@ -100,3 +100,10 @@ def test_what_jfuzzylogic_would_reject(old: str, new: str, code: str, words: str
 
 def test_a_file_jfuzzylogic_reads_gets_no_jfl_warning() -> None:
     assert not [c for c in _codes(BASE, compat="jfuzzylogic") if c[0].startswith("jfl-")]
+
+
+def test_text_after_the_last_function_block_is_not_lexed() -> None:
+    # jFuzzyLogic stops there: a file name pasted after it (corpus: "configuration1.txt")
+    # loads cleanly in the live jFuzzyLogic
+    text = BASE + "\nconfiguration1.txt\n"
+    assert not [c for c in _codes(text, compat="jfuzzylogic") if c[0] == "jfl-rejects"]

@@ -110,7 +110,12 @@ def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> li
             s = lookup(spelling)
             if spelling not in ("SINGLETONS", "FUNCTION") and (s is None or s.dialect != JFL):
                 found.add("jfl-rejects", f"its grammar has no shape {spelling}", None)
-    for m in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d|\d\.(?![\d.])", _code(text)):
+    code = _code(text)
+    # its parser stops at the last END_FUNCTION_BLOCK: what trails it (a file name pasted
+    # after it, in the corpus) is never lexed
+    ends = [m.end() for m in re.finditer(r"(?i)\bEND_FUNCTION_BLOCK\b", code)]
+    lexed = code[: ends[-1]] if ends else code
+    for m in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d|\d\.(?![\d.])", lexed):
         line = text.count("\n", 0, m.start()) + 1
         found.add("jfl-rejects", "its lexer reads a number only with digits before '.' and '..' "
                   "between spaces", Span(line, 1))  # fmt: skip
