@@ -74,3 +74,28 @@ def test_explain_json(capsys: pytest.CaptureFixture[str]) -> None:
     rule2 = next(r for r in e["rules"] if r["label"] == "2")
     assert rule2["degree"] == pytest.approx(0.75)
     assert rule2["conclusions"][0]["weight"] == 0.8
+
+
+NO_RULE_FIRES = """FUNCTION_BLOCK t
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM low := (0, 1) (5, 0); RANGE := (0 .. 10); END_FUZZIFY
+DEFUZZIFY y TERM a := (0, 0) (5, 1) (10, 0); METHOD : COG; DEFAULT := NAN; RANGE := (0 .. 10);
+END_DEFUZZIFY
+RULEBLOCK r AND : MIN; ACCU : MAX; RULE 1 : IF x IS low THEN y IS a; END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("form", [[], ["--json"]])
+def test_eval_without_a_value_exits_1_and_says_why(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], form: list[str]
+) -> None:
+    """Issue 14.6: NaN is never printed as a result with exit 0."""
+    src = tmp_path / "nan.fcl"
+    src.write_text(NO_RULE_FIRES)
+    assert main(["eval", str(src), "--set", "x=8", *form]) == 1
+    err = capsys.readouterr().err
+    assert "output 'y' has no value" in err and "DEFAULT is NaN" in err
+    assert main(["eval", str(src), "--set", "x=2", *form]) == 0  # the rule fires: y = 5
+    assert "5" in capsys.readouterr().out

@@ -60,6 +60,34 @@ Temp = {{ connection = "mb", address = 0 }}
     assert (tmp_path / "state" / "events.jsonl").read_text().count("\n") == len(kinds)
 
 
+def test_serve_check_warns_when_the_cycles_exceed_the_measured_capacity(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """40 FPLTEST instances at 1 ms need several times what the runtime was measured to
+    hold (docs/runtime.md, Timing); one at 100 ms needs next to nothing."""
+    from fuzzyctl.runtime.capacity import CAPACITY
+
+    fcl = EXAMPLES / "siemens_fpltest.fcl"
+
+    def config(n: int, period: float, priority: int) -> Path:
+        text = f"[runtime]\nrealtime_priority = {priority}\n" + "".join(
+            f'[instances.fb{i}]\nknowledge_base = "{fcl}"\nperiod = {period}\n' for i in range(n)
+        )
+        path = tmp_path / f"c{n}_{priority}.toml"
+        path.write_text(text)
+        return path
+
+    code, out, err = run(["serve", str(config(40, 0.001, 50)), "--check"], capsys)
+    load = float(out.split("need about ")[1].split("%")[0]) / 100
+    assert code == 0 and load > CAPACITY
+    assert "warning: the cycles need about" in err and "expect more jitter and overruns" in err
+    assert "realtime_priority is 0" not in err
+    code, out, err = run(["serve", str(config(5, 0.001, 0)), "--check"], capsys)
+    assert "realtime_priority is 0" in err
+    code, out, err = run(["serve", str(config(1, 0.1, 50)), "--check"], capsys)
+    assert code == 0 and "OK: 1 instance(s)" in out and not err
+
+
 def test_serve_check_reports_every_problem_of_the_file_in_one_pass(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

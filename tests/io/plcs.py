@@ -64,7 +64,8 @@ class ModbusPLC:
             await self._server.serve_forever(background=True)
             return int(self._server.transport.sockets[0].getsockname()[1])
 
-        self.port = self._lt.run(go())
+        # Building a server (asyncua: its whole standard address space) is slow on a loaded machine.
+        self.port = self._lt.run(go(), timeout=60.0)
 
     def stop(self) -> None:
         if self._server is not None:
@@ -168,7 +169,8 @@ class OpcUaPLC:
             self._server = server
             return int(server.bserver._server.sockets[0].getsockname()[1])
 
-        self.port = self._lt.run(go())
+        # Building a server (asyncua: its whole standard address space) is slow on a loaded machine.
+        self.port = self._lt.run(go(), timeout=60.0)
 
     def stop(self) -> None:
         if self._server is not None:
@@ -191,3 +193,54 @@ class OpcUaPLC:
     def get(self, name: str) -> float:
         v = self._lt.run(self.nodes[name].read_value())
         return float(v) if v is not None else math.nan
+
+
+class FreezableProxy:
+    """A TCP proxy on loopback in front of a PLC stand-in.  ``freeze()`` stops forwarding
+    in both directions while keeping every connection open: to the runtime, the peer is
+    alive but answers nothing (a hung PLC, a switch that drops traffic)."""
+
+    def __init__(self, target_port: int) -> None:
+        self._lt = _LoopThread()
+        self.target_port = target_port
+        self._flowing: asyncio.Event | None = None
+        self.port = self._lt.run(self._start())
+
+    async def _start(self) -> int:
+        self._flowing = asyncio.Event()
+        self._flowing.set()
+        self._server = await asyncio.start_server(self._client, "127.0.0.1", 0)
+        return int(self._server.sockets[0].getsockname()[1])
+
+    async def _pump(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        assert self._flowing is not None
+        try:
+            while data := await reader.read(65536):
+                await self._flowing.wait()
+                writer.write(data)
+                await writer.drain()
+        except (ConnectionError, OSError):
+            pass
+        finally:
+            writer.close()
+
+    async def _client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        try:
+            up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target_port)
+        except OSError:
+            writer.close()
+            return
+        await asyncio.gather(self._pump(reader, up_writer), self._pump(up_reader, writer))
+
+    def freeze(self) -> None:
+        assert self._flowing is not None
+        self._lt.loop.call_soon_threadsafe(self._flowing.clear)
+
+    def thaw(self) -> None:
+        assert self._flowing is not None
+        self._lt.loop.call_soon_threadsafe(self._flowing.set)
+
+    def close(self) -> None:
+        self.thaw()
+        self._server.close()
+        self._lt.close()

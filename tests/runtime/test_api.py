@@ -4,25 +4,23 @@ reach the block, online download, the live stream, and the 127.0.0.1 binding wit
 
 from __future__ import annotations
 
-import json
-import os
-import stat
 from collections.abc import Iterator
 from pathlib import Path
 
-import httpx
+import numpy as np
 import pytest
 from fastapi.testclient import TestClient
 from starlette.websockets import WebSocketDisconnect
 
-from fuzzyctl.diagnostics import FuzzyctlError
-from fuzzyctl.runtime.api import create_app
+from fuzzyctl.runtime.api import ApiSettings, LocalBackend, create_app
 from fuzzyctl.runtime.core import Runtime
+from fuzzyctl.runtime.service import Service
 from tests.conftest import EXAMPLES
 from tests.io.plcs import wait_until
 from tests.runtime.helpers import FPLTEST_FCL, make_runtime
 
 TOKEN = "test-token-0123456789abcdef"
+READ_TOKEN = "read-token-0123456789abcdef"
 CONFIG = f"""
 [instances.valve]
 knowledge_base = "{FPLTEST_FCL}"
@@ -49,15 +47,18 @@ def runtime(tmp_path: Path) -> Iterator[Runtime]:
         rt.stop()
 
 
+AUTH = {"Authorization": f"Bearer {TOKEN}"}
+READ = {"Authorization": f"Bearer {READ_TOKEN}"}
+
+
 @pytest.fixture
 def client(runtime: Runtime) -> TestClient:
-    return TestClient(create_app(runtime))
+    settings = ApiSettings(token=TOKEN, read_token=READ_TOKEN, hosts=["testserver"])
+    # TestClient's requests carry the read-only token unless a test gives another one.
+    return TestClient(create_app(LocalBackend(Service(runtime)), settings), headers=READ)
 
 
-AUTH = {"Authorization": f"Bearer {TOKEN}"}
-
-
-def test_reading_needs_no_token_and_shows_live_values(client: TestClient) -> None:
+def test_reading_with_the_read_only_token_shows_live_values(client: TestClient) -> None:
     assert client.get("/api/v1/health").json()["status"] == "ok"
     listing = client.get("/api/v1/instances").json()
     assert {i["name"] for i in listing} == {"valve", "debit"}
@@ -75,22 +76,46 @@ def test_reading_needs_no_token_and_shows_live_values(client: TestClient) -> Non
     assert "/api/v1/instances/{name}/knowledge_base" in spec["paths"]
 
 
-def test_every_write_needs_the_token(client: TestClient) -> None:
-    body = {"running": False}
-    assert client.put("/api/v1/instances/valve/start_stop", json=body).status_code == 401
-    wrong = {"Authorization": "Bearer nope"}
-    assert client.put("/api/v1/instances/valve/start_stop", json=body, headers=wrong).status_code == 401
-    for method, url, payload in [
-        ("patch", "/api/v1/instances/valve/parameters", {"values": {"START_STOP": 0}}),
-        ("put", "/api/v1/instances/debit/mode", {"mode": "manual"}),
-        ("put", "/api/v1/instances/valve/force/Temp", {"value": 3}),
-        ("delete", "/api/v1/instances/valve/force/Temp", None),
-        ("put", "/api/v1/instances/debit/manual/OUT3", {"value": 3}),
-        ("put", "/api/v1/instances/valve/knowledge_base", {"text": "x", "format": "fcl"}),
-    ]:
-        r = client.request(method.upper(), url, json=payload)
-        assert r.status_code == 401, (method, url)
-        assert r.headers["www-authenticate"] == "Bearer"
+NO_TOKEN = {"Authorization": ""}
+WRITES = [
+    ("put", "/api/v1/instances/valve/start_stop", {"running": False}),
+    ("patch", "/api/v1/instances/valve/parameters", {"values": {"START_STOP": 0}}),
+    ("put", "/api/v1/instances/debit/mode", {"mode": "manual"}),
+    ("put", "/api/v1/instances/valve/force/Temp", {"value": 3}),
+    ("delete", "/api/v1/instances/valve/force/Temp", None),
+    ("put", "/api/v1/instances/debit/manual/OUT3", {"value": 3}),
+    ("put", "/api/v1/instances/valve/knowledge_base", {"text": "x", "format": "fcl"}),
+]
+READS = [
+    "/api/v1/instances",
+    "/api/v1/instances/valve",
+    "/api/v1/instances/valve/statistics",
+    "/api/v1/statistics",
+    "/api/v1/instances/valve/knowledge_base",
+    "/api/v1/links",
+    "/api/v1/events",
+    "/api/v1/nowhere",  # no probing of paths without a token either
+]
+
+
+def test_every_write_needs_the_write_token_and_every_read_a_token(
+    client: TestClient, runtime: Runtime
+) -> None:
+    before = runtime.events.last_seq
+    for method, url, payload in WRITES:
+        for headers, status in [(NO_TOKEN, 401), ({"Authorization": "Bearer nope"}, 401), (READ, 403)]:
+            r = client.request(method.upper(), url, json=payload, headers=headers)
+            assert r.status_code == status, (method, url, headers)
+            if status == 401:
+                assert r.headers["www-authenticate"] == "Bearer"
+    assert runtime.events.last_seq == before  # nothing was changed, nothing logged
+    for url in READS:
+        assert client.get(url, headers=NO_TOKEN).status_code == 401, url
+        assert client.get(url, headers={"Authorization": "Bearer nope"}).status_code == 401, url
+    assert client.get("/api/v1/instances/valve", headers=AUTH).status_code == 200  # the write token reads too
+    # Liveness and the API description stay open (they tell nothing about the process).
+    assert client.get("/api/v1/health", headers=NO_TOKEN).status_code == 200
+    assert client.get("/api/v1/openapi.json", headers=NO_TOKEN).status_code == 200
 
 
 def test_requests_are_validated(client: TestClient) -> None:
@@ -182,43 +207,36 @@ def test_live_websocket_streams_snapshots_and_events(client: TestClient) -> None
     assert refused.value.code == 1008
 
 
-def test_api_binds_127_0_0_1_with_a_0600_token_file(tmp_path: Path) -> None:
-    config = f'[runtime]\nstate_dir = "{tmp_path / "state"}"\n[api]\nport = 0\n' + CONFIG
-    rt = make_runtime(tmp_path, config, api=True)
-    rt.start()
-    try:
-        host, port = rt.api_address  # type: ignore[misc]
-        assert host == "127.0.0.1"
-        token_file = tmp_path / "state" / "api-token"
-        assert stat.S_IMODE(token_file.stat().st_mode) == 0o600
-        token = token_file.read_text().strip()
-        assert token == rt.token and len(token) >= 32
-        base = f"http://127.0.0.1:{port}/api/v1"
-        assert httpx.get(f"{base}/health", timeout=5).json()["instances"] == 2
-        r = httpx.put(f"{base}/instances/valve/start_stop", json={"running": False}, timeout=5)
-        assert r.status_code == 401
-        r = httpx.put(
-            f"{base}/instances/valve/start_stop",
-            json={"running": False},
-            headers={"Authorization": f"Bearer {token}"},
-            timeout=5,
-        )
-        assert r.json() == {"START_STOP": 0}
-        # A real WebSocket client on the real server: live snapshots at 20 Hz.
-        from websockets.sync.client import connect
-
-        with connect(f"ws://127.0.0.1:{port}/api/v1/live?rate=20&instances=valve") as ws:
-            first, second = json.loads(ws.recv(timeout=5)), json.loads(ws.recv(timeout=5))
-        assert first["instances"]["valve"]["parameters"]["START_STOP"] == 0
-        assert second["time"] > first["time"]
-    finally:
-        rt.stop()
-    rt2 = make_runtime(tmp_path, config, api=True)  # the second start reuses the token
-    rt2.start()
-    rt2.stop()
-    assert rt2.token == token
-    os.chmod(token_file, 0o644)
-    rt3 = make_runtime(tmp_path, config, api=True)
-    with pytest.raises(FuzzyctlError, match="accessible to other users"):
-        rt3.start()
-    rt3.stop()
+def test_values_the_block_type_cannot_hold_and_loose_json_types_are_refused(
+    client: TestClient, runtime: Runtime
+) -> None:
+    force = "/api/v1/instances/valve/force/Temp"
+    for value in (1e308, -1e308, 3.5e38, -3.41e38):  # beyond a REAL: not clamped, refused
+        r = client.put(force, json={"value": value}, headers=AUTH)
+        assert r.status_code == 400 and "REAL" in r.json()["detail"], value
+    assert runtime.instances["valve"].adapter.forced() == {}
+    r = client.put(force, json={"value": 3.4e38}, headers=AUTH)  # the largest REALs are fine
+    assert r.status_code == 200 and r.json() == {"INPUT1": float(np.float32(3.4e38))}
+    client.delete(force, headers=AUTH)
+    for url, value in [
+        ("/api/v1/instances/debit/force/INP4", 40000),  # an XFUZ input is a 16-bit word
+        ("/api/v1/instances/debit/force/INP4", 2.5),
+        ("/api/v1/instances/debit/manual/OUT3", 1e308),
+        ("/api/v1/instances/debit/manual/OUT3", -32769),
+    ]:
+        r = client.put(url, json={"value": value}, headers=AUTH)
+        assert r.status_code == 400 and "16-bit" in r.json()["detail"], (url, value)
+    assert runtime.instances["debit"].adapter.forced() == {}
+    # JSON's own types only, as the docs say: "yes", 1 and "true" are not booleans.
+    for running in ("yes", 1, "true", None):
+        r = client.put("/api/v1/instances/valve/start_stop", json={"running": running}, headers=AUTH)
+        assert r.status_code == 422, running
+    for value in ("3", True, [3], {"v": 3}):
+        assert client.put(force, json={"value": value}, headers=AUTH).status_code == 422, value
+    assert (
+        client.patch(
+            "/api/v1/instances/valve/parameters", json={"values": {"START_STOP": "65535"}}, headers=AUTH
+        ).status_code
+        == 422
+    )
+    assert runtime.instances["valve"].adapter.block.START_STOP == 0xFFFF

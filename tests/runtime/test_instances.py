@@ -9,7 +9,7 @@ from pathlib import Path
 from pymodbus.client import ModbusTcpClient
 
 from fuzzyctl.io.codec import float32_from_registers, float32_to_registers, int16_to_register
-from fuzzyctl.runtime.adapters import INFO_HOLD, INFO_SAFE, STATUS_IO_FAULT_BIT
+from fuzzyctl.runtime.adapters import INFO_BLOCK_FAULT, INFO_HOLD, INFO_SAFE, STATUS_IO_FAULT_BIT
 from fuzzyctl.runtime.kb import KnowledgeBaseSource
 from tests.conftest import EXAMPLES
 from tests.io.plcs import wait_until
@@ -258,3 +258,118 @@ ERROR = {{ connection = "out", address = 2, type = "uint16" }}
         rt.stop()
         plc.close()
         out.close()
+
+
+def test_a_block_that_cannot_compute_puts_the_safe_value_and_info_42_in_the_field(tmp_path: Path) -> None:
+    """A controller whose inlet singleton (1E39) is beyond the REAL range: cold and low
+    make the block compute +inf.  The master must read the safe value with INFO 16#42 and
+    the instance must say ``safe`` with the reason, until the block computes again."""
+    kb = tmp_path / "huge.fcl"
+    kb.write_text(FPLTEST_FCL.read_text().replace("TERM inlet := 100;", "TERM inlet := 1E39;"))
+    rt = make_runtime(tmp_path, SIEMENS_SERVER.replace(str(FPLTEST_FCL), str(kb)))
+    inst = rt.instances["valve"]
+    try:
+        rt.start()
+        mb = master(rt)
+
+        def field() -> tuple[float, int]:
+            r = mb.read_holding_registers(10, count=3).registers
+            return float32_from_registers(r[0], r[1]), int(r[2])
+
+        mb.write_registers(0, [*float32_to_registers(29.0), *float32_to_registers(99.0)])  # hot, high
+        wait_until(lambda: field() == (-100.0, 0) and inst.snapshot()["state"] == "run", 10)
+        mb.write_registers(0, [*float32_to_registers(1.0), *float32_to_registers(52.0)])  # cold, low
+        wait_until(lambda: field() == (12.5, INFO_BLOCK_FAULT), 10)
+        snap = inst.snapshot()
+        assert snap["state"] == "safe" and "OUTPUT1 = inf" in snap["problems"]["block"][0]
+        assert snap["field_outputs"]["Valve"] == 12.5 and snap["status"]["INFO"] == INFO_BLOCK_FAULT
+        mb.write_registers(0, [*float32_to_registers(29.0), *float32_to_registers(99.0)])
+        wait_until(lambda: field() == (-100.0, 0) and inst.snapshot()["state"] == "run", 10)
+        assert inst.snapshot()["problems"]["block"] == []
+        mb.close()
+    finally:
+        rt.stop()
+    events = assert_log_complete(rt, tmp_path / "events.jsonl")
+    wanted = {"error", "error-cleared", "safe-enter", "safe-exit", "hold-start", "hold-end"}
+    kinds = [e.kind for e in events if e.instance == "valve" and e.kind in wanted]
+    # (The registers hold 0, 0 before the master writes: cold and low, a first episode.)
+    assert kinds[-4:] == ["error", "safe-enter", "error-cleared", "safe-exit"], kinds
+    last_safe = [e for e in events if e.kind == "safe-enter"][-1]
+    assert last_safe.data["reason"] == "block error" and "OUTPUT1 = inf" in last_safe.data["error"]
+
+
+def test_a_parameter_the_field_writes_out_of_range_is_refused_and_the_block_runs_on(tmp_path: Path) -> None:
+    rt = make_runtime(
+        tmp_path,
+        f"""
+[connections.mb]
+type = "modbus-server"
+port = 0
+poll_interval = 0.005
+
+[instances.debit]
+style = "xfuz"
+knowledge_base = "{EXAMPLES / "xfuz_3_3.xfuz"}"
+span_rule = false
+period = 0.01
+params = {{ MAN_AUTO = 1, START = 1, CONT_ASK = 0, T_OFB = 0 }}
+
+[instances.debit.inputs]
+INP1 = {{ connection = "mb", address = 0, type = "int16" }}
+INP4 = {{ connection = "mb", address = 1, type = "int16" }}
+
+[instances.debit.outputs]
+OUT3 = {{ connection = "mb", table = "input", address = 0, type = "int16", safe = -1 }}
+
+[instances.debit.parameters]
+T_OFB = {{ connection = "mb", address = 5, type = "int16" }}
+""",
+    )
+    inst = rt.instances["debit"]
+    try:
+        rt.start()
+        mb = master(rt)
+        mb.write_registers(0, [int16_to_register(0), int16_to_register(-50)])
+        wait_until(lambda: mb.read_input_registers(0, count=1).registers == [8], 10)
+        t_ofb = inst.snapshot()["parameters"]["T_OFB"]
+        mb.write_registers(5, [int16_to_register(-5)])  # T_OFB is 0..32767
+        wait_until(lambda: any(e.kind == "parameter-refused" for e in rt.events.since(0)), 10)
+        cycles = inst.task.stats.count
+        wait_until(lambda: inst.task.stats.count > cycles + 5, 10)
+        snap = inst.snapshot()
+        assert snap["state"] == "run" and snap["error"] is None and snap["parameters"]["T_OFB"] == t_ofb
+        assert mb.read_input_registers(0, count=1).registers == [8]
+        mb.close()
+    finally:
+        rt.stop()
+    assert not any(e.kind == "error" for e in rt.events.since(0))
+
+
+def test_an_internal_error_in_one_instance_puts_it_safe_and_the_others_run_on(tmp_path: Path) -> None:
+    two = SIEMENS_SERVER + f"""
+[instances.other]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+"""
+    rt = make_runtime(tmp_path, two)
+    valve, other = rt.instances["valve"], rt.instances["other"]
+
+    def broken(period: float) -> None:
+        raise ZeroDivisionError("a bug")
+
+    try:
+        rt.start()
+        mb = master(rt)
+        mb.write_registers(0, [*float32_to_registers(9.0), *float32_to_registers(65.0)])
+        wait_until(lambda: valve.snapshot()["state"] == "run", 10)
+        valve.adapter.execute = broken  # type: ignore[method-assign]
+        wait_until(lambda: valve.snapshot()["state"] == "safe", 10)
+        r = mb.read_holding_registers(10, count=3).registers
+        assert float32_from_registers(r[0], r[1]) == 12.5 and r[2] == INFO_BLOCK_FAULT
+        assert "internal error: ZeroDivisionError: a bug" in valve.snapshot()["error"]
+        cycles = other.task.stats.count
+        wait_until(lambda: other.task.stats.count > cycles + 10, 10)  # the cycle thread lives on
+        assert rt.scheduler.alive and other.snapshot()["state"] == "run"
+        mb.close()
+    finally:
+        rt.stop()

@@ -4,10 +4,11 @@ back and checks it against the engine; then the PLC goes away and comes back."""
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 from fuzzyctl.runtime.adapters import INFO_SAFE
-from tests.io.plcs import ModbusPLC, wait_until
+from tests.io.plcs import FreezableProxy, ModbusPLC, wait_until
 from tests.runtime.helpers import (
     FPLTEST_FCL,
     SAFETY_KINDS,
@@ -18,12 +19,13 @@ from tests.runtime.helpers import (
 )
 
 
-def config(port: int, hold: float = 0.3) -> str:
+def config(port: int, hold: float = 0.3, timeout: float = 0.5, deadline: str = "") -> str:
     return f"""
 [connections.plc]
 type = "modbus"
 port = {port}
-timeout = 0.5
+timeout = {timeout}
+{deadline}
 poll_interval = 0.005
 reconnect_min = 0.05
 reconnect_max = 0.2
@@ -79,10 +81,58 @@ def test_modbus_plc_outputs_match_the_engine_and_survive_a_plc_restart(tmp_path:
     events = assert_log_complete(rt, tmp_path / "events.jsonl")
     about = [e for e in events if e.kind in SAFETY_KINDS and (e.instance == "valve" or e.link == "plc")]
     sequence = [e.kind for e in about]
-    start = sequence.index("link-lost")
-    assert sequence[start:] == ["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]
+    # The stopped server answers nothing: the hold starts at the link's deadline (0.25 s)
+    # or when the connection is seen lost, whichever comes first.
+    start = min(sequence.index("link-lost"), sequence.index("hold-start"))
+    tail = sequence[start:]
+    assert sorted(tail) == sorted(["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]), tail
+    for before, after in [
+        ("hold-start", "safe-enter"),
+        ("link-lost", "link-up"),
+        ("safe-enter", "safe-exit"),
+    ]:
+        assert tail.index(before) < tail.index(after), tail
     hold_start = next(e for e in about[start:] if e.kind == "hold-start")
     safe_enter = next(e for e in about[start:] if e.kind == "safe-enter")
     assert safe_enter.mono - hold_start.mono >= 0.3 - 0.02  # not before the hold time
     assert any(e.kind == "link-retry" and e.link == "plc" for e in events)  # reconnect attempts are logged
     assert events[-1].kind == "runtime-stop"
+
+
+def test_a_frozen_plc_holds_from_the_missed_deadline_not_from_the_timeout(tmp_path: Path) -> None:
+    """A peer that stops answering without closing: the hold starts when the link misses
+    its deadline (0.2 s), the safe values come hold_time later, long before the protocol's
+    timeout (5 s) would even declare the link lost."""
+    plc = ModbusPLC()
+    proxy = FreezableProxy(plc.port)
+    rt = make_runtime(tmp_path, config(proxy.port, hold=0.3, timeout=5.0, deadline="deadline = 0.2"))
+    inst = rt.instances["valve"]
+    try:
+        rt.start()
+        plc.set_float(0, 9.0)
+        plc.set_float(2, 65.0, word_order="little")
+        want = fpltest_reference(9.0, 65.0)
+        wait_until(lambda: close(plc.float(10), want) and inst.snapshot()["state"] == "run", 10)
+        frozen_at = time.monotonic()
+        proxy.freeze()
+        wait_until(lambda: inst.snapshot()["state"] == "safe", 4.5)
+        snap = inst.snapshot()
+        # Still within the timeout: the link is up (nothing failed yet), but late.
+        assert rt.links["plc"].state.value == "up" and snap["problems"]["late"] == ["plc"]
+        assert snap["field_outputs"]["Valve"] == -1.0 and snap["status"]["INFO"] == INFO_SAFE
+        proxy.thaw()
+        wait_until(lambda: inst.snapshot()["state"] == "run", 10)
+    finally:
+        rt.stop()
+        proxy.close()
+        plc.close()
+    events = [e for e in rt.events.since(0) if e.mono >= frozen_at and e.instance == "valve"]
+    kinds = [e.kind for e in events if e.kind in SAFETY_KINDS]
+    assert kinds[:3] == ["hold-start", "safe-enter", "safe-exit"], kinds
+    # Other events (an overrun on a loaded machine) may come between: pick the safety ones.
+    hold_start = next(e for e in events if e.kind == "hold-start")
+    safe_enter = next(e for e in events if e.kind == "safe-enter")
+    assert hold_start.data["links"] == ["plc"]
+    assert hold_start.mono - frozen_at >= 0.2 - 0.02  # not before the deadline
+    assert safe_enter.mono - hold_start.mono >= 0.3 - 0.02  # then the hold time
+    assert not any(e.kind == "link-lost" for e in rt.events.since(0))  # the timeout never came

@@ -494,7 +494,10 @@ def runtime(tmp_path: Path) -> Iterator[Any]:
 def test_online_proxy_reads_commands_and_downloads(client: TestClient, runtime: Any, project: Path) -> None:
     host, port = runtime.api_address
     url = f"http://{host}:{port}"
-    listing = client.post("/api/online/instances", json={"url": url}).json()
+    # The runtime wants a token for reading too: the read-only one is enough to watch.
+    refused = client.post("/api/online/instances", json={"url": url})
+    assert refused.status_code == 502 and refused.json()["status"] == 401
+    listing = client.post("/api/online/instances", json={"url": url, "token": runtime.read_token}).json()
     assert [i["name"] for i in listing["instances"]] == ["valve"]
     creds = {"url": url, "instance": "valve", "token": runtime.token}
     r = client.post("/api/online/command", json={**creds, "action": "force", "target": "Temp", "value": 20})

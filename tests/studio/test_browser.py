@@ -12,6 +12,7 @@ import socket
 import subprocess
 import sys
 import time
+import urllib.request
 from pathlib import Path
 from typing import Any
 
@@ -238,6 +239,13 @@ params = {{ MAN_AUTO = 1, START = 1 }}
         while not (state / "api-token").exists() and time.monotonic() < deadline:
             time.sleep(0.1)
         token = (state / "api-token").read_text().strip()
+        # The API process takes a few seconds to import on a loaded machine: wait until it serves.
+        while time.monotonic() < deadline + 40:
+            try:
+                urllib.request.urlopen(f"http://127.0.0.1:{port}/api/v1/health", timeout=5).close()
+                break
+            except OSError:
+                time.sleep(0.2)
         open_file(pg, "siemens_fpltest.fcl")
         tab(pg, "online")
         pg.fill("#on-url", f"http://127.0.0.1:{port}")

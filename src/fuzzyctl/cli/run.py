@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -168,11 +169,36 @@ def eval_(
     result = ctl.evaluate(_parse_sets(set_))
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
+    else:
+        _print_outputs(ctl.name or file.name, result)
+    _fail_without_value(ctl, result)
+
+
+def _fail_without_value(ctl: Any, result: Mapping[str, float]) -> None:
+    """An output that is NaN or infinite is no value for a field device: say why and exit 1,
+    so a script never takes ``null``/``nan`` for a result (issue 14.6)."""
+    missing = [k for k, v in result.items() if not math.isfinite(v)]
+    if not missing:
         return
+    from fuzzyctl.cli.app import err_console
+
+    for name in missing:
+        info = ctl.outputs.get(name)
+        default = getattr(info, "default", None)
+        why = (
+            "no rule fired and its DEFAULT is NaN"
+            if default is not None and math.isnan(default)
+            else "the result is not a finite number"
+        )
+        err_console.print(f"error: output {name!r} has no value ({_fmt(result[name])}): {why}", markup=False)
+    raise typer.Exit(1)
+
+
+def _print_outputs(title: str, result: Mapping[str, float]) -> None:
     from rich.console import Console
     from rich.table import Table
 
-    table = Table(title=f"{ctl.name or file.name}", show_lines=False)
+    table = Table(title=title, show_lines=False)
     table.add_column("output", overflow="fold")
     table.add_column("value", justify="right", overflow="fold", no_wrap=False)
     for k, v in result.items():

@@ -39,9 +39,17 @@ def serve(
         if problems:
             raise ConfigError(problems)
         assert checked is not None
+        from fuzzyctl.runtime import capacity
+
+        runtime = Runtime(checked, api=False, event_log=None)
+        est = capacity.estimate(runtime)  # times the cycles: a runtime that is then dropped
+        runtime.stop()
         typer.echo(
-            f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s)"
+            f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s); "
+            f"the cycles need about {est.load:.1%} of one core (capacity {capacity.CAPACITY:.0%})"
         )
+        for text in capacity.warnings(runtime, est):
+            err_console.print(f"warning: {text}", markup=False)
         return
     cfg = load_config(config)
     runtime = Runtime(cfg, api=api and cfg.api.enabled)
@@ -53,11 +61,19 @@ def serve(
     previous = signal.signal(signal.SIGTERM, on_signal)
     console = Console(highlight=False)
     runtime.start()
+    prio = cfg.runtime.realtime_priority
+    if prio > 1:
+        # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
+        # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
+        from fuzzyctl.runtime.scheduler import set_fifo
+
+        set_fifo(prio - 1)
     try:
         if runtime.api_address is not None:
             host, port = runtime.api_address
             err_console.print(
-                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}",
+                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}, "
+                f"read-only token in {runtime.read_token_path}",
                 markup=False,
             )
         deadline = None if duration is None else time.monotonic() + duration

@@ -239,7 +239,14 @@ class ModbusServerOptions(BaseModel):
 class ModbusServer(Connector):
     """A Modbus TCP server holding a holding-register and an input-register table
     (``registers`` each, every unit id).  Inputs of the controller are registers a master
-    writes; outputs are registers the runtime writes and a master reads."""
+    writes; outputs are registers the runtime writes and a master reads.
+
+    The process image is exchanged with the server's own register lists directly, one
+    slice per point (the datastore calls cost ~20 us each and checked every register in
+    Python: 300 points took 4 ms of the interpreter every poll, time the cycle thread
+    waited for).  Slices are atomic on the event loop, which also serves the master.
+    Should a pymodbus release store its registers differently, the datastore calls are
+    used instead (``direct`` is then False)."""
 
     point_model = ModbusPoint
     options_model = ModbusServerOptions
@@ -250,6 +257,13 @@ class ModbusServer(Connector):
         super().__init__(name, options)
         self._server: Any = None
         self.port = options.port
+        self._tables: dict[str, list[int]] | None = None
+        self._plans: dict[tuple[int, ...], list[tuple[list[int], int, ModbusPoint]]] = {}
+
+    @property
+    def direct(self) -> bool:
+        """Whether the registers are exchanged directly (see the class doc)."""
+        return self._tables is not None
 
     def endpoint(self) -> str:
         return f"modbus-server://{self.options.host}:{self.port}"
@@ -279,6 +293,7 @@ class ModbusServer(Connector):
             raise LinkError(f"{self.endpoint()}: cannot listen")
         self.port = sockets[0].getsockname()[1]
         self._server = server
+        self._tables = _register_lists(server, n)
 
     def _check(self, pts: Sequence[ModbusPoint]) -> None:
         for p in pts:
@@ -286,10 +301,27 @@ class ModbusServer(Connector):
                 served = self.options.registers
                 raise LinkError(f"{self.endpoint()}: {p.describe()} is beyond the {served} registers served")
 
+    def _plan(self, points: Sequence[Point]) -> list[tuple[list[int], int, ModbusPoint]] | None:
+        """(register list, address, point) per point, cached for a list of points."""
+        tables = self._tables
+        if tables is None:
+            return None
+        key = tuple(map(id, points))
+        plan = self._plans.get(key)
+        if plan is None:
+            pts: list[ModbusPoint] = list(points)  # type: ignore[arg-type]
+            self._check(pts)
+            plan = [(tables[p.table], p.address, p) for p in pts]
+            self._plans[key] = plan
+        return plan
+
     async def read(self, points: Sequence[Point]) -> list[float]:
         server = self._server
         if server is None:
             raise LinkError(f"{self.endpoint()}: not serving")
+        plan = self._plan(points)
+        if plan is not None:
+            return [p.decode(regs[a : a + p.width]) for regs, a, p in plan]
         pts: list[ModbusPoint] = list(points)  # type: ignore[arg-type]
         self._check(pts)
         out = [math.nan] * len(pts)
@@ -305,6 +337,11 @@ class ModbusServer(Connector):
         server = self._server
         if server is None:
             raise LinkError(f"{self.endpoint()}: not serving")
+        plan = self._plan(points)
+        if plan is not None:
+            for (regs, a, p), v in zip(plan, values, strict=True):
+                regs[a : a + p.width] = p.encode(v)
+            return
         pts: list[ModbusPoint] = list(points)  # type: ignore[arg-type]
         self._check(pts)
         for table, start, regs in plan_writes(pts, values):
@@ -313,6 +350,27 @@ class ModbusServer(Connector):
 
     async def close(self) -> None:
         server, self._server = self._server, None
+        self._tables = None
+        self._plans.clear()
         if server is not None:
             with contextlib.suppress(Exception):  # a server already torn down
                 await server.shutdown()
+
+
+def _register_lists(server: Any, count: int) -> dict[str, list[int]] | None:
+    """The holding and input register lists of a pymodbus 3.16 simulator device (start
+    address 0, ``count`` registers), or None when they are not where 3.16 keeps them."""
+    try:
+        blocks = server.context.devices[0].block
+        tables = {"holding": blocks["h"], "input": blocks["i"]}
+    except (AttributeError, KeyError, IndexError, TypeError):
+        return None
+    out: dict[str, list[int]] = {}
+    for name, block in tables.items():
+        ok = isinstance(block, tuple) and len(block) == 4 and block[0] == 0
+        if not ok or not isinstance(block[2], list):
+            return None
+        if len(block[2]) < count:
+            return None
+        out[name] = block[2]
+    return out

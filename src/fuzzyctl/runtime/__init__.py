@@ -12,7 +12,24 @@ Schneider XFUZ) running cyclically against field I/O (OPC UA, Modbus TCP, S7).
 docs/runtime.md is the reference.
 """
 
-from fuzzyctl.runtime.config import Config, ConfigError, load_config, parse_config
-from fuzzyctl.runtime.core import Runtime
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    from fuzzyctl.runtime.config import Config, ConfigError, load_config, parse_config
+    from fuzzyctl.runtime.core import Runtime
 
 __all__ = ["Config", "ConfigError", "Runtime", "load_config", "parse_config"]
+
+
+def __getattr__(name: str) -> Any:
+    # Imported on first use: the API process (:mod:`.apiserver`) imports this package for
+    # its HTTP side only, and must not load the blocks, the engine and the protocols.
+    if name == "Runtime":
+        from fuzzyctl.runtime.core import Runtime
+
+        return Runtime
+    if name in ("Config", "ConfigError", "load_config", "parse_config"):
+        from fuzzyctl.runtime import config
+
+        return getattr(config, name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -8,9 +8,15 @@ rounded half away from zero and saturated, manual 2.3) and add the runtime's I/O
 indication to INFO / STATUS (docs/runtime.md, "Safety"):
 
 * Siemens: INFO = 16#40 while an instance holds its last good inputs, 16#41 while its
-  outputs are at their safe values (the block's own codes are 00, 01, 11, 21, 31);
+  outputs are at their safe values, 16#42 while they are because the block cannot compute
+  (an error, a result that is not a finite REAL); the block's own codes are 00, 01, 11,
+  21, 31;
 * XFUZ: STATUS bit 15 (unused by the manual) and ERROR while the outputs are at their safe
-  values.
+  values, for either reason.
+
+A value the API forces or sets is refused when the block's type cannot hold it: a Siemens
+input is a REAL (finite, at most 3.4028235e38 in magnitude), an XFUZ input or manual
+value a 16-bit integer.
 """
 
 from __future__ import annotations
@@ -19,10 +25,12 @@ import math
 import re
 from typing import Any, ClassVar
 
+from fuzzyctl.blocks.siemens.fb import real
 from fuzzyctl.diagnostics import InputError
 from fuzzyctl.runtime.kb import PreparedKB
 
 __all__ = [
+    "INFO_BLOCK_FAULT",
     "INFO_HOLD",
     "INFO_SAFE",
     "STATUS_IO_FAULT_BIT",
@@ -35,11 +43,22 @@ __all__ = [
 
 INFO_HOLD = 0x40
 INFO_SAFE = 0x41
+INFO_BLOCK_FAULT = 0x42
 STATUS_IO_FAULT_BIT = 15
+REAL_LIMIT = 2.0**128 - 2.0**103
+"""The smallest magnitude that an S7 REAL (IEEE single) cannot hold: it rounds to infinity."""
 
 
 class NotSupported(InputError):
     """The block style has no such operation (MAN_AUTO on a Siemens block, ...)."""
+
+
+def exact_word(what: str, value: float) -> int:
+    """A value an operator gives for an XFUZ word: an integer -32768..32767, else refused
+    (the field's values are rounded and saturated instead, see :func:`to_word`)."""
+    if not (math.isfinite(value) and float(value).is_integer() and -32768 <= value <= 32767):
+        raise InputError(f"{what}: {value!r} is not a 16-bit integer (-32768..32767)")
+    return int(value)
 
 
 def to_word(value: float) -> int:
@@ -54,10 +73,12 @@ def to_word(value: float) -> int:
 
 class Adapter:
     """What the runtime needs from a block.  ``fault`` is set by the instance: None,
-    ``"hold"`` or ``"safe"``."""
+    ``"hold"``, ``"safe"`` or ``"block"`` (the block cannot compute)."""
 
     style: ClassVar[str]
     PARAMS: ClassVar[dict[str, tuple[int, int]]] = {}
+    INPUT_LIMIT: ClassVar[float] = math.inf
+    """Field values of this magnitude or more (and NaN) are not inputs the block can read."""
     fault: str | None = None
     block: Any
 
@@ -114,6 +135,11 @@ class Adapter:
     def after_cycle(self) -> None:
         """Called after each execute (XFUZ lowers the REFRESH it raised)."""
 
+    def bad_output(self) -> str | None:
+        """``"OUTPUTn = inf"`` when the last call left an output the block cannot put out
+        (not a finite value of its type); None when all are fine."""
+        return None
+
     @property
     def status(self) -> dict[str, int]:
         """INFO (siemens) or STATUS/ERROR (xfuz), with the runtime's fault indication."""
@@ -157,6 +183,7 @@ class SiemensAdapter(Adapter):
 
     style = "siemens"
     PARAMS: ClassVar[dict[str, tuple[int, int]]] = {"START_STOP": (0, 0xFFFF)}
+    INPUT_LIMIT = REAL_LIMIT
 
     def __init__(self, kb: PreparedKB) -> None:
         super().__init__(kb)
@@ -191,15 +218,25 @@ class SiemensAdapter(Adapter):
         return self._valid_inputs()
 
     def write_input(self, key: str, value: float) -> None:
-        forced = self._forced.get(key)
-        self.block.write_input(int(key[5:]), value if forced is None else forced)
+        # The key is the data block's variable (INPUTn); the block reads it as a REAL.
+        if self._forced:
+            value = self._forced.get(key, value)
+        setattr(self.block, key, real(value))
 
     def read_output(self, key: str) -> float:
         if key == "INFO":
             return float(self.status["INFO"])
         if key == "ENO":
             return float(self.block.ENO)
-        return float(self.block.read_output(int(key[6:])))
+        return float(getattr(self.block, key))
+
+    def bad_output(self) -> str | None:
+        block = self.block
+        for i in range(1, len(self.kb.outputs) + 1):
+            y = block.read_output(i)
+            if not math.isfinite(y):
+                return f"OUTPUT{i} = {y!r}"
+        return None
 
     def get_param(self, key: str) -> int:
         return int(getattr(self.block, key))
@@ -209,7 +246,7 @@ class SiemensAdapter(Adapter):
 
     def execute(self, period: float) -> None:
         for key, value in self._forced.items():  # bound or not, a forced input holds its value
-            self.block.write_input(int(key[5:]), value)
+            setattr(self.block, key, value)
         self.block.execute()
 
     def install(self, kb: PreparedKB) -> None:
@@ -227,7 +264,9 @@ class SiemensAdapter(Adapter):
     @property
     def status(self) -> dict[str, int]:
         info = int(self.block.INFO)
-        if self.fault == "safe":
+        if self.fault == "block":
+            info = INFO_BLOCK_FAULT
+        elif self.fault == "safe":
             info = INFO_SAFE
         elif self.fault == "hold" and info == 0:
             info = INFO_HOLD
@@ -247,10 +286,10 @@ class SiemensAdapter(Adapter):
     def force(self, key: str, value: float | None) -> None:
         if value is None:
             self._forced.pop(key, None)
-        elif not math.isfinite(value):
-            raise InputError(f"force {key}: {value!r} is not a finite REAL")
+        elif not abs(value) < REAL_LIMIT:  # also NaN
+            raise InputError(f"force {key}: {value!r} is not a REAL (finite, |x| <= 3.4028235e38)")
         else:
-            self._forced[key] = float(value)
+            self._forced[key] = real(value)
 
     def forced(self) -> dict[str, float]:
         return dict(self._forced)
@@ -364,7 +403,7 @@ class XfuzAdapter(Adapter):
     @property
     def status(self) -> dict[str, int]:
         status, error = int(self.block.STATUS), bool(self.block.ERROR)
-        if self.fault == "safe":
+        if self.fault in ("safe", "block"):
             status |= 1 << STATUS_IO_FAULT_BIT
             error = True
         return {"STATUS": status - 0x10000 if status >= 0x8000 else status, "ERROR": int(error)}
@@ -393,7 +432,7 @@ class XfuzAdapter(Adapter):
         if value is None:
             command &= ~bit
         else:
-            self.block[f"I{i}_SIM"] = to_word(value)
+            self.block[f"I{i}_SIM"] = exact_word(f"force {key}", value)
             command |= bit
         self.block.COMMAND = command - 0x10000 if command >= 0x8000 else command
 
@@ -402,7 +441,7 @@ class XfuzAdapter(Adapter):
         return {f"INP{i}": float(b[f"I{i}_SIM"]) for i in range(1, 9) if b.COMMAND >> (i - 1) & 1}
 
     def set_manual(self, key: str, value: float) -> None:
-        self.block[f"O{key[3:]}_MAN"] = to_word(value)
+        self.block[f"O{key[3:]}_MAN"] = exact_word(f"O{key[3:]}_MAN", value)
 
     def set_mode(self, auto: bool) -> None:
         self.block.MAN_AUTO = int(auto)

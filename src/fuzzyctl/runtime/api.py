@@ -1,13 +1,24 @@
-"""The runtime's local HTTP + WebSocket API (FastAPI), for the studio and for scripts.
+"""The runtime's HTTP + WebSocket API (FastAPI), for the studio and for scripts.
 
 Everything is under ``/api/v1``; the OpenAPI description is at ``/api/v1/openapi.json``
-and browsable at ``/api/v1/docs``.  Reading needs nothing; every request that changes
-something needs ``Authorization: Bearer <token>`` (the token file is written at the
-first start with mode 0600).  Request bodies are pydantic models: a wrong type, a missing
-or unknown field is a 422 naming it.  Errors are ``{"detail": "..."}``: 400 a value the
-block refuses, 401 a missing or wrong token, 404 an unknown instance, 409 an operation
-the block style does not have, 422 an invalid request or knowledge base (with
+and browsable at ``/api/v1/docs``.  Every request but ``/health`` and the API description
+needs ``Authorization: Bearer <token>``: the write token (file ``api-token``) for
+everything, or the read-only token (file ``api-token-read``) for reading; the WebSocket
+also takes ``?token=``.  The front door (:mod:`fuzzyctl.webguard`) refuses a foreign Host
+(DNS rebinding), a foreign Origin (cross-origin reads, cross-site WebSocket), a missing
+token before the body is read, and a body over the limit (Content-Length or chunked).
+
+Request bodies are strict pydantic models: a wrong type (``"yes"`` for a boolean, ``"1"``
+for a number), a missing or unknown field is a 422 naming it, never echoing the value.
+Errors are ``{"detail": "..."}``: 400 a value the block refuses, 401 no or a wrong token,
+403 a refused host, origin or token, 404 an unknown instance, 409 an operation the block
+style does not have, 413 a body too large, 422 an invalid request or knowledge base (with
 ``diagnostics``).
+
+The app talks to the runtime through a backend: in ``fuzzyctl serve`` the API runs in its
+own process (:mod:`.apiserver`) and the backend forwards each call over a local socket
+(:mod:`.rpc`), so that no HTTP work runs on the interpreter of the cycle thread;
+:class:`LocalBackend` calls a :class:`~.service.Service` in the same process (tests).
 
 docs/runtime.md has the reference with curl examples.
 """
@@ -17,48 +28,68 @@ docs/runtime.md has the reference with curl examples.
 
 import asyncio
 import contextlib
-import math
-import secrets
-import time
-from typing import TYPE_CHECKING, Annotated, Any, Literal
+from dataclasses import dataclass, field
+from typing import Annotated, Any, Literal, Protocol
 
-from fastapi import Depends, FastAPI, HTTPException, Path, Query, Request, WebSocket, WebSocketDisconnect
-from fastapi.encoders import jsonable_encoder
+import anyio
+from fastapi import Depends, FastAPI, Path, Query, Request, WebSocket
 from fastapi.exceptions import RequestValidationError
 from fastapi.responses import JSONResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, StringConstraints
 
 from fuzzyctl import __version__
-from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
-from fuzzyctl.runtime.adapters import NotSupported
+from fuzzyctl.runtime.service import Service, ServiceError, short
+from fuzzyctl.webguard import LOOPBACK_NAMES, Guard, Refusal, bearer_token, token_matches
 
-if TYPE_CHECKING:
-    from fuzzyctl.runtime.core import Runtime
-    from fuzzyctl.runtime.instance import Instance
-
-__all__ = ["API_PREFIX", "create_app"]
+__all__ = ["API_PREFIX", "ApiSettings", "Backend", "LocalBackend", "create_app"]
 
 API_PREFIX = "/api/v1"
+OPEN_PATHS = frozenset(
+    f"{API_PREFIX}/{p}" for p in ("health", "openapi.json", "docs", "docs/oauth2-redirect")
+)
+SMALL_BODY = 64 * 1024  # every request body but a knowledge base
 Number = float | int | None
+Name = Annotated[str, StringConstraints(min_length=1, max_length=64)]
 
 
-def clean(obj: Any) -> Any:
-    """JSON-safe: NaN and infinities become null (JSON has no NaN)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [clean(v) for v in obj]
-    return obj
+class Backend(Protocol):
+    """How the app reaches the runtime: one awaitable call per operation of
+    :class:`~fuzzyctl.runtime.service.Service`."""
+
+    async def call(self, op: str, **args: Any) -> Any: ...
+
+
+class LocalBackend:
+    """A :class:`Service` in this process, called on a worker thread."""
+
+    def __init__(self, service: Service) -> None:
+        self.service = service
+
+    async def call(self, op: str, **args: Any) -> Any:
+        return await anyio.to_thread.run_sync(lambda: self.service.call(op, args))
+
+
+@dataclass(frozen=True)
+class ApiSettings:
+    """What the app needs to know besides the backend."""
+
+    token: str
+    read_token: str | None = None
+    hosts: list[str] | None = field(default_factory=lambda: sorted(LOOPBACK_NAMES))
+    """Host names answered (None: any); see :func:`allowed_hosts`."""
+    origins: list[str] = field(default_factory=list)
+    max_body: int = 8 * 1024 * 1024
+    live_rate_max: float = 20.0
+    live_clients_max: int = 8
 
 
 # ---------------------------------------------------------------------------- models
 
 
 class _Body(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    # strict: "yes" is not a boolean, "1" not a number (JSON's own types only)
+    model_config = ConfigDict(extra="forbid", strict=True)
 
 
 class StartStopBody(_Body):
@@ -66,8 +97,10 @@ class StartStopBody(_Body):
 
 
 class ParametersBody(_Body):
-    values: dict[str, float] = Field(
-        min_length=1, description='parameters by manual name, e.g. {"START_STOP": 65535} or {"MAN_AUTO": 1}'
+    values: dict[Name, float] = Field(
+        min_length=1,
+        max_length=64,
+        description='parameters by manual name, e.g. {"START_STOP": 65535} or {"MAN_AUTO": 1}',
     )
 
 
@@ -81,7 +114,7 @@ class ValueBody(_Body):
 
 class DownloadBody(_Body):
     text: str = Field(min_length=1, max_length=5_000_000, description="the knowledge base source")
-    format: str = Field(default="fcl", description="fcl, fpl, xfuz, fis, fll or json")
+    format: str = Field(default="fcl", max_length=16, description="fcl, fpl, xfuz, fis, fll or json")
 
 
 class Health(BaseModel):
@@ -210,8 +243,66 @@ class DownloadResult(BaseModel):
 # ---------------------------------------------------------------------------- app
 
 
-def create_app(runtime: "Runtime") -> FastAPI:
-    """The API of a runtime (its token must be set: ``runtime.token``)."""
+def authorizer(settings: ApiSettings) -> Any:
+    """The token check of the front door: the write token for everything, the read-only
+    token for GET/HEAD and the WebSocket; ``/health`` and the API description are open."""
+
+    def authorize(scope: dict[str, Any], headers: dict[str, str]) -> Refusal | None:
+        path = scope["path"]
+        if path in OPEN_PATHS:
+            return None
+        given = bearer_token(headers)
+        reading = scope["type"] == "websocket" or scope.get("method") in ("GET", "HEAD")
+        if given is None and scope["type"] == "websocket":
+            from urllib.parse import parse_qs
+
+            values = parse_qs(scope.get("query_string", b"").decode("latin-1")).get("token")
+            given = values[0] if values else None
+        if token_matches(given, settings.token):
+            return None
+        if token_matches(given, settings.read_token):
+            if reading:
+                return None
+            return Refusal(403, "the read-only token cannot change anything; use the write token")
+        return Refusal(
+            401,
+            "a valid token is required: Authorization: Bearer <token from the token file>",
+            (("WWW-Authenticate", "Bearer"),),
+        )
+
+    return authorize
+
+
+def _errors(exc: RequestValidationError) -> list[dict[str, Any]]:
+    """Validation errors naming the field, never the value sent (no "input", no "ctx")."""
+    return [
+        {
+            "type": e.get("type"),
+            "loc": [short(str(x), 64) if isinstance(x, str) else x for x in e.get("loc", ())],
+            "msg": short(str(e.get("msg", "")), 200),
+        }
+        for e in exc.errors()[:20]
+    ]
+
+
+# The front door has checked the token already; this declares it in the OpenAPI
+# description (the lock in /api/v1/docs).
+_bearer = HTTPBearer(auto_error=False, description="the write token, or the read-only token for reading")
+
+
+def _documented(_creds: Annotated[HTTPAuthorizationCredentials | None, Depends(_bearer)]) -> None:
+    return None
+
+
+Token = Annotated[None, Depends(_documented)]
+InstanceName = Annotated[
+    str, Path(description="instance name (the [instances.<name>] table)", max_length=200)
+]
+PointName = Annotated[str, Path(description="an input or output name", max_length=64)]
+
+
+def create_app(backend: Backend, settings: ApiSettings) -> Any:
+    """The API (an ASGI app: FastAPI behind :class:`~fuzzyctl.webguard.Guard`)."""
     app = FastAPI(
         title="fuzzyctl runtime",
         version=__version__,
@@ -220,173 +311,119 @@ def create_app(runtime: "Runtime") -> FastAPI:
         docs_url=f"{API_PREFIX}/docs",
         redoc_url=None,
     )
-    started = time.monotonic()
-    bearer = HTTPBearer(auto_error=False, description="the token from the runtime's token file")
-
-    def require_token(
-        creds: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)],
-    ) -> None:
-        expected = runtime.token
-        if (
-            expected is None
-            or creds is None
-            or creds.scheme.lower() != "bearer"
-            or not secrets.compare_digest(creds.credentials.encode(), expected.encode())
-        ):
-            raise HTTPException(
-                status_code=401,
-                detail="a valid token is required: Authorization: Bearer <token from the token file>",
-                headers={"WWW-Authenticate": "Bearer"},
-            )
-
-    Writer = Annotated[None, Depends(require_token)]
-    InstanceName = Annotated[str, Path(description="instance name (the [instances.<name>] table)")]
-
-    def get_instance(name: str) -> "Instance":
-        if name not in runtime.instances:
-            raise HTTPException(404, f"no instance {name!r}")
-        return runtime.instances[name]
 
     @app.exception_handler(RequestValidationError)
     async def _invalid_request(_request: Request, exc: RequestValidationError) -> JSONResponse:
-        # FastAPI's own handler echoes the input, which may be NaN (not JSON): clean it.
-        return JSONResponse({"detail": clean(jsonable_encoder(exc.errors()))}, status_code=422)
+        return JSONResponse({"detail": _errors(exc)}, status_code=422)
 
-    @app.exception_handler(InputError)
-    async def _input_error(_request: Request, exc: InputError) -> JSONResponse:
-        return JSONResponse({"detail": str(exc)}, status_code=409 if isinstance(exc, NotSupported) else 400)
+    @app.exception_handler(ServiceError)
+    async def _refused(_request: Request, exc: ServiceError) -> JSONResponse:
+        body: dict[str, Any] = {"detail": exc.detail}
+        if exc.diagnostics is not None:
+            body["diagnostics"] = exc.diagnostics
+        return JSONResponse(body, status_code=exc.status)
 
-    @app.exception_handler(DiagnosticError)
-    async def _diag_error(_request: Request, exc: DiagnosticError) -> JSONResponse:
-        return JSONResponse(
-            {"detail": exc.render(), "diagnostics": [d.to_dict() for d in exc.diagnostics]}, status_code=422
-        )
+    _reading(app, backend)
+    _writing(app, backend)
+    _live(app, backend, settings)
 
-    @app.exception_handler(FuzzyctlError)
-    async def _fuzzyctl_error(_request: Request, exc: FuzzyctlError) -> JSONResponse:
-        return JSONResponse({"detail": str(exc)}, status_code=422)
+    def max_body(_method: str, path: str) -> int:
+        return settings.max_body if path.endswith("/knowledge_base") else SMALL_BODY
 
-    # --- reading -------------------------------------------------------------------
+    return Guard(
+        app,
+        hosts=settings.hosts,
+        origins=settings.origins,
+        origin_on_reads=True,
+        max_body=max_body,
+        authorize=authorizer(settings),
+        json_only=lambda path: path.startswith(API_PREFIX),
+    )
 
+
+def _reading(app: FastAPI, backend: Backend) -> None:
     @app.get(f"{API_PREFIX}/health", response_model=Health, tags=["read"])
-    def health() -> dict[str, Any]:
-        """Liveness: the runtime answers."""
-        return {
-            "status": "ok",
-            "version": __version__,
-            "instances": len(runtime.instances),
-            "uptime": time.monotonic() - started,
-        }
+    async def health() -> Any:
+        """Liveness: the runtime answers (no token needed)."""
+        return await backend.call("health")
 
     @app.get(f"{API_PREFIX}/instances", response_model=list[InstanceSummary], tags=["read"])
-    def list_instances() -> list[dict[str, Any]]:
+    async def list_instances(_: Token) -> Any:
         """Every instance with its state, INFO/STATUS and link states."""
-        out = []
-        for inst in runtime.instances.values():
-            s = inst.snapshot()
-            out.append(
-                {
-                    "name": s["name"],
-                    "style": s["style"],
-                    "period": s["period"],
-                    "state": s["state"],
-                    "status": s["status"],
-                    "cycles": s["cycles"],
-                    "overruns": s["overruns"],
-                    "last_duration": s["last_cycle"]["duration"] if s["last_cycle"] else None,
-                    "links": s["links"],
-                    "error": s["error"],
-                }
-            )
-        return out
+        return await backend.call("instances")
 
     @app.get(f"{API_PREFIX}/instances/{{name}}", response_model=InstanceDetail, tags=["read"])
-    def read_instance(name: InstanceName) -> Any:
+    async def read_instance(name: InstanceName, _: Token) -> Any:
         """Live values of one instance, consistent with one cycle boundary."""
-        return clean(get_instance(name).snapshot())
+        return await backend.call("instance", name=name)
 
     @app.get(f"{API_PREFIX}/instances/{{name}}/statistics", response_model=Statistics, tags=["read"])
-    def read_statistics(name: InstanceName) -> Any:
+    async def read_statistics(name: InstanceName, _: Token) -> Any:
         """Cycle statistics (seconds): counts over the run, percentiles over the last
         2000 cycles."""
-        return get_instance(name).statistics()
+        return await backend.call("statistics", name=name)
 
     @app.get(f"{API_PREFIX}/statistics", response_model=dict[str, Statistics], tags=["read"])
-    def read_all_statistics() -> Any:
-        return {n: i.statistics() for n, i in runtime.instances.items()}
+    async def read_all_statistics(_: Token) -> Any:
+        return await backend.call("all_statistics")
 
     @app.get(
         f"{API_PREFIX}/instances/{{name}}/knowledge_base", response_model=KnowledgeBaseText, tags=["read"]
     )
-    def read_knowledge_base(name: InstanceName) -> Any:
+    async def read_knowledge_base(name: InstanceName, _: Token) -> Any:
         """The knowledge base the instance runs, as it was loaded or downloaded (the
         studio shows its difference to the edited one before a download)."""
-        source = get_instance(name).knowledge_base_source()
-        return {
-            "format": source.format,
-            "origin": source.origin,
-            "sha256": source.sha256,
-            "text": source.text,
-        }
+        return await backend.call("knowledge_base", name=name)
 
     @app.get(f"{API_PREFIX}/links", response_model=dict[str, LinkInfo], tags=["read"])
-    def read_links() -> Any:
+    async def read_links(_: Token) -> Any:
         """Every connection: state, endpoint, counters, last error."""
-        return runtime.links_state()
+        return await backend.call("links")
 
     @app.get(f"{API_PREFIX}/events", response_model=EventPage, tags=["read"])
-    def read_events(
+    async def read_events(
+        _: Token,
         after: Annotated[int, Query(ge=0, description="only events with a larger seq")] = 0,
         limit: Annotated[int, Query(ge=1, le=10000)] = 1000,
-        kind: Annotated[list[str] | None, Query(description="only these kinds")] = None,
+        kind: Annotated[list[str] | None, Query(description="only these kinds", max_length=50)] = None,
     ) -> Any:
         """The event log, oldest first; page with ``after`` = the last seq you have."""
-        events = runtime.events.since(after, limit, set(kind) if kind else None)
-        return {
-            "first_seq": runtime.events.first_seq,
-            "last_seq": runtime.events.last_seq,
-            "events": [clean(e.to_dict()) for e in events],
-        }
+        return await backend.call("events", after=after, limit=limit, kinds=kind)
 
-    # --- writing -------------------------------------------------------------------
 
+def _writing(app: FastAPI, backend: Backend) -> None:
     @app.put(f"{API_PREFIX}/instances/{{name}}/start_stop", tags=["write"])
-    def start_stop(name: InstanceName, body: StartStopBody, _: Writer) -> dict[str, int]:
+    async def start_stop(name: InstanceName, body: StartStopBody, _: Token) -> Any:
         """Siemens: START_STOP = 16#FFFF or 0.  XFUZ: START = 1 or 0."""
-        inst = get_instance(name)
-        if inst.adapter.style == "siemens":
-            return {"START_STOP": inst.set_parameter("START_STOP", 0xFFFF if body.running else 0)}
-        return {"START": inst.set_parameter("START", 1 if body.running else 0)}
+        return await backend.call("start_stop", name=name, running=body.running)
 
     @app.patch(f"{API_PREFIX}/instances/{{name}}/parameters", tags=["write"])
-    def set_parameters(name: InstanceName, body: ParametersBody, _: Writer) -> dict[str, int]:
+    async def set_parameters(name: InstanceName, body: ParametersBody, _: Token) -> Any:
         """Write block parameters by manual name (validated by the block style; all or
         nothing is checked first)."""
-        return get_instance(name).set_parameters(body.values)
+        return await backend.call("set_parameters", name=name, values=body.values)
 
     @app.put(f"{API_PREFIX}/instances/{{name}}/mode", tags=["write"])
-    def set_mode(name: InstanceName, body: ModeBody, _: Writer) -> dict[str, int]:
+    async def set_mode(name: InstanceName, body: ModeBody, _: Token) -> Any:
         """XFUZ MAN_AUTO (manual: OUTi = Oi_MAN; auto: OUTi = Oi_CALC)."""
-        inst = get_instance(name)
-        inst.set_mode(body.mode == "auto")
-        return {"MAN_AUTO": int(body.mode == "auto")}
+        return await backend.call("set_mode", name=name, mode=body.mode)
 
     @app.put(f"{API_PREFIX}/instances/{{name}}/force/{{input}}", tags=["write"])
-    def force(name: InstanceName, input: str, body: ValueBody, _: Writer) -> dict[str, float]:
+    async def force(name: InstanceName, input: PointName, body: ValueBody, _: Token) -> Any:
         """Force an input (XFUZ: Ii_SIM and COMMAND bit; Siemens: the runtime's force
-        table).  Returns every forced input."""
-        return get_instance(name).force(input, body.value)
+        table).  Returns every forced input.  A value the input's type cannot hold (a
+        Siemens REAL: |x| < 3.4e38; an XFUZ word: an integer -32768..32767) is a 400."""
+        return await backend.call("force", name=name, input=input, value=body.value)
 
     @app.delete(f"{API_PREFIX}/instances/{{name}}/force/{{input}}", tags=["write"])
-    def release(name: InstanceName, input: str, _: Writer) -> dict[str, float]:
+    async def release(name: InstanceName, input: PointName, _: Token) -> Any:
         """Release a forced input."""
-        return get_instance(name).force(input, None)
+        return await backend.call("release", name=name, input=input)
 
     @app.put(f"{API_PREFIX}/instances/{{name}}/manual/{{output}}", tags=["write"])
-    def manual(name: InstanceName, output: str, body: ValueBody, _: Writer) -> dict[str, float]:
-        """XFUZ Oi_MAN, the output value in manual mode."""
-        get_instance(name).set_manual(output, body.value)
-        return {output: body.value}
+    async def manual(name: InstanceName, output: PointName, body: ValueBody, _: Token) -> Any:
+        """XFUZ Oi_MAN, the output value in manual mode (an integer -32768..32767)."""
+        return await backend.call("manual", name=name, output=output, value=body.value)
 
     @app.put(
         f"{API_PREFIX}/instances/{{name}}/knowledge_base",
@@ -394,55 +431,72 @@ def create_app(runtime: "Runtime") -> FastAPI:
         tags=["write"],
         responses={422: {"description": "the knowledge base cannot be used (diagnostics included)"}},
     )
-    def download(name: InstanceName, body: DownloadBody, _: Writer) -> Any:
+    async def download(name: InstanceName, body: DownloadBody, _: Token) -> Any:
         """Online download: replace the knowledge base while the instance runs (Siemens:
         stop, transfer, restart; XFUZ: REFRESH), atomically between two cycles."""
-        get_instance(name)
-        return runtime.download(name, body.text, body.format, origin="api")
+        return await backend.call("download", name=name, text=body.text, format=body.format)
 
-    # --- live ----------------------------------------------------------------------
+
+def _live(app: FastAPI, backend: Backend, settings: ApiSettings) -> None:
+    clients = [0]  # WebSocket clients now
 
     @app.websocket(f"{API_PREFIX}/live")
     async def live(
         ws: WebSocket,
         rate: Annotated[float, Query(gt=0, le=20)] = 10.0,
-        instances: Annotated[str | None, Query(description="comma-separated names (default all)")] = None,
+        instances: Annotated[
+            str | None, Query(description="comma-separated names (default all)", max_length=10000)
+        ] = None,
         events: Annotated[bool, Query(description="also push new events")] = True,
     ) -> None:
         """Pushes ``{"type": "snapshot", "time", "instances": {name: detail}, "events": [...]}``
-        ``rate`` times a second (at most 20)."""
-        names = list(runtime.instances) if not instances else [n for n in instances.split(",") if n]
-        unknown = [n for n in names if n not in runtime.instances]
+        ``rate`` times a second (at most 20).  Messages from the client are ignored (text or
+        binary); the token is the Authorization header or ``?token=``."""
+        if clients[0] >= settings.live_clients_max:
+            await ws.close(code=1013)  # try again later (refused at the handshake)
+            return
+        clients[0] += 1
+        try:
+            await _stream(ws, rate, instances, events)
+        finally:
+            clients[0] -= 1
+
+    async def _stream(ws: WebSocket, rate: float, instances: str | None, events: bool) -> None:
+        wanted = [n for n in (instances or "").split(",") if n]
         await ws.accept()
-        if unknown:
-            await ws.send_json({"type": "error", "detail": f"no instance {', '.join(map(repr, unknown))}"})
+        try:
+            start = await backend.call("live_start", names=wanted)
+        except ServiceError as exc:
+            await ws.send_json({"type": "error", "detail": exc.detail})
             await ws.close(code=1008)
             return
-        rate = min(rate, runtime.config.api.live_rate_max)
-        last_seq = runtime.events.last_seq
+        names, last_seq = start["names"], start["last_seq"]
+        rate = min(rate, settings.live_rate_max)
         loop = asyncio.get_running_loop()
         next_time = loop.time()
+        receiver = asyncio.ensure_future(ws.receive())
         try:
             while True:
-                message: dict[str, Any] = {
-                    "type": "snapshot",
-                    "time": time.time(),
-                    "instances": {n: runtime.instances[n].snapshot() for n in names},
-                }
-                if events:
-                    new = runtime.events.since(last_seq, 1000)
-                    if new:
-                        last_seq = new[-1].seq
-                    message["events"] = [e.to_dict() for e in new]
-                await ws.send_json(clean(message))
-                next_time += 1.0 / rate
-                delay = next_time - loop.time()
-                if delay < 0:
-                    next_time = loop.time()
-                    delay = 0
-                with contextlib.suppress(asyncio.TimeoutError):
-                    await asyncio.wait_for(ws.receive_text(), delay)
-        except WebSocketDisconnect:
+                try:
+                    message = await backend.call("live", names=names, after=last_seq, events=events)
+                except ServiceError:
+                    await ws.close(code=1012)  # the runtime is stopping
+                    return
+                last_seq = message.pop("last_seq")
+                await ws.send_json(message)
+                next_time = max(next_time + 1.0 / rate, loop.time())
+                # Wait for the next tick; whatever the client sends (text, bytes) is ignored.
+                while True:
+                    done, _ = await asyncio.wait({receiver}, timeout=max(0.0, next_time - loop.time()))
+                    if not done:
+                        break
+                    if receiver.result()["type"] == "websocket.disconnect":
+                        return
+                    receiver = asyncio.ensure_future(ws.receive())
+        except (ConnectionError, RuntimeError):  # the client vanished mid-send
             return
-
-    return app
+        finally:
+            if not receiver.done():
+                receiver.cancel()
+                with contextlib.suppress(BaseException):
+                    await receiver

@@ -72,9 +72,27 @@ class ApiConfig(_Strict):
     host: str = "127.0.0.1"
     port: int = Field(default=8765, ge=0, le=65535)
     token_file: str = Field(default="api-token", description="in state_dir unless absolute")
+    read_token_file: str = Field(
+        default="api-token-read", description="the read-only token, in state_dir unless absolute"
+    )
+    allowed_hosts: list[str] = Field(
+        default_factory=list,
+        description="more names clients may use in the Host header (besides loopback and the bound "
+        'address); ["*"] accepts any (no DNS-rebinding protection)',
+    )
+    allowed_origins: list[str] = Field(
+        default_factory=list, description='browser origins allowed, e.g. "http://scada.local:8080"'
+    )
+    max_body: int = Field(
+        default=8 * 1024 * 1024,
+        ge=64 * 1024,
+        le=64 * 1024 * 1024,
+        description="bytes of a knowledge-base upload, at most (other bodies: 64 KiB)",
+    )
     live_rate_max: float = Field(
         default=20.0, gt=0, le=20.0, description="WebSocket updates per second, at most"
     )
+    live_clients_max: int = Field(default=8, ge=1, le=256, description="WebSocket clients at once")
 
 
 class ConnectionConfig(_Strict):
@@ -83,9 +101,20 @@ class ConnectionConfig(_Strict):
 
     type: str
     poll_interval: float = Field(default=0.01, ge=0.001, le=60)
+    deadline: float | None = Field(
+        default=None,
+        gt=0,
+        le=600,
+        description="seconds without a complete exchange after which the instances using the "
+        "connection hold (a frozen peer); default max(0.25, 10 x poll_interval)",
+    )
     reconnect_min: float = Field(default=0.1, gt=0, le=60)
     reconnect_max: float = Field(default=5.0, gt=0, le=600)
     options: dict[str, Any] = Field(default_factory=dict)
+
+    @property
+    def effective_deadline(self) -> float:
+        return self.deadline if self.deadline is not None else max(0.25, 10 * self.poll_interval)
 
 
 class BindingConfig(_Strict):

@@ -1,9 +1,14 @@
 """The runtime: builds connections, links and instances from a configuration, runs the
-cycle thread, the I/O event loop and the API server, and stops them cleanly.
+cycle thread, the I/O event loop and the API process, and stops them cleanly.
 
 Threads: ``fuzzyctl-cycles`` runs every instance's task (:mod:`.scheduler`);
-``fuzzyctl-io`` runs an asyncio loop with one coroutine per link (:mod:`.links`) and the
-uvicorn server of the API (:mod:`.api`); ``fuzzyctl-events`` writes the event file.
+``fuzzyctl-io`` runs an asyncio loop with one coroutine per link (:mod:`.links`);
+``fuzzyctl-api-rpc`` and ``fuzzyctl-api-download`` answer the API process
+(:mod:`.apiserver`, :mod:`.rpc`), which serves HTTP in a process of its own;
+``fuzzyctl-events`` writes the event file.  With ``realtime_priority`` the cycle thread
+runs SCHED_FIFO at that priority and the threads that answer the field and the API one
+level below: a thread that holds the interpreter lock when the cycle thread wants it must
+not be preempted by an ordinary process meanwhile.
 """
 
 from __future__ import annotations
@@ -11,7 +16,6 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import gc
-import os
 import socket
 import sys
 import threading
@@ -28,9 +32,10 @@ from fuzzyctl.runtime.events import EventLog
 from fuzzyctl.runtime.instance import Instance
 from fuzzyctl.runtime.kb import KnowledgeBaseSource, PreparedKB, prepare_kb, read_kb
 from fuzzyctl.runtime.links import Link
-from fuzzyctl.runtime.scheduler import RuntimeClock, Scheduler, auto_phases
+from fuzzyctl.runtime.scheduler import RuntimeClock, Scheduler, auto_phases, set_fifo
+from fuzzyctl.webguard import LOOPBACK_NAMES
 
-__all__ = ["Runtime"]
+__all__ = ["Runtime", "allowed_hosts"]
 
 KEEP_RECORDS = 1  # the task's own record list; the instance keeps its timings in a GC-free ring
 
@@ -49,7 +54,8 @@ class Runtime:
             log_path = (config.state_dir / name) if name else None
         else:
             log_path = Path(event_log) if event_log is not None else None
-        self.events = EventLog(log_path)
+        prio = config.runtime.realtime_priority
+        self.events = EventLog(log_path, thread_setup=(lambda: set_fifo(prio - 1)) if prio > 1 else None)
         self.api_enabled = config.api.enabled if api is None else api
         self._stop = threading.Event()
         self.clock = RuntimeClock(self._stop, config.runtime.spin)
@@ -74,7 +80,11 @@ class Runtime:
             on_start=self._scheduler_started,
         )
         self.token: str | None = None
+        self.read_token: str | None = None
+        self.token_path: Path | None = None
+        self.read_token_path: Path | None = None
         self.api_address: tuple[str, int] | None = None
+        self.api_process: Any = None
         self._loop: asyncio.AbstractEventLoop | None = None
         self._io_stop: asyncio.Event | None = None
         self._io_thread: threading.Thread | None = None
@@ -221,11 +231,10 @@ class Runtime:
         if self.api_enabled:
             from fuzzyctl.runtime.token import load_or_create_token
 
-            token_path = Path(api.token_file).expanduser()
-            if not token_path.is_absolute():
-                token_path = self.config.state_dir / token_path
-            self.token = load_or_create_token(token_path)
-            self.token_path = token_path
+            self.token_path = self._state_file(api.token_file)
+            self.read_token_path = self._state_file(api.read_token_file)
+            self.token = load_or_create_token(self.token_path)
+            self.read_token = load_or_create_token(self.read_token_path)
             sock = socket.socket(socket.AF_INET6 if ":" in api.host else socket.AF_INET, socket.SOCK_STREAM)
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             try:
@@ -240,6 +249,8 @@ class Runtime:
             sock.setblocking(False)
             self._api_socket = sock
             self.api_address = sock.getsockname()[:2]
+            # Started first: its imports take seconds, they overlap with the rest of the start.
+            self._start_api(sock)
         self.started = True
         self.events.emit(
             "runtime-start",
@@ -255,10 +266,47 @@ class Runtime:
         self._io_ready.wait(30)
         if self._io_error is not None:
             raise FuzzyctlError(f"the I/O loop failed to start: {self._io_error}")
+        if self.api_process is not None:
+            try:
+                self.api_process.wait_ready()
+            except BaseException:
+                self.stop()
+                raise
         sys.setswitchinterval(self.config.runtime.switch_interval)
         gc.collect()
         gc.freeze()  # startup objects out of the collector's way: shorter pauses in the cycle thread
         self.scheduler.start()
+
+    def _state_file(self, name: str) -> Path:
+        path = Path(name).expanduser()
+        return path if path.is_absolute() else self.config.state_dir / path
+
+    def _start_api(self, sock: socket.socket) -> None:
+        from fuzzyctl.runtime.api import ApiSettings
+        from fuzzyctl.runtime.apiserver import ApiProcess
+        from fuzzyctl.runtime.service import Service
+
+        api = self.config.api
+        assert self.token is not None
+        settings = ApiSettings(
+            token=self.token,
+            read_token=self.read_token,
+            hosts=allowed_hosts(api.host, api.allowed_hosts),
+            origins=list(api.allowed_origins),
+            max_body=api.max_body,
+            live_rate_max=api.live_rate_max,
+            live_clients_max=api.live_clients_max,
+        )
+        prio = self.config.runtime.realtime_priority
+
+        def below_cycles() -> None:
+            if prio > 1:
+                set_fifo(prio - 1)
+
+        self.api_process = ApiProcess(
+            Service(self), sock, settings, emit=self.events.emit, thread_setup=below_cycles
+        )
+        self.api_process.start(wait=False)
 
     def _scheduler_started(self, problem: str | None) -> None:
         if problem is not None:
@@ -281,39 +329,18 @@ class Runtime:
 
     async def _io(self) -> None:
         prio = self.config.runtime.realtime_priority
-        if prio > 1 and hasattr(os, "sched_setscheduler"):
+        if prio > 1:
             # The I/O thread holds the GIL the cycle thread needs: if the OS preempted it for
             # another process while it holds the GIL, the raised cycle thread would wait anyway.
-            with contextlib.suppress(OSError):
-                os.sched_setscheduler(0, os.SCHED_FIFO, os.sched_param(prio - 1))
+            set_fifo(prio - 1)
         self._loop = asyncio.get_running_loop()
         self._io_stop = asyncio.Event()
         link_tasks = [
             asyncio.create_task(link.run(self._io_stop), name=f"link-{n}") for n, link in self.links.items()
         ]
-        server: Any = None
-        server_task = None
-        if self._api_socket is not None:
-            import uvicorn
-
-            from fuzzyctl.runtime.api import create_app
-
-            app = create_app(self)
-            server = uvicorn.Server(
-                uvicorn.Config(
-                    app, log_level="warning", access_log=False, lifespan="off", ws="websockets-sansio"
-                )
-            )
-            server.install_signal_handlers = lambda: None  # the CLI owns signals
-            server_task = asyncio.create_task(server.serve(sockets=[self._api_socket]), name="api")
         self._io_ready.set()
         await self._io_stop.wait()
-        if server is not None:
-            server.should_exit = True
         await asyncio.gather(*link_tasks, return_exceptions=True)
-        if server_task is not None:
-            with contextlib.suppress(asyncio.TimeoutError):
-                await asyncio.wait_for(server_task, 5)
 
     def call_io(self, coro: Any, timeout: float = 10.0) -> Any:
         """Run a coroutine on the I/O loop from another thread and wait for its result."""
@@ -326,6 +353,9 @@ class Runtime:
         if not self.started:
             self.events.close()
             return
+        if self.api_process is not None:
+            self.api_process.stop()  # first: no request reaches a runtime that is stopping
+            self.api_process = None
         self._stop.set()
         self.scheduler.join(10)
         if self._loop is not None and self._io_stop is not None:
@@ -381,7 +411,16 @@ class Runtime:
         try:
             kb = self.prepare_download(name, text, format, origin)
         except FuzzyctlError as exc:
-            detail = exc.render() if isinstance(exc, DiagnosticError) else str(exc)
+            if isinstance(exc, DiagnosticError):
+                # Places and messages, no source excerpts: rendering those splits the whole
+                # (possibly megabytes of) text once per diagnostic, holding the interpreter.
+                shown = [
+                    f"{d.location()}: {d.severity.value}: {d.message[:300]}" for d in exc.diagnostics[:20]
+                ]
+                more = len(exc.diagnostics) - len(shown)
+                detail = "\n".join(shown + ([f"... {more} more"] if more > 0 else []))
+            else:
+                detail = str(exc)
             self.events.emit(
                 "download-refused",
                 f"{name}: download refused: {detail.splitlines()[0] if detail else exc}",
@@ -389,7 +428,7 @@ class Runtime:
                 instance=name if name in self.instances else None,
                 format=format,
                 origin=origin,
-                error=detail,
+                error=detail[:4000],
             )
             raise
         return self.instances[name].download(kb, source=origin)
@@ -410,6 +449,23 @@ class Runtime:
                 "points": len(link.points),
             }
         return out
+
+
+def allowed_hosts(bind: str, extra: list[str]) -> list[str] | None:
+    """The names the API answers to in the Host header (docs/runtime.md, "Security"):
+    loopback, the bound address, and ``extra``; bound to every interface (0.0.0.0, ::),
+    also this machine's name and its addresses.  ``["*"]`` in ``extra``: any (None)."""
+    if "*" in extra:
+        return None
+    names = set(LOOPBACK_NAMES) | {h.lower().strip("[]") for h in extra}
+    if bind in ("0.0.0.0", "::", ""):
+        for name in {socket.gethostname(), socket.getfqdn()}:
+            names.add(name.lower())
+            with contextlib.suppress(OSError):
+                names.update(str(info[4][0]).lower() for info in socket.getaddrinfo(name, None))
+    else:
+        names.add(bind.lower().strip("[]"))
+    return sorted(names)
 
 
 def check_config(path: str | Path) -> tuple[Config | None, list[str]]:

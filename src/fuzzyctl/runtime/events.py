@@ -53,7 +53,13 @@ class Event:
 class EventLog:
     """Thread-safe, gap-free event log with an optional JSON-lines file."""
 
-    def __init__(self, path: Path | None = None, *, keep: int = 100_000) -> None:
+    def __init__(
+        self,
+        path: Path | None = None,
+        *,
+        keep: int = 100_000,
+        thread_setup: Callable[[], object] | None = None,
+    ) -> None:
         self._lock = threading.Lock()
         self._events: deque[Event] = deque(maxlen=keep)
         self._seq = 0
@@ -61,6 +67,7 @@ class EventLog:
         self.path = path
         self._queue: queue.SimpleQueue[Event | None] = queue.SimpleQueue()
         self._writer: threading.Thread | None = None
+        self._thread_setup = thread_setup
         if path is not None:
             path.parent.mkdir(parents=True, exist_ok=True)
             self._file = path.open("a", encoding="utf-8")
@@ -139,6 +146,8 @@ class EventLog:
             return self._events[0].seq if self._events else self._seq + 1
 
     def _write_loop(self) -> None:
+        if self._thread_setup is not None:
+            self._thread_setup()  # (the runtime: real-time below the cycle thread, see core)
         while True:
             event = self._queue.get()
             if event is None:

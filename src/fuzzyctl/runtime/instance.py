@@ -113,15 +113,26 @@ class ParamBinding:
 
 @dataclass
 class Problems:
+    """What keeps an instance from ``run``: links down, links late (up, but no complete
+    exchange for longer than their ``deadline``: a frozen peer), inputs not a number."""
+
     links: list[str] = field(default_factory=list)
     inputs: list[str] = field(default_factory=list)
+    late: list[str] = field(default_factory=list)
+    late_by: float = 0.0
 
     def __bool__(self) -> bool:
-        return bool(self.links or self.inputs)
+        return bool(self.links or self.inputs or self.late)
 
     def text(self) -> str:
-        parts = [f"link {n} down" for n in self.links] + [f"input {n} invalid" for n in self.inputs]
+        parts = [f"link {n} down" for n in self.links]
+        parts += [f"link {n} late (no exchange for {self.late_by:.3g} s)" for n in self.late]
+        parts += [f"input {n} invalid" for n in self.inputs]
         return ", ".join(parts)
+
+
+NO_PROBLEMS = Problems()  # shared by the cycles that have none (never mutated)
+STATUS_KEYS = frozenset({"INFO", "ENO", "STATUS", "ERROR"})
 
 
 class Instance:
@@ -145,8 +156,11 @@ class Instance:
         self.outputs: list[OutputBinding] = []
         self.params: list[ParamBinding] = []
         self.state = SafetyState.SAFE
+        """The reported state: ``io_state``, or ``safe`` while the block cannot compute."""
         self.state_since = 0.0
-        self.problems = Problems()
+        self.io_state = SafetyState.SAFE
+        self.io_since = 0.0
+        self.problems = NO_PROBLEMS
         self.error: str | None = None
         self.downloads = 0
         self.last_download: dict[str, Any] | None = None
@@ -202,23 +216,18 @@ class Instance:
             try:
                 self._cycle(ctx.start, ctx.period)
             except Exception as exc:  # a bug in one instance must not stop the others
-                message = f"internal error: {type(exc).__name__}: {exc}"
-                if message != self.error:
-                    self.error = message
-                    self.events.emit("error", f"{self.name}: {message}", level="error", instance=self.name)
+                try:
+                    self._block_fault(f"internal error: {type(exc).__name__}: {exc}", ctx.start)
+                except Exception:  # not even the status can be read: the safe values at least
+                    for o in self.outputs:
+                        if o.safe is not None and o.key not in STATUS_KEYS:
+                            for cell in o.cells:
+                                cell.value = o.safe
 
     def _cycle(self, now: float, period: float) -> None:
         adapter = self.adapter
         if not self._started:
-            self._started = True
-            self.state_since = now
-            self.events.emit(
-                "safe-enter",
-                f"{self.name}: outputs at their safe values until every input has been read",
-                level="warning",
-                instance=self.name,
-                reason="startup",
-            )
+            self._start(now)
         if adapter.before_cycle():
             self._rekey()
             self.events.emit(
@@ -227,60 +236,130 @@ class Instance:
                 instance=self.name,
                 sha256=adapter.kb.source.sha256,
             )
-        problems = Problems()
+        problems = NO_PROBLEMS
         for lk in self.links:
-            if not lk.up:
-                problems.links.append(lk.name)
+            if not lk.up or now - lk.last_exchange > lk.deadline:
+                problems = self._link_problem(problems, lk, now)
+        limit = adapter.INPUT_LIMIT  # beyond it (or NaN) the block's type cannot hold the value
         for b in self.inputs:
             v = b.cell.value
-            good = b.link.up and math.isfinite(v)
-            if good:
+            up = b.link.up
+            if up and -limit < v < limit:
                 b.last_good = v
-            elif b.link.up or b.last_good is None:  # the link is fine but the value is not a number
-                problems.inputs.append(b.name)
-            valid = good or not b.link.up
-            if valid != b.valid and b.link.up:
-                b.valid = valid
-                self.events.emit(
-                    "input-valid" if valid else "input-invalid",
-                    f"{self.name}: input {b.name} = {v!r}"
-                    + ("" if valid else ", running on its last good value"),
-                    level="info" if valid else "warning",
-                    instance=self.name,
-                    input=b.name,
-                    value=None if math.isnan(v) else v,
-                )
+                if not b.valid:
+                    self._input_validity(b, v, True)
+            else:
+                if up or b.last_good is None:  # the link is fine but the value is not a number
+                    if problems is NO_PROBLEMS:
+                        problems = Problems()
+                    problems.inputs.append(b.name)
+                if up and b.valid:
+                    self._input_validity(b, v, False)
             if b.last_good is not None:
                 adapter.write_input(b.key, b.last_good)
         for p in self.params:
             self._param_from_field(p)
-        self._safety(now, problems)
-        adapter.fault = None if self.state is SafetyState.RUN else self.state.value
+        if problems is NO_PROBLEMS and self.io_state is SafetyState.RUN:
+            self.problems = problems  # the usual cycle: nothing to change
+        else:
+            self._safety(now, problems)
+        adapter.fault = None if self.io_state is SafetyState.RUN else self.io_state.value
         try:
             adapter.execute(period)
             adapter.after_cycle()
+            bad = adapter.bad_output()
+            if bad is not None:
+                raise FuzzyctlError(f"the block computed {bad}: not a number it can output")
+        except FuzzyctlError as exc:  # a parameter the field or API set out of range, no result, ...
+            self._block_fault(str(exc), now)
+        else:
             if self.error is not None:
-                self.events.emit("error-cleared", f"{self.name}: the block runs again", instance=self.name)
-                self.error = None
-        except FuzzyctlError as exc:  # a parameter the field or API set out of range, ...
-            if str(exc) != self.error:
-                self.error = str(exc)
-                self.events.emit(
-                    "error", f"{self.name}: {exc}; outputs at safe values", level="error", instance=self.name
-                )
-        safe = self.state is SafetyState.SAFE or self.error is not None
+                self._block_cleared(now)
+        self._write_outputs()
+
+    def _write_outputs(self) -> None:
+        """Block values (safe values in ``safe``) into the output cells; parameters mirrored."""
+        adapter = self.adapter
+        safe = self.state is SafetyState.SAFE
         for o in self.outputs:
-            if safe and o.key not in ("INFO", "ENO", "STATUS", "ERROR"):
+            if safe and o.key not in STATUS_KEYS:
                 value = o.safe if o.safe is not None else o.last
             else:
                 value = adapter.read_output(o.key)
-            if value is None or not math.isfinite(value):
+            if value is None or value - value != 0.0:  # nothing yet, or not finite
                 continue
             o.last = value
             for cell in o.cells:
                 cell.value = value
         for p in self.params:
             p.mirror.value = float(adapter.get_param(p.key))
+
+    def _start(self, now: float) -> None:
+        self._started = True
+        self.state_since = now
+        self.events.emit(
+            "safe-enter",
+            f"{self.name}: outputs at their safe values until every input has been read",
+            level="warning",
+            instance=self.name,
+            reason="startup",
+        )
+
+    def _link_problem(self, problems: Problems, lk: Link, now: float) -> Problems:
+        if problems is NO_PROBLEMS:
+            problems = Problems()
+        if lk.up:
+            problems.late.append(lk.name)
+            problems.late_by = max(problems.late_by, now - lk.last_exchange)
+        else:
+            problems.links.append(lk.name)
+        return problems
+
+    def _input_validity(self, b: InputBinding, v: float, valid: bool) -> None:
+        b.valid = valid
+        self.events.emit(
+            "input-valid" if valid else "input-invalid",
+            f"{self.name}: input {b.name} = {v!r}" + ("" if valid else ", running on its last good value"),
+            level="info" if valid else "warning",
+            instance=self.name,
+            input=b.name,
+            value=None if math.isnan(v) else v,
+        )
+
+    def _block_fault(self, message: str, now: float) -> None:
+        """The block could not compute: safe values on the outputs at once, INFO 16#42 /
+        STATUS bit 15 with ERROR, state ``safe``, one ``error`` event per distinct cause."""
+        self.adapter.fault = "block"
+        if message != self.error:
+            self.error = message
+            self.events.emit(
+                "error", f"{self.name}: {message}; outputs at safe values", level="error", instance=self.name
+            )
+        if self.state is not SafetyState.SAFE:
+            self.events.emit(
+                "safe-enter",
+                f"{self.name}: the block cannot compute; outputs at their safe values",
+                level="error",
+                instance=self.name,
+                reason="block error",
+                error=message,
+                safe_values={o.name: o.safe for o in self.outputs},
+            )
+            self.state, self.state_since = SafetyState.SAFE, now
+        self._write_outputs()
+
+    def _block_cleared(self, now: float) -> None:
+        self.events.emit("error-cleared", f"{self.name}: the block runs again", instance=self.name)
+        self.error = None
+        if self.io_state is not SafetyState.SAFE:
+            self.events.emit(
+                "safe-exit",
+                f"{self.name}: the block computes again; outputs from the block",
+                instance=self.name,
+                after=round(now - self.state_since, 6),
+            )
+            self.state, self.state_since = self.io_state, now
+        self.adapter.fault = None if self.io_state is SafetyState.RUN else self.io_state.value
 
     def _param_from_field(self, p: ParamBinding) -> None:
         v = p.cell.value
@@ -295,45 +374,65 @@ class Instance:
         if v == current or (first and p.mirror.sent is None and v == 0 and current != 0):
             # A fresh node or register holds 0 before we mirrored anything: not a command.
             return
-        self._set_param(p.key, v, source=f"field:{p.link.name}")
+        try:
+            self._set_param(p.key, v, source=f"field:{p.link.name}")
+        except InputError as exc:  # the field wrote a value the block refuses: keep the old one
+            self.events.emit(
+                "parameter-refused",
+                f"{self.name}: {exc} (field:{p.link.name}); {p.key} stays {current}",
+                level="warning",
+                instance=self.name,
+                parameter=p.key,
+                value=v,
+                source=f"field:{p.link.name}",
+            )
 
     def _safety(self, now: float, problems: Problems) -> None:
+        """The I/O state machine (run -> hold -> safe -> run); a block fault overrides the
+        reported state with ``safe`` while it lasts (:meth:`_block_fault`)."""
         self.problems = problems
         hold = self.config.hold_time
+        state = self.io_state
         if not problems:
-            if self.state is not SafetyState.RUN:
-                kind = "safe-exit" if self.state is SafetyState.SAFE else "hold-end"
+            if state is not SafetyState.RUN:
+                kind = "safe-exit" if state is SafetyState.SAFE else "hold-end"
+                still = "; the block still cannot compute" if self.error is not None else "; running normally"
                 self.events.emit(
                     kind,
-                    f"{self.name}: every link up and every input good; running normally",
+                    f"{self.name}: every link up and every input good{still}",
                     instance=self.name,
-                    after=round(now - self.state_since, 6),
+                    after=round(now - self.io_since, 6),
                 )
-                self.state, self.state_since = SafetyState.RUN, now
+                self._set_io(SafetyState.RUN, now)
             return
-        if self.state is SafetyState.RUN:
-            self.state, self.state_since = SafetyState.HOLD, now
+        if state is SafetyState.RUN:
+            self._set_io(SafetyState.HOLD, now)
             self.events.emit(
                 "hold-start",
                 f"{self.name}: {problems.text()}; running on the last good inputs for {hold:g} s",
                 level="warning",
                 instance=self.name,
-                links=problems.links,
+                links=problems.links + problems.late,
                 inputs=problems.inputs,
                 hold_time=hold,
             )
-        if self.state is SafetyState.HOLD and now - self.state_since >= hold:
-            self.state, self.state_since = SafetyState.SAFE, now
+        if self.io_state is SafetyState.HOLD and now - self.io_since >= hold:
+            self._set_io(SafetyState.SAFE, now)
             self.events.emit(
                 "safe-enter",
                 f"{self.name}: {problems.text()} for {hold:g} s; outputs at their safe values",
                 level="error",
                 instance=self.name,
-                links=problems.links,
+                links=problems.links + problems.late,
                 inputs=problems.inputs,
                 reason="hold time elapsed",
                 safe_values={o.name: o.safe for o in self.outputs},
             )
+
+    def _set_io(self, state: SafetyState, now: float) -> None:
+        self.io_state, self.io_since = state, now
+        if self.error is None:  # while the block fails, the reported state stays safe
+            self.state, self.state_since = state, now
 
     def _rekey(self, kb: PreparedKB | None = None) -> None:
         for b in self.inputs:
@@ -522,7 +621,12 @@ class Instance:
                 "period": self.config.period,
                 "state": self.state.value,
                 "state_since": self.state_since,
-                "problems": {"links": list(self.problems.links), "inputs": list(self.problems.inputs)},
+                "problems": {
+                    "links": list(self.problems.links),
+                    "late": list(self.problems.late),
+                    "inputs": list(self.problems.inputs),
+                    "block": [] if self.error is None else [self.error],
+                },
                 "error": self.error,
                 "status": adapter.status,
                 "inputs": inputs,

@@ -9,6 +9,7 @@ itself is a reference swap (see :mod:`fuzzyctl.runtime.instance`).
 
 from __future__ import annotations
 
+import functools
 import hashlib
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,16 +63,23 @@ def read_kb(path: Path, format: str | None = None) -> KnowledgeBaseSource:
     return KnowledgeBaseSource(formats.decode(data), fmt.name, str(path))
 
 
+@functools.lru_cache(maxsize=8)
+def _parse(text: str, format: str, path: str | None) -> Document:
+    """The model of a knowledge-base text.  Cached: a configuration often runs many
+    instances of one file, and a model is immutable (each instance still gets its own
+    block, with its own state)."""
+    from fuzzyctl import formats
+
+    return formats.read_text(text, format, path=path).document
+
+
 def prepare_kb(
     source: KnowledgeBaseSource, style: str, *, check_profile: bool = True, span_rule: bool = True
 ) -> PreparedKB:
     """Parse, check and build the block object of a knowledge base.  Raises
     DiagnosticError (with file:line:column diagnostics) or FuzzyctlError."""
-    from fuzzyctl import formats
-
     path = source.origin if source.origin != "api" else None
-    loaded = formats.read_text(source.text, source.format, path=path)
-    document = loaded.document
+    document = _parse(source.text, source.format, path)
     fb = document.main
     inputs = tuple(v.name for v in fb.inputs)
     outputs = tuple(v.name for v in fb.outputs)

@@ -47,6 +47,9 @@ class OutCell:
         self.sent: float | None = None
 
 
+_Lists = tuple[list[Point], list[InCell], list[Point], list[OutCell], list[Point], list[OutCell]]
+
+
 @dataclass
 class LinkCounters:
     exchanges: int = 0
@@ -65,21 +68,32 @@ class Link:
         self.connector = connector
         self.config = config
         self.events = events
-        self.state = LinkState.DOWN
+        self._state = LinkState.DOWN
+        self.up = False
+        """Whether the link is up: a plain attribute, read several times per instance and
+        cycle by the cycle thread."""
         self.counters = LinkCounters()
+        self.deadline = config.effective_deadline
+        self.last_exchange = 0.0
+        """``time.perf_counter()`` at the end of the last complete exchange: an instance
+        whose link has none for longer than ``deadline`` holds, before the protocol's timeout
+        declares the link lost (a frozen peer)."""
         self._in: dict[Point, InCell] = {}
         self._out: dict[Point, OutCell] = {}
         self._mirror: dict[Point, OutCell] = {}
+        self._lists: _Lists | None = None  # the bindings as parallel lists, made at the first exchange
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
         """The cell of an input point (shared when several bindings read the same point)."""
+        self._lists = None
         return self._in.setdefault(point, InCell())
 
     def output(self, point: Point) -> OutCell:
         """The cell of an output point, written every exchange."""
         if point in self._out or point in self._mirror:
             raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        self._lists = None
         return self._out.setdefault(point, OutCell())
 
     def mirror(self, point: Point) -> OutCell:
@@ -87,6 +101,7 @@ class Link:
         value a client writes is not overwritten before the runtime reads it)."""
         if point in self._out or point in self._mirror:
             raise LinkError(f"{point.describe()} on {self.name} is written by two bindings")
+        self._lists = None
         return self._mirror.setdefault(point, OutCell())
 
     @property
@@ -94,30 +109,42 @@ class Link:
         return list({**self._in, **self._out, **self._mirror})
 
     @property
-    def up(self) -> bool:
-        return self.state is LinkState.UP
+    def state(self) -> LinkState:
+        return self._state
+
+    @state.setter
+    def state(self, state: LinkState) -> None:
+        self._state = state
+        self.up = state is LinkState.UP
 
     # --- the exchange
     async def exchange(self) -> None:
         """Read every input point, write every output (and changed mirror)."""
         t0 = time.perf_counter()
-        if self._in:
-            points = list(self._in)
-            values = await self.connector.read(points)
+        lists = self._lists
+        if lists is None:
+            # Points hash slowly (pydantic models): walk parallel lists, not the dicts.
+            lists = self._lists = (
+                list(self._in), list(self._in.values()),
+                list(self._out), list(self._out.values()),
+                list(self._mirror), list(self._mirror.values()),
+            )  # fmt: skip
+        in_points, in_cells, out_points_all, out_cells, mirror_points, mirror_cells = lists
+        if in_points:
+            values = await self.connector.read(in_points)
             now = time.perf_counter()
-            for p, v in zip(points, values, strict=True):
-                in_cell = self._in[p]
+            for in_cell, v in zip(in_cells, values, strict=True):
                 in_cell.value, in_cell.stamp = v, now
         out_points: list[Point] = []
         out_values: list[float] = []
         sent: list[OutCell] = []
-        for p, out_cell in self._out.items():
+        for p, out_cell in zip(out_points_all, out_cells, strict=True):
             value = out_cell.value
             if value is not None:
                 out_points.append(p)
                 out_values.append(value)
                 sent.append(out_cell)
-        for p, out_cell in self._mirror.items():
+        for p, out_cell in zip(mirror_points, mirror_cells, strict=True):
             value = out_cell.value
             if value is not None and value != out_cell.sent:
                 out_points.append(p)
@@ -128,7 +155,8 @@ class Link:
             for out_cell, value in zip(sent, out_values, strict=True):
                 out_cell.sent = value
         self.counters.exchanges += 1
-        self.counters.last_exchange_ms = (time.perf_counter() - t0) * 1e3
+        self.last_exchange = end = time.perf_counter()
+        self.counters.last_exchange_ms = (end - t0) * 1e3
 
     async def _connect(self) -> None:
         await self.connector.connect()

@@ -4,6 +4,12 @@ The browser holds the model being edited (fuzzyctl's JSON form) and sends it wit
 request; the server checks it, writes it as FCL, evaluates it with the engine, runs the
 simulated process and talks to a running ``fuzzyctl serve``.  Files are read and written
 only inside the project directory.  docs/studio.md is the user's guide.
+
+The front door (:mod:`fuzzyctl.webguard`) refuses, before the app sees them: another Host
+than the loopback names when bound to loopback (DNS rebinding), writes from another
+origin (CSRF), bodies over 16 MB (announced or chunked), and - when the studio has a
+token - every request without it.  The browser gets the token once from the URL printed
+at start (``/?token=...``), which sets an HttpOnly, SameSite=Strict cookie.
 """
 
 # No `from __future__ import annotations`: FastAPI reads the annotations at run time.
@@ -15,9 +21,8 @@ from pathlib import Path
 from typing import Any
 
 from fastapi import FastAPI, Request
-from fastapi.encoders import jsonable_encoder
 from fastapi.exceptions import RequestValidationError
-from fastapi.responses import FileResponse, JSONResponse, Response
+from fastapi.responses import FileResponse, JSONResponse, RedirectResponse, Response
 from fastapi.staticfiles import StaticFiles
 
 from fuzzyctl import __version__
@@ -49,10 +54,12 @@ from fuzzyctl.studio.schemas import (
     TextBody,
 )
 from fuzzyctl.studio.simulate import SimSessions, describe_configs
+from fuzzyctl.webguard import LOOPBACK_NAMES, Guard, Refusal, bearer_token, token_matches
 
 STATIC = Path(__file__).parent / "static"
 MAX_BODY = 16 * 1024 * 1024
 LOCAL_HOSTS = {"127.0.0.1", "localhost", "[::1]", "::1"}
+COOKIE = "fuzzyctl_studio_token"
 
 
 def plotly_bundle() -> Path:
@@ -75,10 +82,43 @@ def _clean(obj: Any) -> Any:
     return obj
 
 
-def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.0.1") -> FastAPI:
+def _cookie_token(headers: dict[str, str]) -> str | None:
+    for part in headers.get("cookie", "").split(";"):
+        name, _, value = part.strip().partition("=")
+        if name == COOKIE:
+            return value
+    return None
+
+
+def studio_authorizer(token: str) -> Any:
+    """Every request needs the token: ``Authorization: Bearer``, the cookie, or (for the
+    page itself, ``GET /``) ``?token=``."""
+
+    def authorize(scope: dict[str, Any], headers: dict[str, str]) -> Refusal | None:
+        given = bearer_token(headers) or _cookie_token(headers)
+        if given is None and scope["path"] == "/":
+            from urllib.parse import parse_qs
+
+            values = parse_qs(scope.get("query_string", b"").decode("latin-1")).get("token")
+            given = values[0] if values else None
+        if token_matches(given, token):
+            return None
+        return Refusal(
+            401,
+            "this studio needs its token: open the URL it printed at start (/?token=...)",
+            (("WWW-Authenticate", "Bearer"),),
+        )
+
+    return authorize
+
+
+def create_app(
+    root: str | Path, *, file: str | None = None, host: str = "127.0.0.1", token: str | None = None
+) -> Any:
     """The studio for the project directory ``root``; ``file`` (relative to it) is opened
-    at start.  Requests naming another host than the one bound are refused (DNS
-    rebinding), and so are writes from another origin (CSRF)."""
+    at start.  Bound to loopback, requests naming another host are refused (DNS
+    rebinding); writes from another origin are refused (CSRF); with ``token``, every
+    request needs it (docs/studio.md, "Security")."""
     project = ProjectDir.at(root)
     if file is not None:
         project.resolve(file)
@@ -93,29 +133,19 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         docs_url="/api/docs",
         redoc_url=None,
     )
-    check_host = host in LOCAL_HOSTS
-
-    @app.middleware("http")
-    async def _guard(request: Request, call_next: Any) -> Response:
-        hostname = (request.headers.get("host") or "").rsplit(":", 1)[0]
-        if check_host and hostname not in LOCAL_HOSTS:
-            return JSONResponse({"detail": f"host {hostname!r} not served"}, status_code=403)
-        if request.method not in ("GET", "HEAD", "OPTIONS"):
-            origin = request.headers.get("origin")
-            if origin is not None and origin.split("://", 1)[-1] != request.headers.get("host"):
-                return JSONResponse({"detail": "cross-origin request refused"}, status_code=403)
-            length = request.headers.get("content-length")
-            if length is not None and length.isdigit() and int(length) > MAX_BODY:
-                return JSONResponse({"detail": "request too large"}, status_code=413)
-            kind = request.headers.get("content-type", "")
-            if request.url.path.startswith("/api/") and not kind.startswith("application/json"):
-                return JSONResponse({"detail": "send JSON (content-type: application/json)"}, status_code=415)
-        response: Response = await call_next(request)
-        return response
 
     @app.exception_handler(RequestValidationError)
     async def _invalid(_request: Request, exc: RequestValidationError) -> JSONResponse:
-        return JSONResponse({"detail": _clean(jsonable_encoder(exc.errors()))}, status_code=422)
+        # The field and the reason, never the value sent (which may be megabytes).
+        errors = [
+            {
+                "type": e.get("type"),
+                "loc": [str(x)[:64] for x in e.get("loc", ())],
+                "msg": str(e.get("msg"))[:200],
+            }
+            for e in exc.errors()[:20]
+        ]
+        return JSONResponse({"detail": errors}, status_code=422)
 
     @app.exception_handler(PathError)
     async def _path_error(_request: Request, exc: PathError) -> JSONResponse:
@@ -403,7 +433,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
     def online_instances(body: OnlineBody) -> Any:
         """Connect: the runtime's health and instances."""
         health = online.call(body.url, "GET", "/health")
-        instances = online.call(body.url, "GET", "/instances")
+        instances = online.call(body.url, "GET", "/instances", token=body.token)
         return {"health": health, "instances": instances, "api": online.base_url(body.url)}
 
     @app.post("/api/online/read")
@@ -411,7 +441,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         """Live values of the chosen instance."""
         if not body.instance:
             raise InputError("choose an instance")
-        return online.call(body.url, "GET", f"/instances/{online.quote(body.instance)}")
+        return online.call(body.url, "GET", f"/instances/{online.quote(body.instance)}", token=body.token)
 
     @app.post("/api/online/command")
     def online_command(body: OnlineCommandBody) -> Any:
@@ -442,7 +472,7 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         dialog of a download shows their difference)."""
         if not body.instance:
             raise InputError("choose an instance")
-        running = online.knowledge_base_fcl(body.url, body.instance)
+        running = online.knowledge_base_fcl(body.url, body.instance, token=body.token)
         _document, fb = model_of(body)
         return {"running": running, "edited": analysis.fcl_text(Document((fb,)))}
 
@@ -470,8 +500,24 @@ def create_app(root: str | Path, *, file: str | None = None, host: str = "127.0.
         )
 
     @app.get("/", include_in_schema=False)
-    def index() -> FileResponse:
+    def index(request: Request) -> Response:
+        if token is not None and "token" in request.query_params:
+            # The front door checked it: keep it in a cookie, and take it out of the address bar.
+            from urllib.parse import urlencode
+
+            rest = [(k, v) for k, v in request.query_params.multi_items() if k != "token"]
+            target = "/" + ("?" + urlencode(rest) if rest else "")
+            response = RedirectResponse(target, status_code=303)
+            response.set_cookie(COOKIE, token, httponly=True, samesite="strict", path="/")
+            return response
         return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
 
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
-    return app
+    return Guard(
+        app,
+        hosts=sorted(LOOPBACK_NAMES) if host in LOCAL_HOSTS else None,
+        origin_on_reads=False,
+        max_body=lambda _method, _path: MAX_BODY,
+        authorize=None if token is None else studio_authorizer(token),
+        json_only=lambda path: path.startswith("/api/"),
+    )

@@ -1,6 +1,7 @@
 """On line: the studio's backend talks to a running ``fuzzyctl serve`` (docs/runtime.md)
 on the browser's behalf, so that the browser needs no cross-origin access and the token
-only travels between two local processes.
+only travels between two local processes.  The runtime wants a token for reading too:
+the write token, or its read-only token (enough to watch, not to command).
 
 Only ``http``/``https`` URLs are accepted, and only the runtime API's own paths are
 called (``/api/v1/...``).
@@ -81,13 +82,13 @@ def quote(name: str) -> str:
     return urllib.parse.quote(name, safe="")
 
 
-def knowledge_base_fcl(url: str, instance: str) -> dict[str, Any]:
+def knowledge_base_fcl(url: str, instance: str, token: str | None = None) -> dict[str, Any]:
     """The knowledge base an instance runs, as FCL text (converted when it was loaded
     from another format) for the download diff."""
     from fuzzyctl import formats
     from fuzzyctl.fcl import write
 
-    kb = call(url, "GET", f"/instances/{quote(instance)}/knowledge_base")
+    kb = call(url, "GET", f"/instances/{quote(instance)}/knowledge_base", token=token)
     text = kb.get("text", "") if isinstance(kb, dict) else ""
     fmt = kb.get("format", "fcl") if isinstance(kb, dict) else "fcl"
     if fmt == "fcl":

@@ -24,11 +24,10 @@ that is the engine's reading of ``Rule.condition is None``.
 from __future__ import annotations
 
 import math
+import struct
 from collections.abc import Mapping, Sequence
 from dataclasses import replace
 from typing import Any
-
-import numpy as np
 
 from fuzzyctl.blocks.siemens.analog import DB_FUZZY_LENGTH
 from fuzzyctl.blocks.siemens.info import Info
@@ -50,9 +49,20 @@ __all__ = ["FuzzyFB"]
 N_INPUTS, N_OUTPUTS = 8, 4
 
 
+_REAL = struct.Struct("f")
+_IN_ATTRS = tuple(f"INPUT{i}" for i in range(1, N_INPUTS + 1))
+_OUT_ATTRS = tuple(f"OUTPUT{i}" for i in range(1, N_OUTPUTS + 1))
+
+
 def real(value: float) -> float:
-    """A value as an S7 REAL (IEEE 754 single precision) holds it."""
-    return float(np.float32(value))
+    """A value as an S7 REAL (IEEE 754 single precision) holds it: rounded to nearest,
+    +-inf beyond the REAL range (as numpy's float32 conversion; struct is 4x faster, and
+    this runs for every input and output of every cycle of the runtime)."""
+    try:
+        result: float = _REAL.unpack(_REAL.pack(value))[0]
+    except OverflowError:  # rounds beyond FLT_MAX: IEEE gives the signed infinity
+        return math.copysign(math.inf, value)
+    return result
 
 
 def _term_xs(mf: MembershipFunction) -> list[float]:
@@ -169,10 +179,10 @@ class FuzzyFB:
     # ----------------------------------------------------------------- values
 
     def write_input(self, number: int, value: float) -> None:
-        setattr(self, f"INPUT{number}", real(value))
+        setattr(self, _IN_ATTRS[number - 1], real(value))
 
     def read_output(self, number: int) -> float:
-        return float(getattr(self, f"OUTPUT{number}"))
+        return float(getattr(self, _OUT_ATTRS[number - 1]))
 
     @property
     def inputs(self) -> tuple[float, ...]:
@@ -227,8 +237,8 @@ class FuzzyFB:
             return Info.DISABLED
         values: dict[str, float] = {}
         for i, name in enumerate(self._inputs, start=1):
-            x = getattr(self, f"INPUT{i}")
-            if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
+            x = getattr(self, _IN_ATTRS[i - 1])
+            if isinstance(x, bool) or not isinstance(x, (int, float)) or not math.isfinite(x):
                 raise InputError(f"INPUT{i} ({name}) = {x!r} is not a finite REAL")
             x = real(x)  # what a REAL parameter holds, however it was written
             limits = self._in_limits[i - 1]
@@ -239,5 +249,5 @@ class FuzzyFB:
         for j, name in enumerate(self._outputs, start=1):
             y = float(result[name])
             if not math.isnan(y):  # 1.5: no rule fired -> the last value stays
-                setattr(self, f"OUTPUT{j}", real(y))
+                setattr(self, _OUT_ATTRS[j - 1], real(y))
         return Info.OK

@@ -17,7 +17,7 @@ async function connect() {
   online.url = $("#on-url").value.trim();
   online.token = $("#on-token").value.trim() || null;
   try {
-    const res = await post("/api/online/instances", { url: online.url });
+    const res = await post("/api/online/instances", { url: online.url, token: online.token || null });
     online.instances = res.instances;
     const select = $("#on-instance");
     select.replaceChildren(...res.instances.map((i) => el("option", { value: i.name }, `${i.name} (${i.style}, ${i.state})`)));

@@ -247,7 +247,7 @@ async function sample() {
       }
       shareTrajectory();
     } else {
-      const detail = await post("/api/online/read", { url: online.url, instance: online.instance });
+      const detail = await post("/api/online/read", { url: online.url, token: online.token || null, instance: online.instance });
       if (session !== running) return;
       online.detail = detail;
       push(k * dt(), { ...detail.inputs, ...detail.outputs });
