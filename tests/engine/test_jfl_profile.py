@@ -160,3 +160,23 @@ def test_a_vertical_edge_takes_the_value_reached_from_the_left() -> None:
     iec = fuzzyctl.compile(fuzzyctl.load(text)).evaluate(inputs)["y"]
     assert jfl == pytest.approx(0.25 / 0.75)  # a IS t = 0.25, reached from the left
     assert iec == pytest.approx(1.0 / 1.5)  # IEC: the upper value (docs/engine.md)
+
+
+@pytest.mark.parametrize("backend", ["native", "python", "interpreted", None])
+def test_every_backend_gives_jfuzzylogics_numbers(backend: str | None) -> None:
+    # the C and generated-Python evaluators compute IEC arithmetic: a jfuzzylogic plan never
+    # reaches them, whatever backend is asked for (jFuzzyLogic 3.3: 11.701603788948043)
+    import warnings
+
+    from tests.conftest import data_path
+
+    kw = {} if backend is None else {"backend": backend}
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # "native backend unavailable" when asked for explicitly
+        ctl = fuzzyctl.compile(
+            fuzzyctl.load(data_path("jfuzzylogic", "fcl", "tipper.fcl")), compat="jfuzzylogic", **kw
+        )
+    assert ctl.evaluate({"service": 3, "food": 7})["tip"] == pytest.approx(11.701603788948043, abs=1e-12)
+    assert ctl.evaluate_batch({"service": [3.0], "food": [7.0]})["tip"][0] == pytest.approx(
+        11.701603788948043, abs=1e-12
+    )
