@@ -30,38 +30,64 @@ def f32(x: float) -> float:
 # ---------------------------------------------------------------- 1.3 / 1.4 FPLTEST
 
 
+# Section 1.4: x_S' = (mu_A x_A + mu_B x_B + ...) / (mu_A + mu_B + ...), one mu per rule (the
+# glossary: "the influences on a particular linguistic value of the output variable
+# resulting from various rules are added together"); AND is the minimum.  FPLTEST's rules:
+# 1 cold&low -> inlet (+100), 2 cold&high -> closed (0), 3 hot&low -> closed, 4 hot&high ->
+# drainage (-100); cold = (27 - T)/24 on [3, 27], low = (95 - p)/40 on [55, 95].
 @pytest.mark.parametrize(
     ("temp", "pressure", "valve"),
     [
-        # cold .75, hot .25, low .75, high .25: inlet .75, closed max(.25, .25), drainage .25
-        # -> (75 - 25) / 1.25
-        (9.0, 65.0, 40.0),
+        # cold .75, hot .25, low .75, high .25: inlet .75, closed .25 + .25, drainage .25
+        # -> (75 + 0 - 25) / (.75 + .5 + .25) = 100/3 (by the maximum it would be 50/1.25 = 40)
+        (9.0, 65.0, 100.0 / 3.0),
         # cold 1, low .5, high .5: inlet .5, closed .5 -> 50 / 1
         (3.0, 75.0, 50.0),
-        # cold 7/24, hot 17/24, low 7/8, high 1/8: inlet 7/24, closed max(1/8, 17/24), drainage
-        # 1/8 -> (700/24 - 12.5) / (7/24 + 17/24 + 1/8) = 400/27
-        (20.0, 60.0, 400.0 / 27.0),
-        # symmetric: every rule .5 -> 0
+        # cold 7/24, hot 17/24, low 7/8, high 1/8: inlet 7/24, closed 1/8 + 17/24, drainage
+        # 1/8 -> (700/24 - 12.5) / (7/24 + 20/24 + 3/24) = 40/3
+        (20.0, 60.0, 40.0 / 3.0),
+        # symmetric: every rule .5, closed 1 -> (50 - 50) / 2 = 0
         (15.0, 75.0, 0.0),
         # hot 1, high 1: drainage only
         (30.0, 100.0, -100.0),
+        # cold 5/8, hot 3/8, low 3/8, high 5/8: inlet 3/8, closed 5/8 + 3/8, drainage 3/8
+        # -> (37.5 - 37.5) / (3/8 + 1 + 3/8) = 0 (by the maximum also 0: symmetric)
+        (12.0, 80.0, 0.0),
+        # cold 11/12, hot 1/12, low 1/4, high 3/4: inlet 1/4, closed 3/4 + 1/12, drainage 1/12
+        # -> (25 - 25/3) / (1/4 + 10/12 + 1/12) = (50/3) / (7/6) = 100/7
+        (5.0, 85.0, 100.0 / 7.0),
     ],
 )
-def test_siemens_1_3_fpltest_evaluates_as_computed_by_hand(
+def test_siemens_1_4_fpltest_adds_the_rules_of_one_term_as_computed_by_hand(
     temp: float, pressure: float, valve: float
 ) -> None:
     assert call(fpltest(), temp, pressure) == f32(valve)
 
 
+def test_siemens_1_4_block_adds_whatever_the_program_s_accu() -> None:
+    # The same rules written with ACCU : MAX still run as the block computes (1.4): the
+    # block has no other accumulation.  The IEC engine keeps Table 5 for the program.
+    import fuzzyctl
+
+    text = (EXAMPLES / "siemens_fpltest.fcl").read_text().replace("ACCU : NSUM;", "ACCU : MAX;")
+    program = parse_fcl(text)
+    fb = FuzzyFB(program)
+    assert any(d.code == "siemens-accumulation" for d in fb.diagnostics)
+    assert call(fb, 9.0, 65.0) == f32(100 / 3)
+    assert fuzzyctl.compile(program).evaluate({"Temp": 9.0, "Pressure": 65.0})["Valve"] == pytest.approx(40.0)
+
+
 def test_siemens_1_3_fpltest_and_iec_figure_7() -> None:
-    # Figure 7 differs from FPLTEST only by "WITH 0.8" on rule 2 (and DEFAULT := 0), so they
-    # agree wherever rule 2 does not decide the degree of "closed", and differ where it does.
+    # Figure 7 differs from FPLTEST only by "WITH 0.8" on rule 2 (and DEFAULT := 0); run by
+    # the block it adds 0.8 * rule 2 + rule 3 on "closed".  They agree where rule 2 is 0.
     figure7 = FuzzyFB(parse_fcl((EXAMPLES / "figure7.fcl").read_text()), check_profile=False)
-    for temp, pressure in ((9, 65), (20, 60), (15, 50), (27, 90), (30, 100)):
+    for temp, pressure in ((15, 50), (27, 90), (30, 100), (9, 55)):
         assert call(figure7, temp, pressure) == call(fpltest(), temp, pressure)
     # Temp 3, Pressure 75: inlet .5, closed .5 (FPLTEST) or .4 (figure 7) -> 50 / 0.9.
     assert call(figure7, 3.0, 75.0) == f32(50 / 0.9)
     assert call(fpltest(), 3.0, 75.0) == 50.0
+    # Temp 9, Pressure 65: inlet .75, closed .8 * .25 + .25 = .45, drainage .25 -> 50 / 1.45
+    assert call(figure7, 9.0, 65.0) == f32(50 / 1.45)
 
 
 # ---------------------------------------------------------------- 3.1 INFO, START_STOP, ENO
@@ -70,7 +96,7 @@ def test_siemens_1_3_fpltest_and_iec_figure_7() -> None:
 def test_siemens_3_1_info_00_processed_and_real_outputs() -> None:
     fb = fpltest()
     assert fb.START_STOP == 0xFFFF  # enabled by the download, as the configuration tool does
-    assert call(fb, 20.0, 60.0) == f32(400 / 27) != 400 / 27  # a REAL holds single precision
+    assert call(fb, 20.0, 60.0) == f32(40 / 3) != 40 / 3  # a REAL holds single precision
     assert fb.INFO == 0x00 and fb.ENO is True
 
 
@@ -80,7 +106,8 @@ def test_siemens_3_1_start_stop_0_gives_info_01_and_keeps_outputs() -> None:
     fb.START_STOP = 0
     fb.set_inputs({"Temp": 30.0, "Pressure": 100.0})
     assert fb.execute() == Info.DISABLED == 0x01 and fb.ENO is False
-    assert fb.OUTPUT1 == 40.0  # old value
+    old = f32(100 / 3)
+    assert fb.outputs[0] == old  # old value
     fb.START_STOP = 123  # any non-zero word processes
     assert fb.execute() == 0x00 and fb.OUTPUT1 == -100.0
 
@@ -204,6 +231,11 @@ def test_siemens_3_2_fuzzy_ai_unipolar_bipolar_thermocouple() -> None:
         75.0,
         100.0,
     ]
+    # 3.2 note: a bipolar signal needs symmetric MIN/MAX; Pressure 50..100 is not, and the
+    # result says so (the value is the manual's formula all the same)
+    bipolar = fuzzy_ai(fb, 0, bipolar=True, input_nr=2)
+    assert bipolar.warning is not None and "MIN 50 and MAX 100 are not symmetric" in bipolar.warning
+    assert fuzzy_ai(fb, 0, input_nr=2).warning is None  # unipolar: no such constraint
     # FACTOR and OFFSET: 75 * 2 - 10 = 140, written as is (the FB clamps, not FUZZY_AI)
     assert fuzzy_ai(fb, 0, bipolar=True, factor=2.0, offset=-10.0, input_nr=2).value == 140.0
     assert fb.INPUT2 == 140.0
@@ -233,14 +265,16 @@ def test_siemens_3_2_fuzzy_ai_info_codes() -> None:
 
 def test_siemens_3_3_fuzzy_ao_bipolar_unipolar() -> None:
     fb = fpltest()  # Valve -101..101
-    call(fb, 9.0, 65.0)  # OUTPUT1 = 40
-    # bipolar: 27648 (2 * 40 - 101 + 101) / 202 = 10949.70 -> 10950
+    call(fb, 9.0, 65.0)  # OUTPUT1 = 100/3 as a REAL
+    out = f32(100 / 3)
+    # bipolar: 27648 (2 * 33.33 - 101 + 101) / 202 = 9124.75 -> 9125
     r = fuzzy_ao(fb, bipolar=True)
-    assert (r.info, r.eno, r.word) == (0x00, True, 10950) and r.value == pytest.approx(2211840 / 202)
-    # unipolar: 27648 (40 + 101) / 202 = 19298.85 -> 19299
-    assert fuzzy_ao(fb).word == 19299
-    # FACTOR 0.5, OFFSET 100: 10949.70 * 0.5 + 100 = 5574.85 -> 5575
-    assert fuzzy_ao(fb, bipolar=True, factor=0.5, offset=100.0).word == 5575
+    assert (r.info, r.eno, r.word) == (0x00, True, 9125) and r.value == pytest.approx(55296 * out / 202)
+    assert r.warning is None  # -101..101 is symmetric
+    # unipolar: 27648 (33.33 + 101) / 202 = 18386.38 -> 18386
+    assert fuzzy_ao(fb).word == 18386
+    # FACTOR 0.5, OFFSET 100: 9124.75 * 0.5 + 100 = 4662.38 -> 4662
+    assert fuzzy_ao(fb, bipolar=True, factor=0.5, offset=100.0).word == 4662
     # saturated to the INT range
     assert fuzzy_ao(fb, factor=10.0).word == 32767
 

@@ -72,7 +72,8 @@ def small(
         )
         for r in range(n_rules)
     )
-    fb = FunctionBlock("p", inputs + outputs, fuzzify, defuzzify, (RuleBlock("rb", rules, span=Span(49, 1)),))
+    block = RuleBlock("rb", rules, accu="NSUM", span=Span(49, 1))  # the block's sum (1.4)
+    fb = FunctionBlock("p", inputs + outputs, fuzzify, defuzzify, (block,))
     return replace(fb, **changes) if changes else fb
 
 
@@ -81,9 +82,11 @@ def codes(fb: FunctionBlock) -> list[str]:
 
 
 def test_siemens_1_3_fpltest_fits_the_block() -> None:
-    # Only a note: "drainage" has 8 characters, 7 are significant ("drainag"), still unique.
-    (note,) = check_siemens(read_fpl((EXAMPLES / "fpltest.fpl").read_text()))
-    assert note.severity is Severity.NOTE and note.code == "siemens-long-name" and "drainag" in note.message
+    # Only a warning: "drainage" has 8 characters where the term dialog takes 7 (6.4); 7 are
+    # significant ("drainag", 1.3) and still unique.
+    (w,) = check_siemens(read_fpl((EXAMPLES / "fpltest.fpl").read_text()))
+    assert w.severity is Severity.WARNING and w.code == "siemens-name" and "drainag" in w.message
+    assert not w.is_error
 
 
 def test_siemens_3_1_at_most_8_inputs_with_7_terms_and_4_outputs_with_9_terms() -> None:
@@ -146,7 +149,7 @@ def test_siemens_1_3_outputs_are_singletons_and_the_operators_are_the_block_s() 
         accu="BSUM",
     )
     found = codes(replace(fb, defuzzify=(area,), rule_blocks=(replace(fb.rule_blocks[0], and_op="PROD"),)))
-    assert found == ["siemens-method", "siemens-operator", "siemens-operator", "siemens-output-shape"]
+    assert found == ["siemens-method", "siemens-operator", "siemens-output-shape"]  # BSUM: a warning
     local = replace(fb, variables=(*fb.variables, Variable("mid", VarKind.LOCAL)))
     assert codes(local) == ["siemens-intermediate"]
 
@@ -160,8 +163,9 @@ def test_siemens_1_3_significant_name_lengths() -> None:
         fuzzify=(replace(fb.fuzzify[0], variable="temperature_a"), fb.fuzzify[1]),
     )
     warnings = [d for d in check_siemens(renamed) if not d.is_error]
-    assert all(d.severity is Severity.NOTE for d in warnings)
-    assert [d.code for d in warnings] == ["siemens-long-name"] and "temperatur" in warnings[0].message
+    assert all(d.severity is Severity.WARNING for d in warnings)
+    assert [d.code for d in warnings] == ["siemens-name"] and "temperatur" in warnings[0].message
+    assert "13 characters, the configuration tool takes 10" in warnings[0].message
     twin = replace(fb.variables[1], name="temperature_b")
     clash = replace(renamed, variables=(long_in, twin, *fb.variables[2:]))
     assert "siemens-name-collision" in codes(clash)
@@ -179,3 +183,57 @@ def test_siemens_1_5_default_value_is_reported_as_not_used() -> None:
     with_default = replace(fb, defuzzify=(replace(fb.defuzzify[0], default=Default(5.0)),))
     (d,) = check_siemens(with_default)
     assert d.code == "siemens-default" and not d.is_error and "keeps the last value" in d.message
+
+
+def test_siemens_6_2_6_4_names_the_configuration_tool_takes() -> None:
+    # Project <= 8 characters (6.2 "Define Project"), inputs and outputs <= 10 (6.4), terms
+    # <= 7 (6.4); letters, digits and "_", not starting with a digit (6.4).
+    fb = small()
+    assert check_siemens(replace(fb, name="PROJECT8")) == []
+    (d,) = check_siemens(replace(fb, name="PROJECT_9"))
+    assert (d.code, d.severity) == ("siemens-name", Severity.WARNING) and "9 characters" in d.message
+    (d,) = check_siemens(replace(fb, name="1st"))
+    assert "first character may not be a number" in d.message
+    three = small(n_inputs=3)  # in2 is in no rule: rename it freely
+
+    def named(name: str) -> FunctionBlock:
+        var = replace(three.variables[2], name=name)
+        fz = replace(three.fuzzify[2], variable=name)
+        return replace(
+            three,
+            variables=(*three.variables[:2], var, *three.variables[3:]),
+            fuzzify=(*three.fuzzify[:2], fz),
+        )
+
+    assert check_siemens(named("abcdefghij")) == []
+    (d,) = check_siemens(named("débit"))
+    assert d.code == "siemens-name" and "only '_'" in d.message
+    seven = FuzzifyBlock(
+        "in0", (Term("abcdefg", ShapeMF("triangle", (0, 1, 2))), Term("t-1", ShapeMF("triangle", (1, 2, 3))))
+    )
+    (d,) = check_siemens(replace(fb, fuzzify=(seven, fb.fuzzify[1])))
+    assert d.code == "siemens-name" and "in0.t-1" in d.message
+
+
+def test_siemens_3_2_3_3_bipolar_needs_symmetric_limits() -> None:
+    fb = read_fpl((EXAMPLES / "fpltest.fpl").read_text())  # Temp 0..30, Pressure 50..100, Valve -101..101
+    bipolar = [
+        d for d in check_siemens(fb, bipolar=["Valve", "INPUT1"]) if d.code.startswith("siemens-bipolar")
+    ]
+    (d,) = bipolar
+    assert d.severity is Severity.WARNING and d.message.startswith("Temp: MIN 0 and MAX 30 are not symmetric")
+    assert "FUZZY_AI" in d.message
+    assert [d.code for d in check_siemens(fb, bipolar=["Flow"]) if d.is_error] == ["siemens-bipolar"]
+    assert not [d for d in check_siemens(fb, bipolar=["OUTPUT1"]) if d.code.startswith("siemens-bipolar")]
+
+
+def test_siemens_1_4_accumulation_other_than_a_sum_is_a_warning_where_terms_are_shared() -> None:
+    fb = small()  # both rules conclude out0 IS s0
+    (d,) = check_siemens(replace(fb, rule_blocks=(replace(fb.rule_blocks[0], accu="MAX"),)))
+    assert (d.code, d.severity) == ("siemens-accumulation", Severity.WARNING) and "rules 0, 1" in d.message
+    (d,) = check_siemens(replace(fb, rule_blocks=(replace(fb.rule_blocks[0], accu=None),)))
+    assert "MAX (the default)" in d.message
+    assert check_siemens(replace(fb, rule_blocks=(replace(fb.rule_blocks[0], accu="SUM"),))) == []
+    # one rule per term: every accumulation is the same sum
+    one = small(n_rules=1)
+    assert check_siemens(replace(one, rule_blocks=(replace(one.rule_blocks[0], accu="MAX"),))) == []

@@ -316,6 +316,57 @@ def test_xfuz_2_6_4_rising_edge_of_refresh() -> None:
     assert fb["OUT1"] == 1000
 
 
+def test_xfuz_2_6_4_refresh_keeps_degre_and_status_bits_0_to_6() -> None:
+    # 2.6-4: on REFRESH "all the other internal data keep their values" (2.6-1: on a cold
+    # restart they are set to 0).  A gap between "low" (D 30) and "high" (A 40): at 35 no
+    # rule is active -> OUT1 at its default (bit 0) and the "no active rule" alarm (bit 6).
+    gap = list(singleton_base().fa)
+    gap[0:9] = (*encode_name("low"), 0, -32768, -32768, 20, 30)
+    with_gap = replace(singleton_base(), fa=tuple(gap), contask=True)
+    no_gap = replace(singleton_base(), contask=True)
+
+    def infer(fb: XfuzFB, level: int) -> None:
+        fb["INP1"], fb.START = level, 0
+        fb.execute()
+        fb.START = 1
+        fb.execute()
+        assert fb.inferred
+
+    def refresh(fb: XfuzFB, constants: XfuzConstants) -> None:
+        fb.constants, fb.REFRESH = constants, 1
+        snap = fb.execute()
+        assert not snap.inferred and fb.kb.memberships[0].points[3] == (30 if constants is with_gap else 60)
+        fb.REFRESH = 0
+
+    fb = XfuzFB(with_gap)
+    fb.MAN_AUTO = 1
+    infer(fb, 25)  # low (30 - 25) / 10 = .5 -> 255 * .5 = 127.5 -> 128
+    assert fb.DEGRE[:2] == [128, 0] and fb.status_bits == ()
+    refresh(fb, no_gap)  # a new knowledge base: DEGRE stays until the next inference
+    assert fb.DEGRE[:2] == [128, 0] and fb.snapshot().degre[:2] == (128, 0)
+    infer(fb, 35)  # now low (60 - 35) / 40 = .625 -> 159.4 -> 159
+    assert fb.DEGRE[:2] == [159, 0]
+
+    refresh(fb, with_gap)
+    infer(fb, 35)
+    assert fb.DEGRE[:2] == [0, 0] and fb.status_bits == (0, 6)
+    refresh(fb, no_gap)  # bits 0-6 of the last inference stay (bits 7-14: the new base's checks)
+    assert fb.status_bits == (0, 6) and not fb.ERROR
+    infer(fb, 35)
+    assert fb.status_bits == () and fb.DEGRE[:2] == [159, 0]
+    refresh(fb, with_gap)
+    infer(fb, 35)
+    assert fb.status_bits == (0, 6)
+    fb.INIT = 1  # cold restart: set to 0
+    fb.execute()
+    fb.START = 0
+    fb.execute()
+    infer(fb, 25)
+    fb.INIT = 1
+    fb.execute()
+    assert fb.DEGRE == [0] * 64 and fb.status_bits == ()
+
+
 def test_xfuz_2_6_5_on_demand_infers_on_each_rising_edge_of_start() -> None:
     fb = XfuzFB(example())  # CONTASK$ = 1 by default
     fb.MAN_AUTO, fb["INP1"], fb["INP4"] = 1, 0, -50
@@ -349,10 +400,11 @@ def test_xfuz_2_8_checks_only_on_cold_restart_init_and_refresh() -> None:
     fb["INP1"], fb["INP4"] = 0, -50
     fb.execute()
     assert fb.STATUS & (1 << 14) == 0 and fb.inferred
-    # ... until REFRESH: bit 14, ERROR, inferences blocked.
+    # ... until REFRESH: bit 14, ERROR, inferences blocked (bit 2, OUT3 at its default in
+    # the last inference, is information REFRESH keeps, 2.6-4).
     fb.REFRESH = 1
     fb.execute()
-    assert fb.status_bits == (14,) and fb.ERROR
+    assert fb.status_bits == (2, 14) and fb.ERROR
     fb.REFRESH = fb.START = 0
     fb.execute()
     fb.START = 1

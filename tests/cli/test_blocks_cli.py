@@ -169,18 +169,19 @@ def test_blocks_siemens_runs_one_row_per_cycle(tmp_path: Path, capsys: pytest.Ca
     code, out, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(path)], capsys)
     assert code == 0, err
     got = rows(out)
-    # 40 (hand computation in tests/blocks/test_siemens_fb.py); START_STOP 0: INFO 01 and the
-    # value kept; back on at (30, 100): drainage -100; (-5, 200) is clamped to (0, 100): cold
-    # 1, high 1 -> closed 0.
+    # 100/3 (the sum of manual 1.4, hand computation in tests/blocks/test_siemens_fb.py),
+    # printed as the REAL holds it; START_STOP 0: INFO 01 and the value kept; back on at
+    # (30, 100): drainage -100; (-5, 200) is clamped to (0, 100): cold 1, high 1 -> closed 0.
+    third = "33.33333206176758"
     assert [(r["Valve"], r["INFO"], r["ENO"]) for r in got] == [
-        ("40.0", "00", "1"),
-        ("40.0", "01", "0"),
-        ("40.0", "01", "0"),
+        (third, "00", "1"),
+        (third, "01", "0"),
+        (third, "01", "0"),
         ("-100.0", "00", "1"),
         ("0.0", "00", "1"),
     ]
     code, out, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(path), "--json"], capsys)
-    assert code == 0 and json.loads(out)[0] == {"cycle": 0, "Valve": 40.0, "INFO": "00", "ENO": 1}
+    assert code == 0 and json.loads(out)[0] == {"cycle": 0, "Valve": float(third), "INFO": "00", "ENO": 1}
 
 
 def test_blocks_siemens_and_check_report_what_does_not_fit(
@@ -192,11 +193,29 @@ def test_blocks_siemens_and_check_report_what_does_not_fit(
     code, out, _ = run(
         ["blocks", "siemens", str(EXAMPLES / "figure7.fcl"), str(path), "--no-profile"], capsys
     )
-    assert code == 0 and rows(out)[0]["valve"] == "40.0"
+    # the block's sum (1.4) with the program's WITH 0.8: inlet .75, closed .8 * .25 + .25,
+    # drainage .25 -> 50 / 1.45, as a REAL
+    assert code == 0 and rows(out)[0]["valve"] == "34.482757568359375"
     code, _, err = run(["blocks", "check", str(EXAMPLES / "figure7.fcl")], capsys)
     assert code == 1 and "siemens-weight" not in err and "WITH 0.8" in err
     code, out, _ = run(["blocks", "check", str(EXAMPLES / "fpltest.fpl"), "--json"], capsys)
-    assert code == 0 and [d["code"] for d in json.loads(out)] == ["siemens-long-name"]
+    assert code == 0 and [d["code"] for d in json.loads(out)] == ["siemens-name"]  # "drainage"
+    code, out, _ = run(
+        [
+            "blocks",
+            "check",
+            str(EXAMPLES / "fpltest.fpl"),
+            "--json",
+            "--bipolar",
+            "Valve",
+            "--bipolar",
+            "Temp",
+        ],
+        capsys,
+    )
+    found = json.loads(out)
+    assert code == 0 and [d["code"] for d in found] == ["siemens-name", "siemens-bipolar-asymmetric"]
+    assert found[1]["message"].startswith("Temp: MIN 0 and MAX 30")
     bad = samples(tmp_path, "Temp,Flow\n1,2\n")
     code, _, err = run(["blocks", "siemens", str(EXAMPLES / "fpltest.fpl"), str(bad)], capsys)
     assert code == 1 and "unknown column 'Flow'" in err

@@ -98,7 +98,7 @@ EXPECTED_FPLTEST = FunctionBlock(
             ),
             and_op="MIN",
             act="MIN",
-            accu="MAX",
+            accu="NSUM",  # Fuzzy Control adds the rules of one term (1.4): Rule_02 + Rule_03
         ),
     ),
 )
@@ -315,3 +315,28 @@ def test_names_fpl_cannot_read_are_renamed() -> None:
     a, b = (v.name for v in again.inputs)
     got = fuzzyctl.compile(again).evaluate_batch({a: xs, b: xs[::-1]})[again.outputs[0].name]
     assert np.allclose(want, got, rtol=0.0, atol=1e-9)
+
+
+def test_siemens_1_4_fpl_means_the_sum_of_the_rules_of_one_term() -> None:
+    # An FPL file means what Fuzzy Control computes: x = sum(mu_rule x_rule) / sum(mu_rule)
+    # (1.4).  FPLTEST at Temp 9, Pressure 65: inlet .75, closed .25 + .25, drainage .25 ->
+    # (75 - 25) / 1.5 = 100/3 through the IEC engine too (ACCU NSUM).
+    app = read_fpl((EXAMPLES / "fpltest.fpl").read_text())
+    assert app.main.rule_blocks[0].accu == "NSUM"
+    assert fuzzyctl.compile(app).evaluate({"Temp": 9.0, "Pressure": 65.0})["Valve"] == pytest.approx(100 / 3)
+    # An FCL program with ACCU MAX (or none) whose term "closed" is concluded by two rules
+    # computes 40 there: FPL cannot say it without changing the result.
+    fcl = (EXAMPLES / "siemens_fpltest.fcl").read_text()
+    as_max = read_text(fcl.replace("ACCU : NSUM;", "ACCU : MAX;"), "fcl").document
+    with pytest.raises(fuzzyctl.formats.LossError, match=r"adds the degrees.*rules Rule_02, Rule_03"):
+        convert(as_max, "fpl")
+    text, losses = convert(as_max, "fpl", lossy=True)
+    assert len(losses) == 1 and read_fpl(text).main.rule_blocks[0].accu == "NSUM"
+    no_accu = read_text(fcl.replace("        ACCU : NSUM;\n", ""), "fcl").document
+    assert any("MAX (the default)" in str(loss) for loss in fuzzyctl.formats.get("fpl").losses(no_accu))
+    assert fuzzyctl.formats.get("fpl").losses(read_text(fcl, "fcl").document) == []
+    # One rule per term: MAX and the sum agree, nothing is lost.
+    rule_3 = "        RULE Rule_03 : IF Temp IS hot AND Pressure IS low THEN Valve IS closed;\n"
+    assert rule_3 in fcl
+    one = read_text(fcl.replace(rule_3, "").replace("ACCU : NSUM;", "ACCU : MAX;"), "fcl").document
+    assert fuzzyctl.formats.get("fpl").losses(one) == []

@@ -93,10 +93,12 @@ class ModbusPLC:
 
 
 class S7PLC:
-    """A python-snap7 server with DB1 (256 bytes)."""
+    """A python-snap7 server with one data block: DB1 of 256 bytes, or ``db``/``data`` (the
+    bytearray the server serves and the test reads and writes in place)."""
 
-    def __init__(self) -> None:
-        self.db = bytearray(256)
+    def __init__(self, db: int = 1, data: bytearray | None = None) -> None:
+        self.number = db
+        self.db = bytearray(256) if data is None else data
         self.port = 0
         self._server: Any = None
         self.start()
@@ -105,7 +107,7 @@ class S7PLC:
         import snap7
 
         server = snap7.Server(log=False)
-        server.register_area(snap7.SrvArea.DB, 1, self.db)
+        server.register_area(snap7.SrvArea.DB, self.number, self.db)
         server.start_to("127.0.0.1", self.port)
         self.port = server.server_socket.getsockname()[1]
         self._server = server

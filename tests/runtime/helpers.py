@@ -31,6 +31,11 @@ def fpltest_reference(temp: float, pressure: float) -> float:
     return f32(_ENGINE.evaluate({"Temp": t, "Pressure": p})["Valve"])
 
 
+FPLTEST_9_65 = f32(100.0 / 3.0)
+"""FPLTEST at Temp 9, Pressure 65 by the manual's formula (1.4, the rules of one term
+added): inlet .75, closed .25 + .25, drainage .25 -> (75 - 25) / 1.5, as a REAL."""
+
+
 def make_runtime(tmp_path: Path, toml: str, *, api: bool = False) -> Runtime:
     path = tmp_path / "serve.toml"
     path.write_text(toml, encoding="utf-8")

@@ -108,7 +108,8 @@ def test_every_write_needs_the_write_token_and_every_read_a_token(
             assert r.status_code == status, (method, url, headers)
             if status == 401:
                 assert r.headers["www-authenticate"] == "Bearer"
-    assert runtime.events.last_seq == before  # nothing was changed, nothing logged
+    # Nothing was changed, nothing logged (cycle overruns of a loaded test machine aside).
+    assert [e.kind for e in runtime.events.since(before) if e.kind != "overrun"] == []
     for url in READS:
         assert client.get(url, headers=NO_TOKEN).status_code == 401, url
         assert client.get(url, headers={"Authorization": "Bearer nope"}).status_code == 401, url

@@ -14,6 +14,7 @@ from fuzzyctl.runtime.kb import KnowledgeBaseSource
 from tests.conftest import EXAMPLES
 from tests.io.plcs import wait_until
 from tests.runtime.helpers import (
+    FPLTEST_9_65,
     FPLTEST_FCL,
     assert_log_complete,
     close,
@@ -104,10 +105,11 @@ def test_a_nan_input_is_never_propagated_hold_then_safe_then_recovery(tmp_path: 
             return int(mb.read_holding_registers(12, count=1).registers[0])
 
         mb.write_registers(0, [*float32_to_registers(9.0), *float32_to_registers(65.0)])
-        wait_until(lambda: close(valve(), 40.0) and info() == 0, 10)
+        wait_until(lambda: close(valve(), FPLTEST_9_65) and info() == 0, 10)
         mb.write_registers(0, list(float32_to_registers(math.nan)))
         wait_until(lambda: info() == INFO_HOLD, 10)
-        assert close(valve(), 40.0)  # hold: the last good Temp (9.0) is used, NaN never reaches the block
+        # hold: the last good Temp (9.0) is used, NaN never reaches the block
+        assert close(valve(), FPLTEST_9_65)
         wait_until(lambda: info() == INFO_SAFE and valve() == 12.5, 10)
         assert rt.instances["valve"].adapter.block.INPUT1 == 9.0
         mb.write_registers(0, list(float32_to_registers(25.0)))

@@ -8,7 +8,14 @@ import math
 from pathlib import Path
 
 from tests.io.plcs import OpcUaPLC, wait_until
-from tests.runtime.helpers import FPLTEST_FCL, assert_log_complete, close, fpltest_reference, make_runtime
+from tests.runtime.helpers import (
+    FPLTEST_9_65,
+    FPLTEST_FCL,
+    assert_log_complete,
+    close,
+    fpltest_reference,
+    make_runtime,
+)
 
 
 def test_opcua_plc_outputs_match_the_engine(tmp_path: Path) -> None:
@@ -82,7 +89,7 @@ expose = ["ua"]
             for _ in range(300):
                 seen["Valve"] = await node("Valve").read_value()
                 seen["INFO"] = await node("INFO").read_value()
-                if close(seen["Valve"], 40.0) and seen["INFO"] == 0:
+                if close(seen["Valve"], FPLTEST_9_65) and seen["INFO"] == 0:
                     break
                 await asyncio.sleep(0.02)
             # START_STOP written by the client is applied to the block (a parameter node)

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tests.io.plcs import S7PLC, ModbusPLC, wait_until
 from tests.runtime.helpers import (
+    FPLTEST_9_65,
     FPLTEST_FCL,
     assert_log_complete,
     close,
@@ -90,13 +91,13 @@ INFO = {{ connection = "out", address = 2, type = "uint16" }}
         rt.start()
         cpu.set_real(0, 9.0)
         cpu.set_real(4, 65.0)
-        wait_until(lambda: close(out.float(0), 40.0), 10)
+        wait_until(lambda: close(out.float(0), FPLTEST_9_65), 10)
         cpu.stop()
         wait_until(
             lambda: out.float(0) == 55.5 and out.registers(2, 1) == [0x41], 10
         )  # safe value, INFO 16#41
         cpu.start()  # same port, the DB still holds the process values
-        wait_until(lambda: close(out.float(0), 40.0) and out.registers(2, 1) == [0], 15)
+        wait_until(lambda: close(out.float(0), FPLTEST_9_65) and out.registers(2, 1) == [0], 15)
     finally:
         rt.stop()
         cpu.close()
@@ -105,4 +106,4 @@ INFO = {{ connection = "out", address = 2, type = "uint16" }}
     seq = safety_sequence(events, instance="valve", link="cpu")
     start = seq.index("link-lost")
     assert seq[start:] == ["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]
-    assert fpltest_reference(9.0, 65.0) == 40.0
+    assert fpltest_reference(9.0, 65.0) == FPLTEST_9_65

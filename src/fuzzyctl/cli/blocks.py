@@ -317,13 +317,21 @@ def check(
         ),
     ],
     as_json: JsonOpt = False,
+    bipolar: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--bipolar",
+            help="An input or output (name or INPUTn/OUTPUTn) wired to a bipolar FUZZY_AI/FUZZY_AO: "
+            "its MIN and MAX must be symmetric (manual 3.2, 3.3).  Repeat for several.",
+        ),
+    ] = None,
 ) -> None:
     """Check a controller against the siemens profile (limits of the S7 FUZZY block).
 
     Exit status 1 when it does not fit (errors), 0 otherwise (warnings are printed)."""
     from fuzzyctl.blocks.siemens import check_siemens
 
-    diags = _located(check_siemens(_load(application)), application).diagnostics
+    diags = _located(check_siemens(_load(application), bipolar=bipolar or ()), application).diagnostics
     if as_json:
         typer.echo(json.dumps([d.to_dict() for d in diags], indent=1))
     else:

@@ -42,6 +42,8 @@ def convert(
     fmt = formats.get(to_format) if to_format else formats.for_path(target)
     text, losses = formats.convert(loaded.document, fmt.name, lossy=lossy)
     formats.write_atomic(target, text)
+    for note in fmt.notes(loaded.document):
+        err_console.print(f"warning: {note}", markup=False)
     for loss in losses:
         err_console.print(f"dropped: {loss}", markup=False)
     typer.echo(f"wrote {target} ({fmt.name}{', lossy' if losses else ''})")

@@ -13,6 +13,7 @@ from dataclasses import dataclass
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, has_errors
 from fuzzyctl.fcl.checks import CheckContext, register_provider, run_checks
+from fuzzyctl.fcl.no_if import without_if_parts
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source, decode, read_source
 from fuzzyctl.fcl.writer import write
@@ -47,10 +48,13 @@ def check_source(source: Source, *, strict: bool = False, compat: str = "iec") -
     construct jFuzzyLogic 3.3 would reject or misread (:mod:`fuzzyctl.fcl.jfl`)."""
     parsed = parse_source(source)
     diagnostics = list(parsed.diagnostics)
-    if parsed.document is not None and not has_errors(diagnostics):
+    document = parsed.document
+    if document is not None and not has_errors(diagnostics):
+        document, notes = without_if_parts(document)  # IF ALWAYS THEN: Siemens 1.5 rules
+        diagnostics.extend(notes)
         context = CheckContext(source.path, {"strict": strict, "compat": compat, "parsed": parsed})
-        diagnostics.extend(run_checks(parsed.document, context))
-    return LoadResult(parsed.document, diagnostics, source, parsed.spellings)
+        diagnostics.extend(run_checks(document, context))
+    return LoadResult(document, diagnostics, source, parsed.spellings)
 
 
 def load_text(text: str, path: str | None = None, *, strict: bool = False, compat: str = "iec") -> LoadResult:

@@ -64,12 +64,20 @@ def _degrees(t: Term) -> list[float | Ref]:
 
 
 def _variable_points(t: Term) -> bool:
+    """Abscissae given by variables (Table 9: "constant or variable points")."""
     mf = t.mf
     if isinstance(mf, PointsMF | SingletonsMF):
-        return any(isinstance(p.x, Ref) or isinstance(p.y, Ref) for p in mf.points)
+        return any(isinstance(p.x, Ref) for p in mf.points)
     if isinstance(mf, SingletonMF):
         return isinstance(mf.value, Ref)
     return False
+
+
+def _variable_degrees(t: Term) -> bool:
+    """Degrees given by variables: Table 9 keeps the degree co-ordinate at 0 or 1, Table 10
+    lists "variable membership values" as Open level."""
+    mf = t.mf
+    return isinstance(mf, PointsMF | SingletonsMF) and any(isinstance(p.y, Ref) for p in mf.points)
 
 
 def depth(c: Condition | None) -> int:
@@ -154,6 +162,8 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
                 add(open_, "accumulation", f"ACCU: {rb.accu}")
             for rule in rb.rules:
                 c = rule.condition
+                if c is None:  # written IF ALWAYS THEN (fcl/no_if.py): a degree input
+                    add(ext, "condition", "rule without IF part: IF ALWAYS (an input variable)")
                 if _uses(c, Or):
                     add(ext, "conditional aggregation", "operator OR in a condition")
                 if _uses(c, Not) or any(s.negated for s in walk_condition(c) if not isinstance(s, Degree)):
@@ -200,6 +210,8 @@ def _term_features(t: Term, side: str, add: object) -> None:
         return
     if _variable_points(t):
         add(ext, "membership function", f"{side}: variable points")
+    if _variable_degrees(t):
+        add(open_, "membership function", f"{side}: variable membership degrees")
     degrees = [d for d in _degrees(t) if not isinstance(d, Ref)]
     if any(d not in (0.0, 1.0) for d in degrees):
         add(open_, "membership function", f"{side}: degrees between 0 and 1")

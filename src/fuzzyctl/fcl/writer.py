@@ -13,6 +13,7 @@ from collections.abc import Iterable
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
+from fuzzyctl.fcl.no_if import with_if_parts
 from fuzzyctl.fcl.parser import number_text
 from fuzzyctl.model import (
     And,
@@ -321,6 +322,7 @@ def unwritable_names(fb: FunctionBlock) -> list[Diagnostic]:
 def write_block(fb: FunctionBlock) -> str:
     """FCL text of one function block; a name FCL could not read back is an error (all such
     names are listed) rather than a file that does not load."""
+    fb = with_if_parts(fb)  # rules without an IF part: IF ALWAYS THEN (fcl/no_if.py)
     problems = unwritable_names(fb)
     if problems:
         raise DiagnosticError(problems)

@@ -59,6 +59,10 @@ def _nothing_lost(document: Document) -> tuple[Document, list[Loss]]:
     return document, []
 
 
+def _no_notes(document: Document) -> list[Loss]:
+    return []
+
+
 @dataclass(frozen=True)
 class Format:
     """A file format: name, file extensions, reader, writer and expressibility check."""
@@ -69,6 +73,10 @@ class Format:
     read: Reader | None = None
     write: Writer | None = None
     lower: Lowerer = field(default=_nothing_lost)
+    notes: Callable[[Document], list[Loss]] = field(default=_no_notes)
+    """What the writer says in a nearest form of its own rather than as the model does: not a
+    loss (the written file computes the same), but worth a warning to whoever reads the file
+    with another tool (FCL: a rule without an IF part becomes ``IF ALWAYS THEN``)."""
 
     def losses(self, document: Document) -> list[Loss]:
         """What this format cannot express of ``document`` (empty: a lossless write)."""

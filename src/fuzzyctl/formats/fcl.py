@@ -203,17 +203,9 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rules = []
             for rule in block.rules:
                 condition = rule.condition
-                if condition is None:
-                    losses.append(
-                        Loss(
-                            f"rule {rule.label!r}",
-                            "FCL has no rule without a condition (MATLAB's all don't-care, fuzzylite's "
-                            "'x is any'); dropped",
-                        )
-                    )
-                    continue
                 rule = _rule_weight_to_conclusions(fb, block, rule, losses)
-                rule = replace(rule, condition=_hedges_in_fcl(condition, f"rule {rule.label!r}", losses))
+                if condition is not None:  # no IF part: the writer's IF ALWAYS (see notes)
+                    rule = replace(rule, condition=_hedges_in_fcl(condition, f"rule {rule.label!r}", losses))
                 if any(c.hedges for c in rule.conclusions):
                     losses.append(Loss(f"rule {rule.label!r}", "FCL has no hedges on conclusions"))
                     rule = replace(rule, conclusions=tuple(replace(c, hedges=()) for c in rule.conclusions))
@@ -237,6 +229,29 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         )
         blocks.append(fb)
     return replace(document, blocks=tuple(blocks)), losses
+
+
+def notes(document: Document) -> list[Loss]:
+    """Rules without an IF part (Siemens 1.5, MATLAB's all don't-care, fuzzylite's ``x is
+    any``): FCL has none; they are written ``IF ALWAYS THEN`` with ``ALWAYS : REAL := 1.0``,
+    a degree input left unconnected (:mod:`fuzzyctl.fcl.no_if`), which fuzzyctl reads back as
+    rules without an IF part and other IEC tools as an input."""
+    from fuzzyctl.fcl.no_if import always_name
+
+    out = []
+    for fb in document.blocks:
+        labels = [rule.label for _rb, rule in fb.rules() if rule.condition is None]
+        if labels:
+            name = always_name(fb)
+            out.append(
+                Loss(
+                    f"rule(s) {', '.join(repr(x) for x in labels)}",
+                    f"no IF part (degree 1): written 'IF {name} THEN ...' with the input "
+                    f"{name} : REAL := 1.0, which must stay unconnected (fuzzyctl reads it back as a "
+                    "rule without IF part; other IEC 61131-7 tools see an input)",
+                )
+            )
+    return out
 
 
 def _read(text: str, path: str | None) -> Loaded:
@@ -264,4 +279,5 @@ FORMAT = Format(
     read=_read if _available else None,
     write=_write if _available else None,
     lower=lower,
+    notes=notes,
 )

@@ -16,8 +16,13 @@ inputs to the limits, so both readings agree inside the range and the shoulder a
 with an FCL program outside it.  An output term whose points all have degree 1 (the
 "narrow rectangle" of the manual) is the singleton at its centre.
 
-The rule base reads as IEC AND MIN, ACT MIN, ACCU MAX, METHOD COGS (COG when an output has
+The rule base reads as IEC AND MIN, ACT MIN, ACCU NSUM, METHOD COGS (COG when an output has
 area terms) and ``DEFAULT := NC``: Fuzzy Control keeps the last output when no rule fires.
+ACCU NSUM because Fuzzy Control *adds* the contributions of several rules to one output
+term (1.4, ``x_S' = (mu_A x_A + mu_B x_B + ...) / (mu_A + mu_B + ...)`` with one mu per
+rule; glossary, "Singleton Function": "the influences ... resulting from various rules are
+added together"); NSUM is the Table 5 sum, and its normalisation cancels in the centre of
+gravity, so with singletons it computes exactly the manual's formula.
 MIN/MAX of an input become the range of its FUZZIFY block, of an output the range of its
 DEFUZZIFY block.  The block limits its inputs to [MIN, MAX] (1.5); that changes nothing when
 every point of the input's terms lies in [MIN, MAX] (points lists are constant beyond their
@@ -61,15 +66,18 @@ NAME = "fpl"
 EXTENSIONS = (".fpl",)
 
 __all__ = [
+    "ADDING_ACCU",
     "EXTENSIONS",
     "FORMAT",
     "KEYWORDS",
     "NAME",
+    "SIEMENS_ACCU",
     "FplResult",
     "is_fpl_name",
     "leaves",
     "parse_fpl",
     "read_fpl",
+    "shared_conclusions",
 ]
 
 # --------------------------------------------------------------------------- lexer
@@ -674,10 +682,34 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
     rule_blocks: tuple[RuleBlock, ...] = ()
     if base is not None:
         rules = tuple(Rule(r.label, r.condition, tuple(r.conclusions), span=r.span) for r in base.rules)
-        rule_blocks = (RuleBlock(base.name, rules, and_op="MIN", act="MIN", accu="MAX", span=base.span),)
+        rule_blocks = (
+            RuleBlock(base.name, rules, and_op="MIN", act="MIN", accu=SIEMENS_ACCU, span=base.span),
+        )
     return FunctionBlock(
         p.project, tuple(variables), tuple(fuzzify), tuple(defuzzify), rule_blocks, comments=tuple(comments)
     )
+
+
+SIEMENS_ACCU = "NSUM"
+"""The IEC accumulation that computes what Fuzzy Control computes (1.4): the sum of the
+rules' degrees per output term (NSUM's normalisation cancels in a centre of gravity)."""
+
+ADDING_ACCU = frozenset({"NSUM", "SUM"})
+"""Accumulations that add the rules' degrees without a bound, as Fuzzy Control does."""
+
+
+def shared_conclusions(block: FunctionBlock) -> list[tuple[str, str, list[Rule]]]:
+    """``(output, term, rules)`` for every output term that two or more rules conclude.
+
+    Only there does the accumulation matter for singleton outputs: one rule per term gives
+    the same degrees under MAX, BSUM, NSUM or SUM, so the Siemens sum (1.4) equals an
+    IEC ``ACCU : MAX`` program exactly when this list is empty."""
+    seen: dict[tuple[str, str], list[Rule]] = {}
+    for _rb, rule in block.rules():
+        for c in rule.conclusions:
+            if c.term is not None:
+                seen.setdefault((c.variable, c.term), []).append(rule)
+    return [(v, t, rules) for (v, t), rules in seen.items() if len(rules) > 1]
 
 
 def leaves(cond: Condition | None) -> Iterator[Is]:

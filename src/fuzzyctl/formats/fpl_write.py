@@ -8,7 +8,7 @@ from dataclasses import replace
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
 from fuzzyctl.formats._common import identifier
 from fuzzyctl.formats._lower import rename
-from fuzzyctl.formats.fpl import is_fpl_name, leaves
+from fuzzyctl.formats.fpl import ADDING_ACCU, SIEMENS_ACCU, is_fpl_name, leaves, shared_conclusions
 from fuzzyctl.model import (
     And,
     Condition,
@@ -92,8 +92,10 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
                 rb.span,
                 "fpl-expr-op",
             )
-        if rb.accu not in (None, "MAX"):
-            err(f"ACCU : {rb.accu} cannot be written in FPL (Fuzzy Control uses MAX)", rb.span, "fpl-expr-op")
+        accu_problem = _accu_problem(block, rb.accu)
+        if accu_problem is not None:
+            hint = "write ACCU : NSUM to say what Fuzzy Control computes"
+            err(accu_problem, rb.item_span("accu"), "fpl-expr-op", hint=hint)
         if rb.act not in (None, "MIN", "PROD") or (rb.act == "PROD" and not _all_singletons(block)):
             err(f"ACT : {rb.act} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op")
         if not rb.enabled or rb.rule_activation is not None:
@@ -164,6 +166,31 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
         if v.kind is VarKind.OUTPUT and block.defuzzify_block(v.name) is None:
             err(f"output {v.name} has no DEFUZZIFY block", v.span, "fpl-expr-output")
     return diags
+
+
+def _accu_problem(block: FunctionBlock, accu: str | None) -> str | None:
+    """Why ``accu`` would compute something else than Fuzzy Control, which adds the degrees
+    of the rules concluding one output term (1.4); None when it computes the same."""
+    for dz in block.defuzzify:
+        if dz.accu is not None and dz.accu not in ADDING_ACCU:
+            accu = dz.accu
+    if accu in ADDING_ACCU:
+        return None
+    name = accu or "MAX (the default)"
+    if not _all_singletons(block):
+        return (
+            f"ACCU : {name} cannot be written in FPL: Fuzzy Control adds overlapping output "
+            "areas (1.4, summation)"
+        )
+    shared = shared_conclusions(block)
+    if not shared:
+        return None  # one rule per term: every accumulation gives the same degrees
+    output, term, rules = shared[0]
+    labels = ", ".join(r.label for r in rules)
+    return (
+        f"ACCU : {name} cannot be written in FPL: Fuzzy Control adds the degrees of the rules "
+        f"concluding the same term (1.4), and {output} IS {term} is concluded by rules {labels}"
+    )
 
 
 def _all_singletons(block: FunctionBlock) -> bool:
@@ -324,7 +351,7 @@ def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
                 rules=tuple(rules) if rb.enabled else (),
                 and_op="MIN",
                 or_op=None,
-                accu="MAX",
+                accu=SIEMENS_ACCU,
                 act=None if rb.act in (None, "MIN") else "MIN",
                 enabled=True,
                 rule_activation=None,

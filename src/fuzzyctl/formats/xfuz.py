@@ -51,6 +51,7 @@ from fuzzyctl.formats.xfuz_tables import (
     OPEN_HIGH,
     OPEN_LOW,
     RG_SIZE,
+    KnowledgeBase,
     SlotKind,
     StatusBit,
     XfuzConstants,
@@ -358,9 +359,6 @@ def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
 # --------------------------------------------------------------------------- tables -> model
 
 
-
-
-
 def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
     if singleton:
         return SingletonMF(float(mf.singleton()))
@@ -522,6 +520,7 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         )
         cond: Condition | None = conds[0] if len(conds) == 1 else (And(tuple(conds)) if conds else None)
         rules.append(Rule(str(rule.number), cond, concl))
+    rules, fuzzify = _rules_without_if(kb, rules, fuzzify, term_names)
     ops = {0: "MIN", 1: "PROD"}
     block = FunctionBlock(
         name,
@@ -532,6 +531,49 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         (OptionsBlock(_options_text(c, renamed, discr)),),
     )
     return block, diags
+
+
+def _rules_without_if(
+    kb: KnowledgeBase, rules: list[Rule], fuzzify: list[FuzzifyBlock], term_names: dict[int, str]
+) -> tuple[list[Rule], list[FuzzifyBlock]]:
+    """The form the writer gives a rule without an IF part (Siemens 1.5), read back: a rule
+    whose only predicate is an input function named ``ALWAYS`` (``ALWAYS2``, ...) open on both
+    sides (1 for every input word) has no IF part; the function goes when no rule is left
+    that names it."""
+    always = {
+        term_names[mf.number]
+        for mf in kb.memberships
+        if mf.number in term_names
+        and slot_kind(mf.slot) is SlotKind.INPUT
+        and re.fullmatch(r"ALWAYS\d*", mf.name or "")
+        and (mf.a, mf.b, mf.c, mf.d) == (OPEN_LOW, OPEN_LOW, OPEN_HIGH, OPEN_HIGH)
+    }
+
+    def bare(cond: Condition | None) -> bool:
+        return isinstance(cond, Is) and not cond.negated and cond.term in always
+
+    if not any(bare(r.condition) for r in rules):
+        return rules, fuzzify
+    carried = {
+        (r.condition.variable, r.condition.term)
+        for r in rules
+        if isinstance(r.condition, Is) and bare(r.condition)
+    }
+    rules = [replace(r, condition=None) if bare(r.condition) else r for r in rules]
+    still = {(leaf.variable, leaf.term) for r in rules for leaf in _predicates(r.condition)}
+    fuzzify = [
+        replace(f, terms=tuple(t for t in f.terms if (f.variable, t.name) not in carried - still))
+        for f in fuzzify
+    ]
+    return rules, [f for f in fuzzify if f.terms]
+
+
+def _predicates(cond: Condition | None) -> Iterator[Is]:
+    if isinstance(cond, Is):
+        yield cond
+    elif isinstance(cond, And):
+        for c in cond.operands:
+            yield from _predicates(c)
 
 
 def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
@@ -580,6 +622,21 @@ def _lower(document: Document) -> tuple[Document, list[Loss]]:
     return lowered, [Loss(element, reason) for element, reason in losses]
 
 
+def _format_notes(document: Document) -> list[Loss]:
+    """A rule without an IF part (Siemens 1.5) has a predicate in RG: ``INPi IS ALWAYS``."""
+    fb = document.main
+    labels = [rule.label for _rb, rule in fb.rules() if rule.condition is None]
+    if not labels or not fb.inputs:
+        return []
+    return [
+        Loss(
+            f"rule(s) {', '.join(repr(x) for x in labels)}",
+            "no IF part (degree 1): written with the predicate 'INPi IS ALWAYS', a function open on "
+            "both sides (1 for every input word) on the first input, one of the 64 of FA",
+        )
+    ]
+
+
 FORMAT = Format(
     NAME,
     EXTENSIONS,
@@ -587,4 +644,5 @@ FORMAT = Format(
     read=_read,
     write=_write,
     lower=_lower,
+    notes=_format_notes,
 )

@@ -31,11 +31,13 @@ from fuzzyctl.model import (
     Condition,
     Document,
     FunctionBlock,
+    FuzzifyBlock,
     Is,
     MembershipFunction,
     Not,
     Or,
     Param,
+    Point,
     PointsMF,
     Range,
     Rule,
@@ -49,7 +51,15 @@ from fuzzyctl.model import (
     is_constant,
 )
 
-__all__ = ["check_xfuz", "constants_from_model", "lower_xfuz", "slot_labels", "write_xfuz"]
+__all__ = [
+    "ALWAYS",
+    "check_xfuz",
+    "constants_from_model",
+    "lower_xfuz",
+    "slot_labels",
+    "with_always_predicate",
+    "write_xfuz",
+]
 
 
 _SLOT_NAME = re.compile(r"^(INP|OUT|VAR)([1-8])$", re.IGNORECASE)
@@ -215,10 +225,45 @@ def slot_labels(block: FunctionBlock | Document) -> dict[str, str]:
     }
 
 
+ALWAYS = "ALWAYS"
+"""The term that carries a rule without an IF part in the tables (RG needs a predicate): a
+function open on both sides (xA = xB = -32768, xC = xD = 32767), 1 for every input word."""
+
+
+def with_always_predicate(fb: FunctionBlock) -> FunctionBlock:
+    """``fb`` with each rule without an IF part (Siemens 1.5, degree 1) given the predicate
+    ``INPi IS ALWAYS``, a term that is 1 on the whole 16-bit range, added to the first input
+    (``fb`` itself when it has no such rule or no input)."""
+    if not any(rule.condition is None for _rb, rule in fb.rules()) or not fb.inputs:
+        return fb
+    carrier = next((v for v in fb.inputs if fb.fuzzify_block(v.name) is not None), fb.inputs[0])
+    block = fb.fuzzify_block(carrier.name) or FuzzifyBlock(carrier.name, ())
+    taken = {t.name.upper() for t in block.terms}
+    name, n = ALWAYS, 1
+    while name.upper() in taken:
+        n += 1
+        name = f"{ALWAYS[: 8 - len(str(n))]}{n}"
+    term = Term(name, PointsMF((Point(0.0, 1.0),)))  # one point: constant 1 (IEC 5.2.2)
+    grown = replace(block, terms=(*block.terms, term))
+    fuzzify = [grown if f.variable == carrier.name else f for f in fb.fuzzify]
+    if fb.fuzzify_block(carrier.name) is None:
+        fuzzify.append(grown)
+    predicate = Is(carrier.name, name)
+    rule_blocks = tuple(
+        replace(
+            rb, rules=tuple(replace(r, condition=predicate) if r.condition is None else r for r in rb.rules)
+        )
+        for rb in fb.rule_blocks
+    )
+    return replace(fb, fuzzify=tuple(fuzzify), rule_blocks=rule_blocks)
+
+
 def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants, list[Diagnostic]]:
     """Encode a function block into XFUZ constants.  Returns the constants and the
-    diagnostics; when there are errors the constants are not meaningful."""
+    diagnostics; when there are errors the constants are not meaningful.  A rule without an
+    IF part gets the predicate ``INPi IS ALWAYS`` (:func:`with_always_predicate`)."""
     fb = block.main if isinstance(block, Document) else block
+    fb = with_always_predicate(fb)
     diags: list[Diagnostic] = []
     opts = _read_options(fb, diags)
 
@@ -517,7 +562,7 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     replaced, and the XFUZ semantics themselves when the program does not already state
     them: defuzzification on Discr points (no ``XFUZ DISCR`` option) and 16-bit integer
     inputs and outputs (REAL variables)."""
-    fb = document.main
+    fb = with_always_predicate(document.main)
     losses: list[tuple[str, str]] = [
         (f"function block {b.name}", "XFUZ holds one rule base") for b in document.blocks[1:]
     ]

@@ -1,5 +1,25 @@
-"""Siemens S7 client (python-snap7): REALs and INTs in data blocks, addressed by DB number
-and byte offset (``DB1.DBD8`` is ``{db = 1, offset = 8}``).
+"""Siemens S7 client (python-snap7): REALs, INTs, WORDs and BYTEs in data blocks, addressed
+by DB number and byte offset (``DB1.DBD8`` is ``{db = 1, offset = 8}``), or by parameter
+name in a FUZZY instance data block (``{db = 30, parameter = "INPUT1"}``).
+
+The FUZZY instance DB (Siemens S7 Fuzzy Control manual, Tables 3-1..3-3) as the PLC holds
+it, S7 types big-endian:
+
+==========  ============  =========  ==============================================
+byte        parameter     type       meaning
+==========  ============  =========  ==============================================
+0..28       INPUT1..8     REAL       inputs of the fuzzy application (4 bytes each)
+32..44      OUTPUT1..4    REAL       outputs of the fuzzy application
+48          INFO          BYTE       B#16#00, 01, 11, 21 (49 is the padding to the WORD)
+50          START_STOP    WORD       0: do not process, else process
+52..2125    FUZZY[0..2073] BYTE      the block's internal area ("52 to 2126"; the DB
+                                     is 2126 bytes long, 3.4)
+==========  ============  =========  ==============================================
+
+With these bindings ``fuzzyctl serve`` stands in for FB30 beside a PLC whose program keeps
+its FUZZY DB (FUZZY_AI writes INPUTn, FUZZY_AO reads OUTPUTn, the program watches INFO and
+sets START_STOP): only the bound parameters are read and written; the internal area is the
+PLC's (the soft block keeps its application in the runtime).
 
 python-snap7 is pure Python from release 3.0 on (it no longer loads the native snap7
 library), so nothing but the wheel is needed; pyproject.toml requires >= 3.0 for that.
@@ -13,50 +33,104 @@ import asyncio
 import contextlib
 import logging
 import math
+import re
 import struct
 from collections.abc import Sequence
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 from fuzzyctl.io.base import Connector, LinkError, Point, bounded
 from fuzzyctl.io.codec import real_from_bytes, real_to_bytes
 
-__all__ = ["S7Client", "S7Options", "S7Point"]
+__all__ = ["FUZZY_DB", "FUZZY_DB_INTERNAL", "S7Client", "S7Options", "S7Point", "fuzzy_db_address"]
 
 logging.getLogger("snap7").setLevel(logging.CRITICAL)  # the runtime reports link state itself
 
 MAX_SPAN = 400  # bytes read in one request before we split (the client chunks by PDU anyway)
 
+S7Type = Literal["real", "int", "word", "byte"]
+_WIDTH = {"real": 4, "int": 2, "word": 2, "byte": 1}
+_RANGE = {"int": (-32768, 32767), "word": (0, 65535), "byte": (0, 255)}
+_FORMAT = {"int": ">h", "word": ">H", "byte": ">B"}
+_AREA = {"real": "DBD", "int": "DBW", "word": "DBW", "byte": "DBB"}
+
+FUZZY_DB: dict[str, tuple[int, S7Type]] = {
+    **{f"INPUT{i}": (4 * (i - 1), "real") for i in range(1, 9)},  # Table 3-1
+    **{f"OUTPUT{i}": (32 + 4 * (i - 1), "real") for i in range(1, 5)},  # Table 3-2
+    "INFO": (48, "byte"),  # Table 3-2
+    "START_STOP": (50, "word"),  # Table 3-3
+}
+"""The parameters of a FUZZY instance DB: name -> (byte offset, S7 type), Tables 3-1..3-3."""
+FUZZY_DB_INTERNAL = (52, 2126)
+"""The internal area ``FUZZY`` (Table 3-3, "52 to 2126"): bytes 52 up to the DB length 2126
+(3.4), addressed as ``FUZZY[0]`` .. ``FUZZY[2073]``, BYTE each."""
+
+
+def fuzzy_db_address(parameter: str) -> tuple[str, int, S7Type]:
+    """``(name, byte offset, type)`` of a FUZZY instance DB parameter (``INPUT1``..``INPUT8``,
+    ``OUTPUT1``..``OUTPUT4``, ``INFO``, ``START_STOP``, ``FUZZY[n]``), case-insensitive;
+    ValueError naming the valid ones otherwise."""
+    name = parameter.strip().upper()
+    if name in FUZZY_DB:
+        offset, kind = FUZZY_DB[name]
+        return name, offset, kind
+    m = re.fullmatch(r"FUZZY\s*\[\s*(\d+)\s*\]", name)
+    first, end = FUZZY_DB_INTERNAL
+    if m is not None and first + int(m.group(1)) < end:
+        return f"FUZZY[{int(m.group(1))}]", first + int(m.group(1)), "byte"
+    raise ValueError(
+        f"{parameter!r} is not a parameter of a FUZZY instance DB (Tables 3-1..3-3: INPUT1..INPUT8, "
+        f"OUTPUT1..OUTPUT4, INFO, START_STOP, or FUZZY[0]..FUZZY[{end - first - 1}] of the internal area)"
+    )
+
 
 class S7Point(Point):
-    """A value in a data block: ``{db = 1, offset = 8}`` (REAL) or ``type = "int"``."""
+    """A value in a data block: ``{db = 1, offset = 8}`` (REAL), ``type = "int"``, ``"word"``
+    or ``"byte"``; or a FUZZY instance DB parameter ``{db = 30, parameter = "OUTPUT1"}``,
+    whose offset and type come from the manual's Tables 3-1..3-3 (:data:`FUZZY_DB`)."""
 
     area: Literal["DB"] = "DB"
     db: int = Field(ge=1, le=65535)
     offset: int = Field(ge=0, le=65535, description="byte offset in the data block")
-    type: Literal["real", "int", "word"] = "real"
+    type: S7Type = "real"
+    parameter: str | None = Field(
+        default=None, description="FUZZY instance DB parameter (Tables 3-1..3-3) instead of offset/type"
+    )
+
+    @model_validator(mode="before")
+    @classmethod
+    def _fuzzy_db_parameter(cls, data: Any) -> Any:
+        if not isinstance(data, dict) or data.get("parameter") is None:
+            return data
+        if "offset" in data or "type" in data:
+            raise ValueError("give either parameter (a FUZZY instance DB name) or offset/type, not both")
+        if not isinstance(data["parameter"], str):
+            raise ValueError("parameter is a name such as 'INPUT1'")
+        name, offset, kind = fuzzy_db_address(data["parameter"])
+        return {**data, "parameter": name, "offset": offset, "type": kind}
 
     @property
     def width(self) -> int:
-        return 4 if self.type == "real" else 2
+        return _WIDTH[self.type]
 
     def describe(self) -> str:
-        return f"DB{self.db}.{'DBD' if self.type == 'real' else 'DBW'}{self.offset} {self.type.upper()}"
+        address = f"DB{self.db}.{_AREA[self.type]}{self.offset} {self.type.upper()}"
+        return f"DB{self.db}.{self.parameter} ({address})" if self.parameter else address
 
     def decode(self, data: bytes | bytearray, at: int) -> float:
         if self.type == "real":
             return real_from_bytes(data, at)
-        return float(struct.unpack_from(">h" if self.type == "int" else ">H", data, at)[0])
+        return float(struct.unpack_from(_FORMAT[self.type], data, at)[0])
 
     def encode(self, value: float) -> bytes:
         if self.type == "real":
             return real_to_bytes(value)
         if math.isnan(value):
             raise ValueError("NaN has no integer representation")
-        low, high = (-32768, 32767) if self.type == "int" else (0, 65535)
+        low, high = _RANGE[self.type]
         n = math.floor(abs(value) + 0.5) * (1 if value >= 0 else -1) if math.isfinite(value) else value
-        return struct.pack(">h" if self.type == "int" else ">H", int(min(max(n, low), high)))
+        return struct.pack(_FORMAT[self.type], int(min(max(n, low), high)))
 
 
 class S7Options(BaseModel):

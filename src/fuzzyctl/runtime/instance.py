@@ -362,14 +362,22 @@ class Instance:
         self.adapter.fault = None if self.io_state is SafetyState.RUN else self.io_state.value
 
     def _param_from_field(self, p: ParamBinding) -> None:
-        v = p.cell.value
-        if not p.link.up or not math.isfinite(v) or p.cell.stamp == p.seen_stamp:
+        v, stamp = p.cell.value, p.cell.stamp
+        if not p.link.up or not math.isfinite(v) or stamp == p.seen_stamp:
             return
-        p.seen_stamp = p.cell.stamp
-        if v == p.seen:
-            return
+        # What the field held before this read: the last value read, or our mirror when
+        # it was written between that read and this one.  Without the second case a
+        # command written right after the mirror (START_STOP 16#FFFF -> 0 before we read
+        # the 16#FFFF back) would look like no change and be lost.
+        before = p.seen
+        last_send = p.mirror.last_send
+        if last_send is not None and p.seen_stamp < last_send[1] < stamp:
+            before = last_send[0]
+        p.seen_stamp = stamp
         first = p.seen is None
         p.seen = v
+        if v == before:
+            return
         current = self.adapter.get_param(p.key)
         if v == current or (first and p.mirror.sent is None and v == 0 and current != 0):
             # A fresh node or register holds 0 before we mirrored anything: not a command.

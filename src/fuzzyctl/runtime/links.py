@@ -40,11 +40,14 @@ class InCell:
 class OutCell:
     """One output point: the value the cycle wants in the field (None: nothing yet)."""
 
-    __slots__ = ("sent", "value")
+    __slots__ = ("last_send", "sent", "value")
 
     def __init__(self) -> None:
         self.value: float | None = None
         self.sent: float | None = None
+        # (value, perf_counter after the write), one tuple so the cycle thread never sees
+        # a value with another write's time; kept across reconnects, unlike ``sent``.
+        self.last_send: tuple[float, float] | None = None
 
 
 _Lists = tuple[list[Point], list[InCell], list[Point], list[OutCell], list[Point], list[OutCell]]
@@ -152,8 +155,10 @@ class Link:
                 sent.append(out_cell)
         if out_points:
             await self.connector.write(out_points, out_values)
+            done = time.perf_counter()
             for out_cell, value in zip(sent, out_values, strict=True):
                 out_cell.sent = value
+                out_cell.last_send = (value, done)
         self.counters.exchanges += 1
         self.last_exchange = end = time.perf_counter()
         self.counters.last_exchange_ms = (end - t0) * 1e3

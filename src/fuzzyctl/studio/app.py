@@ -224,13 +224,16 @@ def create_app(
 
     @app.get("/api/info")
     def info() -> dict[str, Any]:
-        """Version, project directory, the file opened at start, formats."""
+        """Version, project directory, the file opened at start, formats, and the name limits
+        of the S7 configuration tool its dialogs check (the siemens profile's)."""
         from fuzzyctl import formats
+        from fuzzyctl.blocks.siemens.profile import LIMITS
 
         return {
             "version": __version__,
             "root": str(project.root),
             "file": file,
+            "siemens_limits": {k: LIMITS[k] for k in ("project_name", "variable_name", "term_name")},
             "formats": [
                 {
                     "name": f.name,

@@ -9,7 +9,8 @@ call of :meth:`XfuzFB.execute`:
   every other internal datum is 0 (MANUAL mode, START = 0) and the knowledge base is
   copied and checked;
 * warm restart: nothing;
-* rising edge of REFRESH: as a cold restart but the other internal data keep their values;
+* rising edge of REFRESH: as a cold restart but the other internal data keep their values
+  (MAN_AUTO, START, DEGRE, STATUS bits 0-6 of the last inference);
 * otherwise the nominal cycle of the Grafcet: read INPi or, for each bit 0-7 of COMMAND,
   Ii_SIM; run the inferences on a rising edge of START (CONT_ASK = 1, on demand) or every
   T_OFB while START = 1 (CONT_ASK = 0, continuous, T_OFB rounded to a multiple of the task
@@ -44,6 +45,8 @@ from fuzzyctl.formats.xfuz_tables import (
 __all__ = ["XfuzFB", "XfuzSnapshot"]
 
 N_IN, N_OUT, N_RULES = 8, 6, 64
+DEGRE_FULL = 255
+"""DEGRE holds a rule's degree 0..1 as 0..255, rounded (2.3)."""
 _ARRAYS = {"INP": N_IN, "OUT": N_OUT, "I_SIM": N_IN, "O_CALC": N_OUT, "O_MAN": N_OUT, "O_DEF": N_OUT}
 _BITS = ("INIT", "MAN_AUTO", "CONT_ASK", "START", "REFRESH", "INHIB")
 _WORDS = ("T_OFB", "MONITOR", "COMMAND")
@@ -169,10 +172,7 @@ class XfuzFB:
         self._kb = decode_kb(c, span_rule=self.span_rule)
         self._inference = XfuzInference(self._kb)
         self._kb_status = sum(1 << b for b in self._kb.error_bits)
-        # The last inference no longer describes the outputs, which are back at Oi_DEF$.
-        self._info_status = 0
-        self.DEGRE = [0] * N_RULES
-        self._count = 0
+        self._count = 0  # the T_OFB period starts again with the new knowledge base
         self._update_status()
 
     def cold_restart(self) -> None:
@@ -182,6 +182,10 @@ class XfuzFB:
         self.MONITOR = self.COMMAND = 0
         self.arrays["I_SIM"] = [0] * N_IN
         self._prev = {"INIT": 0, "REFRESH": 0, "START": 0}
+        # "All the other internal data are set to 0": the inference's information (STATUS
+        # bits 0-6, DEGRE) too.
+        self._info_status = 0
+        self.DEGRE = [0] * N_RULES
         self._load_constants()
 
     def warm_restart(self) -> None:
@@ -189,7 +193,10 @@ class XfuzFB:
 
     def refresh(self) -> None:
         """2.6-4 (what a rising edge of REFRESH does): ``$`` constants and the knowledge
-        base reloaded, the other internal data (MAN_AUTO, START, ...) kept."""
+        base reloaded, "all the other internal data keep their values": MAN_AUTO, START,
+        and the last inference's DEGRE and STATUS bits 0-6 (default
+        value on OUTi, no active rule), until the next inference recomputes them.  STATUS
+        bits 7-14 are the new knowledge base's checks (2.8)."""
         self._load_constants()
 
     # ----------------------------------------------------------------- the cycle (2.6-5)
@@ -261,7 +268,7 @@ class XfuzFB:
         if not result.any_active and not self.COMMAND >> 8 & 1:
             info |= 1 << StatusBit.NO_ACTIVE_RULE
         self._info_status = info
-        self.DEGRE = [min(255, math.floor(255.0 * d + 0.5)) for d in result.degrees]
+        self.DEGRE = [min(DEGRE_FULL, math.floor(DEGRE_FULL * d + 0.5)) for d in result.degrees]
         self.DEGRE += [0] * (N_RULES - len(self.DEGRE))
 
     def _assign_outputs(self) -> None:

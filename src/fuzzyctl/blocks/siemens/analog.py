@@ -13,6 +13,10 @@ The thermocouple formula is printed as ``Xi / (10.0 * FACTOR + OFFSET)`` in the 
 modules deliver tenths of a degree and FACTOR/OFFSET are "the gradient and offset of the
 normalisation line", so we read it as the line ``Xi / 10 * FACTOR + OFFSET``.
 
+With BIPOLAR and MIN/MAX that are not symmetric the manual warns that values "may be
+calculated incorrectly" (3.2, 3.3 notes): the formula is applied as printed and the
+result's ``warning`` says so (the ``siemens`` profile says it ahead, ``bipolar=``).
+
 INFO, checked in this order and stopping at the first that applies ("execution is stopped
 immediately"): 21 the data block is not a fuzzy data block of sufficient length, 11 no
 valid fuzzy application in it, 31 INPUT_NR not 1..8 / OUTPUT_NR not 1..4, 01 START_STOP =
@@ -65,6 +69,9 @@ class AnalogResult:
     info: int
     value: float | None = None
     word: int | None = None
+    warning: str | None = None
+    """Set when a bipolar signal meets asymmetric MIN/MAX (3.2, 3.3 notes: the value "may be
+    calculated incorrectly"); the value is computed by the manual's formula all the same."""
 
     @property
     def eno(self) -> bool:
@@ -78,6 +85,15 @@ def _check_db(db: object) -> Info | None:
     if not getattr(db, "has_application", False):
         return Info.NO_APPLICATION
     return None
+
+
+def _bipolar_warning(what: str, number: int, x_min: float, x_max: float) -> str | None:
+    if x_min == -x_max:
+        return None
+    return (
+        f"{what}{number}: MIN {x_min:g} and MAX {x_max:g} are not symmetric; with a bipolar signal "
+        "the value may be calculated incorrectly (manual 3.2/3.3: give e.g. -100.0 and +100.0)"
+    )
 
 
 def _raw_word(name: str, value: int) -> int:
@@ -107,6 +123,7 @@ def fuzzy_ai(
     if fuzzy_db.START_STOP == 0:
         return AnalogResult(Info.DISABLED)
     xi = _raw_word("AI value", ai_value)
+    note = None
     if therm_el:
         value = xi / 10.0 * factor + offset
     else:
@@ -115,10 +132,11 @@ def fuzzy_ai(
             value = (x_min * (FULL_SCALE - xi) + x_max * (xi + FULL_SCALE)) / (
                 2 * FULL_SCALE
             ) * factor + offset
+            note = _bipolar_warning("INPUT", input_nr, x_min, x_max)
         else:
             value = (x_min * (FULL_SCALE - xi) + x_max * xi) / FULL_SCALE * factor + offset
     fuzzy_db.write_input(input_nr, value)
-    return AnalogResult(Info.OK, value)
+    return AnalogResult(Info.OK, value, warning=note)
 
 
 def fuzzy_ao(
@@ -143,9 +161,11 @@ def fuzzy_ao(
     if x_max == x_min:
         return AnalogResult(Info.NO_APPLICATION)
     out = fuzzy_db.read_output(output_nr)
+    note = None
     if bipolar:
         xq = FULL_SCALE * (2 * out - x_max - x_min) / (x_max - x_min) * factor + offset
+        note = _bipolar_warning("OUTPUT", output_nr, x_min, x_max)
     else:
         xq = FULL_SCALE * (out - x_min) / (x_max - x_min) * factor + offset
     rounded = math.floor(abs(xq) + 0.5) * (1 if xq >= 0 else -1)
-    return AnalogResult(Info.OK, xq, int(min(max(rounded, -32768), 32767)))
+    return AnalogResult(Info.OK, xq, int(min(max(rounded, -32768), 32767)), warning=note)

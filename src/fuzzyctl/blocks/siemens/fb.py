@@ -16,6 +16,12 @@ Each :meth:`FuzzyFB.execute` is one call of the block:
   are evaluated, and each output takes its new value - or keeps its last one when no rule
   fired for it (0.0 before the first value, 1.5).
 
+Inference (1.4): AND is the minimum, and the output is the centre of gravity of the
+singletons weighted by the *sum* of the degrees of the rules concluding each of them,
+``(mu_A x_A + mu_B x_B + ...) / (mu_A + mu_B + ...)`` with one mu per rule.  The block has
+no other accumulation: whatever ACCU a program writes, the block adds (the ``siemens``
+profile warns where that changes the result; ``ACCU : NSUM`` is the IEC way to say it).
+
 The values are REALs: the block reads its inputs and writes its outputs in IEEE single
 precision, as the PLC holds them.  A rule with an empty IF part acts with degree 1 (1.5);
 that is the engine's reading of ``Rule.condition is None``.
@@ -31,22 +37,19 @@ from typing import Any
 
 from fuzzyctl.blocks.siemens.analog import DB_FUZZY_LENGTH
 from fuzzyctl.blocks.siemens.info import Info
-from fuzzyctl.blocks.siemens.profile import check_siemens
+from fuzzyctl.blocks.siemens.profile import check_siemens, variable_limits
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, InputError, error
 from fuzzyctl.model import (
     Default,
     Document,
     FunctionBlock,
-    MembershipFunction,
-    PointsMF,
-    ShapeMF,
-    SingletonMF,
-    is_constant,
 )
 
-__all__ = ["FuzzyFB"]
+__all__ = ["BLOCK_ACCU", "FuzzyFB", "block_semantics"]
 
 N_INPUTS, N_OUTPUTS = 8, 4
+BLOCK_ACCU = "SUM"
+"""The block's accumulation: the plain sum of the rules' degrees per output term (1.4)."""
 
 
 _REAL = struct.Struct("f")
@@ -65,25 +68,17 @@ def real(value: float) -> float:
     return result
 
 
-def _term_xs(mf: MembershipFunction) -> list[float]:
-    if isinstance(mf, PointsMF):
-        return [float(p.x) for p in mf.points if is_constant(p.x)]  # type: ignore[arg-type]
-    if isinstance(mf, SingletonMF) and is_constant(mf.value):
-        return [float(mf.value)]  # type: ignore[arg-type]
-    if isinstance(mf, ShapeMF):
-        return [float(p) for p in mf.params if is_constant(p)]  # type: ignore[arg-type]
-    return []
-
-
-def _limits(fb: FunctionBlock, name: str) -> tuple[float, float] | None:
-    """MIN/MAX of a variable: its RANGE, else the span of its terms."""
-    var = fb.variable(name)
-    fz, dz = fb.fuzzify_block(name), fb.defuzzify_block(name)
-    rng = (var.range if var else None) or (fz.range if fz else None) or (dz.range if dz else None)
-    if rng is not None:
-        return (rng.low, rng.high)
-    xs = [x for block in (fz, dz) if block for t in block.terms for x in _term_xs(t.mf)]
-    return (min(xs), max(xs)) if xs else None
+def block_semantics(fb: FunctionBlock) -> FunctionBlock:
+    """``fb`` as the FUZZY block computes it, for the engine: no rule fired -> NaN (the
+    block then keeps the last value, 1.5); the degrees of the rules concluding one output
+    term are added (1.4: ``x_S' = (mu_A x_A + mu_B x_B + ...) / (mu_A + mu_B + ...)``, one
+    mu per rule, and the glossary's "influences ... resulting from various rules are added
+    together"), whatever ACCU the program writes: the block has no other accumulation."""
+    return replace(
+        fb,
+        defuzzify=tuple(replace(d, default=Default(math.nan), accu=None) for d in fb.defuzzify),
+        rule_blocks=tuple(replace(rb, accu=BLOCK_ACCU) for rb in fb.rule_blocks),
+    )
 
 
 class FuzzyFB:
@@ -94,7 +89,8 @@ class FuzzyFB:
 
     ``check_profile=False`` downloads a controller that breaks the ``siemens`` profile
     (operators, shapes, limits other than the I/O count); it then runs with the
-    controller's own semantics, which a real S7 block would not."""
+    controller's own operators and shapes, which a real S7 block would not - but always
+    with the block's accumulation (the sum, 1.4) and its "last value" rule (1.5)."""
 
     def __init__(
         self,
@@ -144,14 +140,16 @@ class FuzzyFB:
             )
         if any(d.is_error for d in diags):
             raise DiagnosticError(diags)
-        # The block keeps the last value when no rule fires: ask the engine for NaN then.
-        prepared = replace(fb, defuzzify=tuple(replace(d, default=Default(math.nan)) for d in fb.defuzzify))
-        self._controller = compile_controller(prepared)
+        self._controller = compile_controller(block_semantics(fb))
         self.application = fb
         self._inputs = tuple(v.name for v in fb.inputs)
         self._outputs = tuple(v.name for v in fb.outputs)
-        self._in_limits = [_limits(fb, n) for n in self._inputs] + [None] * (N_INPUTS - len(self._inputs))
-        self._out_limits = [_limits(fb, n) for n in self._outputs] + [None] * (N_OUTPUTS - len(self._outputs))
+        self._in_limits = [variable_limits(fb, n) for n in self._inputs] + [None] * (
+            N_INPUTS - len(self._inputs)
+        )
+        self._out_limits = [variable_limits(fb, n) for n in self._outputs] + [None] * (
+            N_OUTPUTS - len(self._outputs)
+        )
         self.diagnostics = diags
         self.START_STOP = 0xFFFF
         return diags

@@ -7,6 +7,7 @@ import { post, del } from "./api.js";
 import { $, el, plot, openDialog, COLORS } from "./ui.js";
 import { setTrajectory } from "./surface.js";
 import { online } from "./online.js";
+import { bases, stacks } from "./rulebars.js";
 
 const POINTS = 150;
 const ARCHIVE = 500;
@@ -380,10 +381,12 @@ async function bars(record) {
   const o = e.outputs.find((x) => x.name === output);
   const [lo, hi] = range(output);
   const width = (hi - lo) / 60;
+  const base = bases(xs, ys, stacks(b, output));
+  const top = Math.max(1, ...ys.map((y, i) => y + base[i]));
   plot($("#rec-bars"), [
-    { type: "bar", x: xs, y: ys, width: xs.map(() => width), text: labels, textposition: "inside", insidetextanchor: "start", marker: { color: COLORS[0] }, hoverinfo: "skip" },
-    { x: [o.value], y: [-0.06], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
-  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${fmt(o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12, 1.05], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
+    { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), text: labels, textposition: "inside", insidetextanchor: "start", marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
+    { x: [o.value], y: [-0.06 * top], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
+  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${fmt(o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.05 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
   $("#rec-bars").dataset.value = String(o.value);
   $("#rec-bars").dataset.rules = JSON.stringify(labels.map((l, i) => [l, ys[i]]));
 }

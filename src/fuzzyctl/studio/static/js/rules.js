@@ -1,6 +1,7 @@
 // The rule editor (manual 6.5): one column per rule, one row per input (IF, joined by
 // AND) and per output (THEN), a term picker in every cell; append, insert blank, delete,
 // compress.  Rules the table cannot show (OR, NOT, WITH, hedges) are kept and shown as text.
+// A column with a THEN part only is a rule without an IF part (degree 1, manual 1.5).
 import { state, on, fb, inputs, outputs, changed, status } from "./state.js";
 import { $, el, fillDiagnostics } from "./ui.js";
 
@@ -35,8 +36,11 @@ function fromCells(rule, ins, outs) {
   rule.conclusions = outputs().filter((v) => outs[v.name]).map((v) => ({ variable: v.name, term: outs[v.name], weight: null, hedges: [] }));
 }
 
+/** A rule is part of the knowledge base once it has a THEN part; without an IF part it acts
+ * with degree 1 (manual 1.5: "a rule without an IF part still has an influence ... as if the
+ * conditions of the IF part were fully fulfilled").  An IF part alone has no influence. */
 export function complete(rule) {
-  return !!rule.condition && rule.conclusions.length > 0;
+  return rule.conclusions.length > 0;
 }
 
 export function conditionText(c) {
@@ -50,7 +54,7 @@ export function conditionText(c) {
 
 export function ruleText(rule) {
   const then = rule.conclusions.map((c) => `${c.variable}${c.term ? " IS " + c.term : ""}${c.weight !== null && c.weight !== undefined ? " WITH " + (typeof c.weight === "object" ? c.weight.name : c.weight) : ""}`).join(", ");
-  return `IF ${conditionText(rule.condition)} THEN ${then}`;
+  return `${rule.condition ? `IF ${conditionText(rule.condition)}` : "(no IF part: degree 1)"} THEN ${then}`;
 }
 
 function nextLabel(block) {
@@ -77,7 +81,7 @@ function render() {
   $("#rb-accu").value = block.accu || "";
   const head = el("tr", {}, el("th", { scope: "col" }, "Rule"));
   block.rules.forEach((r, j) => {
-    const th = el("th", { scope: "col", class: `rule-head${j === selectedRule ? " selected" : ""}${complete(r) ? "" : " incomplete"}`, tabindex: "0", "data-rule": j, title: complete(r) ? ruleText(r) : "incomplete: needs an IF and a THEN part" }, r.label);
+    const th = el("th", { scope: "col", class: `rule-head${j === selectedRule ? " selected" : ""}${complete(r) ? "" : " incomplete"}`, tabindex: "0", "data-rule": j, title: complete(r) ? ruleText(r) : "incomplete: needs a THEN part" }, r.label);
     th.addEventListener("click", () => select(j));
     th.addEventListener("keydown", (e) => e.key === "Enter" && select(j));
     head.append(th);
@@ -119,7 +123,15 @@ function render() {
   const diags = state.report ? state.report.diagnostics.filter((d) => d.element && (d.element === `ruleblock:${rb}` || d.element.startsWith(`rule:${rb}:`))) : [];
   fillDiagnostics($("#rule-diags"), diags);
   const incomplete = block.rules.filter((r) => !complete(r)).length;
-  if (incomplete) $("#rule-diags").prepend(el("li", { class: "note" }, `${incomplete} incomplete rule(s) (no IF or no THEN part): not part of the knowledge base until complete, not saved.`));
+  if (incomplete) $("#rule-diags").prepend(el("li", { class: "note" }, `${incomplete} incomplete rule(s) (no THEN part): not part of the knowledge base until complete, not saved.`));
+  noIfNote(block);
+}
+
+/** Rules with a THEN part only (manual 1.5): say what they do and how FCL holds them. */
+function noIfNote(block) {
+  const labels = block.rules.filter((r) => !r.condition && r.conclusions.length).map((r) => r.label);
+  if (!labels.length) return;
+  $("#rule-diags").prepend(el("li", { class: "note", "data-no-if": labels.join(",") }, `rule(s) ${labels.join(", ")}: no IF part, acting with degree 1 (manual 1.5); saved in FCL as "IF ALWAYS THEN", ALWAYS an unconnected input := 1.0.`));
 }
 
 function markSelected() {

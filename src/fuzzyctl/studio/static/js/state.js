@@ -91,8 +91,8 @@ export async function recheck() {
 }
 
 let ruleMap = [];
-/** The model part of every analysis request.  Rules the table holds without an IF or a
- * THEN part yet are left out (they are not FCL); ``ruleMap`` turns the indices of the
+/** The model part of every analysis request.  Rules the table holds without a THEN part
+ * yet are left out (they do nothing, manual 1.5); ``ruleMap`` turns the indices of the
  * rules sent back into the table's. */
 export function body(extra = {}) {
   const doc = JSON.parse(JSON.stringify(state.doc));
@@ -103,7 +103,7 @@ export function body(extra = {}) {
       const kept = [];
       const map = [];
       rb.rules.forEach((r, j) => {
-        if (r.condition && r.conclusions.length) {
+        if (r.conclusions.length) { // no IF part: degree 1 (manual 1.5); no THEN part: no effect
           kept.push(r);
           map.push(j);
         }

@@ -2,6 +2,7 @@
 // questions, terms (insert, delete, rename, "insert N" evenly spread), points in a table
 // and draggable on the chart (singletons move as a line), zoom in five steps.
 import { state, on, fb, inputs, outputs, termBlock, range, changed, handles, localCurve, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status } from "./state.js";
+import { nameWarning } from "./names.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
 
 let current = null; // variable name
@@ -125,12 +126,13 @@ function render() {
     return;
   }
   if (term >= blk.terms.length) term = Math.max(0, blk.terms.length - 1);
-  $("#var-name").value = current;
+  // A field being typed in keeps its text when a check's report redraws the view.
+  if (document.activeElement !== $("#var-name")) $("#var-name").value = current;
   const [lo, hi] = range(current);
   if (document.activeElement !== $("#var-min")) $("#var-min").value = lo;
   if (document.activeElement !== $("#var-max")) $("#var-max").value = hi;
   $("#term-select").replaceChildren(...blk.terms.map((t, i) => el("option", { value: i, selected: i === term }, t.name)));
-  $("#term-name").value = blk.terms[term] ? blk.terms[term].name : "";
+  if (document.activeElement !== $("#term-name")) $("#term-name").value = blk.terms[term] ? blk.terms[term].name : "";
   const isOut = !isInput(current);
   $("#out-options").hidden = !isOut;
   if (isOut) {
@@ -393,11 +395,14 @@ export function init() {
   $("#var-name").addEventListener("change", (e) => {
     const name = e.target.value.trim();
     if (name === current) return;
-    if (!isIdentifier(name)) return status(`${name}: a name is a letter or _ followed by letters, digits or _`, "error"), render();
-    if (variableNames().includes(name)) return status(`${name} exists already`, "error"), render();
+    const refuse = (message) => ((e.target.value = current), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: a name is a letter or _ followed by letters, digits or _`);
+    if (variableNames().includes(name)) return refuse(`${name} exists already`);
     renameVariable(current, name);
     current = name;
     changed("rename");
+    const warn = nameWarning("variable", name);
+    if (warn) status(warn, "warning");
   });
   $("#term-select").addEventListener("change", (e) => {
     term = +e.target.value;
@@ -409,11 +414,14 @@ export function init() {
     const name = e.target.value.trim();
     const old = blk.terms[term].name;
     if (name === old) return;
-    if (!isIdentifier(name)) return status(`${name}: not a valid term name`, "error"), render();
-    if (blk.terms.some((t) => t.name === name)) return status(`${current} has a term ${name} already`, "error"), render();
+    const refuse = (message) => ((e.target.value = old), status(message, "error"), render());
+    if (!isIdentifier(name)) return refuse(`${name}: not a valid term name`);
+    if (blk.terms.some((t) => t.name === name)) return refuse(`${current} has a term ${name} already`);
     blk.terms[term].name = name;
     renameTerm(current, old, name);
     changed("rename");
+    const warn = nameWarning("term", name);
+    if (warn) status(warn, "warning");
   });
   $("#var-range-apply").addEventListener("click", setRange);
   $("#term-insert").addEventListener("click", insertTerm);
