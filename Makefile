@@ -9,7 +9,7 @@ BIN    := $(VENV)/bin
 # venv of their own, never in .venv (which has the numpy users get)
 PEERS  := .venv-peers
 
-.PHONY: run simulate docs-img test fuzz lint typecheck pytest system-deps clean
+.PHONY: run simulate docs-img studio-img test fuzz lint typecheck pytest system-deps clean
 STUDIO_PORT ?= 8770
 
 $(BIN)/python:
@@ -43,6 +43,11 @@ simulate: $(VENV)/.installed
 # The plot in the README: generated from the crane example, never drawn by hand.
 docs-img: $(VENV)/.installed
 	$(BIN)/fuzzyctl simulate examples/crane.toml --png docs/img/crane.png --no-csv --no-html
+
+# The screenshots of docs/studio.md: taken by the studio's browser tests (1400x900, headless
+# Debian chromium), written to docs/img/studio/ as well as test-artifacts/studio/.
+studio-img: $(VENV)/.installed-dev system-deps
+	FUZZYCTL_STUDIO_DOCS=1 $(BIN)/pytest -q tests/studio -k browser
 
 lint: $(VENV)/.installed-dev
 	$(BIN)/ruff check src tests benchmarks

@@ -1,6 +1,7 @@
-"""Browser fixtures shared by the studio's Playwright tests: one studio server and one
-chromium (Debian's, no browser download) for the whole session, a fresh page per test
-that fails the test on any console error and leaves a screenshot in test-artifacts/."""
+"""Browser fixtures shared by the studio's Playwright tests: one studio server, one
+chromium (Debian's, no browser download) and one browser context for the whole session,
+a fresh page per test that fails the test on any console error and leaves a screenshot
+in test-artifacts/."""
 
 from __future__ import annotations
 
@@ -50,6 +51,7 @@ def studio(browser_project: Path) -> Iterator[str]:
 @pytest.fixture(scope="session")
 def browser() -> Iterator[Any]:
     import playwright.sync_api as sync_api  # a dev dependency: missing is a failure
+
     if not Path(CHROMIUM).exists():
         pytest.fail(f"{CHROMIUM} missing: `make test` installs Debian's chromium (scripts/system-deps.sh)")
     with sync_api.sync_playwright() as p:
@@ -58,17 +60,28 @@ def browser() -> Iterator[Any]:
         b.close()
 
 
-@pytest.fixture
-def page(browser: Any, studio: str, request: pytest.FixtureRequest) -> Iterator[Any]:
+@pytest.fixture(scope="session")
+def browser_context(browser: Any) -> Iterator[Any]:
+    """One context for the session: its HTTP cache keeps plotly.js (3.5 MB) parsed once,
+    not once per test (each test still gets a fresh page; the studio's remembered pane
+    sizes and rule view are cleared before every page)."""
     context = browser.new_context(viewport={"width": 1400, "height": 900}, accept_downloads=True)
-    pg = context.new_page()
+    context.add_init_script("try { localStorage.clear(); } catch (e) {}")
+    yield context
+    context.close()
+
+
+@pytest.fixture
+def page(browser_context: Any, studio: str, request: pytest.FixtureRequest) -> Iterator[Any]:
+    pg = browser_context.new_page()
     errors: list[str] = []
     pg.on("console", lambda m: m.type == "error" and errors.append(m.text))
     pg.on("pageerror", lambda e: errors.append(f"{e} {e.stack}"))
+    request.node.console_errors = errors  # a test that provokes an error may take it off
     pg.goto(studio)
     pg.wait_for_selector("body[data-ready=true]")
     yield pg
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     pg.screenshot(path=str(ARTIFACTS / f"{request.node.name}-end.png"))
-    context.close()
+    pg.close()
     assert errors == [], f"console errors: {errors}"

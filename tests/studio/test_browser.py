@@ -20,7 +20,19 @@ import pytest
 
 import fuzzyctl
 from tests.conftest import EXAMPLES
-from tests.studio.browser import RECORDED, fcl_text, open_file, reading, settle, shot, surface_z, tab
+from tests.studio.browser import (
+    RECORDED,
+    cell_text,
+    fcl_text,
+    open_file,
+    reading,
+    rule_mode,
+    set_cell,
+    settle,
+    shot,
+    surface_z,
+    tab,
+)
 from tests.studio.test_api import triangle_closed_form
 
 
@@ -36,7 +48,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     assert (
         pg.locator("#diagram .node.input").count() == 2 and pg.locator("#diagram .node.output").count() == 1
     )
-    shot(pg, "01-new-project")
+    shot(pg, "01-new-project", doc=True)
     # rename input1 and reduce it to three terms (evenly spread over -100..100)
     pg.click('#diagram [data-id="var:input1"]')
     pg.fill("#var-name", "temp")
@@ -48,13 +60,13 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     settle(pg)
     assert pg.locator("#term-select option").all_inner_texts() == ["neg", "zero", "pos"]
     # fill the rule table: temp neg/zero/pos x input2 n_big -> output1 n_large/zero/p_large
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     for label, (t, out) in enumerate([("neg", "n_large"), ("zero", "zero"), ("pos", "p_large")]):
         pg.click("#rule-append")
-        pg.select_option(f'select[data-rule="{label}"][data-var="temp"]', t)
-        pg.select_option(f'select[data-rule="{label}"][data-var="output1"]', out)
+        set_cell(pg, label, "temp", t)
+        set_cell(pg, label, "output1", out)
     settle(pg)
-    shot(pg, "02-rule-table")
+    shot(pg, "02-rule-table", doc=True)
     pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
     text = fcl_text(pg)
     assert "RULE 1 : IF temp IS neg THEN output1 IS n_large;" in text
@@ -86,7 +98,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     settle(pg)
     moved = float(pg.input_value('#points-table [aria-label="point 2 x"]'))
     assert 45 <= moved <= 55, moved
-    shot(pg, "04-dragged-point")
+    shot(pg, "04-dragged-point", doc=True)
     tab(pg, "surface")
     pg.wait_for_function(
         f"JSON.stringify(document.querySelector('#sf-chart').data[0].z) !== {json.dumps(before)!r}"
@@ -104,7 +116,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
             ctl.reset()
             expect = ctl.evaluate({"temp": xs[i], "input2": ys[j]})["output1"]
             assert after[j][i] == pytest.approx(expect, abs=1e-9)
-    shot(pg, "05-surface-after")
+    shot(pg, "05-surface-after", doc=True)
 
     # curve recorder: a triangle on temp, input2 constant; 10 s display at 100x
     tab(pg, "recorder")
@@ -144,7 +156,7 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     pg.wait_for_function(
         f"Math.abs(parseFloat(document.querySelector('#rec-bars').dataset.value) - {out}) < 1e-9"
     )
-    shot(pg, "06-recorder-triangle")
+    shot(pg, "06-recorder-triangle", doc=True)
 
     # save as, then reload: the same rules, the moved point, the recorder settings
     pg.click("#btn-saveas")
@@ -159,8 +171,8 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     pg.reload()
     pg.wait_for_selector("body[data-ready=true]")
     open_file(pg, "mixer.fcl")
-    tab(pg, "rules")
-    assert pg.input_value('select[data-rule="2"][data-var="output1"]') == "p_large"
+    rule_mode(pg, "rows")
+    assert cell_text(pg, 2, "output1") == "p_large"
     tab(pg, "recorder")
     assert pg.input_value("#rec-length") == "10"
     assert "Curve" in pg.inner_text("#rec-sig-temp")
@@ -183,7 +195,7 @@ def test_simulated_crane_loop_and_trajectory(page: Any, browser_project: Path) -
     pg.click("#rec-stop")
     values = reading(pg, 100)
     t, position, power = values["t"], values["position"], values["fb_power"]
-    shot(pg, "07-crane-loop")
+    shot(pg, "07-crane-loop", doc=True)
     # the same loop run by fuzzyctl.sim
     from fuzzyctl.sim.config import build_loop, load_config
 
@@ -201,11 +213,28 @@ def test_simulated_crane_loop_and_trajectory(page: Any, browser_project: Path) -
     path = pg.evaluate("document.querySelector('#sf-chart').data[1]")
     assert path["type"] == "scatter3d" and len(path["x"]) >= k
     assert path["x"][k] == pytest.approx(trace["fb.distance"][k], abs=1e-9)
-    shot(pg, "08-crane-trajectory")
+    shot(pg, "08-crane-trajectory", doc=True)
 
 
-def test_online_monitoring_and_download(page: Any, browser_project: Path, tmp_path: Path) -> None:
+def test_online_monitoring_and_download(
+    page: Any, browser_project: Path, tmp_path: Path, request: pytest.FixtureRequest
+) -> None:
     pg = page
+    # not connected: the state is in the menu bar, every command is disabled with a reason
+    tab(pg, "online")
+    assert pg.inner_text("#online-badge") == "● off line"
+    for button in (
+        "#on-start",
+        "#on-stop",
+        "#on-auto",
+        "#on-manual",
+        "#on-force",
+        "#on-release",
+        "#on-download",
+    ):
+        assert pg.is_disabled(button)
+        assert "not connected" in (pg.get_attribute(button, "title") or "")
+    assert "not connected" in pg.inner_text("#on-reason")
     state = tmp_path / "state"
     config = tmp_path / "serve.toml"
     with socket.socket() as s:
@@ -256,6 +285,11 @@ params = {{ MAN_AUTO = 1, START = 1 }}
             if pg.locator("#on-instance option").count():
                 break
         pg.wait_for_selector("#on-state")
+        assert pg.inner_text("#online-badge").startswith("● on line: valve @ 127.0.0.1:")
+        assert pg.is_enabled("#on-start") and pg.is_enabled("#on-download")
+        # MAN_AUTO belongs to XFUZ instances: disabled for the Siemens one, with the reason
+        assert pg.is_disabled("#on-manual")
+        assert "XFUZ" in (pg.get_attribute("#on-manual", "title") or "")
         pg.select_option("#on-force-input", "Temp")
         pg.fill("#on-force-value", "5")
         pg.click("#on-force")
@@ -275,15 +309,15 @@ params = {{ MAN_AUTO = 1, START = 1 }}
         tab(pg, "variable")
         pg.select_option("#var-select", "Valve")
         pg.select_option("#term-select", label="inlet")
-        pg.fill('#points-table [aria-label="point 1 x"]', "80")
-        pg.press('#points-table [aria-label="point 1 x"]', "Enter")
+        pg.fill("#param-0", "80")
+        pg.press("#param-0", "Enter")
         settle(pg)
         tab(pg, "online")
         pg.click("#on-download")
         pg.wait_for_selector("#download-diff")
         diff = pg.inner_text("#download-diff")
         assert "- " in diff and "TERM inlet := 100;" in diff and "+         TERM inlet := 80;" in diff
-        shot(pg, "09-download-diff")
+        shot(pg, "09-download-diff", doc=True)
         pg.click("#confirm-download")
         pg.wait_for_function("document.querySelector('#status').textContent.includes('downloaded to valve')")
         edited = ctl.evaluate({"Temp": 5, "Pressure": 60})["Valve"]
@@ -313,7 +347,18 @@ params = {{ MAN_AUTO = 1, START = 1 }}
         pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('MAN_AUTO=0')")
         pg.click("#on-auto")
         pg.wait_for_function("document.querySelector('#on-detail').textContent.includes('MAN_AUTO=1')")
-        tab(pg, "project")  # the On line view stops polling before the runtime goes
+        # the runtime goes away: the menu bar says so in any view
+        tab(pg, "project")
+        proc.terminate()
+        proc.wait(10)
+        pg.wait_for_function(
+            "document.querySelector('#online-badge').textContent.includes('lost')", timeout=15000
+        )
+        assert pg.is_disabled("#on-start")
+        shot(pg, "19-connection-lost", doc=True)
+        # the failed heartbeat requests are the browser's console errors this test expects
+        errors: list[str] = request.node.console_errors
+        errors[:] = [e for e in errors if "502" not in e]
     finally:
         proc.terminate()
         proc.wait(10)

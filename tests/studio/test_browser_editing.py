@@ -17,8 +17,20 @@ from typing import Any
 import pytest
 
 import fuzzyctl
-from tests.conftest import shared_path
-from tests.studio.browser import fcl_text, new_project, open_file, reading, settle, shot, surface_z, tab
+from tests.conftest import data_path, shared_path
+from tests.studio.browser import (
+    cell_text,
+    fcl_text,
+    new_project,
+    open_file,
+    reading,
+    rule_mode,
+    set_cell,
+    settle,
+    shot,
+    surface_z,
+    tab,
+)
 
 
 def points(pg: Any) -> list[float]:
@@ -108,10 +120,10 @@ def test_variable_editor(page: Any) -> None:
     assert "extra" not in term_names(pg)
 
     # a rule uses zero; renaming the term renames it in the rule
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     pg.click("#rule-append")
-    pg.select_option('select[data-rule="0"][data-var="input1"]', "zero")
-    pg.select_option('select[data-rule="0"][data-var="output1"]', "p_large")
+    set_cell(pg, 0, "input1", "zero")
+    set_cell(pg, 0, "output1", "p_large")
     settle(pg)
     tab(pg, "variable")
     pg.select_option("#var-select", "input1")
@@ -164,7 +176,7 @@ def test_variable_editor(page: Any) -> None:
         pg.mouse.move(box["x"] + x0 + (x40 - x0) * k / 8, box["y"] + y)
     pg.mouse.up()
     settle(pg)
-    moved = points(pg)[0]
+    moved = float(pg.input_value("#param-0"))
     assert 38 <= moved <= 42, moved
     assert f"TERM zero := {moved:g};" in fcl_text(pg).replace(".0;", ";")
     shot(pg, "12-singleton-dragged")
@@ -173,11 +185,11 @@ def test_variable_editor(page: Any) -> None:
 def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     pg = page
     new_project(pg, "table", 2, 1)
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     for j, (a, y) in enumerate([("n_big", "n_large"), ("zero", "zero"), ("p_big", "p_large")]):
         pg.click("#rule-append")
-        pg.select_option(f'select[data-rule="{j}"][data-var="input1"]', a)
-        pg.select_option(f'select[data-rule="{j}"][data-var="output1"]', y)
+        set_cell(pg, j, "input1", a)
+        set_cell(pg, j, "output1", y)
     # insert a blank rule before the second one: an incomplete rule is not FCL yet
     pg.click('#rule-table th[data-rule="1"]')
     pg.click("#rule-insert")
@@ -227,10 +239,14 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
     )
     pg.fill("#code-input", "\n".join(fixed))
     pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
-    tab(pg, "rules")
-    assert pg.input_value('select[data-rule="1"][data-var="input2"]') == "zero"
-    assert pg.input_value('select[data-rule="1"][data-var="output1"]') == "p_small"
-    assert "OR" in pg.inner_text("#rule-table td.text-rule")
+    rule_mode(pg, "rows")
+    assert cell_text(pg, 1, "input2") == "zero"
+    assert cell_text(pg, 1, "output1") == "p_small"
+    assert (
+        pg.input_value('#rule-table input[data-rule="2"][data-part="if"]')
+        == "input1 IS zero OR input2 IS zero"
+    )
+    assert cell_text(pg, 2, "output1") == "zero"  # its THEN part is still a cell
     # the conformance level follows the model: the OR rule (without an OR operator in its
     # rule block) lifts it above Basic, and the panel says why
     assert pg.inner_text("#level-badge") == "level: Extension"
@@ -244,7 +260,7 @@ def test_rule_table_and_text_editor_share_the_model(page: Any) -> None:
 def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> None:
     pg = page
     new_project(pg, "three", 3, 1)
-    tab(pg, "rules")
+    rule_mode(pg, "rows")
     table = [
         ("n_big", "n_big", "n_big", "n_large"),
         ("p_big", "zero", "zero", "p_small"),
@@ -254,7 +270,7 @@ def test_surface_family_parameter_rotation_animation_and_explain(page: Any) -> N
     for j, (a, b, c, y) in enumerate(table):
         pg.click("#rule-append")
         for var, term in (("input1", a), ("input2", b), ("input3", c), ("output1", y)):
-            pg.select_option(f'select[data-rule="{j}"][data-var="{var}"]', term)
+            set_cell(pg, j, var, term)
     settle(pg)
     ctl = fuzzyctl.compile(fuzzyctl.load(fcl_text(pg)))
 
@@ -366,13 +382,16 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     assert pg.inner_text("#rec-sig-Temp") == "Temp: Minimum"
     pg.select_option("#rec-speed", "100")
     pg.click("#rec-start")
-    # more than 500 samples: the archive is full and the oldest records are gone
-    pg.wait_for_function("document.querySelector('#rec-chart').layout.xaxis.range[0] >= 60", timeout=20000)
+    # more than 450 samples: the archive is full and the oldest records are gone
+    pg.wait_for_function(
+        "(document.querySelector('#rec-chart').layout?.xaxis.range[0] ?? 0) >= 60", timeout=30000
+    )
     pg.click("#rec-stop")
     values = reading(pg, 75)
     assert values["Temp"] == 0  # the range minimum
     scroll = pg.locator("#rec-scroll")
-    assert scroll.is_enabled() and scroll.get_attribute("max") == "349"  # 500 - 150 - 1
+    # the archive: three display lengths (45 s) of 0.1 s records, 450 - 150 - 1 positions
+    assert scroll.is_enabled() and scroll.get_attribute("max") == "299"
     # scroll to the oldest record of the archive
     pg.eval_on_selector("#rec-scroll", "(e) => { e.value = 0; e.dispatchEvent(new Event('input')); }")
     first = reading(pg, 0)
@@ -397,19 +416,46 @@ def test_recorder_signals_length_archive_and_bars(page: Any, browser_project: Pa
     shot(pg, "17-recorder-archive")
 
 
-@pytest.mark.extra("corpus")  # a real FIS file with OR rules
-def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
+# A FIS file imported and exported, then the keyboard: the real-world one of the corpus (an
+# extra suite) and MATLAB's tipper with its OR rules, vendored from fuzzylite (every clone).
+IMPORTS = [
+    pytest.param(
+        ("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis"),
+        {"len": 40.0, "wid": 20.0, "n": 30.0},
+        "PL",
+        marks=pytest.mark.extra("corpus"),
+        id="corpus",
+    ),
+    pytest.param(
+        ("data", "fuzzylite", "mamdani", "matlab", "tipper.fis"),
+        {"service": 3.0, "food": 7.0},
+        "tip",
+        id="vendored",
+    ),
+]
+
+
+@pytest.mark.parametrize(("where", "point", "output"), IMPORTS)
+def test_import_export_and_keyboard(
+    page: Any, browser_project: Path, where: tuple[str, ...], point: dict[str, float], output: str
+) -> None:
     pg = page
-    fis = shared_path("corpus", "fis", "AlexMolio__nn_classification__fuzzy.fis")
+    fis = shared_path(*where) if where[0] == "corpus" else data_path(*where[1:])
     pg.set_input_files("#import-file", str(fis))
     pg.wait_for_function("document.querySelector('#status').textContent.includes('imported')")
     assert "(fis)" in pg.inner_text("#status")
     settle(pg)
-    assert pg.locator("#diagram .node.input").count() == 3
+    assert pg.locator("#diagram .node.input").count() == len(point)
     ref = fuzzyctl.compile(fuzzyctl.load(fis))
-    point = {"len": 40.0, "wid": 20.0, "n": 30.0}
     imported = fuzzyctl.compile(fuzzyctl.load(fcl_text(pg)))
     assert imported.evaluate(point) == pytest.approx(ref.evaluate(point))
+    # the rules are editable: cells, and the OR rules text fields (not greyed-out text)
+    rule_mode(pg, "rows")
+    assert pg.locator("#rule-table tbody tr").count() == len(ref.plan.rules)
+    conditions = pg.evaluate(
+        "[...document.querySelectorAll('#rule-table input[data-part=\"if\"]')].map((e) => e.value)"
+    )
+    assert any(" OR " in c for c in conditions) == (where[0] == "data")  # the corpus file has none
     # export as FLL: the downloaded file computes the same
     pg.click("#btn-export")
     pg.select_option("#export-format", "fll")
@@ -421,30 +467,31 @@ def test_import_export_and_keyboard(page: Any, browser_project: Path) -> None:
     assert info.value.suggested_filename.endswith(".fll")
 
     # keyboard: Alt+digit picks a view, arrows move along the tabs, Ctrl+S saves
-    pg.keyboard.press("Alt+3")
-    assert pg.is_visible("#view-rules")
+    pg.keyboard.press("Alt+4")
+    assert pg.is_visible("#view-ruleviewer")
     pg.keyboard.press("ArrowRight")
     assert pg.is_visible("#view-text")
     assert pg.evaluate("document.activeElement.dataset.view") == "text"
     pg.keyboard.press("Control+s")
     pg.wait_for_selector("#dlg-saveas[open]")
-    pg.fill("#saveas-path", "imported.fcl")
+    name = f"imported-{where[0]}.fcl"
+    pg.fill("#saveas-path", name)
     pg.keyboard.press("Enter")
-    pg.wait_for_function("document.querySelector('#status').textContent.includes('saved imported.fcl')")
-    again = fuzzyctl.compile(fuzzyctl.load(browser_project / "imported.fcl"))
+    pg.wait_for_function(f"document.querySelector('#status').textContent.includes('saved {name}')")
+    again = fuzzyctl.compile(fuzzyctl.load(browser_project / name))
     assert again.evaluate(point) == pytest.approx(ref.evaluate(point))
     # a change, then Save (no dialog: the project has its file now)
     tab(pg, "variable")
-    pg.select_option("#var-select", "PL")
+    pg.select_option("#var-select", output)
     pg.select_option("#out-method", "MOM")
     settle(pg)
     assert pg.inner_text("#project-name").startswith("●")  # unsaved changes
     pg.click("#btn-save")
     pg.wait_for_function("!document.querySelector('#project-name').textContent.startsWith('●')")
-    block = fuzzyctl.load(browser_project / "imported.fcl").main.defuzzify_block("PL")
+    block = fuzzyctl.load(browser_project / name).main.defuzzify_block(output)
     assert block is not None and block.method == "MOM"
     # Tab reaches the buttons of the menu bar in order
     pg.focus("#btn-new")
     pg.keyboard.press("Tab")
     assert pg.evaluate("document.activeElement.id") == "btn-open"
-    shot(pg, "18-imported")
+    shot(pg, f"18-imported-{where[0]}")

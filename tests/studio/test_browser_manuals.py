@@ -9,7 +9,17 @@ from typing import Any
 
 import pytest
 
-from tests.studio.browser import RECORDED, fcl_text, open_file, settle, shot, tab
+from tests.studio.browser import (
+    RECORDED,
+    cell_text,
+    fcl_text,
+    open_file,
+    rule_mode,
+    set_cell,
+    settle,
+    shot,
+    tab,
+)
 
 
 def test_siemens_rule_bars_stack_the_rules_of_one_singleton(page: Any) -> None:
@@ -56,9 +66,9 @@ def test_rule_without_if_part_and_the_tool_s_name_limits(page: Any) -> None:
     pg.wait_for_selector("#diagram svg")
     settle(pg)
     # a column with a THEN part only: a rule acting with degree 1 (1.5), part of the program
-    tab(pg, "rules")
+    rule_mode(pg, "columns")  # the manual's table, one column per rule
     pg.click("#rule-append")
-    pg.select_option('select[data-rule="0"][data-var="output1"]', "p_large")
+    set_cell(pg, 0, "output1", "p_large")
     pg.wait_for_selector("#rule-diags [data-no-if]")
     assert "incomplete" not in pg.inner_text("#rule-diags")
     assert pg.get_attribute("#rule-diags [data-no-if]", "data-no-if") == "1"
@@ -73,12 +83,27 @@ def test_rule_without_if_part_and_the_tool_s_name_limits(page: Any) -> None:
     pg.wait_for_function("document.querySelector('#check-badge').textContent.startsWith('OK')")
     tab(pg, "rules")
     pg.wait_for_function(
-        "document.querySelector('select[data-rule=\"0\"][data-var=\"output1\"]').value === 'p_small'"
+        'document.querySelector(\'#rule-table td.cell[data-rule="0"][data-var="output1"]\')'
+        ".textContent.trim() === 'p_small'"
     )
-    assert pg.locator('#rule-table select[data-var="ALWAYS"]').count() == 0
+    assert cell_text(pg, 0, "output1") == "p_small"
+    assert pg.locator('#rule-table td.cell[data-var="ALWAYS"]').count() == 0
+    # the rules as text write it as FCL does, and read it back as a rule without an IF part
+    rule_mode(pg, "text")
+    assert pg.input_value("#rules-input") == "IF ALWAYS THEN output1 IS p_small;"
+    parsed = int(pg.get_attribute("#rules-text", "data-parsed") or "0")
+    pg.fill("#rules-input", "IF ALWAYS THEN output1 IS n_large;")
+    pg.wait_for_function(f"+document.querySelector('#rules-text').dataset.parsed > {parsed}")
+    assert pg.get_attribute("#rules-text", "data-ok") == "true"
+    rule_mode(pg, "columns")
+    assert cell_text(pg, 0, "output1") == "n_large"
+    assert pg.locator('#rule-table td.cell[data-var="ALWAYS"]').count() == 0
+    settle(pg)
+    assert "RULE 1 : IF ALWAYS THEN output1 IS n_large;" in fcl_text(pg)
     # an IF part alone has no influence (1.5): incomplete
+    rule_mode(pg, "columns")
     pg.click("#rule-append")
-    pg.select_option('select[data-rule="1"][data-var="input1"]', "zero")
+    set_cell(pg, 1, "input1", "zero")
     assert "1 incomplete rule(s) (no THEN part)" in pg.inner_text("#rule-diags")
     # names longer than the tool takes (6.4): accepted, with a warning
     tab(pg, "variable")

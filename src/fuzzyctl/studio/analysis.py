@@ -66,6 +66,14 @@ def fcl_text(document: Document) -> str:
     return write(document)
 
 
+def fcl_losses(document: Document) -> list[str]:
+    """What the model holds that FCL cannot write (a FIS rule weight, fuzzylite's
+    lock-range, ...): saving as FCL would drop it, so the studio says so first."""
+    from fuzzyctl import formats
+
+    return [str(loss) for loss in formats.get("fcl").losses(document)]
+
+
 def content_key(document: Document) -> str:
     """A hash of what the model means (source positions and comments left out)."""
     return hashlib.sha256(repr(document.blocks).encode("utf-8")).hexdigest()
@@ -84,6 +92,9 @@ class Report:
     level: str | None
     features: list[dict[str, str]]
     document: Document | None
+    parsed: Document | None = None
+    """The document as parsed, also when the checks found errors (None after a syntax
+    error): the rule and term editors read their lines from it."""
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -103,7 +114,7 @@ def check_text(text: str, path: str | None = None) -> Report:
     try:
         result = load_text(text, path)
     except DiagnosticError as exc:
-        return Report(False, [_diag(d, None) for d in exc.diagnostics], None, [], None)
+        return Report(False, [_diag(d, None) for d in exc.diagnostics], None, [], None, None)
     diagnostics: list[Diagnostic] = list(result.diagnostics)
     document = result.document
     if document is not None and not has_errors(diagnostics):
@@ -128,6 +139,7 @@ def check_text(text: str, path: str | None = None) -> Report:
         level,
         features,
         document if ok else None,
+        document,
     )
 
 
@@ -245,12 +257,21 @@ def display_ranges(fb: FunctionBlock, settings: dict[str, Any] | None = None) ->
     return out
 
 
+def views(document: Document, settings: dict[str, Any] | None) -> dict[str, Any]:
+    """What the editors draw of a document just opened or imported, so that the browser
+    needs no second check: display ranges, term curves, what FCL cannot write."""
+    ranges = display_ranges(document.main, settings)
+    return {"ranges": ranges, "curves": curves(document.main, ranges), "fcl_losses": fcl_losses(document)}
+
+
 def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[str, Any]]:
     """How each term of each input and output looks, for the editors: ``{"points":
     [[x, mu], ...]}`` (exact for piecewise-linear terms, 201 samples for smooth ones,
-    extended flat to the range ends), ``{"singleton": x}``, or ``{"text": ...}`` for terms
-    given by variables or expressions (edited in the text editor)."""
+    extended flat to the range ends), ``{"singleton": x}``, ``{"spikes": [[x, mu], ...]}``,
+    or ``{"text": ...}`` for terms given by variables or expressions; each also has
+    ``"fcl"``, the term as the FCL text writes it (after ``:=``)."""
     from fuzzyctl.engine.shapes import membership_np, pwl_points
+    from fuzzyctl.fcl.writer import mf_text
 
     out: dict[str, dict[str, Any]] = {}
     for v in (*fb.inputs, *fb.outputs):
@@ -289,6 +310,7 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
                         shape = {"points": [[float(a), float(b)] for a, b in zip(xs, ys, strict=True)]}
                 except (ValueError, ZeroDivisionError, FloatingPointError):
                     pass
+            shape["fcl"] = mf_text(mf)
             terms[t.name] = shape
         out[v.name] = terms
     return out
@@ -480,6 +502,17 @@ def record(
             **{k: _finite(v) for k, v in outputs.items()},
         },
     }
+
+
+def clean(obj: Any) -> Any:
+    """JSON-ready: NaN and infinities become None (JSON has no such numbers)."""
+    if isinstance(obj, float):
+        return obj if math.isfinite(obj) else None
+    if isinstance(obj, dict):
+        return {k: clean(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [clean(v) for v in obj]
+    return obj
 
 
 def dumps(data: Any) -> str:

@@ -28,7 +28,7 @@ from fastapi.staticfiles import StaticFiles
 from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
 from fuzzyctl.model import Document, FunctionBlock
-from fuzzyctl.studio import analysis, online
+from fuzzyctl.studio import analysis, api_editing, online
 from fuzzyctl.studio.project import (
     PathError,
     ProjectDir,
@@ -207,7 +207,7 @@ def create_app(
                 "sha256": None,
                 "document": analysis.document_to_json(document),
                 "settings": settings,
-                "ranges": analysis.display_ranges(document.main, settings),
+                **analysis.views(document, settings),
                 **report.to_dict(),
             }
         return {
@@ -216,7 +216,7 @@ def create_app(
             "sha256": sha256(text),
             "document": analysis.document_to_json(document),
             "settings": settings,
-            "ranges": analysis.display_ranges(document.main, settings),
+            **analysis.views(document, settings),
             **report.to_dict(),
         }
 
@@ -294,7 +294,13 @@ def create_app(
         report = analysis.check_text(text)
         ranges = analysis.display_ranges(fb, settings_of(body))
         return _clean(
-            {"text": text, "ranges": ranges, "curves": analysis.curves(fb, ranges), **report.to_dict()}
+            {
+                "text": text,
+                "ranges": ranges,
+                "curves": analysis.curves(fb, ranges),
+                "fcl_losses": analysis.fcl_losses(document),
+                **report.to_dict(),
+            }
         )
 
     @app.post("/api/parse")
@@ -377,7 +383,7 @@ def create_app(
                 "document": analysis.document_to_json(document),
                 "settings": settings,
                 "text": text,
-                "ranges": analysis.display_ranges(document.main, settings),
+                **analysis.views(document, settings),
                 "warnings": [d.to_dict() for d in loaded.diagnostics],
                 **report.to_dict(),
             }
@@ -515,6 +521,7 @@ def create_app(
             return response
         return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
 
+    app.include_router(api_editing.router(cache))
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     return Guard(
         app,

@@ -39,6 +39,10 @@ class Signal(Body):
 class RecorderSettings(Body):
     curves: Annotated[list[Name], Field(max_length=5)] = Field(default_factory=list)
     length: Annotated[float, Field(ge=10, le=9999, allow_inf_nan=False)] = 60.0
+    archive: Annotated[float, Field(ge=10, le=9999, allow_inf_nan=False)] | None = Field(
+        default=None, description="archive length in seconds: the display length to about three times it"
+    )
+    shared: bool | None = Field(default=None, description="curves of one quantity share one axis")
     bar_output: Name | None = None
     signals: dict[Name, Signal] = Field(default_factory=dict)
     loop: RelPath | None = None
@@ -138,3 +142,23 @@ class OnlineCommandBody(OnlineBody):
 
 class DownloadBody(OnlineBody, ModelBody):
     pass
+
+
+class RulesTextBody(ModelBody):
+    """The rule text editor: the lines of one rule block."""
+
+    rule_block: Annotated[int, Field(ge=0, le=1000)] = 0
+    text: Annotated[str, StringConstraints(max_length=5_000_000)]
+
+
+class TermTextBody(ModelBody):
+    """A term written as FCL (what follows ``:=``)."""
+
+    variable: Name
+    text: Annotated[str, StringConstraints(min_length=1, max_length=100_000)]
+
+
+class RuleViewBody(ModelBody):
+    """The rule viewer at one input point."""
+
+    inputs: dict[Name, Finite]

@@ -89,6 +89,7 @@ def describe_configs(root: Path, files: list[str], current: str | None) -> list[
                 if isinstance(setpoints, dict)
                 else {},
                 "inputs": controller.get("inputs", {}) if isinstance(controller, dict) else {},
+                "outputs": controller.get("outputs", {}) if isinstance(controller, dict) else {},
             }
         )
     out.sort(key=lambda c: (not c["matches"], c["path"]))
@@ -133,6 +134,7 @@ class SimSessions:
             "columns": list(loop.columns),
             "units": loop.units,
             "duration": config.duration,
+            "panels": config.panels,
             "fuzzy": {
                 "inputs": [
                     c[3:]

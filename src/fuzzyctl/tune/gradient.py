@@ -6,8 +6,10 @@ maximal in every MAX accumulation) the output of a system with
 
 * input terms given by points, triangles, trapezoids (linear pieces) or Gaussians,
 * conditions that are ANDs (MIN or PROD) of ``variable IS term``,
-* singleton outputs under CoGS (accumulation MAX, SUM or BSUM), or Takagi-Sugeno outputs
-  (constant, linear or singleton terms) under WTAVER / WTSUM,
+* singleton outputs under CoGS (accumulation MAX, SUM or BSUM), Takagi-Sugeno outputs
+  (constant, linear or singleton terms) under WTAVER / WTSUM, or Mamdani outputs with
+  points/triangle/trapezoid terms under COG or COA (activation MIN or PROD, accumulation
+  MAX, SUM or BSUM: :mod:`fuzzyctl.tune.gradient_cog`),
 
 is a rational function of the parameters, and its gradient follows by the chain rule:
 
@@ -20,8 +22,8 @@ is a rational function of the parameters, and its gradient follows by the chain 
 
 Where it does not hold (:func:`unsupported` says why): on the boundaries between pieces
 (a sample exactly on a breakpoint, ties in MIN/MAX: a set of measure zero, where the
-one-sided derivative is used), for Mamdani outputs defuzzified by area (COG/COA of clipped
-sets: piecewise rational in the breakpoints, not implemented here), for OR, NOT, hedges,
+one-sided derivative is used), for Mamdani outputs by LM, RM, MOM or with PROBOR/NSUM
+or smooth terms, for OR, NOT, hedges,
 chained rule blocks, other norms, fuzzylite's rule activation methods and firing
 threshold, and for other shapes.  There the tuner falls back to finite differences of the
 engine's outputs.  Samples where no rule fires take the DEFAULT value (derivative 0).
@@ -37,6 +39,7 @@ import numpy.typing as npt
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.shapes import pwl_value_np
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
+from fuzzyctl.tune import gradient_cog
 
 Arr = npt.NDArray[np.float64]
 PSlot = tuple[str, int, int, int] | tuple[str, int, int] | tuple[str, int]
@@ -109,8 +112,12 @@ def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
                 return f"{name}: {op.method} with ACCU {op.accu}"
             if any(t.kind not in ("constant", "linear", "singleton") or not t.constant for t in op.terms):
                 return f"{name}: function or Tsukamoto terms"
+        elif op.kind == "mamdani":
+            why = gradient_cog.unsupported(op)
+            if why:
+                return why
         else:
-            return f"{name}: {op.kind} output (area defuzzification is piecewise rational: not implemented)"
+            return f"{name}: {op.kind} output"
     return None
 
 
@@ -245,6 +252,8 @@ def _accumulate(accu: str, items: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, 
 def _output(
     oi: int, op: OutputPlan, plan: Plan, fired: list[tuple[Arr, Grad]], vals: Sequence[Arr], n: int
 ) -> tuple[Arr, Grad]:
+    if op.kind == "mamdani":
+        return _mamdani(oi, op, plan, fired, n)
     contribs = _contributions(op, fired)
     per_term: dict[int, list[tuple[Arr, Grad]]] = {}
     for t, v, g in contribs:
@@ -294,13 +303,34 @@ def _output(
         for key, d in zg.items():
             _add(grad, key, dy_dz * d)
     grad = {k: np.where(fired_rows, d, 0.0) for k, d in grad.items()}
-    y = np.where(fired_rows, y, np.nan)
+    return _clamped(op, np.where(fired_rows, y, np.nan), grad)
+
+
+def _clamped(op: OutputPlan, y: Arr, grad: Grad) -> tuple[Arr, Grad]:
     if op.clamp is not None:
         lo, hi = op.clamp
         inside = (y >= lo) & (y <= hi)
         grad = {k: np.where(inside, d, 0.0) for k, d in grad.items()}
         y = np.where(np.isnan(y), y, np.clip(y, lo, hi))
     return y, grad
+
+
+def _mamdani(oi: int, op: OutputPlan, plan: Plan, fired: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, Grad]:
+    """COG or COA of a Mamdani output (:mod:`fuzzyctl.tune.gradient_cog`) chained with the
+    rules' degrees; NaN where the set is empty."""
+    weights = [float(c.weight) for c in op.contributions]  # type: ignore[arg-type]
+    res = gradient_cog.cog_partials(
+        op, [a for a, _g in fired], weights, plan.options.weight_before_activation, n
+    )
+    grad: Grad = {}
+    for ci, c in enumerate(op.contributions):
+        _a, g = fired[c.rule]
+        for key, d in g.items():
+            _add(grad, key, res.d_degree[ci] * d)
+        _add(grad, ("with", c.rule, c.conclusion), res.d_weight[ci])
+    for (t, p), d in res.d_term.items():
+        _add(grad, ("out", oi, t, p), d)
+    return _clamped(op, res.value, grad)
 
 
 def slot_map(fb: FunctionBlock, plan: Plan) -> dict[tuple[object, ...], PSlot] | None:

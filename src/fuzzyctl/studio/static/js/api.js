@@ -16,23 +16,50 @@ export class ApiError extends Error {
   }
 }
 
-async function request(method, path, body) {
+// The busy indicator: a bar under the menu bar (and the "busy" mark on <body>) while a
+// request has been under way for more than 150 ms; background polling does not count.
+let pending = 0;
+let shown = null;
+function busy(delta, quiet) {
+  if (quiet) return;
+  pending += delta;
+  const bar = document.getElementById("busy");
+  if (pending > 0 && shown === null) {
+    shown = setTimeout(() => {
+      document.body.dataset.busy = "true";
+      if (bar) bar.hidden = false;
+    }, 150);
+  } else if (pending === 0) {
+    clearTimeout(shown);
+    shown = null;
+    document.body.dataset.busy = "false";
+    if (bar) bar.hidden = true;
+  }
+}
+
+async function request(method, path, body, { quiet = false } = {}) {
   const init = { method, headers: { Accept: "application/json" } };
   if (body !== undefined) {
     init.headers["Content-Type"] = "application/json";
     init.body = JSON.stringify(body);
   }
-  const response = await fetch(path, init);
+  busy(1, quiet);
+  let response;
   let payload = null;
   try {
-    payload = await response.json();
-  } catch (_) {
-    payload = null;
+    response = await fetch(path, init);
+    try {
+      payload = await response.json();
+    } catch (_) {
+      payload = null;
+    }
+  } finally {
+    busy(-1, quiet);
   }
   if (!response.ok) throw new ApiError(response.status, payload);
   return payload;
 }
 
-export const get = (path) => request("GET", path);
-export const post = (path, body) => request("POST", path, body);
+export const get = (path, options) => request("GET", path, undefined, options);
+export const post = (path, body, options) => request("POST", path, body, options);
 export const del = (path) => request("DELETE", path, {});

@@ -1,6 +1,6 @@
 // The studio's shell: views, the file menu, the check panel, keyboard shortcuts.
 import { get, post } from "./api.js";
-import { state, on, emit, load, changed, body, newDocument, status, cleanSettings } from "./state.js";
+import { state, on, emit, load, changed, recheck, body, newDocument, status, cleanSettings } from "./state.js";
 import { $, el, confirmDialog, openDialog, fillDiagnostics } from "./ui.js";
 import * as diagram from "./diagram.js";
 import * as variable from "./variable.js";
@@ -10,8 +10,11 @@ import * as surface from "./surface.js";
 import * as recorder from "./recorder.js";
 import * as explain from "./explain.js";
 import * as onlineView from "./online.js";
+import * as ruleviewer from "./ruleviewer.js";
+import * as panes from "./panes.js";
+import { setShapes } from "./terms.js";
 
-const views = { project: diagram, variable, rules, text, surface, recorder, explain, online: onlineView };
+const views = { project: diagram, variable, rules, ruleviewer, text, surface, recorder, explain, online: onlineView };
 let current = "project";
 
 export function show(view) {
@@ -51,7 +54,14 @@ function renderReport(report) {
     }
     if (state.settings && Object.keys(cleanSettings()).length) detail.append(el("p", { class: "hint" }, "The saved file also holds the studio's view settings in an OPTIONS block (an Open-level element); exports and downloads leave it out."));
   }
-  fillDiagnostics($("#all-diags"), report.diagnostics);
+  const losses = (report.fcl_losses || []).map((l) => ({ severity: "warning", message: `saving as FCL drops: ${l}`, element: null }));
+  fillDiagnostics($("#all-diags"), [...report.diagnostics, ...losses]);
+}
+
+function renderBlocks() {
+  const blocks = state.doc ? state.doc.blocks : [];
+  $("#fb-picker").hidden = blocks.length < 2;
+  $("#fb-select").replaceChildren(...blocks.map((b, i) => el("option", { value: i, selected: i === state.block }, b.name || `block ${i + 1}`)));
 }
 
 function renderTitle() {
@@ -231,7 +241,7 @@ function bindShell() {
     } else if (e.altKey && key === "n") {
       e.preventDefault();
       newProject();
-    } else if (e.altKey && /^[1-8]$/.test(e.key)) {
+    } else if (e.altKey && /^[1-9]$/.test(e.key)) {
       e.preventDefault();
       const tab = tabs[+e.key - 1];
       show(tab.dataset.view);
@@ -244,6 +254,13 @@ function bindShell() {
   on("report", renderReport);
   on("dirty", renderTitle);
   on("loaded", renderTitle);
+  on("loaded", renderBlocks);
+  $("#fb-select").addEventListener("change", (e) => {
+    state.block = +e.target.value;
+    emit("model", "all");
+    recheck();
+  });
+  $("#online-badge").addEventListener("click", () => show("online"));
   on("status", ({ message, kind }) => {
     const s = $("#status");
     s.textContent = message;
@@ -253,8 +270,12 @@ function bindShell() {
 
 async function start() {
   bindShell();
+  panes.init();
   for (const view of Object.values(views)) view.init?.();
-  state.info = await get("/api/info");
+  $("#loading-text").textContent = "Reading the project…";
+  const [info, shapes] = await Promise.all([get("/api/info"), get("/api/shapes")]);
+  state.info = info;
+  setShapes(shapes);
   if (state.info.file) await openPath(state.info.file);
   else status("New (Alt+N) creates a project, Open (Ctrl+O) opens one from the project directory.");
   const params = new URLSearchParams(location.search);
@@ -263,5 +284,8 @@ async function start() {
   document.body.dataset.ready = "true";
 }
 
-start().catch((err) => status(String(err.message || err), "error"));
+start().catch((err) => {
+  status(String(err.message || err), "error");
+  $("#loading-text").textContent = `The studio could not start: ${err.message || err}`;
+});
 export { changed };

@@ -1,8 +1,12 @@
 // The curve recorder (manual 6.7): up to five variables against time, display length
-// 10-9999 s with 150 values per display, an archive of 500 records, a reading line, the
-// bars of rule effectiveness over the output's singletons with the centre of gravity.
-// Sources: test signals (off line), a simulated process (issue 9), a running runtime.
-import { state, on, inputs, outputs, range, body, fmt, status, isInput } from "./state.js";
+// 10-9999 s with 150 values per display, an archive of the display length up to about
+// three times it (at most 500 records), a reading line, the bars of rule effectiveness
+// over the output's singletons with the centre of gravity.  Curves are scaled to their
+// own range (the manual) or, with "shared axis", curves of one quantity (one unit) share
+// one.  Sources: test signals (off line; the outputs read "???" while a curve drives an
+// input, manual 6.7), a simulated process (issue 9: the display holds the whole run and
+// the recorder stops at its end), a running runtime.
+import { state, on, inputs, outputs, range, body, fmt, num, niceTicks, status, isInput } from "./state.js";
 import { post, del } from "./api.js";
 import { $, el, plot, openDialog, COLORS } from "./ui.js";
 import { setTrajectory } from "./surface.js";
@@ -10,7 +14,7 @@ import { online } from "./online.js";
 import { bases, stacks } from "./rulebars.js";
 
 const POINTS = 150;
-const ARCHIVE = 500;
+const MAX_RECORDS = 500;
 let archive = []; // [{t, v: {name: value}}]
 let running = null;
 let t0 = 0; // left edge of the display
@@ -29,6 +33,36 @@ function rec() {
 const source = () => $("#rec-source").value;
 const length = () => rec().length || 60;
 const dt = () => length() / POINTS;
+/** The archive length in seconds: the display length up to three times it (manual 6.7). */
+const archiveLength = () => Math.max(length(), Math.min(3 * length(), rec().archive || 3 * length()));
+/** Records the archive holds: its length over the sampling time, at most 500. */
+const archiveRecords = () => Math.min(MAX_RECORDS, Math.round(archiveLength() / dt()));
+
+/** The unit of a recorded column, when the plant knows it: its own, that of the signal a
+ * fuzzy input reads as it is, or that of a column drawn in the same panel of the loop
+ * configuration ([plot] panels: a setpoint beside its measurement). */
+function unitOf(name) {
+  if (source() !== "sim" || !sim) return null;
+  const units = sim.info.units || {};
+  if (units[name]) return units[name];
+  const config = configs.find((c) => c.path === rec().loop) || {};
+  const base = name.startsWith("fb.") ? name.slice(3) : null;
+  const mapped = base && ((config.inputs || {})[base] || (config.outputs || {})[base]);
+  if (typeof mapped === "string" && units[mapped.trim()]) return units[mapped.trim()];
+  for (const panel of sim.info.panels || []) {
+    if (!panel.includes(name)) continue;
+    const mate = panel.find((c) => units[c]);
+    if (mate) return units[mate];
+  }
+  return null;
+}
+
+function format(name, v) {
+  const [lo, hi] = ownScale(name);
+  const unit = unitOf(name);
+  const text = fmt(v, 4, hi - lo);
+  return unit ? `${text} ${unit}` : text;
+}
 
 function available() {
   if (source() === "sim" && sim) return sim.info.columns.filter((c) => c !== "t");
@@ -40,7 +74,32 @@ function fuzzyName(name) {
   return name.startsWith("fb.") ? name.slice(3) : name;
 }
 
+/** The range a curve is drawn over: shared with the curves of the same quantity when the
+ * shared axis is on. */
 function scale(name) {
+  if (!rec().shared) return ownScale(name);
+  const unit = unitOf(name);
+  const key = unit || (isFuzzy(name) ? `range ${ownScale(name).join(" ")}` : null);
+  if (!key) return ownScale(name);
+  let lo = Infinity;
+  let hi = -Infinity;
+  for (const other of rec().curves) {
+    const otherUnit = unitOf(other);
+    const otherKey = otherUnit || (isFuzzy(other) ? `range ${ownScale(other).join(" ")}` : null);
+    if (otherKey !== key) continue;
+    const [a, b] = ownScale(other);
+    lo = Math.min(lo, a);
+    hi = Math.max(hi, b);
+  }
+  return [lo, hi];
+}
+
+function isFuzzy(name) {
+  const base = fuzzyName(name);
+  return [...inputs(), ...outputs()].some((v) => v.name === base) && (source() !== "sim" || name.startsWith("fb."));
+}
+
+function ownScale(name) {
   const base = fuzzyName(name);
   if ([...inputs(), ...outputs()].some((v) => v.name === base) && (source() !== "sim" || name.startsWith("fb."))) return range(base);
   let lo = Infinity;
@@ -110,8 +169,33 @@ function renderSignals() {
     button.addEventListener("click", () => editSignal(v.name));
     row.append(button);
   }
-  const outs = el("span", { class: "hint", id: "rec-outputs-now" }, "");
-  row.append(outs);
+  row.append(el("span", { class: "sep" }), el("span", { class: "outputs-now", id: "rec-outputs-now" }, ""));
+  outputsNow();
+}
+
+/** The outputs for the test signals as the "Curve parameters" dialog shows them: their
+ * values when every input is a constant, "???" as soon as a curve drives an input
+ * (manual 6.7: they are no longer single values). */
+async function outputsNow() {
+  const box = $("#rec-outputs-now");
+  if (!box || !state.doc) return;
+  const signals = inputs().map((v) => [v.name, signalOf(v.name)]);
+  const curve = signals.some(([, s]) => s.kind === "triangle");
+  if (curve) {
+    box.replaceChildren(...outputs().map((o) => el("span", { class: "out-now", "data-output": o.name, title: "an input is driven by a curve: the output is not a single value" }, `${o.name} = ???  `)));
+    return;
+  }
+  const point = {};
+  for (const [name, s] of signals) {
+    const [lo, hi] = range(name);
+    point[name] = s.kind === "constant" ? s.value : s.kind === "minimum" ? lo : s.kind === "maximum" ? hi : 0;
+  }
+  try {
+    const e = await post("/api/explain", body({ inputs: point }), { quiet: true });
+    box.replaceChildren(...e.outputs.map((o) => el("span", { class: "out-now", "data-output": o.name, "data-value": o.value ?? "" }, `${o.name} = ${format(o.name, o.value)}  `)));
+  } catch (_) {
+    box.textContent = "";
+  }
 }
 
 async function editSignal(name) {
@@ -183,6 +267,8 @@ async function renderSim() {
   const select = el("select", { id: "rec-loop", "aria-label": "plant" }, ...configs.map((c) => el("option", { value: c.path, selected: c.path === r.loop }, `${c.title} (${c.plant}${c.matches ? ", this controller" : ""})`)));
   select.addEventListener("change", () => {
     r.loop = select.value;
+    const chosen = configs.find((x) => x.path === r.loop);
+    if (chosen && chosen.duration) setLength(Math.ceil(chosen.duration));
     renderSim();
   });
   row.append(el("label", {}, "Plant ", select));
@@ -236,7 +322,10 @@ async function sample() {
       if (session !== running) return; // stopped meanwhile: the recording ended at Stop
       res.t.forEach((t, i) => push(t, Object.fromEntries(Object.entries(res.values).map(([name, vs]) => [name, vs[i]]))));
     } else if (source() === "sim") {
-      const res = await post("/api/sim/step", { id: sim.id, seconds: n * dt() });
+      // never past the configuration's duration: the run ends at the display's right edge
+      const reached = archive.length ? archive[archive.length - 1].t : 0;
+      const seconds = Math.min(n * dt(), Math.max(sim.info.period || 0.01, (sim.info.duration || Infinity) - reached));
+      const res = await post("/api/sim/step", { id: sim.id, seconds });
       if (session !== running) return;
       const rows = res.rows;
       const count = rows.t.length;
@@ -247,6 +336,12 @@ async function sample() {
         if (t + 1e-9 >= k * dt()) push(t, Object.fromEntries(Object.keys(rows).map((c) => [c, rows[c][i]])));
       }
       shareTrajectory();
+      if (sim.info.duration && res.t >= sim.info.duration - 1e-9) {
+        draw();
+        stop();
+        status(`the simulated run is complete (${fmt(sim.info.duration)} s, the configuration's duration): move the reading line, or Start again`);
+        return;
+      }
     } else {
       const detail = await post("/api/online/read", { url: online.url, token: online.token || null, instance: online.instance });
       if (session !== running) return;
@@ -268,7 +363,7 @@ async function sample() {
 
 function push(t, values) {
   archive.push({ t, v: values });
-  if (archive.length > ARCHIVE) archive.shift();
+  while (archive.length > archiveRecords()) archive.shift();
   k++;
   while (t > t0 + length()) t0 += length() / 4; // the manual's shift by a quarter
 }
@@ -302,20 +397,20 @@ function draw() {
   });
   const sel = r.curves[selectedCurve] || r.curves[0];
   const [lo, hi] = sel ? scale(sel) : [0, 1];
-  const ticks = [0, 0.25, 0.5, 0.75, 1];
+  const ticks = niceTicks(lo, hi, 5); // round values of the selected curve's scale
   const stopped = !running;
   const reading = stopped && archive.length ? readingRecord() : null;
   const shapes = reading ? [{ type: "line", x0: reading.t, x1: reading.t, y0: -0.02, y1: 1.02, line: { color: "#333", width: 1.5 } }] : [];
   plot($("#rec-chart"), traces, {
     xaxis: { range: [t0, t0 + length()], title: { text: "time [s]" } },
-    yaxis: { range: [-0.03, 1.03], tickvals: ticks, ticktext: ticks.map((f) => fmt(lo + f * (hi - lo), 4)), title: { text: sel || "" } },
+    yaxis: { range: [-0.03, 1.03], tickvals: ticks.map((v) => (v - lo) / (hi - lo)), ticktext: ticks.map((v) => num(v)), title: { text: sel ? `${sel}${unitOf(sel) ? ` [${unitOf(sel)}]` : ""}${rec().shared ? " (shared axis)" : ""}` : "" } },
     shapes,
     margin: { l: 60, r: 15, t: 10, b: 40 },
   }, { staticPlot: true });
   const last = reading || archive[archive.length - 1];
   r.curves.forEach((name, i) => {
     const cell = $(`#rec-cur-${i}`);
-    if (cell) cell.textContent = last ? fmt(last.v[name]) : "";
+    if (cell) cell.textContent = last ? format(name, last.v[name]) : "";
   });
   for (let i = r.curves.length; i < 5; i++) if ($(`#rec-cur-${i}`)) $(`#rec-cur-${i}`).textContent = "";
   const scroll = $("#rec-scroll");
@@ -328,10 +423,10 @@ function draw() {
 
 function values(record) {
   const tbody = $("#rec-values tbody");
-  tbody.replaceChildren(el("tr", {}, el("th", {}, "t [s]"), el("td", { class: "num", id: "rec-val-t", "data-value": record.t }, fmt(record.t))));
+  tbody.replaceChildren(el("tr", {}, el("th", {}, "t [s]"), el("td", { class: "num", id: "rec-val-t", "data-value": record.t }, fmt(record.t, 4, length()))));
   for (const [name, v] of Object.entries(record.v)) {
     if (name === "t") continue;
-    tbody.append(el("tr", {}, el("th", {}, name), el("td", { class: "num", id: `rec-val-${name.replace(/\./g, "_")}`, "data-value": v ?? "" }, fmt(v))));
+    tbody.append(el("tr", {}, el("th", {}, name), el("td", { class: "num", id: `rec-val-${name.replace(/\./g, "_")}`, "data-value": v ?? "" }, format(name, v))));
   }
 }
 
@@ -386,7 +481,7 @@ async function bars(record) {
   plot($("#rec-bars"), [
     { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), text: labels, textposition: "inside", insidetextanchor: "start", marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
     { x: [o.value], y: [-0.06 * top], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
-  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${fmt(o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.05 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
+  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${format(output, o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.05 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
   $("#rec-bars").dataset.value = String(o.value);
   $("#rec-bars").dataset.rules = JSON.stringify(labels.map((l, i) => [l, ys[i]]));
 }
@@ -436,7 +531,16 @@ function setLength(value) {
   const v = Math.max(10, Math.min(9999, value || 60));
   rec().length = v;
   $("#rec-length").value = v;
-  $("#rec-sampling").textContent = `sampling time ${fmt(v / POINTS, 4)} s, archive ${ARCHIVE} records`;
+  setArchive(rec().archive || 3 * v);
+}
+
+function setArchive(value) {
+  const v = Math.max(length(), Math.min(3 * length(), Math.min(9999, value || 3 * length())));
+  rec().archive = Math.round(v * 1000) / 1000;
+  $("#rec-archive").value = rec().archive;
+  $("#rec-archive").min = length();
+  $("#rec-archive").max = Math.min(9999, 3 * length());
+  $("#rec-sampling").textContent = `sampling time ${Number((length() / POINTS).toPrecision(4))} s, archive ${archiveRecords()} records`;
 }
 
 function layout() {
@@ -456,6 +560,12 @@ export function init() {
     layout();
   });
   $("#rec-length").addEventListener("change", (e) => setLength(parseFloat(e.target.value)));
+  $("#rec-archive").addEventListener("change", (e) => setArchive(parseFloat(e.target.value)));
+  $("#rec-shared").addEventListener("change", (e) => {
+    rec().shared = e.target.checked || undefined;
+    draw();
+  });
+  on("model", () => !$("#view-recorder").hidden && source() === "test" && outputsNow());
   $("#rec-start").addEventListener("click", start);
   $("#rec-stop").addEventListener("click", stop);
   $("#rec-stop").disabled = true;
@@ -486,6 +596,7 @@ export function init() {
     stop();
     archive = [];
     sim = null;
+    const chosen = state.settings.recorder && state.settings.recorder.length;
     // a loop configuration made for this controller: the simulated process is ready
     if ($("#rec-source").dataset.touched) return;
     fetch(`/api/sim/configs?current=${encodeURIComponent(state.path || "")}`)
@@ -494,6 +605,8 @@ export function init() {
         const match = (res.configs || []).find((c) => c.matches);
         if (match && !$("#rec-source").dataset.touched) {
           rec().loop = match.path;
+          // the display holds the whole run, so the transient stays in view
+          if (!chosen) rec().length = Math.max(10, Math.min(9999, Math.ceil(match.duration || 60)));
           $("#rec-source").value = "sim";
           if (!$("#view-recorder").hidden) layout();
         }
@@ -506,6 +619,7 @@ export function init() {
 export function shown() {
   if (!state.doc) return;
   setLength(length());
+  $("#rec-shared").checked = !!rec().shared;
   layout();
 }
 

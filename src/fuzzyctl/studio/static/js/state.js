@@ -59,23 +59,39 @@ export function diagnosticsFor(prefix) {
 
 let timer = null;
 let seq = 0;
-/** Something in the model changed: views redraw now, the check runs shortly after. */
-export function changed(what = "model", { quiet = false } = {}) {
+let inFlight = false; // a check is on its way
+let again = false; // the model changed while it was
+/** Something in the model changed: views redraw now, the check runs shortly after.  One
+ * check is in flight at a time; changes meanwhile are checked together when it returns
+ * (a 500-rule model takes a while to check, edits must not queue up behind each other). */
+let changes = 0; // model changes so far; a check reports which of them it saw
+export function changed(what = "model", { quiet = false, delay = 150 } = {}) {
   state.dirty = true;
+  changes++;
+  document.body.dataset.changes = String(changes);
+  if (inFlight) again = true; // the check under way is of the model before this change
   if (!quiet) emit("model", what);
   emit("dirty", true);
   clearTimeout(timer);
-  timer = setTimeout(recheck, 150);
+  timer = setTimeout(recheck, delay);
 }
 
 export async function recheck() {
   if (!state.doc) return;
+  if (inFlight) {
+    again = true;
+    return;
+  }
+  inFlight = true;
+  again = false;
   const mine = ++seq;
+  const seen = changes;
+  emit("checking", true);
   try {
     const request = body();
     const map = ruleMap;
     const report = await post("/api/check", request);
-    if (mine !== seq) return; // a newer check is on its way
+    if (mine !== seq || again) return; // a newer check follows: its answer is the one to show
     for (const d of report.diagnostics) {
       const m = /^rule:(\d+):(\d+)$/.exec(d.element || "");
       if (m && map[+m[1]]) d.element = `rule:${m[1]}:${map[+m[1]][+m[2]]}`;
@@ -83,11 +99,32 @@ export async function recheck() {
     state.report = report;
     state.textError = null;
     emit("report", report);
+    // for tests and timing: how many checks came back, and up to which change they saw
+    document.body.dataset.checks = String(+(document.body.dataset.checks || 0) + 1);
+    document.body.dataset.checkedChanges = String(seen);
   } catch (err) {
-    if (mine !== seq) return;
+    if (mine !== seq || again) return;
     state.report = { ok: false, diagnostics: [{ severity: "error", message: err.message, element: null }], level: null, ranges: (state.report || {}).ranges || {}, curves: (state.report || {}).curves || {} };
     emit("report", state.report);
+  } finally {
+    inFlight = false;
+    emit("checking", false);
+    if (again) recheck();
   }
+}
+
+/** The request body of the editors that read text in the edited function block (rule
+ * lines, a term): the model without rules or source positions, small however many rules. */
+export function bodyWithoutRules(extra = {}) {
+  const doc = { ...state.doc, blocks: state.doc.blocks.map((b) => ({ ...b, rule_blocks: b.rule_blocks.map((rb) => ({ ...rb, rules: [] })) })) };
+  return { document: withoutSpans(doc), block: state.block, ...extra };
+}
+
+/** A copy of the model without source positions: they point into the file as it was
+ * opened, the server reads the model from its FCL text again, and they are most of the
+ * size of a large rule base's JSON. */
+export function withoutSpans(value) {
+  return JSON.parse(JSON.stringify(value, (key, v) => (key === "span" || key === "item_spans" ? undefined : v)));
 }
 
 let ruleMap = [];
@@ -95,7 +132,7 @@ let ruleMap = [];
  * yet are left out (they do nothing, manual 1.5); ``ruleMap`` turns the indices of the
  * rules sent back into the table's. */
 export function body(extra = {}) {
-  const doc = JSON.parse(JSON.stringify(state.doc));
+  const doc = withoutSpans(state.doc);
   const b = doc.blocks[state.block];
   ruleMap = [];
   if (b) {
@@ -128,46 +165,16 @@ export function load(result, { path = result.path, sha = result.sha256 } = {}) {
   state.path = path;
   state.sha = sha;
   state.dirty = false;
-  state.report = { ok: result.ok, diagnostics: result.diagnostics || [], level: result.level, features: result.features || [], text: result.text, ranges: result.ranges || {}, curves: {} };
+  state.report = { ok: result.ok, diagnostics: result.diagnostics || [], level: result.level, features: result.features || [], text: result.text, ranges: result.ranges || {}, curves: result.curves || {}, fcl_losses: result.fcl_losses || [] };
   emit("loaded", result);
   emit("model", "all");
   emit("dirty", false);
-  recheck();
+  // an opened or imported file comes checked, with its curves; a new project is checked now
+  if (result.curves) emit("report", state.report);
+  else recheck();
 }
 
-// --- term helpers ------------------------------------------------------------------
-
-/** The draggable handles of a term: [{x, y, set(x)}] or null when the term is not a
- * constant point list, singleton, triangle or trapezoid (edited as text then). */
-export function handles(term) {
-  const mf = term.mf;
-  const num = (v) => typeof v === "number";
-  if (mf.type === "points" && mf.points.every((p) => num(p.x) && num(p.y))) {
-    return mf.points.map((p) => ({ x: p.x, y: p.y, set: (x) => (p.x = x) }));
-  }
-  if (mf.type === "singleton" && num(mf.value)) {
-    return [{ x: mf.value, y: 1, set: (x) => (mf.value = x), singleton: true }];
-  }
-  if (mf.type === "shape" && (mf.kind === "triangle" || mf.kind === "trapezoid") && mf.params.every(num)) {
-    const ys = mf.kind === "triangle" ? [0, 1, 0] : [0, 1, 1, 0];
-    return mf.params.map((x, i) => ({ x, y: ys[i], set: (v) => (mf.params[i] = v) }));
-  }
-  return null;
-}
-
-/** Points to draw for a term from the local model (live while dragging), extended flat
- * to the range ends as IEC defines; null: use the server's curve. */
-export function localCurve(term, lo, hi) {
-  const h = handles(term);
-  if (!h) return null;
-  if (h[0].singleton) return { singleton: h[0].x };
-  const pts = h.map((p) => [p.x, p.y]).sort((a, b) => a[0] - b[0]);
-  if (term.mf.type === "shape") {
-    // a shape is 0 outside its support
-    return { points: [[Math.min(lo, pts[0][0]), 0], ...pts, [Math.max(hi, pts[pts.length - 1][0]), 0]] };
-  }
-  return { points: [[Math.min(lo, pts[0][0]), pts[0][1]], ...pts, [Math.max(hi, pts[pts.length - 1][0]), pts[pts.length - 1][1]]] };
-}
+// --- new terms ----------------------------------------------------------------------
 
 export const SIEMENS_INPUT_NAMES = { 1: ["zero"], 2: ["low", "high"], 3: ["neg", "zero", "pos"], 4: ["n_big", "n_small", "p_small", "p_big"], 5: ["n_big", "n_small", "zero", "p_small", "p_big"], 6: ["n_big", "n_medium", "n_small", "p_small", "p_medium", "p_big"], 7: ["n_big", "n_medium", "n_small", "zero", "p_small", "p_medium", "p_big"] };
 export const SIEMENS_OUTPUT_NAMES = { 1: ["zero"], 2: ["low", "high"], 3: ["neg", "zero", "pos"], 4: ["n_large", "n_small", "p_small", "p_large"], 5: ["n_large", "n_small", "zero", "p_small", "p_large"], 6: ["n_large", "n_medium", "n_small", "p_small", "p_medium", "p_large"], 7: ["n_large", "n_medium", "n_small", "zero", "p_small", "p_medium", "p_large"] };
@@ -234,12 +241,56 @@ export function isIdentifier(name) {
   return /^[A-Za-z_][A-Za-z0-9_]*$/.test(name);
 }
 
-export function fmt(v, digits = 5) {
+/** A number as an engineer reads it: fixed decimals, four significant digits, no
+ * exponent between 0.001 and 100000, and 0 for what is 0 at that resolution
+ * (``4.476e-13`` is ``0.000``).  With ``span`` (the variable's range width) the decimals
+ * resolve 1/1000 of the range, so every value of one variable has the same decimals. */
+export function fmt(v, digits = 4, span = null) {
   if (v === null || v === undefined || Number.isNaN(v)) return "—";
   if (typeof v !== "number") return String(v);
+  if (!Number.isFinite(v)) return v > 0 ? "∞" : "−∞";
   const a = Math.abs(v);
-  if (a !== 0 && (a >= 1e6 || a < 1e-3)) return v.toExponential(3);
-  return String(Number(v.toPrecision(digits)));
+  let decimals;
+  if (span && span > 0) decimals = Math.ceil(-Math.log10(span / 1000));
+  else if (a < 1e-9) decimals = 3;
+  else if (a >= 1e5 || a < 1e-3) return v.toExponential(digits - 1);
+  else decimals = digits - 1 - Math.floor(Math.log10(a));
+  decimals = Math.max(0, Math.min(6, decimals));
+  const text = v.toFixed(decimals);
+  return /^-0(\.0*)?$/.test(text) ? text.slice(1) : text;
+}
+
+/** A number of the model as written (a range limit, a parameter): no trailing zeros,
+ * at most six significant digits. */
+export function num(v) {
+  if (v === null || v === undefined || Number.isNaN(v)) return "—";
+  if (typeof v !== "number") return String(v);
+  return String(Number(v.toPrecision(6)));
+}
+
+/** A value of variable ``name`` formatted over its range, with its unit when known. */
+export function fmtVar(name, v, unit = null) {
+  const [lo, hi] = range(name);
+  const text = fmt(v, 4, hi - lo);
+  return unit ? `${text} ${unit}` : text;
+}
+
+/** Round tick values for an axis over [lo, hi]: steps of 1, 2, 2.5 or 5 times a power of
+ * ten, about ``n`` of them. */
+export function niceTicks(lo, hi, n = 5) {
+  const span = hi - lo;
+  if (!(span > 0)) return [lo];
+  const raw = span / n;
+  const power = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 2.5, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
+  const out = [];
+  for (let v = Math.ceil(lo / step) * step; v <= hi + step * 1e-9; v += step) out.push(Number(v.toPrecision(12)));
+  return out;
+}
+
+/** A degree of membership: three decimals. */
+export function deg(v) {
+  return v === null || v === undefined || Number.isNaN(v) ? "—" : v.toFixed(3);
 }
 
 export function status(message, kind = "info") {

@@ -1,7 +1,7 @@
 // The 3D graphic display (manual 6.6): two inputs on X and Y, an output on Z, the other
 // inputs as family parameters, rotation, the 4D animation of a third input in steps of
 // N %, and the trajectory of the last simulated loop over the surface (issue 9).
-import { state, on, emit, inputs, outputs, range, body, fmt, status } from "./state.js";
+import { state, on, emit, inputs, outputs, range, body, fmt, num, niceTicks, status } from "./state.js";
 import { post } from "./api.js";
 import { $, el, plot } from "./ui.js";
 
@@ -80,7 +80,7 @@ async function refresh() {
     if (mine !== seq) return; // a newer request is under way: its answer is the one to show
     data = answer;
     frame = 0;
-    draw();
+    await draw();
     $("#sf-chart").dataset.fixed = JSON.stringify(fixed);
     $("#sf-note").textContent = `${s.z} over ${s.x} and ${s.y}; click a point to explain it.`;
     emit("surface", data);
@@ -97,6 +97,14 @@ function camera() {
   return { eye: { x: r * Math.cos(el_) * Math.cos(az), y: r * Math.cos(el_) * Math.sin(az), z: r * Math.sin(el_) } };
 }
 
+/** Round ticks inside the range: the ends of X and Y meet at the corners of the floor, where
+ * their labels would stand on each other. */
+function innerTicks(lo, hi) {
+  const span = hi - lo;
+  const values = niceTicks(lo, hi, 5).filter((v) => v > lo + span * 0.04 && v < hi - span * 0.04);
+  return { tickvals: values, ticktext: values.map((v) => num(v)) };
+}
+
 function draw() {
   if (!data) return;
   const s = settings();
@@ -110,11 +118,12 @@ function draw() {
   const [yl, yh] = range(s.y);
   const [zl, zh] = range(s.z);
   const title = f.value === null || f.value === undefined ? "" : `${$("#sf-anim").value} = ${fmt(f.value)}`;
-  plot($("#sf-chart"), traces, {
+  return plot($("#sf-chart"), traces, {
     scene: {
-      xaxis: { title: { text: s.x }, range: [xl, xh] },
-      yaxis: { title: { text: s.y }, range: [yl, yh] },
-      zaxis: { title: { text: s.z }, range: [zl, zh] },
+      // few ticks, kept apart from the corner where the X and Y labels would meet
+      xaxis: { title: { text: s.x }, range: [xl, xh], ...innerTicks(xl, xh), tickfont: { size: 11 } },
+      yaxis: { title: { text: s.y }, range: [yl, yh], ...innerTicks(yl, yh), tickfont: { size: 11 } },
+      zaxis: { title: { text: s.z }, range: [zl, zh], nticks: 6, tickfont: { size: 11 } },
       camera: camera(),
       aspectmode: "cube",
     },
@@ -149,6 +158,12 @@ async function toggleAnimation() {
   }, 250);
 }
 
+/** The angle of one rotation step: 5 to 45 degrees (manual 6.6); the speed follows. */
+function rotationStep() {
+  const v = Math.round(+$("#sf-rot-step").value || 10);
+  return Math.max(5, Math.min(45, v));
+}
+
 function toggleRotation() {
   const button = $("#sf-rotate");
   if (rotating) {
@@ -160,8 +175,8 @@ function toggleRotation() {
   button.textContent = "Stop";
   rotating = setInterval(() => {
     const slider = $("#sf-rot");
-    slider.value = (+slider.value + 10) % 360;
-    Plotly.relayout($("#sf-chart"), { "scene.camera": camera() });
+    slider.value = (+slider.value + rotationStep()) % 360;
+    if (window.Plotly) Plotly.relayout($("#sf-chart"), { "scene.camera": camera() });
   }, 200);
 }
 
@@ -177,8 +192,9 @@ export function init() {
     settings().points = Math.max(5, Math.min(80, parseInt(e.target.value, 10) || 31));
     schedule();
   });
-  for (const id of ["#sf-rot", "#sf-elev"]) $(id).addEventListener("input", () => data && Plotly.relayout($("#sf-chart"), { "scene.camera": camera() }));
+  for (const id of ["#sf-rot", "#sf-elev"]) $(id).addEventListener("input", () => data && window.Plotly && Plotly.relayout($("#sf-chart"), { "scene.camera": camera() }));
   $("#sf-rotate").addEventListener("click", toggleRotation);
+  $("#sf-rot-step").addEventListener("change", (e) => (e.target.value = rotationStep()));
   $("#sf-animate").addEventListener("click", toggleAnimation);
   $("#sf-trajectory").addEventListener("change", draw);
   on("model", () => {

@@ -54,13 +54,13 @@ export function confirmDialog(title, content, buttons) {
 }
 
 /** Fill a list with diagnostics; each item leads to the element it concerns. */
-export function fillDiagnostics(list, diagnostics) {
+export function fillDiagnostics(list, diagnostics, { onClick = goTo } = {}) {
   list.replaceChildren();
   for (const d of diagnostics) {
-    const where = d.line ? `${d.line}:${d.column}` : "";
+    const where = d.line ? `${d.line}${d.column ? ":" + d.column : ""}` : "";
     const item = el("li", { class: d.severity, tabindex: "0", title: d.element || "" }, `${d.severity}${where ? " " + where : ""}: ${d.message}`);
-    item.addEventListener("click", () => goTo(d));
-    item.addEventListener("keydown", (e) => e.key === "Enter" && goTo(d));
+    item.addEventListener("click", () => onClick(d));
+    item.addEventListener("keydown", (e) => e.key === "Enter" && onClick(d));
     list.append(item);
   }
 }
@@ -78,7 +78,30 @@ function goTo(d) {
   }
 }
 
-/** plotly with the studio's look; never throws into the console. */
+// plotly.js (3.5 MB) is read when the first chart is drawn, not before the studio starts:
+// the project, rule and text views are ready at once.
+let plotlyLoading = null;
+export function plotlyReady() {
+  if (window.Plotly) return Promise.resolve(window.Plotly);
+  if (!plotlyLoading) {
+    plotlyLoading = new Promise((resolve, reject) => {
+      const bar = document.getElementById("busy");
+      if (bar) bar.hidden = false;
+      const script = document.createElement("script");
+      script.src = "/vendor/plotly.min.js";
+      script.onload = () => {
+        if (bar && document.body.dataset.busy !== "true") bar.hidden = true;
+        resolve(window.Plotly);
+      };
+      script.onerror = () => reject(new Error("plotly.js could not be loaded"));
+      document.head.append(script);
+    });
+  }
+  return plotlyLoading;
+}
+
+/** plotly with the studio's look.  Before plotly.js is there the chart says it is coming,
+ * and only the last drawing asked for is made once it is. */
 export function plot(node, traces, layout = {}, config = {}) {
   const base = {
     margin: { l: 50, r: 20, t: 20, b: 40 },
@@ -87,7 +110,23 @@ export function plot(node, traces, layout = {}, config = {}) {
     font: { family: "system-ui, sans-serif", size: 12 },
     showlegend: false,
   };
-  return Plotly.react(node, traces, { ...base, ...layout }, { displaylogo: false, responsive: true, ...config });
+  const args = [traces, { ...base, ...layout }, { displaylogo: false, responsive: true, ...config }];
+  if (window.Plotly) return window.Plotly.react(node, ...args);
+  const first = !node._pendingPlot;
+  node._pendingPlot = args;
+  if (first && !node.querySelector(".plot-container")) node.textContent = "loading the charts (plotly.js)…";
+  return plotlyReady().then((Plotly) => {
+    const pending = node._pendingPlot;
+    node._pendingPlot = null;
+    if (!pending) return null;
+    if (!node.querySelector(".plot-container")) node.textContent = "";
+    return Plotly.react(node, ...pending);
+  });
+}
+
+/** Axis ticks that never collide: plotly picks at most ``n`` ticks. */
+export function ticks(n = 6) {
+  return { nticks: n, automargin: true };
 }
 
 export const COLORS = ["#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2", "#17becf"];

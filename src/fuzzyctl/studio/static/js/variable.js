@@ -1,9 +1,14 @@
-// Input and output editors (manual 6.4): name, value range with the manual's two
-// questions, terms (insert, delete, rename, "insert N" evenly spread), points in a table
-// and draggable on the chart (singletons move as a line), zoom in five steps.
-import { state, on, fb, inputs, outputs, termBlock, range, changed, handles, localCurve, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, fmt, status } from "./state.js";
+// Input and output editors (manual 6.4 and MATLAB's membership function editor): name,
+// value range with the manual's two questions, terms (insert, delete, rename, "insert N"
+// evenly spread), and every term kind the engine reads - points, singletons, triangle,
+// trapezoid, Gaussian, bell, sigmoid ... and expressions - with a field per parameter,
+// the term as FCL text, handles to drag on the chart (singletons and spikes as lines),
+// every curve labelled, zoom in five steps.
+import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsFor, evenTerms, termNames, isIdentifier, isInput, num, status, bodyWithoutRules } from "./state.js";
+import { post } from "./api.js";
 import { nameWarning } from "./names.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
+import { SHAPES, kindOf, kindLabel, kinds, handles, placeOf, convert, paramName, readParam, paramText, positions, rescale, localCurve } from "./terms.js";
 
 let current = null; // variable name
 let term = 0; // index of the selected term
@@ -22,97 +27,187 @@ function selected() {
   return { blk, t: blk && blk.terms[term] ? blk.terms[term] : null };
 }
 
+function serverCurve(name) {
+  const curves = (state.report && state.report.curves && state.report.curves[current]) || {};
+  return curves[name] || {};
+}
+
+function curveOf(t, lo, hi) {
+  const local = localCurve(t, lo, hi);
+  if (local) return local;
+  if (t.mf.type === "shape" && t.mf.kind === "constant" && typeof t.mf.params[0] === "number") return { singleton: t.mf.params[0] };
+  return serverCurve(t.name);
+}
+
 function viewRange() {
   const [lo, hi] = range(current);
   if (!zoom) return [lo, hi];
   const { t } = selected();
-  const h = t ? handles(t) : null;
-  const centre = h && h[point] ? h[point].x : (lo + hi) / 2;
+  const h = t ? handles(t) : [];
+  const centre = h[point] ? h[point].x : (lo + hi) / 2;
   const half = (hi - lo) / 2 / 2 ** zoom;
   return [centre - half, centre + half];
+}
+
+// --- the chart -------------------------------------------------------------------------
+
+function labels(blk, lo, hi, view) {
+  const placed = [];
+  const span = view[1] - view[0];
+  return blk.terms
+    .map((t, i) => {
+      const curve = curveOf(t, lo, hi);
+      if (curve.text !== undefined && curve.points === undefined) return null;
+      const { c } = placeOf(curve, lo, hi);
+      const x = Math.max(view[0] + span * 0.03, Math.min(view[1] - span * 0.03, c));
+      // labels closer than 7 % of the view step up, so neighbours never cover each other
+      let level = 0;
+      while (placed.some((p) => p.level === level && Math.abs(p.x - x) < span * 0.07)) level++;
+      placed.push({ x, level });
+      return { x, y: 1.04 + 0.065 * Math.min(level, 4), text: t.name, showarrow: false, font: { color: COLORS[i % COLORS.length], size: i === term ? 14 : 12 }, xanchor: "center" };
+    })
+    .filter(Boolean);
 }
 
 function renderChart() {
   const node = chart();
   const blk = current ? termBlock(current) : null;
   if (!blk) {
-    Plotly.purge(node);
+    if (window.Plotly) Plotly.purge(node);
     return;
   }
   const [lo, hi] = range(current);
+  const view = viewRange();
   const traces = [];
-  const serverCurves = (state.report && state.report.curves && state.report.curves[current]) || {};
   blk.terms.forEach((t, i) => {
     const active = i === term;
     const color = COLORS[i % COLORS.length];
-    const curve = localCurve(t, lo, hi) || serverCurves[t.name] || {};
-    const line = { color, width: active ? 3.5 : 1.5 };
+    const curve = curveOf(t, lo, hi);
+    const line = { color, width: active ? 3.5 : 1.6 };
     if (curve.singleton !== undefined) {
-      traces.push({ x: [curve.singleton, curve.singleton], y: [0, 1], mode: "lines", line, name: t.name, hoverinfo: "name" });
+      traces.push({ x: [curve.singleton, curve.singleton], y: [0, 1], mode: "lines", line, name: t.name });
     } else if (curve.points) {
-      traces.push({ x: curve.points.map((p) => p[0]), y: curve.points.map((p) => p[1]), mode: "lines", line, name: t.name, hoverinfo: "name" });
+      traces.push({ x: curve.points.map((p) => p[0]), y: curve.points.map((p) => p[1]), mode: "lines", line, name: t.name });
     } else if (curve.spikes) {
       for (const [x, y] of curve.spikes) traces.push({ x: [x, x], y: [0, y], mode: "lines", line, name: t.name });
     }
     if (active) {
-      const h = handles(t) || [];
+      const h = handles(t);
       traces.push({
         x: h.map((p) => p.x),
-        y: h.map((p) => (p.singleton ? 1 : p.y)),
+        y: h.map((p) => p.y),
         mode: "markers",
         marker: { size: h.map((_, k) => (k === point ? 15 : 10)), color: "#fff", line: { color, width: 2.5 } },
-        hoverinfo: "skip",
+        name: `${t.name} handles`,
       });
     }
   });
-  const annotations = blk.terms.map((t, i) => {
-    const h = handles(t);
-    const xs = h ? h.filter((p) => p.singleton || p.y > 0.5).map((p) => p.x) : [];
-    const x = xs.length ? xs.reduce((a, b) => a + b, 0) / xs.length : null;
-    return x === null ? null : { x, y: 1.08, text: t.name, showarrow: false, font: { color: COLORS[i % COLORS.length], size: i === term ? 13 : 11 } };
-  }).filter(Boolean);
   plot(node, traces, {
-    xaxis: { range: viewRange(), fixedrange: true, zeroline: false, title: { text: current } },
-    yaxis: { range: [-0.05, 1.15], fixedrange: true, title: { text: "degree" } },
+    xaxis: { range: view, fixedrange: true, zeroline: false, title: { text: current }, nticks: 10 },
+    yaxis: { range: [-0.04, 1.33], fixedrange: true, title: { text: "degree of membership" }, tickvals: [0, 0.25, 0.5, 0.75, 1] },
     dragmode: false,
     hovermode: false,
-    annotations,
-    margin: { l: 50, r: 20, t: 10, b: 45 },
-  }, { staticPlot: false, displayModeBar: false });
+    annotations: labels(blk, lo, hi, view),
+    margin: { l: 55, r: 20, t: 10, b: 45 },
+  }, { displayModeBar: false });
 }
 
-function renderTable() {
-  const tbody = $("#points-table tbody");
-  tbody.replaceChildren();
-  const { t } = selected();
-  const h = t ? handles(t) : null;
-  if (!t) return;
-  if (!h) {
-    tbody.append(el("tr", {}, el("td", { colspan: 3 }, `${t.mf.type} ${t.mf.kind || ""}: edit in the FCL text`)));
+// --- the term panel ----------------------------------------------------------------------
+
+function field(labelText, value, onChange, attrs = {}) {
+  const input = el("input", { value, spellcheck: "false", "aria-label": labelText, ...attrs });
+  input.addEventListener("change", () => onChange(input.value, input));
+  input.addEventListener("keydown", (e) => e.key === "Enter" && (e.preventDefault(), input.dispatchEvent(new Event("change"))));
+  return [el("label", { for: attrs.id || null }, labelText), input];
+}
+
+function renderParams(t) {
+  const box = $("#term-params");
+  box.replaceChildren();
+  const mf = t.mf;
+  const isOut = !isInput(current);
+  if (mf.type === "singleton") {
+    box.append(...field("value", paramText(mf.value), (v, input) => setParam(() => (mf.value = readParam(v)), input), { id: "param-0" }));
+  } else if (mf.type === "shape") {
+    const spec = SHAPES[mf.kind] || { params: [] };
+    mf.params.forEach((p, i) => {
+      box.append(...field(paramName(mf.kind, i), paramText(p), (v, input) => setParam(() => (mf.params[i] = readParam(v)), input), { id: `param-${i}`, title: spec.summary || "" }));
+    });
+    if (!["constant", "linear"].includes(mf.kind)) box.append(...field("height", paramText(mf.height), (v, input) => setParam(() => (mf.height = readParam(v)), input), { id: "param-height", title: "scales the shape (fuzzylite's height)" }));
+  }
+  $("#term-summary").textContent = mf.type === "shape" ? `${mf.kind}: ${(SHAPES[mf.kind] || {}).summary || ""}` : mf.type === "points" ? "IEC points: linear between the points, constant beyond the first and the last" : mf.type === "singleton" ? "a singleton (manual: a line on the output's axis)" : mf.type === "singletons" ? "singletons: degree y at each x, 0 elsewhere" : "an expression of the inputs: edit it in the FCL field";
+  if (isOut && mf.type === "function") $("#term-summary").textContent += " (Takagi-Sugeno output)";
+}
+
+function setParam(apply, input) {
+  const before = JSON.stringify(selected().t.mf);
+  apply();
+  const mf = selected().t.mf;
+  const values = mf.type === "shape" ? [...mf.params, mf.height] : [mf.value];
+  if (values.some((v) => v === undefined)) {
+    selected().t.mf = JSON.parse(before);
+    input.classList.add("bad");
+    status("a parameter is a number or the name of a variable", "error");
     return;
   }
-  h.forEach((p, k) => {
-    const x = el("input", { type: "number", step: "any", value: String(p.x), "aria-label": `point ${k + 1} x`, size: 8 });
+  changed("points");
+}
+
+function renderPoints(t) {
+  const tbody = $("#points-table tbody");
+  tbody.replaceChildren();
+  const mf = t.mf;
+  const list = mf.type === "points" || mf.type === "singletons" ? mf.points : null;
+  $("#points-table").hidden = !list;
+  $("#point-add").parentElement.hidden = !list;
+  if (!list) return;
+  list.forEach((p, k) => {
+    const x = el("input", { type: "text", inputmode: "decimal", value: paramText(p.x), "aria-label": `point ${k + 1} x`, size: 8 });
     x.addEventListener("change", () => {
-      const v = parseFloat(x.value);
-      if (!Number.isFinite(v)) return;
-      p.set(v);
+      const v = readParam(x.value);
+      if (v === undefined) return;
+      p.x = v;
       point = k;
       changed("points");
     });
-    let y = el("span", {}, p.singleton ? "—" : fmt(p.y));
-    if (t.mf.type === "points") {
-      y = el("input", { type: "number", step: "any", min: 0, max: 1, value: String(p.y), "aria-label": `point ${k + 1} degree`, size: 5 });
-      y.addEventListener("change", () => {
-        const v = parseFloat(y.value);
-        if (Number.isFinite(v) && v >= 0 && v <= 1) {
-          t.mf.points[k].y = v;
-          changed("points");
-        }
-      });
-    }
-    tbody.append(el("tr", { class: k === point ? "selected" : null }, el("td", {}, String(k + 1)), el("td", {}, x), el("td", {}, y)));
+    const y = el("input", { type: "text", inputmode: "decimal", value: paramText(p.y), "aria-label": `point ${k + 1} degree`, size: 5 });
+    y.addEventListener("change", () => {
+      const v = readParam(y.value);
+      if (v === undefined || (typeof v === "number" && (v < 0 || v > 1))) return status("a degree is between 0 and 1 (or a variable)", "error");
+      p.y = v;
+      changed("points");
+    });
+    const row = el("tr", { class: k === point ? "selected" : null }, el("td", {}, String(k + 1)), el("td", {}, x), el("td", {}, y));
+    row.addEventListener("focusin", () => (point = k));
+    tbody.append(row);
   });
+}
+
+function renderTerm() {
+  const { t } = selected();
+  $("#term-editor").disabled = !t;
+  if (!t) {
+    $("#term-params").replaceChildren();
+    $("#points-table tbody").replaceChildren();
+    return;
+  }
+  if (document.activeElement !== $("#term-name")) $("#term-name").value = t.name;
+  const kind = kindOf(t.mf);
+  const list = kinds(!isInput(current));
+  if (!list.includes(kind)) list.push(kind);
+  $("#term-kind").replaceChildren(...list.map((k) => el("option", { value: k, selected: k === kind }, kindLabel(k))));
+  renderParams(t);
+  renderPoints(t);
+  const fcl = serverCurve(t.name).fcl;
+  const field = $("#term-fcl");
+  const key = `${current}\u0000${t.name}`;
+  if (field.dataset.term !== key) {
+    // another term: its own text, whatever was typed for the last one
+    field.dataset.term = key;
+    field.classList.remove("bad");
+    $("#term-fcl-diags").replaceChildren();
+    field.value = fcl ?? "";
+  } else if (document.activeElement !== field && fcl !== undefined && !field.classList.contains("bad")) field.value = fcl;
 }
 
 function render() {
@@ -131,8 +226,9 @@ function render() {
   const [lo, hi] = range(current);
   if (document.activeElement !== $("#var-min")) $("#var-min").value = lo;
   if (document.activeElement !== $("#var-max")) $("#var-max").value = hi;
-  $("#term-select").replaceChildren(...blk.terms.map((t, i) => el("option", { value: i, selected: i === term }, t.name)));
-  if (document.activeElement !== $("#term-name")) $("#term-name").value = blk.terms[term] ? blk.terms[term].name : "";
+  const termSelect = $("#term-select");
+  termSelect.size = Math.max(2, Math.min(8, blk.terms.length));
+  termSelect.replaceChildren(...blk.terms.map((t, i) => el("option", { value: i, selected: i === term, title: kindLabel(kindOf(t.mf)) }, t.name)));
   const isOut = !isInput(current);
   $("#out-options").hidden = !isOut;
   if (isOut) {
@@ -141,7 +237,7 @@ function render() {
     if (document.activeElement !== $("#out-default")) $("#out-default").value = !d ? "" : d.no_change && d.value === null ? "NC" : d.value === null ? "" : String(d.value);
   }
   renderChart();
-  renderTable();
+  renderTerm();
   fillDiagnostics($("#var-diags"), [...diagnosticsFor(`var:${current}`), ...diagnosticsFor(`term:${current}`)]);
 }
 
@@ -226,7 +322,7 @@ async function setRange() {
   if (!(Number.isFinite(lo) && Number.isFinite(hi) && lo < hi)) return status("the minimum must be below the maximum", "error");
   const [oldLo, oldHi] = range(current);
   const blk = termBlock(current);
-  const xs = blk.terms.flatMap((t) => (handles(t) || []).map((p) => p.x));
+  const xs = blk.terms.flatMap((t) => positions(t.mf));
   let adjust = false;
   if (xs.some((x) => x < lo || x > hi)) {
     const answer = await confirmDialog("Change the value range", "There are some points outside the selected range. Adjust all membership functions?", [["cancel", "Cancel"], ["ok", "OK"]]);
@@ -237,15 +333,15 @@ async function setRange() {
     adjust = answer === "yes";
   }
   if (adjust) {
-    const scale = (x) => Math.round((lo + ((x - oldLo) * (hi - lo)) / (oldHi - oldLo)) * 1e6) / 1e6;
-    for (const t of blk.terms) for (const p of handles(t) || []) p.set(scale(p.x));
+    const k = (hi - lo) / (oldHi - oldLo);
+    for (const t of blk.terms) rescale(t.mf, (x) => lo + (x - oldLo) * k, k);
   }
   if (blk.range) blk.range = { low: lo, high: hi };
   else state.settings.ranges = { ...(state.settings.ranges || {}), [current]: [lo, hi] };
   // the new range shows at once; the check confirms it
   if (state.report) state.report.ranges = { ...state.report.ranges, [current]: [lo, hi] };
   changed("range");
-  status(`${current}: range ${lo} … ${hi}${adjust ? ", membership functions adjusted" : ""}`);
+  status(`${current}: range ${num(lo)} … ${num(hi)}${adjust ? ", membership functions adjusted" : ""}`);
 }
 
 function insertTerm() {
@@ -290,7 +386,65 @@ async function insertN() {
   point = 0;
   const lost = blankMissingTerms(current);
   changed("terms");
-  status(`${n} terms spread over ${lo} … ${hi}${lost ? `; ${lost} rule(s) referred to the old terms` : ""}`);
+  status(`${n} terms spread over ${num(lo)} … ${num(hi)}${lost ? `; ${lost} rule(s) referred to the old terms` : ""}`);
+}
+
+function changeKind(kind) {
+  const { t } = selected();
+  if (!t || kindOf(t.mf) === kind) return;
+  const [lo, hi] = range(current);
+  const mf = convert(kind, placeOf(curveOf(t, lo, hi), lo, hi), inputs().length);
+  if (!mf) {
+    $("#term-fcl").focus();
+    status("write the expression in the FCL field (FUNCTION ...), then Enter", "info");
+    renderTerm();
+    return;
+  }
+  t.mf = mf;
+  point = 0;
+  changed("points");
+  status(`${t.name} is a ${kindLabel(kind)} now: set its parameters or drag its handles`);
+}
+
+async function applyFcl() {
+  const { t } = selected();
+  const input = $("#term-fcl");
+  if (!t || !input.value.trim()) return;
+  let result;
+  try {
+    result = await post("/api/term/parse", bodyWithoutRules({ variable: current, text: input.value }));
+  } catch (err) {
+    fillDiagnostics($("#term-fcl-diags"), [{ severity: "error", message: err.message }]);
+    input.classList.add("bad");
+    return;
+  }
+  fillDiagnostics($("#term-fcl-diags"), result.diagnostics.map((d) => ({ ...d, line: null, message: `${d.column ? `column ${d.column}: ` : ""}${d.message}` })), { onClick: () => input.focus() });
+  input.classList.toggle("bad", !result.ok);
+  if (!result.ok) return;
+  t.mf = result.mf;
+  point = 0;
+  changed("points");
+  status(`${t.name} := ${input.value.trim()}`);
+}
+
+function addPoint(remove) {
+  const { t } = selected();
+  if (!t || (t.mf.type !== "points" && t.mf.type !== "singletons")) return;
+  const pts = t.mf.points;
+  if (remove) {
+    if (pts.length <= 1) return status("a term keeps at least one point", "error");
+    pts.splice(Math.min(point, pts.length - 1), 1);
+    point = Math.max(0, point - 1);
+  } else {
+    const at = Math.min(point, pts.length - 1);
+    const next = pts[at + 1];
+    const here = pts[at];
+    const [lo, hi] = range(current);
+    const x = next && typeof next.x === "number" ? (here.x + next.x) / 2 : Math.min(hi, here.x + (hi - lo) / 20);
+    pts.splice(at + 1, 0, { x: Math.round(x * 1e6) / 1e6, y: typeof here.y === "number" ? here.y : 0 });
+    point = at + 1;
+  }
+  changed("points");
 }
 
 // --- dragging ------------------------------------------------------------------------
@@ -309,11 +463,13 @@ function nearestHandle(event) {
   const blk = termBlock(current);
   let best = null;
   blk.terms.forEach((t, i) => {
-    (handles(t) || []).forEach((p, k) => {
+    handles(t).forEach((p, k) => {
       const hx = ax.xa.l2p(p.x) + ax.xa._offset;
       const dx = Math.abs(hx - px);
       // a singleton is a line: grab it anywhere along its height
-      const hy = ax.ya.l2p(p.singleton ? Math.min(1, Math.max(0, ax.ya.p2l(py - ax.ya._offset))) : p.y) + ax.ya._offset;
+      const top = p.line ? Math.max(p.y, 0.05) : p.y;
+      const yAt = p.line ? Math.min(top, Math.max(0, ax.ya.p2l(py - ax.ya._offset))) : p.y;
+      const hy = ax.ya.l2p(yAt) + ax.ya._offset;
       const d = Math.hypot(dx, hy - py) + (i === term ? 0 : 3); // prefer the selected term
       if (d < 14 && (!best || d < best.d)) best = { i, k, d };
     });
@@ -343,9 +499,12 @@ function onMove(event) {
   const digits = Math.max(0, 3 - Math.floor(Math.log10(Math.max(1e-9, hi - lo))));
   x = Number(x.toFixed(Math.min(8, digits)));
   const { t } = selected();
-  handles(t)[point].set(x);
+  const h = handles(t);
+  if (!h[point]) return;
+  h[point].set(x);
   renderChart();
-  renderTable();
+  renderParams(t);
+  renderPoints(t);
   changed("points", { quiet: true });
 }
 
@@ -357,14 +516,14 @@ function onUp() {
 
 function onKey(event) {
   const { t } = selected();
-  const h = t ? handles(t) : null;
-  if (!h) return;
+  const h = t ? handles(t) : [];
+  if (!h.length) return;
   const [lo, hi] = viewRange();
   const step = (hi - lo) / (event.shiftKey ? 1000 : 100);
   if (event.key === "ArrowLeft" || event.key === "ArrowRight") {
     event.preventDefault();
-    const x = h[point].x + (event.key === "ArrowRight" ? step : -step);
-    h[point].set(Number(x.toPrecision(10)));
+    const p = h[Math.min(point, h.length - 1)];
+    p.set(Number((p.x + (event.key === "ArrowRight" ? step : -step)).toPrecision(10)));
     changed("points");
   } else if (event.key === "ArrowUp" || event.key === "ArrowDown") {
     event.preventDefault();
@@ -378,7 +537,11 @@ function onKey(event) {
 
 export function init() {
   on("model", () => !$("#view-variable").hidden && !dragging && render());
-  on("report", () => !$("#view-variable").hidden && !dragging && render());
+  on("report", () => {
+    if ($("#view-variable").hidden) return;
+    if (dragging) renderChart(); // the engine's curve of a smooth shape follows the drag
+    else render();
+  });
   on("loaded", () => {
     current = null;
     term = 0;
@@ -407,6 +570,8 @@ export function init() {
   $("#term-select").addEventListener("change", (e) => {
     term = +e.target.value;
     point = 0;
+    $("#term-fcl").classList.remove("bad");
+    $("#term-fcl-diags").replaceChildren();
     render();
   });
   $("#term-name").addEventListener("change", (e) => {
@@ -423,6 +588,11 @@ export function init() {
     const warn = nameWarning("term", name);
     if (warn) status(warn, "warning");
   });
+  $("#term-kind").addEventListener("change", (e) => changeKind(e.target.value));
+  $("#term-fcl").addEventListener("keydown", (e) => e.key === "Enter" && (e.preventDefault(), applyFcl()));
+  $("#term-fcl").addEventListener("change", applyFcl);
+  $("#point-add").addEventListener("click", () => addPoint(false));
+  $("#point-del").addEventListener("click", () => addPoint(true));
   $("#var-range-apply").addEventListener("click", setRange);
   $("#term-insert").addEventListener("click", insertTerm);
   $("#term-delete").addEventListener("click", deleteTerm);

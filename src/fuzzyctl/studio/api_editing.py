@@ -1,0 +1,57 @@
+"""The studio's editing endpoints: the rule text editor, a term written as FCL, and the
+rule viewer (the logic is in :mod:`fuzzyctl.studio.editing` and
+:mod:`fuzzyctl.studio.ruleview`)."""
+
+# No `from __future__ import annotations`: FastAPI reads the annotations at run time.
+
+from typing import Any
+
+from fastapi import APIRouter
+
+from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.model import SHAPES, FunctionBlock
+from fuzzyctl.studio import analysis, editing, ruleview
+from fuzzyctl.studio.project import split_settings
+from fuzzyctl.studio.schemas import ModelBody, RulesTextBody, RuleViewBody, TermTextBody
+
+
+def edited_block(body: ModelBody) -> FunctionBlock:
+    """The function block being edited, from a request's model."""
+    document, _settings = split_settings(analysis.document_from_json(body.document))
+    if body.block >= len(document.blocks):
+        raise FuzzyctlError(f"block {body.block}: the model has {len(document.blocks)} function block(s)")
+    return document.blocks[body.block]
+
+
+def router(cache: analysis.ControllerCache) -> APIRouter:
+    """The endpoints, sharing the app's cache of compiled controllers."""
+    api = APIRouter()
+
+    @api.get("/api/shapes")
+    def shapes() -> dict[str, Any]:
+        """The parametric term kinds the engine reads: parameter names and formulas."""
+        return {
+            kind: {"params": list(spec.params), "summary": spec.summary, "variadic": spec.variadic}
+            for kind, spec in SHAPES.items()
+        }
+
+    @api.post("/api/rules/parse")
+    def rules_parse(body: RulesTextBody) -> Any:
+        """The rule text editor: one rule per line, read by the FCL parser and checked;
+        the rules when the lines have no errors, diagnostics with the typed lines' numbers."""
+        return analysis.clean(editing.parse_rules(edited_block(body), body.rule_block, body.text))
+
+    @api.post("/api/term/parse")
+    def term_parse(body: TermTextBody) -> Any:
+        """A term written as FCL (any spelling the parser reads): its model form."""
+        return analysis.clean(editing.parse_term(edited_block(body), body.variable, body.text))
+
+    @api.post("/api/ruleview")
+    def rule_view(body: RuleViewBody) -> Any:
+        """The rule viewer's rows at one input point: term degrees, rule degrees and each
+        conclusion's activated set, the accumulated sets and the outputs."""
+        fb = edited_block(body)
+        ranges = analysis.display_ranges(fb, body.settings.model_dump(exclude_none=True))
+        return analysis.clean(ruleview.rule_view(cache.get(fb, "ruleview"), fb, body.inputs, ranges))
+
+    return api
