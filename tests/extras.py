@@ -76,29 +76,29 @@ def extra_files(name: str, *parts: str, pattern: str = "*", recursive: bool = Fa
     return sorted(root.rglob(pattern) if recursive else root.glob(pattern))
 
 
-def _suite_of(item: pytest.Item) -> str | None:
+def _suites_of(item: pytest.Item) -> list[str]:
+    """The suites a test needs: ``@pytest.mark.extra("corpus", "jfl_oracle")`` needs both."""
     marker = item.get_closest_marker("extra")
     if marker is None:
-        return None
-    if len(marker.args) != 1:
-        raise pytest.UsageError(f"{item.nodeid}: @pytest.mark.extra takes one suite name")
-    return suite(str(marker.args[0])).name
+        return []
+    if not marker.args:
+        raise pytest.UsageError(f"{item.nodeid}: @pytest.mark.extra takes suite names")
+    return [suite(str(a)).name for a in marker.args]
 
 
 def pytest_configure(config: pytest.Config) -> None:
     config.addinivalue_line(
-        "markers", "extra(name): needs data outside the repository (tests/extras.py); deselected when absent"
+        "markers",
+        "extra(name, ...): needs data outside the repository (tests/extras.py); deselected when absent",
     )
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     keep, drop = [], []
     for item in items:
-        name = _suite_of(item)
-        if name is None:
-            keep.append(item)
-        elif EXTRA_SUITES[name].available:
-            item.user_properties.append((USER_PROPERTY, name))
+        names = _suites_of(item)
+        if all(EXTRA_SUITES[name].available for name in names):
+            item.user_properties.extend((USER_PROPERTY, name) for name in names)
             keep.append(item)
         else:
             drop.append(item)

@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from matplotlib.axes import Axes
     from matplotlib.figure import Figure
 
+    from fuzzyctl.diagnostics import Diagnostic
     from fuzzyctl.engine.controller import Controller
     from fuzzyctl.engine.plan import Plan
     from fuzzyctl.engine.variables import VariableInfo
@@ -30,18 +31,19 @@ BACKENDS = ("auto", "native", "python", "interpreted")
 _KEYS: OrderedDict[int, tuple[Document, str]] = OrderedDict()
 
 
-def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
+def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = False) -> Document:
     """Read a fuzzy system from a file path or from source text.
 
     ``format`` (``"fcl"``, ...) overrides detection by file extension; text that is not an
-    existing path is parsed as FCL unless ``format`` says otherwise.  Raises
-    :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics when the
-    input is not valid."""
+    existing path is parsed as FCL unless ``format`` says otherwise.  ``strict``: refuse, as
+    a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7).
+    Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
+    when the input is not valid."""
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        return _load_path(path, fmt)
+        return _load_path(path, fmt, strict)
     from fuzzyctl import formats
     from fuzzyctl.diagnostics import DiagnosticError, error
     from fuzzyctl.fcl import load_text
@@ -51,10 +53,10 @@ def load(path_or_text: str | Path, *, format: str | None = None) -> Document:
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
-    return load_text(text).raise_for_errors()
+    return load_text(text, strict=strict).raise_for_errors()
 
 
-def _load_path(path: Path, fmt: str) -> Document:
+def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
     from fuzzyctl import cache
     from fuzzyctl.diagnostics import DiagnosticError
 
@@ -67,7 +69,7 @@ def _load_path(path: Path, fmt: str) -> Document:
         except DiagnosticError:
             data = None  # the reader reports it with its place
         if data is not None:
-            key = content_key(data, fmt)
+            key = content_key(data, fmt + (":strict" if strict else ""))
             doc = _cached(f"documents/{key}.pickle")
             from fuzzyctl.model import Document
 
@@ -78,7 +80,7 @@ def _load_path(path: Path, fmt: str) -> Document:
     if fmt == "fcl":
         from fuzzyctl.fcl import load_file
 
-        doc = load_file(path).raise_for_errors()
+        doc = load_file(path, strict=strict).raise_for_errors()
     else:
         from fuzzyctl import formats
 
@@ -122,13 +124,29 @@ def compile(
     docs/codegen.md; without a C compiler it warns and uses the Python path), ``"python"``
     (generated Python for single evaluations, numpy for batches) or ``"interpreted"`` (the
     reference interpreter only); ``compat="fuzzylite"`` etc. reproduces other tools'
-    semantics (default IEC 61131-7).  Raises :class:`~fuzzyctl.diagnostics.DiagnosticError`
-    for what the engine cannot evaluate."""
-    plan, key = _plan(model, block, options)
+    semantics (default IEC 61131-7).  ``strict=True`` refuses what a strict IEC 61131-7
+    reading refuses and the engine otherwise settles with a warning: an output without RANGE
+    whose terms do not fall to 0, identifiers that are Table 7 keywords; the warnings it
+    settles with are the controller's ``warnings``.  Raises
+    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
+    if options.get("strict"):
+        _refuse_reserved(model)
+    plan, key, found = _plan(model, block, options)
     from fuzzyctl.model import Document
 
     fb = model.block(block) if isinstance(model, Document) else model
-    return _controller(plan, backend, key, fb)
+    return _controller(plan, backend, key, fb, found)
+
+
+def _refuse_reserved(model: Document | FunctionBlock) -> None:
+    from fuzzyctl.diagnostics import DiagnosticError, has_errors
+    from fuzzyctl.fcl.reserved import check_reserved_words
+    from fuzzyctl.model import Document
+
+    doc = model if isinstance(model, Document) else Document((model,))
+    found = check_reserved_words(doc, doc.path, strict=True)
+    if has_errors(found):
+        raise DiagnosticError(found)
 
 
 def compile_path(
@@ -147,19 +165,32 @@ def compile_path(
     path = Path(path)
     fmt = (format or "").lower() or (path.suffix.lower().lstrip(".") or "fcl")
     if cache.enabled():
+        from fuzzyctl.diagnostics import DiagnosticError
+        from fuzzyctl.limits import read_input
+
         try:
-            key = _plan_key(content_key(path.read_bytes(), fmt), block, options)
-        except OSError:
-            key = None
-        plan = _cached(f"plans/{key}.pickle") if key is not None else None
-        if plan is not None:
-            return _controller(plan, backend, key)
+            key = _plan_key(content_key(read_input(path, fmt), fmt), block, options)
+        except DiagnosticError:
+            key = None  # load() reports it
+        hit = _cached_plan(key) if key is not None else None
+        if hit is not None:
+            return _controller(hit[0], backend, key, None, hit[1])
     return compile(load(path, format=fmt), block=block, backend=backend, **options)
 
 
 def _controller(
-    plan: Plan, backend: str | None, key: str | None, model: FunctionBlock | None = None
+    plan: Plan,
+    backend: str | None,
+    key: str | None,
+    model: FunctionBlock | None = None,
+    found: tuple[Diagnostic, ...] = (),
 ) -> Controller:
+    ctl = _backend(plan, backend, key, model)
+    ctl.warnings = found
+    return ctl
+
+
+def _backend(plan: Plan, backend: str | None, key: str | None, model: FunctionBlock | None) -> Controller:
     backend = backend or os.environ.get("FUZZYCTL_BACKEND") or "auto"
     if backend not in BACKENDS:
         from fuzzyctl.diagnostics import FuzzyctlError
@@ -182,9 +213,15 @@ def compile_plan(model: Document | FunctionBlock, *, block: str | None = None, *
     return _plan(model, block, options)[0]
 
 
+def _cached_plan(key: str) -> tuple[Plan, tuple[Diagnostic, ...]] | None:
+    """A plan and the warnings compiling it gave, from the cache."""
+    hit = _cached(f"plans/{key}.pickle")
+    return hit if isinstance(hit, tuple) and len(hit) == 2 else None
+
+
 def _plan(
     model: Document | FunctionBlock, block: str | None, options: dict[str, Any]
-) -> tuple[Plan, str | None]:
+) -> tuple[Plan, str | None, tuple[Diagnostic, ...]]:
     from fuzzyctl import cache
     from fuzzyctl.engine.compile import compile_block
 
@@ -193,13 +230,13 @@ def _plan(
     if doc_key is not None and doc_key[0] is model and cache.enabled():
         key = _plan_key(doc_key[1], block, options)
         if key is not None:
-            plan = _cached(f"plans/{key}.pickle")
-            if plan is not None:
-                return plan, key
-    plan = compile_block(model, block=block, backend="interpreted", **options).plan
+            hit = _cached_plan(key)
+            if hit is not None:
+                return hit[0], key, hit[1]
+    ctl = compile_block(model, block=block, backend="interpreted", **options)
     if key is not None:
-        _store(f"plans/{key}.pickle", plan)
-    return plan, key
+        _store(f"plans/{key}.pickle", (ctl.plan, ctl.warnings))
+    return ctl.plan, key, ctl.warnings
 
 
 def _plan_key(doc_key: str, block: str | None, options: dict[str, Any]) -> str | None:

@@ -402,12 +402,18 @@ class And:
 
     operands: tuple[Condition, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
+    grouped: bool = field(default=False, compare=False, repr=False)
+    """Written in parentheses of its own.  IEC 61131-7 binds AND tighter than OR, so
+    ``a OR b AND c`` and ``a OR (b AND c)`` are the same tree; jFuzzyLogic reads AND and OR
+    left to right, so its profile needs to know which one was written."""
 
 
 @dataclass(frozen=True)
 class Or:
     operands: tuple[Condition, ...]
     span: Span | None = field(default=None, compare=False, repr=False)
+    grouped: bool = field(default=False, compare=False, repr=False)
+    """Written in parentheses of its own (see :attr:`And.grouped`)."""
 
 
 Condition: TypeAlias = Is | Degree | Not | And | Or
@@ -567,6 +573,23 @@ OPERATOR_PAIRS: dict[str, str] = {
     "HAMACHER": "HAMACHER",
     "EINSTEIN": "EINSTEIN",
 }
+_AND_OF_OR: dict[str, str] = {v: k for k, v in OPERATOR_PAIRS.items()}
+
+
+def implied_operators(and_op: str | None, or_op: str | None) -> tuple[str, str]:
+    """The AND and OR a rule block evaluates with (Table 3): a missing one is the pair of the
+    one given, neither given is MIN/MAX.  Writers of formats that state both (FIS, FLL) or
+    allow one (FPL, XFUZ) use it so that what is implied is not lost."""
+    if and_op is None and or_op is None:
+        return "MIN", "MAX"
+    if or_op is None:
+        assert and_op is not None
+        return and_op, OPERATOR_PAIRS.get(and_op, "MAX")
+    if and_op is None:
+        return _AND_OF_OR.get(or_op, "MIN"), or_op
+    return and_op, or_op
+
+
 # Activation with any t-norm (fuzzylite exports e.g. ``ACT : EPROD``, stored as EINSTEIN).
 ACT_METHODS = frozenset({"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER", "EINSTEIN"})
 # Accumulation: Table 5 (MAX, BSUM, NSUM), jFuzzyLogic's SUM (unbounded) and PROBOR (a + b - ab,

@@ -32,6 +32,20 @@ NOT_EXPRESSIBLE_C = {
     ),
     "fuzzylite/mamdani/octave/mamdani_tip_calculator.fcl": "smooth output terms (numerical integration)",
     "fuzzylite/tsukamoto/tsukamoto.fcl": "Tsukamoto (monotonic) output terms",
+    # gaussian outputs without RANGE: they load since issue 15 (the span of the terms)
+    **{
+        f"jfuzzylogic/fcl/{name}.fcl": "smooth output terms (numerical integration)"
+        for name in (
+            "QoS/LarsenQoSFewRules",
+            "QoS/LarsenQoSManyRules",
+            "QoS/MamdaniQoSFewRules",
+            "QoS/MamdaniQoSManyRules",
+            "trust/LarsenFewRules",
+            "trust/LarsenManyRules",
+            "trust/MamdaniFewRules",
+            "trust/MamdaniManyRules",
+        )
+    },
 }
 
 

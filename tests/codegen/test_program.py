@@ -96,7 +96,15 @@ def test_takagi_sugeno_outputs(method: str, accu: str | None) -> None:
     _agree(fuzzyctl.compile(fb, backend="interpreted").plan)
 
 
-@pytest.mark.parametrize("compat", ["fuzzylite", "pyfuzzylite", "jfuzzylogic"])
+def test_the_jfuzzylogic_profile_is_not_generated() -> None:
+    """That profile reproduces jFuzzyLogic's 1000-point arithmetic for cross-checks."""
+    fb = _block("COGS", "MAX", SINGLETONS, ())
+    plan = fuzzyctl.compile(fb, backend="interpreted", compat="jfuzzylogic").plan
+    with pytest.raises(CodegenError, match=r"jfuzzylogic profile .* iec profile"):
+        build_program(plan, "c")
+
+
+@pytest.mark.parametrize("compat", ["fuzzylite", "pyfuzzylite"])
 def test_compat_switches(compat: str) -> None:
     for out in (
         SINGLETONS,

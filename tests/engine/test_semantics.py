@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -10,6 +11,7 @@ import pytest
 import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, InputError
+from fuzzyctl.engine.lower import lower
 from fuzzyctl.engine.support import unsupported
 from tests.engine.builders import (
     and_,
@@ -103,9 +105,10 @@ def test_with_scales_the_activated_set_iec_and_the_degree_in_compat_mode() -> No
     assert max(v for _x, v in iec.breakpoints) == pytest.approx(0.5)
     assert [x for x, v in iec.breakpoints if v == pytest.approx(0.5)] == [5.0]
     jfl = fuzzyctl.compile(fb, compat="jfuzzylogic").explain({"x": 10.0}).output("y")
-    # min(0.5 * 1, tri): a trapezoid with a plateau from 2.5 to 7.5
+    # min(0.5 * 1, tri): a trapezoid with a plateau from 2.5 to 7.5, drawn at jFuzzyLogic's
+    # samples (x += 0.01 drifts by a few ulps)
     plateau = [x for x, v in jfl.breakpoints if v == pytest.approx(0.5)]
-    assert (plateau[0], plateau[-1]) == (2.5, 7.5)
+    assert (plateau[0], plateau[-1]) == (pytest.approx(2.5, abs=1e-12), pytest.approx(7.5, abs=1e-12))
 
 
 def test_weight_given_by_an_input_is_read_each_evaluation() -> None:
@@ -267,14 +270,52 @@ def test_cog_with_singletons_is_cogs_and_coa_with_singletons_is_an_error() -> No
         fuzzyctl.compile(_one_input({"a": single(0.0), "b": single(10.0)}, r, method="COA"))
 
 
-def test_range_defaults_to_the_hull_of_the_supports_and_unbounded_needs_a_range() -> None:
-    r = [rule("1", is_("x", "up"), then("y", "a"))]
+def test_range_defaults_to_the_hull_of_the_supports_and_unbounded_takes_the_span_of_the_terms() -> None:
+    r = [rule("1", is_("x", "up"), then("y", "b"))]
     c = fuzzyctl.compile(
         _one_input({"a": shape("triangle", 2, 4, 6), "b": shape("trapezoid", 5, 7, 8, 12)}, r)
     )
     assert (c.plan.outputs[0].low, c.plan.outputs[0].high) == (2.0, 12.0)
-    with pytest.raises(DiagnosticError, match="term b"):
-        fuzzyctl.compile(_one_input({"a": shape("triangle", 2, 4, 6), "b": shape("gaussian", 5, 1)}, r))
+    # a gaussian never reaches 0: jFuzzyLogic's universe, mean +- 4 sigma (1..9) joined with
+    # the triangle's a..c (2..6), with a warning that names the term and the universe
+    fb = _one_input({"a": shape("triangle", 2, 4, 6), "b": shape("gaussian", 5, 1)}, r)
+    plan, diags = lower(fb)
+    assert plan is not None and (plan.outputs[0].low, plan.outputs[0].high) == (1.0, 9.0)
+    (w,) = [d for d in diags if d.code == "universe-from-terms"]
+    assert not w.is_error and "term b" in w.message and "[1, 9]" in w.message and "4 sigma" in w.message
+    # symmetric set, clipped at 1 over [1, 9]: the centroid is the mean
+    assert fuzzyctl.compile(fb).evaluate({"x": 10.0})["y"] == pytest.approx(5.0, abs=1e-12)
+    with pytest.raises(DiagnosticError, match=r"term b \(gaussian\).*give a RANGE"):
+        fuzzyctl.compile(fb, strict=True)
+
+
+def test_terms_spanning_one_point_give_that_point_when_a_rule_fires() -> None:
+    # jFuzzyLogic's DeMorgan tests: TERM v := (0, 1) (0, 1); and no RANGE
+    flat = m.PointsMF((m.Point(3.0, 1.0), m.Point(3.0, 1.0)))
+    fb = _one_input({"a": flat}, [rule("1", is_("x", "up"), then("y", "a"))], default=m.Default(-1.0))
+    c = fuzzyctl.compile(fb)
+    assert c.evaluate({"x": 5.0})["y"] == 3.0
+    assert c.evaluate({"x": 0.0})["y"] == -1.0  # nothing fired: DEFAULT
+    with pytest.raises(DiagnosticError, match="give a RANGE"):
+        fuzzyctl.compile(fb, strict=True)
+
+
+def test_an_output_no_rule_concludes_is_its_default_whatever_its_terms() -> None:
+    # jFuzzyLogic's noRules test: a DEFUZZIFY block without terms; or terms whose parameters
+    # are variables and no RANGE - neither universe is ever needed
+    fb = _one_input({}, [rule("1", is_("x", "up"), then("y2", "a"))], default=m.Default(4.0))
+    fb = dataclasses.replace(
+        fb,
+        variables=(*fb.variables, m.Variable("y2", m.VarKind.OUTPUT)),
+        defuzzify=(
+            *fb.defuzzify,
+            m.DefuzzifyBlock("y2", (m.Term("a", m.SingletonMF(1.0)),), method="COGS", default=m.Default(0.0)),
+        ),
+    )
+    plan, diags = lower(fb)
+    assert plan is not None
+    assert any(d.code == "output-unused" and "y" in d.message for d in diags)
+    assert fuzzyctl.compile(fb).evaluate({"x": 10.0}) == {"y": 4.0, "y2": 1.0}
 
 
 def test_terms_are_limited_to_the_range() -> None:

@@ -34,8 +34,13 @@ def first_error(text: str):  # type: ignore[no-untyped-def]
             "no membership",
         ),
         (
+            "FUNCTION_BLOCK f\nVAR_INPUT\nt : REAL // ends here;\nq : REAL;\nEND_VAR\n" + TAIL,
+            3,
+            "missing ';'",
+        ),
+        (
             HEAD
-            + "FUZZIFY t\nTERM hot := (3, 0) (27, 1) // ends here;\nTERM c := (1, 0) (2, 1);\nEND_FUZZIFY\n"
+            + "FUZZIFY t\nTERM hot := FUNCTION t * 2 // ends here;\nTERM c := (1, 0) (2, 1);\nEND_FUZZIFY\n"
             + TAIL,
             5,
             "missing ';'",
@@ -92,3 +97,19 @@ def test_cycle_between_rule_blocks_through_locals() -> None:
     )
     d = first_error(text)
     assert d.code == "rule-block-cycle" and "one -> two -> one" in d.message
+
+
+def test_a_term_without_semicolon_loads_with_a_warning() -> None:
+    """scalablurry reads terms without ';' (and files written for it hide the ';' in a //
+    comment): the term ends where the next item starts."""
+    text = (
+        HEAD
+        + "FUZZIFY t\nTERM hot := triangular 0 1 3 // instead of (0, 1) (3, 0);\nTERM c := (1, 0) (2, 1);\n"
+        + "END_FUZZIFY\n"
+        + TAIL
+    )
+    result = load_text(text, "x.fcl")
+    assert result.ok
+    (w,) = [d for d in result.diagnostics if d.code == "missing-semicolon"]
+    assert w.span is not None and w.span.line == 5 and "TERM hot" in w.message
+    assert [t.name for t in result.document.main.fuzzify[0].terms] == ["hot", "c"]  # type: ignore[union-attr]

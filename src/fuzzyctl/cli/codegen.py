@@ -51,6 +51,14 @@ def codegen(
     block: Annotated[
         str | None, typer.Option("--block", help="Only this function block (default: every block).")
     ] = None,
+    strict: Annotated[
+        bool,
+        typer.Option(
+            "--strict",
+            help="Refuse what a strict IEC 61131-7 reading refuses: names that are reserved keywords, "
+            "an output without RANGE whose terms do not fall to 0.",
+        ),
+    ] = False,
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
@@ -62,16 +70,18 @@ def codegen(
         raise typer.BadParameter("--dialect and --lreal apply to --lang st", param_hint="--lang")
     if lang is Lang.st and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
-    doc = fuzzyctl.load(source)
+    doc = fuzzyctl.load(source, strict=strict)
     if lang is Lang.st:
-        text = generate_st(doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal)
+        text = generate_st(
+            doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+        )
         if output is None:
             typer.echo(text, nl=False)
             return
         write_atomic(output, text)
         err_console.print(f"wrote {output}", markup=False)
         return
-    files = generate_c(doc, block=block, single=single)
+    files = generate_c(doc, block=block, single=single, strict=strict)
     out_dir = output or Path(".")
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")

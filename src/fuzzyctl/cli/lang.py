@@ -13,24 +13,24 @@ import typer
 from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, app, err_console
 
 
-def _load(file: Path):  # type: ignore[no-untyped-def]
+def _load(file: Path, strict: bool = False, compat: str = "iec"):  # type: ignore[no-untyped-def]
     """Load and check ``file``; when the language checks pass, add what the engine reports
     (features it will not evaluate, decisions worth knowing) so that ``check`` never says OK
-    to a file ``eval`` refuses."""
+    to a file ``eval`` refuses (with the same ``--strict`` and ``--compat``)."""
     from dataclasses import replace
 
     from fuzzyctl.diagnostics import has_errors
     from fuzzyctl.engine.support import unsupported
     from fuzzyctl.fcl import load_file
 
-    result = load_file(file)
+    result = load_file(file, strict=strict, compat=compat)
     if result.document is None or has_errors(result.diagnostics):
         return result
     # The engine validates models from every reader, so it re-finds some language errors;
     # keep only what the language checks did not already say about the same line.
     seen = {(d.code, d.span.line if d.span else None) for d in result.diagnostics}
     for fb in result.document.blocks:
-        for d in unsupported(fb):
+        for d in unsupported(fb, compat=compat, strict=strict):
             if (d.code, d.span.line if d.span else None) not in seen:
                 result.diagnostics.append(replace(d, file=d.file or result.source.path))
     return result
@@ -48,6 +48,22 @@ def check(
         bool, typer.Option("--checklist", help="Print the data check list of IEC 61131-7 Table 11.")
     ] = False,
     as_json: Annotated[bool, typer.Option("--json", help="Diagnostics and report as JSON.")] = False,
+    strict: Annotated[
+        bool,
+        typer.Option(
+            "--strict",
+            help="What a strict IEC 61131-7 tool refuses is an error: names that are reserved "
+            "keywords (Table 7), an output without RANGE whose terms do not fall to 0.",
+        ),
+    ] = False,
+    compat: Annotated[
+        str,
+        typer.Option(
+            "--compat",
+            help="Check for this engine profile (iec, fuzzylite, pyfuzzylite, jfuzzylogic); "
+            "jfuzzylogic also warns about what jFuzzyLogic 3.3 would reject.",
+        ),
+    ] = "iec",
     conformance_statement: Annotated[
         bool,
         typer.Option(
@@ -63,6 +79,7 @@ def check(
     from rich.table import Table
 
     from fuzzyctl.diagnostics import DiagnosticError, Severity, more_line, select_shown
+    from fuzzyctl.engine.compile import COMPAT_PROFILES
     from fuzzyctl.fcl import conformance
 
     if conformance_statement:
@@ -71,9 +88,10 @@ def check(
     if file is None:
         err_console.print("error: give an FCL file to check (or --conformance)", markup=False)
         raise typer.Exit(EXIT_USAGE)
-
+    if compat not in COMPAT_PROFILES:
+        raise typer.BadParameter(f"unknown profile {compat!r} (known: {', '.join(COMPAT_PROFILES)})")
     try:
-        result = _load(file)
+        result = _load(file, strict, compat)
     except DiagnosticError as exc:
         if as_json:
             typer.echo(

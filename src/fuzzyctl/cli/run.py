@@ -27,12 +27,24 @@ BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to
 CompatOpt = Annotated[
     str, typer.Option("--compat", help="Semantics: iec (default), fuzzylite, pyfuzzylite, jfuzzylogic.")
 ]
+StrictOpt = Annotated[
+    bool,
+    typer.Option(
+        "--strict",
+        help="Refuse what a strict IEC 61131-7 reading refuses: an output without RANGE whose terms "
+        "do not fall to 0, names that are reserved keywords.",
+    ),
+]
 
 
-def _controller(file: Path, block: str | None, compat: str) -> Any:
+def _controller(file: Path, block: str | None, compat: str, strict: bool = False) -> Any:
     import fuzzyctl
+    from fuzzyctl.cli.app import err_console
 
-    return fuzzyctl.compile(fuzzyctl.load(file), block=block, compat=compat)
+    ctl = fuzzyctl.compile(fuzzyctl.load(file, strict=strict), block=block, compat=compat, strict=strict)
+    for d in ctl.warnings:  # what the engine settled with a warning (a universe from the terms, ...)
+        err_console.print(d.render(), style="yellow", markup=False, highlight=False)
+    return ctl
 
 
 def _parse_sets(pairs: list[str] | None) -> dict[str, float]:
@@ -110,6 +122,7 @@ def eval_(
     ] = "nan",
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
+    strict: StrictOpt = False,
     dask_in: DaskOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -136,7 +149,7 @@ def eval_(
         raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
     if as_json and as_table:
         raise typer.BadParameter("use either --json or --table", param_hint="--table")
-    ctl = _controller(file, block, compat)
+    ctl = _controller(file, block, compat, strict)
     if data is not None:
         from fuzzyctl.cli.app import err_console
         from fuzzyctl.cli.eval_data import evaluate_file
@@ -204,9 +217,10 @@ def explain(
     width: Annotated[int, typer.Option("--width", help="Width of the text plot.")] = 64,
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
+    strict: StrictOpt = False,
 ) -> None:
     """Evaluate once and show why: term degrees, rule degrees, accumulated sets, values."""
-    ctl = _controller(file, block, compat)
+    ctl = _controller(file, block, compat, strict)
     e = ctl.explain(_parse_sets(set_))
     if png is not None:
         from fuzzyctl.engine.plot import save_png

@@ -41,6 +41,10 @@ _KNOWN_FIELDS: dict[str, set[str]] = {
         "hedges_carry_over",
         "weight_whole_rule",
         "quad_rtol",
+        # lowering decisions only (errors, the universe): nothing for the generator to do
+        "strict",
+        "span_universe",
+        "ignore_declared_range",
     },
     "OutputPlan": {
         "name",

@@ -22,7 +22,7 @@ from __future__ import annotations
 import math
 
 from fuzzyctl.codegen import terms as T
-from fuzzyctl.codegen.context import Gen, Target
+from fuzzyctl.codegen.context import CodegenError, Gen, Target
 from fuzzyctl.codegen.guard import check_known_fields
 from fuzzyctl.codegen.ir import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
@@ -321,4 +321,9 @@ def build_program(plan: Plan, target: Target) -> Program:
     """The program of one lowered function block for ``target`` ("c" or "st").  Raises
     :class:`~fuzzyctl.codegen.context.CodegenError` naming the first element the target
     cannot express."""
+    if plan.options.emulate is not None:
+        raise CodegenError(
+            f"the {plan.options.emulate} profile reproduces another tool's arithmetic (1000-point "
+            "sets, ...) for cross-checks; generate code from the iec profile"
+        )
     return _Builder(plan, target).build()

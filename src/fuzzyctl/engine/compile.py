@@ -28,8 +28,14 @@ COMPAT_PROFILES: dict[str, Options] = {
     "pyfuzzylite": Options(
         weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"
     ),
-    # jFuzzyLogic 3.3: WITH scales the condition degree
-    "jfuzzylogic": Options(weight_before_activation=True, weight_whole_rule=True),
+    # jFuzzyLogic 3.3, reproduced by engine/jfl.py (docs/engine.md, "jfuzzylogic profile")
+    "jfuzzylogic": Options(
+        weight_before_activation=True,
+        weight_whole_rule=True,
+        span_universe=True,
+        ignore_declared_range=True,
+        emulate="jfuzzylogic",
+    ),
 }
 
 
@@ -72,7 +78,9 @@ def compile_block(
     if backend not in ("python", "interpreted"):
         raise FuzzyctlError(f"unknown backend {backend!r} (available: python, interpreted, native)")
     plan, diags = lower(fb, opts)
+    path = getattr(model, "path", None) if isinstance(model, Document) else None
     if plan is None:
-        path = getattr(model, "path", None) if isinstance(model, Document) else None
         raise DiagnosticError([dataclasses.replace(d, file=d.file or path) for d in diags])
-    return Controller(plan, specialise=backend == "python", model=fb)
+    controller = Controller(plan, specialise=backend == "python", model=fb)
+    controller.warnings = tuple(dataclasses.replace(d, file=d.file or path) for d in diags)
+    return controller

@@ -11,7 +11,7 @@ import warnings
 from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING, Any
 
-from fuzzyctl.diagnostics import InputError
+from fuzzyctl.diagnostics import Diagnostic, InputError
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.variables import VariableMap, inputs_of, outputs_of
 
@@ -44,6 +44,16 @@ class Controller:
         self._state: list[float | None] = [None] * len(plan.outputs)
         self._required = tuple(i.name for i in plan.inputs if i.default is None)
         self._degree = tuple(i.degree for i in plan.inputs)
+        #: what compiling decided with a warning (a universe taken from the terms, a term
+        #: defined twice, ...): :class:`~fuzzyctl.diagnostics.Diagnostic` objects
+        self.warnings: tuple[Diagnostic, ...] = ()
+        self._jfl: Any = None
+        if plan.options.emulate == "jfuzzylogic":
+            # another tool's arithmetic (1000-point sets, ...): one evaluator serves every path
+            from fuzzyctl.engine.jfl import JflEvaluator
+
+            self._jfl = JflEvaluator(plan)
+            specialise = False
         self._specialise = specialise
         self._interp_obj: Interpreter | None = None
         # the generated evaluators, made on first use (None: not yet; False: the plan uses
@@ -113,7 +123,9 @@ class Controller:
         values = self._values(merge_inputs(inputs, values_by_name))
         fast = self._fast
         res: list[float] | None = None
-        if fast is not None:
+        if self._jfl is not None:
+            res = [float(v[0]) for v in self._jfl.run([[v] for v in values], self._state, 1)]
+        elif fast is not None:
             try:
                 res = fast(values, self._state)
             except ArithmeticError:  # Python raises where numpy and C give inf/NaN: take the IEEE value
@@ -128,6 +140,8 @@ class Controller:
         self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
     ) -> dict[str, float]:
         """Evaluate through the interpreter (the unspecialised path), for cross-checks."""
+        if self._jfl is not None:  # that profile has one evaluator
+            return self.evaluate(inputs, **values_by_name)
         values = self._values(merge_inputs(inputs, values_by_name))
         rec = self._interp.run(values, self._state)
         return {o.name: r.value for o, r in zip(self.plan.outputs, rec.outputs, strict=True) if o.is_output}
@@ -140,7 +154,11 @@ class Controller:
         from fuzzyctl.engine import explain as explain_mod
 
         values = self._values(merge_inputs(inputs, values_by_name))
-        rec = self._interp.run(values, self._state)
+        rec = (
+            self._jfl.record(values, self._state)
+            if self._jfl is not None
+            else self._interp.run(values, self._state)
+        )
         named = dict(zip(self.inputs, values, strict=True))
         return explain_mod.build(self.plan, named, rec)
 
@@ -216,6 +234,9 @@ class Controller:
         import numpy as np
 
         m = len(part[0]) if part else 0
+        if self._jfl is not None:
+            got: list[npt.NDArray[np.float64]] = self._jfl.run(part, self._state, m or 1)
+            return got
         batch = self._batch
         if batch is not None:
             outs: list[npt.NDArray[np.float64]] = batch(part, self._state, m)

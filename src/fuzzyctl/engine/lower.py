@@ -14,8 +14,8 @@ import math
 
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic
+from fuzzyctl.engine import lower_jfl, selection, shapes
 from fuzzyctl.engine import operators as ops
-from fuzzyctl.engine import selection, shapes
 from fuzzyctl.engine.lower_outputs import _output
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _param, _term
 from fuzzyctl.engine.plan import (
@@ -108,7 +108,7 @@ class _Block:
             a = self.block_ops[bi][3]
             if a is not None and a not in found:
                 found.append(a)
-        if len(found) > 1:
+        if len(found) > 1 and ctx.options.emulate != "jfuzzylogic":  # there each block applies its own
             ctx.warn(
                 f"rule blocks concluding {name} disagree on ACCU ({', '.join(found)}); {found[0]} is used",
                 db.span if db else None,
@@ -169,9 +169,10 @@ def _variables(b: _Block) -> None:
 def _block_operators(b: _Block) -> None:
     """Each rule block's AND/OR pair, activation and accumulation."""
     ctx = b.ctx
+    jfl = ctx.options.emulate == "jfuzzylogic"
     for rb in ctx.fb.rule_blocks:
         try:
-            and_op, or_op = ops.resolve_pair(rb.and_op, rb.or_op)
+            and_op, or_op = lower_jfl.operator_pair(rb) if jfl else ops.resolve_pair(rb.and_op, rb.or_op)
         except KeyError as exc:
             ctx.err(
                 f"rule block {rb.name or ''}: unknown AND/OR operator {exc.args[0]!r}",
@@ -185,9 +186,9 @@ def _block_operators(b: _Block) -> None:
             ctx.err(f"rule block {rb.name or ''}: unknown activation {rb.act!r}", rb.span, "act-unknown")
             act = "MIN"
         accu: str | None = None
-        if rb.accu is not None:
+        if rb.accu is not None or jfl:
             try:
-                accu = ops.resolve_accu(rb.accu)
+                accu = lower_jfl.accumulation(rb) if jfl else ops.resolve_accu(rb.accu)
             except KeyError:
                 ctx.err(
                     f"rule block {rb.name or ''}: unknown accumulation {rb.accu!r}", rb.span, "accu-unknown"
@@ -274,15 +275,19 @@ def _chained(b: _Block) -> None:
 def _rules(b: _Block) -> None:
     """Every rule's condition, weight and conclusions; rule activation methods per block."""
     ctx = b.ctx
+    jfl = ctx.options.emulate == "jfuzzylogic"
     for bi, rb in enumerate(ctx.fb.rule_blocks):
         and_op, or_op, act, _accu = b.block_ops[bi]
         first_rule = len(b.rules)
         for rule in rb.rules:
             deps: set[str] = set()
+            condition = rule.condition
+            if jfl and condition is not None:
+                condition = lower_jfl.left_to_right(condition)
             cond = (
                 _cond(
                     ctx,
-                    rule.condition,
+                    condition,
                     and_op,
                     or_op,
                     b.fuzzy_index,
@@ -293,9 +298,11 @@ def _rules(b: _Block) -> None:
                     deps,
                     rule.label,
                 )
-                if rule.condition is not None
+                if condition is not None
                 else CTrue()
             )
+            if jfl:
+                deps.clear()  # jFuzzyLogic reads an output's crisp value: no rule waits for another
             concls: list[ConclusionPlan] = []
             conclusions = rule.conclusions
             if ctx.options.weight_whole_rule:
@@ -309,7 +316,9 @@ def _rules(b: _Block) -> None:
             weight = _rule_weight(ctx, rule, b.inputs)
             if cond is None or weight is None:
                 continue
-            b.rules.append(RulePlan(rule.label, rb.name, cond, act, tuple(concls), weight))
+            b.rules.append(
+                RulePlan(rule.label, rb.name, cond, act, tuple(concls), weight, accu=_accu if jfl else None)
+            )
             b.rule_deps.append(deps)
             b.rule_concludes.append({c.variable for c in rule.conclusions})
         if rb.rule_activation is not None:

@@ -6,10 +6,10 @@ import math
 
 from fuzzyctl import model as m
 from fuzzyctl.engine import operators as ops
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine import shapes, universe
 from fuzzyctl.engine.grid import build_grid
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
-from fuzzyctl.engine.plan import Contribution, OutputPlan, RulePlan, Slot, TermPlan
+from fuzzyctl.engine.plan import Contribution, OutputPlan, PParam, RulePlan, Slot, TermPlan
 
 METHOD_ALIASES = {
     "MM": "MOM",
@@ -79,16 +79,41 @@ def _output(
     if method is not None and method not in m.DEFUZZ_METHODS:
         ctx.err(f"DEFUZZIFY {var.name}: unknown method {db.method!r}", db.span, "method-unknown")
         return None
+    if not contributions:
+        # Nothing is ever accumulated: the output is its DEFAULT (NC: its previous value), so
+        # neither its universe nor how its terms combine matters (jFuzzyLogic's noRules test).
+        ctx.warn(
+            f"output {var.name}: no rule concludes it; it always gives its DEFAULT",
+            db.span,
+            "output-unused",
+        )
+        return OutputPlan(
+            var.name, "singleton", "COGS", accu_for(var.name, db) or "MAX", (), (), default, no_change
+        )
     accu = accu_for(var.name, db)
     # a function of x is a fuzzy set (smooth, integrated numerically), not a Sugeno value
     kinds = {"function_of_x" if t.kind == "function" and uses_x(t.expr) else t.kind for t in tps}
     if not tps:
         ctx.err(f"DEFUZZIFY {var.name} has no terms", db.span, "no-terms")
         return None
+    if ctx.options.emulate == "jfuzzylogic" and not _jfl_terms_fit(ctx, var, db, method, kinds):
+        return None
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
-    if method in ("COGS", "WTAVER", "WTSUM") and kinds <= shapes.TSUKAMOTO_KINDS:
+    if (
+        method in ("COGS", "WTAVER", "WTSUM")
+        and kinds <= shapes.TSUKAMOTO_KINDS
+        and all(t.kind != "points" or (t.pwl is not None and shapes.monotone(t.pwl)) for t in tps)
+        and ctx.options.emulate is None
+    ):
         # Tsukamoto: a weighted average of where each monotonic term reaches its degree
+        if "points" in kinds:
+            ctx.warn(
+                f"DEFUZZIFY {var.name}: {method} over monotonic point terms is Tsukamoto inference "
+                "(jfuzzyqt): each rule contributes where its term reaches the rule's degree",
+                db.span,
+                "tsukamoto-points",
+            )
         ts_accu = accu if accu is not None else ctx.options.ts_default_accu
         return OutputPlan(
             var.name,
@@ -197,6 +222,20 @@ def _mamdani_output(
     if bounds is None:
         return None
     low, high = bounds
+    if low == high:
+        # the terms span one point (jFuzzyLogic's DeMorgan tests: TERM v := (0, 1) (0, 1)):
+        # every sample of the set is there, so the output is that point whenever a rule fires
+        point = tuple(
+            TermPlan(
+                t.name,
+                "singletons",
+                (low, shapes.membership(t.kind, _consts(t.params), _const(t.height), low)),
+            )
+            for t in tps
+        )
+        return OutputPlan(
+            var.name, "singleton", "COGS", accu or "MAX", point, tuple(contributions), default, no_change
+        )
     acc = accu or "MAX"
     acts = {c.act for c in contributions}
     exact = kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
@@ -212,15 +251,20 @@ def _mamdani_output(
 def _universe(
     ctx: _Ctx, var: m.Variable, db: m.DefuzzifyBlock, tps: tuple[TermPlan, ...]
 ) -> tuple[float, float] | None:
-    """[RANGE min, max], else the hull of the terms' supports."""
-    rng = db.range or var.range
+    """The interval an area-based method integrates over: the RANGE if given, else the hull
+    of the terms' supports; when a term does not fall to 0 outside a finite interval, the
+    span of the terms as jFuzzyLogic computes it (:mod:`~fuzzyctl.engine.universe`), with a
+    warning naming the term and the universe (an error under ``strict``).  The jFuzzyLogic
+    profile always takes the span (its sample points depend on it) and ignores a RANGE on
+    the declaration line."""
+    opts = ctx.options
+    rng = db.range if opts.ignore_declared_range else (db.range or var.range)
     if rng is not None:
         low, high = float(rng.low), float(rng.high)
         if not (math.isfinite(low) and math.isfinite(high) and low < high):
             ctx.err(f"DEFUZZIFY {var.name}: RANGE must be finite with min < max", rng.span, "range-invalid")
             return None
         return low, high
-    lows, highs = [], []
     for t in tps:
         if not t.constant:
             ctx.err(
@@ -229,23 +273,93 @@ def _universe(
                 "range-needed",
             )
             return None
-        lo, hi = shapes.support(
-            t.kind,
-            [float(p) for p in t.params if not isinstance(p, Slot)],
-            float(t.height) if not isinstance(t.height, Slot) else 1.0,
-        )
-        if not (math.isfinite(lo) and math.isfinite(hi)):
-            ctx.err(
-                f"DEFUZZIFY {var.name}: term {t.name} ({t.kind}) is not zero outside a finite interval; "
-                "give a RANGE",
-                db.span,
-                "range-needed",
+    params = [[float(p) for p in t.params if not isinstance(p, Slot)] for t in tps]
+    heights = [float(t.height) if not isinstance(t.height, Slot) else 1.0 for t in tps]
+    supports = [shapes.support(t.kind, p, h) for t, p, h in zip(tps, params, heights, strict=True)]
+    unbounded = next((t for t, s in zip(tps, supports, strict=True) if not all(map(math.isfinite, s))), None)
+    if unbounded is None and not opts.span_universe:
+        low, high = min(s[0] for s in supports), max(s[1] for s in supports)
+    else:
+        spans = [universe.span(t.kind, p) for t, p in zip(tps, params, strict=True)]
+        low, high = min(s[0] for s in spans), max(s[1] for s in spans)
+        if unbounded is not None:
+            term = next((mt for mt in db.terms if mt.name == unbounded.name), None)
+            where = term.span if term is not None and term.span is not None else db.span
+            rule = universe.span_rule(unbounded.kind)
+            message = (
+                f"DEFUZZIFY {var.name}: term {unbounded.name} ({unbounded.kind}) is not 0 outside a "
+                f"finite interval and there is no RANGE"
             )
-            return None
-        lows.append(lo)
-        highs.append(hi)
-    low, high = min(lows), max(highs)
+            if opts.strict or not (math.isfinite(low) and math.isfinite(high)):
+                ctx.err(
+                    message + ("; give a RANGE" if opts.strict else "; its span is infinite: give a RANGE"),
+                    where,
+                    "range-needed",
+                    hint=f"add RANGE := ({low:g} .. {high:g}); to DEFUZZIFY {var.name}"
+                    if math.isfinite(low) and math.isfinite(high) and low < high
+                    else None,
+                )
+                return None
+            ctx.warn(
+                message + f": the universe is [{low:g}, {high:g}], the span of its terms as "
+                f"jFuzzyLogic computes it ({unbounded.name}: {rule})",
+                where,
+                "universe-from-terms",
+            )
+    if low == high and not opts.strict and math.isfinite(low):
+        ctx.warn(
+            f"DEFUZZIFY {var.name}: no RANGE and its terms span the single point {low:g} "
+            f"(jFuzzyLogic's universe): the output is {low:g} whenever a rule fires",
+            db.span,
+            "universe-from-terms",
+        )
+        return low, high
     if not low < high:
         ctx.err(f"DEFUZZIFY {var.name}: the terms have no extent; give a RANGE", db.span, "range-needed")
         return None
     return low, high
+
+
+def _consts(params: tuple[PParam, ...]) -> list[float]:
+    return [float(p) for p in params if not isinstance(p, Slot)]
+
+
+def _const(p: PParam) -> float:
+    return float(p) if not isinstance(p, Slot) else 1.0
+
+
+#: jFuzzyLogic's discrete terms (a HashMap of points) and the methods that take them
+_JFL_DISCRETE = {"singleton", "singletons", "function"}
+_JFL_DISCRETE_METHODS = {"COGS", "COGF"}
+
+
+def _jfl_terms_fit(
+    ctx: _Ctx, var: m.Variable, db: m.DefuzzifyBlock, method: str | None, kinds: set[str]
+) -> bool:
+    """jFuzzyLogic accumulates singleton and FUNCTION terms only into COGS/COGF (discrete)
+    and every other term only into COG/COA/LM/RM/MM (sampled); METHOD defaults to COG.  It
+    throws as soon as a rule concludes a term of the other sort, so its profile refuses."""
+    if "singletons" in kinds:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: jFuzzyLogic 3.3 cannot load SINGLETONS terms (its parser fails on "
+            "them: 'Unknown (or unimplemented) option : VALUE_REAL')",
+            db.span,
+            "jfl-singletons",
+        )
+        return False
+    meth = (db.method or "COG").upper()
+    discrete = meth in _JFL_DISCRETE_METHODS
+    wrong = sorted(kinds - _JFL_DISCRETE) if discrete else sorted(kinds & (_JFL_DISCRETE | {"function_of_x"}))
+    if meth not in {"COG", "COA", "LM", "RM", "MM", "MOM", *_JFL_DISCRETE_METHODS}:
+        ctx.err(f"DEFUZZIFY {var.name}: jFuzzyLogic has no METHOD {db.method}", db.span, "jfl-method")
+        return False
+    if wrong:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: jFuzzyLogic cannot accumulate {', '.join(wrong)} terms with METHOD "
+            f"{meth}{'' if db.method else ' (its default)'}: "
+            + ("COGS and COGF take singletons and FUNCTION terms" if discrete else "use COGS for singletons"),
+            db.span,
+            "jfl-method",
+        )
+        return False
+    return True

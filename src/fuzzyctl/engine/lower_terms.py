@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import math
 import sys
 from collections.abc import Iterable
@@ -206,6 +207,7 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
             )
             return None
         tp = TermPlan(t.name, mf.kind, params, h)
+        tp = _unordered_vertices(ctx, tp, t.span, where)
         _check_shape(ctx, tp, t.span, where)
     else:
         ex = _expr(ctx, mf.expr, where, outputs if is_output else {}, True, mf.argument)
@@ -223,6 +225,62 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
 
 
 _WIDTH_MIN, _WIDTH_MAX = 1e-150, 1e150
+
+
+def _unordered_vertices(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> TermPlan:
+    """A triangle or trapezoid whose vertices are not in ascending order (node-fuzzylite's
+    ``Trapezoid 1 0 2 3``) is read as fuzzylite reads it - its formula compares x with each
+    vertex in turn - with a warning; jFuzzyLogic refuses it, and so does its profile."""
+    if tp.kind not in ("triangle", "trapezoid") or not tp.constant:
+        return tp
+    p = [float(v) for v in tp.params if not isinstance(v, Slot)]
+    if p == sorted(p) or not all(math.isfinite(v) for v in p) or ctx.options.emulate == "jfuzzylogic":
+        return tp
+    pts = fuzzylite_vertices(tp.kind, p)
+    ctx.warn(
+        f"{where}: {tp.kind} {' '.join(f'{v:g}' for v in p)} has its vertices out of order; read as "
+        "fuzzylite reads it: " + " ".join(f"({x:g}, {y:g})" for x, y in pts),
+        span,
+        "shape-unordered",
+    )
+    params: tuple[PParam, ...] = tuple(v for x, y in pts for v in (x, y))
+    return TermPlan(tp.name, "points", params, tp.height)
+
+
+def fuzzylite_vertices(kind: str, p: list[float]) -> list[tuple[float, float]]:
+    """The points of fuzzylite's Triangle / Trapezoid formula for any vertex order: between
+    two successive vertices the same branch of the formula holds, and it is linear."""
+
+    def branch(x: float) -> tuple[float, float, float] | None:  # (x0, y0, slope) of the branch at x
+        if kind == "triangle":
+            a, b, c = p
+            if x < a or x > c:
+                return None
+            return (a, 0.0, 1.0 / (b - a)) if x < b else (c, 0.0, -1.0 / (c - b))
+        a, b, c, d = p
+        if x < a or x > d:
+            return None
+        if x < b:
+            return (a, 0.0, 1.0 / (b - a))
+        if x <= c:
+            return (x, 1.0, 0.0)
+        return (d, 0.0, -1.0 / (d - c))
+
+    xs = sorted(set(p))
+    pts: list[tuple[float, float]] = []
+    for lo, hi in itertools.pairwise(xs):
+        got = branch(0.5 * (lo + hi))
+        if got is None:
+            ys = (0.0, 0.0)
+        else:
+            x0, y0, slope = got
+            ys = (y0 + slope * (lo - x0), y0 + slope * (hi - x0)) if slope else (y0, y0)
+        pts += [(lo, ys[0]), (hi, ys[1])]
+    out: list[tuple[float, float]] = []
+    for pt in pts:  # drop repeated points (a vertical edge keeps its two values)
+        if not out or out[-1] != pt:
+            out.append(pt)
+    return out
 
 
 def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> None:
@@ -256,18 +314,22 @@ def _check_shape(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> No
 
 def _first_terms(ctx: _Ctx, var: str, terms: Iterable[m.Term]) -> list[m.Term]:
     """Terms in declaration order; a repeated name keeps its first definition (as fuzzylite
-    C++ does) and is reported."""
-    seen: dict[str, m.Term] = {}
+    C++ does; jFuzzyLogic, and its profile, the last) and is reported."""
+    last = ctx.options.emulate == "jfuzzylogic"
+    seen: dict[str, int] = {}
     out: list[m.Term] = []
     for t in terms:
         if t.name in seen:
             ctx.warn(
-                f"term {t.name!r} of {var} is defined twice; the first definition is used",
+                f"term {t.name!r} of {var} is defined twice; the {'last' if last else 'first'} "
+                "definition is used",
                 t.span,
                 "duplicate-term",
             )
+            if last:
+                out[seen[t.name]] = t
             continue
-        seen[t.name] = t
+        seen[t.name] = len(out)
         out.append(t)
     return out
 

@@ -216,6 +216,8 @@ class RulePlan:
     conclusions: tuple[ConclusionPlan, ...]
     weight: PParam = 1.0
     selection: int | None = None  # index into Plan.selections
+    #: the rule block's own accumulation, applied as this rule is evaluated (jFuzzyLogic profile)
+    accu: str | None = None
 
 
 @dataclass(frozen=True)
@@ -333,6 +335,17 @@ class Options:
     hedges_carry_over: bool = False  # fuzzylite 6: a conclusion's hedges modify the next ones
     weight_whole_rule: bool = False  # jFuzzyLogic: a WITH anywhere in a rule weights every conclusion
     quad_rtol: float = 1e-10
+    #: an output without RANGE whose terms do not fall to 0 is an error instead of taking the
+    #: span of its terms (``--strict``)
+    strict: bool = False
+    #: jFuzzyLogic: the universe is always the span of the terms, never their supports' hull
+    span_universe: bool = False
+    #: jFuzzyLogic: a RANGE on the VAR declaration line is ignored (only DEFUZZIFY's counts)
+    ignore_declared_range: bool = False
+    #: ``"jfuzzylogic"``: the plan is evaluated by :mod:`fuzzyctl.engine.jfl`, which reproduces
+    #: jFuzzyLogic 3.3 (its 1000-point defuzzification and the rest, docs/engine.md); the
+    #: code generators refuse such a plan
+    emulate: str | None = None
 
 
 @dataclass(frozen=True)

@@ -14,6 +14,7 @@ exact defuzzifiers integrate these lists in closed form.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Callable, Sequence
 from typing import Any
@@ -28,8 +29,9 @@ Points = tuple[tuple[float, float], ...]
 PWL_KINDS = frozenset({"points", "triangle", "trapezoid", "rectangle", "ramp", "binary"})
 #: Takagi-Sugeno output terms: a value, not a fuzzy set.
 TS_KINDS = frozenset({"constant", "linear", "function"})
-#: Monotonic shapes a weighted average can invert (Tsukamoto outputs, fuzzylite).
-TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "arc"})
+#: Monotonic shapes a weighted average can invert (Tsukamoto outputs, fuzzylite; monotonic
+#: ``points`` under COGS: jfuzzyqt's Tsukamoto).
+TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "arc", "points"})
 #: Smooth parametric shapes (integrated by adaptive quadrature on outputs).
 SMOOTH_KINDS = frozenset(
     {
@@ -596,6 +598,8 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
     """The x at which a monotonic term reaches degree ``y`` (Tsukamoto inference)."""
     h = float(height)
     p = list(params)
+    if kind == "points":
+        return float(_monotone_inverse(p, h, y))
     try:
         if kind == "ramp":
             s, e = p
@@ -634,6 +638,8 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
 def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
     """Vectorised :func:`tsukamoto`."""
     h = height
+    if kind == "points":
+        return _monotone_inverse([float(v) for v in params], float(h), y)
     with np.errstate(all="ignore"):
         if kind == "ramp":
             s, e = params
@@ -659,3 +665,21 @@ def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
             r = e - s
             return e + np.where(s < e, -1.0, 1.0) * np.sqrt(np.maximum(r * r - (y * r / h) ** 2, 0.0))
     raise ValueError(f"{kind} is not monotonic")
+
+
+def monotone(points: Points) -> bool:
+    """Whether a breakpoint list never falls or never rises (a Tsukamoto term)."""
+    ys = [y for _x, y in points]
+    return all(a <= b for a, b in itertools.pairwise(ys)) or all(
+        a >= b for a, b in itertools.pairwise(ys)
+    )
+
+
+def _monotone_inverse(params: Sequence[float], h: float, y: Any) -> Any:
+    """Where monotonic points reach degree ``y`` (the nearest end beyond their values)."""
+    pts = pwl_points("points", params, h)
+    assert pts is not None
+    xs, ys = [x for x, _y in pts], [v for _x, v in pts]
+    if ys[0] > ys[-1]:
+        xs, ys = xs[::-1], ys[::-1]
+    return np.interp(y, ys, xs)

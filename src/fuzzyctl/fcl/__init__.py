@@ -40,8 +40,12 @@ class LoadResult:
         return self.document
 
 
-def check_source(source: Source) -> LoadResult:
-    """Parse and check decoded text; never raises for bad input."""
+def check_source(source: Source, *, strict: bool = False, compat: str = "iec") -> LoadResult:
+    """Parse and check decoded text; never raises for bad input.
+
+    ``strict``: what a strict IEC 61131-7 tool refuses is an error (identifiers that are
+    Table 7 keywords), not a warning.  ``compat="jfuzzylogic"`` adds a warning for each
+    construct jFuzzyLogic 3.3 would reject or misread (:mod:`fuzzyctl.fcl.jfl`)."""
     from fuzzyctl.limits import check_document, check_text
 
     try:
@@ -56,19 +60,21 @@ def check_source(source: Source) -> LoadResult:
     if document is not None and not has_errors(diagnostics):
         document, notes = without_if_parts(document)  # IF ALWAYS THEN: Siemens 1.5 rules
         diagnostics.extend(notes)
-        diagnostics.extend(run_checks(document, CheckContext(source.path)))
+        context = CheckContext(source.path, {"strict": strict, "compat": compat, "parsed": parsed})
+        diagnostics.extend(run_checks(document, context))
     return LoadResult(document, diagnostics, source, parsed.spellings)
 
 
-def load_text(text: str, path: str | None = None) -> LoadResult:
-    """Parse and check FCL source text."""
-    return check_source(Source(text.removeprefix("\ufeff"), path))
+def load_text(text: str, path: str | None = None, *, strict: bool = False, compat: str = "iec") -> LoadResult:
+    """Parse and check FCL source text (``strict``, ``compat``: see :func:`check_source`)."""
+    return check_source(Source(text.removeprefix("\ufeff"), path), strict=strict, compat=compat)
 
 
-def load_file(path: str | os.PathLike[str]) -> LoadResult:
+def load_file(path: str | os.PathLike[str], *, strict: bool = False, compat: str = "iec") -> LoadResult:
     """Read, parse and check an FCL file (missing file, directory, binary data and
-    undecodable text raise :class:`DiagnosticError`)."""
-    return check_source(read_source(path))
+    undecodable text raise :class:`DiagnosticError`); ``strict``, ``compat``: see
+    :func:`check_source`."""
+    return check_source(read_source(path), strict=strict, compat=compat)
 
 
 def parse_fcl(text: str, path: str | None = None) -> Document:

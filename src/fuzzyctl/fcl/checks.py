@@ -13,6 +13,8 @@ from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
+from fuzzyctl.fcl.jfl import check_jfuzzylogic
+from fuzzyctl.fcl.reserved import check_reserved_words
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     Condition,
@@ -127,22 +129,6 @@ def mf_params(mf: object) -> list[Param]:
 
 def is_singleton(mf: object) -> bool:
     return isinstance(mf, SingletonMF | SingletonsMF) or (isinstance(mf, ShapeMF) and mf.kind == "constant")
-
-
-# Shapes whose membership does not fall to 0 on at least one side.
-_UNBOUNDED_KINDS = {"sigmoid", "ramp", "sshape", "zshape", "binary", "concave", "linear", "constant"}
-_AREA_METHODS = {None, "COG", "COA", "LM", "RM", "MOM", "COGF"}
-
-
-def unbounded(mf: object) -> bool:
-    """True when the membership stays above 0 towards -inf or +inf (so an area-based
-    defuzzification needs a RANGE)."""
-    if isinstance(mf, PointsMF) and mf.points:
-        first, last = mf.points[0].y, mf.points[-1].y
-        return (not isinstance(first, Ref) and first != 0) or (not isinstance(last, Ref) and last != 0)
-    if isinstance(mf, ShapeMF):
-        return mf.kind in _UNBOUNDED_KINDS
-    return False
 
 
 # --------------------------------------------------------------------------- built-in checks
@@ -309,18 +295,6 @@ def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None
             d.span,
             "missing-default",
         )
-    if d.range is None and d.method in _AREA_METHODS:
-        for t in d.terms:
-            if unbounded(t.mf):
-                r.warning(
-                    f"DEFUZZIFY {d.variable}: term {t.name} does not fall to 0 at one end and there is "
-                    f"no RANGE, so {d.method or 'CoG'} depends on the universe each tool assumes (the "
-                    "standard: the range of the data type; jFuzzyLogic: the span of the terms)",
-                    t.span,
-                    "unbounded-output",
-                    hint=f"add RANGE(min..max); to DEFUZZIFY {d.variable}",
-                )
-                break
     if d.method == "COGF" and not any(isinstance(t.mf, FunctionMF) for t in d.terms):
         r.warning(
             f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function"
@@ -557,6 +531,23 @@ def _names(e: object) -> set[str]:
     return out
 
 
+def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+    """Identifiers that are IEC 61131-7 Table 7 keywords (:mod:`fuzzyctl.fcl.reserved`)."""
+    return check_reserved_words(doc, ctx.file, bool(ctx.options.get("strict")))
+
+
 register_provider("declarations", check_declarations)
 register_provider("rules", check_rules)
 register_provider("functions", check_functions)
+
+
+def check_jfl(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+    """Under ``compat="jfuzzylogic"``: what jFuzzyLogic 3.3 would reject or read differently
+    (:mod:`fuzzyctl.fcl.jfl`)."""
+    if ctx.options.get("compat") != "jfuzzylogic":
+        return []
+    return check_jfuzzylogic(doc, ctx.file, ctx.options.get("parsed"))
+
+
+register_provider("reserved", check_reserved)
+register_provider("jfuzzylogic", check_jfl)

@@ -275,10 +275,21 @@ class _Builder(Transformer[Token, Any]):
     # ---------------------------------------------------------------- terms and blocks
     def term(self, children: list[Any]) -> Term:
         name, mf, semi = children[1], children[2], children[3]
+        span = _outer(children)
+        if semi is None:
+            end = Span(span.line, span.column) if span else None
+            if isinstance(mf, _Function):  # its ';' is what ends the expression's text
+                self.state.error(f"missing ';' at the end of FUNCTION TERM {name}", end, "missing-semicolon")
+                return Term(str(name), FunctionMF(mf.expr, ""), span)
+            self.state.warn(
+                f"missing ';' at the end of TERM {name} (read as if it were there, as scalablurry does)",
+                end,
+                "missing-semicolon",
+            )
         if isinstance(mf, _Function):
             text = self.state.source.text[mf.start : semi.start_pos]
             mf = FunctionMF(mf.expr, " ".join(text.split()))
-        return Term(str(name), mf, _outer(children))
+        return Term(str(name), mf, span)
 
     def range_stmt(self, children: list[Any]) -> Range:
         low, high = (_number(t) for t in _tokens(children, "NUMBER"))
@@ -436,6 +447,8 @@ class _Builder(Transformer[Token, Any]):
 
     def group(self, children: list[Any]) -> Condition:
         inner: Condition = children[0]
+        if isinstance(inner, And | Or):
+            inner = replace(inner, grouped=True)  # for jFuzzyLogic's left-to-right reading
         return inner
 
     def and_condition(self, children: list[Any]) -> And:

@@ -46,6 +46,7 @@ from fuzzyctl.model import (
     Term,
     Unary,
     VarKind,
+    implied_operators,
 )
 
 # Defuzzification methods whose output terms act as points (a weighted average of term
@@ -235,7 +236,16 @@ def prepare(
                 losses.append(Loss(label, "a condition on a local variable cannot be written"))
                 continue
             rules.extend(split_rules(fb, block, replace(rule, condition=condition), losses, running_hedges))
-        new_blocks.append(replace(block, rules=tuple(rules)))
+        # Table 3: a block that declares one operator evaluates with its pair; FIS and FLL
+        # have no such rule (an absent one is MIN/MAX or "none"), so the pair is written
+        # when the rules use it (a block without OR keeps its OR undeclared: nothing to lose)
+        and_op, or_op = block.and_op, block.or_op
+        if (and_op is None) != (or_op is None):
+            implied = implied_operators(and_op, or_op)
+            connectives = _connectives([r.condition for r in rules])
+            and_op = implied[0] if and_op is not None or And in connectives else None
+            or_op = implied[1] if or_op is not None or Or in connectives else None
+        new_blocks.append(replace(block, rules=tuple(rules), and_op=and_op, or_op=or_op))
 
     # Defaults: make the implicit explicit, so that a target with another convention keeps ours.
     defuzzify = []
@@ -257,6 +267,20 @@ def prepare(
 
     fb, renames = rename(fb, valid, valid)
     return fb, losses, renames
+
+
+def _connectives(conditions: list[Condition | None]) -> set[type]:
+    """The connectives (:class:`And`, :class:`Or`) the conditions use."""
+    found: set[type] = set()
+    todo = [c for c in conditions if c is not None]
+    while todo:
+        c = todo.pop()
+        if isinstance(c, And | Or):
+            found.add(type(c))
+            todo.extend(c.operands)
+        elif isinstance(c, Not):
+            todo.append(c.operand)
+    return found
 
 
 def _singleton_as_triangle(term: Term) -> Term:

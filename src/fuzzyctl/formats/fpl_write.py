@@ -26,6 +26,7 @@ from fuzzyctl.model import (
     Span,
     Variable,
     VarKind,
+    implied_operators,
     is_constant,
 )
 
@@ -83,9 +84,13 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
     if block.locals:
         err("FPL for Fuzzy Control has no intermediate variables", block.locals[0].span, "fpl-expr-local")
     for rb in block.rule_blocks:
-        if rb.and_op not in (None, "MIN"):
+        and_op = implied_operators(rb.and_op, rb.or_op)[0]  # OR : ASUM alone means AND : PROD
+        if and_op != "MIN":
             err(
-                f"AND : {rb.and_op} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op"
+                f"AND : {and_op}{'' if rb.and_op else f' (the pair of OR : {rb.or_op})'} cannot be "
+                "written in FPL (Fuzzy Control uses MIN)",
+                rb.span,
+                "fpl-expr-op",
             )
         accu_problem = _accu_problem(block, rb.accu)
         if accu_problem is not None:

@@ -48,6 +48,7 @@ from fuzzyctl.model import (
     Span,
     Term,
     VarKind,
+    implied_operators,
     is_constant,
 )
 
@@ -286,8 +287,9 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         )
     rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
     op = {None: 0, "MIN": 0, "PROD": 1}
-    if rb.and_op not in op:
-        err(f"AND : {rb.and_op}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
+    and_op = implied_operators(rb.and_op, rb.or_op)[0] if rb.or_op else rb.and_op  # OR : ASUM alone: PROD
+    if and_op not in op:
+        err(f"AND : {and_op}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
     if rb.act not in op:
         err(f"ACT : {rb.act}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
     if rb.accu not in (None, "MAX"):
@@ -460,7 +462,7 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         )
     esv, fa, rg = encode_kb(kb)
     constants = XfuzConstants(
-        op_et=op.get(rb.and_op, 0),
+        op_et=op.get(and_op, 0),
         op_impl=op.get(rb.act, 0),
         op_defuz=op_defuz,
         out_pt=out_pt,
@@ -576,9 +578,10 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     opts = _read_options(fb, [])
     rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
     losses += [(f"rule block {b.name}", "XFUZ holds one rule base") for b in fb.rule_blocks[1:]]
-    and_op = rb.and_op if rb.and_op in (None, "MIN", "PROD") else "MIN"
+    implied_and = implied_operators(rb.and_op, rb.or_op)[0] if rb.or_op else rb.and_op  # Table 3
+    and_op = implied_and if implied_and in (None, "MIN", "PROD") else "MIN"
     act = rb.act if rb.act in (None, "MIN", "PROD") else "MIN"
-    if and_op != rb.and_op or act != rb.act or rb.accu not in (None, "MAX"):
+    if and_op != implied_and or act != rb.act or rb.accu not in (None, "MAX"):
         losses.append((f"rule block {rb.name}", "XFUZ offers AND MIN/PROD, ACT MIN/PROD and ACCU MAX only"))
     or_is_max = rb.or_op == "MAX" or (rb.or_op is None and and_op in (None, "MIN"))
     local_names = {v.name for v in fb.locals}

@@ -1,0 +1,71 @@
+"""Names that IEC 61131-7 reserves (Table 7, 5.4.2) used as identifiers.
+
+The parser is lenient: ``MIN``, ``NC``, ``CoG`` or ``BSUM`` stand wherever a name may, since
+the grammar knows from context what is meant.  A strict IEC 61131-7 tool reserves them, so
+such a file would not load there: :func:`check_reserved_words` warns (an error under
+``strict``), naming the keyword and the line, so that a file that passes ``check --strict``
+also loads in a strict tool.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+
+from fuzzyctl.diagnostics import Diagnostic, error, warning
+from fuzzyctl.model import DefuzzifyBlock, Document, FuzzifyBlock, Span
+
+__all__ = ["TABLE7", "check_reserved_words", "reserved_names"]
+
+#: IEC 61131-7 Table 7 "Reserved keywords for FCL" (the parentheses left out), upper case
+#: (FCL keywords are case-insensitive); the standard's spelling where it is mixed case.
+TABLE7: dict[str, str] = {
+    w.upper(): w
+    for w in (
+        "ACCU", "ACT", "AND", "ASUM", "BDIF", "BSUM", "CoA", "CoG", "CoGS", "DEFAULT",
+        "DEFUZZIFY", "END_DEFUZZIFY", "END_FUNCTION_BLOCK", "END_FUZZIFY", "END_OPTIONS",
+        "END_RULEBLOCK", "END_VAR", "FUNCTION_BLOCK", "FUZZIFY", "IF", "IS", "LM", "MAX",
+        "METHOD", "MIN", "NC", "NOT", "NSUM", "OPTIONS", "OR", "PROD", "RANGE", "RM", "RULE",
+        "RULEBLOCK", "TERM", "THEN", "VAR", "VAR_INPUT", "VAR_OUTPUT", "WITH",
+    )
+}  # fmt: skip
+
+
+def reserved_names(doc: Document) -> Iterator[tuple[str, str, str, Span | None]]:
+    """``(what, name, keyword, span)`` for every identifier of ``doc`` that is a Table 7
+    keyword: function blocks, variables, terms, rule blocks and rule labels (``what`` reads
+    ``"term MIN of temp"``)."""
+
+    def hit(name: str | None) -> str | None:
+        return TABLE7.get(name.upper()) if name else None
+
+    for fb in doc.blocks:
+        if kw := hit(fb.name):
+            yield f"function block {fb.name}", str(fb.name), kw, fb.span
+        for v in fb.variables:
+            if kw := hit(v.name):
+                yield f"variable {v.name}", v.name, kw, v.span
+        blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+        for block in blocks:
+            for t in block.terms:
+                if kw := hit(t.name):
+                    yield f"term {t.name} of {block.variable}", t.name, kw, t.span
+        for rb in fb.rule_blocks:
+            if kw := hit(rb.name):
+                yield f"rule block {rb.name}", str(rb.name), kw, rb.span
+            for rule in rb.rules:
+                if kw := hit(rule.label):
+                    yield f"rule label {rule.label}", rule.label, kw, rule.span
+
+
+def check_reserved_words(doc: Document, file: str | None = None, strict: bool = False) -> list[Diagnostic]:
+    """A warning (``strict``: an error) per identifier that is a Table 7 keyword."""
+    out = []
+    for what, _name, kw, span in reserved_names(doc):
+        where = f" (line {span.line})" if span is not None else ""
+        message = (
+            f"{what}{where}: {kw} is a keyword IEC 61131-7 reserves (Table 7); "
+            "a strict IEC 61131-7 tool will not read it as a name"
+        )
+        make = error if strict else warning
+        out.append(make(message, span, code="reserved-word", file=file, hint="rename it"))
+    return out
