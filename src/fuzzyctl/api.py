@@ -196,7 +196,9 @@ def _backend(plan: Plan, backend: str | None, key: str | None, model: FunctionBl
         from fuzzyctl.diagnostics import FuzzyctlError
 
         raise FuzzyctlError(f"unknown backend {backend!r} (available: {', '.join(BACKENDS)})")
-    if backend in ("native", "auto"):
+    if backend in ("native", "auto") and plan.options.emulate is None:
+        # (an emulated tool's arithmetic - jFuzzyLogic's 1000-point sets - has no C form: the
+        # controller's own evaluator serves every path)
         from fuzzyctl import cache
         from fuzzyctl.codegen.native import compile_native
 

@@ -167,7 +167,7 @@ def test_plan_cache_is_keyed_by_content(tmp_path: Path, monkeypatch: pytest.Monk
     import fuzzyctl.fcl as fcl_pkg
 
     real = fcl_pkg.load_file
-    monkeypatch.setattr(fcl_pkg, "load_file", lambda p: parsed.append(p) or real(p))
+    monkeypatch.setattr(fcl_pkg, "load_file", lambda p, **kw: parsed.append(p) or real(p, **kw))
     again = api.compile_path(f, backend="python")
     assert not parsed, "served from the cache"
     x = {"temp": 10.0, "pressure": 60.0}

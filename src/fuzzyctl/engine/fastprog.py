@@ -492,4 +492,6 @@ def check_fields(obj: object, where: str = "plan") -> None:
 def build_fast(plan: Plan, target: FastTarget) -> FastProgram:
     """The evaluator program of ``plan`` for ``target``; raises :class:`CodegenError` for
     what the target cannot express."""
+    if plan.options.emulate is not None:  # another tool's arithmetic: its own evaluator only
+        raise CodegenError(f"the {plan.options.emulate} profile is evaluated by its own evaluator")
     return FastBuilder(plan, target).build()
