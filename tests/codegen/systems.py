@@ -157,7 +157,7 @@ def reference(plan: Plan, data: np.ndarray, how: str = "fastest") -> np.ndarray:
         how = min(times, key=lambda h: times[h])
     ctl = Controller(plan, specialise=True)
     outs = [o.name for o in plan.outputs if o.is_output]
-    if how == "batch":
+    if how == "batch" and plan.inputs:  # (no input column tells the row count of a batch)
         got = ctl.evaluate_batch({inp.name: data[:, i] for i, inp in enumerate(plan.inputs)})
         cols = [got[n] for n in outs]
         return np.column_stack(cols) if cols else np.zeros((len(data), 0))

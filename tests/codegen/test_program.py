@@ -98,7 +98,13 @@ def test_takagi_sugeno_outputs(method: str, accu: str | None) -> None:
 
 def test_the_jfuzzylogic_profile_is_not_generated() -> None:
     """That profile reproduces jFuzzyLogic's 1000-point arithmetic for cross-checks."""
-    fb = _block("COGS", "MAX", SINGLETONS, ())
+    fb = fuzzyctl.load(
+        """FUNCTION_BLOCK j VAR_INPUT x : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR
+        FUZZIFY x TERM lo := (0, 1) (10, 0); TERM hi := (0, 0) (10, 1); END_FUZZIFY
+        DEFUZZIFY y TERM a := 2; TERM b := 7; METHOD : COGS; DEFAULT := 0; END_DEFUZZIFY
+        RULEBLOCK r AND : MIN; ACCU : MAX; RULE 1 : IF x IS lo THEN y IS a; RULE 2 : IF x IS hi THEN y IS b;
+        END_RULEBLOCK END_FUNCTION_BLOCK"""
+    )
     plan = fuzzyctl.compile(fb, backend="interpreted", compat="jfuzzylogic").plan
     with pytest.raises(CodegenError, match=r"jfuzzylogic profile .* iec profile"):
         build_program(plan, "c")

@@ -225,6 +225,7 @@ def test_diagnostics_are_those_of_fuzzyctl_check(
             ("missing-accu", "ruleblock:0"),
             ("missing-default", "var:y"),
             ("missing-default", "var:z"),
+            ("output-unused", "var:z"),  # no rule concludes z: it is its DEFAULT
         ]
 
 

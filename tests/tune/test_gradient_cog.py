@@ -77,7 +77,7 @@ CASES = [
     (0, "MIN", "MIN", "MAX", "iec", "CoG"),
     (1, "PROD", "PROD", "SUM", "iec", "CoG"),
     (2, "MIN", "MIN", "BSUM", "iec", "CoG"),
-    (3, "PROD", "MIN", "MAX", "jfuzzylogic", "CoG"),  # WITH before activation
+    (3, "PROD", "MIN", "MAX", "pyfuzzylite", "CoG"),  # WITH before activation
     (4, "MIN", "PROD", "MAX", "iec", "CoG"),
     (5, "PROD", "MIN", "SUM", "iec", "CoG"),
     (6, "MIN", "MIN", "MAX", "iec", "CoA"),

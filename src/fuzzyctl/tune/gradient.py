@@ -78,6 +78,8 @@ def _cond_unsupported(c: CondPlan) -> str | None:
 
 def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
     """Why the closed form does not apply to ``outputs`` of ``plan`` (``None``: it does)."""
+    if plan.options.emulate is not None:
+        return f"the {plan.options.emulate} profile's sampled arithmetic"
     if plan.chained:
         return "chained rule blocks (local variables)"
     if plan.selections:
