@@ -8,6 +8,7 @@ output terms given by variables, smooth output sets).
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -347,7 +348,7 @@ class Interpreter:
         assert op.low is not None and op.high is not None
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
-        cuts = smooth_cuts(op, values, self.pv)
+        cuts = smooth_cuts(op, values, self.pv, contribs)
         xs = np.linspace(op.low, op.high, 401)
         rec.samples = (xs, f(xs))
         if not contribs:
@@ -438,7 +439,15 @@ def accumulated_function(
     return f
 
 
-def smooth_cuts(op: OutputPlan, values: Sequence[float], pv: Any) -> list[float]:
+def smooth_cuts(
+    op: OutputPlan,
+    values: Sequence[float],
+    pv: Any,
+    contribs: Sequence[tuple[int | None, float, float, str]] = (),
+) -> list[float]:
+    """Where the accumulated set may bend: the terms' characteristic points and, for a
+    piecewise-linear term clipped by MIN activation, where its lines reach the rule's degree
+    (a plateau edge inside an interval can be too small for the error estimate to see)."""
     assert op.low is not None and op.high is not None
     cuts = [op.low, op.high]
     for t in op.terms:
@@ -446,4 +455,14 @@ def smooth_cuts(op: OutputPlan, values: Sequence[float], pv: Any) -> list[float]
         for c in shapes.characteristic_points(t.kind, params):
             if op.low < c < op.high:
                 cuts.append(c)
+    for ti, a, _w, act in contribs:
+        term = op.terms[ti] if ti is not None else None
+        if term is None or act != "MIN" or term.kind not in shapes.PWL_KINDS:
+            continue
+        pts = shapes.pwl_points(term.kind, [pv(p, values) for p in term.params], pv(term.height, values))
+        for (x0, y0), (x1, y1) in itertools.pairwise(pts or ()):
+            if x1 > x0 and min(y0, y1) < a < max(y0, y1):
+                c = x0 + (a - y0) * (x1 - x0) / (y1 - y0)
+                if op.low < c < op.high:
+                    cuts.append(c)
     return cuts
