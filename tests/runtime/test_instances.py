@@ -369,8 +369,12 @@ period = 0.01
         wait_until(lambda: valve.snapshot()["state"] == "run", 10)
         valve.adapter.execute = broken  # type: ignore[method-assign]
         wait_until(lambda: valve.snapshot()["state"] == "safe", 10)
-        r = mb.read_holding_registers(10, count=3).registers
-        assert float32_from_registers(r[0], r[1]) == 12.5 and r[2] == INFO_BLOCK_FAULT
+
+        def field_safe() -> bool:  # the next cycle of the link puts the safe value out
+            r = mb.read_holding_registers(10, count=3).registers
+            return float32_from_registers(r[0], r[1]) == 12.5 and r[2] == INFO_BLOCK_FAULT
+
+        wait_until(field_safe, 10)
         assert "internal error: ZeroDivisionError: a bug" in valve.snapshot()["error"]
         cycles = other.task.stats.count
         wait_until(lambda: other.task.stats.count > cycles + 10, 10)  # the cycle thread lives on
