@@ -268,45 +268,50 @@ def needs_init(body: Sequence[Stmt], scalars: set[str]) -> list[str]:
     """Scalar temporaries some path may read before assigning (they start at 0, as in C)."""
     out: set[str] = set()
 
-    def reads(e: Ex, defined: set[str]) -> None:
+    # The names defined on every path so far are a stack of sets, one per nesting level, so
+    # that a branch does not copy all of them (linear, not quadratic, in long rule sections).
+    def reads(e: Ex, defined: list[set[str]]) -> None:
         from fuzzyctl.engine.ir import subexprs
 
         for sub in subexprs(e):
-            if isinstance(sub, Var) and sub.name in scalars and sub.name not in defined:
+            if isinstance(sub, Var) and sub.name in scalars and not any(sub.name in d for d in defined):
                 out.add(sub.name)
 
-    def run(stmts: Sequence[Stmt], defined: set[str]) -> set[str]:
-        d = set(defined)
+    def run(stmts: Sequence[Stmt], outer: list[set[str]]) -> set[str]:
+        """The names ``stmts`` define on every path (beyond ``outer``)."""
+        added: set[str] = set()
+        defined = [*outer, added]
         for s in stmts:
             if isinstance(s, Assign):
-                reads(s.value, d)
+                reads(s.value, defined)
                 if isinstance(s.target, Index):
-                    reads(s.target.index, d)
+                    reads(s.target.index, defined)
                 else:
-                    d.add(s.target.name)
+                    added.add(s.target.name)
             elif isinstance(s, If):
                 branch_sets = []
                 for cond, b in s.branches:
-                    reads(cond, d)
-                    branch_sets.append(run(b, d))
-                branch_sets.append(run(s.orelse, d) if s.orelse else set(d))
-                d = set.intersection(*branch_sets)
+                    reads(cond, defined)
+                    branch_sets.append(run(b, defined))
+                if s.orelse:  # without an else some path adds nothing
+                    branch_sets.append(run(s.orelse, defined))
+                    added |= set.intersection(*branch_sets)
             elif isinstance(s, For):
-                reads(s.start, d)
-                reads(s.stop, d)
-                run(s.body, d | {s.var})
+                reads(s.start, defined)
+                reads(s.stop, defined)
+                run(s.body, [*defined, {s.var}])
             elif isinstance(s, While):
-                reads(s.cond, d)
-                run(s.body, d)
+                reads(s.cond, defined)
+                run(s.body, defined)
             elif isinstance(s, Region):
-                d = run(s.body, d)
+                added |= run(s.body, defined)
             elif isinstance(s, Kernel):
                 for a in s.args:
-                    reads(a, d)
+                    reads(a, defined)
                 for o in s.outs:
                     if isinstance(o, Var):
-                        d.add(o.name)
-        return d
+                        added.add(o.name)
+        return added
 
-    run(body, set())
+    run(body, [])
     return sorted(out)
