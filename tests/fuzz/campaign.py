@@ -393,12 +393,29 @@ def _worker(conn: Connection, memory_mb: int) -> None:
             m = conn.recv()
             if m is None:
                 return
+            _reset_peak_rss()
             try:
                 out = run_one(m, Path(tmp))
             except MemoryError:
                 out = Outcome(m.index, "memory", "MemoryError")
-            out.rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+            out.rss_mb = _peak_rss_mb()
             conn.send(out)
+
+
+def _reset_peak_rss() -> None:
+    """Start this mutant's peak from the current resident size (Linux: clear_refs 5), so that
+    a mutant is not charged with what an earlier one or the imports once needed."""
+    with contextlib.suppress(OSError):
+        Path("/proc/self/clear_refs").write_text("5")
+
+
+def _peak_rss_mb() -> float:
+    """The peak resident size since :func:`_reset_peak_rss` (VmHWM), else the process's."""
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                return int(line.split()[1]) / 1024
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def _cpu_seconds(pid: int) -> float:
