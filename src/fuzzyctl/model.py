@@ -419,6 +419,19 @@ class Or:
 Condition: TypeAlias = Is | Degree | Not | And | Or
 
 
+def walk_condition(c: Condition | None) -> Iterator[Is | Degree]:
+    """The leaves (``IS`` tests and degree inputs) of a condition, left to right."""
+    if c is None:
+        return
+    if isinstance(c, Is | Degree):
+        yield c
+    elif isinstance(c, Not):
+        yield from walk_condition(c.operand)
+    else:
+        for operand in c.operands:
+            yield from walk_condition(operand)
+
+
 @dataclass(frozen=True)
 class Conclusion:
     """Subconclusion ``variable IS term [WITH weight]`` or a bare ``variable``

@@ -37,6 +37,7 @@ from fuzzyctl.model import (
     Span,
     Term,
     VarKind,
+    walk_condition,
 )
 
 
@@ -92,19 +93,6 @@ class _Reporter:
 
     def note(self, message: str, span: Span | None, code: str) -> None:
         self.found.append(Diagnostic(Severity.NOTE, message, span, self.ctx.file, code))
-
-
-def walk_condition(c: Condition | None) -> Iterator[Is | Degree]:
-    """The subconditions of a condition, left to right."""
-    if c is None:
-        return
-    if isinstance(c, Is | Degree):
-        yield c
-    elif isinstance(c, Not):
-        yield from walk_condition(c.operand)
-    else:
-        for operand in c.operands:
-            yield from walk_condition(operand)
 
 
 def uses_operator(c: Condition | None, kind: type) -> bool:

@@ -9,7 +9,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from enum import IntEnum
 
-from fuzzyctl.fcl.checks import is_singleton, walk_condition
+from fuzzyctl.fcl.checks import is_singleton
 from fuzzyctl.model import (
     And,
     Condition,
@@ -25,6 +25,7 @@ from fuzzyctl.model import (
     SingletonMF,
     SingletonsMF,
     Term,
+    walk_condition,
 )
 
 

@@ -18,7 +18,6 @@ can (docs/engine.md).
 from __future__ import annotations
 
 import re
-from collections.abc import Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -26,21 +25,19 @@ from fuzzyctl.diagnostics import Diagnostic, warning
 from fuzzyctl.fcl.shapes import JFL, lookup
 from fuzzyctl.model import (
     Call,
-    Condition,
     DefuzzifyBlock,
     Degree,
     Document,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
-    Is,
-    Not,
     PointsMF,
     Ref,
     ShapeMF,
     SingletonMF,
     SingletonsMF,
     Span,
+    walk_condition,
 )
 
 __all__ = ["check_jfuzzylogic"]
@@ -223,7 +220,7 @@ def _rule(rule: Any, found: _Found) -> None:
     rejects = "jfl-rejects"
     if rule.condition is None:
         found.add(rejects, f"RULE {rule.label} has no condition", rule.span)
-    for c in _walk(rule.condition):
+    for c in walk_condition(rule.condition):
         if isinstance(c, Degree):
             found.add(rejects, f"RULE {rule.label}: a bare variable is not a condition", c.span)
         elif c.hedges:
@@ -238,18 +235,6 @@ def _rule(rule: Any, found: _Found) -> None:
             found.add(rejects, f"RULE {rule.label}: it has no hedges", c.span)
         if c.weight is not None and (i < len(weights) - 1 or isinstance(c.weight, Ref)):
             found.add(rejects, f"RULE {rule.label}: WITH takes a number and ends the rule", c.span)
-
-
-def _walk(c: Condition | None) -> Iterator[Is | Degree]:
-    if c is None:
-        return
-    if isinstance(c, Is | Degree):
-        yield c
-    elif isinstance(c, Not):
-        yield from _walk(c.operand)
-    else:
-        for o in c.operands:
-            yield from _walk(o)
 
 
 def _name(name: str, what: str, span: Span | None, found: _Found) -> None:
