@@ -2,10 +2,14 @@
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from fuzzyctl.codegen.context import CodegenError
+from fuzzyctl.codegen.context import CodegenError, Target
+from fuzzyctl.codegen.defaults import apply_default, parse_default
+from fuzzyctl.codegen.ir import Program
 from fuzzyctl.codegen.program import build_program
+from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.codegen.render_c import render_c
 from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
@@ -29,43 +33,92 @@ def _blocks(model: Document | FunctionBlock, block: str | None) -> list[str | No
     return [fb.name for fb in model.blocks]
 
 
+@dataclass
+class Generated:
+    """One generated function block: its program, and what the generator changed to express
+    it (the rename table, the ``--default`` choice, the quadrature notes of the header)."""
+
+    program: Program
+    renames: list[Rename] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "block": self.program.name,
+            "renames": [r.to_dict() for r in self.renames],
+            "notes": list(self.notes),
+        }
+
+
+def build(plan: Plan, target: Target, default: float | str | None = None) -> Generated:
+    """The program of one lowered block for ``target`` with ``--default`` applied and the
+    interface renamed where the target needs it (header comment lines say so)."""
+    plan, notes = apply_default(plan, parse_default(default))
+    plan, renames = rename_plan(plan, target)
+    prog = build_program(plan, target)
+    extra = [*notes]
+    if renames:
+        extra.append("renamed for the target (model name -> generated name):")
+        extra += [f"  {r.comment()}" for r in renames]
+    prog.header[1:1] = extra
+    quad = [line for line in prog.header if "Gauss-Legendre" in line]
+    return Generated(prog, renames, notes + quad)
+
+
+def plans(model: Document | FunctionBlock | Plan, block: str | None = None, **options: Any) -> list[Plan]:
+    """The lowered plans of ``model``'s blocks (or of ``block``); a plan is taken as is."""
+    if isinstance(model, Plan):
+        return [model]
+    return [lower_block(model, name, **options) for name in _blocks(model, block)]
+
+
 def generate_st(
-    model: Document | FunctionBlock,
+    model: Document | FunctionBlock | Plan,
     *,
     block: str | None = None,
     dialect: str = "codesys",
     lreal: bool = False,
+    default: float | str | None = None,
+    report: list[Generated] | None = None,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
 
     ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept) or ``scl``
     (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
-    computes in LREAL instead of REAL.  Raises :class:`CodegenError` naming what cannot be
-    expressed."""
+    computes in LREAL instead of REAL; ``default`` (a number or ``"hold"``) replaces
+    ``DEFAULT := nan``.  Names the target cannot use are renamed (header comment; ``report``
+    receives one :class:`Generated` per block).  Raises :class:`CodegenError` naming what
+    cannot be expressed."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
     parts = []
-    for name in _blocks(model, block):
-        plan = lower_block(model, name, **options)
-        parts.append(render_st(build_program(plan, "st"), dialect=dialect, lreal=lreal))
+    for plan in plans(model, block, **options):
+        gen = build(plan, "st", default)
+        if report is not None:
+            report.append(gen)
+        parts.append(render_st(gen.program, dialect=dialect, lreal=lreal))
     return "\n".join(parts)
 
 
 def generate_c(
-    model: Document | FunctionBlock,
+    model: Document | FunctionBlock | Plan,
     *,
     block: str | None = None,
     single: bool = False,
+    default: float | str | None = None,
+    report: list[Generated] | None = None,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
-    ``block``); ``single`` computes in float instead of double."""
+    ``block``); ``single`` computes in float instead of double; ``default`` replaces
+    ``DEFAULT := nan`` (without it the C outputs NaN as the engine does)."""
     files: dict[str, str] = {}
-    for name in _blocks(model, block):
-        plan = lower_block(model, name, **options)
-        prog = build_program(plan, "c")
-        header, source = render_c(prog, single=single)
-        files[f"{prog.name}.h"] = header
-        files[f"{prog.name}.c"] = source
+    for plan in plans(model, block, **options):
+        gen = build(plan, "c", default)
+        if report is not None:
+            report.append(gen)
+        header, source = render_c(gen.program, single=single)
+        files[f"{gen.program.name}.h"] = header
+        files[f"{gen.program.name}.c"] = source
     return files

@@ -32,7 +32,7 @@ _KNOWN_FIELDS: dict[str, set[str]] = {
     "EX": set(),
     "FuzzyInputPlan": {"name", "slot", "terms"},
     "GridPlan": {"xs", "left", "right", "point", "active", "shared", "solo", "min_bands", "full"},
-    "InputPlan": {"name", "default", "degree"},
+    "InputPlan": {"name", "default", "degree", "clamp"},
     "Options": {
         "weight_before_activation",
         "firing_threshold",
@@ -60,6 +60,7 @@ _KNOWN_FIELDS: dict[str, set[str]] = {
         "exact",
         "grid",
         "is_output",
+        "clamp",
     },
     "Plan": {
         "name",
@@ -71,11 +72,35 @@ _KNOWN_FIELDS: dict[str, set[str]] = {
         "outputs",
         "output_order",
         "options",
+        "selections",
     },
-    "RulePlan": {"label", "block", "condition", "act", "conclusions"},
+    "RulePlan": {"label", "block", "condition", "act", "conclusions", "weight", "selection"},
+    "SelectionPlan": {"method", "rules", "count", "threshold", "comparison"},
     "Slot": {"index"},
     "TermPlan": {"name", "kind", "params", "height", "expr", "pwl"},
 }
+
+
+#: How the plan's elements are called in messages (never the class names).
+_ELEMENT = {
+    "Plan": "function block",
+    "InputPlan": "input",
+    "FuzzyInputPlan": "input",
+    "OutputPlan": "output",
+    "TermPlan": "term",
+    "RulePlan": "rule",
+    "ConclusionPlan": "rule conclusion",
+    "Contribution": "rule conclusion",
+    "Options": "engine option",
+    "ChainedPlan": "variable",
+    "SelectionPlan": "rule block activation",
+}
+
+
+def _element(obj: object, where: str) -> str:
+    kind = _ELEMENT.get(type(obj).__name__, "element")
+    label = getattr(obj, "name", None) or getattr(obj, "label", None)
+    return f"{kind} {label}" if isinstance(label, str) else f"{kind} of {where}"
 
 
 def check_known_fields(g: Gen, obj: object, where: str = "plan") -> None:
@@ -87,15 +112,20 @@ def check_known_fields(g: Gen, obj: object, where: str = "plan") -> None:
         return
     known = _KNOWN_FIELDS.get(type(obj).__name__)
     if known is None:
-        raise g.refuse(f"{where}: {type(obj).__name__}", "a plan element this generator does not know")
+        raise g.refuse(
+            _element(obj, where),
+            "a feature this version of the generator does not know; evaluate the system with "
+            "fuzzyctl eval / the Python API, or update fuzzyctl",
+        )
     for f in dataclasses.fields(obj):
         value = getattr(obj, f.name)
         if f.name not in known:
             default = f.default if f.default is not dataclasses.MISSING else None
             if value != default and value not in ((), None, False, 0, 0.0):
                 raise g.refuse(
-                    f"{where}: {type(obj).__name__}.{f.name} = {value!r}",
-                    "a semantic switch this generator does not implement",
+                    f"{_element(obj, where)}: {f.name.replace('_', ' ')} = {value!r}",
+                    "a setting this version of the generator does not implement; evaluate the "
+                    "system with fuzzyctl eval / the Python API, or update fuzzyctl",
                 )
             continue
         if f.name != "grid":  # the grid is data, derived from the terms
