@@ -22,30 +22,7 @@ from tests.conftest import DATA, EXAMPLES
 
 #: Conformance systems the C generator refuses, and why (docs/codegen.md repeats this).
 NOT_EXPRESSIBLE_C = {
-    "fuzzylite/mamdani/AllTerms.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/SimpleDimmerChained.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/SimpleDimmerInverse.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/matlab/mam21.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/matlab/mam22.fcl": "smooth output terms (numerical integration)",
-    "fuzzylite/mamdani/octave/investment_portfolio.fcl": (
-        "ACT EINSTEIN and smooth terms (numerical integration)"
-    ),
-    "fuzzylite/mamdani/octave/mamdani_tip_calculator.fcl": "smooth output terms (numerical integration)",
     "fuzzylite/tsukamoto/tsukamoto.fcl": "Tsukamoto (monotonic) output terms",
-    # gaussian outputs without RANGE: they load since issue 15 (the span of the terms)
-    **{
-        f"jfuzzylogic/fcl/{name}.fcl": "smooth output terms (numerical integration)"
-        for name in (
-            "QoS/LarsenQoSFewRules",
-            "QoS/LarsenQoSManyRules",
-            "QoS/MamdaniQoSFewRules",
-            "QoS/MamdaniQoSManyRules",
-            "trust/LarsenFewRules",
-            "trust/LarsenManyRules",
-            "trust/MamdaniFewRules",
-            "trust/MamdaniManyRules",
-        )
-    },
 }
 
 

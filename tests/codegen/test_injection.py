@@ -251,10 +251,13 @@ def test_cli_codegen_on_a_hostile_model(private_cache: Path, capsys: pytest.Capt
     assert main(["codegen", str(src), "--lang", "st", "--dialect", "scl"]) == 0
     st = capsys.readouterr().out
     assert "touch pwned" in st and list(H.st_tokens(st))  # the text is there, in a comment
-    # a hostile name is refused with exit 1 and a message, never written
+    # a hostile name is renamed to an identifier (files named by it), the original text only
+    # in the rename table of the header comment, made inert there
     bad = json.loads(src.read_text())
     bad["blocks"][0]["name"] = H.HOSTILE["c-close"]
     src.write_text(json.dumps(bad))
-    assert main(["codegen", str(src), "--lang", "c", "-o", str(private_cache / "gen2")]) == 1
-    assert "function block name" in capsys.readouterr().err
-    assert not (private_cache / "gen2").exists() or not list((private_cache / "gen2").iterdir())
+    assert main(["codegen", str(src), "--lang", "c", "-o", str(private_cache / "gen2")]) == 0
+    assert sorted(p.name for p in (private_cache / "gen2").iterdir()) == ["PWNED.c", "PWNED.h"]
+    renamed = (private_cache / "gen2" / "PWNED.c").read_text()
+    assert "renamed for the target" in renamed
+    assert list(H.c_tokens(renamed)) == list(H.c_tokens(c_file))

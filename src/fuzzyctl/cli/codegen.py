@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
@@ -51,6 +51,22 @@ def codegen(
     block: Annotated[
         str | None, typer.Option("--block", help="Only this function block (default: every block).")
     ] = None,
+    default: Annotated[
+        str | None,
+        typer.Option(
+            "--default",
+            help="What an output with DEFAULT := nan gives when no rule fires: a number, or 'hold' "
+            "(keep the last value); INFO is 16#02 then.  Needed for ST (no NaN); C outputs NaN without it.",
+        ),
+    ] = None,
+    as_json: Annotated[
+        bool,
+        typer.Option(
+            "--json",
+            help="Print a JSON report: the generated text (or the files written), the rename table, "
+            "the --default choice and the quadrature bounds of smooth outputs.",
+        ),
+    ] = False,
     strict: Annotated[
         bool,
         typer.Option(
@@ -70,22 +86,61 @@ def codegen(
         raise typer.BadParameter("--dialect and --lreal apply to --lang st", param_hint="--lang")
     if lang is Lang.st and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
+    from fuzzyctl.codegen.api import Generated
+    from fuzzyctl.codegen.defaults import parse_default
+    from fuzzyctl.escape import CodegenError
+
+    try:
+        parse_default(default)
+    except CodegenError as exc:
+        raise typer.BadParameter(str(exc), param_hint="--default") from None
     doc = fuzzyctl.load(source, strict=strict)
+    report: list[Generated] = []
     if lang is Lang.st:
         text = generate_st(
-            doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+            doc,
+            block=block,
+            dialect=(dialect or Dialect.codesys).value,
+            lreal=lreal,
+            strict=strict,
+            default=default,
+            report=report,
         )
         if output is None:
-            typer.echo(text, nl=False)
+            if as_json:
+                _json_report(lang, report, text=text)
+            else:
+                typer.echo(text, nl=False)
             return
         write_atomic(output, text)
-        err_console.print(f"wrote {output}", markup=False)
+        _done(as_json, lang, report, [output])
         return
-    files = generate_c(doc, block=block, single=single, strict=strict)
+    files = generate_c(doc, block=block, single=single, strict=strict, default=default, report=report)
     out_dir = output or Path(".")
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")
     out_dir.mkdir(parents=True, exist_ok=True)
     for name, text in files.items():
         write_atomic(out_dir / name, text)
-    err_console.print(f"wrote {', '.join(str(out_dir / n) for n in files)}", markup=False)
+    _done(as_json, lang, report, [out_dir / n for n in files])
+
+
+def _done(as_json: bool, lang: Lang, report: list[Any], written: list[Path]) -> None:
+    if as_json:
+        _json_report(lang, report, written=written)
+    else:
+        err_console.print(f"wrote {', '.join(str(p) for p in written)}", markup=False)
+        for gen in report:
+            for r in gen.renames:
+                err_console.print(f"renamed {r.comment()}", markup=False)
+
+
+def _json_report(lang: Lang, report: list[Any], text: str | None = None, written: list[Path] | None = None) -> None:
+    import json
+
+    out: dict[str, Any] = {"lang": lang.value, "blocks": [g.to_dict() for g in report]}
+    if text is not None:
+        out["text"] = text
+    if written is not None:
+        out["written"] = [str(p) for p in written]
+    typer.echo(json.dumps(out, indent=2))

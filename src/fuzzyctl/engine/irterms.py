@@ -342,15 +342,19 @@ _C_FUNCS = {
     "atan2": "ATAN2",
     "fmod": "FMOD",
 }
+#: The IEC 61131-3 standard functions portable Structured Text may call.
+_ST_FUNCS = frozenset({"EXP", "LN", "LOG", "SQRT", "ABS", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN"})
 _COMPARE = {"eq": "=", "neq": "<>", "lt": "<", "le": "<=", "gt": ">", "ge": ">="}
 
 
 def expression(
     g: Gen, e: ExprPlan, inputs: list[Ex], outputs: Callable[[int], Ex], x: Ex | None, what: str
 ) -> Ex:
-    """A function term (``engine.expr.eval_expr``): C only - IEEE arithmetic gives the same
-    inf/nan as the engine's C-like evaluation."""
-    if g.target != "c":
+    """A function term (``engine.expr.eval_expr``).  C: IEEE arithmetic gives the same
+    inf/nan as the engine's C-like evaluation.  Structured Text: + - * /, comparisons,
+    min/max/sign and the IEC 61131-3 standard functions (EXP, LN, LOG, SQRT, ABS and the
+    trigonometric ones); a PLC faults where the engine would give inf or nan."""
+    if g.target not in ("c", "st"):
         raise g.refuse(what, "function terms are an Open-level feature")
 
     def rec(n: ExprPlan) -> Ex:
@@ -370,6 +374,12 @@ def expression(
             a, b = rec(n.left), rec(n.right)
             if n.op in "+-*/":
                 return Bin(n.op, a, b)
+            if g.target == "st":
+                raise g.refuse(
+                    what,
+                    f"the operator {n.op} has no portable Structured Text form; write the "
+                    "function with + - * / and EXP/LN",
+                )
             return g.call("FMOD" if n.op == "%" else "POW", a, b)
         assert isinstance(n, ECall)
         args = [rec(a) for a in n.args]
@@ -398,6 +408,12 @@ def expression(
             return t
         if fn not in _C_FUNCS:
             raise g.refuse(what, f"function {fn}() is not supported")
+        if g.target == "st" and _C_FUNCS[fn] not in _ST_FUNCS:
+            raise g.refuse(
+                what,
+                f"function {fn}() is no IEC 61131-3 standard function; write the function with "
+                "+ - * / and EXP, LN, LOG, SQRT, ABS, SIN, COS, TAN, ASIN, ACOS or ATAN",
+            )
         return g.call(_C_FUNCS[fn], *args)
 
     return rec(e)
