@@ -137,7 +137,11 @@ def test_every_expressible_system_matches_the_engine(
         worst_core[label] = S.max_error(plan, got[:N_CORE], S.reference(plan, head, "scalar"))
     bad = {k: v for k, v in worst.items() if not v <= 1e-9}
     assert not bad, bad
-    bad_core = {k: v for k, v in worst_core.items() if not v <= 1e-12}
+    # smooth outputs: the generated quadrature against the engine's adaptive one (1e-9 above)
+    smooth = {
+        label for label, plan in systems if any(o.kind == "mamdani" and not o.exact for o in plan.outputs)
+    }
+    bad_core = {k: v for k, v in worst_core.items() if not v <= (1e-9 if k in smooth else 1e-12)}
     assert not bad_core, bad_core
     print(
         f"\nC double: worst deviation {max(worst.values()):.2e} of the range over {len(worst)} systems"

@@ -27,9 +27,7 @@ from tests.extras import extra_files
 pytestmark = pytest.mark.extra("corpus")
 
 FILES = [
-    p
-    for p in extra_files("corpus", "corpus", recursive=True)
-    if p.suffix.lower() in (".fcl", ".fis", ".fll")
+    p for p in extra_files("corpus", "corpus", recursive=True) if p.suffix.lower() in (".fcl", ".fis", ".fll")
 ]
 #: What a refusal must name: the element (how the generator calls the model's parts) ...
 ELEMENT = re.compile(r"^(output|term|input|rule|variable|function block|rule block activation) ")

@@ -259,5 +259,5 @@ def test_cli_codegen_on_a_hostile_model(private_cache: Path, capsys: pytest.Capt
     assert main(["codegen", str(src), "--lang", "c", "-o", str(private_cache / "gen2")]) == 0
     assert sorted(p.name for p in (private_cache / "gen2").iterdir()) == ["PWNED.c", "PWNED.h"]
     renamed = (private_cache / "gen2" / "PWNED.c").read_text()
-    assert "renamed for the target" in renamed
+    assert "renamed for the target" in (private_cache / "gen2" / "PWNED.h").read_text()
     assert list(H.c_tokens(renamed)) == list(H.c_tokens(c_file))

@@ -135,7 +135,9 @@ def _done(as_json: bool, lang: Lang, report: list[Any], written: list[Path]) -> 
                 err_console.print(f"renamed {r.comment()}", markup=False)
 
 
-def _json_report(lang: Lang, report: list[Any], text: str | None = None, written: list[Path] | None = None) -> None:
+def _json_report(
+    lang: Lang, report: list[Any], text: str | None = None, written: list[Path] | None = None
+) -> None:
     import json
 
     out: dict[str, Any] = {"lang": lang.value, "blocks": [g.to_dict() for g in report]}

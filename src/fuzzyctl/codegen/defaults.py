@@ -28,7 +28,7 @@ HOLD = "hold"
 def parse_default(text: str | float | None) -> float | str | None:
     """``--default`` as given: a finite number, ``hold`` or None; else a message naming the
     option."""
-    if text is None or isinstance(text, float | int) and not isinstance(text, bool):
+    if text is None or (isinstance(text, float | int) and not isinstance(text, bool)):
         value = None if text is None else float(text)
         if value is not None and not math.isfinite(value):
             raise CodegenError(f"--default {text}: give a finite number or 'hold'")

@@ -88,16 +88,16 @@ class _Builder(RuleBuilder):
         self._check()
         for inp in plan.inputs:
             self.inputs.append(self._io(inp.name, "input", inp.default))
-        for inp, v in zip(plan.inputs, list(self.inputs), strict=True):
+        for inp, iv in zip(plan.inputs, list(self.inputs), strict=True):
             if inp.clamp is not None:  # lock-range: the limited value is what everything reads
                 lo, hi = inp.clamp
                 lim = g.temp(hint="LIM")
-                b.set(lim, v)
-                with b.if_(v.lt(lo)):
+                b.set(lim, iv)
+                with b.if_(iv.lt(lo)):
                     b.set(lim, lo)
-                with b.elif_(v.gt(hi)):
+                with b.elif_(iv.gt(hi)):
                     b.set(lim, hi)
-                self.inputs[self.inputs.index(v)] = lim
+                self.inputs[self.inputs.index(iv)] = lim
         enable = g.declare("ENABLE", "BOOL", "input", init=True, comment="FALSE: outputs keep their values")
         outs: list[Var] = []
         for op in plan.outputs:
@@ -138,7 +138,9 @@ class _Builder(RuleBuilder):
             contribs = self._rule_section(degrees, weights)
             values: dict[int, Ex] = {}
             exact = [
-                oi for oi in plan.output_order if plan.outputs[oi].kind == "mamdani" and plan.outputs[oi].exact
+                oi
+                for oi in plan.output_order
+                if plan.outputs[oi].kind == "mamdani" and plan.outputs[oi].exact
             ]
             results: dict[int, tuple[Ex, Ex]] = {}
             if exact:
@@ -307,9 +309,10 @@ class _Builder(RuleBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         cal = Q.calibrate(op)
+        bound = Q.cog_bound(op, max(1, len(sets)), cal)
         self.notes.append(
             f"output {op.name}: smooth set, CoG by {Q.NODES}-point Gauss-Legendre on "
-            f"{len(cal.cuts) - 1} intervals, split at located kinks: {Q.cog_bound(op, max(1, len(sets)), cal)}"
+            f"{len(cal.cuts) - 1} intervals, split at located kinks: {bound}"
         )
         return Q.smooth_cog(self.g, op, sets, cal)
 

@@ -28,6 +28,7 @@ rounding (about 1e-6 of the range) dominates it.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 
@@ -91,7 +92,7 @@ def _breakpoints(op: OutputPlan) -> list[float]:
 def calibrate(op: OutputPlan) -> Calibration:
     """The breakpoints of ``op`` refined until every term is integrated to :data:`PANEL_TOL`."""
     assert op.low is not None and op.high is not None
-    width = op.high - op.low
+    width, low = op.high - op.low, op.low
     x8, w8 = (np.array(v) for v in gauss_legendre(NODES))
     x16, w16 = (np.array(v) for v in gauss_legendre(2 * NODES))
     worst = 0.0
@@ -103,13 +104,13 @@ def calibrate(op: OutputPlan) -> Calibration:
             xa, xb = a + x8 * d, a + x16 * d
             fa, fb = _degree_np(t, xa), _degree_np(t, xb)
             e_area = abs(float(fa @ w8 - fb @ w16)) * d
-            e_mom = abs(float((fa * (xa - op.low)) @ w8 - (fb * (xb - op.low)) @ w16)) * d / width
+            e_mom = abs(float((fa * (xa - low)) @ w8 - (fb * (xb - low)) @ w16)) * d / width
             out = max(out, e_area, e_mom)
         return out / d
 
     cuts: list[float] = []
     bps = _breakpoints(op)
-    for a, b in zip(bps, bps[1:], strict=False):
+    for a, b in itertools.pairwise(bps):
         stack = [(a, b, 0)]
         pieces: list[float] = []
         while stack:
@@ -298,4 +299,3 @@ def _locate(
             b.set(hi, x)
             b.set(code, chi)
             b.set(chi, cx)
-
