@@ -203,7 +203,11 @@ class _Builder(RuleBuilder):
             if op.kind == "ts":
                 for t in op.terms:
                     if t.kind in shapes.TSUKAMOTO_KINDS:
-                        raise g.refuse(f"term {op.name}.{t.name}", "Tsukamoto (monotonic) outputs")
+                        raise g.refuse(
+                            f"term {op.name}.{t.name}",
+                            "Tsukamoto (monotonic) outputs are not generated yet; use singleton "
+                            "or linear terms for this output, or run the system with the engine",
+                        )
 
     # ------------------------------------------------------------------ fuzzification
 
