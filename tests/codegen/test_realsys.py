@@ -144,15 +144,13 @@ def test_default_option_is_checked() -> None:
 
 def test_illegal_names_are_renamed_and_compute_the_same() -> None:
     # a reserved word of IEC (TIME), a name that is no identifier, and a too long one
-    text = NAN_FCL.format(
-        name="fb", inp="time", out="Output_With_A_Very_Long_Name_Indeed", default="0"
-    ).replace("FUNCTION_BLOCK fb", "FUNCTION_BLOCK fb")
+    text = NAN_FCL.format(name="tank", inp="time", out="Output_With_A_Very_Long_Name_Indeed", default="0")
     plan = _plan(text)
     report: list[Generated] = []
     st = generate_st(plan, report=report, lreal=True)
     table = {r.original: r.name for r in report[0].renames}
     assert table == {"time": "time_IN", "Output_With_A_Very_Long_Name_Indeed": "Output_With_A_Very_Long"}
-    head = st.split("FUNCTION_BLOCK fb")[0]
+    head = st.split("FUNCTION_BLOCK tank")[0]
     assert "input 'time' is time_IN (a reserved word of the target)" in head
     assert "renamed for the target" in head
     data = np.linspace(-1, 11, 97)[:, None]
@@ -162,7 +160,7 @@ def test_illegal_names_are_renamed_and_compute_the_same() -> None:
     assert S.max_error(plan, got, want) <= 1e-9
     # legal names are kept: nothing renamed, no table
     report2: list[Generated] = []
-    generate_st(_plan(NAN_FCL.format(name="fb", inp="x", out="y", default="0")), report=report2)
+    generate_st(_plan(NAN_FCL.format(name="tank", inp="x", out="y", default="0")), report=report2)
     assert report2[0].renames == []
 
 
@@ -177,9 +175,10 @@ def test_renames_stay_apart_and_legal() -> None:
         assert len({n.upper() for n in new}) == len(new)
         assert all(re.fullmatch(r"[A-Za-z][A-Za-z0-9]*(_[A-Za-z0-9]+)*", n) for n in new), new
         assert renamed.name == "sugeno_tipper"
-        assert {r.original for r in table} >= {"dV*", "dV+", "len", "9lives", "FZ_x", "INFO"}
-        if target == "st":
+        assert {r.original for r in table} >= {"dV*", "dV+", "9lives", "FZ_x", "INFO"}
+        if target == "st":  # LEN is an IEC standard function, no C keyword
             assert all(len(n) <= 24 for n in new)
+            assert {"len", "LEN"} <= {r.original for r in table}
 
 
 # --------------------------------------------------------------------------- smooth outputs

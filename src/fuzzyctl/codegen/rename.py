@@ -74,7 +74,7 @@ def _candidate(name: str, kind: str, target: Target) -> str:
     tag = _TAG[kind]
     if not s:
         s = tag
-    if s[0].isdigit():
+    if s[0].isdigit() or s.upper().startswith(PREFIX):
         s = f"{tag}_{s}"
     limit = MAX_IDENT_ST if target == "st" else MAX_IDENT_C - 8
     if len(s) > limit:
@@ -103,6 +103,9 @@ def rename_plan(plan: Plan, target: Target) -> tuple[Plan, list[Rename]]:
         while new.upper() in taken or _legal(new, target) is not None:
             k += 1
             new = f"{base[: limit - len(str(k)) - 1].rstrip('_')}_{k}"
+            if k > 1000:  # cannot happen with the rules above; never loop forever
+                new = f"{_TAG[kind]}_{len(taken) + 1}"
+                break
         taken.add(new.upper())
         table.append(Rename(kind, name, new, reason))
         return new
