@@ -1,5 +1,5 @@
-"""``fuzzyctl codegen FILE --lang st|c``: IEC 61131-3 Structured Text or C99 from a fuzzy
-system (see docs/codegen.md)."""
+"""``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
+function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from fuzzyctl.cli.app import app, err_console
 
 class Lang(StrEnum):
     st = "st"
+    plcopen = "plcopen"
     c = "c"
 
 
@@ -29,21 +30,27 @@ def codegen(
         Path,
         typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", exists=True, dir_okay=False),
     ],
-    lang: Annotated[Lang, typer.Option("--lang", help="st: Structured Text; c: C99.")] = Lang.st,
+    lang: Annotated[
+        Lang,
+        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
+    ] = Lang.st,
     output: Annotated[
         Path | None,
         typer.Option(
             "-o",
             "--output",
-            help="st: the .st file (default: print); c: the directory for NAME.h and NAME.c (default: .).",
+            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .).",
         ),
     ] = None,
     dialect: Annotated[
         Dialect | None,
-        typer.Option("--dialect", help="st only: codesys (default), twincat or scl (TIA Portal)."),
+        typer.Option(
+            "--dialect",
+            help="st, plcopen: codesys (default), twincat or scl (TIA Portal, st only).",
+        ),
     ] = None,
     lreal: Annotated[
-        bool, typer.Option("--lreal", help="st only: compute in LREAL instead of REAL.")
+        bool, typer.Option("--lreal", help="st, plcopen: compute in LREAL instead of REAL.")
     ] = False,
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
@@ -63,18 +70,21 @@ def codegen(
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
     import fuzzyctl
-    from fuzzyctl.codegen import generate_c, generate_st
+    from fuzzyctl.codegen import generate_c, generate_plcopen, generate_st
     from fuzzyctl.formats import write_atomic
 
     if lang is Lang.c and (dialect is not None or lreal):
-        raise typer.BadParameter("--dialect and --lreal apply to --lang st", param_hint="--lang")
-    if lang is Lang.st and single:
+        raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
+    if lang is not Lang.c and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
-    doc = fuzzyctl.load(source, strict=strict)
-    if lang is Lang.st:
-        text = generate_st(
-            doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+    if lang is Lang.plcopen and dialect is Dialect.scl:
+        raise typer.BadParameter(
+            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
         )
+    doc = fuzzyctl.load(source, strict=strict)
+    if lang is not Lang.c:
+        gen = generate_st if lang is Lang.st else generate_plcopen
+        text = gen(doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict)
         if output is None:
             typer.echo(text, nl=False)
             return

@@ -2,6 +2,7 @@
 embedded targets, and the native evaluation backend built on the C.
 
 * :func:`generate_st` - one FUNCTION_BLOCK per FCL function block (CODESYS, TwinCAT, SCL).
+* :func:`generate_plcopen` - the same blocks as PLCopen TC6 XML 2.01 (one project).
 * :func:`generate_c` - a header and a source file per function block.
 * :mod:`fuzzyctl.codegen.native` - the native backend of ``compile()``.
 
@@ -17,10 +18,10 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from fuzzyctl.codegen.api import generate_c, generate_st, lower_block
+    from fuzzyctl.codegen.api import generate_c, generate_plcopen, generate_st, lower_block
     from fuzzyctl.engine.irgen import CodegenError
 
-__all__ = ["CodegenError", "generate_c", "generate_st", "lower_block"]
+__all__ = ["CodegenError", "generate_c", "generate_plcopen", "generate_st", "lower_block"]
 
 
 def __getattr__(name: str) -> Any:
@@ -28,7 +29,7 @@ def __getattr__(name: str) -> Any:
         from fuzzyctl.engine.irgen import CodegenError
 
         return CodegenError
-    if name in ("generate_c", "generate_st", "lower_block"):
+    if name in ("generate_c", "generate_plcopen", "generate_st", "lower_block"):
         from fuzzyctl.codegen import api
 
         return getattr(api, name)

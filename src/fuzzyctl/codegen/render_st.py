@@ -226,8 +226,13 @@ def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) ->
 
 def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
     """One FUNCTION_BLOCK."""
-    parts = st_parts(prog, dialect=dialect, lreal=lreal)
-    scl = dialect == "scl"
+    return format_st(st_parts(prog, dialect=dialect, lreal=lreal))
+
+
+def format_st(parts: STParts) -> str:
+    """The text of a FUNCTION_BLOCK from its parts: header comments, ``FUNCTION_BLOCK``,
+    the sections, the body lines, ``END_FUNCTION_BLOCK``."""
+    scl = parts.dialect == "scl"
     out = [_comment(line) for line in parts.header]
     if scl:
         out.append(f'FUNCTION_BLOCK "{parts.name}"')
