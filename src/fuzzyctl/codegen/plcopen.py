@@ -38,6 +38,8 @@ PLAINTEXT_INTERFACE = "http://www.3s-software.com/plcopenxml/interfaceasplaintex
 P_DIALECTS = frozenset({"iec", "openplc"})
 #: ST section keyword -> PLCopen variable list.
 VAR_LISTS = {"VAR_INPUT": "inputVars", "VAR_OUTPUT": "outputVars", "VAR": "localVars", "VAR_TEMP": "tempVars"}
+#: Array elements per line of an ``arrayValue`` (large rule tables stay readable and compact).
+VALUES_PER_LINE = 8
 _ELEMENTARY = frozenset({"REAL", "LREAL", "INT", "DINT", "BOOL", "BYTE"})
 
 
@@ -100,8 +102,9 @@ def _variable(x: _Xml, v: STVar) -> None:
             x.empty("simpleValue", value=v.init[0])
         else:
             x.open("arrayValue")
-            for literal in v.init:
-                x.lines.append("  " * x.depth + f'<value><simpleValue value="{xml_attr(literal)}"/></value>')
+            values = [f'<value><simpleValue value="{xml_attr(literal)}"/></value>' for literal in v.init]
+            for k in range(0, len(values), VALUES_PER_LINE):
+                x.lines.append("  " * x.depth + "".join(values[k : k + VALUES_PER_LINE]))
             x.close("arrayValue")
         x.close("initialValue")
     if v.comment:
