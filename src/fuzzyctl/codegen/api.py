@@ -77,7 +77,8 @@ def generate_plcopen(
 
     check_dialect(dialect)
     parts = _st_blocks(model, block, dialect, lreal, options)
-    return render_plcopen(parts, project=project or parts[0].name, version=__version__)
+    name = project or (parts[0].name if parts else "fuzzyctl")
+    return render_plcopen(parts, project=name, version=__version__)
 
 
 def generate_c(
