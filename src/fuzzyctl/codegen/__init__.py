@@ -18,7 +18,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from fuzzyctl.codegen.api import generate_c, generate_plcopen, generate_st, lower_block
+    from fuzzyctl.codegen.api import generate_c, generate_st, lower_block
+    from fuzzyctl.codegen.plcopen import generate_plcopen
     from fuzzyctl.engine.irgen import CodegenError
 
 __all__ = ["CodegenError", "generate_c", "generate_plcopen", "generate_st", "lower_block"]
@@ -29,7 +30,11 @@ def __getattr__(name: str) -> Any:
         from fuzzyctl.engine.irgen import CodegenError
 
         return CodegenError
-    if name in ("generate_c", "generate_plcopen", "generate_st", "lower_block"):
+    if name == "generate_plcopen":
+        from fuzzyctl.codegen import plcopen
+
+        return plcopen.generate_plcopen
+    if name in ("generate_c", "generate_st", "lower_block"):
         from fuzzyctl.codegen import api
 
         return getattr(api, name)

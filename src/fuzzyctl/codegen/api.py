@@ -7,7 +7,7 @@ from typing import Any, Literal
 from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.render_c import render_c
-from fuzzyctl.codegen.render_st import STParts, format_st, st_parts
+from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.model import Document, FunctionBlock
 
@@ -43,42 +43,13 @@ def generate_st(
     (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
     computes in LREAL instead of REAL.  Raises :class:`CodegenError` naming what cannot be
     expressed."""
-    parts = _st_blocks(model, block, dialect, lreal, options)
-    return "\n".join(format_st(p) for p in parts)
-
-
-def _st_blocks(
-    model: Document | FunctionBlock, block: str | None, dialect: str, lreal: bool, options: dict[str, Any]
-) -> list[STParts]:
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
     parts = []
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)
-        parts.append(st_parts(build_program(plan, "st"), dialect=dialect, lreal=lreal))
-    return parts
-
-
-def generate_plcopen(
-    model: Document | FunctionBlock,
-    *,
-    block: str | None = None,
-    dialect: str = "codesys",
-    lreal: bool = False,
-    project: str | None = None,
-    **options: Any,
-) -> str:
-    """PLCopen TC6 XML 2.01 (one project, one ``functionBlock`` POU per function block) whose
-    ST bodies and declarations are those :func:`generate_st` writes for the same ``dialect``
-    and ``lreal``; ``project`` names the project (default: the first block's name).  The
-    ``scl`` dialect is refused (TIA Portal imports SCL source, not PLCopen XML)."""
-    from fuzzyctl import __version__
-    from fuzzyctl.codegen.plcopen import check_dialect, render_plcopen
-
-    check_dialect(dialect)
-    parts = _st_blocks(model, block, dialect, lreal, options)
-    name = project or (parts[0].name if parts else "fuzzyctl")
-    return render_plcopen(parts, project=name, version=__version__)
+        parts.append(render_st(build_program(plan, "st"), dialect=dialect, lreal=lreal))
+    return "\n".join(parts)
 
 
 def generate_c(

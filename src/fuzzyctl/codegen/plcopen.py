@@ -25,10 +25,14 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from datetime import UTC, datetime
+from typing import Any
 
+from fuzzyctl.codegen.api import DIALECTS, _blocks, lower_block
 from fuzzyctl.codegen.context import CodegenError
-from fuzzyctl.codegen.render_st import STParts, STSection, STVar, format_st
+from fuzzyctl.codegen.program import build_program
+from fuzzyctl.codegen.render_st import STParts, STSection, STVar, format_st, st_parts
 from fuzzyctl.escape import st_comment, xml_attr, xml_text
+from fuzzyctl.model import Document, FunctionBlock
 
 NS_TC6 = "http://www.plcopen.org/xml/tc6_0201"
 NS_XHTML = "http://www.w3.org/1999/xhtml"
@@ -211,3 +215,39 @@ def render_plcopen(
     x.close("instances")
     x.close("project")
     return "\n".join(x.lines) + "\n"
+
+
+def st_blocks(
+    model: Document | FunctionBlock, block: str | None, dialect: str, lreal: bool, options: dict[str, Any]
+) -> list[STParts]:
+    """The blocks :func:`fuzzyctl.codegen.api.generate_st` prints, as parts (its
+    ``render_st`` is ``format_st(st_parts(...))``): keep the two pipelines in step -
+    tests/codegen/test_plcopen.py compares their texts."""
+    if dialect not in DIALECTS:
+        raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    parts = []
+    for name in _blocks(model, block):
+        plan = lower_block(model, name, **options)
+        parts.append(st_parts(build_program(plan, "st"), dialect=dialect, lreal=lreal))
+    return parts
+
+
+def generate_plcopen(
+    model: Document | FunctionBlock,
+    *,
+    block: str | None = None,
+    dialect: str = "codesys",
+    lreal: bool = False,
+    project: str | None = None,
+    **options: Any,
+) -> str:
+    """PLCopen TC6 XML 2.01 (one project, one ``functionBlock`` POU per function block) whose
+    ST bodies and declarations are those ``generate_st`` writes for the same ``dialect`` and
+    ``lreal``; ``project`` names the project (default: the first block's name).  The ``scl``
+    dialect is refused (TIA Portal imports SCL source, not PLCopen XML)."""
+    from fuzzyctl import __version__
+
+    check_dialect(dialect)
+    parts = st_blocks(model, block, dialect, lreal, options)
+    name = project or (parts[0].name if parts else "fuzzyctl")
+    return render_plcopen(parts, project=name, version=__version__)
