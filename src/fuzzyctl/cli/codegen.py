@@ -45,12 +45,11 @@ def codegen(
     dialect: Annotated[
         Dialect | None,
         typer.Option(
-            "--dialect",
-            help="st, plcopen: codesys (default), twincat or scl (TIA Portal, st only).",
+            "--dialect", help="st and plcopen: codesys (default), twincat or scl (TIA Portal, st only)."
         ),
     ] = None,
     lreal: Annotated[
-        bool, typer.Option("--lreal", help="st, plcopen: compute in LREAL instead of REAL.")
+        bool, typer.Option("--lreal", help="st and plcopen: compute in LREAL instead of REAL.")
     ] = False,
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
@@ -70,21 +69,21 @@ def codegen(
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
     import fuzzyctl
-    from fuzzyctl.codegen import generate_c, generate_plcopen, generate_st
+    from fuzzyctl.codegen import generate_c, generate_st
     from fuzzyctl.formats import write_atomic
 
     if lang is Lang.c and (dialect is not None or lreal):
         raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
-    if lang is not Lang.c and single:
+    if lang is Lang.st and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
-    if lang is Lang.plcopen and dialect is Dialect.scl:
-        raise typer.BadParameter(
-            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
-        )
+    if lang is Lang.plcopen:
+        _plcopen(source, output, dialect, lreal, single, block, strict)
+        return
     doc = fuzzyctl.load(source, strict=strict)
-    if lang is not Lang.c:
-        gen = generate_st if lang is Lang.st else generate_plcopen
-        text = gen(doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict)
+    if lang is Lang.st:
+        text = generate_st(
+            doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+        )
         if output is None:
             typer.echo(text, nl=False)
             return
@@ -99,3 +98,34 @@ def codegen(
     for name, text in files.items():
         write_atomic(out_dir / name, text)
     err_console.print(f"wrote {', '.join(str(out_dir / n) for n in files)}", markup=False)
+
+
+def _plcopen(
+    source: Path,
+    output: Path | None,
+    dialect: Dialect | None,
+    lreal: bool,
+    single: bool,
+    block: str | None,
+    strict: bool,
+) -> None:
+    """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
+    import fuzzyctl
+    from fuzzyctl.codegen import generate_plcopen
+    from fuzzyctl.formats import write_atomic
+
+    if single:
+        raise typer.BadParameter("--float applies to --lang c (use --lreal)", param_hint="--lang")
+    if dialect is Dialect.scl:
+        raise typer.BadParameter(
+            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
+        )
+    doc = fuzzyctl.load(source, strict=strict)
+    xml = generate_plcopen(
+        doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+    )
+    if output is None:
+        typer.echo(xml, nl=False)
+        return
+    write_atomic(output, xml)
+    err_console.print(f"wrote {output}", markup=False)
