@@ -11,8 +11,10 @@ from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.model import Document, FunctionBlock
 
-Dialect = Literal["codesys", "twincat", "scl"]
-DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl")
+Dialect = Literal["codesys", "twincat", "scl", "iec", "openplc"]
+DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl", "iec", "openplc")
+#: Other names of a dialect: OpenPLC (and Beremiz) compile strict IEC 61131-3 with matiec.
+DIALECT_ALIASES = {"openplc": "iec"}
 
 
 def lower_block(model: Document | FunctionBlock, block: str | None = None, **options: Any) -> Plan:
@@ -39,12 +41,14 @@ def generate_st(
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
 
-    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept) or ``scl``
-    (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
+    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept), ``iec`` (alias
+    ``openplc``: strict IEC 61131-3 as matiec, the compiler of OpenPLC and Beremiz, accepts it)
+    or ``scl`` (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
     computes in LREAL instead of REAL.  Raises :class:`CodegenError` naming what cannot be
     expressed."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    dialect = DIALECT_ALIASES.get(dialect, dialect)
     parts = []
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)

@@ -191,7 +191,12 @@ def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -
     block("VAR_OUTPUT", prog.of("output"))
     block("VAR", prog.of("param"), "tunable parameters: may be changed online")
     block("VAR", prog.of("state") + prog.of("const"), "internal state and tables: do not change")
-    block("VAR_TEMP", prog.of("temp"))
+    # matiec (OpenPLC, Beremiz) turns a VAR_TEMP array without initial value into C that does
+    # not compile, and IEC 61131-3 allows no initial value there: outside SCL the scratch
+    # arrays live in the instance (written before read on every call, like the temporaries).
+    scratch = [] if r.scl else [d for d in prog.of("temp") if d.size is not None]
+    block("VAR", scratch, "scratch arrays of one call (no initial value needed)")
+    block("VAR_TEMP", [d for d in prog.of("temp") if d not in scratch])
     if r.scl:
         out.append("BEGIN")
     r.stmts(prog.body, 1 if r.scl else 0)
