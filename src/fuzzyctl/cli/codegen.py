@@ -21,6 +21,8 @@ class Dialect(StrEnum):
     codesys = "codesys"
     twincat = "twincat"
     scl = "scl"
+    iec = "iec"
+    openplc = "openplc"
 
 
 @app.command()
@@ -40,7 +42,8 @@ def codegen(
     ] = None,
     dialect: Annotated[
         Dialect | None,
-        typer.Option("--dialect", help="st only: codesys (default), twincat or scl (TIA Portal)."),
+        typer.Option("--dialect", help="st only: codesys (default), twincat, scl (TIA Portal) or iec (strict IEC 61131-3 "
+            "as OpenPLC's compiler matiec accepts it; alias openplc)."),
     ] = None,
     lreal: Annotated[
         bool, typer.Option("--lreal", help="st only: compute in LREAL instead of REAL.")

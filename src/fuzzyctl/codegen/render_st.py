@@ -3,7 +3,9 @@ FUNCTION_BLOCK in the portable subset: REAL (or LREAL), arrays with literal boun
 over INT counters, IF instead of MIN/MAX/LIMIT, no ``**``, ``(* *)`` comments, upper-case
 keywords, identifiers of at most 24 characters checked against the reserved words of IEC,
 TwinCAT and SCL.  ``dialect="scl"`` adds Siemens TIA Portal conventions: ``#`` before block
-variables, ``REGION``, ``VERSION`` and ``BEGIN``.
+variables, ``REGION``, ``VERSION`` and ``BEGIN``.  ``dialect="iec"`` (OpenPLC, Beremiz: the
+matiec compiler) writes FOR loops as WHILE loops, since matiec runs ``FOR i := a TO a`` zero
+times.
 """
 
 from __future__ import annotations
@@ -55,6 +57,7 @@ class _ST:
     def __init__(self, prog: Program, dialect: str, lreal: bool) -> None:
         self.prog = prog
         self.scl = dialect == "scl"
+        self.iec = dialect == "iec"
         self.real = "LREAL" if lreal else "REAL"
         self.lines: list[str] = []
 
@@ -116,6 +119,14 @@ class _ST:
                     self.emit("ELSE", ind)
                     self.stmts(s.orelse, ind + 1)
                 self.emit("END_IF;", ind)
+            elif isinstance(s, For) and self.iec:
+                # matiec (OpenPLC) runs FOR i := a TO a zero times: the same loop as WHILE
+                var, step = self.name(s.var), "+" if s.step == 1 else "-"
+                self.emit(f"{var} := {self.ex(s.start)};", ind)
+                self.emit(f"WHILE {var} {'<=' if s.step == 1 else '>='} {self.ex(s.stop, 3)} DO", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit(f"{var} := {var} {step} 1;", ind + 1)
+                self.emit("END_WHILE;", ind)
             elif isinstance(s, For):
                 by = "" if s.step == 1 else " BY -1"
                 self.emit(f"FOR {self.name(s.var)} := {self.ex(s.start)} TO {self.ex(s.stop)}{by} DO", ind)
