@@ -37,6 +37,7 @@ def generate_st(
     block: str | None = None,
     dialect: str = "codesys",
     lreal: bool = False,
+    testbench: int = 0,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
@@ -44,8 +45,9 @@ def generate_st(
     ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept), ``iec`` (alias
     ``openplc``: strict IEC 61131-3 as matiec, the compiler of OpenPLC and Beremiz, accepts it)
     or ``scl`` (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
-    computes in LREAL instead of REAL.  Raises :class:`CodegenError` naming what cannot be
-    expressed."""
+    computes in LREAL instead of REAL; ``testbench`` > 0 adds after each block a PROGRAM that
+    checks it on that many input vectors against the engine (:mod:`fuzzyctl.codegen.testbench`).
+    Raises :class:`CodegenError` naming what cannot be expressed."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
     dialect = DIALECT_ALIASES.get(dialect, dialect)
@@ -53,6 +55,11 @@ def generate_st(
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)
         parts.append(render_st(build_program(plan, "st"), dialect=dialect, lreal=lreal))
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_st_bench
+
+            bench = choose(plan, testbench, single=not lreal)
+            parts.append(render_st_bench(bench, dialect=dialect, lreal=lreal))
     return "\n".join(parts)
 
 
@@ -61,10 +68,12 @@ def generate_c(
     *,
     block: str | None = None,
     single: bool = False,
+    testbench: int = 0,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
-    ``block``); ``single`` computes in float instead of double."""
+    ``block``); ``single`` computes in float instead of double; ``testbench`` > 0 adds
+    ``NAME_testbench.c`` checking the block on that many input vectors against the engine."""
     files: dict[str, str] = {}
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)
@@ -72,4 +81,9 @@ def generate_c(
         header, source = render_c(prog, single=single)
         files[f"{prog.name}.h"] = header
         files[f"{prog.name}.c"] = source
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_c_bench
+
+            bench = choose(plan, testbench, single=single)
+            files[f"{prog.name}_testbench.c"] = render_c_bench(bench, single=single)
     return files
