@@ -12,6 +12,7 @@ measurements" section of the run."""
 from __future__ import annotations
 
 import dataclasses
+import re
 import time
 from pathlib import Path
 
@@ -132,3 +133,82 @@ def test_matiec_compiles_and_runs_what_we_generate(
     )
     record_property("report", summary)
     print("\n" + summary)
+
+
+# --------------------------------------------------------------------------- the test bench
+
+
+def _bench_text(plan: Plan, n: int, lreal: bool = False) -> str:
+    from fuzzyctl.codegen.testbench import choose, render_st_bench
+
+    block = render_st(build_program(plan, "st"), dialect="iec", lreal=lreal)
+    return block + "\n" + render_st_bench(choose(plan, n, single=not lreal), dialect="iec", lreal=lreal)
+
+
+def _tamper_expected(text: str, vector: int) -> str:
+    """Add 1 to the expected value of output 0 at ``vector`` (1-based)."""
+    m = re.search(r"(TB_Y0 : ARRAY\[0\.\.\d+\] OF L?REAL := \[)([^\]]*)\]", text)
+    assert m
+    values = m.group(2).split(", ")
+    values[vector - 1] = repr(float(values[vector - 1].strip("()")) + 1.0)
+    return text[: m.start(2)] + ", ".join(values) + text[m.end(2) :]
+
+
+def _program_driver(names: list[str]) -> str:
+    parts = ['#include <stdio.h>', '#include <stdlib.h>', '#include "POUS.h"', '#include "POUS.c"']
+    parts += ["IEC_TIME __CURRENT_TIME;", "IEC_BOOL __DEBUG;"]
+    for k, name in enumerate(names):
+        n = name.upper()
+        parts.append(
+            f"static int run{k}(void) {{\n  static {n} p;\n  long cycles = 0;\n  {n}_init__(&p, 0);\n"
+            f"  while (!__GET_VAR(p.DONE) && cycles < 100000) {{ {n}_body__(&p); cycles++; }}\n"
+            '  printf("%d %d %d %ld\\n", (int)__GET_VAR(p.PASS), (int)__GET_VAR(p.FAIL_COUNT),'
+            " (int)__GET_VAR(p.FIRST_FAIL), cycles);\n  return 0;\n}"
+        )
+    cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
+    parts.append(f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}")
+    return "\n".join(parts) + "\n"
+
+
+def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
+    matiec: Path, tmp_path: Path, record_property: pytest.RecordProperty
+) -> None:
+    """The generated PROGRAM through iec2c + gcc, one vector per cycle: PASS on the examples
+    (heater_extension has NC and DEFAULT outputs) and a random system, in REAL and LREAL;
+    FAIL with FIRST_FAIL on the vector whose expected literal was changed, and FAIL when a
+    parameter of the block itself is wrong."""
+    import subprocess
+
+    n = 40
+    cases: list[tuple[str, Plan, bool]] = []
+    for name in ("figure7.fcl", "heater_extension.fcl", "tank.fcl"):
+        cases.append((f"examples/{name}", S.plan_of(S.EXAMPLES / name), False))
+    cases.append(("examples/heater_extension.fcl LREAL", S.plan_of(S.EXAMPLES / "heater_extension.fcl"), True))
+    rnd = random_systems(2)[1]
+    cases.append(("random/1", fuzzyctl.compile(rnd, backend="interpreted").plan, False))
+    texts, names = [], []
+    for k, (_label, plan, lreal) in enumerate(cases):
+        texts.append(_bench_text(dataclasses.replace(plan, name=f"B{k}"), n, lreal))
+        names.append(f"TB_B{k}")
+    fig7 = S.plan_of(S.EXAMPLES / "figure7.fcl")
+    k = len(cases)
+    texts.append(_tamper_expected(_bench_text(dataclasses.replace(fig7, name=f"B{k}"), n), 3))
+    names.append(f"TB_B{k}")
+    wrong = _bench_text(dataclasses.replace(fig7, name=f"B{k + 1}"), n)
+    assert "FZ_valve_S : ARRAY[0..2] OF REAL := [-100.0, 0.0, 100.0];" in wrong
+    texts.append(wrong.replace("[-100.0, 0.0, 100.0]", "[-100.0, 0.0, 99.0]"))  # inlet at 99
+    names.append(f"TB_B{k + 1}")
+    M.iec2c(matiec, "\n".join(texts), tmp_path)
+    exe = M.compile_c(matiec, tmp_path, _program_driver(names), "benches")
+    results = []
+    for j in range(len(names)):
+        res = subprocess.run([str(exe), str(j)], capture_output=True, text=True, timeout=60)
+        assert res.returncode == 0, res.stderr
+        results.append(tuple(int(v) for v in res.stdout.split()))
+    for (label, _p, _l), (passed, fails, first, cycles) in zip(cases, results, strict=False):
+        assert (passed, fails, first, cycles) == (1, 0, 0, n), label
+        record_property("report", f"matiec test bench {label}: PASS ({n} vectors, {cycles} cycles)")
+    assert results[k][:3] == (0, 1, 3)  # the changed literal: FAIL at vector 3 only
+    passed, fails, first, _c = results[k + 1]
+    assert passed == 0 and fails >= 1 and first >= 1  # the wrong block fails
+    record_property("report", f"matiec test bench: a wrong block FAILS ({fails} of {n} vectors, first {first})")
