@@ -101,7 +101,7 @@ def driver(blocks: Sequence[Block], real: str) -> str:
         name = b.name.upper()
         n_in = max(1, len(b.inputs))
         sets = "".join(f"    __SET_VAR(fb.,{v.upper()},,({real})x[{i}]);\n" for i, v in enumerate(b.inputs))
-        reads = "".join(f"    if (scanf(\"%la\", &x[{i}]) != 1) return 3;\n" for i in range(len(b.inputs)))
+        reads = "".join(f'    if (scanf("%la", &x[{i}]) != 1) return 3;\n' for i in range(len(b.inputs)))
         prints = "".join(f'    printf("%a ", (double)__GET_VAR(fb.{v.upper()}));\n' for v in b.outputs)
         parts.append(
             f"static int run{k}(void) {{\n"
@@ -113,17 +113,24 @@ def driver(blocks: Sequence[Block], real: str) -> str:
             '    printf("%d\\n", (int)__GET_VAR(fb.INFO));\n  }\n  return 0;\n}'
         )
     cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(blocks)))
-    parts.append(f"int main(int argc, char **argv) {{\n  switch (argc > 1 ? atoi(argv[1]) : -1) {{\n{cases}  }}\n  return 2;\n}}")
+    parts.append(
+        "int main(int argc, char **argv) {\n  switch (argc > 1 ? atoi(argv[1]) : -1) {\n"
+        f"{cases}  }}\n  return 2;\n}}"
+    )
     return "\n".join(parts) + "\n"
 
 
 def run_block(exe: Path, k: int, data: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Block ``k`` of the driver on the rows of ``data``: (outputs, INFO)."""
     lines = [str(len(data))] + [" ".join(float(v).hex() for v in row) for row in data]
-    res = subprocess.run([str(exe), str(k)], input="\n".join(lines) + "\n", capture_output=True, text=True, timeout=120)
+    res = subprocess.run(
+        [str(exe), str(k)], input="\n".join(lines) + "\n", capture_output=True, text=True, timeout=120
+    )
     assert res.returncode == 0, (res.returncode, res.stderr[-2000:])
     rows = [line.split() for line in res.stdout.splitlines()]
     assert len(rows) == len(data)
-    outs = np.array([[float.fromhex(v) for v in r[:-1]] for r in rows], dtype=np.float64).reshape(len(data), -1)
+    outs = np.array([[float.fromhex(v) for v in r[:-1]] for r in rows], dtype=np.float64).reshape(
+        len(data), -1
+    )
     info = np.array([int(r[-1]) for r in rows], dtype=np.int64)
     return outs, info

@@ -68,7 +68,9 @@ def expected_info(plan: Plan, data: np.ndarray) -> np.ndarray:
     info = []
     for row in data.tolist():
         rec = interp.run(row, state)
-        quiet = any(not o.fired for o, op in zip(rec.outputs, plan.outputs, strict=True) if op.kind != "degree")
+        quiet = any(
+            not o.fired for o, op in zip(rec.outputs, plan.outputs, strict=True) if op.kind != "degree"
+        )
         info.append(2 if quiet else 0)
     return np.array(info)
 
@@ -87,7 +89,11 @@ def compile_all(matiec: Path, where: Path, systems: list[tuple[str, Plan]], real
         render_st(build_program(plan, "st"), dialect="iec", lreal=real == "LREAL") for _l, plan in systems
     )
     blocks = [
-        M.Block(plan.name or "", tuple(i.name for i in plan.inputs), tuple(o.name for o in plan.outputs if o.is_output))
+        M.Block(
+            plan.name or "",
+            tuple(i.name for i in plan.inputs),
+            tuple(o.name for o in plan.outputs if o.is_output),
+        )
         for _l, plan in systems
     ]
     M.iec2c(matiec, text, where)
@@ -101,7 +107,9 @@ def matiec() -> Path:
 
 
 @pytest.fixture(scope="module", params=list(TOL))
-def compiled(request: pytest.FixtureRequest, matiec: Path, tmp_path_factory: pytest.TempPathFactory) -> Compiled:
+def compiled(
+    request: pytest.FixtureRequest, matiec: Path, tmp_path_factory: pytest.TempPathFactory
+) -> Compiled:
     """Every system in one precision, through one iec2c and one gcc run (a worker builds
     only the precision its tests need)."""
     real = str(request.param)
@@ -155,7 +163,7 @@ def _tamper_expected(text: str, vector: int) -> str:
 
 
 def _program_driver(names: list[str]) -> str:
-    parts = ['#include <stdio.h>', '#include <stdlib.h>', '#include "POUS.h"', '#include "POUS.c"']
+    parts = ["#include <stdio.h>", "#include <stdlib.h>", '#include "POUS.h"', '#include "POUS.c"']
     parts += ["IEC_TIME __CURRENT_TIME;", "IEC_BOOL __DEBUG;"]
     for k, name in enumerate(names):
         n = name.upper()
@@ -166,7 +174,9 @@ def _program_driver(names: list[str]) -> str:
             " (int)__GET_VAR(p.FIRST_FAIL), cycles);\n  return 0;\n}"
         )
     cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
-    parts.append(f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}")
+    parts.append(
+        f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}"
+    )
     return "\n".join(parts) + "\n"
 
 
@@ -183,7 +193,9 @@ def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     cases: list[tuple[str, Plan, bool]] = []
     for name in ("figure7.fcl", "heater_extension.fcl", "tank.fcl"):
         cases.append((f"examples/{name}", S.plan_of(S.EXAMPLES / name), False))
-    cases.append(("examples/heater_extension.fcl LREAL", S.plan_of(S.EXAMPLES / "heater_extension.fcl"), True))
+    cases.append(
+        ("examples/heater_extension.fcl LREAL", S.plan_of(S.EXAMPLES / "heater_extension.fcl"), True)
+    )
     rnd = random_systems(2)[1]
     cases.append(("random/1", fuzzyctl.compile(rnd, backend="interpreted").plan, False))
     texts, names = [], []
@@ -211,4 +223,6 @@ def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     assert results[k][:3] == (0, 1, 3)  # the changed literal: FAIL at vector 3 only
     passed, fails, first, _c = results[k + 1]
     assert passed == 0 and fails >= 1 and first >= 1  # the wrong block fails
-    record_property("report", f"matiec test bench: a wrong block FAILS ({fails} of {n} vectors, first {first})")
+    record_property(
+        "report", f"matiec test bench: a wrong block FAILS ({fails} of {n} vectors, first {first})"
+    )

@@ -42,8 +42,11 @@ def codegen(
     ] = None,
     dialect: Annotated[
         Dialect | None,
-        typer.Option("--dialect", help="st only: codesys (default), twincat, scl (TIA Portal) or iec (strict IEC 61131-3 "
-            "as OpenPLC's compiler matiec accepts it; alias openplc)."),
+        typer.Option(
+            "--dialect",
+            help="st only: codesys (default), twincat, scl (TIA Portal) or iec (strict IEC 61131-3 "
+            "as OpenPLC's compiler matiec accepts it; alias openplc).",
+        ),
     ] = None,
     lreal: Annotated[
         bool, typer.Option("--lreal", help="st only: compute in LREAL instead of REAL.")
@@ -85,7 +88,9 @@ def codegen(
     doc = fuzzyctl.load(source, strict=strict)
     if lang is Lang.st:
         text = generate_st(
-            doc, block=block, dialect=(dialect or Dialect.codesys).value,
+            doc,
+            block=block,
+            dialect=(dialect or Dialect.codesys).value,
             lreal=lreal,
             strict=strict,
             testbench=testbench,

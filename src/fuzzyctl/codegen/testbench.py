@@ -89,7 +89,11 @@ class _Engine:
     def once(self, row: list[float]) -> tuple[list[float], list[bool], list[float]]:
         """(declared outputs, fired per output, rule degrees) from a fresh instance."""
         rec = self.interp.run(row, [None] * len(self.plan.outputs))
-        return [rec.outputs[k].value for k in self.outs], [o.fired for o in rec.outputs], list(rec.rule_degrees)
+        return (
+            [rec.outputs[k].value for k in self.outs],
+            [o.fired for o in rec.outputs],
+            list(rec.rule_degrees),
+        )
 
 
 def _scale(plan: Plan, k: int, values: list[float]) -> float:
@@ -110,7 +114,10 @@ def choose(plan: Plan, n: int, *, single: bool, seed: int = 0) -> Bench:
     mid = [(lo + hi) / 2 for lo, hi in bounds]
     cands = [eng.cast([rng.uniform(lo, hi) for lo, hi in bounds]) for _ in range(_SEARCH)]
     # beyond the terms (not for degrees): where no rule may fire
-    wide = [(lo, hi) if plan.inputs[i].degree else (lo - 0.3 * (hi - lo), hi + 0.3 * (hi - lo)) for i, (lo, hi) in enumerate(bounds)]
+    wide = [
+        (lo, hi) if plan.inputs[i].degree else (lo - 0.3 * (hi - lo), hi + 0.3 * (hi - lo))
+        for i, (lo, hi) in enumerate(bounds)
+    ]
     cands += [eng.cast([rng.uniform(lo, hi) for lo, hi in wide]) for _ in range(_SEARCH // 4)]
     evals = [eng.once(c) for c in cands]
     rel = TOLERANCE["REAL" if single else "LREAL"]
@@ -148,7 +155,10 @@ def choose(plan: Plan, n: int, *, single: bool, seed: int = 0) -> Bench:
             row = eng.cast([*mid[:i], end, *mid[i + 1 :]])
             if stable(row):
                 picked.append((row, f"{plan.inputs[i].name} at the {label} end"))
-    for label, ends in (("all inputs low", [b[0] for b in bounds]), ("all inputs high", [b[1] for b in bounds])):
+    for label, ends in (
+        ("all inputs low", [b[0] for b in bounds]),
+        ("all inputs high", [b[1] for b in bounds]),
+    ):
         row = eng.cast(ends)
         if plan.inputs and stable(row):
             picked.append((row, label))
@@ -185,7 +195,9 @@ def _replay(plan: Plan, rows: list[list[float]]) -> tuple[list[list[float]], lis
     for row in rows:
         rec = interp.run(row, state)
         expected.append([rec.outputs[k].value for k in outs])
-        quiet = any(not o.fired for o, op in zip(rec.outputs, plan.outputs, strict=True) if op.kind != "degree")
+        quiet = any(
+            not o.fired for o, op in zip(rec.outputs, plan.outputs, strict=True) if op.kind != "degree"
+        )
         info.append(2 if quiet else 0)
     return expected, info
 
@@ -198,8 +210,8 @@ def _header(bench: Bench, real: str) -> list[str]:
         "fuzzyctl's engine computed at generation time",
         f"tolerance: |output - expected| <= {bench.relative:g} x the output's range (arithmetic in {real}); "
         "INFO must be equal",
-        f"covers {bench.covered_rules} of {len(plan.rules)} rules where each fires strongest, the range ends, "
-        "and no rule fired (DEFAULT / NC) where the block has such inputs",
+        f"covers {bench.covered_rules} of {len(plan.rules)} rules where each fires strongest, "
+        "the range ends, and no rule fired (DEFAULT / NC) where the block has such inputs",
         "PASS is TRUE once every vector matched; FAIL_COUNT counts the vectors that did not; "
         "FIRST_FAIL is the number (1-based) of the first of them, 0 if none",
     ]
@@ -285,7 +297,9 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
     for c, _op in enumerate(outs):
         vals = ", ".join(_c_num(e[c], single) for e in bench.expected)
         lines.append(f"static const double {name}_TB_Y{c}[{n}] = {{{vals}}};")
-    lines.append(f"static const unsigned char {name}_TB_INFO[{n}] = {{{', '.join(str(v) for v in bench.info)}}};")
+    lines.append(
+        f"static const unsigned char {name}_TB_INFO[{n}] = {{{', '.join(str(v) for v in bench.info)}}};"
+    )
     lines += [
         "",
         f"int {name}_testbench(int *first_fail)",
