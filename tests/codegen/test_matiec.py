@@ -226,3 +226,31 @@ def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     record_property(
         "report", f"matiec test bench: a wrong block FAILS ({fails} of {n} vectors, first {first})"
     )
+
+
+# --------------------------------------------------------------------------- names
+
+
+def test_iec_dialect_refuses_every_name_of_matiecs_library(matiec: Path, tmp_path: Path) -> None:
+    """matiec refuses a variable named like a function or function block of its library
+    (e.g. ``integral``): the iec dialect refuses all of them, read from matiec's own files,
+    and nothing else the examples use."""
+    from fuzzyctl.codegen import CodegenError, generate_st
+    from fuzzyctl.escape import st_ident_iec
+
+    pous = set()
+    for lib in sorted((matiec / "lib").glob("*.txt")):
+        pous |= set(re.findall(r"^\s*(?:FUNCTION_BLOCK|FUNCTION)\s+(\w+)", lib.read_text(), flags=re.M))
+    assert len(pous) > 900 and {"PID", "INTEGRAL", "INT_TO_REAL", "ADD_REAL"} <= pous
+    for name in sorted(pous):
+        with pytest.raises(CodegenError, match="OpenPLC's compiler"):
+            st_ident_iec(name, "variable")
+    src = (S.EXAMPLES / "figure7.fcl").read_text()
+    with pytest.raises(CodegenError, match="variable 'integral' is the name of a standard function"):
+        generate_st(fuzzyctl.load(src.replace("pressure", "integral")), dialect="openplc")
+    # and matiec does refuse the name (the codesys text, which does not check it)
+    text = generate_st(fuzzyctl.load(src.replace("pressure", "integral")), dialect="codesys")
+    with pytest.raises(AssertionError, match="iec2c failed"):
+        M.iec2c(matiec, text, tmp_path)
+    for path in S.example_files():  # the examples' names all pass
+        generate_st(S.load(path), dialect="iec")

@@ -35,7 +35,7 @@ from fuzzyctl.codegen.ir import (
     Var,
     While,
 )
-from fuzzyctl.escape import st_comment, st_ident
+from fuzzyctl.escape import st_comment, st_ident, st_ident_iec
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 #: IEC 61131-3 standard functions (Table 22/23) the program may call.
@@ -170,9 +170,10 @@ def _init(d: Decl) -> str:
 
 def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
     """One FUNCTION_BLOCK."""
-    st_ident(prog.name, "function block name")
+    check = st_ident_iec if dialect == "iec" else st_ident
+    check(prog.name, "function block name")
     for d in prog.decls:
-        st_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
+        check(d.name, "variable" if d.storage in ("input", "output") else "identifier")
     r = _ST(prog, dialect, lreal)
     out: list[str] = []
     for line in prog.header:
