@@ -243,7 +243,7 @@ def test_iec_dialect_refuses_every_name_of_matiecs_library(matiec: Path, tmp_pat
         pous |= set(re.findall(r"^\s*(?:FUNCTION_BLOCK|FUNCTION)\s+(\w+)", lib.read_text(), flags=re.M))
     assert len(pous) > 900 and {"PID", "INTEGRAL", "INT_TO_REAL", "ADD_REAL"} <= pous
     for name in sorted(pous):
-        with pytest.raises(CodegenError, match="OpenPLC's compiler|reserved word|longer than 24"):
+        with pytest.raises(CodegenError, match=r"OpenPLC's compiler|reserved word|longer than 24"):
             st_ident_iec(name, "variable")
     src = (S.EXAMPLES / "figure7.fcl").read_text()
     with pytest.raises(CodegenError, match="variable 'integral' is the name of a standard function"):
