@@ -228,7 +228,7 @@ def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = Fal
         raise CodegenError("the test bench is written for --dialect codesys, twincat or iec (not scl)")
     plan, real = bench.plan, "LREAL" if lreal else "REAL"
     fb = st_ident(plan.name or "FUZZY", "function block name")
-    prog = st_ident(f"TB_{fb}"[:24], "test bench name")
+    prog = st_ident(f"TB_{fb}"[:24].rstrip("_"), "test bench name")
     n = len(bench.rows)
     outs = [plan.outputs[k] for k in _outputs(plan)]
     out: list[str] = [f"(* {st_comment(line)} *)" for line in _header(bench, real)]
@@ -270,7 +270,7 @@ def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = Fal
     return "\n".join(out) + "\n"
 
 
-def _c_num(v: float, single: bool) -> str:
+def _c_num(v: float) -> str:
     if not math.isfinite(v):
         raise CodegenError(f"the value {v} cannot be written in the C test bench")
     s = repr(float(v))
@@ -292,10 +292,10 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
     lines += ["#include <stdio.h>", f'#include "{name}.h"', ""]
     for i, inp in enumerate(plan.inputs):
         c_ident(inp.name, "variable")
-        vals = ", ".join(_c_num(row[i], single) for row in bench.rows)
+        vals = ", ".join(_c_num(row[i]) for row in bench.rows)
         lines.append(f"static const double {name}_TB_X{i}[{n}] = {{{vals}}};")
     for c, _op in enumerate(outs):
-        vals = ", ".join(_c_num(e[c], single) for e in bench.expected)
+        vals = ", ".join(_c_num(e[c]) for e in bench.expected)
         lines.append(f"static const double {name}_TB_Y{c}[{n}] = {{{vals}}};")
     lines.append(
         f"static const unsigned char {name}_TB_INFO[{n}] = {{{', '.join(str(v) for v in bench.info)}}};"
@@ -316,7 +316,7 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
     lines.append(f"        bad = {name}_step(&fb) != {name}_TB_INFO[k];")
     for c, op in enumerate(outs):
         lines.append(f"        d = (double)fb.{op.name} - {name}_TB_Y{c}[k];")
-        lines.append(f"        if (!((d < 0 ? -d : d) <= {_c_num(bench.tolerance[c], single)})) bad = 1;")
+        lines.append(f"        if (!((d < 0 ? -d : d) <= {_c_num(bench.tolerance[c])})) bad = 1;")
     lines += [
         "        if (bad) {",
         "            fails++;",
