@@ -37,7 +37,28 @@ TOL = {"REAL": 1e-4, "LREAL": 1e-9}
 
 
 def random_systems(n: int = N_RANDOM) -> list[fuzzyctl.model.FunctionBlock]:
-    """``n`` random systems from the engine's strategy, the same ones on every run."""
+    """``n`` random systems from the engine's strategy, the same ones on every run: drawn in
+    a fresh interpreter, since what hypothesis draws depends on what the process ran before."""
+    import base64
+    import pickle
+    import subprocess
+    import sys
+
+    from tests.conftest import ROOT
+
+    code = (
+        "import base64, pickle; from tests.codegen.test_matiec import _draw; "
+        f"print(base64.b64encode(pickle.dumps(_draw({n}))).decode())"
+    )
+    res = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+    drawn: list[fuzzyctl.model.FunctionBlock] = pickle.loads(
+        base64.b64decode(res.stdout.strip().splitlines()[-1])
+    )
+    return drawn
+
+
+def _draw(n: int) -> list[fuzzyctl.model.FunctionBlock]:
     drawn: list[fuzzyctl.model.FunctionBlock] = []
 
     @settings(
