@@ -1,5 +1,5 @@
-"""``fuzzyctl codegen FILE --lang st|c``: IEC 61131-3 Structured Text or C99 from a fuzzy
-system (see docs/codegen.md)."""
+"""``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
+function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from fuzzyctl.cli.app import app, err_console
 
 class Lang(StrEnum):
     st = "st"
+    plcopen = "plcopen"
     c = "c"
 
 
@@ -21,6 +22,8 @@ class Dialect(StrEnum):
     codesys = "codesys"
     twincat = "twincat"
     scl = "scl"
+    iec = "iec"
+    openplc = "openplc"
 
 
 @app.command()
@@ -29,25 +32,41 @@ def codegen(
         Path,
         typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", exists=True, dir_okay=False),
     ],
-    lang: Annotated[Lang, typer.Option("--lang", help="st: Structured Text; c: C99.")] = Lang.st,
+    lang: Annotated[
+        Lang,
+        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
+    ] = Lang.st,
     output: Annotated[
         Path | None,
         typer.Option(
             "-o",
             "--output",
-            help="st: the .st file (default: print); c: the directory for NAME.h and NAME.c (default: .).",
+            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .).",
         ),
     ] = None,
     dialect: Annotated[
         Dialect | None,
-        typer.Option("--dialect", help="st only: codesys (default), twincat or scl (TIA Portal)."),
+        typer.Option(
+            "--dialect",
+            help="st and plcopen: codesys (default), twincat, scl (TIA Portal, st only) or iec "
+            "(strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc).",
+        ),
     ] = None,
     lreal: Annotated[
-        bool, typer.Option("--lreal", help="st only: compute in LREAL instead of REAL.")
+        bool, typer.Option("--lreal", help="st and plcopen: compute in LREAL instead of REAL.")
     ] = False,
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
     ] = False,
+    testbench: Annotated[
+        int,
+        typer.Option(
+            "--testbench",
+            min=0,
+            help="Also write a test bench: N input vectors (every rule, the range ends, no rule fired, "
+            "random) with the engine's outputs; st: a PROGRAM after the block, c: NAME_testbench.c.",
+        ),
+    ] = 0,
     block: Annotated[
         str | None, typer.Option("--block", help="Only this function block (default: every block).")
     ] = None,
@@ -83,7 +102,7 @@ def codegen(
     from fuzzyctl.formats import write_atomic
 
     if lang is Lang.c and (dialect is not None or lreal):
-        raise typer.BadParameter("--dialect and --lreal apply to --lang st", param_hint="--lang")
+        raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
     if lang is Lang.st and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
     from fuzzyctl.codegen.api import Generated
@@ -94,6 +113,9 @@ def codegen(
         parse_default(default)
     except CodegenError as exc:
         raise typer.BadParameter(str(exc), param_hint="--default") from None
+    if lang is Lang.plcopen:
+        _plcopen(source, output, dialect, lreal, single, block, strict, default)
+        return
     doc = fuzzyctl.load(source, strict=strict)
     report: list[Generated] = []
     if lang is Lang.st:
@@ -105,6 +127,7 @@ def codegen(
             strict=strict,
             default=default,
             report=report,
+            testbench=testbench,
         )
         if output is None:
             if as_json:
@@ -115,7 +138,9 @@ def codegen(
         write_atomic(output, text)
         _done(as_json, lang, report, [output])
         return
-    files = generate_c(doc, block=block, single=single, strict=strict, default=default, report=report)
+    files = generate_c(
+        doc, block=block, single=single, strict=strict, testbench=testbench, default=default, report=report
+    )
     out_dir = output or Path(".")
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")
@@ -146,3 +171,40 @@ def _json_report(
     if written is not None:
         out["written"] = [str(p) for p in written]
     typer.echo(json.dumps(out, indent=2))
+
+
+def _plcopen(
+    source: Path,
+    output: Path | None,
+    dialect: Dialect | None,
+    lreal: bool,
+    single: bool,
+    block: str | None,
+    strict: bool,
+    default: str | None = None,
+) -> None:
+    """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
+    import fuzzyctl
+    from fuzzyctl.codegen import generate_plcopen
+    from fuzzyctl.formats import write_atomic
+
+    if single:
+        raise typer.BadParameter("--float applies to --lang c (use --lreal)", param_hint="--lang")
+    if dialect is Dialect.scl:
+        raise typer.BadParameter(
+            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
+        )
+    doc = fuzzyctl.load(source, strict=strict)
+    xml = generate_plcopen(
+        doc,
+        block=block,
+        dialect=(dialect or Dialect.codesys).value,
+        lreal=lreal,
+        strict=strict,
+        default=default,
+    )
+    if output is None:
+        typer.echo(xml, nl=False)
+        return
+    write_atomic(output, xml)
+    err_console.print(f"wrote {output}", markup=False)

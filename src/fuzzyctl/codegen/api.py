@@ -15,8 +15,10 @@ from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.model import Document, FunctionBlock
 
-Dialect = Literal["codesys", "twincat", "scl"]
-DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl")
+Dialect = Literal["codesys", "twincat", "scl", "iec", "openplc"]
+DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl", "iec", "openplc")
+#: Other names of a dialect: OpenPLC (and Beremiz) compile strict IEC 61131-3 with matiec.
+DIALECT_ALIASES = {"openplc": "iec"}
 
 
 def lower_block(model: Document | FunctionBlock, block: str | None = None, **options: Any) -> Plan:
@@ -39,6 +41,7 @@ class Generated:
     it (the rename table, the ``--default`` choice, the quadrature notes of the header)."""
 
     program: Program
+    plan: Plan  # the plan the program computes (``--default`` applied, names renamed)
     renames: list[Rename] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
 
@@ -62,7 +65,7 @@ def build(plan: Plan, target: Target, default: float | str | None = None) -> Gen
         extra += [f"  {r.comment()}" for r in renames]
     prog.header[1:1] = extra
     quad = [line for line in prog.header if "Gauss-Legendre" in line]
-    return Generated(prog, renames, notes + quad)
+    return Generated(prog, plan, renames, notes + quad)
 
 
 def plans(model: Document | FunctionBlock | Plan, block: str | None = None, **options: Any) -> list[Plan]:
@@ -78,26 +81,35 @@ def generate_st(
     block: str | None = None,
     dialect: str = "codesys",
     lreal: bool = False,
+    testbench: int = 0,
     default: float | str | None = None,
     report: list[Generated] | None = None,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
 
-    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept) or ``scl``
-    (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
-    computes in LREAL instead of REAL; ``default`` (a number or ``"hold"``) replaces
-    ``DEFAULT := nan``.  Names the target cannot use are renamed (header comment; ``report``
-    receives one :class:`Generated` per block).  Raises :class:`CodegenError` naming what
-    cannot be expressed."""
+    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept), ``iec`` (alias
+    ``openplc``: strict IEC 61131-3 as matiec, the compiler of OpenPLC and Beremiz, accepts it)
+    or ``scl`` (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
+    computes in LREAL instead of REAL; ``testbench`` > 0 adds after each block a PROGRAM that
+    checks it on that many input vectors against the engine (:mod:`fuzzyctl.codegen.testbench`);
+    ``default`` (a number or ``"hold"``) replaces ``DEFAULT := nan``.  Names the target cannot
+    use are renamed (header comment; ``report`` receives one :class:`Generated` per block).
+    Raises :class:`CodegenError` naming what cannot be expressed."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    dialect = DIALECT_ALIASES.get(dialect, dialect)
     parts = []
     for plan in plans(model, block, **options):
         gen = build(plan, "st", default)
         if report is not None:
             report.append(gen)
         parts.append(render_st(gen.program, dialect=dialect, lreal=lreal))
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_st_bench
+
+            bench = choose(gen.plan, testbench, single=not lreal)
+            parts.append(render_st_bench(bench, dialect=dialect, lreal=lreal))
     return "\n".join(parts)
 
 
@@ -106,19 +118,27 @@ def generate_c(
     *,
     block: str | None = None,
     single: bool = False,
+    testbench: int = 0,
     default: float | str | None = None,
     report: list[Generated] | None = None,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
-    ``block``); ``single`` computes in float instead of double; ``default`` replaces
-    ``DEFAULT := nan`` (without it the C outputs NaN as the engine does)."""
+    ``block``); ``single`` computes in float instead of double; ``testbench`` > 0 adds
+    ``NAME_testbench.c`` checking the block on that many input vectors against the engine;
+    ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does)."""
     files: dict[str, str] = {}
     for plan in plans(model, block, **options):
         gen = build(plan, "c", default)
         if report is not None:
             report.append(gen)
-        header, source = render_c(gen.program, single=single)
-        files[f"{gen.program.name}.h"] = header
-        files[f"{gen.program.name}.c"] = source
+        prog = gen.program
+        header, source = render_c(prog, single=single)
+        files[f"{prog.name}.h"] = header
+        files[f"{prog.name}.c"] = source
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_c_bench
+
+            bench = choose(gen.plan, testbench, single=single)
+            files[f"{prog.name}_testbench.c"] = render_c_bench(bench, single=single)
     return files

@@ -311,18 +311,25 @@ def rename(
     rules passes its own checks."""
 
     def fixer(valid: Callable[[str], bool] | None) -> Callable[[str, set[str]], str]:
+        check = valid or is_identifier
+        # the next number to try for each base within one set of names, so that n clashes
+        # cost n tries in all, not n^2/2 (a block may repeat a term name thousands of times)
+        next_number: dict[str, int] = {}
+
         def fix(name: str, taken: set[str]) -> str:
-            if valid is None:
-                return identifier(name, taken)
-            if valid(name) and name not in taken:
+            if not taken:  # a new block's names
+                next_number.clear()
+            if check(name) and name not in taken:
                 taken.add(name)
                 return name
             # identifier() gives an ASCII identifier, which may still be one the target
             # reserves (FCL's ``if``): number it until the target accepts it
             base = identifier(name, set())
-            candidate, n = base, 2
-            while candidate in taken or not valid(candidate):
+            n = next_number.get(base)
+            candidate, n = (base, 2) if n is None else (f"{base}_{n}", n + 1)
+            while candidate in taken or not check(candidate):
                 candidate, n = f"{base}_{n}", n + 1
+            next_number[base] = n
             taken.add(candidate)
             return candidate
 
