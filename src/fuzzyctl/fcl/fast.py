@@ -56,6 +56,15 @@ _LABEL = re.compile(r"\w+")
 # Where runs may start: comments and OPTIONS text are skipped as lark skips them.
 _SCAN = re.compile(rf"({_COMMENT})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
 _OPTIONS_END = re.compile(r"(?s:.+?)(?=\bEND_OPTIONS?\b)", re.I)
+# The most common rule, on one line with spaces only: read with one match.
+_NAME = r"[^\W\d]\w*"
+_ATOM = rf"{_NAME}[ \t]+IS[ \t]+{_NAME}"
+_SIMPLE_RULE = re.compile(
+    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*)"
+    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*)[ \t]*;",
+    re.I,
+)
+_PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
 
 COMMENT, NUMBER, WORD, LABEL, PUNCT = 1, 2, 3, 4, 5
@@ -69,6 +78,8 @@ KEYWORDS = frozenset(_KEYWORD_TEXT.split())
 MAX_FAST_NESTING = 30
 #: Shortest run worth taking from lark (its first and last statements stay with lark).
 MIN_RUN = 3
+#: Statements in a row not taken after which only the one-match forms are tried.
+MAX_MISSES = 1000
 
 
 class _Bail(Exception):
@@ -99,15 +110,18 @@ class FastResult:
         lo, hi = bisect_left(self.offsets, start), bisect_left(self.offsets, end)
         return list(zip(self.offsets[lo:hi], self.items[lo:hi], self.spellings[lo:hi], strict=True))
 
-    _line_at: tuple[int, int] = (0, 1)
+    _at: tuple[int, int, int] = (0, 1, 0)  # an offset, its line, where that line starts
 
     def add_comment(self, body: str, offset: int) -> None:
         """Record a comment (in source order)."""
-        pos, line = self._line_at
-        line += self.text.count("\n", pos, offset)
-        self._line_at = (offset, line)
-        column = offset - self.text.rfind("\n", 0, offset)
-        self.comments.append(FastComment(body, offset, line, column, line + body.count("\n")))
+        pos, line, ls = self._at
+        text = self.text
+        line += text.count("\n", pos, offset)
+        nl = text.rfind("\n", pos, offset)
+        if nl >= 0:
+            ls = nl + 1
+        self._at = (offset, line, ls)
+        self.comments.append(FastComment(body, offset, line, offset - ls + 1, line + body.count("\n")))
 
     def spellings_before(self, end: int | None) -> set[str]:
         n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
@@ -122,6 +136,8 @@ class FastResult:
 class _Reader:
     """Scanner and parser over ``text`` (positions are string offsets)."""
 
+    quick_only = False  # after many statements not taken: only the one-match forms
+
     def __init__(self, text: str) -> None:
         self.text = text
         self.pos = 0
@@ -130,7 +146,7 @@ class _Reader:
         self.base = 0
         self.base_line = 1
         self.base_ls = 0
-        self.next_nl = -1
+        self.next_nl = text.find("\n")
         self.la: tuple[int, int, int, str] | None = None
 
     def statement(self) -> tuple[Rule | Term, str | None]:
@@ -148,14 +164,19 @@ class _Reader:
         else:  # back to the last statement of a run
             self.base_line -= text.count("\n", offset, self.base)
             self.base_ls = text.rfind("\n", 0, offset) + 1
+        if offset < self.base:
+            nl = text.find("\n", offset, self.base)
+            if nl >= 0:
+                self.next_nl = nl
+        elif 0 <= self.next_nl < offset:
+            self.next_nl = text.find("\n", offset)
         self.base = offset
-        self.next_nl = text.find("\n", offset)
 
     def lc(self, p: int) -> tuple[int, int]:
         if p <= self.next_nl or self.next_nl < 0:
             return self.base_line, p - self.base_ls + 1
         text = self.text
-        return self.base_line + text.count("\n", self.base, p), p - text.rfind("\n", 0, p)
+        return self.base_line + text.count("\n", self.base, p), p - text.rfind("\n", self.base, p)
 
     def span(self, a: int, b: int) -> Span:
         la, ca = self.lc(a)
@@ -232,6 +253,50 @@ class _RuleReader(_Reader):
     """RULE label : IF condition THEN conclusions [;]"""
 
     def statement(self) -> tuple[Rule, None]:
+        m = _SIMPLE_RULE.match(self.text, self.pos)
+        if m is not None:
+            rule = self.simple(m)
+            if rule is not None:
+                return rule, None
+        if self.quick_only:
+            raise _Bail
+        return self.general(), None
+
+    def simple(self, m: re.Match[str]) -> Rule | None:
+        """The rule matched by _SIMPLE_RULE (``None`` when a name is a keyword)."""
+        text = self.text
+        line, col = self.lc(m.start())
+        shift = col - m.start()  # column = offset + shift on this line
+        s2, e2, s3, e3 = m.start(2), m.end(2), m.start(3), m.end(3)
+        condition = _spaced_condition(text[s2:e2], s2, line, shift)
+        if condition is None:
+            condition = self._condition(s2, e2, line, shift)
+            if condition is None:
+                return None
+        conclusions = []
+        for part in _PART.finditer(text, s3, e3):
+            v, t = part.group(1), part.group(2)
+            if v is None or v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+                return None
+            span = Span(line, part.start() + shift, line, part.end() + shift)
+            conclusions.append(Conclusion(v, t, None, span))
+        self.seek(m.end())
+        return Rule(m.group(1), condition, tuple(conclusions), Span(line, col, line, m.end() + shift))
+
+    def _condition(self, start: int, end: int, line: int, shift: int) -> Condition | None:
+        groups: list[list[Is]] = [[]]
+        for part in _PART.finditer(self.text, start, end):
+            if part.lastindex == 3:
+                if part.group(3).upper() == "OR":
+                    groups.append([])
+                continue
+            v, t = part.group(1), part.group(2)
+            if v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+                return None
+            groups[-1].append(Is(v, t, False, (), Span(line, part.start() + shift, line, part.end() + shift)))
+        return _precedence(groups)
+
+    def general(self) -> Rule:
         _, r0, _ = self.keyword("RULE")
         k, a, _, _ = self.next()
         if k not in (NUMBER, WORD, LABEL):
@@ -257,7 +322,7 @@ class _RuleReader(_Reader):
             _, _, end, _ = self.next()
         elif not (k == WORD and w in ("RULE", "END_RULEBLOCK")):
             raise _Bail
-        return Rule(label, condition, tuple(conclusions), self.span(r0, end)), None
+        return Rule(label, condition, tuple(conclusions), self.span(r0, end))
 
     def or_condition(self) -> Condition:
         first = self.and_condition()
@@ -351,6 +416,8 @@ class _TermReader(_Reader):
     """TERM name := points | number | shape numbers ;"""
 
     def statement(self) -> tuple[Term, str | None]:
+        if self.quick_only:
+            raise _Bail
         _, t0, _ = self.keyword("TERM")
         name, _, _ = self.word()
         self.punct(":=")
@@ -401,6 +468,40 @@ class _TermReader(_Reader):
             raise _Bail from None
 
 
+def _spaced_condition(cond: str, pos: int, line: int, shift: int) -> Condition | None:
+    """``v IS t AND ...`` (as _SIMPLE_RULE matched it) with single spaces between the words,
+    read by splitting (``None``: other spacing, or a keyword as a name)."""
+    if "  " in cond or "\t" in cond:
+        return None
+    words = cond.split(" ")
+    groups: list[list[Is]] = [[]]
+    n = len(words)
+    i = 0
+    pos += shift
+    while True:
+        v, t = words[i], words[i + 2]
+        if v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+            return None
+        b = pos + len(v) + len(t) + 4
+        groups[-1].append(Is(v, t, False, (), Span(line, pos, line, b)))
+        i += 3
+        if i >= n:
+            return _precedence(groups)
+        op = words[i]
+        if len(op) == 2:
+            groups.append([])
+        pos = b + len(op) + 2
+        i += 1
+
+
+def _precedence(groups: list[list[Is]]) -> Condition:
+    """OR of ANDs of the subconditions grouped between the ORs."""
+    ors: list[Condition] = [
+        g[0] if len(g) == 1 else And(tuple(g), _join(g[0].span, g[-1].span)) for g in groups
+    ]
+    return ors[0] if len(ors) == 1 else Or(tuple(ors), _join(ors[0].span, ors[-1].span))
+
+
 def _join(first: Span | None, last: Span | None) -> Span | None:
     if first is None or last is None:
         return first
@@ -413,7 +514,7 @@ def read_runs(text: str) -> FastResult | None:
     result = FastResult(text)
     blanks: list[tuple[int, int]] = []
     readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
-    pos = 0
+    pos = misses = 0
     while True:
         m = _SCAN.search(text, pos)
         if m is None:
@@ -428,7 +529,12 @@ def read_runs(text: str) -> FastResult | None:
                 break
             pos = body.end()
             continue
+        taken = len(blanks)
         pos = _run(readers[word], word, m.start(), result, blanks)
+        misses = 0 if len(blanks) > taken else misses + 1
+        if misses > MAX_MISSES:  # a file of statements this reader does not take
+            for reader in readers.values():
+                reader.quick_only = True
     if not blanks:
         return None
     result.text = _blank(text, blanks)

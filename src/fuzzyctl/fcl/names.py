@@ -89,6 +89,8 @@ def resolve_names(fb: FunctionBlock, warn: Warn) -> FunctionBlock:
     def condition(c: Condition) -> Condition:
         # a part that needs no change is kept as it is (no copy of a large rule base)
         if isinstance(c, Is):
+            if not c.hedges and c.term in terms.get(c.variable, no_terms) and c.variable in r.declared:
+                return c  # the common case: declared names, as written
             var = r.variable(c.variable, c.span)
             hedges, term = r.words([*c.hedges, c.term], terms.get(var, no_terms), c.span)
             if var == c.variable and term == c.term and hedges == c.hedges:
@@ -107,6 +109,8 @@ def resolve_names(fb: FunctionBlock, warn: Warn) -> FunctionBlock:
         return replace(c, operands=operands)
 
     def conclusion(c: Conclusion) -> Conclusion:
+        if not c.hedges and c.term in terms.get(c.variable, no_terms) and c.variable in r.declared:
+            return c
         var = r.variable(c.variable, c.span)
         if c.term is None:
             return c if var == c.variable else replace(c, variable=var)
