@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import identifier, is_identifier
+from fuzzyctl.formats._common import NameSet, identifier, is_identifier, numbered
 from fuzzyctl.model import (
     And,
     Binary,
@@ -319,22 +319,17 @@ def rename(
                 return name
             # identifier() gives an ASCII identifier, which may still be one the target
             # reserves (FCL's ``if``): number it until the target accepts it
-            base = identifier(name, set())
-            candidate, n = base, 2
-            while candidate in taken or not valid(candidate):
-                candidate, n = f"{base}_{n}", n + 1
-            taken.add(candidate)
-            return candidate
+            return numbered(identifier(name, set()), taken, valid)
 
         return fix
 
     fix_variable, fix_term = fixer(valid_variable), fixer(valid_term)
-    taken_vars: set[str] = set()
+    taken_vars: set[str] = NameSet()
     var_map = {v.name: fix_variable(v.name, taken_vars) for v in fb.variables}
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     term_maps: dict[str, dict[str, str]] = {}
     for blk in blocks:
-        taken: set[str] = set()
+        taken: set[str] = NameSet()
         term_maps[blk.variable] = {t.name: fix_term(t.name, taken) for t in blk.terms}
     if all(k == v for k, v in var_map.items()) and all(
         k == v for names in term_maps.values() for k, v in names.items()
