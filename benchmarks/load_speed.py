@@ -89,7 +89,8 @@ def child(python: str, code: str, args: list[str], env: dict[str, str], timeout:
         return {"cpu": float("nan"), "rss": float("nan"), "status": f"over {timeout:.0f} s"}
     lines = res.stdout.strip().splitlines()
     if res.returncode != 0 or not lines:
-        return {"cpu": float("nan"), "rss": float("nan"), "status": f"exit {res.returncode}: {res.stderr[-300:]}"}
+        failed = f"exit {res.returncode}: {res.stderr[-300:]}"
+        return {"cpu": float("nan"), "rss": float("nan"), "status": failed}
     out: dict[str, Any] = json.loads(lines[-1])
     return out
 
