@@ -1,5 +1,5 @@
-"""``fuzzyctl codegen FILE --lang st|c``: IEC 61131-3 Structured Text or C99 from a fuzzy
-system (see docs/codegen.md)."""
+"""``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
+function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
 
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ from fuzzyctl.cli.app import app, err_console
 
 class Lang(StrEnum):
     st = "st"
+    plcopen = "plcopen"
     c = "c"
 
 
@@ -29,21 +30,26 @@ def codegen(
         Path,
         typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", exists=True, dir_okay=False),
     ],
-    lang: Annotated[Lang, typer.Option("--lang", help="st: Structured Text; c: C99.")] = Lang.st,
+    lang: Annotated[
+        Lang,
+        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
+    ] = Lang.st,
     output: Annotated[
         Path | None,
         typer.Option(
             "-o",
             "--output",
-            help="st: the .st file (default: print); c: the directory for NAME.h and NAME.c (default: .).",
+            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .).",
         ),
     ] = None,
     dialect: Annotated[
         Dialect | None,
-        typer.Option("--dialect", help="st only: codesys (default), twincat or scl (TIA Portal)."),
+        typer.Option(
+            "--dialect", help="st and plcopen: codesys (default), twincat or scl (TIA Portal, st only)."
+        ),
     ] = None,
     lreal: Annotated[
-        bool, typer.Option("--lreal", help="st only: compute in LREAL instead of REAL.")
+        bool, typer.Option("--lreal", help="st and plcopen: compute in LREAL instead of REAL.")
     ] = False,
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
@@ -67,9 +73,12 @@ def codegen(
     from fuzzyctl.formats import write_atomic
 
     if lang is Lang.c and (dialect is not None or lreal):
-        raise typer.BadParameter("--dialect and --lreal apply to --lang st", param_hint="--lang")
+        raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
     if lang is Lang.st and single:
         raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
+    if lang is Lang.plcopen:
+        _plcopen(source, output, dialect, lreal, single, block, strict)
+        return
     doc = fuzzyctl.load(source, strict=strict)
     if lang is Lang.st:
         text = generate_st(
@@ -89,3 +98,34 @@ def codegen(
     for name, text in files.items():
         write_atomic(out_dir / name, text)
     err_console.print(f"wrote {', '.join(str(out_dir / n) for n in files)}", markup=False)
+
+
+def _plcopen(
+    source: Path,
+    output: Path | None,
+    dialect: Dialect | None,
+    lreal: bool,
+    single: bool,
+    block: str | None,
+    strict: bool,
+) -> None:
+    """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
+    import fuzzyctl
+    from fuzzyctl.codegen import generate_plcopen
+    from fuzzyctl.formats import write_atomic
+
+    if single:
+        raise typer.BadParameter("--float applies to --lang c (use --lreal)", param_hint="--lang")
+    if dialect is Dialect.scl:
+        raise typer.BadParameter(
+            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
+        )
+    doc = fuzzyctl.load(source, strict=strict)
+    xml = generate_plcopen(
+        doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+    )
+    if output is None:
+        typer.echo(xml, nl=False)
+        return
+    write_atomic(output, xml)
+    err_console.print(f"wrote {output}", markup=False)

@@ -11,6 +11,9 @@ changes what the command does, only how fast it starts.
 from __future__ import annotations
 
 import math
+import os
+import re
+import sys
 from pathlib import Path
 
 
@@ -68,27 +71,76 @@ def try_quick(argv: list[str]) -> int | None:
             return None
         if not sep or not name.strip():
             return None
-    try:
-        from fuzzyctl.api import compile_path
+    from fuzzyctl.cli import quick_record
 
-        ctl = compile_path(file, block=block, compat=compat)
-        result = ctl.evaluate(values)
-    except Exception:  # every error is reported by the full command line
-        return None
+    record, key = quick_record.lookup(file, block, compat)
+    result = record.run(values) if record is not None else None
+    if record is not None and result is not None:
+        title, warnings = record.title, record.warnings
+    else:
+        try:
+            from fuzzyctl.api import compile_path
+            from fuzzyctl.diagnostics import render_all
+
+            ctl = compile_path(file, block=block, compat=compat)
+            title, warnings = f"{ctl.name or file.name}", render_all(ctl.warnings)
+            if key is not None:
+                quick_record.save(key, ctl, title)
+            result = ctl.evaluate(values)
+        except Exception:  # every error is reported by the full command line
+            return None
     if not all(math.isfinite(v) for v in result.values()):
         return None  # an output without a value: the full command line says why and exits 1
+    for line in warnings:  # as cli/run.py's _controller (without its colour)
+        print(line, file=sys.stderr)
     if as_json:
         import json
 
         print(json.dumps(result))
         return 0
+    rows = [(k, f"{v:.10g}") for k, v in result.items()]
+    text = plain_table(title, rows) if _plain_console() else None
+    if text is not None:
+        sys.stdout.write(text)
+        return 0
     from rich.console import Console
     from rich.table import Table
 
-    table = Table(title=f"{ctl.name or file.name}", show_lines=False)
+    table = Table(title=title, show_lines=False)
     table.add_column("output", overflow="fold")  # as cli/run.py's _print_outputs
     table.add_column("value", justify="right", overflow="fold", no_wrap=False)
-    for k, v in result.items():
-        table.add_row(k, f"{v:.10g}")
+    for k, v in rows:
+        table.add_row(k, v)
     Console(highlight=False).print(table)
     return 0
+
+
+#: where rich would render differently from :func:`plain_table` (colour forced, another width)
+_RICH_ENV = ("FORCE_COLOR", "TTY_COMPATIBLE", "TTY_INTERACTIVE", "COLUMNS", "JUPYTER_COLUMNS")
+_PLAIN = re.compile(r"[A-Za-z0-9_.+\- ]*\Z")
+
+
+def _plain_console() -> bool:
+    """Output to a file or pipe, where rich draws without colour at 80 columns."""
+    return not sys.stdout.isatty() and not any(k in os.environ for k in _RICH_ENV)
+
+
+def plain_table(title: str, rows: list[tuple[str, str]]) -> str | None:
+    """The two-column table rich prints to a file or pipe (heavy head box, title centred above
+    it), without importing rich (~60 ms of a start); None where rich would do more than draw
+    it (markup or wide characters in a name, a title or table that must wrap)."""
+    if not all(_PLAIN.match(t) for t in (title, *(c for r in rows for c in r))):
+        return None
+    w0 = max(len("output"), *(len(r[0]) for r in rows))
+    w1 = max(len("value"), *(len(r[1]) for r in rows))
+    width = w0 + w1 + 7  # three bars and a space either side of each cell
+    if width > 80 or len(title) > width or not title.strip() or title != title.strip():
+        return None
+    pad = width - len(title)
+    lines = [" " * (pad // 2) + title + " " * (pad - pad // 2)]
+    lines.append(f"┏{'━' * (w0 + 2)}┳{'━' * (w1 + 2)}┓")
+    lines.append(f"┃ {'output'.ljust(w0)} ┃ {'value'.rjust(w1)} ┃")
+    lines.append(f"┡{'━' * (w0 + 2)}╇{'━' * (w1 + 2)}┩")
+    lines += [f"│ {a.ljust(w0)} │ {b.rjust(w1)} │" for a, b in rows]
+    lines.append(f"└{'─' * (w0 + 2)}┴{'─' * (w1 + 2)}┘")
+    return "\n".join(lines) + "\n"

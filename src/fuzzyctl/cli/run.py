@@ -42,8 +42,12 @@ def _controller(file: Path, block: str | None, compat: str, strict: bool = False
     from fuzzyctl.cli.app import err_console
 
     ctl = fuzzyctl.compile(fuzzyctl.load(file, strict=strict), block=block, compat=compat, strict=strict)
-    for d in ctl.warnings:  # what the engine settled with a warning (a universe from the terms, ...)
-        err_console.print(d.render(), style="yellow", markup=False, highlight=False)
+    from fuzzyctl.diagnostics import render_all
+
+    # what the engine settled with a warning (a universe from the terms, ...), capped: a file
+    # that repeats a line thousands of times must not print thousands of warnings
+    for line in render_all(ctl.warnings):
+        err_console.print(line, style="yellow", markup=False, highlight=False)
     return ctl
 
 

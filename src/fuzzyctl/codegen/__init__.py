@@ -2,6 +2,7 @@
 embedded targets, and the native evaluation backend built on the C.
 
 * :func:`generate_st` - one FUNCTION_BLOCK per FCL function block (CODESYS, TwinCAT, SCL).
+* :func:`generate_plcopen` - the same blocks as PLCopen TC6 XML 2.01 (one project).
 * :func:`generate_c` - a header and a source file per function block.
 * :mod:`fuzzyctl.codegen.native` - the native backend of ``compile()``.
 
@@ -18,9 +19,10 @@ from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     from fuzzyctl.codegen.api import generate_c, generate_st, lower_block
+    from fuzzyctl.codegen.plcopen import generate_plcopen
     from fuzzyctl.engine.irgen import CodegenError
 
-__all__ = ["CodegenError", "generate_c", "generate_st", "lower_block"]
+__all__ = ["CodegenError", "generate_c", "generate_plcopen", "generate_st", "lower_block"]
 
 
 def __getattr__(name: str) -> Any:
@@ -28,6 +30,10 @@ def __getattr__(name: str) -> Any:
         from fuzzyctl.engine.irgen import CodegenError
 
         return CodegenError
+    if name == "generate_plcopen":
+        from fuzzyctl.codegen import plcopen
+
+        return plcopen.generate_plcopen
     if name in ("generate_c", "generate_st", "lower_block"):
         from fuzzyctl.codegen import api
 

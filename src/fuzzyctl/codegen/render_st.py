@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.codegen.ir import (
@@ -133,12 +134,10 @@ def _comment(text: str) -> str:
     return f"(* {st_comment(text)} *)"
 
 
-def _type(d: Decl, real: str) -> str:
-    base = {"REAL": real, "INT": "INT", "DINT": "DINT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
-    return f"ARRAY[0..{d.size - 1}] OF {base}" if d.size is not None else base
+def _init_values(d: Decl) -> tuple[str, ...] | None:
+    """The initial value of ``d`` as ST literals (one for a scalar, one per element of an
+    array); None when the declaration has none."""
 
-
-def _init(d: Decl) -> str:
     def one(v: float | bool) -> str:
         if d.type == "BOOL":
             return "TRUE" if v else "FALSE"
@@ -147,54 +146,112 @@ def _init(d: Decl) -> str:
         return st_real(float(v))
 
     if d.init is None:
-        return ""
+        return None
     if isinstance(d.init, tuple):
         if d.storage != "param" and not any(d.init):
             # IEC 61131-3 initialises to 0 / FALSE anyway; long literal lists cost PLC
             # editors (and Earley parsers) dearly.  Parameters stay explicit for the tuner.
-            return ""
-        return " := [" + ", ".join(one(v) for v in d.init) + "]"
-    return " := " + one(d.init)
+            return None
+        return tuple(one(v) for v in d.init)
+    return (one(d.init),)
 
 
-def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
-    """One FUNCTION_BLOCK."""
+@dataclass(frozen=True)
+class STVar:
+    """One declared variable: ``name : [ARRAY[0..size-1] OF] base [:= init];``."""
+
+    name: str
+    base: str  # elementary type as written: REAL/LREAL (by precision), INT, DINT, BOOL, BYTE
+    size: int | None  # None: a scalar
+    init: tuple[str, ...] | None  # ST literals (one for a scalar); None: no initial value
+    comment: str  # the model's text, unescaped ("" for none; may hold newlines for arrays)
+
+    @property
+    def type(self) -> str:
+        return f"ARRAY[0..{self.size - 1}] OF {self.base}" if self.size is not None else self.base
+
+    @property
+    def declaration(self) -> str:
+        """``name : TYPE := init`` (no semicolon, no comment)."""
+        if self.init is None:
+            return f"{self.name} : {self.type}"
+        value = f"[{', '.join(self.init)}]" if self.size is not None else self.init[0]
+        return f"{self.name} : {self.type} := {value}"
+
+
+@dataclass(frozen=True)
+class STSection:
+    keyword: str  # VAR_INPUT, VAR_OUTPUT, VAR, VAR_TEMP
+    title: str  # the comment under the keyword ("" for none), unescaped
+    variables: tuple[STVar, ...]
+
+
+@dataclass(frozen=True)
+class STParts:
+    """A FUNCTION_BLOCK as parts (for :func:`render_st` and the PLCopen XML writer): the
+    names are checked identifiers, the comment texts are the model's (escape them per target),
+    the body is the statement lines exactly as ``render_st`` prints them."""
+
+    name: str
+    dialect: str
+    real: str  # REAL or LREAL
+    header: tuple[str, ...]  # comment lines above the block
+    sections: tuple[STSection, ...]  # only the non-empty ones, in order
+    body: tuple[str, ...]
+
+
+def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> STParts:
+    """The declarations and statements of one FUNCTION_BLOCK, before formatting."""
     st_ident(prog.name, "function block name")
     for d in prog.decls:
         st_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
     r = _ST(prog, dialect, lreal)
-    out: list[str] = []
-    for line in prog.header:
-        out.append(_comment(line))
-    out.append(_comment(f"dialect: {dialect}; arithmetic in {r.real}"))
-    if r.scl:
-        out.append(f'FUNCTION_BLOCK "{prog.name}"')
+    r.stmts(prog.body, 1 if r.scl else 0)
+
+    def var(d: Decl) -> STVar:
+        base = {"REAL": r.real, "INT": "INT", "DINT": "DINT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
+        return STVar(d.name, base, d.size, _init_values(d), d.comment or "")
+
+    groups = (
+        ("VAR_INPUT", prog.of("input"), ""),
+        ("VAR_OUTPUT", prog.of("output"), ""),
+        ("VAR", prog.of("param"), "tunable parameters: may be changed online"),
+        ("VAR", prog.of("state") + prog.of("const"), "internal state and tables: do not change"),
+        ("VAR_TEMP", prog.of("temp"), ""),
+    )
+    sections = tuple(STSection(kw, title, tuple(var(d) for d in ds)) for kw, ds, title in groups if ds)
+    header = (*prog.header, f"dialect: {dialect}; arithmetic in {r.real}")
+    return STParts(prog.name, dialect, r.real, header, sections, tuple(r.lines))
+
+
+def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
+    """One FUNCTION_BLOCK."""
+    return format_st(st_parts(prog, dialect=dialect, lreal=lreal))
+
+
+def format_st(parts: STParts) -> str:
+    """The text of a FUNCTION_BLOCK from its parts: header comments, ``FUNCTION_BLOCK``,
+    the sections, the body lines, ``END_FUNCTION_BLOCK``."""
+    scl = parts.dialect == "scl"
+    out = [_comment(line) for line in parts.header]
+    if scl:
+        out.append(f'FUNCTION_BLOCK "{parts.name}"')
         out.append("{ S7_Optimized_Access := 'TRUE' }")
         out.append("VERSION : 0.1")
     else:
-        out.append(f"FUNCTION_BLOCK {prog.name}")
-
-    def block(kw: str, decls: list[Decl], title: str | None = None) -> None:
-        if not decls:
-            return
-        out.append(kw)
-        if title:
-            out.append(f"    {_comment(title)}")
-        for d in decls:
-            for line in d.comment.split("\n") if d.comment and d.size is not None else []:
+        out.append(f"FUNCTION_BLOCK {parts.name}")
+    for sec in parts.sections:
+        out.append(sec.keyword)
+        if sec.title:
+            out.append(f"    {_comment(sec.title)}")
+        for v in sec.variables:
+            for line in v.comment.split("\n") if v.comment and v.size is not None else []:
                 out.append(f"    {_comment(line)}")
-            note = f" {_comment(d.comment)}" if d.comment and d.size is None else ""
-            out.append(f"    {d.name} : {_type(d, r.real)}{_init(d)};{note}")
+            note = f" {_comment(v.comment)}" if v.comment and v.size is None else ""
+            out.append(f"    {v.declaration};{note}")
         out.append("END_VAR")
-
-    block("VAR_INPUT", prog.of("input"))
-    block("VAR_OUTPUT", prog.of("output"))
-    block("VAR", prog.of("param"), "tunable parameters: may be changed online")
-    block("VAR", prog.of("state") + prog.of("const"), "internal state and tables: do not change")
-    block("VAR_TEMP", prog.of("temp"))
-    if r.scl:
+    if scl:
         out.append("BEGIN")
-    r.stmts(prog.body, 1 if r.scl else 0)
-    out += r.lines
+    out += parts.body
     out.append("END_FUNCTION_BLOCK")
     return "\n".join(out) + "\n"

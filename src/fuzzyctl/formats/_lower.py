@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import NameSet, identifier, is_identifier, numbered
+from fuzzyctl.formats._common import identifier, is_identifier
 from fuzzyctl.model import (
     And,
     Binary,
@@ -311,25 +311,37 @@ def rename(
     rules passes its own checks."""
 
     def fixer(valid: Callable[[str], bool] | None) -> Callable[[str, set[str]], str]:
+        check = valid or is_identifier
+        # the next number to try for each base within one set of names, so that n clashes
+        # cost n tries in all, not n^2/2 (a block may repeat a term name thousands of times)
+        next_number: dict[str, int] = {}
+
         def fix(name: str, taken: set[str]) -> str:
-            if valid is None:
-                return identifier(name, taken)
-            if valid(name) and name not in taken:
+            if not taken:  # a new block's names
+                next_number.clear()
+            if check(name) and name not in taken:
                 taken.add(name)
                 return name
             # identifier() gives an ASCII identifier, which may still be one the target
             # reserves (FCL's ``if``): number it until the target accepts it
-            return numbered(identifier(name, set()), taken, valid)
+            base = identifier(name, set())
+            n = next_number.get(base)
+            candidate, n = (base, 2) if n is None else (f"{base}_{n}", n + 1)
+            while candidate in taken or not check(candidate):
+                candidate, n = f"{base}_{n}", n + 1
+            next_number[base] = n
+            taken.add(candidate)
+            return candidate
 
         return fix
 
     fix_variable, fix_term = fixer(valid_variable), fixer(valid_term)
-    taken_vars: set[str] = NameSet()
+    taken_vars: set[str] = set()
     var_map = {v.name: fix_variable(v.name, taken_vars) for v in fb.variables}
     blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     term_maps: dict[str, dict[str, str]] = {}
     for blk in blocks:
-        taken: set[str] = NameSet()
+        taken: set[str] = set()
         term_maps[blk.variable] = {t.name: fix_term(t.name, taken) for t in blk.terms}
     if all(k == v for k, v in var_map.items()) and all(
         k == v for names in term_maps.values() for k, v in names.items()
