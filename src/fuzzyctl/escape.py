@@ -340,3 +340,35 @@ def _shown(name: object) -> str:
     terminal or hide control characters in it."""
     text = repr(name)
     return text if len(text) <= 60 else text[:57] + "..."
+
+
+# The functions and function blocks of the library matiec (the compiler of OpenPLC and
+# Beremiz) loads with every program, typed variants and conversions included (e.g. ADD_REAL,
+# INT_TO_REAL, PID, RAMP, INTEGRAL): matiec refuses them as variable names.
+_IEC_TYPES = (
+    "(?:BOOL|SINT|INT|DINT|LINT|USINT|UINT|UDINT|ULINT|REAL|LREAL|TIME|DATE|TOD|DT|STRING|BYTE|"
+    "WORD|DWORD|LWORD|DATE_AND_TIME|TIME_OF_DAY)"
+)
+_IEC_POUS = """
+ABS ACOS ADD AND ASIN ATAN CONCAT COS CTD CTU CTUD DELETE DERIVATIVE DIV DIVTIME EQ EXP EXPT
+FIND F_TRIG GE GT HYSTERESIS INSERT INTEGRAL LE LEFT LEN LIMIT LN LOG LT MAX MID MIN MOD MOVE
+MUL MULTIME MUX NE NOT OR PID RAMP REPLACE RIGHT ROL ROR RS RTC R_TRIG SEL SEMA SHL SHR SIN
+SQRT SR SUB TAN TOF TON TP TRUNC XOR
+"""
+_IEC_LIBRARY = re.compile(
+    rf"(?:{'|'.join(_IEC_POUS.split())})(?:_{_IEC_TYPES}){{0,2}}"
+    rf"|(?:{_IEC_TYPES}_)?(?:{_IEC_TYPES}|BCD)_TO_(?:BCD_)?{_IEC_TYPES}|{_IEC_TYPES}_TO_BCD(?:_{_IEC_TYPES})?",
+    re.IGNORECASE,
+)
+
+
+def st_ident_iec(name: str, what: str) -> str:
+    """:func:`st_ident`, and not the name of a function or function block of matiec's library
+    (OpenPLC, Beremiz), which matiec refuses as a variable name."""
+    st_ident(name, what)
+    if _IEC_LIBRARY.fullmatch(name):
+        raise CodegenError(
+            f"{what} {_shown(name)} is the name of a standard function or function block "
+            "in OpenPLC's compiler (matiec): rename it"
+        )
+    return name

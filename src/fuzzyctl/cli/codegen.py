@@ -22,6 +22,8 @@ class Dialect(StrEnum):
     codesys = "codesys"
     twincat = "twincat"
     scl = "scl"
+    iec = "iec"
+    openplc = "openplc"
 
 
 @app.command()
@@ -45,7 +47,9 @@ def codegen(
     dialect: Annotated[
         Dialect | None,
         typer.Option(
-            "--dialect", help="st and plcopen: codesys (default), twincat or scl (TIA Portal, st only)."
+            "--dialect",
+            help="st and plcopen: codesys (default), twincat, scl (TIA Portal, st only) or iec "
+            "(strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc).",
         ),
     ] = None,
     lreal: Annotated[
@@ -54,6 +58,15 @@ def codegen(
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
     ] = False,
+    testbench: Annotated[
+        int,
+        typer.Option(
+            "--testbench",
+            min=0,
+            help="Also write a test bench: N input vectors (every rule, the range ends, no rule fired, "
+            "random) with the engine's outputs; st: a PROGRAM after the block, c: NAME_testbench.c.",
+        ),
+    ] = 0,
     block: Annotated[
         str | None, typer.Option("--block", help="Only this function block (default: every block).")
     ] = None,
@@ -82,7 +95,12 @@ def codegen(
     doc = fuzzyctl.load(source, strict=strict)
     if lang is Lang.st:
         text = generate_st(
-            doc, block=block, dialect=(dialect or Dialect.codesys).value, lreal=lreal, strict=strict
+            doc,
+            block=block,
+            dialect=(dialect or Dialect.codesys).value,
+            lreal=lreal,
+            strict=strict,
+            testbench=testbench,
         )
         if output is None:
             typer.echo(text, nl=False)
@@ -90,7 +108,7 @@ def codegen(
         write_atomic(output, text)
         err_console.print(f"wrote {output}", markup=False)
         return
-    files = generate_c(doc, block=block, single=single, strict=strict)
+    files = generate_c(doc, block=block, single=single, strict=strict, testbench=testbench)
     out_dir = output or Path(".")
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")

@@ -11,8 +11,10 @@ from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.model import Document, FunctionBlock
 
-Dialect = Literal["codesys", "twincat", "scl"]
-DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl")
+Dialect = Literal["codesys", "twincat", "scl", "iec", "openplc"]
+DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl", "iec", "openplc")
+#: Other names of a dialect: OpenPLC (and Beremiz) compile strict IEC 61131-3 with matiec.
+DIALECT_ALIASES = {"openplc": "iec"}
 
 
 def lower_block(model: Document | FunctionBlock, block: str | None = None, **options: Any) -> Plan:
@@ -35,20 +37,29 @@ def generate_st(
     block: str | None = None,
     dialect: str = "codesys",
     lreal: bool = False,
+    testbench: int = 0,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
 
-    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept) or ``scl``
-    (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
-    computes in LREAL instead of REAL.  Raises :class:`CodegenError` naming what cannot be
-    expressed."""
+    ``dialect`` is ``codesys`` / ``twincat`` (IEC 61131-3 text both accept), ``iec`` (alias
+    ``openplc``: strict IEC 61131-3 as matiec, the compiler of OpenPLC and Beremiz, accepts it)
+    or ``scl`` (Siemens TIA Portal: ``#`` before block variables, ``REGION``, ``VERSION``); ``lreal``
+    computes in LREAL instead of REAL; ``testbench`` > 0 adds after each block a PROGRAM that
+    checks it on that many input vectors against the engine (:mod:`fuzzyctl.codegen.testbench`).
+    Raises :class:`CodegenError` naming what cannot be expressed."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    dialect = DIALECT_ALIASES.get(dialect, dialect)
     parts = []
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)
         parts.append(render_st(build_program(plan, "st"), dialect=dialect, lreal=lreal))
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_st_bench
+
+            bench = choose(plan, testbench, single=not lreal)
+            parts.append(render_st_bench(bench, dialect=dialect, lreal=lreal))
     return "\n".join(parts)
 
 
@@ -57,10 +68,12 @@ def generate_c(
     *,
     block: str | None = None,
     single: bool = False,
+    testbench: int = 0,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
-    ``block``); ``single`` computes in float instead of double."""
+    ``block``); ``single`` computes in float instead of double; ``testbench`` > 0 adds
+    ``NAME_testbench.c`` checking the block on that many input vectors against the engine."""
     files: dict[str, str] = {}
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)
@@ -68,4 +81,9 @@ def generate_c(
         header, source = render_c(prog, single=single)
         files[f"{prog.name}.h"] = header
         files[f"{prog.name}.c"] = source
+        if testbench:
+            from fuzzyctl.codegen.testbench import choose, render_c_bench
+
+            bench = choose(plan, testbench, single=single)
+            files[f"{prog.name}_testbench.c"] = render_c_bench(bench, single=single)
     return files

@@ -27,7 +27,7 @@ from collections.abc import Sequence
 from datetime import UTC, datetime
 from typing import Any
 
-from fuzzyctl.codegen.api import DIALECTS, _blocks, lower_block
+from fuzzyctl.codegen.api import DIALECT_ALIASES, DIALECTS, _blocks, lower_block
 from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.render_st import STParts, STSection, STVar, format_st, st_parts
@@ -225,6 +225,7 @@ def st_blocks(
     tests/codegen/test_plcopen.py compares their texts."""
     if dialect not in DIALECTS:
         raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
+    dialect = DIALECT_ALIASES.get(dialect, dialect)
     parts = []
     for name in _blocks(model, block):
         plan = lower_block(model, name, **options)

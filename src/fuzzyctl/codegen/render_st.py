@@ -3,7 +3,9 @@ FUNCTION_BLOCK in the portable subset: REAL (or LREAL), arrays with literal boun
 over INT counters, IF instead of MIN/MAX/LIMIT, no ``**``, ``(* *)`` comments, upper-case
 keywords, identifiers of at most 24 characters checked against the reserved words of IEC,
 TwinCAT and SCL.  ``dialect="scl"`` adds Siemens TIA Portal conventions: ``#`` before block
-variables, ``REGION``, ``VERSION`` and ``BEGIN``.
+variables, ``REGION``, ``VERSION`` and ``BEGIN``.  ``dialect="iec"`` (OpenPLC, Beremiz: the
+matiec compiler) writes FOR loops as WHILE loops, since matiec runs ``FOR i := a TO a`` zero
+times.
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ from fuzzyctl.codegen.ir import (
     Var,
     While,
 )
-from fuzzyctl.escape import st_comment, st_ident
+from fuzzyctl.escape import st_comment, st_ident, st_ident_iec
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 #: IEC 61131-3 standard functions (Table 22/23) the program may call.
@@ -56,6 +58,7 @@ class _ST:
     def __init__(self, prog: Program, dialect: str, lreal: bool) -> None:
         self.prog = prog
         self.scl = dialect == "scl"
+        self.iec = dialect == "iec"
         self.real = "LREAL" if lreal else "REAL"
         self.lines: list[str] = []
 
@@ -117,6 +120,14 @@ class _ST:
                     self.emit("ELSE", ind)
                     self.stmts(s.orelse, ind + 1)
                 self.emit("END_IF;", ind)
+            elif isinstance(s, For) and self.iec:
+                # matiec (OpenPLC) runs FOR i := a TO a zero times: the same loop as WHILE
+                var, step = self.name(s.var), "+" if s.step == 1 else "-"
+                self.emit(f"{var} := {self.ex(s.start)};", ind)
+                self.emit(f"WHILE {var} {'<=' if s.step == 1 else '>='} {self.ex(s.stop, 3)} DO", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit(f"{var} := {var} {step} 1;", ind + 1)
+                self.emit("END_WHILE;", ind)
             elif isinstance(s, For):
                 by = "" if s.step == 1 else " BY -1"
                 self.emit(f"FOR {self.name(s.var)} := {self.ex(s.start)} TO {self.ex(s.stop)}{by} DO", ind)
@@ -202,9 +213,10 @@ class STParts:
 
 def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> STParts:
     """The declarations and statements of one FUNCTION_BLOCK, before formatting."""
-    st_ident(prog.name, "function block name")
+    check = st_ident_iec if dialect == "iec" else st_ident
+    check(prog.name, "function block name")
     for d in prog.decls:
-        st_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
+        check(d.name, "variable" if d.storage in ("input", "output") else "identifier")
     r = _ST(prog, dialect, lreal)
     r.stmts(prog.body, 1 if r.scl else 0)
 
@@ -212,12 +224,17 @@ def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) ->
         base = {"REAL": r.real, "INT": "INT", "DINT": "DINT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
         return STVar(d.name, base, d.size, _init_values(d), d.comment or "")
 
+    # matiec (OpenPLC, Beremiz) turns a VAR_TEMP array without initial value into C that does
+    # not compile, and IEC 61131-3 allows no initial value there: outside SCL the scratch
+    # arrays live in the instance (written before read on every call, like the temporaries).
+    scratch = [] if r.scl else [d for d in prog.of("temp") if d.size is not None]
     groups = (
         ("VAR_INPUT", prog.of("input"), ""),
         ("VAR_OUTPUT", prog.of("output"), ""),
         ("VAR", prog.of("param"), "tunable parameters: may be changed online"),
         ("VAR", prog.of("state") + prog.of("const"), "internal state and tables: do not change"),
-        ("VAR_TEMP", prog.of("temp"), ""),
+        ("VAR", scratch, "scratch arrays of one call (no initial value needed)"),
+        ("VAR_TEMP", [d for d in prog.of("temp") if d not in scratch], ""),
     )
     sections = tuple(STSection(kw, title, tuple(var(d) for d in ds)) for kw, ds, title in groups if ds)
     header = (*prog.header, f"dialect: {dialect}; arithmetic in {r.real}")
