@@ -31,10 +31,12 @@ from fuzzyctl.model import (
     Binary,
     Call,
     DefuzzifyBlock,
+    Degree,
     Document,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
+    Is,
     Not,
     Or,
     Range,
@@ -141,6 +143,10 @@ def depth(node: object) -> int:
     """How deep a condition or an expression nests (``a IS b``: 1, ``NOT (a IS b)``: 2; a
     chain ``x + y + z`` counts each operator), computed without recursion so that any tree
     can be measured."""
+    if isinstance(node, Is | Degree):
+        return 1
+    if isinstance(node, And | Or) and all(isinstance(o, Is | Degree) for o in node.operands):
+        return 2  # the common rule, measured without the stack
     deepest = 0
     stack = [(node, 1)]
     while stack:

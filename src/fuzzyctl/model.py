@@ -23,6 +23,7 @@ import math
 from collections.abc import Iterator
 from dataclasses import dataclass, field
 from enum import StrEnum
+from functools import cached_property
 from typing import TypeAlias
 
 # --------------------------------------------------------------------------- positions
@@ -533,14 +534,49 @@ class FunctionBlock:
     def locals(self) -> tuple[Variable, ...]:
         return self._of_kind(VarKind.LOCAL)
 
+    @cached_property
+    def _index(self) -> tuple[dict[str, Variable], dict[str, FuzzifyBlock], dict[str, DefuzzifyBlock]]:
+        """The first variable, FUZZIFY and DEFUZZIFY block of each name (lookups in constant
+        time: a large system asks for them once per rule)."""
+        variables: dict[str, Variable] = {}
+        fuzzify: dict[str, FuzzifyBlock] = {}
+        defuzzify: dict[str, DefuzzifyBlock] = {}
+        for v in self.variables:
+            variables.setdefault(v.name, v)
+        for f in self.fuzzify:
+            fuzzify.setdefault(f.variable, f)
+        for d in self.defuzzify:
+            defuzzify.setdefault(d.variable, d)
+        return variables, fuzzify, defuzzify
+
     def variable(self, name: str) -> Variable | None:
-        return next((v for v in self.variables if v.name == name), None)
+        return self._index[0].get(name)
 
     def fuzzify_block(self, variable: str) -> FuzzifyBlock | None:
-        return next((f for f in self.fuzzify if f.variable == variable), None)
+        return self._index[1].get(variable)
 
     def defuzzify_block(self, variable: str) -> DefuzzifyBlock | None:
-        return next((d for d in self.defuzzify if d.variable == variable), None)
+        return self._index[2].get(variable)
+
+    @cached_property
+    def _term_names(self) -> dict[str, frozenset[str]]:
+        names: dict[str, set[str]] = {}
+        for f in self.fuzzify:
+            names.setdefault(f.variable, set()).update(t.name for t in f.terms)
+        for d in self.defuzzify:
+            names.setdefault(d.variable, set()).update(t.name for t in d.terms)
+        return {k: frozenset(v) for k, v in names.items()}
+
+    def term_names(self, variable: str) -> frozenset[str] | None:
+        """The terms of ``variable`` in its FUZZIFY and DEFUZZIFY blocks (``None``: it has no
+        such block)."""
+        return self._term_names.get(variable)
+
+    def __getstate__(self) -> dict[str, object]:
+        state = dict(self.__dict__)
+        state.pop("_index", None)  # caches, not part of the model
+        state.pop("_term_names", None)
+        return state
 
     def rules(self) -> Iterator[tuple[RuleBlock, Rule]]:
         for block in self.rule_blocks:

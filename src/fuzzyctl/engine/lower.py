@@ -453,6 +453,8 @@ def _expr_outputs(e: ExprPlan, out: set[int]) -> None:
 
 
 def _hedges(ctx: _Ctx, hedges: tuple[str, ...], span: m.Span | None, where: str) -> tuple[str, ...] | None:
+    if not hedges:
+        return ()
     hs = tuple(h.lower() for h in hedges)
     for h in hs:
         if h not in HEDGE_NAMES and shapes.power_of(h) is None:
@@ -510,17 +512,15 @@ def _cond(
                 return None
             return CChained(chained_index[c.variable], names.index(c.term), hs, c.negated)
         if c.variable in fuzzy_index:
-            fz = ctx.fb.fuzzify_block(c.variable)
-            assert fz is not None
-            names = [t.name for t in _dedup(fz.terms)]
-            if c.term.lower() == "any" and c.term not in names:  # fuzzylite "x is any"
+            index = ctx.fuzzy_terms(c.variable)
+            if c.term.lower() == "any" and c.term not in index:  # fuzzylite "x is any"
                 hs = (*hs, "any")
             if "any" in hs:
                 return CTerm(fuzzy_index[c.variable], 0, hs, c.negated)
-            if c.term not in names:
+            if c.term not in index:
                 ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
                 return None
-            return CTerm(fuzzy_index[c.variable], names.index(c.term), hs, c.negated)
+            return CTerm(fuzzy_index[c.variable], index[c.term], hs, c.negated)
         var = ctx.fb.variable(c.variable)
         if var is None:
             ctx.err(f"{where}: undeclared variable {c.variable!r}", c.span, "undeclared-variable")
@@ -556,16 +556,6 @@ def _cond(
         return None
     kids = tuple(p for p in parts if p is not None)
     return CAnd(and_op, kids) if isinstance(c, m.And) else COr(or_op, kids)
-
-
-def _dedup(terms: tuple[m.Term, ...]) -> list[m.Term]:
-    seen: set[str] = set()
-    out = []
-    for t in terms:
-        if t.name not in seen:
-            seen.add(t.name)
-            out.append(t)
-    return out
 
 
 def _conclusion(

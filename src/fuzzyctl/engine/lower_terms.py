@@ -71,6 +71,20 @@ class _Ctx:
     diags: list[Diagnostic] = field(default_factory=list)
     slots: dict[str, int] = field(default_factory=dict)
     constants: dict[str, float] = field(default_factory=dict)
+    # FUZZIFY variable -> {term name: index of its first term of that name}
+    term_index: dict[str, dict[str, int]] = field(default_factory=dict)
+
+    def fuzzy_terms(self, variable: str) -> dict[str, int]:
+        """The terms of FUZZIFY ``variable`` by name (the first of a repeated name), once
+        per variable: a large rule base asks once per subcondition."""
+        index = self.term_index.get(variable)
+        if index is None:
+            index = {}
+            fz = self.fb.fuzzify_block(variable)
+            for t in fz.terms if fz is not None else ():
+                index.setdefault(t.name, len(index))
+            self.term_index[variable] = index
+        return index
 
     def err(self, msg: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
         self.diags.append(error(msg, span, code=code, hint=hint))

@@ -302,11 +302,9 @@ def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     yield from r.found
 
 
-def _terms_of(fb: FunctionBlock, name: str) -> set[str] | None:
-    blocks = [b for b in term_blocks(fb) if b.variable == name]
-    if not blocks:
-        return None
-    return {t.name for b in blocks for t in b.terms}
+def _terms_of(fb: FunctionBlock, name: str) -> frozenset[str] | None:
+    """The terms of ``name`` in its FUZZIFY and DEFUZZIFY blocks (``None``: no such block)."""
+    return fb.term_names(name)
 
 
 def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:

@@ -23,6 +23,7 @@ from fuzzyctl.model import (
     Is,
     Not,
     Or,
+    Rule,
     Span,
 )
 
@@ -36,6 +37,7 @@ class _Resolver:
         self.by_lower: dict[str, list[str]] = {}
         for name in self.declared:
             self.by_lower.setdefault(name.lower(), []).append(name)
+        self._lowered: dict[int, dict[str, str]] = {}  # term set (by identity) -> lower-case map
 
     def variable(self, name: str, span: Span | None) -> str:
         if name in self.declared:
@@ -51,10 +53,14 @@ class _Resolver:
         return name
 
     def words(self, words: list[str], terms: set[str], span: Span | None) -> tuple[tuple[str, ...], str]:
+        if len(words) == 1 and words[0] in terms:
+            return (), words[0]
         for i in range(len(words)):
             if " ".join(words[i:]) in terms:
                 return tuple(words[:i]), " ".join(words[i:])
-        lowered = {t.lower(): t for t in terms}
+        lowered = self._lowered.get(id(terms))
+        if lowered is None:
+            lowered = self._lowered[id(terms)] = {t.lower(): t for t in terms}
         for i in range(len(words)):
             hit = lowered.get(" ".join(words[i:]).lower())
             if hit is not None:
@@ -78,39 +84,47 @@ def resolve_names(fb: FunctionBlock, warn: Warn) -> FunctionBlock:
     for b in blocks:
         terms.setdefault(b.variable, set()).update(t.name for t in b.terms)
 
+    no_terms: set[str] = set()
+
     def condition(c: Condition) -> Condition:
+        # a part that needs no change is kept as it is (no copy of a large rule base)
         if isinstance(c, Is):
+            if not c.hedges and c.term in terms.get(c.variable, no_terms) and c.variable in r.declared:
+                return c  # the common case: declared names, as written
             var = r.variable(c.variable, c.span)
-            hedges, term = r.words([*c.hedges, c.term], terms.get(var, set()), c.span)
+            hedges, term = r.words([*c.hedges, c.term], terms.get(var, no_terms), c.span)
+            if var == c.variable and term == c.term and hedges == c.hedges:
+                return c
             return replace(c, variable=var, term=term, hedges=hedges)
         if isinstance(c, Degree):
-            return replace(c, variable=r.variable(c.variable, c.span))
+            var = r.variable(c.variable, c.span)
+            return c if var == c.variable else replace(c, variable=var)
         if isinstance(c, Not):
-            return replace(c, operand=condition(c.operand))
-        if isinstance(c, And):
-            return replace(c, operands=tuple(condition(o) for o in c.operands))
-        assert isinstance(c, Or)
-        return replace(c, operands=tuple(condition(o) for o in c.operands))
+            operand = condition(c.operand)
+            return c if operand is c.operand else replace(c, operand=operand)
+        assert isinstance(c, And | Or)
+        operands = tuple(condition(o) for o in c.operands)
+        if all(a is b for a, b in zip(operands, c.operands, strict=True)):
+            return c
+        return replace(c, operands=operands)
 
     def conclusion(c: Conclusion) -> Conclusion:
+        if not c.hedges and c.term in terms.get(c.variable, no_terms) and c.variable in r.declared:
+            return c
         var = r.variable(c.variable, c.span)
         if c.term is None:
-            return replace(c, variable=var)
-        hedges, term = r.words([*c.hedges, c.term], terms.get(var, set()), c.span)
+            return c if var == c.variable else replace(c, variable=var)
+        hedges, term = r.words([*c.hedges, c.term], terms.get(var, no_terms), c.span)
+        if var == c.variable and term == c.term and hedges == c.hedges:
+            return c
         return replace(c, variable=var, term=term, hedges=hedges)
 
-    rule_blocks = tuple(
-        replace(
-            rb,
-            rules=tuple(
-                replace(
-                    rule,
-                    condition=condition(rule.condition) if rule.condition is not None else None,
-                    conclusions=tuple(conclusion(c) for c in rule.conclusions),
-                )
-                for rule in rb.rules
-            ),
-        )
-        for rb in fb.rule_blocks
-    )
+    def rule(rule: Rule) -> Rule:
+        cond = condition(rule.condition) if rule.condition is not None else None
+        concl = tuple(conclusion(c) for c in rule.conclusions)
+        if cond is rule.condition and all(a is b for a, b in zip(concl, rule.conclusions, strict=True)):
+            return rule
+        return replace(rule, condition=cond, conclusions=concl)
+
+    rule_blocks = tuple(replace(rb, rules=tuple(rule(x) for x in rb.rules)) for rb in fb.rule_blocks)
     return replace(fb, fuzzify=fuzzify, defuzzify=defuzzify, rule_blocks=rule_blocks)

@@ -24,6 +24,7 @@ from lark.exceptions import UnexpectedInput, VisitError
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl import keywords, shapes
+from fuzzyctl.fcl.fast import FastResult, read_runs
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.model import (
@@ -151,6 +152,24 @@ class ParseState:
     last_token: Token | None = None
     # How each shape was spelled, for the conformance report (kind -> spellings).
     spellings: set[str] = field(default_factory=set)
+    # Statements read by the fast reader (fuzzyctl.fcl.fast), merged into their blocks.
+    fast: FastResult | None = None
+
+    def fast_items(self, children: Sequence[Any], items: list[Any]) -> list[Any]:
+        """``items`` of the block made of ``children`` (its opening keyword first, its END
+        last) with the statements the fast reader took from the same block, in source order."""
+        fast = self.fast
+        if fast is None or not children:
+            return items
+        first, last = children[0], children[-1]
+        if not isinstance(first, Token) or not isinstance(last, Token):
+            return items
+        got = fast.between(first.start_pos or 0, last.start_pos or 0)
+        if not got:
+            return items
+        merged = items + [item for _offset, item, _spelling in got]
+        merged.sort(key=lambda x: (x.span.line, x.span.column))
+        return merged
 
     def error(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
         self.diagnostics.append(error(message, span, code=code, file=self.source.path, hint=hint))
@@ -375,7 +394,7 @@ class _Builder(Transformer[Token, Any]):
     def fuzzify_block(self, children: list[Any]) -> FuzzifyBlock:
         name: Token = children[1]
         span = _outer(children)
-        terms = tuple(c for c in children if isinstance(c, Term))
+        terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Term)]))
         ranges = [c for c in children if isinstance(c, Range)]
         if len(ranges) > 1:
             self.state.error("RANGE given twice in this FUZZIFY block", ranges[1].span, "duplicate-item")
@@ -384,7 +403,7 @@ class _Builder(Transformer[Token, Any]):
     def defuzzify_block(self, children: list[Any]) -> DefuzzifyBlock:
         name: Token = children[1]
         span = _outer(children)
-        terms = tuple(c for c in children if isinstance(c, Term))
+        terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Term)]))
         ranges = [c for c in children if isinstance(c, Range)]
         if len(ranges) > 1:
             self.state.error("RANGE given twice in this DEFUZZIFY block", ranges[1].span, "duplicate-item")
@@ -504,7 +523,7 @@ class _Builder(Transformer[Token, Any]):
 
         return RuleBlock(
             name,
-            tuple(c for c in children if isinstance(c, Rule)),
+            tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Rule)])),
             value("and_op"),
             value("or_op"),
             value("act"),
@@ -643,24 +662,29 @@ class ParseResult:
     spellings: frozenset[str] = frozenset()
 
 
-def parse_source(source: Source) -> ParseResult:
-    """Parse decoded FCL text; never raises for bad input."""
+def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
+    """Parse decoded FCL text; never raises for bad input.  ``fast``: runs of plain RULE
+    and TERM statements are read by :mod:`fuzzyctl.fcl.fast` (the same model; ``False``
+    reads everything with lark)."""
     from fuzzyctl.fcl.errors import syntax_diagnostic
 
     state = ParseState(source)
+    state.fast = read_runs(source.text) if fast else None
+    text = state.fast.text if state.fast is not None else source.text
     lark = _parser()
     builder = lark.options.transformer
     assert isinstance(builder, _Builder)
-    text = source.text
     # One parser and one builder serve every parse; the lock keeps parses from mixing states.
     _LOCK.acquire()
     builder.state = state
     _ACTIVE.append(state)
     try:
         document: Document | None = cast(Document, lark.parse(text))
+        _merge_comments(state, None)
     except UnexpectedInput as exc:
-        recovered = _recover(lark, state, exc, source)
+        recovered = _recover(lark, state, exc, text)
         if recovered is None:
+            _merge_comments(state, _error_pos(exc))
             state.diagnostics.insert(0, syntax_diagnostic(exc, state))
             document = None
         else:
@@ -680,23 +704,45 @@ def parse_source(source: Source) -> ParseResult:
     return ParseResult(document, state.diagnostics, source, frozenset(state.spellings))
 
 
-def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, source: Source) -> Document | None:
+def _error_pos(exc: UnexpectedInput) -> int | None:
+    token = getattr(exc, "token", None)
+    if isinstance(token, Token) and token.type != "$END":
+        return token.start_pos
+    pos = getattr(exc, "pos_in_stream", None)
+    return pos if isinstance(pos, int) else None
+
+
+def _merge_comments(state: ParseState, end: int | None) -> None:
+    """The comments and shape spellings of the text the fast reader took (before ``end``)
+    among lark's."""
+    if state.fast is None:
+        return
+    state.spellings.update(state.fast.spellings_before(end))
+    extra = state.fast.comments_before(end)
+    if extra:
+        state.comments.extend(_Comment(c.text, c.line, c.column, c.end_line) for c in extra)
+        state.comments.sort(key=lambda c: (c.line, c.column))
+
+
+def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> Document | None:
     """Text after the last END_FUNCTION_BLOCK is ignored with a warning (jFuzzyLogic's
-    ANTLR grammar stops there too); any other syntax error is not recovered."""
+    ANTLR grammar stops there too); any other syntax error is not recovered.  ``text`` is
+    what lark reads (see parse_source)."""
     from lark.exceptions import UnexpectedToken
 
     if not isinstance(exc, UnexpectedToken) or exc.expected - {"FUNCTION_BLOCK", "$END"}:
         return None
     pos = exc.token.start_pos
-    if pos is None or "END_FUNCTION_BLOCK" not in source.text[:pos].upper():
+    if pos is None or "END_FUNCTION_BLOCK" not in state.source.text[:pos].upper():
         return None
     state.diagnostics.clear()
     state.comments.clear()
     state.spellings.clear()
     try:
-        document = cast(Document, lark.parse(source.text[:pos]))
+        document = cast(Document, lark.parse(text[:pos]))
     except UnexpectedInput:
         return None
+    _merge_comments(state, pos)
     state.warn(
         "text after END_FUNCTION_BLOCK is ignored",
         Span(exc.token.line or 0, exc.token.column or 0),

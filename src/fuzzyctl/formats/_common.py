@@ -33,6 +33,13 @@ def fmt_number(value: float) -> str:
 
 def parse_number(text: str) -> float:
     """A number as MATLAB and fuzzylite write them (``1.5``, ``-Inf``, ``NaN``, ``1e-3``)."""
+    try:
+        value = float(text)  # the common case, at once
+    except ValueError:
+        pass
+    else:
+        if not math.isinf(value):
+            return value
     lowered = text.strip().lower()
     if lowered in {"inf", "+inf", "infinity"}:
         return math.inf

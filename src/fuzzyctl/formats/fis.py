@@ -185,8 +185,11 @@ def _sections(text: str, rep: Reporter) -> tuple[list[_Section], bool]:
     return sections, mentions_fuzzylite
 
 
+_SEPARATORS = re.compile(r"[\s,;]+")
+
+
 def _numbers(text: str, rep: Reporter, line: int, what: str) -> list[float]:
-    parts = [p for p in re.split(r"[\s,;]+", text.strip()) if p]
+    parts = [p for p in _SEPARATORS.split(text.strip()) if p]
     out: list[float] = []
     for part in parts:
         try:

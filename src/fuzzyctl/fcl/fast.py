@@ -1,0 +1,588 @@
+"""The bulk of a large FCL file read without lark: runs of RULE and TERM statements.
+
+A file with thousands of rules (or terms) is almost entirely a run of statements of one
+kind, each of which the grammar reads the same way whatever came before.  This module finds
+such runs (outside comments and OPTIONS text, which it skips as the lark lexer does), reads
+each statement with a small hand-written scanner and recursive-descent parser into the same
+model objects and spans the lark transformer builds, and tells the caller which text to
+blank out (spaces in place of every character but ``\\n``, so that lines and columns of what
+lark still reads are unchanged).
+
+The fast reader only accepts the plain forms that produce no diagnostic; anything else (a
+multi-word name, a keyword used as a name, a missing ';' after a TERM, an unknown shape,
+FUNCTION terms, a number out of range, deep nesting, ...) ends the run, and lark reads it.
+The first and the last statement of a run are always left to lark, so that lark enters and
+leaves the blanked text in the state it would have been in, and every syntax error (with its
+"previous token") is found by lark exactly as before.  ``fcl.lark`` stays the grammar of
+record; tests/fcl/test_fast.py checks that both paths give the same model on every FCL file
+we have and on generated rule blocks.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from bisect import bisect_left, bisect_right
+from dataclasses import dataclass, field, replace
+
+from fuzzyctl.fcl import shapes
+from fuzzyctl.model import (
+    And,
+    Conclusion,
+    Condition,
+    Degree,
+    Is,
+    MembershipFunction,
+    Not,
+    Or,
+    Param,
+    Point,
+    PointsMF,
+    Ref,
+    Rule,
+    SingletonMF,
+    Span,
+    Term,
+)
+
+# lark's NUMBER (fcl.lark), its COMMENT_* terminals and its WS.
+_NUMBER = r"[-+\u2212\u2013]?(?:(?:\d+(?:\.(?!\.)\d*)?|\.\d+)(?:[eE][-+]?\d+)?|(?i:nan|inf(?:inity)?)(?!\w))"
+_COMMENT = r"\(\*.*?\*\)|/\*.*?\*/|//[^\r\n]*"
+_WS = r"[ \t\f\r\n\ufeff]*"
+# One token with the white space before it: 1 comment, 2 number, 3 word, 4 other \w run,
+# 5 punctuation.
+_TOKEN = re.compile(rf"{_WS}(?:({_COMMENT})|({_NUMBER})|([^\W\d]\w*)|(\w+)|(:=|[:;,()]))", re.S)
+_LABEL = re.compile(r"\w+")
+# Where runs may start: comments and OPTIONS text are skipped as lark skips them.
+_SCAN = re.compile(rf"({_COMMENT})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
+_OPTIONS_END = re.compile(r"(?s:.+?)(?=\bEND_OPTIONS?\b)", re.I)
+# The most common rule, on one line with spaces only: read with one match.
+_NAME = r"[^\W\d]\w*"
+_ATOM = rf"{_NAME}[ \t]+IS[ \t]+{_NAME}"
+_SIMPLE_RULE = re.compile(
+    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*)"
+    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*)[ \t]*;",
+    re.I,
+)
+_PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
+_MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
+
+COMMENT, NUMBER, WORD, LABEL, PUNCT = 1, 2, 3, 4, 5
+
+# Every keyword terminal of fcl.lark: none of them is taken as a name here.
+_KEYWORD_TEXT = """FUNCTION_BLOCK END_FUNCTION_BLOCK VAR_INPUT VAR_OUTPUT VAR END_VAR FUZZIFY END_FUZZIFY
+DEFUZZIFY END_DEFUZZIFY RULEBLOCK END_RULEBLOCK OPTIONS END_OPTIONS OPTION END_OPTION TERM
+RANGE METHOD DEFAULT NC ACCU ACT AND OR NOT RULE IF THEN IS WITH FUNCTION"""
+KEYWORDS = frozenset(_KEYWORD_TEXT.split())
+#: Deepest nesting of parentheses and NOTs read here (far below limits.MAX_NESTING).
+MAX_FAST_NESTING = 30
+#: Shortest run worth taking from lark (its first and last statements stay with lark).
+MIN_RUN = 3
+#: Statements in a row not taken after which only the one-match forms are tried.
+MAX_MISSES = 1000
+
+
+class _Bail(Exception):
+    """Not a statement this reader takes: lark reads it."""
+
+
+@dataclass
+class FastComment:
+    text: str
+    offset: int
+    line: int
+    column: int
+    end_line: int
+
+
+@dataclass
+class FastResult:
+    """Statements read here (by source offset) and the text lark reads instead."""
+
+    text: str
+    offsets: list[int] = field(default_factory=list)
+    items: list[Rule | Term] = field(default_factory=list)
+    spellings: list[str | None] = field(default_factory=list)
+    comments: list[FastComment] = field(default_factory=list)
+
+    def between(self, start: int, end: int) -> list[tuple[int, Rule | Term, str | None]]:
+        """The statements read here whose offset lies in ``[start, end)``."""
+        lo, hi = bisect_left(self.offsets, start), bisect_left(self.offsets, end)
+        return list(zip(self.offsets[lo:hi], self.items[lo:hi], self.spellings[lo:hi], strict=True))
+
+    _at: tuple[int, int, int] = (0, 1, 0)  # an offset, its line, where that line starts
+
+    def add_comment(self, body: str, offset: int) -> None:
+        """Record a comment (in source order)."""
+        pos, line, ls = self._at
+        text = self.text
+        line += text.count("\n", pos, offset)
+        nl = text.rfind("\n", pos, offset)
+        if nl >= 0:
+            ls = nl + 1
+        self._at = (offset, line, ls)
+        self.comments.append(FastComment(body, offset, line, offset - ls + 1, line + body.count("\n")))
+
+    def spellings_before(self, end: int | None) -> set[str]:
+        n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
+        return {s for s in self.spellings[:n] if s is not None}
+
+    def comments_before(self, end: int | None) -> list[FastComment]:
+        if end is None:
+            return list(self.comments)
+        return self.comments[: bisect_right([c.offset for c in self.comments], end - 1)]
+
+
+class _Reader:
+    """Scanner and parser over ``text`` (positions are string offsets)."""
+
+    quick_only = False  # after many statements not taken: only the one-match forms
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.pos = 0
+        self.comments: list[tuple[str, int]] = []
+        # line of the current statement's start and where that line starts
+        self.base = 0
+        self.base_line = 1
+        self.base_ls = 0
+        self.next_nl = text.find("\n")
+        self.la: tuple[int, int, int, str] | None = None
+
+    def statement(self) -> tuple[Rule | Term, str | None]:
+        """One statement and the spelling of its shape (``_Bail`` when not taken)."""
+        raise NotImplementedError
+
+    # ---------------------------------------------------------------- positions
+    def at_statement(self, offset: int) -> None:
+        text = self.text
+        if offset >= self.base:
+            self.base_line += text.count("\n", self.base, offset)
+            nl = text.rfind("\n", self.base, offset)
+            if nl >= 0:
+                self.base_ls = nl + 1
+        else:  # back to the last statement of a run
+            self.base_line -= text.count("\n", offset, self.base)
+            self.base_ls = text.rfind("\n", 0, offset) + 1
+        if offset < self.base:
+            nl = text.find("\n", offset, self.base)
+            if nl >= 0:
+                self.next_nl = nl
+        elif 0 <= self.next_nl < offset:
+            self.next_nl = text.find("\n", offset)
+        self.base = offset
+
+    def lc(self, p: int) -> tuple[int, int]:
+        if p <= self.next_nl or self.next_nl < 0:
+            return self.base_line, p - self.base_ls + 1
+        text = self.text
+        return self.base_line + text.count("\n", self.base, p), p - text.rfind("\n", self.base, p)
+
+    def span(self, a: int, b: int) -> Span:
+        la, ca = self.lc(a)
+        lb, cb = self.lc(b)
+        return Span(la, ca, lb, cb)
+
+    # ---------------------------------------------------------------- tokens
+    def _lex(self) -> tuple[int, int, int, str]:
+        """(kind, start, end, upper-case text) of the token at ``pos``, comments recorded
+        and skipped."""
+        m = _TOKEN.match(self.text, self.pos)
+        while m is not None and m.lastindex == COMMENT:
+            self.comments.append((m.group(COMMENT), m.start(COMMENT)))
+            m = _TOKEN.match(self.text, m.end())
+        if m is None:
+            raise _Bail
+        k = m.lastindex or 0
+        self.pos = m.end()
+        return k, m.start(k), self.pos, m.group(k).upper()
+
+    def next(self) -> tuple[int, int, int, str]:
+        la = self.la
+        if la is not None:
+            self.la = None
+            return la
+        return self._lex()
+
+    def peek(self) -> tuple[int, int, int, str]:
+        """The next token, not taken (comments before it are recorded once)."""
+        if self.la is None:
+            self.la = self._lex()
+        return self.la
+
+    def seek(self, pos: int) -> None:
+        self.pos = pos
+        self.la = None
+
+    def word(self) -> tuple[str, int, int]:
+        """A name that is no keyword."""
+        k, a, b, u = self.next()
+        if k != WORD or u in KEYWORDS:
+            raise _Bail
+        return self.text[a:b], a, b
+
+    def keyword(self, *allowed: str) -> tuple[str, int, int]:
+        k, a, b, u = self.next()
+        if k != WORD or u not in allowed:
+            raise _Bail
+        return u, a, b
+
+    def punct(self, p: str) -> int:
+        k, a, _, u = self.next()
+        if k != PUNCT or u != p:
+            raise _Bail
+        return a
+
+    def number(self, a: int, b: int) -> float:
+        tok = self.text[a:b]
+        value = float(tok.translate(_MINUS_SIGNS))
+        if tok[-1:].isdigit() and not math.isfinite(value):
+            raise _Bail  # lark's reader reports it
+        return value
+
+    def param(self) -> tuple[Param, int, int]:
+        k, a, b, u = self.next()
+        if k == NUMBER:
+            return self.number(a, b), a, b
+        if k != WORD or u in KEYWORDS:
+            raise _Bail
+        return Ref(self.text[a:b], self.span(a, b)), a, b
+
+
+class _RuleReader(_Reader):
+    """RULE label : IF condition THEN conclusions [;]"""
+
+    def statement(self) -> tuple[Rule, None]:
+        m = _SIMPLE_RULE.match(self.text, self.pos)
+        if m is not None:
+            rule = self.simple(m)
+            if rule is not None:
+                return rule, None
+        if self.quick_only:
+            raise _Bail
+        return self.general(), None
+
+    def simple(self, m: re.Match[str]) -> Rule | None:
+        """The rule matched by _SIMPLE_RULE (``None`` when a name is a keyword)."""
+        text = self.text
+        line, col = self.lc(m.start())
+        shift = col - m.start()  # column = offset + shift on this line
+        s2, e2, s3, e3 = m.start(2), m.end(2), m.start(3), m.end(3)
+        condition = _spaced_condition(text[s2:e2], s2, line, shift)
+        if condition is None:
+            condition = self._condition(s2, e2, line, shift)
+            if condition is None:
+                return None
+        conclusions = []
+        for part in _PART.finditer(text, s3, e3):
+            v, t = part.group(1), part.group(2)
+            if v is None or v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+                return None
+            span = Span(line, part.start() + shift, line, part.end() + shift)
+            conclusions.append(Conclusion(v, t, None, span))
+        self.seek(m.end())
+        return Rule(m.group(1), condition, tuple(conclusions), Span(line, col, line, m.end() + shift))
+
+    def _condition(self, start: int, end: int, line: int, shift: int) -> Condition | None:
+        groups: list[list[Is]] = [[]]
+        for part in _PART.finditer(self.text, start, end):
+            if part.lastindex == 3:
+                if part.group(3).upper() == "OR":
+                    groups.append([])
+                continue
+            v, t = part.group(1), part.group(2)
+            if v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+                return None
+            groups[-1].append(Is(v, t, False, (), Span(line, part.start() + shift, line, part.end() + shift)))
+        return _precedence(groups)
+
+    def general(self) -> Rule:
+        _, r0, _ = self.keyword("RULE")
+        k, a, _, _ = self.next()
+        if k not in (NUMBER, WORD, LABEL):
+            raise _Bail
+        m = _LABEL.match(self.text, a)
+        if m is None:
+            raise _Bail
+        label = m.group()
+        self.seek(m.end())
+        self.punct(":")
+        self.keyword("IF")
+        self.depth = 0
+        condition = self.or_condition()
+        _, _, end = self.keyword("THEN")
+        conclusions = [self.conclusion()]
+        while True:
+            k, _, _, w = self.peek()
+            if not ((k == PUNCT and w == ",") or (k == WORD and w == "AND")):
+                break
+            self.next()
+            conclusions.append(self.conclusion())
+        if k == PUNCT and w == ";":
+            _, _, end, _ = self.next()
+        elif not (k == WORD and w in ("RULE", "END_RULEBLOCK")):
+            raise _Bail
+        return Rule(label, condition, tuple(conclusions), self.span(r0, end))
+
+    def or_condition(self) -> Condition:
+        first = self.and_condition()
+        k, _, _, w = self.peek()
+        if not (k == WORD and w == "OR"):
+            return first
+        operands = [first]
+        while k == WORD and w == "OR":
+            self.next()
+            operands.append(self.and_condition())
+            k, _, _, w = self.peek()
+        return Or(tuple(operands), _join(first.span, operands[-1].span))
+
+    def and_condition(self) -> Condition:
+        first = self.not_condition()
+        k, _, _, w = self.peek()
+        if not (k == WORD and w == "AND"):
+            return first
+        operands = [first]
+        while k == WORD and w == "AND":
+            self.next()
+            operands.append(self.not_condition())
+            k, _, _, w = self.peek()
+        return And(tuple(operands), _join(first.span, operands[-1].span))
+
+    def not_condition(self) -> Condition:
+        k, a, b, u = self.next()
+        if k == PUNCT and u == "(":
+            self._deeper()
+            inner = self.or_condition()
+            self.punct(")")
+            self.depth -= 1
+            return replace(inner, grouped=True) if isinstance(inner, And | Or) else inner
+        if k == WORD and u == "NOT":
+            self._deeper()
+            operand = self.not_condition()
+            self.depth -= 1
+            return Not(operand, _join(self.span(a, b), operand.span))
+        if k != WORD or u in KEYWORDS:
+            raise _Bail
+        name = self.text[a:b]
+        k2, _, _, w2 = self.peek()
+        if k2 != WORD or w2 != "IS":
+            if (k2 == WORD and w2 in ("AND", "OR", "THEN")) or (k2 == PUNCT and w2 == ")"):
+                return Degree(name, self.span(a, b))
+            raise _Bail
+        self.next()
+        k2, _, _, w2 = self.peek()
+        negated = k2 == WORD and w2 == "NOT"
+        if negated:
+            self.next()
+        words, end = self._ids()
+        return Is(name, words[-1], negated, tuple(words[:-1]), self.span(a, end))
+
+    def _deeper(self) -> None:
+        self.depth += 1
+        if self.depth > MAX_FAST_NESTING:
+            raise _Bail
+
+    def _ids(self) -> tuple[list[str], int]:
+        """ID+ (hedges and a term): names up to the next keyword or punctuation."""
+        w, _, end = self.word()
+        words = [w]
+        while True:
+            k, _, _, up = self.peek()
+            if k != WORD or up in KEYWORDS:
+                return words, end
+            w, _, end = self.word()
+            words.append(w)
+
+    def conclusion(self) -> Conclusion:
+        variable, a, end = self.word()
+        term: str | None = None
+        hedges: tuple[str, ...] = ()
+        weight: Param | None = None
+        k, _, _, w = self.peek()
+        if k == WORD and w == "IS":
+            self.next()
+            words, end = self._ids()
+            term, hedges = words[-1], tuple(words[:-1])
+            k, _, _, w = self.peek()
+        if k == WORD and w == "WITH":
+            _, _, end, _ = self.next()
+            weight, _, b = self.param()
+            if isinstance(weight, Ref):
+                end = b  # a number has no span of its own: the span ends at WITH
+        return Conclusion(variable, term, weight, self.span(a, end), hedges)
+
+
+class _TermReader(_Reader):
+    """TERM name := points | number | shape numbers ;"""
+
+    def statement(self) -> tuple[Term, str | None]:
+        if self.quick_only:
+            raise _Bail
+        _, t0, _ = self.keyword("TERM")
+        name, _, _ = self.word()
+        self.punct(":=")
+        k, a, b, u = self.next()
+        spelling: str | None = None
+        mf: MembershipFunction
+        if k == PUNCT and u == "(":
+            points = [self.point(a)]
+            while True:
+                k, _, _, w = self.peek()
+                if k == PUNCT and w == ",":
+                    self.next()
+                    k, _, _, w = self.peek()
+                if not (k == PUNCT and w == "("):
+                    break
+                _, p, _, _ = self.next()
+                points.append(self.point(p))
+            mf = PointsMF(tuple(points))
+        elif k == NUMBER:
+            mf = SingletonMF(self.number(a, b))
+        elif k == WORD and u not in KEYWORDS:
+            mf, spelling = self.shape(self.text[a:b])
+        else:
+            raise _Bail
+        end = self.punct(";") + 1
+        return Term(name, mf, self.span(t0, end)), spelling
+
+    def point(self, start: int) -> Point:
+        x, _, _ = self.param()
+        self.punct(",")
+        y, _, _ = self.param()
+        end = self.punct(")") + 1
+        return Point(x, y, self.span(start, end))
+
+    def shape(self, name: str) -> tuple[MembershipFunction, str]:
+        spelling = shapes.lookup(name)
+        if spelling is None or name.upper() == "DISCRETE":
+            raise _Bail
+        args: list[Param] = []
+        while self.peek()[0] == NUMBER:
+            _, a, b, _ = self.next()
+            args.append(self.number(a, b))
+        if not args:
+            raise _Bail
+        try:
+            return shapes.build(spelling, args), spelling.written
+        except shapes.ShapeError:
+            raise _Bail from None
+
+
+def _spaced_condition(cond: str, pos: int, line: int, shift: int) -> Condition | None:
+    """``v IS t AND ...`` (as _SIMPLE_RULE matched it) with single spaces between the words,
+    read by splitting (``None``: other spacing, or a keyword as a name)."""
+    if "  " in cond or "\t" in cond:
+        return None
+    words = cond.split(" ")
+    groups: list[list[Is]] = [[]]
+    n = len(words)
+    i = 0
+    pos += shift
+    while True:
+        v, t = words[i], words[i + 2]
+        if v.upper() in KEYWORDS or t.upper() in KEYWORDS:
+            return None
+        b = pos + len(v) + len(t) + 4
+        groups[-1].append(Is(v, t, False, (), Span(line, pos, line, b)))
+        i += 3
+        if i >= n:
+            return _precedence(groups)
+        op = words[i]
+        if len(op) == 2:
+            groups.append([])
+        pos = b + len(op) + 2
+        i += 1
+
+
+def _precedence(groups: list[list[Is]]) -> Condition:
+    """OR of ANDs of the subconditions grouped between the ORs."""
+    ors: list[Condition] = [
+        g[0] if len(g) == 1 else And(tuple(g), _join(g[0].span, g[-1].span)) for g in groups
+    ]
+    return ors[0] if len(ors) == 1 else Or(tuple(ors), _join(ors[0].span, ors[-1].span))
+
+
+def _join(first: Span | None, last: Span | None) -> Span | None:
+    if first is None or last is None:
+        return first
+    return Span(first.line, first.column, last.end_line, last.end_column)
+
+
+def read_runs(text: str) -> FastResult | None:
+    """The runs of plain RULE and TERM statements of ``text`` (``None`` when there is no run
+    worth taking from lark)."""
+    result = FastResult(text)
+    blanks: list[tuple[int, int]] = []
+    readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
+    pos = misses = 0
+    while True:
+        m = _SCAN.search(text, pos)
+        if m is None:
+            break
+        if m.lastindex == 1:
+            pos = m.end()
+            continue
+        word = m.group(2).upper()
+        if word.startswith("OPTION"):
+            body = _OPTIONS_END.match(text, m.end())
+            if body is None:
+                break
+            pos = body.end()
+            continue
+        taken = len(blanks)
+        pos = _run(readers[word], word, m.start(), result, blanks)
+        misses = 0 if len(blanks) > taken else misses + 1
+        if misses > MAX_MISSES:  # a file of statements this reader does not take
+            for reader in readers.values():
+                reader.quick_only = True
+    if not blanks:
+        return None
+    result.text = _blank(text, blanks)
+    return result
+
+
+def _run(reader: _Reader, word: str, start: int, result: FastResult, blanks: list[tuple[int, int]]) -> int:
+    """Read the run of ``word`` statements from ``start``; keep the inner ones in ``result``.
+    Returns where the search for the next run goes on."""
+    got: list[tuple[int, Rule | Term, str | None]] = []
+    reader.comments = []
+    at = start
+    while True:
+        reader.seek(at)
+        reader.at_statement(at)
+        try:
+            item, spelling = reader.statement()
+        except _Bail:
+            break
+        got.append((at, item, spelling))
+        try:
+            kind, a, _, u = reader.peek()  # comments before it are recorded here
+        except _Bail:
+            break
+        if kind != WORD or u != word:
+            break
+        at = a
+    if len(got) < MIN_RUN:
+        return start + len(word)
+    lo, hi = got[1][0], got[-1][0]
+    blanks.append((lo, hi))
+    for offset, item, spelling in got[1:-1]:
+        result.offsets.append(offset)
+        result.items.append(item)
+        result.spellings.append(spelling)
+    for body, offset in reader.comments:
+        if lo <= offset < hi:
+            result.add_comment(body, offset)
+    return hi
+
+
+def _blank(text: str, regions: list[tuple[int, int]]) -> str:
+    """``text`` with every character of ``regions`` but ``\\n`` replaced by a space."""
+    out: list[str] = []
+    pos = 0
+    for a, b in regions:
+        out.append(text[pos:a])
+        out.append("\n".join(" " * len(line) for line in text[a:b].split("\n")))
+        pos = b
+    out.append(text[pos:])
+    return "".join(out)

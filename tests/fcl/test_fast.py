@@ -1,0 +1,188 @@
+"""The fast reader of RULE and TERM runs (fuzzyctl.fcl.fast) against lark, the grammar of
+record: the same model - every field, spans and comments included - the same diagnostics
+(place, wording, order) and the same shape spellings, on every FCL file we have and on
+generated rule and term blocks (valid ones, and ones with a mistake somewhere)."""
+
+from __future__ import annotations
+
+import dataclasses
+import random
+from pathlib import Path
+from typing import Any
+
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from fuzzyctl.fcl import fast
+from fuzzyctl.fcl.parser import parse_source
+from fuzzyctl.fcl.source import Source, read_source
+from tests.extras import extra_files
+
+ROOT = Path(__file__).resolve().parents[2]
+LOCAL = sorted({*ROOT.joinpath("examples").rglob("*.fcl"), *ROOT.joinpath("tests", "data").rglob("*.fcl")})
+
+
+def deep(obj: Any) -> Any:
+    """Everything a model object holds, compared fields included (spans, comments)."""
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        return (type(obj).__name__, *(deep(getattr(obj, f.name)) for f in dataclasses.fields(obj)))
+    if isinstance(obj, list | tuple):
+        return tuple(deep(x) for x in obj)
+    if isinstance(obj, float) and obj != obj:
+        return "nan"
+    return obj
+
+
+def both(text: str, path: str | None = "t.fcl") -> tuple[Any, Any]:
+    source = Source(text, path)
+    fast_result = parse_source(source)
+    lark_result = parse_source(source, fast=False)
+    return (
+        (deep(fast_result.document), deep(fast_result.diagnostics), fast_result.spellings),
+        (deep(lark_result.document), deep(lark_result.diagnostics), lark_result.spellings),
+    )
+
+
+def assert_same(text: str, path: str | None = "t.fcl") -> None:
+    got, want = both(text, path)
+    assert got[1] == want[1]  # diagnostics first: the clearer message
+    assert got[0] == want[0]
+    assert got[2] == want[2]
+
+
+def _read(path: Path) -> str | None:
+    try:
+        return read_source(path).text
+    except Exception:  # undecodable files are refused before parsing, by both paths
+        return None
+
+
+@pytest.mark.parametrize("path", LOCAL, ids=lambda p: str(p.relative_to(ROOT)))
+def test_same_model_on_local_files(path: Path) -> None:
+    text = _read(path)
+    if text is not None:
+        assert_same(text, str(path))
+
+
+CORPUS = extra_files("corpus", "corpus", pattern="*.fcl", recursive=True)
+
+
+@pytest.mark.extra("corpus")
+def test_same_model_on_the_corpus() -> None:
+    assert CORPUS, "no FCL file in the corpus"
+    taken = 0
+    for path in CORPUS:
+        text = _read(path)
+        if text is None:
+            continue
+        if fast.read_runs(text) is not None:
+            taken += 1
+        got, want = both(text, str(path))
+        assert got == want, path
+    assert taken > len(CORPUS) // 2  # the fast reader is used on most real files
+
+
+def test_fast_reader_takes_the_bulk_of_a_rule_base() -> None:
+    head = (
+        "FUNCTION_BLOCK f VAR_INPUT a, b : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR\n"
+        "FUZZIFY a TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY\n"
+        "FUZZIFY b TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY\n"
+        "DEFUZZIFY y TERM lo := 0; TERM hi := 1; METHOD : COGS; END_DEFUZZIFY\nRULEBLOCK r\n"
+    )
+    rules = "".join(f"RULE {k} : IF a IS lo AND b IS hi THEN y IS lo;\n" for k in range(50))
+    text = head + rules + "END_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+    result = fast.read_runs(text)
+    assert result is not None and len(result.items) == 48  # all but the first and the last
+    assert_same(text)
+    # a mistake in the middle: lark reads it, with its place
+    broken = text.replace("RULE 25 : IF a IS lo AND", "RULE 25 : IF a IS lo AND ;")
+    got, want = both(broken)
+    assert got == want and want[0] is None
+
+
+# --------------------------------------------------------------------------- generated text
+
+NAMES = ["a", "b", "Temp", "x_1", "lo", "hi", "very", "and", "NC", "with", "is", "not", "inf", "e1", "é"]
+WS = [" ", "  ", "\n", "\t", " (* c *) ", " // note\n", "\r\n", " /* x\n y */ "]
+
+
+def _ws(rng: random.Random) -> str:
+    return rng.choice(WS) if rng.random() < 0.3 else " "
+
+
+def _cond(rng: random.Random, depth: int) -> str:
+    r = rng.random()
+    if depth > 0 and r < 0.15:
+        return "NOT" + _ws(rng) + _cond(rng, depth - 1)
+    if depth > 0 and r < 0.3:
+        return "(" + _cond(rng, depth - 1) + ")"
+    if depth > 0 and r < 0.5:
+        op = rng.choice(["AND", "OR", "and", "Or"])
+        return _cond(rng, depth - 1) + _ws(rng) + op + _ws(rng) + _cond(rng, depth - 1)
+    name = rng.choice(NAMES)
+    if r < 0.55:
+        return name
+    words = [rng.choice(NAMES) for _ in range(rng.choice([1, 1, 1, 2]))]
+    neg = "NOT " if rng.random() < 0.15 else ""
+    return f"{name}{_ws(rng)}IS{_ws(rng)}{neg}{' '.join(words)}"
+
+
+def _conclusion(rng: random.Random) -> str:
+    text = rng.choice(NAMES)
+    if rng.random() < 0.85:
+        text += " IS " + " ".join(rng.choice(NAMES) for _ in range(rng.choice([1, 1, 2])))
+    if rng.random() < 0.2:
+        text += " WITH " + rng.choice(["0.5", "1", "-1", "inf", "1e999", "w", ".5", "2e-3", "\u22121"])
+    return text
+
+
+def _rule(rng: random.Random, k: int) -> str:
+    label = rng.choice([str(k), f"R{k}", f"{k}a", f"_{k}", "1.5"])
+    concl = (rng.choice([", ", " AND ", " and "])).join(
+        _conclusion(rng) for _ in range(rng.choice([1, 1, 2]))
+    )
+    end = rng.choice([";", ";", ";", ""])
+    return f"RULE{_ws(rng)}{label}{_ws(rng)}:{_ws(rng)}IF {_cond(rng, 3)}{_ws(rng)}THEN {concl}{end}\n"
+
+
+def _term(rng: random.Random, k: int) -> str:
+    name = rng.choice(NAMES) + str(k % 3)
+    r = rng.random()
+    if r < 0.4:
+        mf = " ".join(f"({rng.choice(['0', '1', '-2.5', 'x', 'inf'])},{_ws(rng)}{rng.choice(['0', '1'])})"
+                      for _ in range(rng.choice([1, 2, 3])))  # fmt: skip
+    elif r < 0.55:
+        mf = rng.choice(["0", "1.5", "-3", "nan", "x"])
+    else:
+        shape = rng.choice(["TRIAN", "trian", "TRAP", "GAUSS", "gbell", "Triangle", "Discrete", "nope"])
+        mf = (
+            shape
+            + " "
+            + " ".join(rng.choice(["0", "1", "2", "3", "z"]) for _ in range(rng.choice([2, 3, 4])))
+        )
+    return f"TERM {name} := {mf}{rng.choice([';', ';', ';', ''])}\n"
+
+
+def _document(rng: random.Random) -> str:
+    terms = "".join(_term(rng, k) for k in range(rng.randrange(0, 8)))
+    rules = "".join(_rule(rng, k) for k in range(rng.randrange(0, 10)))
+    text = (
+        "FUNCTION_BLOCK g\nVAR_INPUT a : REAL; b : REAL; Temp : REAL; END_VAR\n"
+        "VAR_OUTPUT x_1 : REAL; END_VAR\n"
+        f"FUZZIFY a\n{terms}END_FUZZIFY\nFUZZIFY b TERM lo := 0; TERM hi := 1; END_FUZZIFY\n"
+        f"DEFUZZIFY x_1 TERM lo := 0; TERM hi := 1; END_DEFUZZIFY\nRULEBLOCK r\n{rules}END_RULEBLOCK\n"
+        "END_FUNCTION_BLOCK\n"
+    )
+    if rng.random() < 0.3:  # a mistake somewhere
+        pos = rng.randrange(len(text))
+        text = (
+            text[:pos] + rng.choice(["(", ")", ";", "RULE", "TERM", "*)", "(*", "x", ":", "IS"]) + text[pos:]
+        )
+    return text
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1))
+def test_same_model_on_generated_blocks(seed: int) -> None:
+    assert_same(_document(random.Random(seed)))
