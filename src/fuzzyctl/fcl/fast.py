@@ -23,6 +23,7 @@ from __future__ import annotations
 import math
 import re
 from bisect import bisect_left, bisect_right
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from fuzzyctl.fcl import shapes
@@ -325,28 +326,23 @@ class _RuleReader(_Reader):
         return Rule(label, condition, tuple(conclusions), self.span(r0, end))
 
     def or_condition(self) -> Condition:
-        first = self.and_condition()
-        k, _, _, w = self.peek()
-        if not (k == WORD and w == "OR"):
-            return first
-        operands = [first]
-        while k == WORD and w == "OR":
-            self.next()
-            operands.append(self.and_condition())
-            k, _, _, w = self.peek()
-        return Or(tuple(operands), _join(first.span, operands[-1].span))
+        return self._chain("OR", self.and_condition, Or)
 
     def and_condition(self) -> Condition:
-        first = self.not_condition()
+        return self._chain("AND", self.not_condition, And)
+
+    def _chain(self, word: str, operand: Callable[[], Condition], node: type[And] | type[Or]) -> Condition:
+        """``operand (word operand)*``: the operand alone, or one flat node of them all."""
+        first = operand()
         k, _, _, w = self.peek()
-        if not (k == WORD and w == "AND"):
+        if not (k == WORD and w == word):
             return first
         operands = [first]
-        while k == WORD and w == "AND":
+        while k == WORD and w == word:
             self.next()
-            operands.append(self.not_condition())
+            operands.append(operand())
             k, _, _, w = self.peek()
-        return And(tuple(operands), _join(first.span, operands[-1].span))
+        return node(tuple(operands), _join(first.span, operands[-1].span))
 
     def not_condition(self) -> Condition:
         k, a, b, u = self.next()
