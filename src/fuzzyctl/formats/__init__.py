@@ -23,6 +23,7 @@ from pathlib import Path
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
 from fuzzyctl.files import write_atomic
+from fuzzyctl.gcpause import gc_paused
 from fuzzyctl.model import Document
 
 
@@ -162,6 +163,7 @@ def decode(data: bytes) -> str:
         return data.decode("latin-1")
 
 
+@gc_paused()
 def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
     """Parse ``text`` as ``format``."""
     from fuzzyctl.limits import check_document, check_text
