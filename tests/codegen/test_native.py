@@ -11,6 +11,7 @@ the builds here exercise, and -O3 with -ffp-contract=off keeps IEEE arithmetic).
 from __future__ import annotations
 
 import os
+import re
 import threading
 import warnings
 from collections.abc import Iterator
@@ -233,6 +234,10 @@ def test_table_driven_c_agrees_with_the_interpreter(gaussian: bool) -> None:
     kind, files = native.sources(plan)
     assert kind == "fast" and "fz_c_FZ_HKEY" in files["fz_native.c"]
     assert "FZ_R17 =" not in files["fz_native.c"], "no statement per rule"
+    if native.binary_tables():  # the large tables are data for the assembler, not C text
+        assert "fz_c_FZ_HKEY.bin" in files
+        assert re.search(r"fz_c_FZ_HKEY\[\d+\] = \{", files["fz_native.c"]) is None
+        assert ".incbin" in files["fz_native.c"]
     nat = NativeController(plan, native.build(plan))
     data = np.random.default_rng(1).uniform(-1.2, 1.2, (400, 3))
     got = _native_outputs(nat, [i.name for i in plan.inputs], data)

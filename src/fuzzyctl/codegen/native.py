@@ -28,6 +28,7 @@ import hashlib
 import os
 import shutil
 import struct
+import sys
 import tempfile
 import threading
 import warnings
@@ -111,17 +112,25 @@ def _compiler_id(cc: str) -> str:
         return cc
 
 
-def sources(plan: Plan) -> tuple[str, dict[str, str]]:
-    """(kind, {file name: text}) of the native library of ``plan``: kind ``"fast"`` (the
-    evaluator program) or ``"plc"`` (the PLC function block behind the same entry points).
-    Raises :class:`CodegenError` when neither can express the plan."""
+def binary_tables() -> bool:
+    """Whether large constant tables go to the library as data (``.incbin``, GNU assembler
+    on ELF: Linux and the BSDs) rather than as C initialisers."""
+    return sys.platform.startswith(("linux", "freebsd", "netbsd", "openbsd"))
+
+
+def sources(plan: Plan) -> tuple[str, dict[str, str | bytes]]:
+    """(kind, {file name: text or bytes}) of the native library of ``plan``: kind ``"fast"``
+    (the evaluator program, with its large tables as ``.bin`` files where
+    :func:`binary_tables`) or ``"plc"`` (the PLC function block behind the same entry
+    points).  Raises :class:`CodegenError` when neither can express the plan."""
     from fuzzyctl.codegen.render_c import render_native
     from fuzzyctl.engine.fastprog import build_fast
 
     try:
         fp = build_fast(plan, "c")
-        text = render_native(fp) + _FAST_STATE.format(n_prev=max(1, len(plan.outputs)))
-        return "fast", {"fz_native.c": text}
+        tables: dict[str, bytes] | None = {} if binary_tables() else None
+        text = render_native(fp, tables) + _FAST_STATE.format(n_prev=max(1, len(plan.outputs)))
+        return "fast", {"fz_native.c": text, **(tables or {})}
     except CodegenError as fast_error:
         try:
             return "plc", _plc_sources(plan)
@@ -129,7 +138,7 @@ def sources(plan: Plan) -> tuple[str, dict[str, str]]:
             raise fast_error from None
 
 
-def _plc_sources(plan: Plan) -> dict[str, str]:
+def _plc_sources(plan: Plan) -> dict[str, str | bytes]:
     from fuzzyctl.codegen.program import build_program
     from fuzzyctl.codegen.render_c import render_c
 
@@ -184,15 +193,19 @@ def build(plan: Plan, hint: Path | None = None) -> Path:
     _kind, files = sources(plan)
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-build-") as tmp:
-        for fname, text in files.items():
-            Path(tmp, fname).write_text(text)
+        for fname, content in files.items():
+            if isinstance(content, bytes):
+                Path(tmp, fname).write_bytes(content)
+            else:
+                Path(tmp, fname).write_text(content)
         fd, tmp_name = tempfile.mkstemp(dir=out_dir, prefix=f".{lib.stem}.", suffix=".tmp")
         os.close(fd)
         partial = Path(tmp_name)  # unique per build (threads share a pid)
-        cmd = [cc, *CFLAGS, "-o", str(partial), str(Path(tmp, "fz_native.c")), "-lm"]
+        cmd = [cc, *CFLAGS, "-o", str(partial), "fz_native.c", "-lm"]
         import subprocess
 
-        res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+        # run in the build directory: the C includes its tables by relative name
+        res = subprocess.run(cmd, capture_output=True, text=True, timeout=600, cwd=tmp)
         if res.returncode != 0:
             partial.unlink(missing_ok=True)
             raise NativeError(f"the C compiler failed on the generated code:\n{res.stderr.strip()}")
