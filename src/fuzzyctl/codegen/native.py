@@ -169,9 +169,19 @@ def library_key(plan: Plan, cc: str) -> str:
     return h.hexdigest()[:32]
 
 
-def build(plan: Plan, hint: Path | None = None) -> Path:
+def _named_key(content_key: str, cc: str) -> str:
+    h = hashlib.sha256(b"plan-key\0" + content_key.encode())
+    h.update(cache.code_fingerprint().encode())
+    h.update(" ".join(CFLAGS).encode() + b"\0" + _compiler_id(cc).encode())
+    return h.hexdigest()[:32]
+
+
+def build(plan: Plan, hint: Path | None = None, content_key: str | None = None) -> Path:
     """Compile (or find in the cache) the shared library of ``plan``.  ``hint`` is a file
-    naming the library of this plan, written here (it saves hashing a large plan)."""
+    naming the library of this plan, written here (it saves hashing a large plan);
+    ``content_key``, the plan's own cache key (derived from the bytes of the file it came
+    from and the options), names the library instead of a hash of the plan's repr (0.2 s
+    for 10,000 rules)."""
     out_dir = cache_dir() / "native"
     if hint is not None:
         try:
@@ -184,7 +194,7 @@ def build(plan: Plan, hint: Path | None = None) -> Path:
     cc = compiler()
     if cc is None:
         raise NativeError("no C compiler found (set CC or install cc)")
-    lib = out_dir / f"{library_key(plan, cc)}.so"
+    lib = out_dir / f"{library_key(plan, cc) if content_key is None else _named_key(content_key, cc)}.so"
     if hint is not None:
         cache.write_atomic(hint, lib.name.encode())
     if lib.exists():
@@ -391,13 +401,18 @@ def notice(message: str) -> None:
 
 
 def compile_native(
-    plan: Plan, model: FunctionBlock | None = None, *, explicit: bool = True, hint: Path | None = None
+    plan: Plan,
+    model: FunctionBlock | None = None,
+    *,
+    explicit: bool = True,
+    hint: Path | None = None,
+    content_key: str | None = None,
 ) -> Controller:
     """A native controller for ``plan``, or the Python one when there is no compiler or the
     plan uses something the C generators cannot express: with a warning when native was
     asked for (``explicit``), a one-line notice for a missing compiler otherwise."""
     try:
-        return NativeController(plan, build(plan, hint), model)
+        return NativeController(plan, build(plan, hint, content_key), model)
     except NativeError as exc:
         if explicit:
             warnings.warn(

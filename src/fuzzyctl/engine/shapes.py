@@ -670,9 +670,7 @@ def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
 def monotone(points: Points) -> bool:
     """Whether a breakpoint list never falls or never rises (a Tsukamoto term)."""
     ys = [y for _x, y in points]
-    return all(a <= b for a, b in itertools.pairwise(ys)) or all(
-        a >= b for a, b in itertools.pairwise(ys)
-    )
+    return all(a <= b for a, b in itertools.pairwise(ys)) or all(a >= b for a, b in itertools.pairwise(ys))
 
 
 def _monotone_inverse(params: Sequence[float], h: float, y: Any) -> Any:

@@ -93,9 +93,7 @@ def with_if_parts(fb: FunctionBlock) -> FunctionBlock:
     blocks = tuple(
         replace(
             rb,
-            rules=tuple(
-                replace(r, condition=Degree(name)) if r.condition is None else r for r in rb.rules
-            ),
+            rules=tuple(replace(r, condition=Degree(name)) if r.condition is None else r for r in rb.rules),
         )
         for rb in fb.rule_blocks
     )
