@@ -270,9 +270,10 @@ SHAPES = ("valid", "errors", "garbage", "one-line", "deep", "not")
 # prints them, exit 1 on a refusal, 3 on anything else); FCL also goes through `check`.
 _CHILD = """
 import sys
-from fuzzyctl.cli.app import main
-if sys.argv[1] == "check":
-    sys.exit(main(["check", sys.argv[2]]))
+if sys.argv[1] == "check":  # the console script's own entry point
+    from fuzzyctl.cli.entry import run
+    sys.argv = ["fuzzyctl", "check", sys.argv[2]]
+    run()
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
 try:

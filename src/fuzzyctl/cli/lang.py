@@ -6,34 +6,45 @@ from __future__ import annotations
 import json
 import sys
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, app, err_console
+
+if TYPE_CHECKING:
+    from fuzzyctl.fcl import LoadResult
 
 
 def _load(file: Path, strict: bool = False, compat: str = "iec"):  # type: ignore[no-untyped-def]
     """Load and check ``file``; when the language checks pass, add what the engine reports
     (features it will not evaluate, decisions worth knowing) so that ``check`` never says OK
     to a file ``eval`` refuses (with the same ``--strict`` and ``--compat``)."""
-    from dataclasses import replace
-
     from fuzzyctl.diagnostics import has_errors
-    from fuzzyctl.engine.support import unsupported
     from fuzzyctl.fcl import load_file
+    from fuzzyctl.gcpause import gc_paused
 
     result = load_file(file, strict=strict, compat=compat)
     if result.document is None or has_errors(result.diagnostics):
         return result
+    with gc_paused():
+        _add_engine_diagnostics(result, compat, strict)
+    return result
+
+
+def _add_engine_diagnostics(result: LoadResult, compat: str, strict: bool) -> None:
+    from dataclasses import replace
+
+    from fuzzyctl.engine.support import unsupported
+
     # The engine validates models from every reader, so it re-finds some language errors;
     # keep only what the language checks did not already say about the same line.
     seen = {(d.code, d.span.line if d.span else None) for d in result.diagnostics}
+    assert result.document is not None
     for fb in result.document.blocks:
         for d in unsupported(fb, compat=compat, strict=strict):
             if (d.code, d.span.line if d.span else None) not in seen:
                 result.diagnostics.append(replace(d, file=d.file or result.source.path))
-    return result
 
 
 @app.command()
@@ -103,7 +114,10 @@ def check(
             raise typer.Exit(EXIT_ERRORS) from None
         raise
     doc = result.document
-    feats = conformance.features(doc, result.spellings) if result.ok and doc is not None else []
+    from fuzzyctl.gcpause import gc_paused
+
+    with gc_paused():
+        feats = conformance.features(doc, result.spellings) if result.ok and doc is not None else []
     lvl = conformance.level(feats)
     if as_json:
         report: dict[str, object] = {

@@ -480,6 +480,11 @@ def _cond(
     deps: set[str],
     label: str,
 ) -> CondPlan | None:
+    if type(c) is m.Is and not c.hedges and c.variable in fuzzy_index and c.variable not in chained_index:
+        found = ctx.fuzzy_terms(c.variable).get(c.term)
+        if found is not None:  # the common test, `input IS term`, without the general path
+            return CTerm(fuzzy_index[c.variable], found, (), c.negated)
+
     def rec(x: m.Condition) -> CondPlan | None:
         return _cond(
             ctx,

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from enum import IntEnum
+from typing import Any
 
 from fuzzyctl.fcl.checks import is_singleton
 from fuzzyctl.model import (
@@ -17,6 +18,7 @@ from fuzzyctl.model import (
     Document,
     FunctionBlock,
     FunctionMF,
+    Is,
     Not,
     Or,
     PointsMF,
@@ -96,6 +98,45 @@ def depth(c: Condition | None) -> int:
     return best
 
 
+def _flat(c: Condition | None) -> tuple[Is, ...] | None:
+    """The tests of a condition that is one test or one AND / OR of tests, else None."""
+    if isinstance(c, Is):
+        return (c,)
+    if isinstance(c, And | Or) and all(type(o) is Is for o in c.operands):
+        return c.operands  # type: ignore[return-value]
+    return None
+
+
+def _flat_features(c: Condition | None, leaves: tuple[Is, ...], outputs: set[str], add: Any) -> None:
+    ext, open_ = Level.EXTENSION, Level.OPEN
+    if isinstance(c, Or):
+        add(ext, "conditional aggregation", "operator OR in a condition")
+    for s in leaves:
+        if s.negated:
+            add(ext, "conditional aggregation", "operator NOT")
+        if s.hedges:
+            add(open_, "condition", "hedges (fuzzylite)")
+        if s.variable in outputs:
+            add(open_, "condition", "output variable in a condition (chained rules)")
+
+
+def _nested_features(c: Condition | None, outputs: set[str], add: Any) -> None:
+    ext, open_ = Level.EXTENSION, Level.OPEN
+    if _uses(c, Or):
+        add(ext, "conditional aggregation", "operator OR in a condition")
+    if _uses(c, Not) or any(s.negated for s in walk_condition(c) if not isinstance(s, Degree)):
+        add(ext, "conditional aggregation", "operator NOT")
+    if depth(c) > 0:
+        add(ext, "parentheses", "( ) in conditions")
+    for s in walk_condition(c):
+        if isinstance(s, Degree):
+            add(ext, "condition", "input variables as subconditions")
+        elif s.hedges:
+            add(open_, "condition", "hedges (fuzzylite)")
+        if s.variable in outputs:
+            add(open_, "condition", "output variable in a condition (chained rules)")
+
+
 def _uses(c: Condition | None, kind: type) -> bool:
     if c is None or not isinstance(c, And | Or | Not):
         return False
@@ -165,19 +206,11 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
                 c = rule.condition
                 if c is None:  # written IF ALWAYS THEN (fcl/no_if.py): a degree input
                     add(ext, "condition", "rule without IF part: IF ALWAYS (an input variable)")
-                if _uses(c, Or):
-                    add(ext, "conditional aggregation", "operator OR in a condition")
-                if _uses(c, Not) or any(s.negated for s in walk_condition(c) if not isinstance(s, Degree)):
-                    add(ext, "conditional aggregation", "operator NOT")
-                if depth(c) > 0:
-                    add(ext, "parentheses", "( ) in conditions")
-                for s in walk_condition(c):
-                    if isinstance(s, Degree):
-                        add(ext, "condition", "input variables as subconditions")
-                    elif s.hedges:
-                        add(open_, "condition", "hedges (fuzzylite)")
-                    if s.variable in outputs:
-                        add(open_, "condition", "output variable in a condition (chained rules)")
+                leaves = _flat(c)
+                if leaves is not None:  # the common rule: one walk over its tests
+                    _flat_features(c, leaves, outputs, add)
+                else:
+                    _nested_features(c, outputs, add)
                 if len(rule.conclusions) > 1:
                     add(ext, "conclusion", "n subconclusions")
                 for concl in rule.conclusions:
