@@ -98,9 +98,7 @@ def compare_corpus(files: list[Path]) -> tuple[Stats, list[str], list[str]]:
                 else:
                     err = abs(mine - want) / scale[out]
                 st.add(err, f"{name} {out} row {i} ours {mine!r} jfl {want!r}", method[out])
-    refused_but_clean = [
-        f.name for f, a in zip(ours_refuse, answers[len(ctls) :], strict=True) if a.clean
-    ]
+    refused_but_clean = [f.name for f, a in zip(ours_refuse, answers[len(ctls) :], strict=True) if a.clean]
     return st, refused_but_clean, cannot
 
 

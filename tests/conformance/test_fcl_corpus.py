@@ -76,9 +76,7 @@ def test_no_engine_runs_the_rejected_files() -> None:
         [Job(shared_path("corpus", "fcl", n), all_inputs=0.0) for n in names], cache=True
     )
     for name, answer in zip(names, answers, strict=True):
-        ran = answer.load_error is None and any(
-            not isinstance(v, str) for row in answer.rows for v in row
-        )
+        ran = answer.load_error is None and any(not isinstance(v, str) for row in answer.rows for v in row)
         assert not ran, (name, answer)
         why = _rejected()[name][3]
         assert ("LOAD_ERROR" in why) == (answer.load_error is not None), (name, why, answer)
