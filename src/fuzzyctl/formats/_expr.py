@@ -87,7 +87,7 @@ class _Parser:
     MAX_NESTING, and every node's depth is kept so that a tree deeper than that (a chain
     ``x + x + ...``) is refused as soon as it is built."""
 
-    def __init__(self, text: str) -> None:
+    def __init__(self, text: str, leaves: dict[str, Num | Name]) -> None:
         from fuzzyctl.limits import MAX_NESTING
 
         self.text = text
@@ -97,8 +97,8 @@ class _Parser:
         self.k = 0  # the next token's place in it
         self.before = 0  # tokens in the chunks before it
         self.open = 0  # expressions begun and not finished
-        self.names: dict[str, Name] = {}  # equal leaves are one object
-        self.numbers: dict[str, Num] = {}
+        self.leaves = leaves  # equal leaves are one object (by their text)
+        self.read: set[str] = set()  # the names read
 
     @property
     def index(self) -> int:
@@ -138,19 +138,20 @@ class _Parser:
         value: Expr | None = None
         depth = 0
         powers = _BINARY_POWER
-        names, numbers = self.names, self.numbers
+        leaves, read = self.leaves, self.read
         self.begin(stack, 0)
         while True:
             if value is None:  # a primary: a leaf, or the start of what holds one
                 number, name, op = self.take()
                 if number:
-                    value = numbers.get(number) or self.number(number)
+                    value = leaves.get(number) or self.number(number)
                     depth = 1
                 elif name:
                     if self.peek()[2] != "(":
-                        value = names.get(name)
+                        value = leaves.get(name)
                         if value is None:
-                            value = names[name] = Name(name)
+                            value = leaves[name] = Name(name)
+                        read.add(name)
                         depth = 1
                     else:
                         self.k += 1
@@ -217,7 +218,7 @@ class _Parser:
         if math.isinf(value):  # 1e400, 5001 digits: not an infinity the file spelt
             shown = text if len(text) <= 24 else f"{text[:20]}... ({len(text)} characters)"
             raise self.fail(f"the number {shown} is too large (beyond 1.8e308)", self.index - 1)
-        num = self.numbers[text] = Num(value)
+        num = self.leaves[text] = Num(value)
         return num
 
     def expect(self, op: str) -> None:
@@ -226,18 +227,19 @@ class _Parser:
             raise self.fail(f"expected {op!r} but found {tok[0] or tok[1] or tok[2]!r}", self.index - 1)
 
 
-def parse_function(text: str) -> tuple[Expr, set[str]]:
+def parse_function(text: str, leaves: dict[str, Num | Name] | None = None) -> tuple[Expr, set[str]]:
     """Parse an infix expression, and say which names it reads (as :func:`names_in`);
     raises :class:`ExprError` (also for one nesting deeper than
-    :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike)."""
+    :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike).
+    ``leaves``: the numbers and names read before (by their text), to share with them."""
     _check_characters(text)
-    parser = _Parser(text)
+    parser = _Parser(text, {} if leaves is None else leaves)
     result = parser.parse()
     leftover = parser.peek()
     if leftover is not _END:
         shown = leftover[0] or leftover[1] or leftover[2]
         raise parser.fail(f"unexpected {shown!r} after the expression")
-    return result, set(parser.names)
+    return result, parser.read
 
 
 def parse_expr(text: str) -> Expr:

@@ -41,6 +41,8 @@ from fuzzyctl.model import (
     FunctionMF,
     FuzzifyBlock,
     MembershipFunction,
+    Name,
+    Num,
     Point,
     PointsMF,
     Range,
@@ -160,7 +162,15 @@ def _numbers(words: list[str], rep: Reporter, line: int, what: str) -> list[floa
         ) from None
 
 
-def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, names: set[str]) -> Term:
+def _term(
+    value: str,
+    rep: Reporter,
+    line: int,
+    var: _Variable,
+    n_inputs: int,
+    names: set[str],
+    leaves: dict[str, Num | Name],
+) -> Term:
     words = value.split()
     if len(words) < 2:
         raise rep.fail("term: expected 'name Class parameters'", line, code="fll-term")
@@ -169,7 +179,7 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
     mf: MembershipFunction
     if cls == "Function":
         try:
-            expr, reads = parse_function(rest)
+            expr, reads = parse_function(rest, leaves)
         except ExprError as exc:
             raise rep.fail(f"Function {name!r}: {exc}", line, code="fll-function") from None
         argument = "x" if "x" in reads and "x" not in names else None
@@ -300,8 +310,9 @@ def read(text: str, path: str | None = None) -> Loaded:
                 raise rep.fail(f"two variables are called {v.name!r}", v.line, code="duplicate-variable")
             seen.add(v.name)
     n_inputs = sum(1 for v in variables if v.kind is VarKind.INPUT)
+    leaves: dict[str, Num | Name] = {}  # the Function terms' numbers and names, one object each
     for var, value, number in pending_terms:
-        var.terms.append(_term(value, rep, number, var, n_inputs, names))
+        var.terms.append(_term(value, rep, number, var, n_inputs, names, leaves))
     rule_blocks = _rule_blocks(blocks, variables, rep)
     rep.raise_if_errors()
     inputs = [v for v in variables if v.kind is VarKind.INPUT]
