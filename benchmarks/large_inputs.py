@@ -157,6 +157,82 @@ def fll(shape: str, size: int) -> str:
         return FLL_HEAD + "  rule: if " + "(" * d + "a is lo" + ")" * d + " then y is hi\n"
     if shape == "not":
         return FLL_HEAD + "  rule: if " + "not " * (size // 4) + "a is lo then y is hi\n"
+    return _fll_more(shape, size)
+
+
+# More FLL shapes (each valid unless said): long mixed and/or rules, conditions nested 90
+# deep, Function terms nested or chained past the limit (refused) and many valid ones,
+# thousands of terms and variables, duplicate term names (renamed with a warning), a
+# number of a million digits (refused), a Discrete term of a million points, hedge chains
+# in a condition and in a conclusion (refused over 100), CR-only line ends.
+FLL_SHAPES = (
+    "or-and",
+    "nested",
+    "fn-deep",
+    "fn-chain",
+    "fn-many",
+    "terms",
+    "dup-terms",
+    "variables",
+    "huge-number",
+    "discrete",
+    "hedges",
+    "then-hedges",
+    "cr",
+)
+
+
+def _fll_more(shape: str, size: int) -> str:
+    rule = "  rule: if a is lo then y is hi\n"
+    if shape == "or-and":
+        return (
+            FLL_HEAD
+            + "  rule: if "
+            + "a is lo or a is very hi and " * (size // 28)
+            + "a is lo then y is hi\n"
+        )
+    if shape == "nested":
+        d = 45
+        cond = "(a is lo and " * d + "(a is hi or " * d + "a is lo" + ")" * (2 * d)
+        return _repeat(FLL_HEAD, lambda k: f"  rule: if {cond} then y is hi\n", "", size)
+    if shape == "fn-deep":
+        d = size // 2
+        return FLL_HEAD.replace("term: hi Triangle 0 1 1", "term: f Function " + "(" * d + "x" + ")" * d, 1)
+    if shape == "fn-chain":
+        return FLL_HEAD.replace(
+            "term: hi Triangle 0 1 1", "term: f Function " + "x + " * (size // 4) + "x", 1
+        )
+    if shape == "fn-many":
+        head = FLL_HEAD.split("OutputVariable")[0]
+        return _repeat(
+            head, lambda k: f"  term: f{k} Function 1 / (1 + exp(-(x - {k % 9}) ^ 2)) * sin(x)\n", "", size
+        )
+    if shape == "terms":
+        head = FLL_HEAD.split("OutputVariable")[0]
+        n = size // 60
+        terms = "".join(f"  term: t{k} Triangle 0 0.5 1\n" for k in range(n))
+        tail = FLL_HEAD[FLL_HEAD.index("OutputVariable") :]
+        return _repeat(head + terms + tail, lambda k: f"  rule: if a is t{k % n} then y is hi\n", "", size)
+    if shape == "dup-terms":
+        head = FLL_HEAD.split("OutputVariable")[0]
+        return _repeat(head, lambda k: "  term: lo Triangle 0 0 1\n", "", size)
+    if shape == "variables":
+        return _repeat(
+            "Engine: many\n",
+            lambda k: f"InputVariable: v{k}\n  range: 0 1\n  term: lo Triangle 0 0 1\n",
+            "",
+            size,
+        )
+    if shape == "huge-number":
+        return FLL_HEAD.replace("range: 0 1", "range: 0 " + "9" * size, 1)
+    if shape == "discrete":
+        return FLL_HEAD.replace("Triangle 0 0 1", "Discrete " + "0.5 1 " * (size // 6) + "1 0", 1)
+    if shape == "hedges":
+        return FLL_HEAD + "  rule: if a is " + "very " * (size // 5) + "lo then y is hi\n"
+    if shape == "then-hedges":
+        return FLL_HEAD + "  rule: if a is lo then " + "y is very hi and " * (size // 17) + "y is hi\n"
+    if shape == "cr":
+        return _repeat(FLL_HEAD, lambda k: rule, "", size).replace("\n", "\r")
     return _garbage(size)
 
 
@@ -264,6 +340,8 @@ FORMATS: dict[str, tuple[str, Callable[[str, int], str]]] = {
     "xfuz": (".csv.xfuz", xfuz),
 }
 SHAPES = ("valid", "errors", "garbage", "one-line", "deep", "not")
+#: Shapes run for one format only (by default, after the common ones).
+FORMAT_SHAPES: dict[str, tuple[str, ...]] = {"fll": FLL_SHAPES}
 
 
 # The child: fuzzyctl.load() inside the CLI's error boundary (diagnostics printed as the CLI
@@ -313,7 +391,7 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--mb", type=float, default=10.0, help="size of each file in MB (default 10)")
     ap.add_argument("--formats", default=",".join(FORMATS))
-    ap.add_argument("--shapes", default=",".join(SHAPES))
+    ap.add_argument("--shapes", default="", help="default: the common shapes and the format's own")
     ap.add_argument("--timeout", type=float, default=60.0)
     ap.add_argument(
         "--under-limit", action="store_true", help="also run each shape just under the size limit"
@@ -337,7 +415,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as tmp:
         for fmt in args.formats.split(","):
             ext, make = FORMATS[fmt]
-            for shape in args.shapes.split(","):
+            shapes = args.shapes.split(",") if args.shapes else [*SHAPES, *FORMAT_SHAPES.get(fmt, ())]
+            for shape in shapes:
                 for size in sizes:
                     path = Path(tmp) / f"{fmt}-{shape}{ext}"
                     size = size if size > 0 else max_input_bytes(fmt) - 4096

@@ -264,22 +264,6 @@ def _cached(rel: str) -> Any:
     from fuzzyctl import cache
 
     path = cache.cache_dir() / rel
-    from fuzzyctl.gcpause import gc_paused
-
-    try:
-        with open(path, "rb") as fh, gc_paused():
-            obj = pickle.load(fh)
-    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError, ValueError):
-        return None
-    cache.touch(path)
-    return obj
-
-
-def _store(rel: str, obj: Any) -> None:
-    from fuzzyctl import cache
-    from fuzzyctl.gcpause import gc_paused
-
-    path = cache.cache_dir() / rel
     try:
         with gc_paused():  # the collector walking the model under the pickler: 0.9 s, not 0.3
             data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)

@@ -44,8 +44,11 @@ from fuzzyctl.model import (
 )
 
 DEFAULT_MAX_INPUT_BYTES = 8 * 1024 * 1024
-#: Formats whose files are larger for the same system (read by a C parser, so faster).
-FORMAT_MAX_INPUT_BYTES = {"json": 12 * DEFAULT_MAX_INPUT_BYTES}
+#: Formats whose files are larger for the same system (read by a C parser, so faster), and
+#: FLL, whose terse lines make the most model per byte (a Function term or a nested rule
+#: costs three times what an FCL rule of that length does to read, check and cache; the
+#: largest real FLL file we know of is 14 KB).
+FORMAT_MAX_INPUT_BYTES = {"json": 12 * DEFAULT_MAX_INPUT_BYTES, "fll": DEFAULT_MAX_INPUT_BYTES // 8}
 MAX_NESTING = 100
 MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
 MAX_DIGITS = 400

@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
+from typing import Any
 
 from fuzzyctl.formats._common import fmt_number
 from fuzzyctl.model import Binary, Call, Expr, Name, Num, Unary
 
-_TOKEN = re.compile(
-    r"\s*(?:(?P<num>(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?)|(?P<name>[A-Za-z_][A-Za-z0-9_.]*)|(?P<op>[-+*/%^(),]))"
-)
 _BINARY_POWER = {"+": 10, "-": 10, "*": 20, "/": 20, "%": 20, "^": 40}
 _UNARY_POWER = 30
 
@@ -28,108 +27,225 @@ class ExprError(ValueError):
         self.position = position
 
 
-def _tokens(text: str) -> list[tuple[str, str, int]]:
-    out: list[tuple[str, str, int]] = []
-    pos = 0
-    end = len(text.rstrip())  # linear: no rescanning of the rest of the text per token
-    while pos < end:
-        m = _TOKEN.match(text, pos)
-        if m is None or m.end() == pos:
-            start = pos
-            while start < end and text[start].isspace():
-                start += 1
-            raise ExprError(f"unexpected character {text[start]!r} in expression", start)
-        kind = m.lastgroup or "op"
-        out.append((kind, m.group(kind), m.start(kind)))
-        pos = m.end()
-    return out
+_NUMBER = r"(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_ONE = rf"(?:{_NUMBER}|[A-Za-z_][A-Za-z0-9_.]*|[-+*/%^(),])"
+# How far the text is made of tokens: one pass in C, keeping no state per token.
+_LEXICAL = re.compile(rf"(?:\s*{_ONE})*+")
+# Tokens without positions (cheaper than match objects); one is found again on an error.
+_TUPLES = re.compile(rf"\s*(?:({_NUMBER})|([A-Za-z_][A-Za-z0-9_.]*)|([-+*/%^(),]))")
+# Text between these characters is never one token: chunks end before one of them.
+_CUT = re.compile(r"[\s*/%^(),]")
+_CHUNK = 1 << 14
+
+
+def _check_characters(text: str) -> None:
+    """Refuse text that is not a sequence of tokens, at its first stray character (before
+    any other error, wherever that is)."""
+    end = len(text.rstrip())
+    stop = _LEXICAL.match(text).end()  # type: ignore[union-attr]
+    if stop < end:
+        while text[stop].isspace():
+            stop += 1
+        raise ExprError(f"unexpected character {text[stop]!r} in expression", stop)
+
+
+def _chunks(text: str) -> Iterator[list[tuple[str, str, str]]]:
+    """The (number, name, operator) tokens of checked text, a chunk at a time, so that a long
+    expression is never held as one list of tokens; each chunk ends with ``_MORE``, the last
+    with ``_END``."""
+    pos, size = 0, len(text)
+    while True:
+        cut = _CUT.search(text, pos + _CHUNK) if pos + _CHUNK < size else None
+        end = cut.start() if cut else size
+        tokens = _TUPLES.findall(text, pos, end)
+        tokens.append(_MORE if cut else _END)
+        yield tokens
+        if not cut:
+            return
+        pos = end
+
+
+def _position(text: str, index: int) -> int:
+    """Where token ``index`` starts (``len(text)`` past the last)."""
+    for k, m in enumerate(_TUPLES.finditer(text)):
+        if k == index:
+            return m.start(m.lastindex or 0)
+    return len(text)
+
+
+_END = ("", "", "")  # the token after the last
+_MORE = ("", "", "more")  # the end of a chunk, not of the text (never returned by peek)
+_BEGIN_EXPR = "expr"
+
+
+class _Parser:
+    """Operator precedence over a token stream, with an explicit stack instead of recursion.
+
+    It reads as the recursive descent ``expression(p) := primary (op expression(p'))*`` (the
+    grammar in the module docstring) would, and reports the same errors; ``open`` counts the
+    expressions begun and not finished (the descent's recursion depth), which may not exceed
+    MAX_NESTING, and every node's depth is kept so that a tree deeper than that (a chain
+    ``x + x + ...``) is refused as soon as it is built."""
+
+    def __init__(self, text: str, leaves: dict[str, Num | Name]) -> None:
+        from fuzzyctl.limits import MAX_NESTING
+
+        self.text = text
+        self.limit = MAX_NESTING
+        self.chunks = _chunks(text)
+        self.toks = next(self.chunks)  # the current chunk
+        self.k = 0  # the next token's place in it
+        self.before = 0  # tokens in the chunks before it
+        self.open = 0  # expressions begun and not finished
+        self.leaves = leaves  # equal leaves are one object (by their text)
+        self.read: set[str] = set()  # the names read
+
+    @property
+    def index(self) -> int:
+        """How many tokens were taken."""
+        return self.before + self.k
+
+    def fail(self, message: str, index: int | None = None) -> ExprError:
+        return ExprError(message, _position(self.text, self.index if index is None else index))
+
+    def peek(self) -> tuple[str, str, str]:
+        """The next token, ``_END`` after the last."""
+        tok = self.toks[self.k]
+        while tok is _MORE:
+            self.before += self.k
+            self.toks, self.k = next(self.chunks), 0
+            tok = self.toks[0]
+        return tok
+
+    def take(self) -> tuple[str, str, str]:
+        tok = self.toks[self.k]
+        if tok is _MORE or tok is _END:
+            tok = self.peek()
+            if tok is _END:
+                raise ExprError("expression ends too early", len(self.text))
+        self.k += 1
+        return tok
+
+    def deeper(self, depth: int) -> int:
+        if depth > self.limit:
+            raise ExprError(f"the expression nests more than {self.limit} levels deep", 0)
+        return depth
+
+    def parse(self) -> Expr:
+        # frames: ["expr", min_power, left, its depth, pending operator], ["paren"],
+        # ["unary", sign], ["call", name, args, deepest arg]
+        stack: list[list[Any]] = []
+        value: Expr | None = None
+        depth = 0
+        powers = _BINARY_POWER
+        leaves, read = self.leaves, self.read
+        self.begin(stack, 0)
+        while True:
+            if value is None:  # a primary: a leaf, or the start of what holds one
+                number, name, op = self.take()
+                if number:
+                    value = leaves.get(number) or self.number(number)
+                    depth = 1
+                elif name:
+                    if self.peek()[2] != "(":
+                        value = leaves.get(name)
+                        if value is None:
+                            value = leaves[name] = Name(name)
+                        read.add(name)
+                        depth = 1
+                    else:
+                        self.k += 1
+                        if self.peek()[2] == ")":
+                            self.k += 1
+                            value, depth = Call(name.lower(), ()), 1
+                        else:
+                            stack.append(["call", name.lower(), [], 0])
+                            self.begin(stack, 0)
+                elif op == "(":
+                    stack.append(["paren"])
+                    self.begin(stack, 0)
+                elif op == "-" or op == "+":
+                    stack.append(["unary", op])
+                    self.begin(stack, _UNARY_POWER)
+                else:
+                    raise self.fail(f"unexpected {op!r} in expression", self.index - 1)
+                continue
+            frame = stack[-1]
+            kind = frame[0]
+            if kind is _BEGIN_EXPR:
+                if frame[4] is not None:
+                    depth = self.deeper(1 + max(frame[3], depth))
+                    value = Binary(frame[4], frame[2], value)
+                op = self.peek()[2]
+                power = powers.get(op, 0) if op else 0
+                if power > frame[1] or (power == frame[1] and op == "^"):
+                    self.k += 1
+                    frame[2], frame[3], frame[4] = value, depth, op
+                    value = None
+                    self.begin(stack, power if op == "^" else power + 1)
+                    continue
+                stack.pop()
+                self.open -= 1
+                if not stack:
+                    return value
+            elif kind == "paren":
+                self.expect(")")
+                stack.pop()
+            elif kind == "unary":
+                stack.pop()
+                value, depth = Unary(frame[1], value), self.deeper(depth + 1)
+            else:  # a call's argument
+                frame[2].append(value)
+                frame[3] = max(frame[3], depth)
+                if self.peek()[2] == ",":
+                    self.k += 1
+                    value = None
+                    self.begin(stack, 0)
+                    continue
+                self.expect(")")
+                stack.pop()
+                value, depth = Call(frame[1], tuple(frame[2])), self.deeper(frame[3] + 1)
+
+    def begin(self, stack: list[list[Any]], min_power: int) -> None:
+        """Start an expression (of operators binding at least ``min_power``)."""
+        stack.append([_BEGIN_EXPR, min_power, None, 0, None])
+        self.open += 1
+        if self.open > self.limit:
+            raise self.fail(f"the expression nests more than {self.limit} levels deep")
+
+    def number(self, text: str) -> Num:
+        value = float(text)
+        if math.isinf(value):  # 1e400, 5001 digits: not an infinity the file spelt
+            shown = text if len(text) <= 24 else f"{text[:20]}... ({len(text)} characters)"
+            raise self.fail(f"the number {shown} is too large (beyond 1.8e308)", self.index - 1)
+        num = self.leaves[text] = Num(value)
+        return num
+
+    def expect(self, op: str) -> None:
+        tok = self.take()
+        if tok[2] != op:
+            raise self.fail(f"expected {op!r} but found {tok[0] or tok[1] or tok[2]!r}", self.index - 1)
+
+
+def parse_function(text: str, leaves: dict[str, Num | Name] | None = None) -> tuple[Expr, set[str]]:
+    """Parse an infix expression, and say which names it reads (as :func:`names_in`);
+    raises :class:`ExprError` (also for one nesting deeper than
+    :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike).
+    ``leaves``: the numbers and names read before (by their text), to share with them."""
+    _check_characters(text)
+    parser = _Parser(text, {} if leaves is None else leaves)
+    result = parser.parse()
+    leftover = parser.peek()
+    if leftover is not _END:
+        shown = leftover[0] or leftover[1] or leftover[2]
+        raise parser.fail(f"unexpected {shown!r} after the expression")
+    return result, parser.read
 
 
 def parse_expr(text: str) -> Expr:
     """Parse an infix expression; raises :class:`ExprError` (also for one nesting deeper than
     :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike)."""
-    from fuzzyctl.limits import MAX_NESTING, expr_depth
-
-    tokens = _tokens(text)
-    index = 0
-    depth = 0
-
-    def peek() -> tuple[str, str, int] | None:
-        return tokens[index] if index < len(tokens) else None
-
-    def take() -> tuple[str, str, int]:
-        nonlocal index
-        tok = peek()
-        if tok is None:
-            raise ExprError("expression ends too early", len(text))
-        index += 1
-        return tok
-
-    def expect(op: str) -> None:
-        _kind, value, pos = take()
-        if value != op:
-            raise ExprError(f"expected {op!r} but found {value!r}", pos)
-
-    def primary() -> Expr:
-        kind, value, pos = take()
-        if kind == "num":
-            number = float(value)
-            if math.isinf(number):  # 1e400, 5001 digits: not an infinity the file spelt
-                shown = value if len(value) <= 24 else f"{value[:20]}... ({len(value)} characters)"
-                raise ExprError(f"the number {shown} is too large (beyond 1.8e308)", pos)
-            return Num(number)
-        if kind == "name":
-            nxt = peek()
-            if nxt is not None and nxt[1] == "(":
-                take()
-                args: list[Expr] = []
-                if (peek() or ("", "", 0))[1] != ")":
-                    args.append(expression(0))
-                    while (peek() or ("", "", 0))[1] == ",":
-                        take()
-                        args.append(expression(0))
-                expect(")")
-                return Call(value.lower(), tuple(args))
-            return Name(value)
-        if value == "(":
-            inner = expression(0)
-            expect(")")
-            return inner
-        if value in {"-", "+"}:
-            return Unary(value, expression(_UNARY_POWER))
-        raise ExprError(f"unexpected {value!r} in expression", pos)
-
-    def expression(min_power: int) -> Expr:
-        nonlocal depth
-        depth += 1
-        try:
-            if depth > MAX_NESTING:
-                pos = (peek() or ("", "", len(text)))[2]
-                raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", pos)
-            return _operators(min_power)
-        finally:
-            depth -= 1
-
-    def _operators(min_power: int) -> Expr:
-        left = primary()
-        while True:
-            tok = peek()
-            if tok is None or tok[0] != "op" or tok[1] not in _BINARY_POWER:
-                return left
-            power = _BINARY_POWER[tok[1]]
-            if power < min_power or (power == min_power and tok[1] != "^"):
-                return left
-            take()
-            right = expression(power if tok[1] == "^" else power + 1)
-            left = Binary(tok[1], left, right)
-
-    result = expression(0)
-    leftover = peek()
-    if leftover is not None:
-        raise ExprError(f"unexpected {leftover[1]!r} after the expression", leftover[2])
-    if expr_depth(result) > MAX_NESTING:  # a long chain a + b + c ... is a deep tree too
-        raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", 0)
-    return result
+    return parse_function(text)[0]
 
 
 def names_in(expr: Expr) -> set[str]:

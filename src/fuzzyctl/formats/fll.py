@@ -28,28 +28,28 @@ import re
 from dataclasses import dataclass, field
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats._common import Reporter, parse_number, unique_name
-from fuzzyctl.formats._expr import ExprError, names_in, parse_expr
+from fuzzyctl.formats._common import Reporter, parse_number
+from fuzzyctl.formats._expr import ExprError, parse_function
+from fuzzyctl.formats._fll_rules import HEDGE_WORDS as HEDGE_WORDS  # the writer avoids them as names
+from fuzzyctl.formats._fll_rules import Lookup, RuleError, parse_rule
 from fuzzyctl.formats._terms import FLL_TYPES
 from fuzzyctl.model import (
-    And,
-    Conclusion,
-    Condition,
     Default,
     DefuzzifyBlock,
     Document,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
-    Is,
     MembershipFunction,
-    Or,
+    Name,
+    Num,
     Point,
     PointsMF,
     Range,
     Rule,
     RuleBlock,
     ShapeMF,
+    Span,
     Term,
     Variable,
     VarKind,
@@ -92,7 +92,6 @@ DEFUZZIFIERS = {
     "WeightedAverage": "WTAVER",
     "WeightedSum": "WTSUM",
 }
-HEDGE_WORDS = frozenset({"not", "very", "somewhat", "extremely", "seldom", "any"})
 KEYWORDS = frozenset({"if", "then", "and", "or", "is", "with"})
 
 _LINE = re.compile(r"^(?P<indent>\s*)(?P<key>[A-Za-z][A-Za-z-]*)\s*:\s?(?P<value>.*)$")
@@ -107,6 +106,8 @@ class _Variable:
     clamp: bool = False
     terms: list[Term] = field(default_factory=list)
     term_names: set[str] = field(default_factory=set)
+    #: the next suffix to try for each duplicated term name (see _unique_term)
+    next_suffix: dict[str, int] = field(default_factory=dict)
     accu: str | None = None
     method: str | None = None
     default: float = math.nan
@@ -124,6 +125,23 @@ class _Block:
     act: str | None = None
     rule_activation: str | None = None
     rules: list[tuple[str, int]] = field(default_factory=list)
+
+
+class _Reporter(Reporter):
+    """A :class:`Reporter` making each whole-line span once: FLL places everything by line,
+    and a variable's line is the place of its Variable, block and terms alike."""
+
+    def __init__(self, path: str | None, lines: list[str]) -> None:
+        super().__init__(path, lines)
+        self.line_spans: dict[int, Span] = {}
+
+    def span(self, line: int, column: int = 1, width: int = 0) -> Span:
+        if column != 1 or width:
+            return super().span(line, column, width)
+        span = self.line_spans.get(line)
+        if span is None:
+            span = self.line_spans[line] = super().span(line)
+        return span
 
 
 def _bool(value: str, rep: Reporter, line: int, key: str) -> bool:
@@ -144,7 +162,15 @@ def _numbers(words: list[str], rep: Reporter, line: int, what: str) -> list[floa
         ) from None
 
 
-def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, names: set[str]) -> Term:
+def _term(
+    value: str,
+    rep: Reporter,
+    line: int,
+    var: _Variable,
+    n_inputs: int,
+    names: set[str],
+    leaves: dict[str, Num | Name],
+) -> Term:
     words = value.split()
     if len(words) < 2:
         raise rep.fail("term: expected 'name Class parameters'", line, code="fll-term")
@@ -153,10 +179,10 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
     mf: MembershipFunction
     if cls == "Function":
         try:
-            expr = parse_expr(rest)
+            expr, reads = parse_function(rest, leaves)
         except ExprError as exc:
             raise rep.fail(f"Function {name!r}: {exc}", line, code="fll-function") from None
-        argument = "x" if "x" in names_in(expr) and "x" not in names else None
+        argument = "x" if "x" in reads and "x" not in names else None
         mf = FunctionMF(expr, rest.strip(), argument)
     elif cls == "Constant":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
@@ -199,7 +225,7 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
             )
         height = params[mapping.arity] if len(params) > mapping.arity else 1.0
         mf = ShapeMF(mapping.kind, mapping.to_model(params), height)
-    unique = unique_name(name, var.term_names)
+    unique = _unique_term(name, var)
     if unique != name:
         rep.warning(
             f"duplicate term name {name!r} in {var.name!r}: rules use the first (as fuzzylite C++ does); "
@@ -210,144 +236,27 @@ def _term(value: str, rep: Reporter, line: int, var: _Variable, n_inputs: int, n
     return Term(unique, mf, rep.span(line))
 
 
-class _RuleParser:
-    """Recursive descent over one rule's words (``and`` binds tighter than ``or``)."""
-
-    def __init__(self, text: str, line: int, rep: Reporter, variables: dict[str, _Variable]) -> None:
-        self.words = re.findall(r"\(|\)|[^\s()]+", text)
-        self.pos = 0
-        self.line = line
-        self.rep = rep
-        self.variables = variables
-        self.depth = 0  # parentheses open (bounded: the descent recurses)
-
-    def fail(self, message: str) -> Exception:
-        return self.rep.fail(f"rule: {message}", self.line, code="fll-rule")
-
-    def peek(self) -> str | None:
-        return self.words[self.pos] if self.pos < len(self.words) else None
-
-    def take(self, what: str) -> str:
-        word = self.peek()
-        if word is None:
-            raise self.fail(f"expected {what} but the rule ends")
-        self.pos += 1
-        return word
-
-    def expect(self, word: str) -> None:
-        found = self.take(repr(word))
-        if found != word:
-            raise self.fail(f"expected {word!r} but found {found!r}")
-
-    def rule(self, label: str) -> Rule:
-        self.expect("if")
-        condition = self.disjunction()
-        self.expect("then")
-        conclusions = self.consequent()
-        weight: float | None = None
-        if self.peek() == "with":
-            self.take("with")
-            word = self.take("a weight")
-            try:
-                weight = parse_number(word)
-            except ValueError:
-                raise self.fail(f"weight must be a number, found {word!r}") from None
-        if self.peek() is not None:
-            raise self.fail(f"unexpected {self.peek()!r} at the end")
-        value = None if isinstance(condition, bool) else condition
-        return Rule(
-            label,
-            value,
-            tuple(conclusions),
-            self.rep.span(self.line),
-            weight=None if weight is None or weight == 1.0 else weight,
-        )
-
-    # Conditions are Condition objects, or True for "x is any" (always holds).
-    def disjunction(self) -> Condition | bool:
-        operands = [self.conjunction()]
-        while self.peek() == "or":
-            self.take("or")
-            operands.append(self.conjunction())
-        if any(o is True for o in operands):
-            return True
-        items = tuple(o for o in operands if not isinstance(o, bool))
-        return items[0] if len(items) == 1 else Or(items, self.rep.span(self.line))
-
-    def conjunction(self) -> Condition | bool:
-        operands = [self.atom()]
-        while self.peek() == "and":
-            self.take("and")
-            operands.append(self.atom())
-        items = tuple(o for o in operands if not isinstance(o, bool))
-        if not items:
-            return True
-        return items[0] if len(items) == 1 else And(items, self.rep.span(self.line))
-
-    def atom(self) -> Condition | bool:
-        if self.peek() == "(":
-            from fuzzyctl.limits import MAX_NESTING
-
-            self.take("(")
-            self.depth += 1
-            if self.depth > MAX_NESTING:
-                raise self.fail(f"the condition nests more than {MAX_NESTING} parentheses deep")
-            inner = self.disjunction()
-            self.depth -= 1
-            self.expect(")")
-            return inner
-        name = self.take("a variable")
-        var = self.variables.get(name)
-        if var is None:
-            raise self.fail(f"unknown variable {name!r}")
-        self.expect("is")
-        hedges: list[str] = []
-        while self.peek() in HEDGE_WORDS:
-            hedges.append(self.take("a hedge"))
-            if hedges[-1] == "any":
-                break
-        if hedges and hedges[-1] == "any":
-            if "not" in hedges:
-                raise self.fail("'not any' never holds and is not supported")
-            return True
-        term = self.take("a term")
-        if term not in var.term_names:
-            raise self.fail(f"{name!r} has no term {term!r}")
-        negated = bool(hedges) and hedges[0] == "not"
-        rest = tuple(hedges[1:] if negated else hedges)
-        if "not" in rest:
-            raise self.fail("'not' after another hedge is not supported (write it first)")
-        return Is(name, term, negated, rest, self.rep.span(self.line))
-
-    def consequent(self) -> list[Conclusion]:
-        out: list[Conclusion] = []
-        running: tuple[str, ...] = ()
-        while True:
-            name = self.take("an output variable")
-            var = self.variables.get(name)
-            if var is None or var.kind is not VarKind.OUTPUT:
-                raise self.fail(f"{name!r} is not an output variable")
-            self.expect("is")
-            own: list[str] = []
-            while self.peek() in HEDGE_WORDS - {"any", "not"}:
-                own.append(self.take("a hedge"))
-            if self.peek() in {"any", "not"}:
-                raise self.fail(f"hedge {self.peek()!r} is not supported in a conclusion")
-            term = self.take("a term")
-            if term not in var.term_names:
-                raise self.fail(f"{name!r} has no term {term!r}")
-            # fuzzylite hedges a running degree: earlier conclusions' hedges apply too.
-            running = (*own, *running)
-            out.append(Conclusion(name, term, None, self.rep.span(self.line), running))
-            if self.peek() != "and":
-                return out
-            self.take("and")
+def _unique_term(name: str, var: _Variable) -> str:
+    """What :func:`unique_name` gives (``name``, else the first free ``name_2``, ...),
+    without trying every taken suffix again for each duplicate: names are only ever added,
+    so the first free suffix never goes down."""
+    taken = var.term_names
+    if name not in taken:
+        taken.add(name)
+        return name
+    n = var.next_suffix.get(name, 2)
+    while f"{name}_{n}" in taken:
+        n += 1
+    var.next_suffix[name] = n + 1
+    unique = f"{name}_{n}"
+    taken.add(unique)
+    return unique
 
 
 def read(text: str, path: str | None = None) -> Loaded:
     """Parse an FLL file into a one-block :class:`Document`."""
     lines = text.splitlines()
-    rep = Reporter(path, lines)
+    rep = _Reporter(path, lines)
     engine_name: str | None = None
     engine_line = 1
     saw_engine = False
@@ -401,28 +310,10 @@ def read(text: str, path: str | None = None) -> Loaded:
                 raise rep.fail(f"two variables are called {v.name!r}", v.line, code="duplicate-variable")
             seen.add(v.name)
     n_inputs = sum(1 for v in variables if v.kind is VarKind.INPUT)
+    leaves: dict[str, Num | Name] = {}  # the Function terms' numbers and names, one object each
     for var, value, number in pending_terms:
-        var.terms.append(_term(value, rep, number, var, n_inputs, names))
-    by_name = {v.name: v for v in variables}
-    rule_blocks: list[RuleBlock] = []
-    for block in blocks:
-        rules = [
-            _RuleParser(text, number, rep, by_name).rule(str(i))
-            for i, (text, number) in enumerate(block.rules, start=1)
-        ]
-        rule_blocks.append(
-            RuleBlock(
-                block.name,
-                tuple(rules),
-                block.and_op,
-                block.or_op,
-                block.act,
-                None,
-                rep.span(block.line),
-                enabled=block.enabled,
-                rule_activation=block.rule_activation,
-            )
-        )
+        var.terms.append(_term(value, rep, number, var, n_inputs, names, leaves))
+    rule_blocks = _rule_blocks(blocks, variables, rep)
     rep.raise_if_errors()
     inputs = [v for v in variables if v.kind is VarKind.INPUT]
     outputs = [v for v in variables if v.kind is VarKind.OUTPUT]
@@ -458,6 +349,34 @@ def read(text: str, path: str | None = None) -> Loaded:
         span=rep.span(engine_line),
     )
     return Loaded(Document((fb,), path), rep.warnings)
+
+
+def _rule_blocks(blocks: list[_Block], variables: list[_Variable], rep: Reporter) -> list[RuleBlock]:
+    lookup: Lookup = {
+        v.name: (v.name, v.kind is VarKind.OUTPUT, {t: t for t in v.term_names}) for v in variables
+    }
+    out: list[RuleBlock] = []
+    for block in blocks:
+        rules: list[Rule] = []
+        for i, (text, number) in enumerate(block.rules, start=1):
+            try:
+                rules.append(parse_rule(text, str(i), rep.span(number), lookup))
+            except RuleError as exc:
+                raise rep.fail(f"rule: {exc}", number, code="fll-rule") from None
+        out.append(
+            RuleBlock(
+                block.name,
+                tuple(rules),
+                block.and_op,
+                block.or_op,
+                block.act,
+                None,
+                rep.span(block.line),
+                enabled=block.enabled,
+                rule_activation=block.rule_activation,
+            )
+        )
+    return out
 
 
 def _variable_key(
