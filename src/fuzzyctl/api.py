@@ -262,6 +262,21 @@ def _remember(doc: Document, key: str) -> None:
 
 def _cached(rel: str) -> Any:
     from fuzzyctl import cache
+    from fuzzyctl.gcpause import gc_paused
+
+    path = cache.cache_dir() / rel
+    try:
+        with open(path, "rb") as fh, gc_paused():
+            obj = pickle.load(fh)
+    except (OSError, pickle.UnpicklingError, EOFError, AttributeError, ImportError, TypeError, ValueError):
+        return None
+    cache.touch(path)
+    return obj
+
+
+def _store(rel: str, obj: Any) -> None:
+    from fuzzyctl import cache
+    from fuzzyctl.gcpause import gc_paused
 
     path = cache.cache_dir() / rel
     try:
