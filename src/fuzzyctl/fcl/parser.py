@@ -502,7 +502,15 @@ class _Builder(Transformer[Token, Any]):
         condition: Condition | None = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
         conclusions = next(c for c in children if isinstance(c, tuple))
         span = _outer(children)
-        if (d := depth(condition)) > MAX_NESTING:
+        fast = self.state.fast
+        found = None
+        if fast is not None and isinstance(condition, Degree) and condition.variable == "_":
+            found = fast.condition_at(condition.span)  # a condition the fast reader read
+        if found is not None:
+            condition, d = found
+        else:
+            d = depth(condition)
+        if d > MAX_NESTING:
             # refused here: every later step walks conditions recursively
             self.state.error(
                 f"rule {label}: the condition nests {d} levels deep (the limit is {MAX_NESTING})",
