@@ -17,7 +17,6 @@ Runs of ``(``, ``)`` and ``NOT`` separated by white space only are taken with on
 from __future__ import annotations
 
 import re
-from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from fuzzyctl.limits import MAX_NESTING
@@ -40,6 +39,8 @@ _OPENS = re.compile(rf"(?:{_WS}*\((?!\*))+")
 _CLOSES = re.compile(rf"(?:{_WS}*\))+")
 _NOTS = re.compile(rf"(?:{_WS}*NOT(?!\w))+", re.I)
 _NOT = re.compile("NOT", re.I)
+# `` IS term`` followed by what ends a subcondition (so no hedge follows).
+_IS_TERM = re.compile(r"[ \t]+(?i:IS)[ \t]+([^\W\d]\w*)(?=[ \t]*\)|[ \t]+(?i:AND|OR|THEN)(?!\w))")
 
 
 class Bail(Exception):
@@ -146,6 +147,13 @@ class ConditionParser:
         r = self.r
         if k != WORD or u in KEYWORDS:
             raise Bail
+        m = _IS_TERM.match(r.text, b)  # the common ``v IS t`` with one match
+        if m is not None and m.group(1).upper() not in KEYWORDS:
+            r.seek(m.end(1))
+            self.end = end = m.end(1)
+            if not self.build:
+                return None, 1
+            return Is(r.text[a:b], m.group(1), False, (), r.span(a, end)), 1
         k2, _, _, w2 = r.peek()
         if not (k2 == WORD and w2 == "IS"):
             if (k2 == WORD and w2 in ("AND", "OR", "THEN")) or (k2 == PUNCT and w2 == ")"):
@@ -300,5 +308,5 @@ class ConditionParser:
     def _group(self, cur: _Level) -> tuple[Condition | None, int]:
         node, h = self._reduce(cur)
         if isinstance(node, And | Or) and not node.grouped:
-            node = replace(node, grouped=True)  # for jFuzzyLogic's left-to-right reading
+            node = type(node)(node.operands, node.span, True)  # for jFuzzyLogic's reading
         return node, h
