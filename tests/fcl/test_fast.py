@@ -310,3 +310,28 @@ def test_every_condition_read_fast_on_the_corpus(monkeypatch: pytest.MonkeyPatch
         if text is not None:
             got, want = both(text, str(path))
             assert got == want, path
+
+
+POINTS = {
+    "long": " ".join(f"({k / 100}, {k % 2})" for k in range(200)) + ";",
+    "commas and comments": ", ".join(f"({k}, (* y *) 1)" for k in range(60)) + " // end\n;",
+    "names": " ".join(f"(x{k}, {k % 2})" for k in range(60)) + ";",
+    "spread over lines": "\n".join(f"( {k},\n 0 )" for k in range(60)) + "\n;",
+    "no semicolon": " ".join(f"({k}, 1)" for k in range(60)),
+    "huge number": " ".join(f"({k}, 1)" for k in range(60)) + " (1e999, 0);",
+    "unclosed": " ".join(f"({k}, 1)" for k in range(60)) + " (3, 1;",
+}
+
+
+@pytest.mark.parametrize("name", sorted(POINTS))
+def test_long_point_lists(name: str, substitute_min: int) -> None:
+    points = POINTS[name]
+    alone = HEAD.replace("TERM hi := (0, 0) (1, 1);", f"TERM hi := {points}")
+    assert_same(alone)
+    three = HEAD.replace(
+        "TERM hi := (0, 0) (1, 1);", f"TERM hi := {points} TERM m := {points} TERM n := {points}"
+    )
+    assert_same(three + "RULE 1 : IF a IS hi THEN y IS lo;\n" + TAIL)
+    if name == "long" and substitute_min:
+        result = fast.read_runs(alone + TAIL)
+        assert result is not None and len(result.points) == 1

@@ -113,6 +113,9 @@ class FastResult:
     #: (line, column) in their place.  Each with its depth (``None``: deeper than
     #: limits.MAX_NESTING, which the rule reports).
     conditions: dict[tuple[int, int], tuple[Condition | None, int]] = field(default_factory=dict)
+    #: Long point lists of the TERMs that lark reads, read here instead: lark reads ``0`` in
+    #: their place.  By the (line, column) of the TERM keyword.
+    points: dict[tuple[int, int], PointsMF] = field(default_factory=dict)
 
     def between(self, start: int, end: int) -> list[tuple[int, Rule | Term, str | None]]:
         """The statements read here whose offset lies in ``[start, end)``."""
@@ -136,6 +139,10 @@ class FastResult:
         """The condition read here whose placeholder lark read at ``span``."""
         return self.conditions.get((span.line, span.column)) if span is not None else None
 
+    def points_at(self, span: Span | None) -> PointsMF | None:
+        """The points read here of the TERM whose keyword lark read at ``span``."""
+        return self.points.get((span.line, span.column)) if span is not None else None
+
     def spellings_before(self, end: int | None) -> set[str]:
         n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
         return {s for s in self.spellings[:n] if s is not None}
@@ -144,6 +151,9 @@ class FastResult:
         if end is None:
             return list(self.comments)
         return self.comments[: bisect_right([c.offset for c in self.comments], end - 1)]
+
+
+_Part = tuple[int, int, "Condition | PointsMF | None", int]
 
 
 class _Reader:
@@ -163,9 +173,11 @@ class _Reader:
         self.la: tuple[int, int, int, str] | None = None
         # the last place whose line was counted, its line, where that line starts
         self.cursor = (0, 1, 0)
-        # the condition of the statement being read: start, end, node, depth
-        self.cond: tuple[int, int, Condition | None, int] | None = None
-        self.bailed: dict[int, tuple[int, int, Condition | None, int] | None] = {}
+        # what lark need not read of the statement being read: start, end, what it is
+        # (a condition, None when too deep, or a point list), the condition's depth
+        self.cond: _Part | None = None
+        self.bailed: dict[int, _Part | None] = {}
+        self.last_end = 0  # where the last point read ends
 
     def statement(self) -> tuple[Rule | Term, str | None]:
         """One statement and the spelling of its shape (``_Bail`` when not taken)."""
@@ -391,6 +403,7 @@ class _TermReader(_Reader):
     """TERM name := points | number | shape numbers ;"""
 
     def statement(self) -> tuple[Term, str | None]:
+        self.cond = None
         if self.quick_only:
             raise _Bail
         _, t0, _ = self.keyword("TERM")
@@ -399,6 +412,7 @@ class _TermReader(_Reader):
         k, a, b, u = self.next()
         spelling: str | None = None
         mf: MembershipFunction
+        part: _Part | None = None
         if k == PUNCT and u == "(":
             points = [self.point(a)]
             while True:
@@ -411,6 +425,8 @@ class _TermReader(_Reader):
                 _, p, _, _ = self.next()
                 points.append(self.point(p))
             mf = PointsMF(tuple(points))
+            if self.last_end - a >= SUBSTITUTE_MIN:
+                part = (a, self.last_end, mf, 0)
         elif k == NUMBER:
             mf = SingletonMF(self.number(a, b))
         elif k == WORD and u not in KEYWORDS:
@@ -418,6 +434,7 @@ class _TermReader(_Reader):
         else:
             raise _Bail
         end = self.punct(";") + 1
+        self.cond = part
         return Term(name, mf, self.span(t0, end)), spelling
 
     def point(self, start: int) -> Point:
@@ -425,6 +442,7 @@ class _TermReader(_Reader):
         self.punct(",")
         y, _, _ = self.param()
         end = self.punct(")") + 1
+        self.last_end = end
         return Point(x, y, self.span(start, end))
 
     def shape(self, name: str) -> tuple[MembershipFunction, str]:
@@ -481,9 +499,9 @@ def read_runs(text: str) -> FastResult | None:
     """The runs of plain RULE and TERM statements of ``text``, and the long conditions of
     the rules lark reads (``None`` when there is nothing worth taking from lark)."""
     result = FastResult(text)
-    blanks: list[tuple[int, int, int]] = []
+    blanks: list[tuple[int, int, int, str]] = []
     comments: dict[int, str] = {}
-    subs: dict[int, tuple[int, int, Condition | None, int]] = {}
+    subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]] = {}
     readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
     pos = misses = 0
     while True:
@@ -506,15 +524,15 @@ def read_runs(text: str) -> FastResult | None:
         if misses > MAX_MISSES:  # a file of statements this reader does not take
             for reader in readers.values():
                 reader.quick_only = True
-    line, ls, pos = 1, 0, 0
+    lines = _Lines(text)
     for p in sorted(subs):
-        a, b, condition, depth = subs[p]
-        line += text.count("\n", pos, p)
-        nl = text.rfind("\n", pos, p)
-        ls = nl + 1 if nl >= 0 else ls
-        pos = p
-        result.conditions[(line, p - ls + 1)] = (condition, depth)
-        blanks.append((a, b, p))
+        a, b, part, levels, statement = subs[p]
+        if isinstance(part, PointsMF):
+            result.points[lines.at(statement)] = part
+            blanks.append((a, b, p, "0"))
+        else:
+            result.conditions[lines.at(p)] = (part, levels)
+            blanks.append((a, b, p, "_"))
     if not blanks:
         return None
     for offset in sorted(comments):
@@ -529,15 +547,15 @@ def _run(
     word: str,
     start: int,
     result: FastResult,
-    blanks: list[tuple[int, int, int]],
+    blanks: list[tuple[int, int, int, str]],
     comments: dict[int, str],
-    subs: dict[int, tuple[int, int, Condition | None, int]],
+    subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]],
 ) -> int:
     """Read the run of ``word`` statements from ``start``; keep the inner ones in ``result``
     and the long conditions of the others.  Returns where the search for the next run goes
     on."""
     got: list[tuple[int, Rule | Term, str | None]] = []
-    conds: list[tuple[int, tuple[int, int, Condition | None, int]]] = []
+    conds: list[tuple[int, _Part]] = []
     reader.comments = []
     at = start
     resume = start + len(word)
@@ -570,20 +588,20 @@ def _run(
     lo = hi = start
     if len(got) >= MIN_RUN:
         lo, hi = got[1][0], got[-1][0]
-        blanks.append((lo, hi, -1))
+        blanks.append((lo, hi, -1, ""))
         for offset, item, spelling in got[1:-1]:
             result.offsets.append(offset)
             result.items.append(item)
             result.spellings.append(spelling)
         resume = hi
     regions = [(lo, hi)]
-    for offset, (a, b, condition, levels) in conds:
-        if (lo <= offset < hi) or (condition is not None and b - a < SUBSTITUTE_MIN):
+    for offset, (a, b, part, levels) in conds:
+        if (lo <= offset < hi) or (part is not None and b - a < SUBSTITUTE_MIN):
             continue
         p = _placeholder(reader.text, a, b)
         if p < 0:
             continue
-        subs[p] = (a, b, condition, levels)
+        subs[p] = (a, b, part, levels, offset)
         regions.append((a, b))
     for body, offset in reader.comments:
         if any(a <= offset < b for a, b in regions):
@@ -601,16 +619,32 @@ def _placeholder(text: str, a: int, b: int) -> int:
     return -1
 
 
-def _blank(text: str, regions: list[tuple[int, int, int]]) -> str:
+class _Lines:
+    """(line, column) of offsets asked for in increasing order."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.pos, self.line, self.ls = 0, 1, 0
+
+    def at(self, p: int) -> tuple[int, int]:
+        self.line += self.text.count("\n", self.pos, p)
+        nl = self.text.rfind("\n", self.pos, p)
+        if nl >= 0:
+            self.ls = nl + 1
+        self.pos = p
+        return self.line, p - self.ls + 1
+
+
+def _blank(text: str, regions: list[tuple[int, int, int, str]]) -> str:
     """``text`` with every character of ``regions`` but ``\\n`` replaced by a space, and
-    ``_`` at the placeholder offset of each (when not -1)."""
+    the placeholder mark at the offset of each (when not -1)."""
     out: list[str] = []
     pos = 0
-    for a, b, p in regions:
+    for a, b, p, mark in regions:
         out.append(text[pos:a])
         blank = "\n".join(" " * len(line) for line in text[a:b].split("\n"))
         if p >= 0:
-            blank = blank[: p - a] + "_" + blank[p - a + 1 :]
+            blank = blank[: p - a] + mark + blank[p - a + 1 :]
         out.append(blank)
         pos = b
     out.append(text[pos:])

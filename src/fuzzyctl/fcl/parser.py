@@ -294,6 +294,9 @@ class _Builder(Transformer[Token, Any]):
     # ---------------------------------------------------------------- terms and blocks
     def term(self, children: list[Any]) -> Term:
         name, mf, semi = children[1], children[2], children[3]
+        fast = self.state.fast
+        if fast is not None and isinstance(mf, SingletonMF) and fast.points:
+            mf = fast.points_at(_tok_span(children[0])) or mf  # points the fast reader read
         span = _outer(children)
         if semi is None:
             end = Span(span.line, span.column) if span else None
