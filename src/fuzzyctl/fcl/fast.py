@@ -66,14 +66,17 @@ _LABEL = re.compile(r"\w+")
 # Where runs may start: comments and OPTIONS text are skipped as lark skips them.
 _SCAN = re.compile(rf"({_COMMENT})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
 _OPTIONS_END = re.compile(r"(?s:.+?)(?=\bEND_OPTIONS?\b)", re.I)
-# The most common rule, on one line with spaces only: read with one match.
+# The most common rule, on one line with spaces only: read with one match (possessive
+# repeats: no backtracking entry kept per AND of a long chain).
 _NAME = r"[^\W\d]\w*"
 _ATOM = rf"{_NAME}[ \t]+IS[ \t]+{_NAME}"
 _SIMPLE_RULE = re.compile(
-    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*)"
-    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*)[ \t]*;",
+    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*+)"
+    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*+)[ \t]*;",
     re.I,
 )
+# The rest of a point ``(x, y)`` after its '(' when both are numbers.
+_POINT_REST = re.compile(rf"[ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
 _PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
 _WORD_CHAR = re.compile(r"\w")
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
@@ -274,8 +277,11 @@ class _Reader:
 
     def number(self, a: int, b: int) -> float:
         tok = self.text[a:b]
-        value = float(tok.translate(_MINUS_SIGNS))
-        if tok[-1:].isdigit() and not math.isfinite(value):
+        try:
+            value = float(tok)
+        except ValueError:  # a Unicode minus sign
+            value = float(tok.translate(_MINUS_SIGNS))
+        if (value == math.inf or value == -math.inf) and tok[-1:].isdigit():
             raise _Bail  # lark's reader reports it
         return value
 
@@ -438,7 +444,15 @@ class _TermReader(_Reader):
         return Term(name, mf, self.span(t0, end)), spelling
 
     def point(self, start: int) -> Point:
-        x, _, _ = self.param()
+        m = _POINT_REST.match(self.text, self.pos) if self.la is None else None
+        if m is not None:  # two numbers and ')' with one match
+            x: Param = self.number(*m.span(1))
+            y: Param = self.number(*m.span(2))
+            end = m.end()
+            self.seek(end)
+            self.last_end = end
+            return Point(x, y, self.span(start, end))
+        x, _, _ = self.param()  # a name, or a comment inside
         self.punct(",")
         y, _, _ = self.param()
         end = self.punct(")") + 1

@@ -35,9 +35,13 @@ KEYWORDS = frozenset(_KEYWORD_TEXT.split())
 
 _WS = r"[ \t\f\r\n\ufeff]"
 # More of the same token after one was read ('(*' opens a comment: not a parenthesis).
-_OPENS = re.compile(rf"(?:{_WS}*\((?!\*))+")
-_CLOSES = re.compile(rf"(?:{_WS}*\))+")
-_NOTS = re.compile(rf"(?:{_WS}*NOT(?!\w))+", re.I)
+# Possessive: a plain repeated group keeps a backtracking entry per repetition (100 MB
+# for a million parentheses).
+_OPENS = re.compile(rf"(?:{_WS}*\((?!\*))++")
+_CLOSES = re.compile(rf"(?:{_WS}*\))++")
+_NOTS = re.compile(rf"(?:{_WS}*NOT(?!\w))++", re.I)
+# ``NOT (`` again and again (each a level of its own)
+_NOT_OPENS = re.compile(rf"(?:{_WS}*NOT(?!\w){_WS}*\((?!\*))++", re.I)
 _NOT = re.compile("NOT", re.I)
 # `` IS term`` followed by what ends a subcondition (so no hedge follows).
 _IS_TERM = re.compile(r"[ \t]+(?i:IS)[ \t]+([^\W\d]\w*)(?=[ \t]*\)|[ \t]+(?i:AND|OR|THEN)(?!\w))")
@@ -177,7 +181,7 @@ class ConditionParser:
         m = _NOTS.match(text, b)
         if m is not None:
             r.seek(m.end())
-        more = 0 if m is None else len(_NOT.findall(m.group()))
+        more = 0 if m is None else m.group().upper().count("NOT")  # white space and NOTs
         cur.n_nots += 1 + more
         if not self.build:
             return
@@ -262,6 +266,14 @@ class ConditionParser:
         self._push(cur, 1)
         if n > 1:
             self._push(_Level(), n - 1)
+        if not self.build:  # ``NOT (`` again and again: one level, repeated
+            r = self.r
+            m = _NOT_OPENS.match(r.text, r.pos) if r.la is None else None
+            if m is not None:
+                r.seek(m.end())
+                level = _Level()
+                level.n_nots = 1
+                self._push(level, m.group().count("("))
         return _Level()
 
     def _close(self, cur: _Level, n: int) -> _Level:
