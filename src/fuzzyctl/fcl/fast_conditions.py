@@ -44,7 +44,10 @@ _NOTS = re.compile(rf"(?:{_WS}*NOT(?!\w))++", re.I)
 _NOT_OPENS = re.compile(rf"(?:{_WS}*NOT(?!\w){_WS}*\((?!\*))++", re.I)
 _NOT = re.compile("NOT", re.I)
 # `` IS term`` followed by what ends a subcondition (so no hedge follows).
-_IS_TERM = re.compile(r"[ \t]+(?i:IS)[ \t]+([^\W\d]\w*)(?=[ \t]*\)|[ \t]+(?i:AND|OR|THEN)(?!\w))")
+# An AND or OR after it is taken too (group 2 and 3: the look-ahead token).
+_IS_TERM = re.compile(
+    r"[ \t]+(?i:IS)[ \t]+([^\W\d]\w*)(?:[ \t]+((?i:AND|OR))(?!\w)|(?=[ \t]*\)|[ \t]+(?i:THEN)(?!\w)))"
+)
 
 
 class Bail(Exception):
@@ -153,7 +156,9 @@ class ConditionParser:
             raise Bail
         m = _IS_TERM.match(r.text, b)  # the common ``v IS t`` with one match
         if m is not None and m.group(1).upper() not in KEYWORDS:
-            r.seek(m.end(1))
+            r.seek(m.end())
+            if m.start(2) >= 0:  # the AND or OR after it, as if peeked
+                r.la = (WORD, m.start(2), m.end(2), m.group(2).upper())
             self.end = end = m.end(1)
             if not self.build:
                 return None, 1
