@@ -3,19 +3,24 @@
 A file with thousands of rules (or terms) is almost entirely a run of statements of one
 kind, each of which the grammar reads the same way whatever came before.  This module finds
 such runs (outside comments and OPTIONS text, which it skips as the lark lexer does), reads
-each statement with a small hand-written scanner and recursive-descent parser into the same
-model objects and spans the lark transformer builds, and tells the caller which text to
-blank out (spaces in place of every character but ``\\n``, so that lines and columns of what
-lark still reads are unchanged).
+each statement with a small hand-written scanner (conditions with the iterative parser of
+fuzzyctl.fcl.fast_conditions) into the same model objects and spans the lark transformer
+builds, and tells the caller which text to blank out (spaces in place of every character
+but ``\\n``, so that lines and columns of what lark still reads are unchanged).  Runs do not
+depend on line ends: a file written on one line is read the same way.
 
-The fast reader only accepts the plain forms that produce no diagnostic; anything else (a
+The fast reader only accepts the forms that produce no diagnostic; anything else (a
 multi-word name, a keyword used as a name, a missing ';' after a TERM, an unknown shape,
-FUNCTION terms, a number out of range, deep nesting, ...) ends the run, and lark reads it.
-The first and the last statement of a run are always left to lark, so that lark enters and
-leaves the blanked text in the state it would have been in, and every syntax error (with its
-"previous token") is found by lark exactly as before.  ``fcl.lark`` stays the grammar of
-record; tests/fcl/test_fast.py checks that both paths give the same model on every FCL file
-we have and on generated rule blocks.
+FUNCTION terms, a number out of range, ...) ends the run, and lark reads it.  The first and
+the last statement of a run are always left to lark, so that lark enters and leaves the
+blanked text in the state it would have been in, and every syntax error (with its "previous
+token") is found by lark exactly as before.  Of the rules and terms lark reads, a long
+condition followed by THEN (or one nesting deeper than limits.MAX_NESTING) and a long point
+list followed by ';' are still read here: lark reads a one-character placeholder in their
+place and the transformer puts back what was read here (FastResult.conditions, .points), so
+that a single rule of a million parentheses costs lark nothing.  ``fcl.lark`` stays the
+grammar of record; tests/fcl/test_fast.py checks that both paths give the same model and
+diagnostics on every FCL file we have, on generated blocks and on deep and long conditions.
 """
 
 from __future__ import annotations
