@@ -77,7 +77,58 @@ def fcl(shape: str, size: int) -> str:
         )
     if shape == "not":
         return FCL_HEAD + "RULE 1 : IF " + "NOT " * (size // 4) + "a IS lo THEN y IS lo;\n" + FCL_TAIL
+    return _fcl_more(shape, size)
+
+
+def _fcl_more(shape: str, size: int) -> str:
+    """The FCL-only shapes (not in SHAPES: see FCL_SHAPES)."""
+    if shape == "and-chain":  # one rule, one line: a IS lo AND a IS lo AND ...
+        return (
+            FCL_HEAD + "RULE 1 : IF " + "a IS lo AND " * (size // 12) + "b IS hi THEN y IS lo;\n" + FCL_TAIL
+        )
+    if shape == "nest-99":  # rules nesting 99 levels (the limit is 100), one after the other
+        cond = "a IS lo AND (" * 98 + "b IS hi" + ")" * 98
+        return _repeat(FCL_HEAD, lambda k: f"RULE {k} : IF {cond} THEN y IS lo;\n", FCL_TAIL, size)
+    if shape == "not-paren":  # NOT (NOT (... : real nesting, refused
+        return (
+            FCL_HEAD
+            + "RULE 1 : IF "
+            + "NOT (" * (size // 6)
+            + "a IS lo"
+            + ")" * (size // 6)
+            + " THEN y IS lo;\n"
+            + FCL_TAIL
+        )
+    if shape == "unclosed":  # deep redundant parentheses, one missing: a syntax error
+        d = size // 2
+        return FCL_HEAD + "RULE 1 : IF " + "(" * d + "a IS lo" + ")" * (d - 1) + " THEN y IS lo;\n" + FCL_TAIL
+    if shape == "comments":  # a comment between every two tokens
+        return _repeat(
+            FCL_HEAD,
+            lambda k: (
+                f"RULE {k} (* r *) : IF a /* x */ IS lo // c\n AND (* y *) b IS hi THEN y (* z *) IS lo;\n"
+            ),
+            FCL_TAIL,
+            size,
+        )
+    if shape == "points":  # one TERM with a huge list of points
+        head = FCL_HEAD.replace(
+            "TERM hi := (0, 0) (1, 1);", "TERM hi := " + "(0.5, 1) " * (size // 9) + ";", 1
+        )
+        return head + "RULE 1 : IF a IS hi THEN y IS lo;\n" + FCL_TAIL
+    if shape == "fuzzify":  # very many small FUZZIFY blocks
+        block = "FUZZIFY v{k} TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY\n"
+        return _repeat(
+            FCL_HEAD.replace("RULEBLOCK r\nAND : MIN;\n", ""),
+            lambda k: block.format(k=k),
+            "END_FUNCTION_BLOCK\n",
+            size,
+        )
     return _garbage(size)
+
+
+#: Shapes only FCL has (adversarial inputs for the fast reader, fcl/fast.py).
+FCL_SHAPES = ("and-chain", "nest-99", "not-paren", "unclosed", "comments", "points", "fuzzify")
 
 
 FIS_HEAD = """[System]

@@ -186,3 +186,152 @@ def _document(rng: random.Random) -> str:
 @given(st.integers(0, 2**32 - 1))
 def test_same_model_on_generated_blocks(seed: int) -> None:
     assert_same(_document(random.Random(seed)))
+
+
+# --------------------------------------------------------------------------- conditions
+
+HEAD = (
+    "FUNCTION_BLOCK f VAR_INPUT a, b : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR\n"
+    "FUZZIFY a TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY\n"
+    "DEFUZZIFY y TERM lo := 0; TERM hi := 1; END_DEFUZZIFY\nRULEBLOCK r\n"
+)
+TAIL = "END_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+
+
+def _rules(*conditions: str, then: str = " THEN y IS lo;") -> str:
+    return HEAD + "".join(f"RULE {k} : IF {c}{then}\n" for k, c in enumerate(conditions)) + TAIL
+
+
+def _nest(n: int, unit: str = "a IS lo AND (") -> str:
+    return unit * n + "b IS hi" + ")" * n
+
+
+DEEP = {
+    # redundant parentheses vanish: the rule reads as a IS lo
+    "parens": "(" * 3000 + "a IS lo" + ")" * 3000,
+    "parens spaced": "( \n" * 500 + "a IS lo AND b" + " )\n" * 500,
+    "parens with comments": "((* c *)(  (/* d */(a IS lo)) // e\n OR (b IS very hi)))",
+    "group in groups": "(((a IS lo AND b IS hi))) OR (((NOT a IS lo)))",
+    "glued": "(a IS lo)AND(b IS hi)",
+    # NOTs: the limit is 100 levels, the atom one of them
+    "nots 99": "NOT " * 99 + "a IS lo",
+    "nots 100": "NOT " * 100 + "a IS lo",
+    "nots 2000": "NOT " * 2000 + "a IS lo",
+    "nots in parens": "NOT (" * 60 + "a IS lo" + ")" * 60,
+    "nots in parens 3000": "NOT(" * 3000 + "a IS lo" + ")" * 3000,
+    "nots and comments": "NOT (* x *) NOT\nNOT // y\n a IS lo",
+    # real nesting: each AND level counts
+    "nest 98": _nest(98),
+    "nest 99": _nest(99),
+    "nest 3000": _nest(3000),
+    "nest or": _nest(150, "a IS lo OR NOT ("),
+    "left nest 120": "(" * 120 + "a IS lo" + " AND b IS hi)" * 120,
+    "left nest 99": "(" * 99 + "a IS lo" + " OR b IS hi)" * 99,
+    "mixed": "(" * 40 + _nest(70) + " AND NOT a IS hi" + ")" * 40 + " OR " + _nest(30, "NOT ("),
+    "too deep then fine": _nest(200) + " OR " + "(" * 50 + "a IS lo" + ")" * 50,
+    "long and": " AND ".join(["a IS lo"] * 3000),
+    "long or of ands": " OR ".join(["(a IS lo AND b IS hi)"] * 500),
+}
+BROKEN = {
+    "unclosed": "(" * 300 + "a IS lo" + ")" * 299,
+    "closed twice": "(" * 300 + "a IS lo" + ")" * 301,
+    "no operand": "NOT " * 300,
+    "empty group": "(" * 200 + ")" * 200,
+    "unclosed comment": "(" * 200 + "(*a IS lo" + ")" * 200,
+    "number": "(" * 200 + "a IS 1" + ")" * 200,
+}
+
+
+@pytest.fixture(params=[200, 0], ids=["long-conditions", "every-condition"])
+def substitute_min(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> int:
+    """The fast reader reads the conditions of the rules that lark reads: long ones (as
+    shipped), or every one (to check the substitution on every shape)."""
+    monkeypatch.setattr(fast, "SUBSTITUTE_MIN", request.param)
+    return int(request.param)
+
+
+@pytest.mark.parametrize("name", sorted(DEEP))
+def test_deep_and_long_conditions(name: str, substitute_min: int) -> None:
+    cond = DEEP[name]
+    alone = _rules(cond)
+    result = fast.read_runs(alone)
+    if len(cond) >= substitute_min:  # lark reads the rule, the fast reader its condition
+        assert result is not None and len(result.conditions) == 1
+    assert_same(alone)
+    assert_same(_rules(*[cond] * 4))  # in a run
+    assert_same(_rules("a IS lo", cond, "a IS lo", "b IS hi", cond, cond, "a IS hi"))
+    # after THEN, a mistake lark reports with the condition read here
+    assert_same(_rules(cond, cond, then=" THEN y IS ;"))
+    assert_same(_rules(cond, then=" THEN y IS lo WITH ;"))
+    assert_same(_rules(cond, then="(* c *) THEN y IS lo;"))
+
+
+@pytest.mark.parametrize("name", sorted(BROKEN))
+def test_broken_deep_conditions(name: str, substitute_min: int) -> None:
+    cond = BROKEN[name]
+    assert_same(_rules(cond))
+    assert_same(_rules("a IS lo", "a IS lo", cond, "a IS lo", "a IS lo", "a IS lo"))
+
+
+def test_too_deep_is_found_without_building_the_tree() -> None:
+    """The place and words lark gives, from a condition the fast reader only measured."""
+    text = _rules(
+        "a IS lo", "NOT (" * 50_000 + "a IS lo" + ")" * 50_000, "(" * 99_999 + "b IS hi" + ")" * 99_999
+    )
+    result = fast.read_runs(text)
+    assert result is not None
+    assert sorted(result.conditions.values(), key=lambda c: c[1])[-1] == (None, 50_001)
+    got = parse_source(Source(text, "t.fcl"))
+    [diag] = got.diagnostics
+    assert diag.message == "rule 1: the condition nests 50001 levels deep (the limit is 100)"
+    assert diag.span is not None and (diag.span.line, diag.span.column) == (6, 1)
+    assert diag.code == "too-deep"
+
+
+def test_every_condition_read_fast_on_generated_blocks(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fast, "SUBSTITUTE_MIN", 0)
+    for seed in range(300):
+        assert_same(_document(random.Random(seed)))
+
+
+def test_every_condition_read_fast_on_local_files(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fast, "SUBSTITUTE_MIN", 0)
+    for path in LOCAL:
+        text = _read(path)
+        if text is not None:
+            assert_same(text, str(path))
+
+
+@pytest.mark.extra("corpus")
+def test_every_condition_read_fast_on_the_corpus(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(fast, "SUBSTITUTE_MIN", 0)
+    for path in CORPUS:
+        text = _read(path)
+        if text is not None:
+            got, want = both(text, str(path))
+            assert got == want, path
+
+
+POINTS = {
+    "long": " ".join(f"({k / 100}, {k % 2})" for k in range(200)) + ";",
+    "commas and comments": ", ".join(f"({k}, (* y *) 1)" for k in range(60)) + " // end\n;",
+    "names": " ".join(f"(x{k}, {k % 2})" for k in range(60)) + ";",
+    "spread over lines": "\n".join(f"( {k},\n 0 )" for k in range(60)) + "\n;",
+    "no semicolon": " ".join(f"({k}, 1)" for k in range(60)),
+    "huge number": " ".join(f"({k}, 1)" for k in range(60)) + " (1e999, 0);",
+    "unclosed": " ".join(f"({k}, 1)" for k in range(60)) + " (3, 1;",
+}
+
+
+@pytest.mark.parametrize("name", sorted(POINTS))
+def test_long_point_lists(name: str, substitute_min: int) -> None:
+    points = POINTS[name]
+    alone = HEAD.replace("TERM hi := (0, 0) (1, 1);", f"TERM hi := {points}")
+    assert_same(alone)
+    three = HEAD.replace(
+        "TERM hi := (0, 0) (1, 1);", f"TERM hi := {points} TERM m := {points} TERM n := {points}"
+    )
+    assert_same(three + "RULE 1 : IF a IS hi THEN y IS lo;\n" + TAIL)
+    if name == "long" and substitute_min:
+        result = fast.read_runs(alone + TAIL)
+        assert result is not None and len(result.points) == 1

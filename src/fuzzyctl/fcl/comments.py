@@ -7,6 +7,7 @@ never take part in equality; the writer prints them again so ``fmt`` keeps them.
 
 from __future__ import annotations
 
+from bisect import bisect_right
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import Any, Protocol
@@ -46,25 +47,54 @@ def _elements(doc: Document) -> list[tuple[int, int, int, int]]:
     return out
 
 
+class _Owners:
+    """Which element a comment at (line, column) belongs to: the deepest element starting
+    earlier on that line, else the deepest one on the first line with an element after it
+    (the first in source order among equally deep ones).  Looked up by bisection, so that a
+    file with a comment on every line takes linear time."""
+
+    def __init__(self, elements: list[tuple[int, int, int, int]]) -> None:
+        self.keys = [(e[0], e[1]) for e in elements]
+        self.lines = [e[0] for e in elements]
+        # (line, depth) -> the columns and ids of those elements, in source order
+        self.at: dict[tuple[int, int], tuple[list[int], list[int]]] = {}
+        for line, column, depth, ident in elements:
+            cols, ids = self.at.setdefault((line, depth), ([], []))
+            cols.append(column)
+            ids.append(ident)
+
+    def of(self, line: int, column: int) -> int | None:
+        for depth in (2, 1, 0):  # earlier on the same line
+            found = self.at.get((line, depth))
+            if found is not None and found[0][0] < column:
+                return found[1][0]
+        start = bisect_right(self.keys, (line, column))
+        if start == len(self.keys):
+            return None
+        first_line = self.lines[start]
+        for depth in (2, 1, 0):
+            found = self.at.get((first_line, depth))
+            if found is None:
+                continue
+            i = bisect_right(found[0], column) if first_line == line else 0
+            if i < len(found[0]):
+                return found[1][i]
+        return None  # pragma: no cover - the element at ``start`` is one of them
+
+
 def attach_comments(doc: Document, comments: Sequence[CommentLike]) -> Document:
     """A copy of ``doc`` with each comment text stored on its element."""
     if not comments:
         return doc
-    elements = _elements(doc)
+    owners = _Owners(_elements(doc))
     owned: dict[int, list[str]] = {}
     loose: list[str] = []
     for c in comments:
-        same_line = [e for e in elements if e[0] == c.line and e[1] < c.column]
-        if same_line:
-            owner = max(same_line, key=lambda e: e[2])[3]
+        owner = owners.of(c.line, c.column)
+        if owner is None:
+            loose.append(c.text)
         else:
-            after = [e for e in elements if (e[0], e[1]) > (c.line, c.column)]
-            if not after:
-                loose.append(c.text)
-                continue
-            first_line = after[0][0]
-            owner = max((e for e in after if e[0] == first_line), key=lambda e: e[2])[3]
-        owned.setdefault(owner, []).append(c.text)
+            owned.setdefault(owner, []).append(c.text)
 
     def with_comments(obj: Any) -> Any:
         texts = owned.get(id(obj))

@@ -3,19 +3,24 @@
 A file with thousands of rules (or terms) is almost entirely a run of statements of one
 kind, each of which the grammar reads the same way whatever came before.  This module finds
 such runs (outside comments and OPTIONS text, which it skips as the lark lexer does), reads
-each statement with a small hand-written scanner and recursive-descent parser into the same
-model objects and spans the lark transformer builds, and tells the caller which text to
-blank out (spaces in place of every character but ``\\n``, so that lines and columns of what
-lark still reads are unchanged).
+each statement with a small hand-written scanner (conditions with the iterative parser of
+fuzzyctl.fcl.fast_conditions) into the same model objects and spans the lark transformer
+builds, and tells the caller which text to blank out (spaces in place of every character
+but ``\\n``, so that lines and columns of what lark still reads are unchanged).  Runs do not
+depend on line ends: a file written on one line is read the same way.
 
-The fast reader only accepts the plain forms that produce no diagnostic; anything else (a
+The fast reader only accepts the forms that produce no diagnostic; anything else (a
 multi-word name, a keyword used as a name, a missing ';' after a TERM, an unknown shape,
-FUNCTION terms, a number out of range, deep nesting, ...) ends the run, and lark reads it.
-The first and the last statement of a run are always left to lark, so that lark enters and
-leaves the blanked text in the state it would have been in, and every syntax error (with its
-"previous token") is found by lark exactly as before.  ``fcl.lark`` stays the grammar of
-record; tests/fcl/test_fast.py checks that both paths give the same model on every FCL file
-we have and on generated rule blocks.
+FUNCTION terms, a number out of range, ...) ends the run, and lark reads it.  The first and
+the last statement of a run are always left to lark, so that lark enters and leaves the
+blanked text in the state it would have been in, and every syntax error (with its "previous
+token") is found by lark exactly as before.  Of the rules and terms lark reads, a long
+condition followed by THEN (or one nesting deeper than limits.MAX_NESTING) and a long point
+list followed by ';' are still read here: lark reads a one-character placeholder in their
+place and the transformer puts back what was read here (FastResult.conditions, .points), so
+that a single rule of a million parentheses costs lark nothing.  ``fcl.lark`` stays the
+grammar of record; tests/fcl/test_fast.py checks that both paths give the same model and
+diagnostics on every FCL file we have, on generated blocks and on deep and long conditions.
 """
 
 from __future__ import annotations
@@ -23,18 +28,27 @@ from __future__ import annotations
 import math
 import re
 from bisect import bisect_left, bisect_right
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 from fuzzyctl.fcl import shapes
+from fuzzyctl.fcl.fast_conditions import (
+    COMMENT,
+    KEYWORDS,
+    LABEL,
+    NUMBER,
+    PUNCT,
+    WORD,
+    Bail,
+    ConditionParser,
+)
+from fuzzyctl.fcl.fast_conditions import join as _join
+from fuzzyctl.limits import depth as nesting
 from fuzzyctl.model import (
     And,
     Conclusion,
     Condition,
-    Degree,
     Is,
     MembershipFunction,
-    Not,
     Or,
     Param,
     Point,
@@ -57,34 +71,32 @@ _LABEL = re.compile(r"\w+")
 # Where runs may start: comments and OPTIONS text are skipped as lark skips them.
 _SCAN = re.compile(rf"({_COMMENT})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
 _OPTIONS_END = re.compile(r"(?s:.+?)(?=\bEND_OPTIONS?\b)", re.I)
-# The most common rule, on one line with spaces only: read with one match.
+# The most common rule, on one line with spaces only: read with one match (possessive
+# repeats: no backtracking entry kept per AND of a long chain).
 _NAME = r"[^\W\d]\w*"
 _ATOM = rf"{_NAME}[ \t]+IS[ \t]+{_NAME}"
 _SIMPLE_RULE = re.compile(
-    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*)"
-    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*)[ \t]*;",
+    rf"RULE[ \t]+(\w+)[ \t]*:[ \t]*IF[ \t]+({_ATOM}(?:[ \t]+(?:AND|OR)[ \t]+{_ATOM})*+)"
+    rf"[ \t]+THEN[ \t]+({_ATOM}(?:[ \t]*,[ \t]*{_ATOM})*+)[ \t]*;",
     re.I,
 )
+# The rest of a point ``(x, y)`` after its '(' when both are numbers.
+_POINT_REST = re.compile(rf"[ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
 _PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
+_WORD_CHAR = re.compile(r"\w")
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
 
-COMMENT, NUMBER, WORD, LABEL, PUNCT = 1, 2, 3, 4, 5
-
-# Every keyword terminal of fcl.lark: none of them is taken as a name here.
-_KEYWORD_TEXT = """FUNCTION_BLOCK END_FUNCTION_BLOCK VAR_INPUT VAR_OUTPUT VAR END_VAR FUZZIFY END_FUZZIFY
-DEFUZZIFY END_DEFUZZIFY RULEBLOCK END_RULEBLOCK OPTIONS END_OPTIONS OPTION END_OPTION TERM
-RANGE METHOD DEFAULT NC ACCU ACT AND OR NOT RULE IF THEN IS WITH FUNCTION"""
-KEYWORDS = frozenset(_KEYWORD_TEXT.split())
-#: Deepest nesting of parentheses and NOTs read here (far below limits.MAX_NESTING).
-MAX_FAST_NESTING = 30
+#: Conditions at least this long (in characters) of the rules that lark reads (the first
+#: and last of a run, a rule alone) are read here all the same, and lark reads a one-letter
+#: name in their place (see FastResult.conditions); so are conditions nesting too deep.
+SUBSTITUTE_MIN = 200
 #: Shortest run worth taking from lark (its first and last statements stay with lark).
 MIN_RUN = 3
 #: Statements in a row not taken after which only the one-match forms are tried.
 MAX_MISSES = 1000
 
 
-class _Bail(Exception):
-    """Not a statement this reader takes: lark reads it."""
+_Bail = Bail
 
 
 @dataclass
@@ -105,6 +117,13 @@ class FastResult:
     items: list[Rule | Term] = field(default_factory=list)
     spellings: list[str | None] = field(default_factory=list)
     comments: list[FastComment] = field(default_factory=list)
+    #: Conditions of rules that lark reads, read here instead: lark reads the name ``_`` at
+    #: (line, column) in their place.  Each with its depth (``None``: deeper than
+    #: limits.MAX_NESTING, which the rule reports).
+    conditions: dict[tuple[int, int], tuple[Condition | None, int]] = field(default_factory=dict)
+    #: Long point lists of the TERMs that lark reads, read here instead: lark reads ``0`` in
+    #: their place.  By the (line, column) of the TERM keyword.
+    points: dict[tuple[int, int], PointsMF] = field(default_factory=dict)
 
     def between(self, start: int, end: int) -> list[tuple[int, Rule | Term, str | None]]:
         """The statements read here whose offset lies in ``[start, end)``."""
@@ -124,6 +143,14 @@ class FastResult:
         self._at = (offset, line, ls)
         self.comments.append(FastComment(body, offset, line, offset - ls + 1, line + body.count("\n")))
 
+    def condition_at(self, span: Span | None) -> tuple[Condition | None, int] | None:
+        """The condition read here whose placeholder lark read at ``span``."""
+        return self.conditions.get((span.line, span.column)) if span is not None else None
+
+    def points_at(self, span: Span | None) -> PointsMF | None:
+        """The points read here of the TERM whose keyword lark read at ``span``."""
+        return self.points.get((span.line, span.column)) if span is not None else None
+
     def spellings_before(self, end: int | None) -> set[str]:
         n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
         return {s for s in self.spellings[:n] if s is not None}
@@ -132,6 +159,9 @@ class FastResult:
         if end is None:
             return list(self.comments)
         return self.comments[: bisect_right([c.offset for c in self.comments], end - 1)]
+
+
+_Part = tuple[int, int, "Condition | PointsMF | None", int]
 
 
 class _Reader:
@@ -149,6 +179,13 @@ class _Reader:
         self.base_ls = 0
         self.next_nl = text.find("\n")
         self.la: tuple[int, int, int, str] | None = None
+        # the last place whose line was counted, its line, where that line starts
+        self.cursor = (0, 1, 0)
+        # what lark need not read of the statement being read: start, end, what it is
+        # (a condition, None when too deep, or a point list), the condition's depth
+        self.cond: _Part | None = None
+        self.bailed: dict[int, _Part | None] = {}
+        self.last_end = 0  # where the last point read ends
 
     def statement(self) -> tuple[Rule | Term, str | None]:
         """One statement and the spelling of its shape (``_Bail`` when not taken)."""
@@ -172,12 +209,21 @@ class _Reader:
         elif 0 <= self.next_nl < offset:
             self.next_nl = text.find("\n", offset)
         self.base = offset
+        self.cursor = (offset, self.base_line, self.base_ls)
 
     def lc(self, p: int) -> tuple[int, int]:
         if p <= self.next_nl or self.next_nl < 0:
             return self.base_line, p - self.base_ls + 1
         text = self.text
-        return self.base_line + text.count("\n", self.base, p), p - text.rfind("\n", self.base, p)
+        pos, line, ls = self.cursor
+        if p < pos:  # counted from the statement's start (positions mostly grow)
+            pos, line, ls = self.base, self.base_line, self.base_ls
+        line += text.count("\n", pos, p)
+        nl = text.rfind("\n", pos, p)
+        if nl >= 0:
+            ls = nl + 1
+        self.cursor = (p, line, ls)
+        return line, p - ls + 1
 
     def span(self, a: int, b: int) -> Span:
         la, ca = self.lc(a)
@@ -236,8 +282,11 @@ class _Reader:
 
     def number(self, a: int, b: int) -> float:
         tok = self.text[a:b]
-        value = float(tok.translate(_MINUS_SIGNS))
-        if tok[-1:].isdigit() and not math.isfinite(value):
+        try:
+            value = float(tok)
+        except ValueError:  # a Unicode minus sign
+            value = float(tok.translate(_MINUS_SIGNS))
+        if (value == math.inf or value == -math.inf) and tok[-1:].isdigit():
             raise _Bail  # lark's reader reports it
         return value
 
@@ -254,10 +303,13 @@ class _RuleReader(_Reader):
     """RULE label : IF condition THEN conclusions [;]"""
 
     def statement(self) -> tuple[Rule, None]:
+        self.cond = None
         m = _SIMPLE_RULE.match(self.text, self.pos)
         if m is not None:
             rule = self.simple(m)
             if rule is not None:
+                if rule.condition is not None and m.end(2) - m.start(2) >= SUBSTITUTE_MIN:
+                    self.cond = (m.start(2), m.end(2), rule.condition, nesting(rule.condition))
                 return rule, None
         if self.quick_only:
             raise _Bail
@@ -309,9 +361,12 @@ class _RuleReader(_Reader):
         self.seek(m.end())
         self.punct(":")
         self.keyword("IF")
-        self.depth = 0
-        condition = self.or_condition()
+        start = self.peek()[1]
+        condition, depth, stop = ConditionParser(self).parse()
         _, _, end = self.keyword("THEN")
+        self.cond = (start, stop, condition, depth)
+        if condition is None:
+            raise _Bail  # too deep: lark reports it, with this condition in its place
         conclusions = [self.conclusion()]
         while True:
             k, _, _, w = self.peek()
@@ -325,60 +380,7 @@ class _RuleReader(_Reader):
             raise _Bail
         return Rule(label, condition, tuple(conclusions), self.span(r0, end))
 
-    def or_condition(self) -> Condition:
-        return self._chain("OR", self.and_condition, Or)
-
-    def and_condition(self) -> Condition:
-        return self._chain("AND", self.not_condition, And)
-
-    def _chain(self, word: str, operand: Callable[[], Condition], node: type[And] | type[Or]) -> Condition:
-        """``operand (word operand)*``: the operand alone, or one flat node of them all."""
-        first = operand()
-        k, _, _, w = self.peek()
-        if not (k == WORD and w == word):
-            return first
-        operands = [first]
-        while k == WORD and w == word:
-            self.next()
-            operands.append(operand())
-            k, _, _, w = self.peek()
-        return node(tuple(operands), _join(first.span, operands[-1].span))
-
-    def not_condition(self) -> Condition:
-        k, a, b, u = self.next()
-        if k == PUNCT and u == "(":
-            self._deeper()
-            inner = self.or_condition()
-            self.punct(")")
-            self.depth -= 1
-            return replace(inner, grouped=True) if isinstance(inner, And | Or) else inner
-        if k == WORD and u == "NOT":
-            self._deeper()
-            operand = self.not_condition()
-            self.depth -= 1
-            return Not(operand, _join(self.span(a, b), operand.span))
-        if k != WORD or u in KEYWORDS:
-            raise _Bail
-        name = self.text[a:b]
-        k2, _, _, w2 = self.peek()
-        if k2 != WORD or w2 != "IS":
-            if (k2 == WORD and w2 in ("AND", "OR", "THEN")) or (k2 == PUNCT and w2 == ")"):
-                return Degree(name, self.span(a, b))
-            raise _Bail
-        self.next()
-        k2, _, _, w2 = self.peek()
-        negated = k2 == WORD and w2 == "NOT"
-        if negated:
-            self.next()
-        words, end = self._ids()
-        return Is(name, words[-1], negated, tuple(words[:-1]), self.span(a, end))
-
-    def _deeper(self) -> None:
-        self.depth += 1
-        if self.depth > MAX_FAST_NESTING:
-            raise _Bail
-
-    def _ids(self) -> tuple[list[str], int]:
+    def ids(self) -> tuple[list[str], int]:
         """ID+ (hedges and a term): names up to the next keyword or punctuation."""
         w, _, end = self.word()
         words = [w]
@@ -397,7 +399,7 @@ class _RuleReader(_Reader):
         k, _, _, w = self.peek()
         if k == WORD and w == "IS":
             self.next()
-            words, end = self._ids()
+            words, end = self.ids()
             term, hedges = words[-1], tuple(words[:-1])
             k, _, _, w = self.peek()
         if k == WORD and w == "WITH":
@@ -412,6 +414,7 @@ class _TermReader(_Reader):
     """TERM name := points | number | shape numbers ;"""
 
     def statement(self) -> tuple[Term, str | None]:
+        self.cond = None
         if self.quick_only:
             raise _Bail
         _, t0, _ = self.keyword("TERM")
@@ -420,6 +423,7 @@ class _TermReader(_Reader):
         k, a, b, u = self.next()
         spelling: str | None = None
         mf: MembershipFunction
+        part: _Part | None = None
         if k == PUNCT and u == "(":
             points = [self.point(a)]
             while True:
@@ -432,6 +436,8 @@ class _TermReader(_Reader):
                 _, p, _, _ = self.next()
                 points.append(self.point(p))
             mf = PointsMF(tuple(points))
+            if self.last_end - a >= SUBSTITUTE_MIN:
+                part = (a, self.last_end, mf, 0)
         elif k == NUMBER:
             mf = SingletonMF(self.number(a, b))
         elif k == WORD and u not in KEYWORDS:
@@ -439,13 +445,23 @@ class _TermReader(_Reader):
         else:
             raise _Bail
         end = self.punct(";") + 1
+        self.cond = part
         return Term(name, mf, self.span(t0, end)), spelling
 
     def point(self, start: int) -> Point:
-        x, _, _ = self.param()
+        m = _POINT_REST.match(self.text, self.pos) if self.la is None else None
+        if m is not None:  # two numbers and ')' with one match
+            x: Param = self.number(*m.span(1))
+            y: Param = self.number(*m.span(2))
+            end = m.end()
+            self.seek(end)
+            self.last_end = end
+            return Point(x, y, self.span(start, end))
+        x, _, _ = self.param()  # a name, or a comment inside
         self.punct(",")
         y, _, _ = self.param()
         end = self.punct(")") + 1
+        self.last_end = end
         return Point(x, y, self.span(start, end))
 
     def shape(self, name: str) -> tuple[MembershipFunction, str]:
@@ -498,17 +514,13 @@ def _precedence(groups: list[list[Is]]) -> Condition:
     return ors[0] if len(ors) == 1 else Or(tuple(ors), _join(ors[0].span, ors[-1].span))
 
 
-def _join(first: Span | None, last: Span | None) -> Span | None:
-    if first is None or last is None:
-        return first
-    return Span(first.line, first.column, last.end_line, last.end_column)
-
-
 def read_runs(text: str) -> FastResult | None:
-    """The runs of plain RULE and TERM statements of ``text`` (``None`` when there is no run
-    worth taking from lark)."""
+    """The runs of plain RULE and TERM statements of ``text``, and the long conditions of
+    the rules lark reads (``None`` when there is nothing worth taking from lark)."""
     result = FastResult(text)
-    blanks: list[tuple[int, int]] = []
+    blanks: list[tuple[int, int, int, str]] = []
+    comments: dict[int, str] = {}
+    subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]] = {}
     readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
     pos = misses = 0
     while True:
@@ -526,59 +538,133 @@ def read_runs(text: str) -> FastResult | None:
             pos = body.end()
             continue
         taken = len(blanks)
-        pos = _run(readers[word], word, m.start(), result, blanks)
+        pos = _run(readers[word], word, m.start(), result, blanks, comments, subs)
         misses = 0 if len(blanks) > taken else misses + 1
         if misses > MAX_MISSES:  # a file of statements this reader does not take
             for reader in readers.values():
                 reader.quick_only = True
+    lines = _Lines(text)
+    for p in sorted(subs):
+        a, b, part, levels, statement = subs[p]
+        if isinstance(part, PointsMF):
+            result.points[lines.at(statement)] = part
+            blanks.append((a, b, p, "0"))
+        else:
+            result.conditions[lines.at(p)] = (part, levels)
+            blanks.append((a, b, p, "_"))
     if not blanks:
         return None
+    for offset in sorted(comments):
+        result.add_comment(comments[offset], offset)
+    blanks.sort()
     result.text = _blank(text, blanks)
     return result
 
 
-def _run(reader: _Reader, word: str, start: int, result: FastResult, blanks: list[tuple[int, int]]) -> int:
-    """Read the run of ``word`` statements from ``start``; keep the inner ones in ``result``.
-    Returns where the search for the next run goes on."""
+def _run(
+    reader: _Reader,
+    word: str,
+    start: int,
+    result: FastResult,
+    blanks: list[tuple[int, int, int, str]],
+    comments: dict[int, str],
+    subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]],
+) -> int:
+    """Read the run of ``word`` statements from ``start``; keep the inner ones in ``result``
+    and the long conditions of the others.  Returns where the search for the next run goes
+    on."""
     got: list[tuple[int, Rule | Term, str | None]] = []
+    conds: list[tuple[int, _Part]] = []
     reader.comments = []
     at = start
+    resume = start + len(word)
     while True:
         reader.seek(at)
         reader.at_statement(at)
         try:
+            if at in reader.bailed:  # read before: not again
+                reader.cond = reader.bailed[at]
+                raise _Bail
             item, spelling = reader.statement()
         except _Bail:
+            reader.bailed[at] = reader.cond
+            if reader.cond is not None:
+                conds.append((at, reader.cond))
+            resume = at + len(word)
             break
+        if reader.cond is not None:
+            conds.append((at, reader.cond))
         got.append((at, item, spelling))
         try:
             kind, a, _, u = reader.peek()  # comments before it are recorded here
         except _Bail:
+            resume = reader.pos
             break
         if kind != WORD or u != word:
+            resume = a
             break
         at = a
-    if len(got) < MIN_RUN:
-        return start + len(word)
-    lo, hi = got[1][0], got[-1][0]
-    blanks.append((lo, hi))
-    for offset, item, spelling in got[1:-1]:
-        result.offsets.append(offset)
-        result.items.append(item)
-        result.spellings.append(spelling)
+    lo = hi = start
+    if len(got) >= MIN_RUN:
+        lo, hi = got[1][0], got[-1][0]
+        blanks.append((lo, hi, -1, ""))
+        for offset, item, spelling in got[1:-1]:
+            result.offsets.append(offset)
+            result.items.append(item)
+            result.spellings.append(spelling)
+        resume = hi
+    regions = [(lo, hi)]
+    for offset, (a, b, part, levels) in conds:
+        if (lo <= offset < hi) or (part is not None and b - a < SUBSTITUTE_MIN):
+            continue
+        p = _placeholder(reader.text, a, b)
+        if p < 0:
+            continue
+        subs[p] = (a, b, part, levels, offset)
+        regions.append((a, b))
     for body, offset in reader.comments:
-        if lo <= offset < hi:
-            result.add_comment(body, offset)
-    return hi
+        if any(a <= offset < b for a, b in regions):
+            comments[offset] = body
+    return resume
 
 
-def _blank(text: str, regions: list[tuple[int, int]]) -> str:
-    """``text`` with every character of ``regions`` but ``\\n`` replaced by a space."""
+def _placeholder(text: str, a: int, b: int) -> int:
+    """Where lark is to read ``_`` in place of the condition ``text[a:b]``: not on a line
+    end, nor glued to a word before it (``IF(``); -1 when there is no such place."""
+    for p in range(a, b):
+        if text[p] == "\n" or (p == a and a > 0 and _WORD_CHAR.match(text, a - 1)):
+            continue
+        return p
+    return -1
+
+
+class _Lines:
+    """(line, column) of offsets asked for in increasing order."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+        self.pos, self.line, self.ls = 0, 1, 0
+
+    def at(self, p: int) -> tuple[int, int]:
+        self.line += self.text.count("\n", self.pos, p)
+        nl = self.text.rfind("\n", self.pos, p)
+        if nl >= 0:
+            self.ls = nl + 1
+        self.pos = p
+        return self.line, p - self.ls + 1
+
+
+def _blank(text: str, regions: list[tuple[int, int, int, str]]) -> str:
+    """``text`` with every character of ``regions`` but ``\\n`` replaced by a space, and
+    the placeholder mark at the offset of each (when not -1)."""
     out: list[str] = []
     pos = 0
-    for a, b in regions:
+    for a, b, p, mark in regions:
         out.append(text[pos:a])
-        out.append("\n".join(" " * len(line) for line in text[a:b].split("\n")))
+        blank = "\n".join(" " * len(line) for line in text[a:b].split("\n"))
+        if p >= 0:
+            blank = blank[: p - a] + mark + blank[p - a + 1 :]
+        out.append(blank)
         pos = b
     out.append(text[pos:])
     return "".join(out)

@@ -294,6 +294,9 @@ class _Builder(Transformer[Token, Any]):
     # ---------------------------------------------------------------- terms and blocks
     def term(self, children: list[Any]) -> Term:
         name, mf, semi = children[1], children[2], children[3]
+        fast = self.state.fast
+        if fast is not None and isinstance(mf, SingletonMF) and fast.points:
+            mf = fast.points_at(_tok_span(children[0])) or mf  # points the fast reader read
         span = _outer(children)
         if semi is None:
             end = Span(span.line, span.column) if span else None
@@ -502,7 +505,15 @@ class _Builder(Transformer[Token, Any]):
         condition: Condition | None = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
         conclusions = next(c for c in children if isinstance(c, tuple))
         span = _outer(children)
-        if (d := depth(condition)) > MAX_NESTING:
+        fast = self.state.fast
+        found = None
+        if fast is not None and isinstance(condition, Degree) and condition.variable == "_":
+            found = fast.condition_at(condition.span)  # a condition the fast reader read
+        if found is not None:
+            condition, d = found
+        else:
+            d = depth(condition)
+        if d > MAX_NESTING:
             # refused here: every later step walks conditions recursively
             self.state.error(
                 f"rule {label}: the condition nests {d} levels deep (the limit is {MAX_NESTING})",
