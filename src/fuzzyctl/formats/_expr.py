@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Iterator
 
 from fuzzyctl.formats._common import fmt_number
 from fuzzyctl.model import Binary, Call, Expr, Name, Num, Unary
@@ -28,21 +29,25 @@ class ExprError(ValueError):
         self.position = position
 
 
-def _tokens(text: str) -> list[tuple[str, str, int]]:
-    out: list[tuple[str, str, int]] = []
-    pos = 0
-    end = len(text.rstrip())  # linear: no rescanning of the rest of the text per token
-    while pos < end:
-        m = _TOKEN.match(text, pos)
-        if m is None or m.end() == pos:
-            start = pos
-            while start < end and text[start].isspace():
-                start += 1
-            raise ExprError(f"unexpected character {text[start]!r} in expression", start)
+# Every token of a text at once (atomic and possessive, so each token is the one _TOKEN
+# takes at that place): where it stops is where _tokens stops.
+# (without the named groups: 3.11's re fails on capturing groups in a possessive repeat)
+_ALL_TOKENS = re.compile("(?>{})*+".format(re.sub(r"\(\?P<\w+>", "(?:", _TOKEN.pattern)))
+
+
+def _tokens(text: str) -> Iterator[tuple[str, str, int]]:
+    """The tokens of ``text``, made as the parser asks for them (an expression nested a
+    million deep is refused after a hundred tokens, not after building a million), or
+    :class:`ExprError` at once for a character that starts no token."""
+    end = len(text.rstrip())
+    pos = _ALL_TOKENS.match(text).end()  # type: ignore[union-attr]  # matches at least ""
+    if pos < end:
+        while pos < end and text[pos].isspace():
+            pos += 1
+        raise ExprError(f"unexpected character {text[pos]!r} in expression", pos)
+    for m in _TOKEN.finditer(text):  # consecutive: the whole text is tokens
         kind = m.lastgroup or "op"
-        out.append((kind, m.group(kind), m.start(kind)))
-        pos = m.end()
-    return out
+        yield (kind, m.group(kind), m.start(kind))
 
 
 def parse_expr(text: str) -> Expr:
@@ -51,18 +56,18 @@ def parse_expr(text: str) -> Expr:
     from fuzzyctl.limits import MAX_NESTING, expr_depth
 
     tokens = _tokens(text)
-    index = 0
+    current = next(tokens, None)
     depth = 0
 
     def peek() -> tuple[str, str, int] | None:
-        return tokens[index] if index < len(tokens) else None
+        return current
 
     def take() -> tuple[str, str, int]:
-        nonlocal index
-        tok = peek()
+        nonlocal current
+        tok = current
         if tok is None:
             raise ExprError("expression ends too early", len(text))
-        index += 1
+        current = next(tokens, None)
         return tok
 
     def expect(op: str) -> None:
@@ -224,6 +229,9 @@ def _eval_constant(expr: Expr) -> float:
         if expr.op == "/":
             return a / b
         if expr.op == "^":
-            return float(a**b)
+            power = a**b
+            if isinstance(power, complex):  # (-8)^0.5: MATLAB's value is complex
+                raise ValueError(f"{fmt_number(a)}^{fmt_number(b)} is not a real number")
+            return float(power)
         return a % b
     raise ValueError("functions are not allowed in a number")
