@@ -275,10 +275,12 @@ def _cached(rel: str) -> Any:
 
 def _store(rel: str, obj: Any) -> None:
     from fuzzyctl import cache
+    from fuzzyctl.gcpause import gc_paused
 
     path = cache.cache_dir() / rel
     try:
-        data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
+        with gc_paused():  # pickling a large model otherwise sets off collections over all of it
+            data = pickle.dumps(obj, protocol=pickle.HIGHEST_PROTOCOL)
     except Exception:  # pragma: no cover - an unpicklable model: no cache
         return
     if cache.write_atomic(path, data):

@@ -55,28 +55,42 @@ def parse_expr(text: str) -> Expr:
     :data:`fuzzyctl.limits.MAX_NESTING`, parentheses, calls, operators and chains alike)."""
     from fuzzyctl.limits import MAX_NESTING, expr_depth
 
-    tokens = _tokens(text)
-    current = next(tokens, None)
-    depth = 0
+    parser = _Parser(text, MAX_NESTING)
+    result = parser.expression(0)
+    leftover = parser.current
+    if leftover is not None:
+        raise ExprError(f"unexpected {leftover[1]!r} after the expression", leftover[2])
+    if expr_depth(result) > MAX_NESTING:  # a long chain a + b + c ... is a deep tree too
+        raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", 0)
+    return result
 
-    def peek() -> tuple[str, str, int] | None:
-        return current
 
-    def take() -> tuple[str, str, int]:
-        nonlocal current
-        tok = current
+class _Parser:
+    """Precedence climbing over the tokens of one text.  A class rather than nested
+    functions: those refer to each other, a reference cycle per expression that the readers
+    (which run with the cyclic GC paused) would keep until they return."""
+
+    def __init__(self, text: str, max_nesting: int) -> None:
+        self.text = text
+        self.max_nesting = max_nesting
+        self.tokens = _tokens(text)
+        self.current = next(self.tokens, None)
+        self.depth = 0
+
+    def take(self) -> tuple[str, str, int]:
+        tok = self.current
         if tok is None:
-            raise ExprError("expression ends too early", len(text))
-        current = next(tokens, None)
+            raise ExprError("expression ends too early", len(self.text))
+        self.current = next(self.tokens, None)
         return tok
 
-    def expect(op: str) -> None:
-        _kind, value, pos = take()
+    def expect(self, op: str) -> None:
+        _kind, value, pos = self.take()
         if value != op:
             raise ExprError(f"expected {op!r} but found {value!r}", pos)
 
-    def primary() -> Expr:
-        kind, value, pos = take()
+    def primary(self) -> Expr:
+        kind, value, pos = self.take()
         if kind == "num":
             number = float(value)
             if math.isinf(number):  # 1e400, 5001 digits: not an infinity the file spelt
@@ -84,57 +98,48 @@ def parse_expr(text: str) -> Expr:
                 raise ExprError(f"the number {shown} is too large (beyond 1.8e308)", pos)
             return Num(number)
         if kind == "name":
-            nxt = peek()
+            nxt = self.current
             if nxt is not None and nxt[1] == "(":
-                take()
+                self.take()
                 args: list[Expr] = []
-                if (peek() or ("", "", 0))[1] != ")":
-                    args.append(expression(0))
-                    while (peek() or ("", "", 0))[1] == ",":
-                        take()
-                        args.append(expression(0))
-                expect(")")
+                if (self.current or ("", "", 0))[1] != ")":
+                    args.append(self.expression(0))
+                    while (self.current or ("", "", 0))[1] == ",":
+                        self.take()
+                        args.append(self.expression(0))
+                self.expect(")")
                 return Call(value.lower(), tuple(args))
             return Name(value)
         if value == "(":
-            inner = expression(0)
-            expect(")")
+            inner = self.expression(0)
+            self.expect(")")
             return inner
         if value in {"-", "+"}:
-            return Unary(value, expression(_UNARY_POWER))
+            return Unary(value, self.expression(_UNARY_POWER))
         raise ExprError(f"unexpected {value!r} in expression", pos)
 
-    def expression(min_power: int) -> Expr:
-        nonlocal depth
-        depth += 1
+    def expression(self, min_power: int) -> Expr:
+        self.depth += 1
         try:
-            if depth > MAX_NESTING:
-                pos = (peek() or ("", "", len(text)))[2]
-                raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", pos)
-            return _operators(min_power)
+            if self.depth > self.max_nesting:
+                pos = (self.current or ("", "", len(self.text)))[2]
+                raise ExprError(f"the expression nests more than {self.max_nesting} levels deep", pos)
+            return self.operators(min_power)
         finally:
-            depth -= 1
+            self.depth -= 1
 
-    def _operators(min_power: int) -> Expr:
-        left = primary()
+    def operators(self, min_power: int) -> Expr:
+        left = self.primary()
         while True:
-            tok = peek()
+            tok = self.current
             if tok is None or tok[0] != "op" or tok[1] not in _BINARY_POWER:
                 return left
             power = _BINARY_POWER[tok[1]]
             if power < min_power or (power == min_power and tok[1] != "^"):
                 return left
-            take()
-            right = expression(power if tok[1] == "^" else power + 1)
+            self.take()
+            right = self.expression(power if tok[1] == "^" else power + 1)
             left = Binary(tok[1], left, right)
-
-    result = expression(0)
-    leftover = peek()
-    if leftover is not None:
-        raise ExprError(f"unexpected {leftover[1]!r} after the expression", leftover[2])
-    if expr_depth(result) > MAX_NESTING:  # a long chain a + b + c ... is a deep tree too
-        raise ExprError(f"the expression nests more than {MAX_NESTING} levels deep", 0)
-    return result
 
 
 def names_in(expr: Expr) -> set[str]:

@@ -276,11 +276,13 @@ def _membership(
 
 def _number(digits: str) -> tuple[int, int] | tuple[int, int, str]:
     """The number of a section or of an MF key as a sort key: ``(0, n)``, or for more
-    digits than Python converts (4300), ``(1, ...)`` after every smaller number."""
+    digits than Python converts (4300, leading zeros aside), ``(1, ...)`` after every
+    smaller number."""
+    if len(digits) > 4300:
+        digits = digits.lstrip("0") or "0"
     if len(digits) <= 4300:
         return (0, int(digits))
-    significant = digits.lstrip("0")
-    return (1, len(significant), significant)
+    return (1, len(digits), digits)
 
 
 class _UniqueNames:
@@ -364,7 +366,7 @@ def _variable(
             )
     for key in ("Enabled",):
         entry = section.get(key)
-        if entry is not None and parse_number(entry[0]) != 1.0:
+        if entry is not None and not _flag(section, key, rep):
             raise rep.fail(
                 f"{name!r} is disabled (Enabled=0): disabled variables are not supported",
                 entry[1],
