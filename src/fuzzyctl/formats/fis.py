@@ -144,7 +144,7 @@ def _sections(text: str, rep: Reporter) -> tuple[list[_Section], bool]:
             if not sections and "fuzzylite" in stripped.lower():
                 mentions_fuzzylite = True
             continue
-        line = _strip_comment(stripped).strip()
+        line = _strip_comment(stripped).strip() if "#" in stripped or "%" in stripped else stripped
         if not line:
             continue
         if line[0] == "[":

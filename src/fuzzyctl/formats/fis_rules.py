@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from functools import lru_cache
 from typing import Protocol
 
+from fuzzyctl.diagnostics import warning
 from fuzzyctl.formats._common import Reporter, parse_number, power_hedge
 from fuzzyctl.formats._expr import eval_constant, parse_expr
 from fuzzyctl.model import (
@@ -225,13 +226,17 @@ def rules(
                 line,
                 code="fis-rule-syntax",
             )
-        if not 0.0 <= weight_value <= 1.0:
-            rep.warning(f"rule weight {weight_value:g} is outside [0, 1]", line, code="fis-weight")
-        # rep.span(line), once for the rule and all its parts
+        # rep.span(line), once for the rule, all its parts and a warning about it
         raw = source[line - 1]
         body = raw.lstrip()
         column = len(raw) - len(body) + 1
         span = Span(line, column, line, column + (len(body.rstrip()) or 1))
+        if not 0.0 <= weight_value <= 1.0:
+            rep.items.append(
+                warning(
+                    f"rule weight {weight_value:g} is outside [0, 1]", span, code="fis-weight", file=rep.path
+                )
+            )
         rule = _rule(ante, cons, weight_value, conn_value, ins, outs, rep, dialect, line, span, len(out) + 1)
         if rule is not None:
             out.append(rule)
