@@ -158,6 +158,28 @@ MF2='hi':'trimf',[0 1 1]
 """
 
 
+def _fis_inputs(n: int, size: int) -> str:
+    """``n`` inputs of two terms each and rules of ``n`` entries up to ``size``."""
+    head = FIS_HEAD.format(n=1).split("[Input1]")[0].replace("NumInputs=1", f"NumInputs={n}")
+    terms = "NumMFs=2\nMF1='lo':'trimf',[0 0 1]\nMF2='hi':'trimf',[0 1 1]\n"
+    inputs = "".join(f"[Input{i}]\nName='x{i}'\nRange=[0 1]\n{terms}" for i in range(1, n + 1))
+    output = FIS_HEAD[FIS_HEAD.index("[Output1]") :]
+    rule = " ".join(["1"] * n) + ", 1 (1) : 1\n"
+    return _repeat(head + inputs + output, lambda k: rule, "", size)
+
+
+def _fis_mfs(size: int, name: Callable[[int], str]) -> str:
+    """One input with as many membership functions as fit in ``size``."""
+    head, tail = FIS_HEAD.format(n=1).split("[Output1]")
+    head = head.replace("NumMFs=2\nMF1='lo':'trimf',[0 0 1]\nMF2='hi':'trimf',[0 1 1]\n", "")
+    return _repeat(
+        head,
+        lambda k: f"MF{k + 1}='{name(k)}':'trimf',[0 0 1]\n",
+        "[Output1]" + tail + "1, 1 (1) : 1\n",
+        size,
+    )
+
+
 def fis(shape: str, size: int) -> str:
     if shape == "valid":
         return _repeat(
@@ -175,6 +197,40 @@ def fis(shape: str, size: int) -> str:
         )
     if shape == "not":
         return FIS_HEAD.format(n=1).replace("NumRules=1", "NumRules=" + "9" * 5001)
+    # the densest rules: version 1.0 lines without punctuation, 8 bytes each
+    if shape == "dense":
+        return _repeat(FIS_HEAD.format(n=size // 8), lambda k: f"{k % 2 + 1} {k % 2 + 1} 1 1\n", "", size)
+    if shape == "cr-only":
+        return fis("valid", size).replace("\n", "\r")
+    if shape == "hedges":  # fractional codes take the general path
+        return _repeat(
+            FIS_HEAD.format(n=size // 16), lambda k: f"{k % 2 + 1}.2, {k % 2 + 1} (1) : 1\n", "", size
+        )
+    if shape == "exprs":  # a different expression on every line
+        return _repeat(FIS_HEAD.format(n=size // 20), lambda k: f"{k + 1}/{k + 1}, 1 (1) : 1\n", "", size)
+    if shape == "warnings":  # a warning on every line
+        return _repeat(FIS_HEAD.format(n=size // 9), lambda k: "1,1(2):1\n", "", size)
+    if shape == "inputs":  # 2,000 inputs, rules of 2,000 entries
+        return _fis_inputs(2000, size)
+    if shape == "mfs":  # one input with hundreds of thousands of terms
+        return _fis_mfs(size, lambda k: f"t{k}")
+    if shape == "same-mfs":  # ... all of one name (renamed t_2, t_3, ...)
+        return _fis_mfs(size, lambda k: "t")
+    if shape == "params":  # one term with millions of parameters (extra ones ignored)
+        return (
+            FIS_HEAD.format(n=1).replace("[0 0 1]", "[0 0 1 " + "0 " * (size // 2) + "]", 1)
+            + "1, 1 (1) : 1\n"
+        )
+    if shape == "expr-params":  # ... each a different expression
+        exprs = " ".join(f"{k}/7" for k in range(size // 9))
+        return FIS_HEAD.format(n=1).replace("[0 0 1]", f"[0 0 1 {exprs}]", 1) + "1, 1 (1) : 1\n"
+    if shape == "system":  # a [System] section of a million keys
+        head, rest = FIS_HEAD.format(n=1).split("[Input1]")
+        return _repeat(head, lambda k: f"Key{k}='value'\n", "[Input1]" + rest + "1, 1 (1) : 1\n", size)
+    if shape == "counts":  # counts of a billion, on few lines
+        return FIS_HEAD.format(n=999_999_999).replace("NumMFs=2", "NumMFs=999999999") + "1, 1 (1) : 1\n"
+    if shape == "comments":  # a quoted string and a comment on every line
+        return _repeat(FIS_HEAD.format(n=size // 30), lambda k: "1, 1 (1) : 1 % 'it''s' # x\n", "", size)
     return _garbage(size)
 
 
@@ -391,8 +447,24 @@ FORMATS: dict[str, tuple[str, Callable[[str, int], str]]] = {
     "xfuz": (".csv.xfuz", xfuz),
 }
 SHAPES = ("valid", "errors", "garbage", "one-line", "deep", "not")
+#: Further shapes of FIS files .
+FIS_SHAPES = (
+    "dense",
+    "cr-only",
+    "hedges",
+    "exprs",
+    "warnings",
+    "inputs",
+    "mfs",
+    "same-mfs",
+    "params",
+    "expr-params",
+    "system",
+    "counts",
+    "comments",
+)
 #: Shapes run for one format only (by default, after the common ones).
-FORMAT_SHAPES: dict[str, tuple[str, ...]] = {"fll": FLL_SHAPES}
+FORMAT_SHAPES: dict[str, tuple[str, ...]] = {"fll": FLL_SHAPES, "fis": FIS_SHAPES, "fcl": FCL_SHAPES}
 
 
 # The child: fuzzyctl.load() inside the CLI's error boundary (diagnostics printed as the CLI

@@ -13,6 +13,7 @@ import fuzzyctl
 from fuzzyctl import formats
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import fis, get
+from fuzzyctl.formats._common import unique_name
 from fuzzyctl.model import And, Conclusion, Is, Or, PointsMF, ShapeMF
 from tests.conftest import DATA, EXAMPLES
 
@@ -147,6 +148,67 @@ def test_duplicate_term_names_stay_reachable_by_index() -> None:
     assert [t.name for t in out.terms] == ["small", "small_2"]
     assert loaded.document.main.rule_blocks[0].rules[1].conclusions[0].term == "small_2"
     assert any(d.code == "duplicate-term" for d in loaded.diagnostics)
+
+
+def test_many_terms_of_one_name_are_numbered_as_unique_name_numbers_them() -> None:
+    # t, t, t_3 (written), t, t: the renaming skips the written t_3, as _common.unique_name does
+    names = ["t", "t", "t_3", "t", "t"]
+    mfs = "".join(f"MF{i}='{n}':'trimf',[0 5 10]\n" for i, n in enumerate(names, start=1))
+    text = HEADER.replace("MF1='small':'trimf',[0 5 10]\nMF2='big':'trapmf',[10 20 25 30]\n", mfs)
+    loaded = fis.read(
+        text.replace("NumMFs=2\n" + mfs, f"NumMFs=5\n{mfs}").format(
+            type="mamdani", defuzz="centroid", nrules=1
+        )
+        + "1 1, 5 (1) : 1\n"
+    )
+    out = loaded.document.main.defuzzify[0]
+    taken: set[str] = set()
+    assert (
+        [t.name for t in out.terms]
+        == [unique_name(n, taken) for n in names]
+        == ["t", "t_2", "t_3", "t_4", "t_5"]
+    )
+    assert loaded.document.main.rule_blocks[0].rules[0].conclusions[0].term == "t_5"
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "code", "words"),
+    [
+        # numbers Python will not convert (over 4300 digits) in a section header and an MF key
+        ("[Input1]", "[Input" + "0" * 5000 + "1]", None, None),
+        ("MF2='hi'", "MF" + "0" * 5000 + "3='hi'", "fis-mf-number", "membership function number 2"),
+        ("MF2='hi'", "MF" + "7" * 5000 + "='hi'", "fis-mf-number", "membership function number 2"),
+        # MATLAB's value of (-8)^0.5 is complex
+        ("[1.5 0]", "[1.5 (-8)^0.5]", "fis-number", "not a real number"),
+        ("NumMFs=2\nMF1='lo'", "Enabled=x\nNumMFs=2\nMF1='lo'", "fis-number", "Enabled must be 0 or 1"),
+    ],
+)
+def test_hostile_numbers_get_a_diagnostic_not_a_traceback(
+    old: str, new: str, code: str | None, words: str
+) -> None:
+    text = (
+        HEADER.replace(old, new, 1).format(type="mamdani", defuzz="centroid", nrules=1) + "1 1, 1 (1) : 1\n"
+    )
+    if code is None:  # read as Input1
+        assert [v.name for v in fis.read(text, "t.fis").document.main.variables] == ["a", "b", "y"]
+        return
+    place = next(i for i, line in enumerate(text.splitlines(), start=1) if new.splitlines()[0][:12] in line)
+    try:
+        found = list(fis.read(text, "t.fis").diagnostics)
+    except DiagnosticError as exc:
+        found = exc.diagnostics
+    d = next(d for d in found if d.code == code)
+    assert words in d.message and d.span is not None and d.span.line == place
+
+
+def test_an_expression_nested_a_million_deep_is_refused_with_its_place() -> None:
+    deep = "(" * 1_000_000 + "0" + ")" * 1_000_000
+    text = HEADER.replace("[1.5 0]", f"[1.5 {deep}]").format(type="mamdani", defuzz="centroid", nrules=0)
+    with pytest.raises(DiagnosticError) as err:
+        fis.read(text, "t.fis")
+    d = err.value.diagnostics[0]
+    assert d.code == "fis-number" and "nests more than" in d.message and "2000001 characters" in d.message
+    assert d.span is not None and d.span.line == HEADER.splitlines().index("MF1='lo':'gaussmf',[1.5 0]") + 1
 
 
 def test_written_fis_reads_back_equal() -> None:

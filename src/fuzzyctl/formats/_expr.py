@@ -340,6 +340,9 @@ def _eval_constant(expr: Expr) -> float:
         if expr.op == "/":
             return a / b
         if expr.op == "^":
-            return float(a**b)
+            power = a**b
+            if isinstance(power, complex):  # (-8)^0.5: MATLAB's value is complex
+                raise ValueError(f"{fmt_number(a)}^{fmt_number(b)} is not a real number")
+            return float(power)
         return a % b
     raise ValueError("functions are not allowed in a number")

@@ -27,26 +27,21 @@ from dataclasses import dataclass, field, replace
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Format, Loaded
-from fuzzyctl.formats._common import Reporter, parse_count, parse_number, power_hedge, unique_name
-from fuzzyctl.formats._expr import ExprError, eval_constant, names_in, parse_expr
+from fuzzyctl.formats._common import Reporter, parse_count, parse_number
+from fuzzyctl.formats._expr import ExprError, names_in, parse_expr
 from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
+from fuzzyctl.formats.fis_rules import TS_KINDS, is_ts_term, numbers, rules
 from fuzzyctl.model import (
-    And,
-    Conclusion,
-    Condition,
     Default,
     DefuzzifyBlock,
     Document,
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
-    Is,
     MembershipFunction,
-    Or,
     Point,
     PointsMF,
     Range,
-    Rule,
     RuleBlock,
     ShapeMF,
     Term,
@@ -94,23 +89,6 @@ DEFUZZ_METHODS = {
     # which is what our COG computes exactly.
     "centroid_integral": "COG",
 }
-# fuzzylite's hedge codes (FisImporter::translateProposition); "any" is resolved apart.
-FUZZYLITE_HEDGE_CODES: dict[int, tuple[str, ...]] = {
-    1: ("seldom",),
-    5: ("somewhat",),
-    20: ("very",),
-    30: ("extremely",),
-    40: ("very", "very"),
-}
-ANY_CODE = 99
-TS_KINDS = frozenset({"constant", "linear"})
-
-
-def _is_ts_term(mf: MembershipFunction) -> bool:
-    """A Takagi-Sugeno output term: constant, linear, or a function of the variables."""
-    return (isinstance(mf, ShapeMF) and mf.kind in TS_KINDS) or (
-        isinstance(mf, FunctionMF) and mf.argument is None
-    )
 
 
 @dataclass
@@ -130,18 +108,19 @@ class _Section:
 _SECTION = re.compile(r"\[\s*(System|Input\s*\d+|Output\s*\d+|Rules)\s*\]", re.IGNORECASE)
 _KEY_VALUE = re.compile(r"([A-Za-z][A-Za-z0-9_]*)\s*=\s*(.*)$")
 _MF = re.compile(r"'([^']*)'\s*:\s*'([^']*)'\s*,\s*\[(.*)\]\s*(?:,\s*(\S+))?\s*$")
-_RULE = re.compile(r"^(?P<ante>[^,]*),(?P<cons>[^(]*)\((?P<w>[^)]*)\)\s*:\s*(?P<conn>\S+)\s*$")
+
+
+# Text outside quotes and whole quoted strings; what follows is a comment, an unclosed
+# quote (quoted to the end of the line) or the end.
+_CODE = re.compile(r"(?:[^'#%]++|'[^']*+')*+")
 
 
 def _strip_comment(line: str) -> str:
     """Drop a trailing ``#`` or ``%`` comment that is outside quotes."""
-    quoted = False
-    for i, ch in enumerate(line):
-        if ch == "'":
-            quoted = not quoted
-        elif ch in "#%" and not quoted:
-            return line[:i]
-    return line
+    if "#" not in line and "%" not in line:
+        return line
+    end = _CODE.match(line).end()  # type: ignore[union-attr]  # matches at least ""
+    return line[:end] if end < len(line) and line[end] != "'" else line
 
 
 def _unquote(value: str) -> str:
@@ -155,6 +134,8 @@ def _sections(text: str, rep: Reporter) -> tuple[list[_Section], bool]:
     """Split the file into sections; also tell whether a comment names fuzzylite."""
     sections: list[_Section] = []
     mentions_fuzzylite = False
+    current: _Section | None = None
+    rule_lines: list[tuple[str, int]] | None = None  # the current section's, in [Rules]
     for number, raw in enumerate(rep.lines, start=1):
         stripped = raw.strip()
         if not stripped:
@@ -163,21 +144,22 @@ def _sections(text: str, rep: Reporter) -> tuple[list[_Section], bool]:
             if not sections and "fuzzylite" in stripped.lower():
                 mentions_fuzzylite = True
             continue
-        line = _strip_comment(stripped).strip()
+        line = _strip_comment(stripped).strip() if "#" in stripped or "%" in stripped else stripped
         if not line:
             continue
-        m = _SECTION.fullmatch(line)
-        if m:
-            sections.append(_Section(re.sub(r"\s+", "", m.group(1)), number))
+        if line[0] == "[":
+            m = _SECTION.fullmatch(line)
+            if m is None:
+                raise rep.fail(f"unknown section {line}", number, code="fis-syntax")
+            current = _Section(re.sub(r"\s+", "", m.group(1)), number)
+            sections.append(current)
+            rule_lines = current.rules if current.header.lower() == "rules" else None
             continue
-        if line.startswith("["):
-            raise rep.fail(f"unknown section {line}", number, code="fis-syntax")
-        if not sections:
+        if rule_lines is not None:
+            rule_lines.append((line, number))
+            continue
+        if current is None:
             raise rep.fail("text before the [System] section", number, code="fis-syntax")
-        current = sections[-1]
-        if current.header.lower() == "rules":
-            current.rules.append((line, number))
-            continue
         kv = _KEY_VALUE.match(line)
         if kv is None:
             raise rep.fail(f"expected 'Key=value' in [{current.header}]", number, code="fis-syntax")
@@ -185,39 +167,20 @@ def _sections(text: str, rep: Reporter) -> tuple[list[_Section], bool]:
     return sections, mentions_fuzzylite
 
 
-_SEPARATORS = re.compile(r"[\s,;]+")
-
-
-def _numbers(text: str, rep: Reporter, line: int, what: str) -> list[float]:
-    parts = [p for p in _SEPARATORS.split(text.strip()) if p]
-    out: list[float] = []
-    for part in parts:
-        try:
-            out.append(parse_number(part))
-        except ValueError:
-            try:  # MATLAB evaluates entries such as -pi/4
-                out.append(eval_constant(parse_expr(part)))
-            except (ValueError, ZeroDivisionError) as exc:
-                # the entry, shortened (it may be 5001 digits or 1000 parentheses), and why
-                shown = part if len(part) <= 40 else f"{part[:30]}... ({len(part)} characters)"
-                raise rep.fail(
-                    f"{what}: expected numbers, found {shown!r} ({exc})", line, code="fis-number"
-                ) from None
-    return out
-
-
 def _range(value: str, rep: Reporter, line: int) -> Range:
     inner = value.strip()
     if not (inner.startswith("[") and inner.endswith("]")):
         raise rep.fail(f"Range must be written [min max], found {value!r}", line, code="fis-range")
-    numbers = _numbers(inner[1:-1], rep, line, "Range")
-    if len(numbers) != 2:
-        raise rep.fail(f"Range needs 2 numbers, found {len(numbers)}", line, code="fis-range")
-    if numbers[0] > numbers[1]:
+    low_high = numbers(inner[1:-1], rep, line, "Range")
+    if len(low_high) != 2:
+        raise rep.fail(f"Range needs 2 numbers, found {len(low_high)}", line, code="fis-range")
+    if low_high[0] > low_high[1]:
         raise rep.fail(
-            f"Range [{numbers[0]:g} {numbers[1]:g}] has its minimum above its maximum", line, code="fis-range"
+            f"Range [{low_high[0]:g} {low_high[1]:g}] has its minimum above its maximum",
+            line,
+            code="fis-range",
         )
-    return Range(numbers[0], numbers[1])
+    return Range(low_high[0], low_high[1])
 
 
 @dataclass
@@ -248,9 +211,9 @@ def _membership(
             raise rep.fail(f"function term: {exc}", line, code="fis-function") from None
         argument = "x" if "x" in names_in(expr) and "x" not in names else None
         return FunctionMF(expr, params_text.strip(), argument)
-    params = _numbers(params_text, rep, line, f"parameters of {kind!r}")
+    params = numbers(params_text, rep, line, f"parameters of {kind!r}")
     if height_text is not None:
-        params.append(_numbers(height_text, rep, line, "height")[0])
+        params.append(numbers(height_text, rep, line, "height")[0])
     if kind_lower == "constant":
         if not params:
             raise rep.fail("'constant' needs a value", line, code="fis-params")
@@ -311,6 +274,35 @@ def _membership(
     return ShapeMF(mapping.kind, values, height)
 
 
+def _number(digits: str) -> tuple[int, int] | tuple[int, int, str]:
+    """The number of a section or of an MF key as a sort key: ``(0, n)``, or for more
+    digits than Python converts (4300, leading zeros aside), ``(1, ...)`` after every
+    smaller number."""
+    if len(digits) > 4300:
+        digits = digits.lstrip("0") or "0"
+    if len(digits) <= 4300:
+        return (0, int(digits))
+    return (1, len(digits), digits)
+
+
+class _UniqueNames:
+    """Term names made unique as :func:`~fuzzyctl.formats._common.unique_name` makes them
+    (``name``, ``name_2``, ``name_3``...), remembering where each name's search stopped:
+    100,000 terms of one name would otherwise take 5 * 10**9 lookups."""
+
+    def __init__(self) -> None:
+        self.taken: set[str] = set()
+        self.next: dict[str, int] = {}
+
+    def unique(self, name: str) -> str:
+        candidate, n = name, self.next.get(name, 2)
+        while candidate in self.taken:
+            candidate, n = f"{name}_{n}", n + 1
+        self.next[name] = n  # every name_k below n is taken, and stays taken
+        self.taken.add(candidate)
+        return candidate
+
+
 def _variable(
     section: _Section, kind: str, rep: Reporter, dialect: str, n_inputs: int, names: set[str]
 ) -> _Var:
@@ -323,10 +315,10 @@ def _variable(
     if rng is None:
         rep.warning(f"[{section.header}] has no Range", section.line, code="fis-missing-key")
     var = _Var(name, rng, [], section)
-    taken: set[str] = set()
+    taken = _UniqueNames()
     mf_entries = [(k, v, line) for k, v, line in section.entries if re.fullmatch(r"MF\d+", k)]
     for position, (key, value, line) in enumerate(mf_entries, start=1):
-        if int(key[2:]) != position:
+        if _number(key[2:]) != (0, position):
             # MATLAB and fuzzylite both take the MF lines in file order, whatever their numbers.
             rep.warning(
                 f"{key} is membership function number {position} of {name!r} (taken in file order)",
@@ -349,7 +341,7 @@ def _variable(
                 line,
                 code="fis-mf-type",
             )
-        unique = unique_name(term_name, taken)
+        unique = taken.unique(term_name)
         if unique != term_name:
             # Rules refer to terms by position, so both stay reachable under distinct names.
             rep.warning(
@@ -374,7 +366,7 @@ def _variable(
             )
     for key in ("Enabled",):
         entry = section.get(key)
-        if entry is not None and parse_number(entry[0]) != 1.0:
+        if entry is not None and not _flag(section, key, rep):
             raise rep.fail(
                 f"{name!r} is disabled (Enabled=0): disabled variables are not supported",
                 entry[1],
@@ -393,190 +385,6 @@ def _flag(section: _Section, key: str, rep: Reporter) -> bool:
         raise rep.fail(f"{key} must be 0 or 1, found {entry[0]!r}", entry[1], code="fis-number") from None
 
 
-def _hedges(code: float, dialect: str, rep: Reporter, line: int) -> tuple[int, tuple[str, ...], bool]:
-    """Term index (1-based, 0 for "any"), hedges, negation of one rule entry."""
-    if not math.isfinite(code) or abs(code) > 1e9:
-        raise rep.fail(f"rule entry {code:g} is not a term number", line, code="fis-rule")
-    negated = code < 0
-    magnitude = abs(code)
-    index = math.floor(magnitude + 1e-9)
-    fraction = round((magnitude - index) * 100)
-    if fraction == 0:
-        return index, (), negated
-    if dialect == "fuzzylite":
-        if fraction == ANY_CODE:
-            return 0, ("any",), negated
-        hedges = FUZZYLITE_HEDGE_CODES.get(fraction)
-        if hedges is None:
-            raise rep.fail(
-                f"rule entry {code:g}: no fuzzylite hedge has code .{fraction:02d}", line, code="fis-hedge"
-            )
-        return index, hedges, negated
-    # Octave: the two decimals times 10 give the power (.05 -> 0.5, .2 -> 2, .3 -> 3)
-    power = fraction / 10.0
-    if power == 2.0:
-        return index, ("very",), negated
-    if power == 0.5:
-        return index, ("somewhat",), negated
-    if power == 4.0:
-        return index, ("very", "very"), negated
-    return index, (power_hedge(power),), negated
-
-
-def _rules(
-    section: _Section | None,
-    inputs: list[_Var],
-    outputs: list[_Var],
-    rep: Reporter,
-    dialect: str,
-    declared: int | None,
-    system_line: int,
-) -> list[Rule]:
-    rules: list[Rule] = []
-    if section is None:
-        return rules
-    n_in, n_out = len(inputs), len(outputs)
-    for text, line in section.rules:
-        m = _RULE.match(text)
-        if m:
-            ante = _numbers(m.group("ante"), rep, line, "rule antecedent")
-            cons = _numbers(m.group("cons"), rep, line, "rule consequent")
-        else:
-            # Version 1.0 writes "i1 i2 o1 w c" without punctuation.
-            values = _numbers(text.replace("(", " ").replace(")", " ").replace(":", " "), rep, line, "rule")
-            if len(values) != n_in + n_out + 2:
-                raise rep.fail(
-                    f"rule: expected '{' '.join(['i'] * n_in)}, {' '.join(['o'] * n_out)} (weight) : 1|2'",
-                    line,
-                    code="fis-rule-syntax",
-                )
-            ante, cons = values[:n_in], values[n_in : n_in + n_out]
-            m = None
-            weight_value, conn_value = values[-2], values[-1]
-        if m is not None:
-            weight_list = _numbers(m.group("w"), rep, line, "rule weight")
-            conn_list = _numbers(m.group("conn"), rep, line, "rule connection")
-            if len(weight_list) != 1 or len(conn_list) != 1:
-                raise rep.fail(
-                    "rule: weight and connection must be single numbers", line, code="fis-rule-syntax"
-                )
-            weight_value, conn_value = weight_list[0], conn_list[0]
-        if len(ante) != n_in:
-            raise rep.fail(
-                f"rule has {len(ante)} antecedent entries but the system has {n_in} inputs",
-                line,
-                code="fis-rule-arity",
-            )
-        if len(cons) != n_out:
-            raise rep.fail(
-                f"rule has {len(cons)} consequent entries but the system has {n_out} outputs",
-                line,
-                code="fis-rule-arity",
-            )
-        if conn_value not in (1.0, 2.0):
-            raise rep.fail(
-                f"rule connection must be 1 (AND) or 2 (OR), found {conn_value:g}",
-                line,
-                code="fis-rule-syntax",
-            )
-        if not 0.0 <= weight_value <= 1.0:
-            rep.warning(f"rule weight {weight_value:g} is outside [0, 1]", line, code="fis-weight")
-        operands: list[Condition] = []
-        always = False
-        for var, code in zip(inputs, ante, strict=True):
-            if code == 0:
-                continue
-            index, hedges, negated = _hedges(code, dialect, rep, line)
-            if hedges == ("any",):
-                # fuzzylite's "x is any" holds with degree 1
-                if negated:
-                    raise rep.fail(
-                        "'not any' (never true) in a rule is not supported", line, code="fis-hedge"
-                    )
-                always = True
-                continue
-            if not 1 <= index <= len(var.terms):
-                raise rep.fail(
-                    f"rule refers to MF{index} of {var.name!r}, which has {len(var.terms)}",
-                    line,
-                    code="fis-rule-index",
-                )
-            operands.append(Is(var.name, var.terms[index - 1].name, negated, hedges, rep.span(line)))
-        condition: Condition | None
-        if not operands:
-            if conn_value == 2.0 and not always:
-                rep.warning(
-                    "rule has no antecedent and connection OR: it never fires (MATLAB); dropped",
-                    line,
-                    code="fis-empty-rule",
-                )
-                continue
-            if not always:
-                rep.warning(
-                    "rule has no antecedent: it fires with degree 1 (MATLAB's AND of don't-cares)",
-                    line,
-                    code="fis-empty-rule",
-                )
-            condition = None
-        elif len(operands) == 1:
-            condition = operands[0]
-        elif conn_value == 1.0:
-            condition = And(tuple(operands), rep.span(line))
-        else:
-            condition = Or(tuple(operands), rep.span(line))
-        if always and conn_value == 2.0:
-            condition = None  # "x is any OR ..." is 1
-        conclusions: list[Conclusion] = []
-        running: tuple[str, ...] = ()
-        for var, code in zip(outputs, cons, strict=True):
-            if code == 0:
-                continue
-            if code < 0:
-                raise rep.fail(
-                    f"negated consequent (-{abs(code):g}) for {var.name!r} is not supported",
-                    line,
-                    code="fis-unsupported",
-                )
-            index, hedges, _ = _hedges(code, dialect, rep, line)
-            if dialect == "fuzzylite":
-                # fuzzylite reads the FIS as rule text and hedges a running degree (see fll.py):
-                # a conclusion without hedges of its own still gets the earlier ones
-                hedges = running = (*hedges, *running)
-            elif hedges:
-                if not all(_is_ts_term(t.mf) for t in var.terms):
-                    raise rep.fail(
-                        f"a hedge on the Mamdani consequent of {var.name!r} is not supported",
-                        line,
-                        code="fis-hedge",
-                    )
-                # Octave raises a Sugeno rule's degree to 1/p for a consequent hedge of power p
-                power = 1.0
-                for h in hedges:
-                    power *= {"very": 2.0, "somewhat": 0.5}.get(h, 0.0) or float(h[4:])
-                hedges = (
-                    (power_hedge(1.0 / power),)
-                    if 1.0 / power not in (2.0, 0.5)
-                    else (("very",) if 1.0 / power == 2.0 else ("somewhat",))
-                )
-            if not 1 <= index <= len(var.terms):
-                raise rep.fail(
-                    f"rule refers to MF{index} of output {var.name!r}, which has {len(var.terms)}",
-                    line,
-                    code="fis-rule-index",
-                )
-            conclusions.append(Conclusion(var.name, var.terms[index - 1].name, None, rep.span(line), hedges))
-        if not conclusions:
-            rep.warning("rule concludes nothing (all consequents 0); dropped", line, code="fis-empty-rule")
-            continue
-        weight = None if weight_value == 1.0 else weight_value
-        rules.append(Rule(str(len(rules) + 1), condition, tuple(conclusions), rep.span(line), weight=weight))
-    if declared is not None and declared != len(section.rules):
-        rep.warning(
-            f"NumRules={declared} but [Rules] lists {len(section.rules)} rules", system_line, code="fis-count"
-        )
-    return rules
-
-
 def read(text: str, path: str | None = None, *, dialect: str | None = None) -> Loaded:
     """Parse a FIS file into a one-block :class:`Document`.
 
@@ -589,10 +397,10 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         raise rep.fail("no [System] section: this is not a FIS file", 1 if lines else None, code="fis-syntax")
     system = systems[0]
     inputs_s = sorted(
-        (s for s in sections if s.header.lower().startswith("input")), key=lambda s: int(s.header[5:])
+        (s for s in sections if s.header.lower().startswith("input")), key=lambda s: _number(s.header[5:])
     )
     outputs_s = sorted(
-        (s for s in sections if s.header.lower().startswith("output")), key=lambda s: int(s.header[6:])
+        (s for s in sections if s.header.lower().startswith("output")), key=lambda s: _number(s.header[6:])
     )
     rules_s = next((s for s in sections if s.header.lower() == "rules"), None)
     fuzzylite_keys = any(
@@ -672,8 +480,8 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
     defuzzify: list[DefuzzifyBlock] = []
     any_mamdani_output = False
     for var in outputs:
-        ts = bool(var.terms) and all(_is_ts_term(t.mf) for t in var.terms)
-        has_ts = any(_is_ts_term(t.mf) for t in var.terms)
+        ts = bool(var.terms) and all(is_ts_term(t.mf) for t in var.terms)
+        has_ts = any(is_ts_term(t.mf) for t in var.terms)
         if has_ts and not ts:
             raise rep.fail(
                 f"output {var.name!r} mixes constant/linear terms with membership functions",
@@ -729,7 +537,14 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         block_accu = accu
     elif any_mamdani_output:
         defuzzify = [d if d.method in {"WTAVER", "WTSUM"} else replace(d, accu=accu) for d in defuzzify]
-    rules = _rules(rules_s, inputs, outputs, rep, dialect, count("NumRules"), system.line)
+    declared_rules = count("NumRules")
+    rule_list = rules(rules_s.rules, inputs, outputs, rep, dialect) if rules_s is not None else []
+    if declared_rules is not None and rules_s is not None and declared_rules != len(rules_s.rules):
+        rep.warning(
+            f"NumRules={declared_rules} but [Rules] lists {len(rules_s.rules)} rules",
+            system.line,
+            code="fis-count",
+        )
     rep.raise_if_errors()
     name_entry = system_value("Name")
     fb = FunctionBlock(
@@ -749,7 +564,7 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
             for v in inputs
         ),
         defuzzify=tuple(defuzzify),
-        rule_blocks=(RuleBlock(None, tuple(rules), and_op, or_op, act, block_accu),)
+        rule_blocks=(RuleBlock(None, tuple(rule_list), and_op, or_op, act, block_accu),)
         if rules_s is not None
         else (),
         span=rep.span(system.line),

@@ -29,7 +29,8 @@ from fuzzyctl.formats._lower import (
     with_range,
 )
 from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
-from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, FUZZYLITE_HEDGE_CODES, OR_METHODS
+from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
+from fuzzyctl.formats.fis_rules import FUZZYLITE_HEDGE_CODES
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
