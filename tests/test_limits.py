@@ -147,3 +147,23 @@ def test_a_huge_line_is_shown_as_a_window_around_the_column() -> None:
     assert len(shown) <= MAX_LINE_SHOWN + 12 and shown.strip().startswith("...")
     col = caret.index("^")
     assert shown[col : col + 3] == "XYZ" and caret[col:].rstrip() == "^~~"
+
+
+def test_a_huge_run_of_unbalanced_parentheses_is_refused_at_its_first() -> None:
+    """An unbalanced condition of 150,000 parentheses is not given to lark (whose error
+    recovery over a million of them took 10 s): refused at the run's first parenthesis."""
+    from fuzzyctl.diagnostics import DiagnosticError
+    from fuzzyctl.fcl.parser import MAX_PAREN_RUN
+
+    head = (
+        "FUNCTION_BLOCK f\nVAR_INPUT a : REAL; END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
+        "FUZZIFY a TERM lo := (0, 1) (1, 0); END_FUZZIFY\n"
+        "DEFUZZIFY y TERM lo := 0; METHOD : COGS; END_DEFUZZIFY\nRULEBLOCK r\n"
+    )
+    n = MAX_PAREN_RUN + 50_000
+    rule = "RULE 1 : IF " + "(" * n + "a IS lo" + ")" * (n - 1) + " THEN y IS lo;\n"
+    with pytest.raises(DiagnosticError) as err:
+        fuzzyctl.load(head + rule + "END_RULEBLOCK\nEND_FUNCTION_BLOCK\n")
+    first = err.value.diagnostics[0]
+    assert f"{n:,} parentheses open in a row" in first.message
+    assert first.span is not None and (first.span.line, first.span.column) == (7, 13)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import textwrap
 import threading
 from collections.abc import Sequence
@@ -27,6 +28,7 @@ from fuzzyctl.fcl import keywords, shapes
 from fuzzyctl.fcl.fast import FastResult, read_runs
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
+from fuzzyctl.limits import MAX_NESTING
 from fuzzyctl.model import (
     And,
     Binary,
@@ -682,6 +684,8 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
     state = ParseState(source)
     state.fast = read_runs(source.text) if fast else None
     text = state.fast.text if state.fast is not None else source.text
+    if _paren_run(state, text):
+        return ParseResult(None, state.diagnostics, source)
     lark = _parser()
     builder = lark.options.transformer
     assert isinstance(builder, _Builder)
@@ -713,6 +717,33 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
 
         document = attach_comments(document, state.comments)
     return ParseResult(document, state.diagnostics, source, frozenset(state.spellings))
+
+
+#: Parentheses open in a row that lark is given at most.  The fast reader takes a condition
+#: of any number of redundant parentheses; one it does not take (unbalanced, say) is left to
+#: lark, whose error recovery over a million of them took 10 s and 500 MB.
+MAX_PAREN_RUN = 100_000
+_PAREN_RUN = re.compile(rf"(?:\((?!\*)[ \t\r\n\f]*){{{MAX_PAREN_RUN + 1}}}+")
+_PARENS = re.compile(r"(?:\((?!\*)[ \t\r\n\f]*)++")
+
+
+def _paren_run(state: ParseState, text: str) -> bool:
+    """Refuse (True, with a diagnostic at its first one) a run of more than
+    :data:`MAX_PAREN_RUN` opening parentheses left for lark to read."""
+    found = _PAREN_RUN.search(text)
+    if found is None:
+        return False
+    start = found.start()
+    count = _PARENS.match(text, start).group().count("(")  # type: ignore[union-attr]
+    line = text.count("\n", 0, start) + 1
+    column = start - text.rfind("\n", 0, start)
+    state.error(
+        f"{count:,} parentheses open in a row: fuzzyctl reads at most {MAX_PAREN_RUN:,} "
+        f"(a condition nests at most {MAX_NESTING} levels)",
+        Span(line, column, line, column + 1),
+        "too-deep",
+    )
+    return True
 
 
 def _error_pos(exc: UnexpectedInput) -> int | None:
