@@ -426,16 +426,19 @@ Condition: TypeAlias = Is | Degree | Not | And | Or
 
 
 def walk_condition(c: Condition | None) -> Iterator[Is | Degree]:
-    """The leaves (``IS`` tests and degree inputs) of a condition, left to right."""
+    """The leaves (``IS`` tests and degree inputs) of a condition, left to right (with an
+    explicit stack: nested generators cost a step per level for every leaf)."""
     if c is None:
         return
-    if isinstance(c, Is | Degree):
-        yield c
-    elif isinstance(c, Not):
-        yield from walk_condition(c.operand)
-    else:
-        for operand in c.operands:
-            yield from walk_condition(operand)
+    stack: list[Condition] = [c]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, Is | Degree):
+            yield node
+        elif isinstance(node, Not):
+            stack.append(node.operand)
+        else:
+            stack.extend(reversed(node.operands))
 
 
 @dataclass(frozen=True)
