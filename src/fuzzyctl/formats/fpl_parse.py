@@ -4,10 +4,11 @@ every diagnostic at its place (the model is built from them in :mod:`fuzzyctl.fo
 Reading time is linear in the size of the file and small per character, as a file of any
 shape may be untrusted (issue 14): one regular expression checks the whole text for
 characters FPL has no token for before anything else is done (a file with any is refused
-with all of them, as nothing else would be reported), then the parser takes the tokens one
-at a time from the same expression, so an error stops the reading at once.  Tokens are
-tuples holding their offset; the line and column of one are only worked out (by bisection in
-the offsets of the line starts) when a diagnostic or the model asks for its place.
+with them, as nothing else would be reported), then the parser takes the tokens one at a
+time, so an error stops the reading at once.  Tokens are tuples holding their offset; the
+line and column of one are only worked out (by bisection in the offsets of the line starts)
+when a diagnostic or the model asks for its place.  A plain rule - the bulk of a large rule
+base - is read by one match; conditions nest without recursion.
 """
 
 from __future__ import annotations
@@ -129,10 +130,14 @@ class _Lines:
 
     def span(self, tok: _Tok) -> Span:
         """The span of a token: its start and end, or its start alone for code and eof."""
-        line, column = self.place(tok.pos)
         if tok.kind in ("code", "eof"):
-            return Span(line, column)
-        return Span(line, column, line, column + len(tok.text))
+            return Span(*self.place(tok.pos))
+        return self.span_at(tok.pos, len(tok.text))
+
+    def span_at(self, pos: int, length: int) -> Span:
+        """The span of the ``length`` characters at ``pos`` (on one line)."""
+        line, column = self.place(pos)
+        return Span(line, column, line, column + length)
 
 
 def lex_errors(text: str, file: str | None) -> list[Diagnostic]:
@@ -238,13 +243,13 @@ class Parser:
         self.pos = 0  # where the next token is looked for
         self.comments = comments
         self.lines = _Lines(text)
-        self.tok: _Tok = self.next_token()
         self.file = file
         self.diags = diags
         self.vars: list[FplVar] = []
         self.rulebases: list[FplRuleBase] = []
         self.connects: list[tuple[str, Span, str, Span]] = []
         self.project: str | None = None
+        self.tok: _Tok = self.next_token()  # the token at the cursor
 
     # -- token helpers
     def next_token(self) -> _Tok:
@@ -511,12 +516,7 @@ class Parser:
             names.add(term.upper())
         if not KEYWORDS.isdisjoint(names):
             return None  # FPL reads keywords as names in some places only: the general path
-        place = self.lines.place
-
-        def span(pos: int, length: int) -> Span:
-            line, column = place(pos)
-            return Span(line, column, line, column + length)
-
+        span = self.lines.span_at
         parts = [Is(v, t, span=span(pos, len(v))) for v, pos, t in leaves]
         condition: Condition = parts[0]
         if len(parts) > 1:
