@@ -3,12 +3,15 @@
 
 For each format (FCL, FIS, FLL, JSON, FPL, XFUZ) the script writes files of the requested
 size in several shapes - a valid system with very many rules, a file with an error on every
-line, random garbage, one single enormous line, deep nesting - and runs the CLI on each in a
-fresh process (``fuzzyctl.load`` inside the CLI's error boundary, which prints the
-diagnostics as the CLI does; FCL also through ``fuzzyctl check``), printing wall and CPU
-time, peak resident memory (of that process) and the exit code.
-Files over the size limit (``FUZZYCTL_MAX_INPUT_BYTES``, default 8 MiB) are refused up
-front, so the script also runs each shape just under the limit.
+line, random garbage, one single enormous line, deep nesting; FPL also the shapes of
+FPL_SHAPES: rules only the general reader takes, CR line ends, many MEMBERs or points, a
+warning every 4 bytes, unclosed objects and comments, bytes FPL has no token for, the real
+tool's largest project grown - and runs the CLI on each in a fresh process
+(``fuzzyctl.load`` inside the CLI's error boundary, which prints the diagnostics as the CLI
+does; FCL also through ``fuzzyctl check``), printing wall and CPU time, peak resident memory
+(of that process) and the exit code.
+Files over the size limit (``FUZZYCTL_MAX_INPUT_BYTES``, default 8 MiB, FPL 1 MiB) are
+refused up front, so the script also runs each shape just under the limit (--under-limit).
 
 usage: python benchmarks/large_inputs.py [--mb 10] [--formats fcl,fis,...] [--shapes ...]
 exit status 1 when a case breaks the goal (time, memory, or an exit code other than 0/1).
