@@ -54,6 +54,9 @@ FORMAT_MAX_INPUT_BYTES = {
     "fll": DEFAULT_MAX_INPUT_BYTES // 8,
     # FIS rules are dense (8 bytes each): 512 KiB is 65,000 rules
     "fis": DEFAULT_MAX_INPUT_BYTES // 16,
+    # the largest project S7 Fuzzy Control allows (8 inputs of 7 terms, 4 outputs of 9, 200
+    # rules; Siemens manual 1.3) is a 77 KB FPL file, 346 KB with 56 conditions a rule
+    "fpl": 1024 * 1024,
 }
 MAX_NESTING = 100
 MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each

@@ -32,16 +32,14 @@ ends), else the FUZZIFY block gets ``clamp``.
 from __future__ import annotations
 
 import math
-import re
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass, field, replace
-from typing import NoReturn
+from dataclasses import dataclass, replace
 
-from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
 from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats.fpl_parse import KEYWORDS, FplVar, Parser, is_fpl_name, parse_project
 from fuzzyctl.model import (
     And,
-    Conclusion,
     Condition,
     Default,
     DefuzzifyBlock,
@@ -80,488 +78,6 @@ __all__ = [
     "shared_conclusions",
 ]
 
-# --------------------------------------------------------------------------- lexer
-
-_TOKEN = re.compile(
-    r"""
-    (?P<comment>/\*.*?\*/)
-  | (?P<code>\#CODE\b.*?(?:\#END_CODE\b|\Z))
-  | (?P<number>[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)
-  | (?P<word>[^\W\d]\w*)
-  | (?P<string>"[^"\n]*")
-  | (?P<punct>[(),=])
-  | (?P<space>\s+)
-    """,
-    re.VERBOSE | re.DOTALL | re.IGNORECASE,
-)
-
-# Objects that own an END (skipping a tolerated object counts these to find its END).
-_OBJECTS = {
-    "PROJECT",
-    "PACKAGE",
-    "VAR",
-    "MEMBER",
-    "FUZZY",
-    "RULE",
-    "CONNECT",
-    "OPTIONS",
-    "SOURCE",
-    "FRAGMENT",
-}
-# Words that end the arguments of a tolerated attribute (MAP, INITIALLY, DEFAULT).
-_STRUCTURAL = _OBJECTS | {
-    "END",
-    "TYPE",
-    "MIN",
-    "MAX",
-    "POINTS",
-    "IF",
-    "THEN",
-    "FROM",
-    "TO",
-    "MAP",
-    "INITIALLY",
-    "DEFAULT",
-}
-# Words FPL reads as keywords wherever they stand (upper-cased): no name may be one of them.
-KEYWORDS = frozenset(_STRUCTURAL | {"IS", "AND", "OR", "NOT"})
-_WORD = re.compile(r"[^\W\d]\w*")
-
-
-def is_fpl_name(name: str) -> bool:
-    """True when FPL reads ``name`` back as one name (a word, not a keyword)."""
-    return _WORD.fullmatch(name) is not None and name.upper() not in KEYWORDS
-
-
-# The manual's texts for the tolerated elements (Siemens 1.3, "Tolerated FPL Elements").
-_TOLERATED_ATTRIBUTES = {
-    "MAP": "MAP ignored: no mapping possible",
-    "INITIALLY": "INITIALLY ignored: preallocation not permitted",
-    "DEFAULT": "DEFAULT ignored: value output with inactive rules not possible "
-    "(Fuzzy Control keeps the last output value)",
-}
-_TOLERATED_OBJECTS = {
-    "OPTIONS": "OPTIONS ignored: additional information for objects",
-    "SOURCE": "SOURCE ignored: C code parts are not used by Fuzzy Control",
-    "FRAGMENT": "FRAGMENT ignored: C code parts are not used by Fuzzy Control",
-}
-
-
-@dataclass(frozen=True)
-class _Tok:
-    kind: str  # "word", "number", "string", "punct", "code", "eof"
-    text: str
-    span: Span
-
-    @property
-    def upper(self) -> str:
-        return self.text.upper() if self.kind == "word" else ""
-
-
-def _lex(text: str, file: str | None, diags: list[Diagnostic], comments: list[str]) -> list[_Tok]:
-    tokens: list[_Tok] = []
-    line, line_start, pos = 1, 0, 0
-    while pos < len(text):
-        m = _TOKEN.match(text, pos)
-        span = Span(line, pos - line_start + 1)
-        if m is None:
-            diags.append(error(f"unexpected character {text[pos]!r}", span, code="fpl-syntax", file=file))
-            pos += 1
-            continue
-        kind = m.lastgroup or ""
-        chunk = m.group()
-        end_col = span.column + len(chunk)
-        if kind == "comment":
-            comments.append(chunk[2:-2].strip())
-        elif kind == "code":
-            tokens.append(_Tok("code", chunk, span))
-        elif kind != "space":
-            tokens.append(_Tok(kind, chunk, Span(line, span.column, line, end_col)))
-        newlines = chunk.count("\n")
-        if newlines:
-            line += newlines
-            line_start = pos + chunk.rfind("\n") + 1
-        pos = m.end()
-    tokens.append(_Tok("eof", "", Span(line, pos - line_start + 1)))
-    return tokens
-
-
-# --------------------------------------------------------------------------- parser
-
-
-class _Abort(Exception):
-    """Stops parsing after an error the parser cannot recover from."""
-
-
-@dataclass
-class _Member:
-    name: str
-    points: list[tuple[float, float]]
-    span: Span
-
-
-@dataclass
-class _Var:
-    name: str
-    span: Span
-    type_name: str | None = None
-    low: float | None = None
-    high: float | None = None
-    members: list[_Member] = field(default_factory=list)
-
-
-@dataclass
-class _Rule:
-    label: str
-    condition: Condition | None
-    conclusions: list[Conclusion]
-    span: Span
-
-
-@dataclass
-class _RuleBase:
-    name: str
-    rules: list[_Rule]
-    span: Span
-
-
-class _Parser:
-    def __init__(self, tokens: list[_Tok], file: str | None, diags: list[Diagnostic]) -> None:
-        self.toks = tokens
-        self.i = 0
-        self.file = file
-        self.diags = diags
-        self.vars: list[_Var] = []
-        self.rulebases: list[_RuleBase] = []
-        self.connects: list[tuple[str, Span, str, Span]] = []
-        self.project: str | None = None
-        self.depth = 0  # parentheses open in a condition (the descent recurses: bounded)
-
-    # -- token helpers
-    @property
-    def tok(self) -> _Tok:
-        return self.toks[self.i]
-
-    def advance(self) -> _Tok:
-        tok = self.toks[self.i]
-        if tok.kind != "eof":
-            self.i += 1
-        return tok
-
-    def at(self, *words: str) -> bool:
-        return self.tok.upper in words
-
-    def fail(self, message: str, tok: _Tok | None = None, hint: str | None = None) -> NoReturn:
-        tok = tok or self.tok
-        self.diags.append(error(message, tok.span, code="fpl-syntax", file=self.file, hint=hint))
-        raise _Abort
-
-    def describe(self, tok: _Tok) -> str:
-        return "end of file" if tok.kind == "eof" else repr(tok.text)
-
-    def expect_word(self, what: str) -> _Tok:
-        tok = self.tok
-        if tok.kind != "word":
-            self.fail(f"expected {what}, found {self.describe(tok)}")
-        return self.advance()
-
-    def expect_keyword(self, word: str) -> _Tok:
-        if not self.at(word):
-            self.fail(f"expected {word}, found {self.describe(self.tok)}")
-        return self.advance()
-
-    def number(self, what: str) -> float:
-        tok = self.tok
-        if tok.kind != "number":
-            self.fail(f"expected a number for {what}, found {self.describe(tok)}")
-        self.advance()
-        return float(tok.text)
-
-    def note(self, message: str, tok: _Tok, severity: Severity, code: str) -> None:
-        self.diags.append(Diagnostic(severity, message, tok.span, self.file, code))
-
-    # -- tolerated elements
-    def skip_tolerated(self) -> bool:
-        """Skip one tolerated element at the cursor; False when there is none."""
-        tok = self.tok
-        if tok.kind == "code":
-            self.advance()
-            self.note(
-                "#CODE..#END_CODE ignored: C source code is not used by Fuzzy Control",
-                tok,
-                Severity.NOTE,
-                "fpl-tolerated",
-            )
-            return True
-        word = tok.upper
-        if word in _TOLERATED_ATTRIBUTES:
-            self.advance()
-            while self.tok.kind != "eof" and self.tok.upper not in _STRUCTURAL and self.tok.kind != "code":
-                self.advance()
-            self.note(_TOLERATED_ATTRIBUTES[word], tok, Severity.WARNING, "fpl-tolerated")
-            return True
-        if word in _TOLERATED_OBJECTS:
-            self.advance()
-            depth = 1
-            while depth:
-                nxt = self.advance()
-                if nxt.kind == "eof":
-                    self.fail(f"{word} object is not closed by END", tok)
-                if nxt.upper == "END":
-                    depth -= 1
-                elif nxt.upper in _OBJECTS:
-                    depth += 1
-            self.note(_TOLERATED_OBJECTS[word], tok, Severity.NOTE, "fpl-tolerated")
-            return True
-        return False
-
-    # -- grammar
-    def parse(self) -> None:
-        while self.skip_tolerated():
-            pass
-        self.expect_keyword("PROJECT")
-        self.project = self.expect_word("the project name").text
-        while True:
-            if self.skip_tolerated():
-                continue
-            tok = self.tok
-            word = tok.upper
-            if word == "VAR":
-                self.parse_var()
-            elif word == "FUZZY":
-                self.parse_fuzzy()
-            elif word == "CONNECT":
-                self.parse_connect()
-            elif word == "PACKAGE":
-                self.fail("PACKAGE is not permissible: Fuzzy Control has no modular fuzzy systems", tok)
-            elif word == "END":
-                self.advance()
-                break
-            elif tok.kind == "eof":
-                # A missing final END loses nothing; say so and accept the file.
-                self.diags.append(
-                    warning("PROJECT is not closed by END", tok.span, code="fpl-missing-end", file=self.file)
-                )
-                break
-            else:
-                self.fail(f"expected VAR, FUZZY, CONNECT or END, found {self.describe(tok)}")
-        while self.skip_tolerated():
-            pass
-        if self.tok.kind != "eof":
-            self.fail(f"unexpected {self.describe(self.tok)} after the end of the project")
-
-    def parse_var(self) -> None:
-        start = self.advance()
-        var = _Var(self.expect_word("a variable name").text, start.span)
-        while True:
-            if self.skip_tolerated():
-                continue
-            tok = self.tok
-            word = tok.upper
-            if word == "TYPE":
-                self.advance()
-                var.type_name = self.expect_word("a type name").text
-                if var.type_name.upper() != "FLOAT":
-                    self.diags.append(
-                        warning(
-                            f"TYPE {var.type_name} read as float: Fuzzy Control variables are always FLOAT",
-                            tok.span,
-                            code="fpl-type",
-                            file=self.file,
-                        )
-                    )
-            elif word == "MIN":
-                self.advance()
-                var.low = self.number("MIN")
-            elif word == "MAX":
-                self.advance()
-                var.high = self.number("MAX")
-            elif word == "MEMBER":
-                var.members.append(self.parse_member())
-            elif word == "END":
-                self.advance()
-                break
-            else:
-                self.fail(
-                    f"expected TYPE, MIN, MAX, MEMBER or END in VAR {var.name}, found {self.describe(tok)}"
-                )
-        if var.low is not None and var.high is not None and var.low >= var.high:
-            self.diags.append(
-                error(
-                    f"VAR {var.name}: MIN {var.low:g} must be below MAX {var.high:g}",
-                    var.span,
-                    code="fpl-range",
-                    file=self.file,
-                )
-            )
-        self.vars.append(var)
-
-    def parse_member(self) -> _Member:
-        start = self.advance()
-        member = _Member(self.expect_word("a membership function name").text, [], start.span)
-        while True:
-            if self.skip_tolerated():
-                continue
-            tok = self.tok
-            if tok.upper == "POINTS":
-                self.advance()
-                numbers: list[tuple[float, _Tok]] = []
-                # Commas separate x from y; a stray comma between points (the manual's
-                # "99.0,1.0, 101.0,1.0") changes nothing, so numbers are simply paired.
-                while self.tok.kind == "number" or (self.tok.kind == "punct" and self.tok.text == ","):
-                    t = self.advance()
-                    if t.kind == "number":
-                        numbers.append((float(t.text), t))
-                if len(numbers) % 2:
-                    self.fail(
-                        f"MEMBER {member.name}: POINTS needs x,y pairs, found {len(numbers)} numbers",
-                        numbers[-1][1] if numbers else tok,
-                    )
-                pts = [(numbers[k][0], numbers[k + 1][0]) for k in range(0, len(numbers), 2)]
-                for k, (x, y) in enumerate(pts):
-                    ytok = numbers[2 * k + 1][1]
-                    if not 0.0 <= y <= 1.0:
-                        self.fail(f"MEMBER {member.name}: degree {y:g} is outside [0, 1]", ytok)
-                    if k and x < pts[k - 1][0]:
-                        self.fail(
-                            f"MEMBER {member.name}: points must be in increasing x order "
-                            f"({x:g} follows {pts[k - 1][0]:g})",
-                            numbers[2 * k][1],
-                        )
-                member.points.extend(pts)
-            elif tok.upper == "END":
-                self.advance()
-                break
-            else:
-                self.fail(
-                    f"expected POINTS or END in MEMBER {member.name}, found {self.describe(tok)}",
-                    hint="equations are not permissible for membership functions (Siemens 1.3)",
-                )
-        if not member.points:
-            self.fail(f"MEMBER {member.name} has no POINTS", start)
-        return member
-
-    def parse_fuzzy(self) -> None:
-        start = self.advance()
-        if self.rulebases:
-            self.fail("only one set of rules (FUZZY) is permitted in Fuzzy Control", start)
-        base = _RuleBase(self.expect_word("the rule base name").text, [], start.span)
-        while True:
-            if self.skip_tolerated():
-                continue
-            tok = self.tok
-            if tok.upper == "RULE":
-                base.rules.append(self.parse_rule())
-            elif tok.upper == "END":
-                self.advance()
-                break
-            else:
-                self.fail(f"expected RULE or END in FUZZY {base.name}, found {self.describe(tok)}")
-        self.rulebases.append(base)
-
-    def parse_rule(self) -> _Rule:
-        start = self.advance()
-        label_tok = self.tok
-        if label_tok.kind not in ("word", "number") or label_tok.upper in ("IF", "THEN", "END"):
-            self.fail(f"expected a rule name, found {self.describe(label_tok)}")
-        self.advance()
-        condition: Condition | None = None
-        if self.at("IF"):
-            self.advance()
-            condition = self.parse_condition()
-        conclusions: list[Conclusion] = []
-        if self.at("THEN"):
-            self.advance()
-            conclusions.append(self.parse_conclusion())
-            while self.at("AND") or (self.tok.kind == "punct" and self.tok.text == ","):
-                self.advance()
-                conclusions.append(self.parse_conclusion())
-        while self.skip_tolerated():
-            pass
-        if not self.at("END"):
-            self.fail(f"expected THEN or END in RULE {label_tok.text}, found {self.describe(self.tok)}")
-        self.advance()
-        return _Rule(label_tok.text, condition, conclusions, start.span)
-
-    def parse_condition(self) -> Condition:
-        first = self.tok
-        parts = [self.parse_subcondition()]
-        while self.at("AND"):
-            self.advance()
-            parts.append(self.parse_subcondition())
-        if self.at("OR"):
-            self.fail("OR is not permissible in Fuzzy Control rules: only AND (Siemens 1.3)")
-        return parts[0] if len(parts) == 1 else And(tuple(parts), span=first.span)
-
-    def parse_subcondition(self) -> Condition:
-        tok = self.tok
-        if tok.kind == "punct" and tok.text == "(":
-            from fuzzyctl.limits import MAX_NESTING
-
-            self.advance()
-            self.depth += 1
-            if self.depth > MAX_NESTING:  # the descent recurses: bounded before the stack is
-                self.fail(f"the condition nests more than {MAX_NESTING} parentheses deep")
-            inner = self.parse_condition()
-            self.depth -= 1
-            if not (self.tok.kind == "punct" and self.tok.text == ")"):
-                self.fail(f"expected ')', found {self.describe(self.tok)}")
-            self.advance()
-            return inner
-        if tok.upper == "NOT":
-            self.fail("NOT is not permissible in Fuzzy Control rules: only AND (Siemens 1.3)")
-        var = self.expect_word("a variable name")
-        self.expect_keyword("IS")
-        if self.at("NOT"):
-            self.fail("NOT is not permissible in Fuzzy Control rules: only AND (Siemens 1.3)")
-        term = self.expect_word("a membership function name")
-        return Is(var.text, term.text, span=var.span)
-
-    def parse_conclusion(self) -> Conclusion:
-        paren = self.tok.kind == "punct" and self.tok.text == "("
-        if paren:
-            self.advance()
-        var = self.expect_word("an output variable name")
-        if (self.tok.kind == "punct" and self.tok.text == "=") or self.at("IS"):
-            self.advance()
-        else:
-            self.fail(f"expected '=' after {var.text}, found {self.describe(self.tok)}")
-        term = self.expect_word("a membership function name")
-        if paren:
-            if not (self.tok.kind == "punct" and self.tok.text == ")"):
-                self.fail(f"expected ')', found {self.describe(self.tok)}")
-            self.advance()
-        return Conclusion(var.text, term.text, span=var.span)
-
-    def parse_connect(self) -> None:
-        start = self.advance()
-        ends: dict[str, _Tok] = {}
-        while not self.at("END"):
-            kw = self.tok
-            if kw.upper not in ("FROM", "TO"):
-                self.fail(f"expected FROM, TO or END in CONNECT, found {self.describe(kw)}")
-            self.advance()
-            if self.at("FROM", "TO"):
-                # The manual's own example has "FROM FROM ProFuzzy": read it, say so.
-                self.diags.append(
-                    warning(
-                        f"repeated {self.tok.text} in CONNECT",
-                        self.tok.span,
-                        code="fpl-repeated-keyword",
-                        file=self.file,
-                    )
-                )
-                continue
-            if kw.upper in ends:
-                self.fail(f"CONNECT has two {kw.upper} parts", kw)
-            ends[kw.upper] = self.expect_word("a variable or rule base name")
-        self.advance()
-        if set(ends) != {"FROM", "TO"}:
-            self.fail("CONNECT needs FROM and TO", start)
-        src, dst = ends["FROM"], ends["TO"]
-        self.connects.append((src.text, src.span, dst.text, dst.span))
-
-
 # --------------------------------------------------------------------------- model building
 
 
@@ -595,9 +111,9 @@ def _output_mf(points: Sequence[tuple[float, float]], low: float, high: float) -
     return PointsMF(_input_points(points, low, high))
 
 
-def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
+def _build(p: Parser, file: str | None, comments: list[str]) -> FunctionBlock:
     diags = p.diags
-    by_name: dict[str, _Var] = {}
+    by_name: dict[str, FplVar] = {}
     for var in p.vars:
         if var.name in by_name:
             diags.append(error(f"VAR {var.name} is defined twice", var.span, code="fpl-duplicate", file=file))
@@ -672,11 +188,13 @@ def _build(p: _Parser, file: str | None, comments: list[str]) -> FunctionBlock:
     method = "COGS" if all_singletons else "COG"
     defuzzify = [replace(d, method=method) for d in defuzzify]
 
+    # The names of each VAR's MEMBERs, made once: a rule base may refer to them very often.
+    members = {name: {m.name for m in var.members} for name, var in by_name.items()}
     for rule in base.rules if base else []:
         for cond in leaves(rule.condition):
-            _check_ref(by_name, kinds, cond.variable, cond.term, VarKind.INPUT, cond.span, file, diags)
+            _check_ref(members, kinds, cond.variable, cond.term, VarKind.INPUT, cond.span, file, diags)
         for c in rule.conclusions:
-            _check_ref(by_name, kinds, c.variable, c.term, VarKind.OUTPUT, c.span, file, diags)
+            _check_ref(members, kinds, c.variable, c.term, VarKind.OUTPUT, c.span, file, diags)
     if not outputs and base and base.rules:
         diags.append(
             warning(
@@ -720,12 +238,16 @@ def shared_conclusions(block: FunctionBlock) -> list[tuple[str, str, list[Rule]]
 
 
 def leaves(cond: Condition | None) -> Iterator[Is]:
-    """The ``v IS t`` subconditions of an AND-only condition."""
-    if isinstance(cond, Is):
-        yield cond
-    elif isinstance(cond, And):
-        for c in cond.operands:
-            yield from leaves(c)
+    """The ``v IS t`` subconditions of an AND-only condition, left to right."""
+    # A stack, not nested generators: a leaf deep in the parentheses would pass through
+    # one generator per level.
+    stack = [cond]
+    while stack:
+        item = stack.pop()
+        if isinstance(item, Is):
+            yield item
+        elif isinstance(item, And):
+            stack.extend(reversed(item.operands))
 
 
 def _condition_vars(cond: Condition | None) -> Iterator[str]:
@@ -734,7 +256,7 @@ def _condition_vars(cond: Condition | None) -> Iterator[str]:
 
 
 def _check_ref(
-    by_name: dict[str, _Var],
+    members: dict[str, set[str]],
     kinds: dict[str, VarKind],
     var: str,
     term: str | None,
@@ -744,7 +266,7 @@ def _check_ref(
     diags: list[Diagnostic],
 ) -> None:
     role = "output" if want is VarKind.OUTPUT else "input"
-    if var not in by_name:
+    if var not in members:
         diags.append(error(f"{var} is not a VAR of this project", span, code="fpl-undeclared", file=file))
     elif kinds.get(var) is not want:
         diags.append(
@@ -755,7 +277,7 @@ def _check_ref(
                 file=file,
             )
         )
-    elif term is not None and term not in {m.name for m in by_name[var].members}:
+    elif term is not None and term not in members[var]:
         diags.append(error(f"{var} has no MEMBER {term}", span, code="fpl-undeclared-term", file=file))
 
 
@@ -763,15 +285,8 @@ def parse_fpl(text: str, *, path: str | None = None) -> FplResult:
     """Read FPL source text; never raises for bad input (see :class:`FplResult`)."""
     diags: list[Diagnostic] = []
     comments: list[str] = []
-    tokens = _lex(text, path, diags, comments)
-    parser = _Parser(tokens, path, diags)
-    block: FunctionBlock | None = None
-    if not any(d.is_error for d in diags):
-        try:
-            parser.parse()
-            block = _build(parser, path, comments)
-        except _Abort:
-            block = None
+    parser = parse_project(text, path, diags, comments)
+    block = _build(parser, path, comments) if parser is not None else None
     ok = block is not None and not any(d.is_error for d in diags)
     doc = Document((block,), path=path, comments=tuple(comments)) if ok and block else None
     return FplResult(doc, tuple(diags))
