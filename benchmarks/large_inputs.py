@@ -10,7 +10,7 @@ tool's largest project grown - and runs the CLI on each in a fresh process
 (``fuzzyctl.load`` inside the CLI's error boundary, which prints the diagnostics as the CLI
 does; FCL also through ``fuzzyctl check``), printing wall and CPU time, peak resident memory
 (of that process) and the exit code.
-Files over the size limit (``FUZZYCTL_MAX_INPUT_BYTES``, default 8 MiB, less for FIS, FLL, FPL) are
+Files over the size limit (``FUZZYCTL_MAX_INPUT_BYTES``, per format: docs/limits.md) are
 refused up front, so the script also runs each shape just under the limit (--under-limit).
 
 usage: python benchmarks/large_inputs.py [--mb 10] [--formats fcl,fis,...] [--shapes ...]

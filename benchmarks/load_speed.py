@@ -8,7 +8,7 @@ system (issue 17.5), and large inputs accepted or refused (issue 14.4), in one r
    system written as FLL (``FllImporter().from_string``) in a fresh process.  CPU seconds of
    the work, the C compiler's included (imports excluded where said: each child times its
    own calls) and the ratio to pyfuzzylite.
-2. Large inputs: FCL files just under the 8 MiB limit (a valid rule base, an error on every
+2. Large inputs: FCL files just under the FCL size limit (a valid rule base, an error on every
    rule, garbage, all on one line), the 10,000-rule FLL and FIS files, and the fuzzer's
    robot.fcl with a TERM line repeated 5000 times (tests/fuzz/campaign.py mutant #16 of the
    suite's seed: load, compile, evaluate, convert, codegen, CLI); CPU seconds and peak RSS
@@ -36,8 +36,6 @@ ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 import large_inputs as L  # noqa: E402
 import systems as S  # noqa: E402
-
-LIMIT = 8 * 1024 * 1024
 
 _FUZZYCTL = """
 import json, resource, sys, time
@@ -136,15 +134,16 @@ def systems_section(args: argparse.Namespace, work: Path, env: dict[str, str]) -
 
 
 def _large_files(work: Path) -> list[tuple[str, Path, str]]:
+    from fuzzyctl.limits import max_input_bytes
+
     out: list[tuple[str, Path, str]] = []
-    under = LIMIT - 4096
     for shape in ("valid", "errors", "garbage", "one-line"):
         path = work / f"big-{shape}.fcl"
-        path.write_text(L.fcl(shape, under))
+        path.write_text(L.fcl(shape, max_input_bytes("fcl") - 4096))
         out.append((f"FCL {shape}, {path.stat().st_size / 2**20:.1f} MiB", path, "none"))
     for fmt in ("fis", "fll"):
         path = work / f"big-valid.{fmt}"
-        path.write_text(getattr(L, fmt)("valid", under))
+        path.write_text(getattr(L, fmt)("valid", max_input_bytes(fmt) - 4096))
         out.append((f"{fmt.upper()} valid, {path.stat().st_size / 2**20:.1f} MiB", path, "none"))
     fll = work / "rules10k-load.fll"
     fll.write_text(S.fll(S.SYSTEMS["rules10k"]))
