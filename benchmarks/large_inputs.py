@@ -29,6 +29,7 @@ import tempfile
 import time
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 GOAL_S, GOAL_MB = 5.0, 500.0
 
@@ -568,7 +569,12 @@ FORMAT_SHAPES: dict[str, tuple[str, ...]] = {
 # The child: fuzzyctl.load() inside the CLI's error boundary (diagnostics printed as the CLI
 # prints them, exit 1 on a refusal, 3 on anything else); FCL also goes through `check`.
 _CHILD = """
-import sys
+import atexit, sys
+def _peak():  # VmHWM: this address space's own peak (ru_maxrss keeps the parent's from fork)
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            open(sys.argv[3], "w").write(line.split()[1])
+atexit.register(_peak)
 if sys.argv[1] == "check":  # the console script's own entry point
     from fuzzyctl.cli.entry import run
     sys.argv = ["fuzzyctl", "check", sys.argv[2]]
@@ -590,21 +596,32 @@ def run_case(path: Path, mode: str, timeout: float) -> tuple[float, float, float
     """(wall seconds, CPU seconds, peak RSS in MB, exit code or None on timeout) of a fresh
     process reading ``path`` (``mode``: load or check)."""
     start = time.perf_counter()
+    peak_file = path.with_suffix(".peak")
+    peak_file.unlink(missing_ok=True)
     proc = subprocess.Popen(
-        [sys.executable, "-c", _CHILD, mode, str(path)], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL
+        [sys.executable, "-c", _CHILD, mode, str(path), str(peak_file)],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
     )
+
+    def peak_mb(usage: Any) -> float:
+        try:
+            return int(peak_file.read_text()) / 1024
+        except (OSError, ValueError):  # killed: the last figure the kernel has
+            return float(usage.ru_maxrss) / 1024
+
     deadline = start + timeout
     while True:
         pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
         if pid:
             wall = time.perf_counter() - start
             cpu = usage.ru_utime + usage.ru_stime
-            return wall, cpu, usage.ru_maxrss / 1024, os.waitstatus_to_exitcode(status)
+            return wall, cpu, peak_mb(usage), os.waitstatus_to_exitcode(status)
         if time.perf_counter() > deadline:
             proc.kill()
             _pid, _status, usage = os.wait4(proc.pid, 0)
             cpu = usage.ru_utime + usage.ru_stime
-            return time.perf_counter() - start, cpu, usage.ru_maxrss / 1024, None
+            return time.perf_counter() - start, cpu, peak_mb(usage), None
         time.sleep(0.01)
 
 

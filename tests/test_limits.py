@@ -19,7 +19,7 @@ from fuzzyctl.diagnostics import (
     render_all,
     warning,
 )
-from fuzzyctl.limits import DEFAULT_MAX_INPUT_BYTES, max_input_bytes, read_input
+from fuzzyctl.limits import max_input_bytes, read_input
 from fuzzyctl.model import Span
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -72,7 +72,7 @@ def test_the_limit_is_an_environment_setting(tmp_path: Path, monkeypatch: pytest
     with pytest.raises(DiagnosticError, match="limit"):
         fuzzyctl.load(path.read_text())
     monkeypatch.setenv("FUZZYCTL_MAX_INPUT_BYTES", "nonsense")
-    assert max_input_bytes("xfuz") == DEFAULT_MAX_INPUT_BYTES
+    assert max_input_bytes("xfuz") == 1024 * 1024
 
 
 def test_cli_refuses_a_large_file_with_exit_1(

@@ -2,7 +2,7 @@
 
 * :func:`max_input_bytes` - the largest model file read, per format
   (:data:`FORMAT_MAX_INPUT_BYTES`): 1.5 MiB of FCL or FLL (the 10,000-rule 8-input system
-  is 1.31 / 1.19 MiB), 512 KiB of FIS, 1 MiB of FPL, 8 MiB of XFUZ, 96 MiB of JSON (which
+  is 1.31 / 1.19 MiB), 512 KiB of FIS, 1 MiB of FPL and of XFUZ, 96 MiB of JSON (which
   spells out every span: that 10,000-rule system is 43.5 MB of JSON).
   ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for every format.  A larger file is refused
   before it is read, with a diagnostic saying the size and the limit; reading time is
@@ -63,6 +63,9 @@ FORMAT_MAX_INPUT_BYTES = {
     # the largest project S7 Fuzzy Control allows (8 inputs of 7 terms, 4 outputs of 9, 200
     # rules; Siemens manual 1.3) is a 77 KB FPL file, 346 KB with 56 conditions a rule
     "fpl": MiB,
+    # an XFUZ block's tables are fixed in size (ESV 62, FA 576, RG 384 words): the examples
+    # are 4 KB
+    "xfuz": MiB,
 }
 MAX_NESTING = 100
 MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
