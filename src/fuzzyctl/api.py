@@ -68,6 +68,7 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
     from fuzzyctl.diagnostics import DiagnosticError
 
     key = None
+    small = False  # a file whose document is cached
     if cache.enabled():
         from fuzzyctl.limits import read_input
 
@@ -94,7 +95,7 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
 
         doc = formats.read_path(path, fmt).document
     if key is not None:
-        if len(data or b"") <= DOCUMENT_CACHE_MAX_BYTES:
+        if small:
             _store(f"documents/{key}.pickle", doc)
         _remember(doc, key)  # the plan and library caches still find this document's work
     return doc
