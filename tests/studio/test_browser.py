@@ -279,9 +279,12 @@ params = {{ MAN_AUTO = 1, START = 1 }}
         tab(pg, "online")
         pg.fill("#on-url", f"http://127.0.0.1:{port}")
         pg.fill("#on-token", token)
-        for _ in range(50):
+        # the instances appear once their knowledge bases are compiled: on a loaded machine
+        # (the other test worker busy, a C compiler running) that took over 10 s
+        connect_by = time.monotonic() + 60
+        while time.monotonic() < connect_by:
             pg.click("#on-connect")
-            pg.wait_for_timeout(200)
+            pg.wait_for_timeout(300)
             if pg.locator("#on-instance option").count():
                 break
         pg.wait_for_selector("#on-state")
