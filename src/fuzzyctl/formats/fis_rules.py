@@ -273,13 +273,7 @@ def _rule(
                 raise rep.fail("'not any' (never true) in a rule is not supported", line, code="fis-hedge")
             always = True
             continue
-        if not 1 <= index <= len(terms):
-            raise rep.fail(
-                f"rule refers to MF{index} of {name!r}, which has {len(terms)}",
-                line,
-                code="fis-rule-index",
-            )
-        operands.append(Is(name, terms[index - 1], negated, hedges, span))
+        operands.append(Is(name, _term(terms, index, f"{name!r}", rep, line), negated, hedges, span))
     condition: Condition | None
     if not operands:
         if conn_value == 2.0 and not always:
@@ -310,6 +304,16 @@ def _rule(
         return None
     weight = None if weight_value == 1.0 else weight_value
     return Rule(str(number), condition, conclusions, span, weight=weight)
+
+
+def _term(terms: Sequence[str], index: int, what: str, rep: Reporter, line: int) -> str:
+    """The name of MF ``index`` (1-based) of a variable, or the error a rule naming an MF the
+    variable does not have gets."""
+    if not 1 <= index <= len(terms):
+        raise rep.fail(
+            f"rule refers to MF{index} of {what}, which has {len(terms)}", line, code="fis-rule-index"
+        )
+    return terms[index - 1]
 
 
 def _conclusions(
@@ -351,11 +355,7 @@ def _conclusions(
                 if 1.0 / power not in (2.0, 0.5)
                 else (("very",) if 1.0 / power == 2.0 else ("somewhat",))
             )
-        if not 1 <= index <= len(terms):
-            raise rep.fail(
-                f"rule refers to MF{index} of output {name!r}, which has {len(terms)}",
-                line,
-                code="fis-rule-index",
-            )
-        conclusions.append(Conclusion(name, terms[index - 1], None, span, hedges))
+        conclusions.append(
+            Conclusion(name, _term(terms, index, f"output {name!r}", rep, line), None, span, hedges)
+        )
     return tuple(conclusions)
