@@ -406,7 +406,7 @@ FUZZY r
 FPL_TAIL = "END\nCONNECT\nFROM a\nTO r\nEND\nCONNECT\nFROM r\nTO y\nEND\nEND\n"
 
 
-def _s7_style(conditions_per_input: int = 1, rules: int = 200) -> str:
+def s7_largest(conditions_per_input: int = 1, rules: int = 200) -> str:
     """With the defaults, the largest configuration Siemens S7 Fuzzy Control allows (manual
     1.3 and 2: 8 inputs of 7 terms, 4 outputs of 9 terms, 200 rules; 10-character variable
     and 7-character term names; CRLF line ends), each rule naming every input
@@ -460,7 +460,7 @@ def fpl(shape: str, size: int) -> str:
     if shape == "not":
         return FPL_HEAD + "RULE R1\nIF " + "NOT " * (size // 4) + "(a is lo)\nTHEN y = lo\nEND\n" + FPL_TAIL
     if shape == "s7-style":  # the real tool's largest file (56 conditions a rule), more rules
-        return _s7_style(7, max(1, 200 * size // len(_s7_style(7))))
+        return s7_largest(7, max(1, 200 * size // len(s7_largest(7))))
     if shape == "commented":  # rules the plain-rule reader leaves to the general one
         return _repeat(
             FPL_HEAD, lambda k: f"RULE R{k} /* {k} */\nIF (a IS lo)\nTHEN y = lo\nEND\n", FPL_TAIL, size
