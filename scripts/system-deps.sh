@@ -5,6 +5,7 @@ set -euo pipefail
 NEEDED=(
   fuzzylite:fuzzylite  # fuzzylite 6.0 command: outside oracle for our FIS/FLL exports
   chromium:chromium    # the browser the studio tests drive (Playwright with executable_path)
+  javac:default-jdk-headless  # Java: tests/engine/test_fdlibm.py checks fdlibm.py against StrictMath
   cc:build-essential   # C compiler and headers: the generated C and the native backend
   flex:flex            # flex, bison, autoconf, automake, libtool: the tests build matiec
   bison:bison          #   (OpenPLC's IEC 61131-3 compiler, extra suite "matiec") from source

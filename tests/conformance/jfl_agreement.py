@@ -1,6 +1,6 @@
 """Agreement of the jfuzzylogic profile with the live jFuzzyLogic on random systems, per
-behaviour (``python -m tests.conformance.jfl_agreement [SYSTEMS_PER_FAMILY] [SEED]`` prints the
-table docs/engine.md shows; test_jfl_oracle.py asserts it)."""
+behaviour (``python -m tests.conformance.jfl_agreement [SYSTEMS_PER_FAMILY] [SEED] [PROFILE] [LIBM]``
+prints the table docs/engine.md shows; test_jfl_oracle.py asserts it)."""
 
 from __future__ import annotations
 
@@ -26,8 +26,8 @@ ONE_STEP = 1.0 / 1000 + 1e-12  # of the range: one of jFuzzyLogic's 1000 sample 
 class Stats:
     """Samples compared for one family: within 1e-9 and 1e-3 of the output's range (of the
     value, at least 1, for discrete outputs), and the worst such error.  ``ties``: samples of
-    a tie-comparing defuzzifier off by at most one sample step (Java's ``Math.exp``, ``cos``,
-    ``pow`` are HotSpot intrinsics that differ from C's libm by one ulp on some arguments, which
+    a tie-comparing defuzzifier off by at most one sample step (against a JVM whose
+    ``Math.exp``, ``cos``, ``pow`` are HotSpot's intrinsics rather than fdlibm: one ulp there
     decides a tie; docs/engine.md)."""
 
     systems: int = 0
@@ -79,9 +79,10 @@ def ours(
     return got, scale, ""
 
 
-def compare(systems: list[System], compat: str = "jfuzzylogic") -> dict[str, Stats]:
-    """Per family: how our ``compat`` profile agrees with the live jFuzzyLogic."""
-    answers = jfl_oracle.run([Job(s.text, s.rows, s.outputs) for s in systems])
+def compare(systems: list[System], compat: str = "jfuzzylogic", libm: str = "fdlibm") -> dict[str, Stats]:
+    """Per family: how our ``compat`` profile agrees with the live jFuzzyLogic (``libm``: the
+    JVM's math, jfl_oracle.LIBM)."""
+    answers = jfl_oracle.run([Job(s.text, s.rows, s.outputs) for s in systems], libm=libm)
     stats: dict[str, Stats] = {}
     for system, answer in zip(systems, answers, strict=True):
         st = stats.setdefault(system.family, Stats())
@@ -141,7 +142,8 @@ if __name__ == "__main__":
     n = int(sys.argv[1]) if len(sys.argv) > 1 else 5
     seed = int(sys.argv[2]) if len(sys.argv) > 2 else 0
     profile = sys.argv[3] if len(sys.argv) > 3 else "jfuzzylogic"
-    result = compare(systems(n, seed), profile)
+    java_math = sys.argv[4] if len(sys.argv) > 4 else "fdlibm"
+    result = compare(systems(n, seed), profile, java_math)
     print(table(result))
     for st in result.values():
         for f in st.failures[: 2 if profile != "jfuzzylogic" else 5]:

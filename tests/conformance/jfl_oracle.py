@@ -8,6 +8,12 @@ oracle jar).  Without ``javac`` each job runs through ``jfl`` itself (slower, sa
 answer under ``~/.cache/fuzzyctl-tests/jfl/answers/``, keyed by the job (model text, rows,
 outputs), JflBatch.java and the oracle jar: jFuzzyLogic is deterministic, so a cached answer
 is the answer it gave to that very question.  Fresh random systems always ask it live.
+
+``libm``: Java's ``Math.exp``, ``cos`` and ``pow`` are, on x86-64 HotSpot, Intel intrinsics
+(``"intrinsic"``); with ``-XX:-UseLibmIntrinsic`` they are fdlibm's, the ``StrictMath`` that
+Java specifies (``"fdlibm"``, the default here, what the jfuzzylogic profile computes).  The
+two differ in the last bit on a few percent of arguments, which moves jFuzzyLogic's own MM, LM,
+RM and COA by a sample step on a tie (docs/engine.md).
 """
 
 from __future__ import annotations
@@ -28,6 +34,8 @@ HERE = Path(__file__).resolve().parent / "jfl"
 TOOLS = extra_path("jfl_oracle", "tools", "jfuzzylogic")
 JARS = ("jfuzzylogic-3.3-oracle.jar", "antlrworks-1.2.jar")
 CACHE = diskcache.CACHE / "jfl"  # $FUZZYCTL_TEST_CACHE or ~/.cache/fuzzyctl-tests
+#: JVM options per choice of Java's math library (see the module's doc)
+LIBM = {"fdlibm": ("-XX:+UnlockDiagnosticVMOptions", "-XX:-UseLibmIntrinsic"), "intrinsic": ()}
 
 
 @dataclass
@@ -82,11 +90,12 @@ def _jars() -> str:
     return os.pathsep.join(str(TOOLS / j) for j in JARS)
 
 
-def run(jobs: list[Job], cache: bool = False) -> list[Answer]:
-    """Ask jFuzzyLogic; one answer per job, in order (``cache``: see the module's doc)."""
+def run(jobs: list[Job], cache: bool = False, libm: str = "fdlibm") -> list[Answer]:
+    """Ask jFuzzyLogic; one answer per job, in order (``cache``, ``libm``: see the module's
+    doc)."""
     if not cache:
-        return [_parse(body) for body in _ask(jobs)]
-    keys = [_key(job) for job in jobs]
+        return [_parse(body) for body in _ask(jobs, libm)]
+    keys = [_key(job, libm) for job in jobs]
     bodies: list[str | None] = [
         (CACHE / "answers" / k).read_text(encoding="utf-8") if (CACHE / "answers" / k).exists() else None
         for k in keys
@@ -94,7 +103,7 @@ def run(jobs: list[Job], cache: bool = False) -> list[Answer]:
     missing = [i for i, b in enumerate(bodies) if b is None]
     if missing:
         (CACHE / "answers").mkdir(parents=True, exist_ok=True)
-        for i, body in zip(missing, _ask([jobs[i] for i in missing]), strict=True):
+        for i, body in zip(missing, _ask([jobs[i] for i in missing], libm), strict=True):
             bodies[i] = body
             tmp = CACHE / "answers" / f"{keys[i]}.{os.getpid()}"
             tmp.write_text(body, encoding="utf-8")
@@ -102,16 +111,16 @@ def run(jobs: list[Job], cache: bool = False) -> list[Answer]:
     return [_parse(b) for b in bodies if b is not None]
 
 
-def _key(job: Job) -> str:
+def _key(job: Job, libm: str) -> str:
     jar = TOOLS / JARS[0]
     model = job.fcl.read_bytes() if isinstance(job.fcl, Path) else job.fcl.encode()
     h = hashlib.sha1((HERE / "JflBatch.java").read_bytes())
-    h.update(f"{jar.stat().st_size}:{jar.stat().st_mtime_ns}\0".encode())
+    h.update(f"{jar.stat().st_size}:{jar.stat().st_mtime_ns}:{libm}\0".encode())
     h.update(model + b"\0" + _csv(job).encode() + b"\0" + ",".join(job.outputs or ["-"]).encode())
     return h.hexdigest()
 
 
-def _ask(jobs: list[Job]) -> list[str]:
+def _ask(jobs: list[Job], libm: str) -> list[str]:
     """jFuzzyLogic's raw answer to each job."""
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-jfl-") as tmp:
         d = Path(tmp)
@@ -129,8 +138,8 @@ def _ask(jobs: list[Job]) -> list[str]:
         if cp is not None:
             (d / "jobs.txt").write_text("\n".join(lines) + "\n", encoding="utf-8")
             got = subprocess.run(
-                ["java", "-Xshare:auto", "-XX:+UseSerialGC", "-XX:TieredStopAtLevel=1", "-cp", cp,
-                 "JflBatch", str(d / "jobs.txt")],
+                ["java", "-Xshare:auto", "-XX:+UseSerialGC", "-XX:TieredStopAtLevel=1", *LIBM[libm],
+                 "-cp", cp, "JflBatch", str(d / "jobs.txt")],
                 check=True, capture_output=True, text=True,
             ).stdout  # fmt: skip
             chunks = got.split("## job ")[1:]
@@ -139,7 +148,8 @@ def _ask(jobs: list[Job]) -> list[str]:
             for i, line in enumerate(lines):
                 model, csv, outs = line.split("\t")
                 args = [str(TOOLS / "jfl"), model, csv] + (["--outputs", outs] if outs != "-" else [])
-                res = subprocess.run(args, capture_output=True, text=True)
+                env = {**os.environ, "JAVA_TOOL_OPTIONS": " ".join(LIBM[libm])}
+                res = subprocess.run(args, capture_output=True, text=True, env=env)
                 body = "\n".join(ln for ln in res.stdout.splitlines() if not ln.startswith("# fb="))
                 chunks.append(f"{i}\n{body}")
     assert len(chunks) == len(jobs), got if cp is not None else chunks

@@ -168,14 +168,44 @@ def test_breaking_the_behaviour_breaks_its_family(
 @settings(max_examples=20 if FUZZ else 1, deadline=None, database=None, derandomize=not FUZZ)
 @given(seed=st.integers(1000, 2**31))
 def test_fresh_random_systems_agree(seed: int) -> None:
-    """``make fuzz``: fresh systems of every family (one per family per example)."""
+    """``make fuzz``: fresh systems of every family (one per family per example), every
+    sample within 1e-9."""
     systems = jfl_agreement.systems(1, seed)
     stats = jfl_agreement.compare(systems)
     for family, s in stats.items():
-        # beyond 1e-9 only one-step ties of MM/LM/RM/COA (a 1-ulp libm difference deciding
-        # which samples reach the maximum; docs/engine.md), and rarely
-        assert s.unexplained == 0, (family, seed, s.failures)
-        assert s.ties <= 0.02 * s.samples, (family, seed, s.ties)
+        assert s.within_1e9 == s.samples, (family, seed, s.failures)
+
+
+def _differ(a: float | str, b: float | str, tol: float) -> bool:
+    if isinstance(a, str) or isinstance(b, str):
+        return a != b
+    if math.isnan(a) or math.isnan(b):
+        return math.isnan(a) != math.isnan(b)
+    return abs(a - b) > tol
+
+
+def test_hotspot_intrinsics_move_jfuzzylogic_itself_exactly_where_we_differ() -> None:
+    """On x86-64, HotSpot's default ``Math.exp``/``cos``/``pow`` are Intel intrinsics, not
+    fdlibm.  jFuzzyLogic's own answers then change where a last bit decides a tie of MM, LM,
+    RM or COA (and in what reads that output's value); those are exactly the samples where
+    our profile (fdlibm, as StrictMath) differs from that JVM."""
+    systems = jfl_agreement.systems(20, 5000)
+    families = ("span_universe", "output_in_condition", "nc_nan", "precedence")
+    systems = [s for s in systems if s.family in families]
+    jobs = [Job(s.text, s.rows, s.outputs) for s in systems]
+    strict = jfl_oracle.run(jobs, cache=True)
+    intrinsic = jfl_oracle.run(jobs, cache=True, libm="intrinsic")
+    moved = 0
+    for system, a, b in zip(systems, strict, intrinsic, strict=True):
+        got, scale, _ = jfl_agreement.ours(system)
+        assert got is not None
+        for k, name in enumerate(b.outputs):
+            for i, (ra, rb) in enumerate(zip(a.rows, b.rows, strict=True)):
+                tol = 1e-9 * scale[name][0]
+                java_moved = _differ(ra[k], rb[k], tol)
+                assert java_moved == _differ(float(got[name][i]), rb[k], tol), (system.seed, name, i)
+                moved += java_moved
+    assert moved > 0
 
 
 # ------------------------------------------------------------------ the corpus
@@ -213,3 +243,28 @@ def test_the_profile_refuses_what_jfuzzylogic_throws_on() -> None:
     assert isinstance(answer.rows[0][0], str) and "discrete" in answer.rows[0][0]
     with pytest.raises(DiagnosticError, match="COG"):
         fuzzyctl.compile(fuzzyctl.load(text), compat="jfuzzylogic")
+
+
+def test_gauss2_of_nan_and_an_output_no_rule_concludes() -> None:
+    """Two readings found by fresh systems: jFuzzyLogic's GAUSS2 gives 1 at NaN (an NC output
+    before its first value), and a condition may test an output that no rule concludes on
+    (its crisp value is its DEFAULT)."""
+    text = (
+        "FUNCTION_BLOCK f\nVAR_INPUT x : REAL; END_VAR\nVAR_OUTPUT y : REAL; z : REAL; END_VAR\n"
+        "FUZZIFY x\n  TERM a := (0, 0) (10, 1);\nEND_FUZZIFY\n"
+        "DEFUZZIFY y\n  TERM g := GAUSS2 4 1 6 1;\n  TERM h := (0, 0) (2, 1) (3, 0);\n  METHOD : COG;\n"
+        "  RANGE := (0 .. 10);\nEND_DEFUZZIFY\n"
+        "DEFUZZIFY z\n  TERM lo := TRAPE 0 0 2 4;\n  TERM hi := TRAPE 3 5 10 10;\n  METHOD : COG;\n"
+        "  DEFAULT := 1;\n  RANGE := (0 .. 10);\nEND_DEFUZZIFY\n"
+        "RULEBLOCK r\n  AND : MIN;\n  ACT : MIN;\n  ACCU : MAX;\n  RULE 1 : IF y IS g THEN y IS h;\n"
+        "  RULE 2 : IF x IS a AND z IS lo THEN y IS g;\nEND_RULEBLOCK\nEND_FUNCTION_BLOCK\n"
+    )
+    rows = [{"x": 2.0}, {"x": 7.0}, {"x": 9.5}]
+    (answer,) = jfl_oracle.run([Job(text, rows)])
+    assert answer.clean and answer.outputs == ["y", "z"]
+    c = fuzzyctl.compile(fuzzyctl.load(text), compat="jfuzzylogic")
+    got = [c.evaluate(r) for r in rows]
+    for want, mine in zip(answer.rows, got, strict=True):
+        assert isinstance(want[0], float) and abs(mine["y"] - want[0]) <= 1e-9 * 10, (want, mine)
+        assert mine["z"] == want[1] == 1.0
+    assert not math.isnan(got[0]["y"])  # with GAUSS2(NaN) = NaN, the first set would be all NaN

@@ -5,7 +5,7 @@ for floats and for numpy arrays."""
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -121,7 +121,20 @@ _NP_FUNCS: dict[str, Any] = {
 }
 
 
-def eval_expr_np(e: ExprPlan, vals: Sequence[Any], outs: Sequence[Any], x: Any = None) -> Any:
+def eval_expr_np(
+    e: ExprPlan,
+    vals: Sequence[Any],
+    outs: Sequence[Any],
+    x: Any = None,
+    funcs: Mapping[str, Any] | None = None,
+) -> Any:
+    """``e`` over arrays; ``funcs`` replaces some of the functions (by name; ``pow`` also
+    serves ``^``)."""
+    table = _NP_FUNCS if funcs is None else {**_NP_FUNCS, **funcs}
+    return _eval_np(e, vals, outs, x, table)
+
+
+def _eval_np(e: ExprPlan, vals: Sequence[Any], outs: Sequence[Any], x: Any, table: Mapping[str, Any]) -> Any:
     with np.errstate(all="ignore"):
         if isinstance(e, ENum):
             return e.value
@@ -132,11 +145,11 @@ def eval_expr_np(e: ExprPlan, vals: Sequence[Any], outs: Sequence[Any], x: Any =
         if isinstance(e, EX):
             return x
         if isinstance(e, EUnary):
-            v = eval_expr_np(e.operand, vals, outs, x)
+            v = _eval_np(e.operand, vals, outs, x, table)
             return -v if e.op == "-" else v
         if isinstance(e, EBinary):
-            a = np.asarray(eval_expr_np(e.left, vals, outs, x), dtype=np.float64)
-            b = np.asarray(eval_expr_np(e.right, vals, outs, x), dtype=np.float64)
+            a = np.asarray(_eval_np(e.left, vals, outs, x, table), dtype=np.float64)
+            b = np.asarray(_eval_np(e.right, vals, outs, x, table), dtype=np.float64)
             if e.op == "+":
                 return a + b
             if e.op == "-":
@@ -147,13 +160,13 @@ def eval_expr_np(e: ExprPlan, vals: Sequence[Any], outs: Sequence[Any], x: Any =
                 return a / b
             if e.op == "%":
                 return np.fmod(a, b)
-            return np.power(a, b)
+            return table["pow"](a, b)
         assert isinstance(e, ECall)
-        args = [np.asarray(eval_expr_np(a, vals, outs, x), dtype=np.float64) for a in e.args]
+        args = [np.asarray(_eval_np(a, vals, outs, x, table), dtype=np.float64) for a in e.args]
         if e.function == "min" or e.function == "max":
-            f = _NP_FUNCS[e.function]
+            f = table[e.function]
             r = args[0]
             for a in args[1:]:
                 r = f(r, a)
             return r
-        return _NP_FUNCS[e.function](*args)
+        return table[e.function](*args)

@@ -85,7 +85,7 @@ class JflEvaluator:
         for op in plan.outputs:
             if op.kind == "degree" and op.contributions:
                 raise FuzzyctlError(f"output {op.name}: jFuzzyLogic has no conclusions without a term")
-            for t in op.terms if op.kind != "mamdani" else ():
+            for t in op.terms if op.kind != "mamdani" and op.contributions else ():
                 if t.kind not in ("singleton", "singletons", "function", "constant"):
                     raise FuzzyctlError(f"term {op.name}.{t.name}: jFuzzyLogic has no {t.kind} output terms")
         names = [o.name for o in plan.outputs]

@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine import fdlibm, shapes
 from fuzzyctl.engine.expr import eval_expr_np
 from fuzzyctl.engine.plan import EBinary, ECall, EUnary, ExprPlan, TermPlan
 
@@ -40,27 +40,27 @@ def membership(kind: str, p: Sequence[Arr], x: Arr) -> Arr:
             return np.where((x < a) | (x > d), 0.0, np.where((x >= b) & (x <= c), 1.0, slope))
         if kind == "gaussian":
             m, s = p
-            return np.exp(-(x - m) * (x - m) / (2 * s * s))
+            return fdlibm.exp(-(x - m) * (x - m) / (2 * s * s))
         if kind == "gaussian2":
             m1, s1, m2, s2 = p
-            left = np.exp(-(x - m1) * (x - m1) / (2 * s1 * s1))
-            right = np.exp(-(x - m2) * (x - m2) / (2 * s2 * s2))
-            return np.where(x < m1, left, np.where(x > m2, right, np.where(np.isnan(x), np.nan, 1.0)))
+            left = fdlibm.exp(-(x - m1) * (x - m1) / (2 * s1 * s1))
+            right = fdlibm.exp(-(x - m2) * (x - m2) / (2 * s2 * s2))
+            return np.where(x < m1, left, np.where(x > m2, right, 1.0))  # NaN: 1, as its Java
         if kind == "bell":
             c, w, b = p
-            return 1.0 / (1.0 + np.power(np.abs((x - c) / w), 2.0 * b))
+            return 1.0 / (1.0 + fdlibm.pow_(np.abs((x - c) / w), 2.0 * b))
         if kind == "sigmoid":
             c, s = p
-            return 1.0 / (1.0 + np.exp(-s * (x - c)))
+            return 1.0 / (1.0 + fdlibm.exp(-s * (x - c)))
         if kind == "dsigmoid_pos":
             c1, s1, c2, s2 = p
-            d = 1.0 / (1.0 + np.exp(-s1 * (x - c1))) - 1.0 / (1.0 + np.exp(-s2 * (x - c2)))
+            d = 1.0 / (1.0 + fdlibm.exp(-s1 * (x - c1))) - 1.0 / (1.0 + fdlibm.exp(-s2 * (x - c2)))
             return np.where(np.isnan(d), np.nan, np.maximum(d, 0.0))
         if kind in ("cosine", "cosine_half"):
             c, w = p
             t = 0.5 * w if kind == "cosine" else w  # jFuzzyLogic's net_max
             u = x - c
-            return np.where((-t <= u) & (u <= t), (np.cos(u * (np.pi / t)) + 1) / 2, 0.0)
+            return np.where((-t <= u) & (u <= t), (fdlibm.cos(u * (np.pi / t)) + 1) / 2, 0.0)
     # shapes jFuzzyLogic does not have (a file using them does not load there)
     return shapes.membership_np(kind, list(p), 1.0, np.asarray(x, dtype=np.float64))
 
@@ -149,8 +149,12 @@ def jfl_expr(e: ExprPlan) -> ExprPlan:
     return e
 
 
+#: Java's ``Math`` as fdlibm computes it, where we have it (the other functions: C's libm)
+_JAVA_MATH = {"exp": fdlibm.exp, "cos": fdlibm.cos, "pow": fdlibm.pow_}
+
+
 def eval_function(e: ExprPlan, vals: Sequence[Arr], outs: Sequence[Arr]) -> Arr:
-    return eval_expr_np(e, vals, outs, _NAN)
+    return eval_expr_np(e, vals, outs, _NAN, _JAVA_MATH)
 
 
 # --------------------------------------------------------------------------- java.util.HashMap

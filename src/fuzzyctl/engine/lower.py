@@ -261,7 +261,7 @@ def _chained(b: _Block) -> None:
     for _rb, rule in fb.rules():
         if rule.condition is not None:
             _collect_vars(rule.condition, referenced)
-    chained_names = [n for n in dict.fromkeys(referenced) if n in b.concluded_terms or n in b.concluded_bare]
+    chained_names = [n for n in dict.fromkeys(referenced) if _has_value(b, n)]
     b.chained_index.update({n: i for i, n in enumerate(chained_names)})
     for n in chained_names:
         src = b.term_source(n)
@@ -270,6 +270,21 @@ def _chained(b: _Block) -> None:
         b.chained.append(
             ChainedPlan(n, tuple(b.chained_term_names[n]), b.accu_for(n, fb.defuzzify_block(n)) or "MAX")
         )
+
+
+def _has_value(b: _Block, name: str) -> bool:
+    """Whether a variable read in a condition has a value there: rules conclude on it or, in
+    the jfuzzylogic profile (conditions read outputs' crisp values), it is an output, whose
+    value is its DEFAULT until it has one."""
+    if name in b.concluded_terms or name in b.concluded_bare:
+        return True
+    var = b.ctx.fb.variable(name)
+    return (
+        b.ctx.options.emulate == "jfuzzylogic"
+        and var is not None
+        and var.kind is m.VarKind.OUTPUT
+        and b.ctx.fb.defuzzify_block(name) is not None
+    )
 
 
 def _rules(b: _Block) -> None:

@@ -87,8 +87,10 @@ def _output(
             db.span,
             "output-unused",
         )
+        # (the jfuzzylogic profile keeps the terms: a condition may test its crisp value)
+        kept = tps if ctx.options.emulate == "jfuzzylogic" else ()
         return OutputPlan(
-            var.name, "singleton", "COGS", accu_for(var.name, db) or "MAX", (), (), default, no_change
+            var.name, "singleton", "COGS", accu_for(var.name, db) or "MAX", kept, (), default, no_change
         )
     accu = accu_for(var.name, db)
     # a function of x is a fuzzy set (smooth, integrated numerically), not a Sugeno value
