@@ -174,3 +174,25 @@ def test_a_huge_run_of_unbalanced_parentheses_is_refused_at_its_first() -> None:
     first = err.value.diagnostics[0]
     assert f"{n:,} parentheses open in a row" in first.message
     assert first.span is not None and (first.span.line, first.span.column) == (7, 13)
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "message"),
+    [
+        ("TYPE float", "TYPE " + "x" * 100_000, f"the name '{'x' * 20}... (100000 characters)' is longer"),
+        ("MAX 30.00", "MAX " + "9" * 5001, f"the number {'9' * 20}... (5001 characters) is too large"),
+        ("POINTS 0.00,1.0", "POINTS 1e400,1.0", "the number 1e400 is too large"),
+    ],
+)
+def test_fpl_never_echoes_a_long_token_nor_reads_inf(
+    tmp_path: Path, old: str, new: str, message: str
+) -> None:
+    """A megabyte-long name or a number beyond the double range in an FPL file: one short
+    error at its place (the FPL reader quoted whole tokens, and read 5001 nines as inf)."""
+    path = tmp_path / "big.fpl"
+    path.write_text((EXAMPLES / "fpltest.fpl").read_text().replace(old, new, 1))
+    with pytest.raises(DiagnosticError) as err:
+        fuzzyctl.load(path)
+    (diag,) = [d for d in err.value.diagnostics if d.is_error]
+    assert diag.message.startswith(message) and len(diag.message) < 100
+    assert diag.span is not None and diag.span.line == (7 if "TYPE" in old else 9 if "MAX" in old else 11)

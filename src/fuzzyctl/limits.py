@@ -84,8 +84,15 @@ __all__ = [
     "expr_depth",
     "max_input_bytes",
     "read_input",
+    "shorten",
     "too_large",
 ]
+
+
+def shorten(text: str, limit: int = 24, keep: int = 20) -> str:
+    """``text`` as a message quotes it: whole up to ``limit`` characters, else its first
+    ``keep`` and its length (a diagnostic never echoes a long piece of the input)."""
+    return text if len(text) <= limit else f"{text[:keep]}... ({len(text)} characters)"
 
 
 def max_input_bytes(format: str | None = None) -> int:

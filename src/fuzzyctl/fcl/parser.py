@@ -28,7 +28,7 @@ from fuzzyctl.fcl import keywords, shapes
 from fuzzyctl.fcl.fast import FastResult, read_runs
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
-from fuzzyctl.limits import MAX_NESTING
+from fuzzyctl.limits import MAX_NESTING, shorten
 from fuzzyctl.model import (
     And,
     Binary,
@@ -597,8 +597,8 @@ def _on_token(tok: Token) -> Token:
         state.prev_token, state.last_token = state.last_token, tok
         if tok.type == "NUMBER" and tok[-1:].isdigit() and not math.isfinite(_number(tok)):
             # 1e400 or 5001 digits: Python reads it as inf, which the file did not say
-            shown = tok if len(tok) <= 24 else f"{tok[:20]}... ({len(tok)} characters)"
-            state.error(f"the number {shown} is too large (beyond 1.8e308)", _tok_span(tok), "number-range")
+            message = f"the number {shorten(tok)} is too large (beyond 1.8e308)"
+            state.error(message, _tok_span(tok), "number-range")
     return tok
 
 

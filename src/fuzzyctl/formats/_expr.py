@@ -13,6 +13,7 @@ from collections.abc import Iterator
 from typing import Any
 
 from fuzzyctl.formats._common import fmt_number
+from fuzzyctl.limits import shorten
 from fuzzyctl.model import Binary, Call, Expr, Name, Num, Unary
 
 _BINARY_POWER = {"+": 10, "-": 10, "*": 20, "/": 20, "%": 20, "^": 40}
@@ -216,8 +217,7 @@ class _Parser:
     def number(self, text: str) -> Num:
         value = float(text)
         if math.isinf(value):  # 1e400, 5001 digits: not an infinity the file spelt
-            shown = text if len(text) <= 24 else f"{text[:20]}... ({len(text)} characters)"
-            raise self.fail(f"the number {shown} is too large (beyond 1.8e308)", self.index - 1)
+            raise self.fail(f"the number {shorten(text)} is too large (beyond 1.8e308)", self.index - 1)
         num = self.leaves[text] = Num(value)
         return num
 

@@ -18,6 +18,7 @@ from typing import Protocol
 from fuzzyctl.diagnostics import warning
 from fuzzyctl.formats._common import Reporter, parse_number, power_hedge
 from fuzzyctl.formats._expr import eval_constant, parse_expr
+from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -85,7 +86,7 @@ def numbers(text: str, rep: Reporter, line: int, what: str) -> list[float]:
         value = _entry(part)
         if isinstance(value, str):
             # the entry, shortened (it may be 5001 digits or 1000 parentheses), and why
-            shown = part if len(part) <= 40 else f"{part[:30]}... ({len(part)} characters)"
+            shown = shorten(part, 40, 30)
             raise rep.fail(f"{what}: expected numbers, found {shown!r} ({value})", line, code="fis-number")
         out.append(value)
     return out

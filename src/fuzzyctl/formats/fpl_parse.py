@@ -13,6 +13,7 @@ base - is read by one match; conditions nest without recursion.
 
 from __future__ import annotations
 
+import math
 import re
 from bisect import bisect_right
 from dataclasses import dataclass, field
@@ -21,7 +22,7 @@ from sys import intern
 from typing import NamedTuple, NoReturn
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
-from fuzzyctl.limits import MAX_NESTING
+from fuzzyctl.limits import MAX_NESTING, shorten
 from fuzzyctl.model import And, Conclusion, Condition, Is, Span
 
 __all__ = ["KEYWORDS", "MAX_UNEXPECTED", "is_fpl_name", "lex_errors", "parse_project"]
@@ -177,7 +178,9 @@ _new_token = tuple.__new__  # a token made without NamedTuple's Python-level __n
 # conditions ``v is t`` or ``(v is t)`` joined by AND, conclusions ``v = t`` joined by AND or
 # commas, no comments.  Anything else - and names that are keywords - takes the general
 # path (Parser.parse_rule), which reads these the same way.
-_NAME = r"[A-Za-z_][A-Za-z0-9_]*(?!\w)"
+#: the longest name read (S7 Fuzzy Control's names are far shorter; a diagnostic quotes names)
+MAX_NAME = 255
+_NAME = rf"[A-Za-z_][A-Za-z0-9_]{{0,{MAX_NAME - 1}}}(?!\w)"
 _IS = rf"{_NAME}\s+[Ii][Ss]\s+{_NAME}"
 _LEAF = rf"(?:\(\s*{_IS}\s*\)|{_IS})"
 _TO = rf"{_NAME}\s*=\s*{_NAME}"
@@ -265,7 +268,10 @@ class Parser:
             kind = m.lastgroup
             chunk = m.group()
             if kind == "word":
-                return _new_token(_Tok, ("word", chunk, m.start(), chunk.upper()))
+                tok = _new_token(_Tok, ("word", chunk, m.start(), chunk.upper()))
+                if len(chunk) > MAX_NAME:  # (messages quote names: never a megabyte of one)
+                    self.fail(f"the name {shorten(chunk)!r} is longer than {MAX_NAME} characters", tok)
+                return tok
             if kind != "comment":
                 return _new_token(_Tok, (kind, chunk, m.start(), ""))
             self.comments.append(chunk[2:-2].strip())
@@ -291,7 +297,14 @@ class Parser:
         raise Abort
 
     def describe(self, tok: _Tok) -> str:
-        return "end of file" if tok.kind == "eof" else repr(tok.text)
+        return "end of file" if tok.kind == "eof" else repr(shorten(tok.text))
+
+    def value(self, tok: _Tok) -> float:
+        """A number token's value; one beyond the double range is an error, never inf."""
+        value = float(tok.text)
+        if math.isinf(value):
+            self.fail(f"the number {shorten(tok.text)} is too large (beyond 1.8e308)", tok)
+        return value
 
     def expect_word(self, what: str) -> _Tok:
         tok = self.tok
@@ -309,7 +322,7 @@ class Parser:
         if tok.kind != "number":
             self.fail(f"expected a number for {what}, found {self.describe(tok)}")
         self.advance()
-        return float(tok.text)
+        return self.value(tok)
 
     def note(self, message: str, tok: _Tok, severity: Severity, code: str) -> None:
         self.diags.append(Diagnostic(severity, message, self.span(tok), self.file, code))
@@ -458,7 +471,7 @@ class Parser:
         while self.tok.kind == "number" or self.at_punct(","):
             t = self.advance()
             if t.kind == "number":
-                numbers.append((float(t.text), t))
+                numbers.append((self.value(t), t))
         if len(numbers) % 2:
             self.fail(
                 f"MEMBER {member}: POINTS needs x,y pairs, found {len(numbers)} numbers",
@@ -637,8 +650,8 @@ def parse_project(text: str, file: str | None, diags: list[Diagnostic], comments
     if lexical:
         diags.extend(lexical)
         return None
-    parser = Parser(text, file, diags, comments)
     try:
+        parser = Parser(text, file, diags, comments)
         parser.parse()
     except Abort:
         return None
