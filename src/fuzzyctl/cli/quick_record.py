@@ -127,14 +127,12 @@ def save(key: str, ctl: Any, title: str) -> None:
     if not isinstance(ctl, NativeController):
         return
     plan = ctl.plan
-    degree = ctl._degree
+    slots, n_results = ctl.result_layout()
     record = {
         "title": title,
-        "inputs": [[s.name, s.default, bool(degree[i])] for i, s in enumerate(plan.inputs)],
-        # the PLC block's wrapper writes only the declared outputs, in order; the evaluator
-        # writes every result (see NativeController.evaluate)
-        "outputs": [[n, k if ctl._plc else i] for k, (n, i) in enumerate(ctl._names)],
-        "n_results": ctl._n_res,
+        "inputs": [[s.name, s.default, bool(s.degree)] for s in plan.inputs],
+        "outputs": [[n, slot] for n, slot in slots],
+        "n_results": n_results,
         "library": str(ctl.library),
         "warnings": render_all(ctl.warnings),
     }

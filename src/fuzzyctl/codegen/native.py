@@ -261,6 +261,14 @@ class NativeController(Controller):
         # (the evaluator's) and no output reads another (a NC value is then only copied)
         self._parallel = not self._plc and not _outputs_read(plan)
 
+    def result_layout(self) -> tuple[list[tuple[str, int]], int]:
+        """Where ``fz_eval`` writes each declared output (its name and index in the result
+        array), and how many results it writes: what a caller of the library without this
+        class needs (the CLI's quick path).  The PLC block's wrapper writes only the declared
+        outputs, in order; the evaluator writes every result."""
+        slots = [(n, k if self._plc else i) for k, (n, i) in enumerate(self._names)]
+        return slots, self._n_res
+
     def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
         values = self._values(merge_inputs(inputs, values_by_name))
         buf = self._in1
