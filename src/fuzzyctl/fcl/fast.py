@@ -29,6 +29,7 @@ import math
 import re
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
+from typing import Any
 
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.fast_conditions import (
@@ -58,6 +59,7 @@ from fuzzyctl.model import (
     SingletonMF,
     Span,
     Term,
+    Variable,
 )
 
 # lark's NUMBER (fcl.lark), its COMMENT_* terminals and its WS.
@@ -124,11 +126,29 @@ class FastResult:
     #: Long point lists of the TERMs that lark reads, read here instead: lark reads ``0`` in
     #: their place.  By the (line, column) of the TERM keyword.
     points: dict[tuple[int, int], PointsMF] = field(default_factory=dict)
+    #: Whole blocks read by fuzzyctl.fcl.fast_blocks (FuzzifyBlock, DefuzzifyBlock,
+    #: RuleBlock, or the variables of a VAR block), by offset; the shape spellings of
+    #: their terms; the variables of the declarations it took inside VAR blocks.
+    blocks: list[tuple[int, Any]] = field(default_factory=list)
+    block_spellings: list[tuple[int, str]] = field(default_factory=list)
+    decls: list[tuple[int, list[Variable]]] = field(default_factory=list)
 
     def between(self, start: int, end: int) -> list[tuple[int, Rule | Term, str | None]]:
         """The statements read here whose offset lies in ``[start, end)``."""
         lo, hi = bisect_left(self.offsets, start), bisect_left(self.offsets, end)
         return list(zip(self.offsets[lo:hi], self.items[lo:hi], self.spellings[lo:hi], strict=True))
+
+    def blocks_between(self, start: int, end: int) -> list[Any]:
+        """The blocks read here whose offset lies in ``[start, end)``."""
+        lo = bisect_left(self.blocks, start, key=_offset)
+        hi = bisect_left(self.blocks, end, key=_offset)
+        return [b for _, b in self.blocks[lo:hi]]
+
+    def decls_between(self, start: int, end: int) -> list[Variable]:
+        """The variables of the declarations read here whose offset lies in ``[start, end)``."""
+        lo = bisect_left(self.decls, start, key=_offset)
+        hi = bisect_left(self.decls, end, key=_offset)
+        return [v for _, vs in self.decls[lo:hi] for v in vs]
 
     _at: tuple[int, int, int] = (0, 1, 0)  # an offset, its line, where that line starts
 
@@ -153,12 +173,18 @@ class FastResult:
 
     def spellings_before(self, end: int | None) -> set[str]:
         n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
-        return {s for s in self.spellings[:n] if s is not None}
+        found = {s for s in self.spellings[:n] if s is not None}
+        found.update(s for at, s in self.block_spellings if end is None or at < end)
+        return found
 
     def comments_before(self, end: int | None) -> list[FastComment]:
         if end is None:
             return list(self.comments)
         return self.comments[: bisect_right([c.offset for c in self.comments], end - 1)]
+
+
+def _offset(entry: tuple[int, Any]) -> int:
+    return entry[0]
 
 
 _Part = tuple[int, int, "Condition | PointsMF | None", int]
