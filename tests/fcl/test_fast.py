@@ -397,6 +397,14 @@ BLOCK_MISTAKES = [
     ("FUZZIFY v", "FUZZIFY rear v"),
     ("THEN y IS hi;", "THEN y IS ;"),
     ("END_VAR", "END_VAR END_VAR"),
+    # between FUNCTION_BLOCKs (a run of blocks goes on into the next one)
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK h-1"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK RULE"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK h;"),
+    ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK h", "FUNCTION_BLOCK h"),
+    ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK h", "END_FUNCTION_BLOCK (* c *) x FUNCTION_BLOCK h"),
+    ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nx"),
 ]
 
 
@@ -413,7 +421,7 @@ def _blocks_document(rng: random.Random) -> str:
         f"FUNCTION_BLOCK g\nVAR_INPUT a : REAL; b : REAL;\n{decls}END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
         f"{body}END_FUNCTION_BLOCK\n"
     )
-    if rng.random() < 0.3:
+    for _ in range(rng.choice([0, 0, 1, 2])):
         text += "FUNCTION_BLOCK h\n" + "".join(b + _sep(rng) for b in blocks[::-1]) + "END_FUNCTION_BLOCK\n"
     if rng.random() < 0.4:
         old, new = rng.choice(BLOCK_MISTAKES)
@@ -461,6 +469,29 @@ def test_fast_reader_takes_runs_of_small_blocks(name: str) -> None:
             broken = _many(block).replace(block.format(k=20), block.replace(old, new, 1).format(k=20))
             assert_same(broken)
             assert_same(_many(block, 3).replace(block.format(k=1), block.replace(old, new, 1).format(k=1)))
+
+
+def test_runs_of_blocks_go_on_into_the_next_function_block() -> None:
+    fb = (
+        "FUNCTION_BLOCK f{k} VAR_INPUT a : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR\n"
+        "FUZZIFY a TERM lo := 0; END_FUZZIFY DEFUZZIFY y TERM lo := 0; END_DEFUZZIFY\n"
+        "RULEBLOCK r RULE 1 : IF a IS lo THEN y IS lo; END_RULEBLOCK END_FUNCTION_BLOCK\n"
+    )
+    text = "".join(fb.format(k=k) for k in range(10))
+    result = read_blocks(text)
+    assert result is not None and len(result.blocks) == 48  # all but the first and the last
+    assert_same(text)
+    assert_same(text.replace("\n", " "))
+    for old, new in [
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK f-5"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK (* c *) f5 // d\n"),
+        ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK f5", "FUNCTION_BLOCK f5"),
+        ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK f5", "END_FUNCTION_BLOCK END_FUNCTION_BLOCK"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK f4"),  # the same name twice
+    ]:
+        assert_same(text.replace(old, new))
+    assert_same(text + "trailing text")
 
 
 def test_fast_reader_takes_runs_of_declarations() -> None:

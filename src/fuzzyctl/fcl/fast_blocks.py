@@ -17,6 +17,7 @@ position (FastResult.blocks, FastResult.decls).  tests/fcl/test_fast.py compares
 from __future__ import annotations
 
 import re
+from bisect import bisect_right
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -267,12 +268,13 @@ class _BlockReader(_Reader):
 
     def var_block(self, word: str, at: int) -> tuple[list[Variable], int]:
         out: list[Variable] = []
+        kind = VarKind(word)
         while True:
             k, a, b, u = self.peek()
             if k == WORD and u == "END_VAR":
                 self.next()
                 return out, b
-            out.extend(self.decl(VarKind(word), a))
+            out.extend(self.decl(kind, a))
 
     def decl(self, kind: VarKind, at: int) -> list[Variable]:
         """``name, ... : TYPE [:= value] ; [RANGE ...]`` from ``at``."""
@@ -338,52 +340,76 @@ def _end_of(reader: _BlockReader, word: str, start: int) -> int:
     return found
 
 
-def _next_block(reader: _BlockReader, at: int) -> tuple[str, int] | None:
-    """The keyword and offset of the block opening at the next token after ``at``."""
+def _next_block(reader: _BlockReader, at: int) -> tuple[str, int, int] | None:
+    """The keyword and offset of the block opening at the next token after ``at``, also
+    past ``END_FUNCTION_BLOCK FUNCTION_BLOCK [name]`` (which lark reads), and where that
+    next token starts."""
     reader.go(at)
     try:
         k, a, _, u = reader.peek()
+        gap = a
+        if k == WORD and u == "END_FUNCTION_BLOCK":
+            reader.next()
+            k, _, _, u = reader.next()
+            if not (k == WORD and u == "FUNCTION_BLOCK"):
+                return None
+            k, a, b, u = reader.peek()
+            if k == WORD and u not in KEYWORDS:
+                if reader.text[b : b + 1] == "-":  # a name of several parts (FB_NAME)
+                    return None
+                reader.next()
+                k, a, _, u = reader.peek()
     except _Bail:
         return None
-    return (u, a) if k == WORD and u in _END else None
+    return (u, a, gap) if k == WORD and u in _END else None
 
 
 def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> int:
     """Read the run of blocks from ``start`` (the first, lark's); keep its inner blocks.
-    Returns where the search for the next run goes on."""
+    A run goes on into the next FUNCTION_BLOCK: lark reads the words between.  Returns
+    where the search for the next run goes on."""
     if word.startswith("VAR"):
         _decl_run(reader, VarKind(word), start + len(word), taken)
     end = _end_of(reader, word, start + len(word))
     if end < 0:
         return start + len(word)
     reader.comments = []
-    got: list[tuple[int, _Block | None, frozenset[str]]] = []
+    # (offset, the block or None when lark reads it, spellings, where the text after the
+    # block before it ends)
+    got: list[tuple[int, _Block | None, frozenset[str], int]] = []
+    ahead: tuple[int, tuple[str, int, int] | None] = (-1, None)  # the last look past a block
     while True:
-        found = _next_block(reader, end)
+        found = ahead[1] if ahead[0] == end else _next_block(reader, end)
         if found is None:
             break
-        w, at = found
+        w, at, gap = found
         last = _end_of(reader, w, at + len(w))
-        if last < 0 or _next_block(reader, last) is None:
-            got.append((at, None, frozenset()))  # the last block: lark's, not read here
+        ahead = (last, _next_block(reader, last) if last >= 0 else None)
+        if ahead[1] is None:
+            got.append((at, None, frozenset(), gap))  # the last block: lark's, not read here
             break
         try:
             block, end = reader.block(w, at)
         except _Bail:
-            got.append((at, None, frozenset()))
+            got.append((at, None, frozenset(), gap))
             break
-        got.append((at, block, frozenset(reader.spellings)))
+        got.append((at, block, frozenset(reader.spellings), gap))
     if len(got) < 2:
         return got[0][0] if got else end
-    lo, hi = got[0][0], got[-1][0]
-    taken.blanks.append((lo, hi, -1, ""))
-    for at, inner, spellings in got[:-1]:
+    starts: list[int] = []
+    stops: list[int] = []
+    for i, (at, inner, spellings, _) in enumerate(got[:-1]):
         assert inner is not None
+        stop = got[i + 1][3]
+        taken.blanks.append((at, stop, -1, ""))
         taken.blocks.append((at, inner, spellings))
+        starts.append(at)
+        stops.append(stop)
     for body, offset in reader.comments:
-        if lo <= offset < hi:
+        i = bisect_right(starts, offset) - 1
+        if i >= 0 and offset < stops[i]:
             taken.comments[offset] = body
-    return hi
+    return got[-1][0]
 
 
 def _decl_run(reader: _BlockReader, kind: VarKind, start: int, taken: _Taken) -> None:
