@@ -106,6 +106,15 @@ class _BlockReader(_Reader):
         self.seek(pos)
         self.at_statement(pos)
 
+    def look_past(self, at: int) -> tuple[str, int, int] | None:
+        """_next_block from ``at``, the line count kept where it was: going back to a
+        statement recounts from the start of its line (on a file of one line, from the
+        start of the text)."""
+        kept = (self.base, self.base_line, self.base_ls, self.next_nl, self.cursor)
+        found = _next_block(self, at)
+        self.base, self.base_line, self.base_ls, self.next_nl, self.cursor = kept
+        return found
+
     def after(self) -> int:
         """Where the next token starts, or where the last one ended."""
         return self.la[1] if self.la is not None else self.pos
@@ -384,7 +393,7 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
             break
         w, at, gap = found
         last = _end_of(reader, w, at + len(w))
-        ahead = (last, _next_block(reader, last) if last >= 0 else None)
+        ahead = (last, reader.look_past(last) if last >= 0 else None)
         if ahead[1] is None:
             got.append((at, None, frozenset(), gap))  # the last block: lark's, not read here
             break
