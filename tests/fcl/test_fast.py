@@ -382,6 +382,9 @@ def _block(rng: random.Random, k: int) -> str:
 
 BLOCK_MISTAKES = [
     ("TERM t0 := (0, 1) (1, 0);", "TERM t0 := ;"),  # a bad TERM
+    ("(0, 1) (1, 0);", "(0, 1) (1, 0),;"),  # a ',' after the last point
+    ("RULE 1 :", "RULE END_RULEBLOCK"),  # a label lark reads: its block does not end there
+    ("RULE 1 : IF a IS lo THEN y IS lo;", "RULE // 1 : IF a IS lo THEN y IS lo;\n"),
     ("END_FUZZIFY", ""),  # a missing END_FUZZIFY
     ("END_DEFUZZIFY", "END_FUZZIFY"),
     ("METHOD : COG;", "METHOD : NOPE;"),
@@ -469,6 +472,56 @@ def test_fast_reader_takes_runs_of_small_blocks(name: str) -> None:
             broken = _many(block).replace(block.format(k=20), block.replace(old, new, 1).format(k=20))
             assert_same(broken)
             assert_same(_many(block, 3).replace(block.format(k=1), block.replace(old, new, 1).format(k=1)))
+
+
+MUTATIONS = [
+    "(",
+    ")",
+    ";",
+    ":",
+    ":=",
+    ",",
+    "-",
+    "x",
+    "1e999",
+    "TERM",
+    "RULE",
+    "END_FUZZIFY",
+    "END_VAR",
+    "END_RULEBLOCK",
+    "END_FUNCTION_BLOCK",
+    "FUNCTION_BLOCK",
+    "FUZZIFY",
+    "VAR_INPUT",
+    "(*",
+    "*)",
+    "//",
+    "\n",
+    "RANGE (0..1);",
+    "METHOD : COG;",
+    "DEFAULT := NC;",
+    "OPTIONS",
+    "END_OPTIONS",
+]
+
+
+@pytest.mark.parametrize("name", sorted(SMALL_BLOCKS))
+def test_same_model_on_mutated_runs_of_blocks(name: str) -> None:
+    """Tokens inserted and text deleted anywhere in a run of small blocks."""
+    rng = random.Random(name)
+    base = _many(SMALL_BLOCKS[name], 6) + _many(SMALL_BLOCKS[name], 4).replace(
+        "FUNCTION_BLOCK f", "FUNCTION_BLOCK g"
+    )
+    for _ in range(150):
+        text = base
+        for _ in range(rng.choice([1, 1, 2])):
+            p = rng.randrange(len(text))
+            if rng.random() < 0.3:
+                text = text[:p] + text[p + rng.randrange(1, 10) :]
+            else:
+                text = text[:p] + " " + rng.choice(MUTATIONS) + " " * rng.randrange(2) + text[p:]
+        got, want = both(text)
+        assert got == want, text
 
 
 def test_runs_of_blocks_go_on_into_the_next_function_block() -> None:

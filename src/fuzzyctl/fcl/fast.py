@@ -457,6 +457,8 @@ class _TermReader(_Reader):
                 if k == PUNCT and w == ",":
                     self.next()
                     k, _, _, w = self.peek()
+                    if not (k == PUNCT and w == "("):
+                        raise _Bail  # a ',' after the last point: lark reports it
                 if not (k == PUNCT and w == "("):
                     break
                 _, p, _, _ = self.next()

@@ -379,8 +379,11 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
     where the search for the next run goes on."""
     if word.startswith("VAR"):
         _decl_run(reader, VarKind(word), start + len(word), taken)
-    end = _end_of(reader, word, start + len(word))
-    if end < 0:
+    try:
+        # read, though lark reads it: its END may not end it (RULE END_RULEBLOCK is a rule
+        # labelled END_RULEBLOCK), and lark must leave it as it leaves a block read here
+        _, end = reader.block(word, start)
+    except _Bail:
         return start + len(word)
     reader.comments = []
     # (offset, the block or None when lark reads it, spellings, where the text after the
