@@ -557,3 +557,15 @@ def test_fast_reader_takes_runs_of_declarations() -> None:
     assert_same(text.replace("v25 : REAL;", "v25 (* c *) : REAL; // d"))
     assert_same(text.replace("v25 : REAL;", "v25 : REAL; v25 : REAL;"))
     assert_same(text.replace("v25 : REAL;", "v 25 : REAL;"))
+
+
+def test_declarations_after_a_run_of_blocks() -> None:
+    """A VAR block ending a run of blocks: lark reads it, the fast reader its declarations;
+    the comments of both runs kept."""
+    decls = "".join(f"v{k} : REAL; (* d{k} *)\n" for k in range(20))
+    block = SMALL_BLOCKS["fuzzify"].replace("END_FUZZIFY", "END_FUZZIFY (* c{k} *)")
+    text = _many(block, 6).replace("END_FUNCTION_BLOCK", f"VAR_INPUT {decls}END_VAR END_FUNCTION_BLOCK")
+    result = read_blocks(text)
+    assert result is not None and len(result.blocks) == 7 and len(result.decls) == 18
+    assert len(result.comments) == 24
+    assert_same(text)

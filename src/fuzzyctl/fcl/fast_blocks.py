@@ -377,19 +377,23 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
     """Read the run of blocks from ``start`` (the first, lark's); keep its inner blocks.
     A run goes on into the next FUNCTION_BLOCK: lark reads the words between.  Returns
     where the search for the next run goes on."""
+    end = -1
     if word.startswith("VAR"):
-        _decl_run(reader, VarKind(word), start + len(word), taken)
-    try:
-        # read, though lark reads it: its END may not end it (RULE END_RULEBLOCK is a rule
-        # labelled END_RULEBLOCK), and lark must leave it as it leaves a block read here
-        _, end = reader.block(word, start)
-    except _Bail:
-        return start + len(word)
+        end = _decl_run(reader, VarKind(word), start + len(word), taken)
+    if end < 0:
+        try:
+            # read, though lark reads it: its END may not end it (RULE END_RULEBLOCK is a
+            # rule labelled END_RULEBLOCK), and lark must leave it as it leaves a block read
+            # here
+            _, end = reader.block(word, start)
+        except _Bail:
+            return start + len(word)
     reader.comments = []
     # (offset, the block or None when lark reads it, spellings, where the text after the
     # block before it ends)
     got: list[tuple[int, _Block | None, frozenset[str], int]] = []
     ahead: tuple[int, tuple[str, int, int] | None] = (-1, None)  # the last look past a block
+    resume = end
     while True:
         found = ahead[1] if ahead[0] == end else _next_block(reader, end)
         if found is None:
@@ -397,17 +401,32 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
         w, at, gap = found
         last = _end_of(reader, w, at + len(w))
         ahead = (last, reader.look_past(last) if last >= 0 else None)
-        if ahead[1] is None:
-            got.append((at, None, frozenset(), gap))  # the last block: lark's, not read here
+        if ahead[1] is None:  # the last block: lark's, not read here (nor again as a first)
+            got.append((at, None, frozenset(), gap))
+            if w.startswith("VAR"):
+                kept = reader.comments  # those of this run
+                _decl_run(reader, VarKind(w), at + len(w), taken)
+                reader.comments = kept
+            resume = last if last >= 0 else at + len(w)
             break
         try:
             block, end = reader.block(w, at)
         except _Bail:
             got.append((at, None, frozenset(), gap))
+            resume = at + len(w)
             break
         got.append((at, block, frozenset(reader.spellings), gap))
+        resume = end
     if len(got) < 2:
-        return got[0][0] if got else end
+        return resume
+    _keep(reader, got, taken)
+    return resume
+
+
+def _keep(
+    reader: _BlockReader, got: list[tuple[int, _Block | None, frozenset[str], int]], taken: _Taken
+) -> None:
+    """Blank and keep the inner blocks of a run (all but its last) and their comments."""
     starts: list[int] = []
     stops: list[int] = []
     for i, (at, inner, spellings, _) in enumerate(got[:-1]):
@@ -421,19 +440,21 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
         i = bisect_right(starts, offset) - 1
         if i >= 0 and offset < stops[i]:
             taken.comments[offset] = body
-    return got[-1][0]
 
 
-def _decl_run(reader: _BlockReader, kind: VarKind, start: int, taken: _Taken) -> None:
-    """The run of declarations after the VAR keyword ending at ``start``."""
+def _decl_run(reader: _BlockReader, kind: VarKind, start: int, taken: _Taken) -> int:
+    """The run of declarations after the VAR keyword ending at ``start``; returns where
+    the block ends when all of it was read (after END_VAR), else -1."""
     reader.comments = []
     got: list[tuple[int, list[Variable]]] = []
     at = start
+    end = -1
     while True:
         reader.go(at)
         try:
-            k, a, _, u = reader.peek()
+            k, a, b, u = reader.peek()
             if k != WORD or u in KEYWORDS:
+                end = b if k == WORD and u == "END_VAR" else -1
                 break
             reader.at_statement(a)
             got.append((a, reader.decl(kind, a)))
@@ -441,13 +462,14 @@ def _decl_run(reader: _BlockReader, kind: VarKind, start: int, taken: _Taken) ->
             break
         at = reader.after()
     if len(got) < MIN_RUN:
-        return
+        return end
     lo, hi = got[1][0], got[-1][0]
     taken.blanks.append((lo, hi, -1, ""))
     taken.decls.extend(got[1:-1])
     for body, offset in reader.comments:
         if lo <= offset < hi:
             taken.comments[offset] = body
+    return end
 
 
 def read_blocks(text: str) -> FastResult | None:
