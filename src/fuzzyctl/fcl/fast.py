@@ -84,6 +84,14 @@ _SIMPLE_RULE = re.compile(
 )
 # The rest of a point ``(x, y)`` after its '(' when both are numbers.
 _POINT_REST = re.compile(rf"[ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
+# The most common TERM, on one line with spaces only: points (short of SUBSTITUTE_MIN) or
+# one number, read with one match.
+_SIMPLE_TERM = re.compile(
+    rf"TERM[ \t]+({_NAME})[ \t]*:=[ \t]*((?:\([ \t]*{_NUMBER}[ \t]*,[ \t]*{_NUMBER}[ \t]*\)[ \t]*)++"
+    rf"|{_NUMBER})[ \t]*;",
+    re.I,
+)
+_POINT = re.compile(rf"\([ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
 _PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
 _WORD_CHAR = re.compile(r"\w")
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
@@ -443,6 +451,9 @@ class _TermReader(_Reader):
         self.cond = None
         if self.quick_only:
             raise _Bail
+        m = _SIMPLE_TERM.match(self.text, self.pos) if self.la is None else None
+        if m is not None and m.group(1).upper() not in KEYWORDS and m.end(2) - m.start(2) < SUBSTITUTE_MIN:
+            return self.simple(m), None
         _, t0, _ = self.keyword("TERM")
         name, _, _ = self.word()
         self.punct(":=")
@@ -475,6 +486,22 @@ class _TermReader(_Reader):
         end = self.punct(";") + 1
         self.cond = part
         return Term(name, mf, self.span(t0, end)), spelling
+
+    def simple(self, m: re.Match[str]) -> Term:
+        """The TERM matched by _SIMPLE_TERM (one line: columns are offsets shifted)."""
+        line, col = self.lc(m.start())
+        shift = col - m.start()
+        mf: MembershipFunction
+        if m.group(2).startswith("("):
+            points = []
+            for p in _POINT.finditer(self.text, m.start(2), m.end(2)):
+                x, y = self.number(*p.span(1)), self.number(*p.span(2))
+                points.append(Point(x, y, Span(line, p.start() + shift, line, p.end() + shift)))
+            mf = PointsMF(tuple(points))
+        else:
+            mf = SingletonMF(self.number(*m.span(2)))
+        self.seek(m.end())
+        return Term(m.group(1), mf, Span(line, col, line, m.end() + shift))
 
     def point(self, start: int) -> Point:
         m = _POINT_REST.match(self.text, self.pos) if self.la is None else None
