@@ -128,11 +128,55 @@ def _fcl_more(shape: str, size: int) -> str:
             "END_FUNCTION_BLOCK\n",
             size,
         )
+    return _fcl_blocks(shape, size)
+
+
+def _fcl_blocks(shape: str, size: int) -> str:
+    """FCL shapes of very many small blocks or declarations (little for the fast reader's
+    runs of RULE and TERM statements)."""
+    no_rules = FCL_HEAD.replace("RULEBLOCK r\nAND : MIN;\n", "")
+    if shape == "defuzzify":  # very many small DEFUZZIFY blocks
+        block = "DEFUZZIFY w{k} TERM lo := 0; TERM hi := 1; METHOD : COGS; DEFAULT := 0; END_DEFUZZIFY\n"
+        return _repeat(no_rules, lambda k: block.format(k=k), "END_FUNCTION_BLOCK\n", size)
+    if shape == "var-input":  # one VAR_INPUT block declaring very many variables
+        return _repeat(
+            "FUNCTION_BLOCK big\nVAR_INPUT\n",
+            lambda k: f"v{k} : REAL;\n",
+            "END_VAR\n" + FCL_HEAD.split("\n", 1)[1] + FCL_TAIL,
+            size,
+        )
+    if shape == "ruleblocks":  # very many RULEBLOCKs of one or two rules
+        return _repeat(
+            no_rules,
+            lambda k: (
+                f"RULEBLOCK r{k}\nRULE 1 : IF a IS lo THEN y IS lo;\n"
+                + ("RULE 2 : IF b IS hi THEN y IS hi;\n" if k % 2 else "")
+                + "END_RULEBLOCK\n"
+            ),
+            "END_FUNCTION_BLOCK\n",
+            size,
+        )
+    if shape == "fblocks":  # very many small FUNCTION_BLOCKs
+        small = FCL_HEAD.replace("FUNCTION_BLOCK big", "FUNCTION_BLOCK f{k}")
+        small += "RULE 1 : IF a IS lo AND b IS hi THEN y IS lo;\n" + FCL_TAIL
+        return _repeat("", lambda k: small.format(k=k), "", size)
     return _garbage(size)
 
 
 #: Shapes only FCL has (adversarial inputs for the fast reader, fcl/fast.py).
-FCL_SHAPES = ("and-chain", "nest-99", "not-paren", "unclosed", "comments", "points", "fuzzify")
+FCL_SHAPES = (
+    "and-chain",
+    "nest-99",
+    "not-paren",
+    "unclosed",
+    "comments",
+    "points",
+    "fuzzify",
+    "defuzzify",
+    "var-input",
+    "ruleblocks",
+    "fblocks",
+)
 
 
 FIS_HEAD = """[System]
@@ -649,7 +693,7 @@ def main() -> int:
     print(
         f"load average: {os.getloadavg()[0]:.1f} (the goal is judged on CPU time when the machine is shared)"
     )
-    print(f"{'format':6} {'shape':9} {'mode':5} {'MB':>6} {'wall s':>7} {'CPU s':>6} {'RSS MB':>7} exit")
+    print(f"{'format':6} {'shape':10} {'mode':5} {'MB':>6} {'wall s':>7} {'CPU s':>6} {'RSS MB':>7} exit")
     with tempfile.TemporaryDirectory() as tmp:
         for fmt in args.formats.split(","):
             ext, make = FORMATS[fmt]
@@ -667,7 +711,7 @@ def main() -> int:
                         shown = "hung" if code is None else str(code)
                         flag = "" if ok else "   <-- over the goal"
                         print(
-                            f"{fmt:6} {shape:9} {mode:5} {mb:6.1f} {wall:7.2f} {cpu:6.2f} {rss:7.0f} "
+                            f"{fmt:6} {shape:10} {mode:5} {mb:6.1f} {wall:7.2f} {cpu:6.2f} {rss:7.0f} "
                             f"{shown}{flag}",
                             flush=True,
                         )

@@ -15,6 +15,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from fuzzyctl.fcl import fast
+from fuzzyctl.fcl.fast_blocks import read_blocks
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source, read_source
 from tests.extras import extra_files
@@ -335,3 +336,236 @@ def test_long_point_lists(name: str, substitute_min: int) -> None:
     if name == "long" and substitute_min:
         result = fast.read_runs(alone + TAIL)
         assert result is not None and len(result.points) == 1
+
+
+# --------------------------------------------------------------------------- whole blocks
+
+SEP = [" ", "\n", "\n\n", " (* between *) ", "\n// line\n", " /* a\n b */ ", "\t", "\r\n"]
+
+
+def _sep(rng: random.Random) -> str:
+    return rng.choice(SEP) if rng.random() < 0.4 else "\n"
+
+
+def _small_term(rng: random.Random, k: int) -> str:
+    mf = rng.choice(["(0, 1) (1, 0)", "0.5", "TRIAN 0 1 2", "trap 0 1 2 3", "(x, 0)", "gauss 1 2"])
+    return f"TERM t{k} := {mf};"
+
+
+def _block(rng: random.Random, k: int) -> str:
+    kind = rng.choice(["FUZZIFY", "FUZZIFY", "DEFUZZIFY", "DEFUZZIFY", "RULEBLOCK", "VAR_OUTPUT", "VAR"])
+    parts: list[str] = []
+    if kind == "FUZZIFY":
+        parts = [f"FUZZIFY v{k}"] + [_small_term(rng, i) for i in range(rng.randrange(0, 4))]
+        if rng.random() < 0.3:
+            parts.insert(rng.randrange(1, len(parts) + 1), "RANGE := (0 .. 10);")
+    elif kind == "DEFUZZIFY":
+        parts = [f"DEFUZZIFY w{k}"] + [_small_term(rng, i) for i in range(rng.randrange(0, 3))]
+        extra = ["METHOD : COG;", "METHOD : cogs;", "DEFAULT := 0;", "DEFAULT := NC;", "ACCU : MAX;",
+                 "RANGE (0, 1);", "METHOD : none;"]  # fmt: skip
+        for item in rng.sample(extra, rng.randrange(0, 3)):
+            parts.insert(rng.randrange(1, len(parts) + 1), item)
+    elif kind == "RULEBLOCK":
+        parts = [f"RULEBLOCK r{k}" if rng.random() < 0.8 else "RULEBLOCK"]
+        parts += rng.sample(["AND : MIN;", "OR : MAX;", "ACT : PROD;", "ACCU : SUM;"], rng.randrange(0, 3))
+        parts += [f"RULE {i} : IF a IS lo AND b IS t{i} THEN y IS hi;" for i in range(rng.randrange(0, 3))]
+        rng.shuffle(parts[1:])
+    else:
+        parts = [kind] + [
+            rng.choice([f"o{k}_{i} : REAL;", f"p{k}_{i}, q{k}_{i} : REAL;", f"i{k}_{i} : INT := 3;",
+                        f"z{k}_{i} : REAL; RANGE(0 .. 1);", f"f{k}_{i} : BOOL := TRUE;"])
+            for i in range(rng.randrange(0, 5))
+        ]  # fmt: skip
+    end = {"FUZZIFY": "END_FUZZIFY", "DEFUZZIFY": "END_DEFUZZIFY", "RULEBLOCK": "END_RULEBLOCK"}
+    return " ".join(parts) + " " + end.get(kind, "END_VAR")
+
+
+BLOCK_MISTAKES = [
+    ("TERM t0 := (0, 1) (1, 0);", "TERM t0 := ;"),  # a bad TERM
+    ("(0, 1) (1, 0);", "(0, 1) (1, 0),;"),  # a ',' after the last point
+    ("RULE 1 :", "RULE END_RULEBLOCK"),  # a label lark reads: its block does not end there
+    ("RULE 1 : IF a IS lo THEN y IS lo;", "RULE // 1 : IF a IS lo THEN y IS lo;\n"),
+    ("END_FUZZIFY", ""),  # a missing END_FUZZIFY
+    ("END_DEFUZZIFY", "END_FUZZIFY"),
+    ("METHOD : COG;", "METHOD : NOPE;"),
+    ("METHOD : COG;", "METHOD : COG"),
+    ("DEFAULT := 0;", "DEFAULT = 0;"),
+    ("RANGE := (0 .. 10);", "RANGE := (10 .. 0);"),
+    ("RANGE := (0 .. 10);", "RANGE := (1 .. 1); RANGE (0 .. 2);"),
+    ("AND : MIN;", "AND : MIN; AND : PROD;"),
+    ("ACCU : MAX;", "ACCU : MAX; ACCU : MAX;"),
+    ("TRIAN 0 1 2", "TRIAN 0 1"),
+    ("0.5;", "1e999;"),
+    (" : REAL;", " : REAL"),
+    ("FUZZIFY v", "FUZZIFY rear v"),
+    ("THEN y IS hi;", "THEN y IS ;"),
+    ("END_VAR", "END_VAR END_VAR"),
+    # between FUNCTION_BLOCKs (a run of blocks goes on into the next one)
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK h-1"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK RULE"),
+    ("FUNCTION_BLOCK h", "FUNCTION_BLOCK h;"),
+    ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK h", "FUNCTION_BLOCK h"),
+    ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK h", "END_FUNCTION_BLOCK (* c *) x FUNCTION_BLOCK h"),
+    ("END_FUNCTION_BLOCK\n", "END_FUNCTION_BLOCK\nx"),
+]
+
+
+def _blocks_document(rng: random.Random) -> str:
+    decls = "".join(
+        f"{rng.choice(['a', 'b', 'c'])}{k} : REAL;{_sep(rng)}" for k in range(rng.randrange(0, 12))
+    )
+    blocks = [_block(rng, k) for k in range(rng.randrange(1, 14))]
+    if rng.random() < 0.2:  # the same block twice
+        i = rng.randrange(len(blocks))
+        blocks.insert(i, blocks[i])
+    body = "".join(b + _sep(rng) for b in blocks)
+    text = (
+        f"FUNCTION_BLOCK g\nVAR_INPUT a : REAL; b : REAL;\n{decls}END_VAR\nVAR_OUTPUT y : REAL; END_VAR\n"
+        f"{body}END_FUNCTION_BLOCK\n"
+    )
+    for _ in range(rng.choice([0, 0, 1, 2])):
+        text += "FUNCTION_BLOCK h\n" + "".join(b + _sep(rng) for b in blocks[::-1]) + "END_FUNCTION_BLOCK\n"
+    if rng.random() < 0.4:
+        old, new = rng.choice(BLOCK_MISTAKES)
+        places = [i for i in range(len(text)) if text.startswith(old, i)]
+        if places:
+            i = rng.choice(places)
+            text = text[:i] + new + text[i + len(old) :]
+    if rng.random() < 0.2:  # the whole file on one line
+        text = text.replace("// line\n", "(* line *)").replace("\r\n", " ").replace("\n", " ")
+    return text
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.integers(0, 2**32 - 1))
+def test_same_model_on_generated_runs_of_blocks(seed: int) -> None:
+    assert_same(_blocks_document(random.Random(seed)))
+
+
+def _many(block: str, n: int = 40) -> str:
+    head = "FUNCTION_BLOCK f VAR_INPUT a, b : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR\n"
+    return head + "".join(block.format(k=k) for k in range(n)) + "END_FUNCTION_BLOCK\n"
+
+
+SMALL_BLOCKS = {
+    "fuzzify": "FUZZIFY v{k} TERM lo := (0, 1) (1, 0); TERM hi := (0, 0) (1, 1); END_FUZZIFY\n",
+    "defuzzify": "DEFUZZIFY w{k} TERM lo := 0; TERM hi := 1; METHOD : COGS; DEFAULT := 0; END_DEFUZZIFY\n",
+    "ruleblocks": "RULEBLOCK r{k} AND : MIN; RULE 1 : IF a IS lo THEN y IS lo; END_RULEBLOCK\n",
+    "var": "VAR_OUTPUT o{k} : REAL; p{k} : REAL := 1; END_VAR\n",
+}
+
+
+@pytest.mark.parametrize("name", sorted(SMALL_BLOCKS))
+def test_fast_reader_takes_runs_of_small_blocks(name: str) -> None:
+    text = _many(SMALL_BLOCKS[name])
+    result = read_blocks(text)
+    # the VAR_OUTPUT block and all the small blocks but the last (VAR_INPUT is the first)
+    assert result is not None and len(result.blocks) == 40
+    assert_same(text)
+    assert_same(text.replace("\n", " "))  # on one line
+    assert_same(text.replace("\n", "\n(* c *) // d\n"))  # comments between blocks
+    # a mistake in a middle block: lark reads that block, with its place
+    for old, new in [*BLOCK_MISTAKES, ("{k} ", "20 "), (" {k}", " AND")]:
+        block = SMALL_BLOCKS[name]
+        if old in block:
+            broken = _many(block).replace(block.format(k=20), block.replace(old, new, 1).format(k=20))
+            assert_same(broken)
+            assert_same(_many(block, 3).replace(block.format(k=1), block.replace(old, new, 1).format(k=1)))
+
+
+MUTATIONS = [
+    "(",
+    ")",
+    ";",
+    ":",
+    ":=",
+    ",",
+    "-",
+    "x",
+    "1e999",
+    "TERM",
+    "RULE",
+    "END_FUZZIFY",
+    "END_VAR",
+    "END_RULEBLOCK",
+    "END_FUNCTION_BLOCK",
+    "FUNCTION_BLOCK",
+    "FUZZIFY",
+    "VAR_INPUT",
+    "(*",
+    "*)",
+    "//",
+    "\n",
+    "RANGE (0..1);",
+    "METHOD : COG;",
+    "DEFAULT := NC;",
+    "OPTIONS",
+    "END_OPTIONS",
+]
+
+
+@pytest.mark.parametrize("name", sorted(SMALL_BLOCKS))
+def test_same_model_on_mutated_runs_of_blocks(name: str) -> None:
+    """Tokens inserted and text deleted anywhere in a run of small blocks."""
+    rng = random.Random(name)
+    base = _many(SMALL_BLOCKS[name], 6) + _many(SMALL_BLOCKS[name], 4).replace(
+        "FUNCTION_BLOCK f", "FUNCTION_BLOCK g"
+    )
+    for _ in range(150):
+        text = base
+        for _ in range(rng.choice([1, 1, 2])):
+            p = rng.randrange(len(text))
+            if rng.random() < 0.3:
+                text = text[:p] + text[p + rng.randrange(1, 10) :]
+            else:
+                text = text[:p] + " " + rng.choice(MUTATIONS) + " " * rng.randrange(2) + text[p:]
+        got, want = both(text)
+        assert got == want, text
+
+
+def test_runs_of_blocks_go_on_into_the_next_function_block() -> None:
+    fb = (
+        "FUNCTION_BLOCK f{k} VAR_INPUT a : REAL; END_VAR VAR_OUTPUT y : REAL; END_VAR\n"
+        "FUZZIFY a TERM lo := 0; END_FUZZIFY DEFUZZIFY y TERM lo := 0; END_DEFUZZIFY\n"
+        "RULEBLOCK r RULE 1 : IF a IS lo THEN y IS lo; END_RULEBLOCK END_FUNCTION_BLOCK\n"
+    )
+    text = "".join(fb.format(k=k) for k in range(10))
+    result = read_blocks(text)
+    assert result is not None and len(result.blocks) == 48  # all but the first and the last
+    assert_same(text)
+    assert_same(text.replace("\n", " "))
+    for old, new in [
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK f-5"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK (* c *) f5 // d\n"),
+        ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK f5", "FUNCTION_BLOCK f5"),
+        ("END_FUNCTION_BLOCK\nFUNCTION_BLOCK f5", "END_FUNCTION_BLOCK END_FUNCTION_BLOCK"),
+        ("FUNCTION_BLOCK f5", "FUNCTION_BLOCK f4"),  # the same name twice
+    ]:
+        assert_same(text.replace(old, new))
+    assert_same(text + "trailing text")
+
+
+def test_fast_reader_takes_runs_of_declarations() -> None:
+    decls = "".join(f"v{k} : REAL;\n" for k in range(50)) + "x, y2 : REAL := 2; RANGE (0 .. 3);\n"
+    text = f"FUNCTION_BLOCK f VAR_INPUT\n{decls}z : BOOL := TRUE;\nEND_VAR END_FUNCTION_BLOCK\n"
+    result = read_blocks(text)
+    assert result is not None and len(result.decls) == 50
+    assert_same(text)
+    assert_same(text.replace("v25 : REAL;", "v25 : REAL"))
+    assert_same(text.replace("v25 : REAL;", "v25 (* c *) : REAL; // d"))
+    assert_same(text.replace("v25 : REAL;", "v25 : REAL; v25 : REAL;"))
+    assert_same(text.replace("v25 : REAL;", "v 25 : REAL;"))
+
+
+def test_declarations_after_a_run_of_blocks() -> None:
+    """A VAR block ending a run of blocks: lark reads it, the fast reader its declarations;
+    the comments of both runs kept."""
+    decls = "".join(f"v{k} : REAL; (* d{k} *)\n" for k in range(20))
+    block = SMALL_BLOCKS["fuzzify"].replace("END_FUZZIFY", "END_FUZZIFY (* c{k} *)")
+    text = _many(block, 6).replace("END_FUNCTION_BLOCK", f"VAR_INPUT {decls}END_VAR END_FUNCTION_BLOCK")
+    result = read_blocks(text)
+    assert result is not None and len(result.blocks) == 7 and len(result.decls) == 18
+    assert len(result.comments) == 24
+    assert_same(text)

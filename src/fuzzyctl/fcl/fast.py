@@ -29,6 +29,7 @@ import math
 import re
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass, field
+from typing import Any
 
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.fast_conditions import (
@@ -58,6 +59,7 @@ from fuzzyctl.model import (
     SingletonMF,
     Span,
     Term,
+    Variable,
 )
 
 # lark's NUMBER (fcl.lark), its COMMENT_* terminals and its WS.
@@ -82,6 +84,14 @@ _SIMPLE_RULE = re.compile(
 )
 # The rest of a point ``(x, y)`` after its '(' when both are numbers.
 _POINT_REST = re.compile(rf"[ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
+# The most common TERM, on one line with spaces only: points (short of SUBSTITUTE_MIN) or
+# one number, read with one match.
+_SIMPLE_TERM = re.compile(
+    rf"TERM[ \t]+({_NAME})[ \t]*:=[ \t]*((?:\([ \t]*{_NUMBER}[ \t]*,[ \t]*{_NUMBER}[ \t]*\)[ \t]*)++"
+    rf"|{_NUMBER})[ \t]*;",
+    re.I,
+)
+_POINT = re.compile(rf"\([ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
 _PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
 _WORD_CHAR = re.compile(r"\w")
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
@@ -124,11 +134,29 @@ class FastResult:
     #: Long point lists of the TERMs that lark reads, read here instead: lark reads ``0`` in
     #: their place.  By the (line, column) of the TERM keyword.
     points: dict[tuple[int, int], PointsMF] = field(default_factory=dict)
+    #: Whole blocks read by fuzzyctl.fcl.fast_blocks (FuzzifyBlock, DefuzzifyBlock,
+    #: RuleBlock, or the variables of a VAR block), by offset; the shape spellings of
+    #: their terms; the variables of the declarations it took inside VAR blocks.
+    blocks: list[tuple[int, Any]] = field(default_factory=list)
+    block_spellings: list[tuple[int, str]] = field(default_factory=list)
+    decls: list[tuple[int, list[Variable]]] = field(default_factory=list)
 
     def between(self, start: int, end: int) -> list[tuple[int, Rule | Term, str | None]]:
         """The statements read here whose offset lies in ``[start, end)``."""
         lo, hi = bisect_left(self.offsets, start), bisect_left(self.offsets, end)
         return list(zip(self.offsets[lo:hi], self.items[lo:hi], self.spellings[lo:hi], strict=True))
+
+    def blocks_between(self, start: int, end: int) -> list[Any]:
+        """The blocks read here whose offset lies in ``[start, end)``."""
+        lo = bisect_left(self.blocks, start, key=_offset)
+        hi = bisect_left(self.blocks, end, key=_offset)
+        return [b for _, b in self.blocks[lo:hi]]
+
+    def decls_between(self, start: int, end: int) -> list[Variable]:
+        """The variables of the declarations read here whose offset lies in ``[start, end)``."""
+        lo = bisect_left(self.decls, start, key=_offset)
+        hi = bisect_left(self.decls, end, key=_offset)
+        return [v for _, vs in self.decls[lo:hi] for v in vs]
 
     _at: tuple[int, int, int] = (0, 1, 0)  # an offset, its line, where that line starts
 
@@ -153,12 +181,18 @@ class FastResult:
 
     def spellings_before(self, end: int | None) -> set[str]:
         n = len(self.offsets) if end is None else bisect_left(self.offsets, end)
-        return {s for s in self.spellings[:n] if s is not None}
+        found = {s for s in self.spellings[:n] if s is not None}
+        found.update(s for at, s in self.block_spellings if end is None or at < end)
+        return found
 
     def comments_before(self, end: int | None) -> list[FastComment]:
         if end is None:
             return list(self.comments)
         return self.comments[: bisect_right([c.offset for c in self.comments], end - 1)]
+
+
+def _offset(entry: tuple[int, Any]) -> int:
+    return entry[0]
 
 
 _Part = tuple[int, int, "Condition | PointsMF | None", int]
@@ -417,6 +451,9 @@ class _TermReader(_Reader):
         self.cond = None
         if self.quick_only:
             raise _Bail
+        m = _SIMPLE_TERM.match(self.text, self.pos) if self.la is None else None
+        if m is not None and m.group(1).upper() not in KEYWORDS and m.end(2) - m.start(2) < SUBSTITUTE_MIN:
+            return self.simple(m), None
         _, t0, _ = self.keyword("TERM")
         name, _, _ = self.word()
         self.punct(":=")
@@ -431,6 +468,8 @@ class _TermReader(_Reader):
                 if k == PUNCT and w == ",":
                     self.next()
                     k, _, _, w = self.peek()
+                    if not (k == PUNCT and w == "("):
+                        raise _Bail  # a ',' after the last point: lark reports it
                 if not (k == PUNCT and w == "("):
                     break
                 _, p, _, _ = self.next()
@@ -447,6 +486,22 @@ class _TermReader(_Reader):
         end = self.punct(";") + 1
         self.cond = part
         return Term(name, mf, self.span(t0, end)), spelling
+
+    def simple(self, m: re.Match[str]) -> Term:
+        """The TERM matched by _SIMPLE_TERM (one line: columns are offsets shifted)."""
+        line, col = self.lc(m.start())
+        shift = col - m.start()
+        mf: MembershipFunction
+        if m.group(2).startswith("("):
+            points = []
+            for p in _POINT.finditer(self.text, m.start(2), m.end(2)):
+                x, y = self.number(*p.span(1)), self.number(*p.span(2))
+                points.append(Point(x, y, Span(line, p.start() + shift, line, p.end() + shift)))
+            mf = PointsMF(tuple(points))
+        else:
+            mf = SingletonMF(self.number(*m.span(2)))
+        self.seek(m.end())
+        return Term(m.group(1), mf, Span(line, col, line, m.end() + shift))
 
     def point(self, start: int) -> Point:
         m = _POINT_REST.match(self.text, self.pos) if self.la is None else None

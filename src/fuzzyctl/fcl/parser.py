@@ -25,7 +25,8 @@ from lark.exceptions import UnexpectedInput, VisitError
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl import keywords, shapes
-from fuzzyctl.fcl.fast import FastResult, read_runs
+from fuzzyctl.fcl.fast import FastResult
+from fuzzyctl.fcl.fast_blocks import merge_blocks, merge_decls, read_blocks
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.limits import MAX_NESTING, shorten
@@ -455,6 +456,8 @@ class _Builder(Transformer[Token, Any]):
             for name, span in decls.names:
                 where = span if len(decls.names) > 1 else decls.span
                 out.append(Variable(name, kind, decls.data_type, decls.initial, decls.range, where))
+        if self.state.fast is not None and self.state.fast.decls:
+            merge_decls(self.state.fast, children, out)
         return out
 
     # ---------------------------------------------------------------- rules
@@ -556,6 +559,8 @@ class _Builder(Transformer[Token, Any]):
 
     def function_block(self, children: list[Any]) -> FunctionBlock:
         name = next((c for c in children if isinstance(c, str) and not isinstance(c, Token)), None)
+        if self.state.fast is not None and self.state.fast.blocks:
+            children = merge_blocks(self.state.fast, children)
         variables: list[Variable] = []
         for c in children:
             if isinstance(c, list):
@@ -682,7 +687,7 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
     from fuzzyctl.fcl.errors import syntax_diagnostic
 
     state = ParseState(source)
-    state.fast = read_runs(source.text) if fast else None
+    state.fast = read_blocks(source.text) if fast else None
     text = state.fast.text if state.fast is not None else source.text
     if _paren_run(state, text):
         return ParseResult(None, state.diagnostics, source)
