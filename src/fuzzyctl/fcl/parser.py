@@ -10,14 +10,12 @@ syntax errors are translated into human messages by :mod:`fuzzyctl.fcl.errors`.
 from __future__ import annotations
 
 import math
-import os
 import re
 import textwrap
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cache
-from importlib import resources
 from typing import Any, cast
 
 from lark import Lark, Token, Transformer
@@ -27,6 +25,7 @@ from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl import keywords, shapes
 from fuzzyctl.fcl.fast import FastResult
 from fuzzyctl.fcl.fast_blocks import merge_blocks, merge_decls, read_blocks
+from fuzzyctl.fcl.grammar import cached_lark, terminal_names
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.limits import MAX_NESTING, shorten
@@ -580,11 +579,6 @@ class _Builder(Transformer[Token, Any]):
         return Document(tuple(children), self.state.source.path)
 
 
-@cache
-def _grammar() -> str:
-    return resources.files("fuzzyctl.fcl").joinpath("fcl.lark").read_text(encoding="utf-8")
-
-
 _COMMENT_TYPES = ("COMMENT_IEC", "COMMENT_C", "COMMENT_LINE")
 _ACTIVE: list[ParseState] = []
 _LOCK = threading.RLock()
@@ -613,61 +607,12 @@ def _parser() -> Lark:
     lark version and kept in the cache directory (lark's ``cache``); a process only loads
     them.  The transformer is swapped per parse (see parse_source)."""
     callbacks: dict[str, Any] = {name: _on_comment for name in _COMMENT_TYPES}
-    callbacks.update({name: _on_token for name in _terminal_names() if name not in (*_COMMENT_TYPES, "WS")})
-    return _lark(
+    callbacks.update({name: _on_token for name in terminal_names() if name not in (*_COMMENT_TYPES, "WS")})
+    return cached_lark(
         maybe_placeholders=True,
         lexer_callbacks=callbacks,
         transformer=_Builder(ParseState(Source(""))),
     )
-
-
-def _terminal_names() -> list[str]:
-    """The grammar's terminal names (for the lexer callbacks), kept beside the tables."""
-    import hashlib
-    import json
-
-    from lark import __version__ as lark_version
-
-    from fuzzyctl import cache as disk
-
-    key = hashlib.sha256((_grammar() + lark_version).encode()).hexdigest()[:24]
-    path = disk.cache_dir() / "lark" / f"fcl-terminals-{key}.json"
-    try:
-        names = json.loads(path.read_text())
-        if isinstance(names, list) and all(isinstance(n, str) for n in names):
-            return names
-    except (OSError, ValueError):
-        pass
-    names = [t.name for t in _lark().terminals]
-    disk.write_atomic(path, json.dumps(names).encode())
-    return names
-
-
-def _lark(**options: Any) -> Lark:
-    """A Lark parser of the FCL grammar, its analysed tables loaded from (or written to) the
-    on-disk cache; without a writable cache directory they are computed in memory."""
-    import hashlib
-
-    from lark import __version__ as lark_version
-
-    from fuzzyctl import cache as disk
-
-    grammar = _grammar()
-    opts: dict[str, Any] = {"parser": "lalr", "lexer": "contextual", **options}
-    spec = repr((sorted(options), options.get("maybe_placeholders")))
-    key = hashlib.sha256((grammar + lark_version + spec).encode()).hexdigest()[:24]
-    path = disk.cache_dir() / "lark" / f"fcl-{key}.cache"
-    if not path.exists():
-        # lark writes its cache file in place: write it elsewhere and rename it, so that
-        # another process never reads half a file
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            tmp = path.with_name(f".{path.name}.{os.getpid()}.{threading.get_ident()}.tmp")
-            Lark(grammar, cache=str(tmp), **opts)
-            os.replace(tmp, path)
-        except OSError:
-            return Lark(grammar, **opts)
-    return Lark(grammar, cache=str(path), **opts)
 
 
 @dataclass
