@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from fuzzyctl.fcl import keywords
+from fuzzyctl.fcl.errors import CLOSERS
 from fuzzyctl.fcl.fast import (
     _COMMENT,
     _NUMBER,
@@ -51,14 +52,7 @@ from fuzzyctl.model import (
 )
 
 _ITEMS = ("VAR_INPUT", "VAR_OUTPUT", "VAR", "FUZZIFY", "DEFUZZIFY", "RULEBLOCK")
-_END = {
-    "VAR_INPUT": "END_VAR",
-    "VAR_OUTPUT": "END_VAR",
-    "VAR": "END_VAR",
-    "FUZZIFY": "END_FUZZIFY",
-    "DEFUZZIFY": "END_DEFUZZIFY",
-    "RULEBLOCK": "END_RULEBLOCK",
-}
+_END = {item: CLOSERS[item] for item in _ITEMS}
 # Where runs of blocks may start: comments and OPTIONS text are skipped as lark skips them.
 _SCAN = re.compile(rf"({_COMMENT})|\b({'|'.join(_ITEMS)}|OPTIONS|OPTION)\b", re.S | re.I)
 _END_SCAN = {end: re.compile(rf"({_COMMENT})|\b{end}\b", re.S | re.I) for end in set(_END.values())}
