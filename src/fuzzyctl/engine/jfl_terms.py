@@ -149,7 +149,7 @@ def jfl_expr(e: ExprPlan) -> ExprPlan:
     return e
 
 
-#: Java's ``Math`` as fdlibm computes it, where we have it (the other functions: C's libm)
+#: Java's ``Math`` as fdlibm computes it, where we have it (the other functions: numpy's)
 _JAVA_MATH = {"exp": fdlibm.exp, "cos": fdlibm.cos, "pow": fdlibm.pow_}
 
 
