@@ -569,6 +569,27 @@ def _precedence(groups: list[list[Is]]) -> Condition:
     return ors[0] if len(ors) == 1 else Or(tuple(ors), _join(ors[0].span, ors[-1].span))
 
 
+def next_item(text: str, scan: re.Pattern[str], pos: int) -> tuple[str, int, int] | None:
+    """The next keyword ``scan`` looks for at or after ``pos`` (upper case, its start and
+    end), skipping comments and OPTIONS text as the lark lexer does; ``None`` at the end of
+    the text or in an OPTIONS block that is never closed.  ``scan``: group 1 a comment,
+    group 2 the keywords, OPTIONS and OPTION among them."""
+    while True:
+        m = scan.search(text, pos)
+        if m is None:
+            return None
+        if m.lastindex == 1:
+            pos = m.end()
+            continue
+        word = m.group(2).upper()
+        if not word.startswith("OPTION"):
+            return word, m.start(), m.end()
+        body = _OPTIONS_END.match(text, m.end())
+        if body is None:
+            return None
+        pos = body.end()
+
+
 def read_runs(text: str) -> FastResult | None:
     """The runs of plain RULE and TERM statements of ``text``, and the long conditions of
     the rules lark reads (``None`` when there is nothing worth taking from lark)."""
@@ -578,22 +599,10 @@ def read_runs(text: str) -> FastResult | None:
     subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]] = {}
     readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
     pos = misses = 0
-    while True:
-        m = _SCAN.search(text, pos)
-        if m is None:
-            break
-        if m.lastindex == 1:
-            pos = m.end()
-            continue
-        word = m.group(2).upper()
-        if word.startswith("OPTION"):
-            body = _OPTIONS_END.match(text, m.end())
-            if body is None:
-                break
-            pos = body.end()
-            continue
+    while (item := next_item(text, _SCAN, pos)) is not None:
+        word, start, _ = item
         taken = len(blanks)
-        pos = _run(readers[word], word, m.start(), result, blanks, comments, subs)
+        pos = _run(readers[word], word, start, result, blanks, comments, subs)
         misses = 0 if len(blanks) > taken else misses + 1
         if misses > MAX_MISSES:  # a file of statements this reader does not take
             for reader in readers.values():

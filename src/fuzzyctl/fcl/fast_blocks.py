@@ -26,7 +26,6 @@ from fuzzyctl.fcl.errors import CLOSERS
 from fuzzyctl.fcl.fast import (
     _COMMENT,
     _NUMBER,
-    _OPTIONS_END,
     MIN_RUN,
     FastResult,
     _Bail,
@@ -34,6 +33,7 @@ from fuzzyctl.fcl.fast import (
     _Reader,
     _RuleReader,
     _TermReader,
+    next_item,
     read_runs,
 )
 from fuzzyctl.fcl.fast_conditions import KEYWORDS, PUNCT, WORD
@@ -473,21 +473,9 @@ def read_blocks(text: str) -> FastResult | None:
     taken = _Taken()
     reader = _BlockReader(text)
     pos = 0
-    while True:
-        m = _SCAN.search(text, pos)
-        if m is None:
-            break
-        if m.lastindex == 1:
-            pos = m.end()
-            continue
-        word = m.group(2).upper()
-        if word.startswith("OPTION"):
-            body = _OPTIONS_END.match(text, m.end())
-            if body is None:
-                break
-            pos = body.end()
-            continue
-        pos = max(_block_run(reader, word, m.start(), taken), m.end())
+    while (item := next_item(text, _SCAN, pos)) is not None:
+        word, start, end = item
+        pos = max(_block_run(reader, word, start, taken), end)
     if not taken.blanks:
         return read_runs(text)
     taken.blanks.sort()
