@@ -60,6 +60,7 @@ def test_modbus_plc_outputs_match_the_engine_and_survive_a_plc_restart(tmp_path:
         assert rt.instances["valve"].snapshot()["state"] == "run"
         last = plc.float(10)
 
+        stopped_at = time.monotonic()
         plc.stop()  # the PLC goes away mid-run
         inst = rt.instances["valve"]
         wait_until(lambda: inst.snapshot()["state"] == "hold", 10)
@@ -79,12 +80,16 @@ def test_modbus_plc_outputs_match_the_engine_and_survive_a_plc_restart(tmp_path:
         rt.stop()
         plc.close()
     events = assert_log_complete(rt, tmp_path / "events.jsonl")
-    about = [e for e in events if e.kind in SAFETY_KINDS and (e.instance == "valve" or e.link == "plc")]
-    sequence = [e.kind for e in about]
+    # From the stop on: on a loaded machine the first connection may already have been
+    # lost and retried at start-up (a slow first answer), which is not what this checks.
+    about = [
+        e
+        for e in events
+        if e.mono >= stopped_at and e.kind in SAFETY_KINDS and (e.instance == "valve" or e.link == "plc")
+    ]
     # The stopped server answers nothing: the hold starts at the link's deadline (0.25 s)
     # or when the connection is seen lost, whichever comes first.
-    start = min(sequence.index("link-lost"), sequence.index("hold-start"))
-    tail = sequence[start:]
+    tail = [e.kind for e in about]
     assert sorted(tail) == sorted(["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]), tail
     for before, after in [
         ("hold-start", "safe-enter"),
@@ -92,8 +97,8 @@ def test_modbus_plc_outputs_match_the_engine_and_survive_a_plc_restart(tmp_path:
         ("safe-enter", "safe-exit"),
     ]:
         assert tail.index(before) < tail.index(after), tail
-    hold_start = next(e for e in about[start:] if e.kind == "hold-start")
-    safe_enter = next(e for e in about[start:] if e.kind == "safe-enter")
+    hold_start = next(e for e in about if e.kind == "hold-start")
+    safe_enter = next(e for e in about if e.kind == "safe-enter")
     assert safe_enter.mono - hold_start.mono >= 0.3 - 0.02  # not before the hold time
     assert any(e.kind == "link-retry" and e.link == "plc" for e in events)  # reconnect attempts are logged
     assert events[-1].kind == "runtime-stop"
@@ -135,4 +140,4 @@ def test_a_frozen_plc_holds_from_the_missed_deadline_not_from_the_timeout(tmp_pa
     assert hold_start.data["links"] == ["plc"]
     assert hold_start.mono - frozen_at >= 0.2 - 0.02  # not before the deadline
     assert safe_enter.mono - hold_start.mono >= 0.3 - 0.02  # then the hold time
-    assert not any(e.kind == "link-lost" for e in rt.events.since(0))  # the timeout never came
+    assert not any(e.kind == "link-lost" and e.mono >= frozen_at for e in rt.events.since(0))  # no timeout
