@@ -15,6 +15,7 @@ import contextlib
 import dataclasses
 import math
 import os
+import platform
 from collections.abc import Callable, Iterator
 
 import numpy as np
@@ -205,7 +206,8 @@ def test_hotspot_intrinsics_move_jfuzzylogic_itself_exactly_where_we_differ() ->
                 java_moved = _differ(ra[k], rb[k], tol)
                 assert java_moved == _differ(float(got[name][i]), rb[k], tol), (system.seed, name, i)
                 moved += java_moved
-    assert moved > 0
+    if platform.machine().lower() in ("x86_64", "amd64"):
+        assert moved > 0  # the intrinsics exist there; elsewhere both JVM settings may agree
 
 
 # ------------------------------------------------------------------ the corpus
