@@ -52,6 +52,8 @@ app = typer.Typer(
 err_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
+FORCE_HINT = "--force replaces it"
+"""How the commands that write files for the user override a read-only target."""
 
 
 def record_table(title: str, figures: dict[str, str], width: int) -> Table:

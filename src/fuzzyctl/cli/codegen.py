@@ -9,7 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app, err_console
+from fuzzyctl.cli.app import FORCE_HINT, app, err_console
 
 
 class Lang(StrEnum):
@@ -94,11 +94,15 @@ def codegen(
             "an output without RANGE whose terms do not fall to 0.",
         ),
     ] = False,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
+    ] = False,
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
     import fuzzyctl
     from fuzzyctl.codegen import generate_c, generate_st
+    from fuzzyctl.files import check_writable
     from fuzzyctl.formats import write_atomic
 
     if lang is Lang.c and (dialect is not None or lreal):
@@ -114,7 +118,7 @@ def codegen(
     except CodegenError as exc:
         raise typer.BadParameter(str(exc), param_hint="--default") from None
     if lang is Lang.plcopen:
-        _plcopen(source, output, dialect, lreal, single, block, strict, default)
+        _plcopen(source, output, dialect, lreal, single, block, strict, default, force)
         return
     doc = fuzzyctl.load(source, strict=strict)
     report: list[Generated] = []
@@ -135,7 +139,7 @@ def codegen(
             else:
                 typer.echo(text, nl=False)
             return
-        write_atomic(output, text)
+        write_atomic(output, text, force=force, hint=FORCE_HINT)
         _done(as_json, lang, report, [output])
         return
     files = generate_c(
@@ -145,8 +149,11 @@ def codegen(
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")
     out_dir.mkdir(parents=True, exist_ok=True)
+    if not force:  # every file checked before any is written: no half-replaced set
+        for name in files:
+            check_writable(out_dir / name, hint=FORCE_HINT)
     for name, text in files.items():
-        write_atomic(out_dir / name, text)
+        write_atomic(out_dir / name, text, force=force, hint=FORCE_HINT)
     _done(as_json, lang, report, [out_dir / n for n in files])
 
 
@@ -182,6 +189,7 @@ def _plcopen(
     block: str | None,
     strict: bool,
     default: str | None = None,
+    force: bool = False,
 ) -> None:
     """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
     import fuzzyctl
@@ -206,5 +214,5 @@ def _plcopen(
     if output is None:
         typer.echo(xml, nl=False)
         return
-    write_atomic(output, xml)
+    write_atomic(output, xml, force=force, hint=FORCE_HINT)
     err_console.print(f"wrote {output}", markup=False)

@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from fuzzyctl.cli.app import app, err_console
+from fuzzyctl.cli.app import FORCE_HINT, app, err_console
 
 
 @app.command()
@@ -29,6 +29,7 @@ def convert(
             "--lossy", help="Write even when the target cannot express everything; list what was dropped."
         ),
     ] = False,
+    force: Annotated[bool, typer.Option("--force", help="Replace TARGET even when it is read-only.")] = False,
 ) -> None:
     """Convert a fuzzy system to another format.
 
@@ -41,7 +42,7 @@ def convert(
         err_console.print(diagnostic.render(), markup=False)
     fmt = formats.get(to_format) if to_format else formats.for_path(target)
     text, losses = formats.convert(loaded.document, fmt.name, lossy=lossy)
-    formats.write_atomic(target, text)
+    formats.write_atomic(target, text, force=force, hint=FORCE_HINT)
     for note in fmt.notes(loaded.document):
         err_console.print(f"warning: {note}", markup=False)
     for loss in losses:

@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, app, err_console
+from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, app, err_console
 
 if TYPE_CHECKING:
     from fuzzyctl.fcl import LoadResult
@@ -218,6 +218,9 @@ def fmt(
         Path | None, typer.Option("-o", "--output", help="Write to this file instead of standard output.")
     ] = None,
     in_place: Annotated[bool, typer.Option("--in-place", "-i", help="Rewrite FILE itself.")] = False,
+    force: Annotated[
+        bool, typer.Option("--force", help="Replace the file written even when it is read-only.")
+    ] = False,
 ) -> None:
     """Print an FCL file in canonical IEC 61131-7 form (exit 1 if it does not load)."""
     from fuzzyctl.fcl import write
@@ -234,4 +237,4 @@ def fmt(
         return
     from fuzzyctl.files import write_atomic
 
-    write_atomic(target, text)
+    write_atomic(target, text, force=force, hint=FORCE_HINT)
