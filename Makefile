@@ -1,6 +1,6 @@
 # Two commands do everything on a fresh machine (see README):
 #   make run   - create .venv, install, start the studio on the container crane (its simulated plant
-#                ready in the curve recorder) and print its URL
+#                ready in the curve recorder) and print its URL (with the token it requires)
 #   make test  - create .venv, install dev extras and system packages, run ruff, mypy, pytest
 PYTHON ?= python3
 VENV   := .venv
@@ -33,8 +33,8 @@ system-deps:
 	@bash scripts/system-deps.sh
 
 run: $(VENV)/.installed
-	@echo "crane demo: open http://127.0.0.1:$(STUDIO_PORT)/?view=recorder and press Start (simulated process)"
-	$(BIN)/fuzzyctl studio examples/crane.fcl --port $(STUDIO_PORT)
+	@echo "crane demo: open the URL printed below (the curve recorder; it holds the studio's token) and press Start (simulated process)"
+	$(BIN)/fuzzyctl studio examples/crane.fcl --port $(STUDIO_PORT) --view recorder
 
 # The crane demo without a browser: CSV, PNG and HTML in build/sim.
 simulate: $(VENV)/.installed

@@ -29,11 +29,15 @@ def browser_project(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return root
 
 
+STUDIO_TOKEN = "browser-test-token-0123456789"
+
+
 @pytest.fixture(scope="session")
 def studio(browser_project: Path) -> Iterator[str]:
+    """The URL `fuzzyctl studio` would print: with its token, as users open it."""
     import uvicorn
 
-    app = create_app(browser_project)
+    app = create_app(browser_project, token=STUDIO_TOKEN)
     sock = socket.socket()
     sock.bind(("127.0.0.1", 0))
     port = sock.getsockname()[1]
@@ -43,7 +47,7 @@ def studio(browser_project: Path) -> Iterator[str]:
     deadline = time.monotonic() + 10
     while not server.started and time.monotonic() < deadline:
         time.sleep(0.05)
-    yield f"http://127.0.0.1:{port}/"
+    yield f"http://127.0.0.1:{port}/?token={STUDIO_TOKEN}"
     server.should_exit = True
     thread.join(5)
 

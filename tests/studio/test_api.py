@@ -6,6 +6,7 @@ process is fuzzyctl.sim's loop, and the on-line proxy reaches a real runtime."""
 from __future__ import annotations
 
 import base64
+import errno
 import json
 import math
 import os
@@ -25,6 +26,7 @@ from fuzzyctl.studio.analysis import test_signal as signal_at
 from tests.conftest import EXAMPLES
 
 BASE = "http://127.0.0.1:8770"
+TOKEN = "studio-test-token-0123456789"
 
 
 @pytest.fixture
@@ -39,7 +41,11 @@ def project(tmp_path: Path) -> Path:
 
 @pytest.fixture
 def client(project: Path) -> TestClient:
-    return TestClient(create_app(project, file="crane.fcl"), base_url=BASE)
+    return TestClient(
+        create_app(project, file="crane.fcl", token=TOKEN),
+        base_url=BASE,
+        headers={"Authorization": f"Bearer {TOKEN}"},
+    )
 
 
 def opened(client: TestClient, path: str) -> dict[str, Any]:
@@ -156,14 +162,15 @@ def test_save_survives_a_failed_write(
     doc = opened(client, "crane.fcl")
 
     def boom(*_args: Any) -> None:
-        raise OSError("disk full")
+        raise OSError(errno.ENOSPC, "No space left on device")
 
     monkeypatch.setattr(os, "replace", boom)
-    with pytest.raises(OSError):
-        client.post(
-            "/api/save",
-            json={"path": "crane.fcl", "document": doc["document"], "expected_sha256": doc["sha256"]},
-        )
+    r = client.post(
+        "/api/save",
+        json={"path": "crane.fcl", "document": doc["document"], "expected_sha256": doc["sha256"]},
+    )
+    assert r.status_code == 507
+    assert r.json()["detail"] == "cannot save 'crane.fcl': the disk is full; the file on disk is unchanged"
     assert (project / "crane.fcl").read_text() == before
     assert sorted(p.name for p in project.iterdir()) == sorted(
         ["crane.fcl", "crane.toml", "figure7.fcl", "xfuz_3_3.xfuz"]

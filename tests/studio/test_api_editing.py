@@ -23,7 +23,7 @@ BASE = "http://127.0.0.1:8770"
 @pytest.fixture
 def client(tmp_path: Path) -> TestClient:
     shutil.copy(EXAMPLES / "crane.fcl", tmp_path / "crane.fcl")
-    return TestClient(create_app(tmp_path), base_url=BASE)
+    return TestClient(create_app(tmp_path, token=None), base_url=BASE)
 
 
 def crane(client: TestClient) -> dict[str, Any]:
@@ -161,7 +161,7 @@ def triangle(x: float, a: float, b: float, c: float) -> float:
 def test_rule_viewer_sets_are_the_activated_terms() -> None:
     fis = data_path("fuzzylite", "mamdani", "matlab", "tipper.fis")
     document = fuzzyctl.load(fis)
-    client = TestClient(create_app(EXAMPLES), base_url=BASE)
+    client = TestClient(create_app(EXAMPLES, token=None), base_url=BASE)
     point = {"service": 3.0, "food": 7.5}
     view = client.post("/api/ruleview", json={"document": to_dict(document), "inputs": point}).json()
     ctl = fuzzyctl.compile(document)

@@ -162,3 +162,24 @@ def test_what_the_editors_do_not_edit_is_shown_and_kept(page: Any, browser_proje
     pg.select_option("#fb-select", "1")
     pg.wait_for_function("document.querySelectorAll('#diagram .node.input').length === 2")
     assert "FUNCTION_BLOCK second" in (pg.text_content("#diagram") or "")
+
+
+def test_the_printed_url_opens_the_studio_and_nothing_else_does(browser: Any, studio: str) -> None:
+    """Without the token the studio answers 401 also on loopback; the URL with it (as
+    `fuzzyctl studio` prints it) opens a working page, and the token leaves the address bar
+    into a cookie the page's scripts cannot read."""
+    plain = studio.split("?")[0]
+    context = browser.new_context()  # a fresh browser: no cookie yet
+    try:
+        pg = context.new_page()
+        assert pg.goto(plain).status == 401
+        assert pg.goto(plain + "api/files").status == 401
+        pg.goto(studio.replace("?", "?view=recorder&"))
+        pg.wait_for_selector("body[data-ready=true]")
+        assert "token" not in pg.url and "view=recorder" in pg.url
+        assert pg.evaluate("document.cookie") == ""  # HttpOnly
+        files = pg.evaluate("fetch('/api/files').then((r) => r.json())")
+        assert "crane.fcl" in [f["path"] for f in files["files"]]
+        assert pg.is_visible("#view-recorder")
+    finally:
+        context.close()

@@ -20,7 +20,7 @@ def client_for(tmp_path: Path) -> TestClient:
     root = tmp_path / "project"
     root.mkdir()
     shutil.copy(EXAMPLES / "siemens_fpltest.fcl", root / "siemens_fpltest.fcl")
-    return TestClient(create_app(root, file="siemens_fpltest.fcl"), base_url=BASE)
+    return TestClient(create_app(root, file="siemens_fpltest.fcl", token=None), base_url=BASE)
 
 
 def test_siemens_1_5_rule_without_if_part_is_checked_saved_and_opened_again(tmp_path: Path) -> None:

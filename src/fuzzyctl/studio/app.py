@@ -7,15 +7,25 @@ only inside the project directory.  docs/studio.md is the user's guide.
 
 The front door (:mod:`fuzzyctl.webguard`) refuses, before the app sees them: another Host
 than the loopback names when bound to loopback (DNS rebinding), writes from another
-origin (CSRF), bodies over 16 MB (announced or chunked), and - when the studio has a
-token - every request without it.  The browser gets the token once from the URL printed
-at start (``/?token=...``), which sets an HttpOnly, SameSite=Strict cookie.
+origin (CSRF), bodies over 16 MB (announced or chunked), and - unless the studio was
+started without a token (``--no-token``) - every request without it, on loopback too
+(another user of the machine must not read and write your files through it).  The browser
+gets the token once from the URL printed at start (``/?token=...``), which sets an
+HttpOnly, SameSite=Strict cookie named after the token (two studios on two ports of one
+host do not overwrite each other's cookie).
+
+A file the studio cannot read or write answers a status and a message the user can act
+on (:class:`~fuzzyctl.studio.project.FileProblem`): 400 a name too long or a path through
+a file, 403 a read-only file or directory, 404, 413 a file too big, 507 a full disk.  The
+API description (Swagger UI at ``/api/docs``) is off unless ``api_docs``: the page loads
+Swagger UI from a CDN, third-party code in a page that holds the token.
 """
 
 # No `from __future__ import annotations`: FastAPI reads the annotations at run time.
 
 import base64
 import binascii
+import hashlib
 import math
 from pathlib import Path
 from typing import Any
@@ -27,11 +37,16 @@ from fastapi.staticfiles import StaticFiles
 
 from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
+from fuzzyctl.files import ReadOnlyError, check_writable
 from fuzzyctl.model import Document, FunctionBlock
 from fuzzyctl.studio import analysis, api_editing, online
 from fuzzyctl.studio.project import (
+    MAX_FILE,
+    FileProblem,
     PathError,
     ProjectDir,
+    check_save_name,
+    os_problem,
     save_atomically,
     sha256,
     split_settings,
@@ -59,7 +74,13 @@ from fuzzyctl.webguard import LOOPBACK_NAMES, Guard, Refusal, bearer_token, toke
 STATIC = Path(__file__).parent / "static"
 MAX_BODY = 16 * 1024 * 1024
 LOCAL_HOSTS = {"127.0.0.1", "localhost", "[::1]", "::1"}
-COOKIE = "fuzzyctl_studio_token"
+COOKIE_PREFIX = "fuzzyctl_studio_"
+
+
+def cookie_name(token: str) -> str:
+    """The cookie holding ``token``: named after a digest of it, because browsers share
+    cookies between the ports of a host (a second studio must not log the first one out)."""
+    return COOKIE_PREFIX + hashlib.sha256(token.encode()).hexdigest()[:16]
 
 
 def plotly_bundle() -> Path:
@@ -82,10 +103,10 @@ def _clean(obj: Any) -> Any:
     return obj
 
 
-def _cookie_token(headers: dict[str, str]) -> str | None:
+def _cookie_token(headers: dict[str, str], name: str) -> str | None:
     for part in headers.get("cookie", "").split(";"):
-        name, _, value = part.strip().partition("=")
-        if name == COOKIE:
+        key, _, value = part.strip().partition("=")
+        if key == name:
             return value
     return None
 
@@ -94,8 +115,10 @@ def studio_authorizer(token: str) -> Any:
     """Every request needs the token: ``Authorization: Bearer``, the cookie, or (for the
     page itself, ``GET /``) ``?token=``."""
 
+    cookie = cookie_name(token)
+
     def authorize(scope: dict[str, Any], headers: dict[str, str]) -> Refusal | None:
-        given = bearer_token(headers) or _cookie_token(headers)
+        given = bearer_token(headers) or _cookie_token(headers, cookie)
         if given is None and scope["path"] == "/":
             from urllib.parse import parse_qs
 
@@ -113,12 +136,19 @@ def studio_authorizer(token: str) -> Any:
 
 
 def create_app(
-    root: str | Path, *, file: str | None = None, host: str = "127.0.0.1", token: str | None = None
+    root: str | Path,
+    *,
+    file: str | None = None,
+    host: str = "127.0.0.1",
+    token: str | None,
+    api_docs: bool = False,
 ) -> Any:
     """The studio for the project directory ``root``; ``file`` (relative to it) is opened
     at start.  Bound to loopback, requests naming another host are refused (DNS
     rebinding); writes from another origin are refused (CSRF); with ``token``, every
-    request needs it (docs/studio.md, "Security")."""
+    request needs it - a caller says ``token=None`` explicitly to serve without one
+    (docs/studio.md, "Security").  ``api_docs`` serves Swagger UI at ``/api/docs`` (it
+    loads its scripts from a CDN)."""
     project = ProjectDir.at(root)
     if file is not None:
         project.resolve(file)
@@ -130,7 +160,7 @@ def create_app(
         version=__version__,
         description="Edit, analyse, simulate and download fuzzy knowledge bases (docs/studio.md).",
         openapi_url="/api/openapi.json",
-        docs_url="/api/docs",
+        docs_url="/api/docs" if api_docs else None,
         redoc_url=None,
     )
 
@@ -150,6 +180,27 @@ def create_app(
     @app.exception_handler(PathError)
     async def _path_error(_request: Request, exc: PathError) -> JSONResponse:
         return JSONResponse({"detail": str(exc)}, status_code=403)
+
+    @app.exception_handler(FileProblem)
+    async def _file_problem(_request: Request, exc: FileProblem) -> JSONResponse:
+        return JSONResponse({"detail": str(exc)}, status_code=exc.status)
+
+    @app.exception_handler(ReadOnlyError)
+    async def _read_only(_request: Request, exc: ReadOnlyError) -> JSONResponse:
+        name = project.relative(exc.path)
+        return JSONResponse(
+            {
+                "detail": f"{name} is read-only: not saved (make it writable, or save under another name)",
+                "readonly": True,
+            },
+            status_code=403,
+        )
+
+    @app.exception_handler(OSError)
+    async def _os_error(request: Request, exc: OSError) -> JSONResponse:
+        # The routes that touch files say which file; this is the net under the others.
+        problem = os_problem(exc, request.url.path, "answer")
+        return JSONResponse({"detail": str(problem)}, status_code=problem.status)
 
     @app.exception_handler(online.OnlineError)
     async def _online_error(_request: Request, exc: online.OnlineError) -> JSONResponse:
@@ -258,7 +309,18 @@ def create_app(
         path = project.resolve(body.path, must_exist=True)
         from fuzzyctl.formats import decode
 
-        text = decode(path.read_bytes())
+        try:
+            size = path.stat().st_size
+            if size > MAX_FILE:
+                raise FileProblem(
+                    413,
+                    f"{body.path} is too big: {size / 2**20:.1f} MB, the studio opens files of up to "
+                    f"{MAX_FILE // 2**20} MB",
+                )
+            data = path.read_bytes()
+        except OSError as exc:
+            raise os_problem(exc, body.path, "open") from None
+        text = decode(data)
         return _clean(opened(path, text))
 
     @app.post("/api/save")
@@ -267,9 +329,18 @@ def create_app(
         atomically.  Refused when the file changed on disk since it was opened."""
         if not body.path.lower().endswith(".fcl"):
             raise PathError("projects are FCL files: the name must end in .fcl")
+        check_save_name(body.path)
         path = project.resolve(body.path)
+        check_save_name(project.relative(path))  # a symbolic link into .git/ is refused too
         document, _fb = model_of(body)
         text = analysis.fcl_text(with_settings(document, settings_of(body)))
+        try:
+            return saved(body, path, text)
+        except OSError as exc:
+            raise os_problem(exc, body.path, "save") from None
+
+    def saved(body: SaveBody, path: Path, text: str) -> Any:
+        check_writable(path)  # told at once, not after "Replace it?"
         if path.exists():
             current = sha256(path.read_text(encoding="utf-8", errors="replace"))
             if body.expected_sha256 is None and not body.overwrite:
@@ -517,7 +588,7 @@ def create_app(
             rest = [(k, v) for k, v in request.query_params.multi_items() if k != "token"]
             target = "/" + ("?" + urlencode(rest) if rest else "")
             response = RedirectResponse(target, status_code=303)
-            response.set_cookie(COOKIE, token, httponly=True, samesite="strict", path="/")
+            response.set_cookie(cookie_name(token), token, httponly=True, samesite="strict", path="/")
             return response
         return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
 

@@ -7,6 +7,7 @@ leaves it (``..``, an absolute path, a symbolic link pointing outside, a NUL byt
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
 import os
@@ -24,6 +25,10 @@ STUDIO_KEYWORD = "STUDIO"
 (curve selection, test signals, display ranges, 3D axes); the knowledge base never sees it."""
 
 _STUDIO_LINE = re.compile(r"^\s*STUDIO\s+(\{.*\})\s*;?\s*$", re.DOTALL)
+NAME_MAX = 255
+"""Bytes of one file or directory name, at most (Linux, macOS and Windows file systems)."""
+MAX_FILE = 16 * 1024 * 1024
+"""The largest file the studio opens (the request-body limit: the model travels back)."""
 PROJECT_EXTENSIONS = (".fcl",)
 LISTED_EXTENSIONS = (".fcl", ".fis", ".fll", ".json", ".fpl", ".xfuz", ".toml")
 MAX_LISTED = 2000
@@ -31,6 +36,52 @@ MAX_LISTED = 2000
 
 class PathError(FuzzyctlError):
     """A path outside the project directory, or not usable as a project file."""
+
+
+class FileProblem(FuzzyctlError):
+    """A file the studio cannot read or write, for a reason the user can act on: answered
+    with ``status`` and the message (never a traceback)."""
+
+    def __init__(self, status: int, message: str) -> None:
+        self.status = status
+        super().__init__(message)
+
+
+# errno -> (HTTP status, what the user is told); the rest is a 500 with the system's reason.
+_OS_PROBLEMS: dict[int, tuple[int, str]] = {
+    errno.ENOSPC: (507, "the disk is full"),
+    errno.EDQUOT: (507, "the disk quota is exhausted"),
+    errno.EFBIG: (413, "the file is too big for the file system"),
+    errno.EACCES: (403, "permission denied"),
+    errno.EPERM: (403, "permission denied"),
+    errno.EROFS: (403, "the file system is read-only"),
+    errno.ENAMETOOLONG: (400, f"a name is too long (at most {NAME_MAX} bytes)"),
+    errno.ENOTDIR: (400, "a part of the path is a file, not a directory"),
+    errno.EEXIST: (400, "a part of the path is a file, not a directory"),
+    errno.EISDIR: (400, "it is a directory"),
+    errno.ENOENT: (404, "no such file or directory"),
+}
+
+
+def os_problem(exc: OSError, relative: str, doing: str) -> FileProblem:
+    """What an OSError while ``doing`` (``"save"``, ``"open"``) ``relative`` tells the user;
+    the file on disk is unchanged (the writes are atomic: fuzzyctl.files)."""
+    status, reason = _OS_PROBLEMS.get(exc.errno or 0, (500, exc.strerror or type(exc).__name__))
+    unchanged = "; the file on disk is unchanged" if doing == "save" else ""
+    return FileProblem(status, f"cannot {doing} {relative!r}: {reason}{unchanged}")
+
+
+def check_save_name(relative: str) -> None:
+    """Refuse, before touching the disk, a name the file system would refuse (over
+    ``NAME_MAX`` bytes) and a path into a hidden directory or to a hidden file (``.git/``,
+    ``.venv/``, any name starting with '.': never the project's, and Save must not write there)."""
+    for part in re.split(r"[/\\]", relative):
+        if len(os.fsencode(part)) > NAME_MAX:
+            raise FileProblem(
+                400, f"the name {part[:40]!r}... is too long: at most {NAME_MAX} bytes per name"
+            )
+        if part.startswith(".") and part not in (".", ""):
+            raise PathError(f"{relative!r}: the studio does not write into hidden files or directories")
 
 
 @dataclass(frozen=True)

@@ -145,7 +145,7 @@ async function save(asNew = false) {
     try {
       result = await post("/api/save", request);
     } catch (err) {
-      if (err.status !== 409) throw err;
+      if (err.status !== 409 || !(err.payload.exists || err.payload.changed)) throw err;
       const answer = await confirmDialog("Replace file?", err.message + ". Replace it?", [["cancel", "Cancel"], ["replace", "Replace"]]);
       if (answer !== "replace") return;
       result = await post("/api/save", { ...request, overwrite: true });
