@@ -119,6 +119,21 @@ def test_every_write_needs_the_write_token_and_every_read_a_token(
     assert client.get("/api/v1/openapi.json", headers=NO_TOKEN).status_code == 200
 
 
+def test_the_docs_page_is_off_unless_the_configuration_asks(client: TestClient, runtime: Runtime) -> None:
+    """Swagger UI would come from a CDN into the page where the token is typed (no installed
+    package ships its assets): off by default, on only with ``[api] docs = true``."""
+    from fuzzyctl.runtime.config import ApiConfig
+
+    assert ApiConfig().docs is False
+    for headers in (NO_TOKEN, AUTH):
+        assert client.get("/api/v1/docs", headers=headers).status_code == 404
+    assert client.get("/api/v1/redoc", headers=AUTH).status_code == 404
+    settings = ApiSettings(token=TOKEN, read_token=READ_TOKEN, hosts=["testserver"], docs=True)
+    with TestClient(create_app(LocalBackend(Service(runtime)), settings)) as documented:
+        page = documented.get("/api/v1/docs")
+        assert page.status_code == 200 and "swagger-ui" in page.text
+
+
 def test_requests_are_validated(client: TestClient) -> None:
     url = "/api/v1/instances/valve/parameters"
     assert client.patch(url, json={"values": {}}, headers=AUTH).status_code == 422

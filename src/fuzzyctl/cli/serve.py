@@ -71,11 +71,18 @@ def serve(
     try:
         if runtime.api_address is not None:
             host, port = runtime.api_address
+            docs = " (docs: /api/v1/docs)" if cfg.api.docs else ""
             err_console.print(
-                f"API on http://{host}:{port}/api/v1 (docs: /api/v1/docs); token in {runtime.token_path}, "
+                f"API on http://{host}:{port}/api/v1{docs}; token in {runtime.token_path}, "
                 f"read-only token in {runtime.read_token_path}",
                 markup=False,
             )
+            if cfg.api.docs:
+                err_console.print(
+                    "warning: [api] docs = true: /api/v1/docs loads Swagger UI from a CDN "
+                    "(third-party code in the page where the token is typed)",
+                    markup=False,
+                )
         deadline = None if duration is None else time.monotonic() + duration
         live_table = table and console.is_terminal
         last = _run(runtime, console, stop, deadline, live_table)

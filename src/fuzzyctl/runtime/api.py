@@ -1,7 +1,9 @@
 """The runtime's HTTP + WebSocket API (FastAPI), for the studio and for scripts.
 
-Everything is under ``/api/v1``; the OpenAPI description is at ``/api/v1/openapi.json``
-and browsable at ``/api/v1/docs``.  Every request but ``/health`` and the API description
+Everything is under ``/api/v1``; the OpenAPI description is at ``/api/v1/openapi.json``,
+and browsable at ``/api/v1/docs`` when ``[api] docs = true`` (off by default: that page
+loads Swagger UI from a CDN - no installed package ships it - into the page where the token
+is typed).  Every request but ``/health`` and the API description
 needs ``Authorization: Bearer <token>``: the write token (file ``api-token``) for
 everything, or the read-only token (file ``api-token-read``) for reading; the WebSocket
 also takes ``?token=``.  The front door (:mod:`fuzzyctl.webguard`) refuses a foreign Host
@@ -82,6 +84,8 @@ class ApiSettings:
     max_body: int = 8 * 1024 * 1024
     live_rate_max: float = 20.0
     live_clients_max: int = 8
+    docs: bool = False
+    """Serve Swagger UI at ``/api/v1/docs`` (its scripts come from a CDN)."""
 
 
 # ---------------------------------------------------------------------------- models
@@ -308,7 +312,7 @@ def create_app(backend: Backend, settings: ApiSettings) -> Any:
         version=__version__,
         description="Live view and control of the fuzzy function blocks run by `fuzzyctl serve`.",
         openapi_url=f"{API_PREFIX}/openapi.json",
-        docs_url=f"{API_PREFIX}/docs",
+        docs_url=f"{API_PREFIX}/docs" if settings.docs else None,
         redoc_url=None,
     )
 

@@ -93,6 +93,12 @@ class ApiConfig(_Strict):
         default=20.0, gt=0, le=20.0, description="WebSocket updates per second, at most"
     )
     live_clients_max: int = Field(default=8, ge=1, le=256, description="WebSocket clients at once")
+    docs: bool = Field(
+        default=False,
+        description="serve the API description as a page at /api/v1/docs (Swagger UI, whose scripts "
+        "come from a CDN: third-party code in the page where the token is typed); "
+        "/api/v1/openapi.json is always served",
+    )
 
 
 class ConnectionConfig(_Strict):

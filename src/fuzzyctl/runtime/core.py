@@ -296,6 +296,7 @@ class Runtime:
             max_body=api.max_body,
             live_rate_max=api.live_rate_max,
             live_clients_max=api.live_clients_max,
+            docs=api.docs,
         )
         prio = self.config.runtime.realtime_priority
 
