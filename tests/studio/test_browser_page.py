@@ -183,3 +183,30 @@ def test_the_printed_url_opens_the_studio_and_nothing_else_does(browser: Any, st
         assert pg.is_visible("#view-recorder")
     finally:
         context.close()
+
+
+def test_save_errors_are_said_in_the_status_line(page: Any, browser_project: Path, request: Any) -> None:
+    """A read-only file, a path through a file and a hidden directory: the status line says
+    why (no "Replace it?" question that could not help), and nothing is written."""
+    pg = page
+    open_file(pg, "crane.fcl")
+    crane = browser_project / "crane.fcl"
+    before = crane.read_bytes()
+    crane.chmod(0o444)
+    try:
+        pg.keyboard.press("Control+s")
+        pg.wait_for_function("document.querySelector('#status').textContent.includes('read-only')")
+        assert pg.inner_text("#status").startswith("crane.fcl is read-only: not saved")
+    finally:
+        crane.chmod(0o644)
+    assert crane.read_bytes() == before
+    for path, said in [("crane.fcl/x.fcl", "is a file, not a directory"), (".git/x.fcl", "hidden")]:
+        pg.click("#btn-saveas")
+        pg.fill("#saveas-path", path)
+        pg.click("#saveas-ok")
+        pg.wait_for_function(f"document.querySelector('#status').textContent.includes({said!r})")
+        assert not pg.evaluate("document.querySelector('#dlg-confirm').open")
+    assert not (browser_project / ".git").exists()
+    # the refused requests are the browser's console errors this test expects
+    errors: list[str] = request.node.console_errors
+    errors[:] = [e for e in errors if "403" not in e and "400" not in e]
