@@ -135,3 +135,30 @@ period = 0.1
     ):
         assert expected in err, (expected, err)
     assert "Traceback" not in err
+
+
+def test_serve_requires_a_token_unless_no_token_is_given(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    cfg = tmp_path / "serve.toml"
+    cfg.write_text(
+        f"""
+[runtime]
+state_dir = "{tmp_path / "state"}"
+[api]
+port = 0
+[instances.valve]
+knowledge_base = "{EXAMPLES / "fpltest.fpl"}"
+period = 0.1
+"""
+    )
+    code, _, err = run(["serve", str(cfg), "--duration", "0.2", "--no-table"], capsys)
+    assert code == 0 and "token in" in err and "warning: --no-token" not in err
+    assert (tmp_path / "state" / "api-token").stat().st_mode & 0o777 == 0o600
+    assert "/api/v1/docs" not in err  # the Swagger UI page is off by default
+    (tmp_path / "state" / "api-token").unlink()
+    (tmp_path / "state" / "api-token-read").unlink()
+    code, _, err = run(["serve", str(cfg), "--duration", "0.2", "--no-table", "--no-token"], capsys)
+    assert code == 0 and "; no token" in err
+    assert "warning: --no-token: any program or user on this machine can read and command" in err
+    assert not (tmp_path / "state" / "api-token").exists()

@@ -134,6 +134,17 @@ def test_the_docs_page_is_off_unless_the_configuration_asks(client: TestClient, 
         assert page.status_code == 200 and "swagger-ui" in page.text
 
 
+def test_without_a_token_only_when_asked_for(runtime: Runtime) -> None:
+    """``serve --no-token`` (ApiSettings(token=None)): every request passes without one;
+    the other checks of the front door stay."""
+    settings = ApiSettings(token=None, hosts=["testserver"])
+    with TestClient(create_app(LocalBackend(Service(runtime)), settings)) as open_api:
+        assert open_api.get("/api/v1/instances/valve").status_code == 200
+        r = open_api.put("/api/v1/instances/valve/start_stop", json={"running": True})
+        assert r.status_code == 200
+        assert open_api.get("/api/v1/instances", headers={"Host": "evil.example"}).status_code == 403
+
+
 def test_requests_are_validated(client: TestClient) -> None:
     url = "/api/v1/instances/valve/parameters"
     assert client.patch(url, json={"values": {}}, headers=AUTH).status_code == 422

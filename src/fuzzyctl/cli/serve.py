@@ -25,6 +25,13 @@ def serve(
         float | None, typer.Option("--duration", min=0, help="stop after this many seconds")
     ] = None,
     check: Annotated[bool, typer.Option("--check", help="check the configuration and exit")] = False,
+    no_token: Annotated[
+        bool,
+        typer.Option(
+            "--no-token",
+            help="the API without a token: any program or user that reaches it can command the instances",
+        ),
+    ] = False,
 ) -> None:
     """Run fuzzy function blocks cyclically against field I/O (OPC UA, Modbus TCP, S7)."""
     from rich.console import Console
@@ -52,7 +59,7 @@ def serve(
             err_console.print(f"warning: {text}", markup=False)
         return
     cfg = load_config(config)
-    runtime = Runtime(cfg, api=api and cfg.api.enabled)
+    runtime = Runtime(cfg, api=api and cfg.api.enabled, token=not no_token)
     stop = threading.Event()
 
     def on_signal(_signum: int, _frame: Any) -> None:
@@ -72,11 +79,19 @@ def serve(
         if runtime.api_address is not None:
             host, port = runtime.api_address
             docs = " (docs: /api/v1/docs)" if cfg.api.docs else ""
-            err_console.print(
-                f"API on http://{host}:{port}/api/v1{docs}; token in {runtime.token_path}, "
-                f"read-only token in {runtime.read_token_path}",
-                markup=False,
+            tokens = (
+                f"token in {runtime.token_path}, read-only token in {runtime.read_token_path}"
+                if runtime.token_required
+                else "no token"
             )
+            err_console.print(f"API on http://{host}:{port}/api/v1{docs}; {tokens}", markup=False)
+            if not runtime.token_required:
+                where = "on this machine" if host in ("127.0.0.1", "::1") else f"that reaches {host}"
+                err_console.print(
+                    f"warning: --no-token: any program or user {where} can read and command "
+                    "the instances through the API",
+                    markup=False,
+                )
             if cfg.api.docs:
                 err_console.print(
                     "warning: [api] docs = true: /api/v1/docs loads Swagger UI from a CDN "

@@ -3,12 +3,13 @@
 Everything is under ``/api/v1``; the OpenAPI description is at ``/api/v1/openapi.json``,
 and browsable at ``/api/v1/docs`` when ``[api] docs = true`` (off by default: that page
 loads Swagger UI from a CDN - no installed package ships it - into the page where the token
-is typed).  Every request but ``/health`` and the API description
-needs ``Authorization: Bearer <token>``: the write token (file ``api-token``) for
-everything, or the read-only token (file ``api-token-read``) for reading; the WebSocket
-also takes ``?token=``.  The front door (:mod:`fuzzyctl.webguard`) refuses a foreign Host
-(DNS rebinding), a foreign Origin (cross-origin reads, cross-site WebSocket), a missing
-token before the body is read, and a body over the limit (Content-Length or chunked).
+is typed).  Every request but ``/health`` and the API description needs
+``Authorization: Bearer <token>`` (unless ``serve --no-token``): the write token (file
+``api-token``) for everything, or the read-only token (file ``api-token-read``) for
+reading; the WebSocket also takes ``?token=``.  The front door (:mod:`fuzzyctl.webguard`)
+refuses a foreign Host (DNS rebinding), a foreign Origin (cross-origin reads, cross-site
+WebSocket), a missing token before the body is read, and a body over the limit
+(Content-Length or chunked).
 
 Request bodies are strict pydantic models: a wrong type (``"yes"`` for a boolean, ``"1"``
 for a number), a missing or unknown field is a 422 naming it, never echoing the value.
@@ -76,7 +77,8 @@ class LocalBackend:
 class ApiSettings:
     """What the app needs to know besides the backend."""
 
-    token: str
+    token: str | None
+    """The write token; None: no token at all (``serve --no-token``), every request passes."""
     read_token: str | None = None
     hosts: list[str] | None = field(default_factory=lambda: sorted(LOOPBACK_NAMES))
     """Host names answered (None: any); see :func:`allowed_hosts`."""
@@ -253,7 +255,7 @@ def authorizer(settings: ApiSettings) -> Any:
 
     def authorize(scope: dict[str, Any], headers: dict[str, str]) -> Refusal | None:
         path = scope["path"]
-        if path in OPEN_PATHS:
+        if path in OPEN_PATHS or settings.token is None:
             return None
         given = bearer_token(headers)
         reading = scope["type"] == "websocket" or scope.get("method") in ("GET", "HEAD")

@@ -46,9 +46,15 @@ class Runtime:
     configured event file (None: memory only)."""
 
     def __init__(
-        self, config: Config, *, api: bool | None = None, event_log: Path | str | None = "config"
+        self,
+        config: Config,
+        *,
+        api: bool | None = None,
+        event_log: Path | str | None = "config",
+        token: bool = True,
     ) -> None:
         self.config = config
+        self.token_required = token  # False: `serve --no-token`, the API open to every local user
         if event_log == "config":
             name = config.runtime.event_log
             log_path = (config.state_dir / name) if name else None
@@ -231,10 +237,11 @@ class Runtime:
         if self.api_enabled:
             from fuzzyctl.runtime.token import load_or_create_token
 
-            self.token_path = self._state_file(api.token_file)
-            self.read_token_path = self._state_file(api.read_token_file)
-            self.token = load_or_create_token(self.token_path)
-            self.read_token = load_or_create_token(self.read_token_path)
+            if self.token_required:
+                self.token_path = self._state_file(api.token_file)
+                self.read_token_path = self._state_file(api.read_token_file)
+                self.token = load_or_create_token(self.token_path)
+                self.read_token = load_or_create_token(self.read_token_path)
             sock = socket.socket(socket.AF_INET6 if ":" in api.host else socket.AF_INET, socket.SOCK_STREAM)
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
             try:
@@ -287,7 +294,7 @@ class Runtime:
         from fuzzyctl.runtime.service import Service
 
         api = self.config.api
-        assert self.token is not None
+        assert self.token is not None or not self.token_required
         settings = ApiSettings(
             token=self.token,
             read_token=self.read_token,
