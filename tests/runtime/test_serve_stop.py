@@ -1,0 +1,258 @@
+"""Stopping safely (docs/runtime.md, "Stopping"): `fuzzyctl serve` as a real process
+against real protocol peers on loopback (a pymodbus server, an asyncua server).  It runs
+until the peers hold the block's normal values, then gets SIGTERM or Ctrl-C (SIGINT): the
+peers must then hold the configured safe values with INFO 16#41 (the safe INFO of the
+docs' Safety table), and the process must have exited 0 within its stop bound.  A peer
+that does not answer at stop time must not keep the process from exiting (its link's
+`stop_timeout`, not the protocol's `timeout`), and a second Ctrl-C exits at once."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from tests.conftest import ROOT
+from tests.io.plcs import FreezableProxy, ModbusPLC, OpcUaPLC, wait_until
+from tests.runtime.helpers import FPLTEST_FCL, close, fpltest_reference
+
+INFO_SAFE = 0x41  # docs/runtime.md, Safety: INFO in the state `safe` (written literally: the docs' number)
+SAFE_VALVE = -1.0
+SAFE_VALVE_UA = 7.5
+# What the stop may cost beyond the links' stop_timeout: the cycle thread's last cycle, the
+# event file, the interpreter's exit, on a shared, loaded machine.  Far below the protocol
+# timeouts used below (10 s), so an exit within it shows the stop_timeout was what bounded it.
+SLACK = 4.0
+
+
+def modbus_connection(name: str, port: int, stop_timeout: float | None = None, timeout: float = 10.0) -> str:
+    extra = "" if stop_timeout is None else f"stop_timeout = {stop_timeout}\n"
+    return f"""
+[connections.{name}]
+type = "modbus"
+port = {port}
+timeout = {timeout}
+poll_interval = 0.01
+reconnect_min = 0.05
+reconnect_max = 0.2
+{extra}"""
+
+
+def modbus_instance(name: str, connection: str) -> str:
+    return f"""
+[instances.{name}]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+hold_time = 0.3
+
+[instances.{name}.inputs]
+Temp = {{ connection = "{connection}", address = 0 }}
+Pressure = {{ connection = "{connection}", address = 2 }}
+
+[instances.{name}.outputs]
+Valve = {{ connection = "{connection}", address = 10, safe = {SAFE_VALVE} }}
+INFO = {{ connection = "{connection}", address = 12, type = "uint16" }}
+"""
+
+
+def opcua_part(plc: OpcUaPLC) -> str:
+    ns = OpcUaPLC.NAMESPACE
+    return f"""
+[connections.ua]
+type = "opcua"
+url = "{plc.url}"
+timeout = 10.0
+poll_interval = 0.01
+reconnect_min = 0.05
+reconnect_max = 0.2
+
+[instances.ua_valve]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+hold_time = 0.3
+
+[instances.ua_valve.inputs]
+Temp = {{ connection = "ua", node = "s=Plant.Temp", namespace = "{ns}" }}
+Pressure = {{ connection = "ua", node = "s=Plant.Pressure", namespace = "{ns}" }}
+
+[instances.ua_valve.outputs]
+Valve = {{ connection = "ua", node = "s=Plant.Valve", namespace = "{ns}", safe = {SAFE_VALVE_UA} }}
+INFO = {{ connection = "ua", node = "s=Plant.INFO", namespace = "{ns}" }}
+"""
+
+
+class Serve:
+    """`fuzzyctl serve CONFIG --no-api --no-table` in a process of its own (this worktree's
+    sources first on the path); its output goes to files, so a full pipe never blocks it."""
+
+    def __init__(self, tmp_path: Path, toml: str) -> None:
+        self.dir = tmp_path
+        config = tmp_path / "serve.toml"
+        config.write_text(f'[runtime]\nstate_dir = "{tmp_path}"\n' + toml, encoding="utf-8")
+        env = dict(os.environ)
+        env["PYTHONPATH"] = os.pathsep.join([str(ROOT / "src"), str(ROOT), env.get("PYTHONPATH", "")])
+        self.out = (tmp_path / "stdout.txt").open("w")
+        self.err = (tmp_path / "stderr.txt").open("w")
+        code = "from fuzzyctl.cli.entry import run; run()"
+        self.proc = subprocess.Popen(
+            [sys.executable, "-c", code, "serve", str(config), "--no-api", "--no-table"],
+            stdout=self.out,
+            stderr=self.err,
+            env=env,
+            cwd=tmp_path,
+        )
+
+    def stop(self, signum: int, timeout: float = 60.0) -> tuple[int, float]:
+        """Send ``signum``; the exit code and the seconds until the process was gone."""
+        t0 = time.monotonic()
+        self.proc.send_signal(signum)
+        rc = self.proc.wait(timeout)
+        return rc, time.monotonic() - t0
+
+    def stderr(self) -> str:
+        return (self.dir / "stderr.txt").read_text(encoding="utf-8")
+
+    def events(self) -> list[dict[str, Any]]:
+        path = self.dir / "events.jsonl"
+        return [json.loads(line) for line in path.read_text(encoding="utf-8").splitlines()]
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+            self.proc.wait(10)
+        self.out.close()
+        self.err.close()
+
+
+def running(plc: ModbusPLC, want: float) -> bool:
+    """The PLC holds the block's value and INFO 0 (normal operation)."""
+    return close(plc.float(10), want) and plc.registers(12, 1) == [0]
+
+
+def running_values(plc: ModbusPLC, temp: float = 9.0, pressure: float = 65.0) -> float:
+    """Put process values in a PLC's registers; the block's answer (the engine's)."""
+    plc.set_float(0, temp)
+    plc.set_float(2, pressure)
+    return fpltest_reference(temp, pressure)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGTERM, signal.SIGINT], ids=["SIGTERM", "SIGINT"])
+def test_a_stopped_serve_leaves_the_safe_values_and_the_safe_info_in_its_peers(
+    tmp_path: Path, signum: int
+) -> None:
+    plc = ModbusPLC()
+    ua = OpcUaPLC(["Temp", "Pressure", "Valve", "INFO"])
+    serve = None
+    try:
+        want = running_values(plc)
+        ua.set("Temp", 18.0)
+        ua.set("Pressure", 80.0)
+        want_ua = fpltest_reference(18.0, 80.0)
+        serve = Serve(
+            tmp_path, modbus_connection("plc", plc.port) + modbus_instance("valve", "plc") + opcua_part(ua)
+        )
+        # Normal operation first: both peers hold the block's values and INFO 0.
+        wait_until(lambda: running(plc, want), 60)
+        wait_until(lambda: close(ua.get("Valve"), want_ua) and ua.get("INFO") == 0.0, 60)
+        assert serve.proc.poll() is None
+        rc, took = serve.stop(signum)
+        assert rc == 0, serve.stderr()
+        # Default stop_timeout 1 s per link, links in parallel.
+        assert took < 1.0 + SLACK, took
+        assert plc.float(10) == SAFE_VALVE
+        assert plc.registers(12, 1) == [INFO_SAFE]
+        assert ua.get("Valve") == SAFE_VALVE_UA
+        assert ua.get("INFO") == float(INFO_SAFE)
+        events = serve.events()
+        # What was written is logged, per link, before the runtime-stop event.
+        writes = {e["link"]: e for e in events if e["kind"] == "stop-write"}
+        assert set(writes) == {"plc", "ua"}, [e["kind"] for e in events]
+        assert all(e["data"]["written"] for e in writes.values())
+        assert any(
+            e["kind"] == "safe-enter" and e["instance"] == "valve" and e["data"]["reason"] == "stop"
+            for e in events
+        )
+        assert events[-1]["kind"] == "runtime-stop"
+    finally:
+        if serve is not None:
+            serve.close()
+        plc.close()
+        ua.close()
+
+
+def test_a_peer_that_does_not_answer_at_stop_delays_the_exit_only_by_its_stop_timeout(
+    tmp_path: Path,
+) -> None:
+    """Three Modbus peers: one frozen just before the stop (connection open, nothing
+    answers: the write hangs until the protocol's 10 s timeout), one stopped (refused),
+    one healthy.  The process is gone within the 0.5 s stop_timeout (plus the slack), far
+    before 10 s, and the healthy peer still got its safe values (the links are written in
+    parallel, not one after the other)."""
+    frozen, gone, healthy = ModbusPLC(), ModbusPLC(), ModbusPLC()
+    proxy = FreezableProxy(frozen.port)
+    serve = None
+    try:
+        want = {name: running_values(plc) for name, plc in [("a", frozen), ("b", gone), ("c", healthy)]}
+        toml = (
+            modbus_connection("a", proxy.port, stop_timeout=0.5)
+            + modbus_connection("b", gone.port, stop_timeout=0.5)
+            + modbus_connection("c", healthy.port, stop_timeout=0.5)
+            + modbus_instance("va", "a")
+            + modbus_instance("vb", "b")
+            + modbus_instance("vc", "c")
+        )
+        serve = Serve(tmp_path, toml)
+        for name, plc in [("a", frozen), ("b", gone), ("c", healthy)]:
+            wait_until(lambda p=plc, w=want[name]: running(p, w), 60)  # type: ignore[misc]
+        gone.stop()
+        proxy.freeze()
+        rc, took = serve.stop(signal.SIGTERM)
+        assert rc == 0, serve.stderr()
+        assert took < 0.5 + SLACK, took  # not the 10 s protocol timeout
+        assert healthy.float(10) == SAFE_VALVE and healthy.registers(12, 1) == [INFO_SAFE]
+        assert close(frozen.float(10), want["a"])  # nothing reached it: the last value stays
+        writes = {e["link"]: e for e in serve.events() if e["kind"] == "stop-write"}
+        assert writes["c"]["data"]["written"] and writes["c"]["level"] == "info"
+        for name in ("a", "b"):
+            assert not writes[name]["data"]["written"] and writes[name]["level"] == "error", writes[name]
+    finally:
+        if serve is not None:
+            serve.close()
+        proxy.close()
+        for plc in (frozen, gone, healthy):
+            plc.close()
+
+
+def test_a_second_ctrl_c_exits_at_once(tmp_path: Path) -> None:
+    """A stop that waits for a frozen peer (stop_timeout 20 s): the first Ctrl-C starts
+    it, the second ends the process at once (exit 130, as an interrupted command)."""
+    plc = ModbusPLC()
+    proxy = FreezableProxy(plc.port)
+    serve = None
+    try:
+        want = running_values(plc)
+        serve = Serve(
+            tmp_path,
+            modbus_connection("plc", proxy.port, stop_timeout=20.0, timeout=30.0)
+            + modbus_instance("valve", "plc"),
+        )
+        wait_until(lambda: close(plc.float(10), want), 60)
+        proxy.freeze()
+        serve.proc.send_signal(signal.SIGINT)
+        wait_until(lambda: "again" in serve.stderr(), 15)  # the stop has begun and says so
+        assert serve.proc.poll() is None  # still waiting for the frozen peer
+        rc, took = serve.stop(signal.SIGINT)
+        assert rc == 130
+        assert took < SLACK, took
+    finally:
+        if serve is not None:
+            serve.close()
+        proxy.close()
+        plc.close()
