@@ -20,12 +20,13 @@ from typing import Any
 import pytest
 
 from tests.conftest import ROOT
-from tests.io.plcs import FreezableProxy, ModbusPLC, OpcUaPLC, wait_until
+from tests.io.plcs import S7PLC, FreezableProxy, ModbusPLC, OpcUaPLC, wait_until
 from tests.runtime.helpers import FPLTEST_FCL, close, fpltest_reference
 
 INFO_SAFE = 0x41  # docs/runtime.md, Safety: INFO in the state `safe` (written literally: the docs' number)
 SAFE_VALVE = -1.0
 SAFE_VALVE_UA = 7.5
+SAFE_VALVE_S7 = 55.5
 # What the stop may cost beyond the links' stop_timeout: the cycle thread's last cycle, the
 # event file, the interpreter's exit, on a shared, loaded machine.  Far below the protocol
 # timeouts used below (10 s), so an exit within it shows the stop_timeout was what bounded it.
@@ -86,6 +87,38 @@ Pressure = {{ connection = "ua", node = "s=Plant.Pressure", namespace = "{ns}" }
 Valve = {{ connection = "ua", node = "s=Plant.Valve", namespace = "{ns}", safe = {SAFE_VALVE_UA} }}
 INFO = {{ connection = "ua", node = "s=Plant.INFO", namespace = "{ns}" }}
 """
+
+
+def s7_part(name: str, port: int, stop_timeout: float | None = None) -> str:
+    extra = "" if stop_timeout is None else f"stop_timeout = {stop_timeout}\n"
+    return f"""
+[connections.{name}]
+type = "s7"
+port = {port}
+timeout = 10.0
+poll_interval = 0.01
+reconnect_min = 0.05
+reconnect_max = 0.2
+{extra}
+[instances.{name}_valve]
+knowledge_base = "{FPLTEST_FCL}"
+period = 0.01
+hold_time = 0.3
+
+[instances.{name}_valve.inputs]
+Temp = {{ connection = "{name}", db = 1, offset = 0 }}
+Pressure = {{ connection = "{name}", db = 1, offset = 4 }}
+
+[instances.{name}_valve.outputs]
+Valve = {{ connection = "{name}", db = 1, offset = 8, safe = {SAFE_VALVE_S7} }}
+INFO = {{ connection = "{name}", db = 1, offset = 12, type = "int" }}
+"""
+
+
+def s7_running(plc: S7PLC, temp: float = 2.0, pressure: float = 96.5) -> float:
+    plc.set_real(0, temp)
+    plc.set_real(4, pressure)
+    return fpltest_reference(temp, pressure)
 
 
 class Serve:
@@ -149,18 +182,25 @@ def test_a_stopped_serve_leaves_the_safe_values_and_the_safe_info_in_its_peers(
 ) -> None:
     plc = ModbusPLC()
     ua = OpcUaPLC(["Temp", "Pressure", "Valve", "INFO"])
+    cpu = S7PLC()
     serve = None
     try:
         want = running_values(plc)
         ua.set("Temp", 18.0)
         ua.set("Pressure", 80.0)
         want_ua = fpltest_reference(18.0, 80.0)
+        want_s7 = s7_running(cpu)
         serve = Serve(
-            tmp_path, modbus_connection("plc", plc.port) + modbus_instance("valve", "plc") + opcua_part(ua)
+            tmp_path,
+            modbus_connection("plc", plc.port)
+            + modbus_instance("valve", "plc")
+            + opcua_part(ua)
+            + s7_part("cpu", cpu.port),
         )
-        # Normal operation first: both peers hold the block's values and INFO 0.
+        # Normal operation first: every peer holds the block's values and INFO 0.
         wait_until(lambda: running(plc, want), 60)
         wait_until(lambda: close(ua.get("Valve"), want_ua) and ua.get("INFO") == 0.0, 60)
+        wait_until(lambda: close(cpu.real(8), want_s7) and cpu.int(12) == 0, 60)
         assert serve.proc.poll() is None
         rc, took = serve.stop(signum)
         assert rc == 0, serve.stderr()
@@ -170,10 +210,11 @@ def test_a_stopped_serve_leaves_the_safe_values_and_the_safe_info_in_its_peers(
         assert plc.registers(12, 1) == [INFO_SAFE]
         assert ua.get("Valve") == SAFE_VALVE_UA
         assert ua.get("INFO") == float(INFO_SAFE)
+        assert cpu.real(8) == SAFE_VALVE_S7 and cpu.int(12) == INFO_SAFE
         events = serve.events()
         # What was written is logged, per link, before the runtime-stop event.
         writes = {e["link"]: e for e in events if e["kind"] == "stop-write"}
-        assert set(writes) == {"plc", "ua"}, [e["kind"] for e in events]
+        assert set(writes) == {"plc", "ua", "cpu"}, [e["kind"] for e in events]
         assert all(e["data"]["written"] for e in writes.values())
         assert any(
             e["kind"] == "safe-enter" and e["instance"] == "valve" and e["data"]["reason"] == "stop"
@@ -185,6 +226,7 @@ def test_a_stopped_serve_leaves_the_safe_values_and_the_safe_info_in_its_peers(
             serve.close()
         plc.close()
         ua.close()
+        cpu.close()
 
 
 def test_a_peer_that_does_not_answer_at_stop_delays_the_exit_only_by_its_stop_timeout(
@@ -192,14 +234,18 @@ def test_a_peer_that_does_not_answer_at_stop_delays_the_exit_only_by_its_stop_ti
 ) -> None:
     """Three Modbus peers: one frozen just before the stop (connection open, nothing
     answers: the write hangs until the protocol's 10 s timeout), one stopped (refused),
-    one healthy.  The process is gone within the 0.5 s stop_timeout (plus the slack), far
+    one healthy; and a frozen S7 CPU (python-snap7 blocks a thread until its socket
+    timeout).  The process is gone within the 0.5 s stop_timeout (plus the slack), far
     before 10 s, and the healthy peer still got its safe values (the links are written in
     parallel, not one after the other)."""
     frozen, gone, healthy = ModbusPLC(), ModbusPLC(), ModbusPLC()
     proxy = FreezableProxy(frozen.port)
+    cpu = S7PLC()
+    cpu_proxy = FreezableProxy(cpu.port)
     serve = None
     try:
         want = {name: running_values(plc) for name, plc in [("a", frozen), ("b", gone), ("c", healthy)]}
+        want_s7 = s7_running(cpu)
         toml = (
             modbus_connection("a", proxy.port, stop_timeout=0.5)
             + modbus_connection("b", gone.port, stop_timeout=0.5)
@@ -207,12 +253,15 @@ def test_a_peer_that_does_not_answer_at_stop_delays_the_exit_only_by_its_stop_ti
             + modbus_instance("va", "a")
             + modbus_instance("vb", "b")
             + modbus_instance("vc", "c")
+            + s7_part("cpu", cpu_proxy.port, stop_timeout=0.5)
         )
         serve = Serve(tmp_path, toml)
         for name, plc in [("a", frozen), ("b", gone), ("c", healthy)]:
             wait_until(lambda p=plc, w=want[name]: running(p, w), 60)  # type: ignore[misc]
+        wait_until(lambda: close(cpu.real(8), want_s7) and cpu.int(12) == 0, 60)
         gone.stop()
         proxy.freeze()
+        cpu_proxy.freeze()
         rc, took = serve.stop(signal.SIGTERM)
         assert rc == 0, serve.stderr()
         assert took < 0.5 + SLACK, took  # not the 10 s protocol timeout
@@ -220,12 +269,15 @@ def test_a_peer_that_does_not_answer_at_stop_delays_the_exit_only_by_its_stop_ti
         assert close(frozen.float(10), want["a"])  # nothing reached it: the last value stays
         writes = {e["link"]: e for e in serve.events() if e["kind"] == "stop-write"}
         assert writes["c"]["data"]["written"] and writes["c"]["level"] == "info"
-        for name in ("a", "b"):
+        assert close(cpu.real(8), want_s7) and cpu.int(12) == 0
+        for name in ("a", "b", "cpu"):
             assert not writes[name]["data"]["written"] and writes[name]["level"] == "error", writes[name]
     finally:
         if serve is not None:
             serve.close()
         proxy.close()
+        cpu_proxy.close()
+        cpu.close()
         for plc in (frozen, gone, healthy):
             plc.close()
 
