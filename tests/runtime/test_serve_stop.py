@@ -19,9 +19,9 @@ from typing import Any
 
 import pytest
 
-from tests.conftest import ROOT
+from tests.conftest import EXAMPLES, ROOT
 from tests.io.plcs import S7PLC, FreezableProxy, ModbusPLC, OpcUaPLC, wait_until
-from tests.runtime.helpers import FPLTEST_FCL, close, fpltest_reference
+from tests.runtime.helpers import FPLTEST_FCL, close, fpltest_reference, make_runtime
 
 INFO_SAFE = 0x41  # docs/runtime.md, Safety: INFO in the state `safe` (written literally: the docs' number)
 SAFE_VALVE = -1.0
@@ -307,4 +307,119 @@ def test_a_second_ctrl_c_exits_at_once(tmp_path: Path) -> None:
         if serve is not None:
             serve.close()
         proxy.close()
+        plc.close()
+
+
+# ---------------------------------------------------------------------------- in process
+# The same stop through Runtime.stop() (what `serve` calls), for what a process test
+# would only make slower: the XFUZ status word, stop_timeout = 0, a link down at the stop.
+
+
+def xfuz_config(port: int, extra: str = "") -> str:
+    return f"""
+[connections.plc]
+type = "modbus"
+port = {port}
+poll_interval = 0.005
+reconnect_min = 0.05
+reconnect_max = 0.1
+{extra}
+[instances.debit]
+style = "xfuz"
+knowledge_base = "{EXAMPLES / "xfuz_3_3.xfuz"}"
+span_rule = false
+period = 0.01
+hold_time = 0.1
+params = {{ MAN_AUTO = 1, START = 1, CONT_ASK = 0, T_OFB = 0 }}
+
+[instances.debit.inputs]
+INP1 = {{ connection = "plc", address = 0, type = "int16" }}
+INP4 = {{ connection = "plc", address = 1, type = "int16" }}
+
+[instances.debit.outputs]
+OUT3 = {{ connection = "plc", address = 10, type = "int16", safe = -7 }}
+STATUS = {{ connection = "plc", address = 11, type = "int16" }}
+ERROR = {{ connection = "plc", address = 12, type = "uint16" }}
+"""
+
+
+def test_a_stopped_xfuz_instance_leaves_its_safe_word_status_bit_15_and_error(tmp_path: Path) -> None:
+    """docs/runtime.md, Safety: XFUZ in `safe` sets STATUS bit 15 (the runtime's
+    addition) and ERROR = 1.  The manual's example 3.3 (Pression 0, Temperature -50)
+    gives Ouverture 8 with STATUS 0 while running."""
+    plc = ModbusPLC()
+    rt = make_runtime(tmp_path, xfuz_config(plc.port))
+    try:
+        rt.start()
+        plc.set_registers(0, [0, (-50) & 0xFFFF])
+        wait_until(lambda: plc.registers(10, 3) == [8, 0, 0], 10)
+        rt.stop()
+        assert plc.registers(10, 3) == [(-7) & 0xFFFF, 0x8000, 1]
+    finally:
+        rt.stop()
+        plc.close()
+
+
+def test_stop_timeout_0_leaves_the_field_as_it_was(tmp_path: Path) -> None:
+    plc = ModbusPLC()
+    rt = make_runtime(tmp_path, xfuz_config(plc.port, "stop_timeout = 0"))
+    try:
+        rt.start()
+        plc.set_registers(0, [0, (-50) & 0xFFFF])
+        wait_until(lambda: plc.registers(10, 3) == [8, 0, 0], 10)
+        rt.stop()
+        assert plc.registers(10, 3) == [8, 0, 0]
+        (write,) = [e for e in rt.events.since(0) if e.kind == "stop-write"]
+        assert write.level == "warning" and write.data["written"] == {}
+    finally:
+        rt.stop()
+        plc.close()
+
+
+def test_a_link_that_is_down_at_the_stop_connects_once_to_write_the_safe_values(tmp_path: Path) -> None:
+    """The PLC restarts while the link waits 30 s before its next attempt: at the stop the
+    link is down, connects once, and the restarted PLC (fresh registers) gets the safe
+    values and INFO 16#41."""
+    plc = ModbusPLC()
+    toml = modbus_connection("plc", plc.port, timeout=0.5).replace(
+        "reconnect_min = 0.05\nreconnect_max = 0.2", "reconnect_min = 30\nreconnect_max = 30"
+    ) + modbus_instance("valve", "plc")
+    rt = make_runtime(tmp_path, toml)
+    try:
+        rt.start()
+        want = running_values(plc)
+        wait_until(lambda: running(plc, want), 10)
+        plc.stop()
+        wait_until(lambda: rt.links["plc"].state.value == "down", 10)
+        plc.start()  # same port, registers 0
+        assert plc.registers(10, 3) == [0, 0, 0]
+        rt.stop()
+        assert plc.float(10) == SAFE_VALVE and plc.registers(12, 1) == [INFO_SAFE]
+    finally:
+        rt.stop()
+        plc.close()
+
+
+def test_an_instance_whose_block_cannot_compute_stops_with_info_42(tmp_path: Path) -> None:
+    """Already `safe` by a block error (an inlet singleton of 1E39 makes OUTPUT1 +inf at
+    cold and low): the stop keeps the block-fault code 16#42, no second safe-enter."""
+    kb = tmp_path / "huge.fcl"
+    kb.write_text(FPLTEST_FCL.read_text().replace("TERM inlet := 100;", "TERM inlet := 1E39;"))
+    plc = ModbusPLC()
+    toml = modbus_connection("plc", plc.port, timeout=0.5) + modbus_instance("valve", "plc").replace(
+        str(FPLTEST_FCL), str(kb)
+    )
+    rt = make_runtime(tmp_path, toml)
+    try:
+        rt.start()
+        plc.set_float(0, 1.0)  # cold
+        plc.set_float(2, 55.0)  # low
+        wait_until(lambda: plc.float(10) == SAFE_VALVE and plc.registers(12, 1) == [0x42], 10)
+        plc.set_registers(10, [0, 0, 0])  # so that the stop has to write them again
+        rt.stop()
+        assert plc.float(10) == SAFE_VALVE and plc.registers(12, 1) == [0x42]
+        reasons = [e.data["reason"] for e in rt.events.since(0) if e.kind == "safe-enter"]
+        assert "stop" not in reasons, reasons
+    finally:
+        rt.stop()
         plc.close()
