@@ -390,7 +390,9 @@ def test_a_link_that_is_down_at_the_stop_connects_once_to_write_the_safe_values(
         want = running_values(plc)
         wait_until(lambda: running(plc, want), 10)
         plc.stop()
-        wait_until(lambda: rt.links["plc"].state.value == "down", 10)
+        # Down, and waiting out its 30 s back-off (not in the middle of an attempt).
+        wait_until(lambda: any(e.kind == "link-retry" for e in rt.events.since(0)), 15)
+        assert rt.links["plc"].state.value == "down"
         plc.start()  # same port, registers 0
         assert plc.registers(10, 3) == [0, 0, 0]
         rt.stop()
@@ -422,4 +424,36 @@ def test_an_instance_whose_block_cannot_compute_stops_with_info_42(tmp_path: Pat
         assert "stop" not in reasons, reasons
     finally:
         rt.stop()
+        plc.close()
+
+
+def test_a_link_down_at_the_stop_whose_peer_then_hangs_gives_up_at_its_stop_timeout(tmp_path: Path) -> None:
+    """The PLC is not there at the start (the link waits out a 30 s back-off), then is,
+    behind a proxy that accepts the connection and answers nothing: the stop's connection
+    attempt and write are cut at stop_timeout (0.3 s), not at the protocol's timeout
+    (3 s: the write would wait 3.5 s), and the log says so.  (The proxy makes the first
+    attempt fail only at that timeout, hence not 10 s here.)"""
+    plc = ModbusPLC()
+    plc.stop()
+    proxy = FreezableProxy(plc.port)
+    toml = modbus_connection("plc", proxy.port, stop_timeout=0.3, timeout=3.0).replace(
+        "reconnect_min = 0.05\nreconnect_max = 0.2", "reconnect_min = 30\nreconnect_max = 30"
+    ) + modbus_instance("valve", "plc")
+    rt = make_runtime(tmp_path, toml)
+    try:
+        rt.start()
+        wait_until(lambda: any(e.kind == "link-retry" for e in rt.events.since(0)), 15)
+        plc.start()
+        proxy.freeze()
+        t0 = time.monotonic()
+        rt.stop()
+        took = time.monotonic() - t0
+        assert took < 2.0, took  # in process: no interpreter to start or end
+        assert plc.registers(10, 3) == [0, 0, 0]  # nothing arrived
+        (write,) = [e for e in rt.events.since(0) if e.kind == "stop-write"]
+        assert write.level == "error", write.message
+        assert "connect and write: no answer within 0.3 s" in write.message, write.message
+    finally:
+        rt.stop()
+        proxy.close()
         plc.close()

@@ -143,16 +143,18 @@ def create_connector(kind: str, name: str, options: Mapping[str, Any]) -> Connec
     return connector_class(kind).from_options(name, options)
 
 
-async def bounded(awaitable: Awaitable[T], timeout: float, what: str) -> T:
+async def bounded(awaitable: Awaitable[T], timeout: float, what: str, *, stated: float | None = None) -> T:
     """Await with a deadline that holds even when the awaited library swallows the
     cancellation (``asyncio.wait_for`` waits for the cancelled task to finish; a protocol
-    stack stuck in its own retry loop would then hang the link)."""
+    stack stuck in its own retry loop would then hang the link).  The error names
+    ``stated`` as the time allowed when given (the configured bound, of which ``timeout``
+    is what was left)."""
     task = asyncio.ensure_future(awaitable)
     done, _ = await asyncio.wait({task}, timeout=timeout)
     if not done:
         task.cancel()
         task.add_done_callback(_consume)
-        raise LinkError(f"{what}: no answer within {timeout:g} s")
+        raise LinkError(f"{what}: no answer within {timeout if stated is None else stated:g} s")
     return task.result()
 
 

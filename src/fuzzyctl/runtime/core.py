@@ -348,13 +348,24 @@ class Runtime:
         )
 
     def _begin_io_stop(self) -> None:
-        """On the I/O loop: every link's stop deadline, then the stop event (in this order,
-        so that no link sees the event without its deadline)."""
+        """On the I/O loop, between two of its steps (no exchange runs meanwhile): every
+        link's stop deadline (from here only the stop write writes outputs), every
+        instance's safe values into the cells, then the stop event."""
         assert self._loop is not None and self._io_stop is not None
-        now = self._loop.time()
-        for link in self.links.values():
-            link.stop_by = now + link.config.stop_timeout
-        self._io_stop.set()
+        try:
+            now = self._loop.time()
+            for link in self.links.values():
+                link.stop_by = now + link.config.stop_timeout
+            t = self.clock.now()
+            for inst in self.instances.values():
+                try:
+                    inst.stop_safe(t)
+                except Exception as exc:  # one instance's bug must not keep the others from the field
+                    self.events.emit(
+                        "error", f"{inst.name}: at stop: {type(exc).__name__}: {exc}", level="error"
+                    )
+        finally:
+            self._io_stop.set()
 
     def stop_bound(self) -> float:
         """Seconds the field writes of a stop may take at most: the largest
@@ -379,9 +390,6 @@ class Runtime:
             self.api_process = None
         self._stop.set()
         self.scheduler.join(10)
-        now = self.clock.now()
-        for inst in self.instances.values():
-            inst.stop_safe(now)
         if self._loop is not None and self._io_stop is not None:
             self._loop.call_soon_threadsafe(self._begin_io_stop)
         if self._io_thread is not None:

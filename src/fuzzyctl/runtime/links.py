@@ -96,7 +96,8 @@ class Link:
         self._lists: _Lists | None = None  # the bindings as parallel lists, made at the first exchange
         self.stop_by: float | None = None
         """The I/O loop's time by which the stop write must be done; set by the runtime
-        before it sets the stop event (None: ``stop_timeout`` from when the loop ends)."""
+        before it sets the stop event (None: ``stop_timeout`` from when the loop ends).
+        Once set, exchanges no longer write outputs: the stop write is the last one."""
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
@@ -150,6 +151,8 @@ class Link:
             now = time.perf_counter()
             for in_cell, v in zip(in_cells, values, strict=True):
                 in_cell.value, in_cell.stamp = v, now
+        if self.stop_by is not None:
+            return  # stopping: the outputs are written once more by the stop write only
         out_points: list[Point] = []
         out_values: list[float] = []
         sent: list[OutCell] = []
@@ -291,7 +294,8 @@ class Link:
         try:
             if self.stop_by - t0 <= 0:
                 raise LinkError(f"no answer within {timeout:g} s")
-            written = await bounded(go(), self.stop_by - t0, f"no answer within {timeout:g} s; write")
+            what = "connect and write" if not self.up else "write"
+            written = await bounded(go(), self.stop_by - t0, what, stated=timeout)
         except Exception as exc:  # whatever the protocol raised: not written, and said so
             self.stop_failed(describe(exc))
             return
