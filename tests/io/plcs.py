@@ -209,6 +209,7 @@ class FreezableProxy:
         self.port = self._lt.run(self._start())
 
     async def _start(self) -> int:
+        self._clients: set[asyncio.Task[None]] = set()
         self._flowing = asyncio.Event()
         self._flowing.set()
         self._server = await asyncio.start_server(self._client, "127.0.0.1", 0)
@@ -227,6 +228,10 @@ class FreezableProxy:
             writer.close()
 
     async def _client(self, reader: asyncio.StreamReader, writer: asyncio.StreamWriter) -> None:
+        task = asyncio.current_task()
+        assert task is not None
+        self._clients.add(task)
+        task.add_done_callback(self._clients.discard)
         try:
             up_reader, up_writer = await asyncio.open_connection("127.0.0.1", self.target_port)
         except OSError:
@@ -242,7 +247,15 @@ class FreezableProxy:
         assert self._flowing is not None
         self._lt.loop.call_soon_threadsafe(self._flowing.set)
 
+    async def _close(self) -> None:
+        self._server.close()
+        # Connections still open (a peer that froze and was never thawed): ended here, not
+        # left pending when the loop stops.
+        for task in list(self._clients):
+            task.cancel()
+        await asyncio.gather(*self._clients, return_exceptions=True)
+
     def close(self) -> None:
         self.thaw()
-        self._server.close()
+        self._lt.run(self._close())
         self._lt.close()

@@ -75,5 +75,16 @@ def safety_sequence(events: list[Event], instance: str | None = None, link: str 
     ]
 
 
+def until_stop(events: list[Event]) -> list[Event]:
+    """The events before the runtime began to stop: its stop puts every instance that is
+    not yet safe into ``safe`` (reason ``stop``) and logs each link's last write
+    (docs/runtime.md, "Stopping")."""
+    for i, e in enumerate(events):
+        stop_safe = e.kind == "safe-enter" and e.data.get("reason") == "stop"
+        if stop_safe or e.kind in ("stop-write", "runtime-stop"):
+            return events[:i]
+    return events
+
+
 def close(a: float, b: float) -> bool:
     return math.isclose(a, b, rel_tol=1e-6, abs_tol=1e-4)

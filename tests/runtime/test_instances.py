@@ -21,6 +21,7 @@ from tests.runtime.helpers import (
     fpltest_reference,
     make_runtime,
     safety_sequence,
+    until_stop,
 )
 
 
@@ -291,7 +292,7 @@ def test_a_block_that_cannot_compute_puts_the_safe_value_and_info_42_in_the_fiel
         mb.close()
     finally:
         rt.stop()
-    events = assert_log_complete(rt, tmp_path / "events.jsonl")
+    events = until_stop(assert_log_complete(rt, tmp_path / "events.jsonl"))
     wanted = {"error", "error-cleared", "safe-enter", "safe-exit", "hold-start", "hold-end"}
     kinds = [e.kind for e in events if e.instance == "valve" and e.kind in wanted]
     # (The registers hold 0, 0 before the master writes: cold and low, a first episode.)

@@ -16,6 +16,7 @@ from tests.runtime.helpers import (
     fpltest_reference,
     make_runtime,
     safety_sequence,
+    until_stop,
 )
 
 
@@ -104,7 +105,7 @@ INFO = {{ connection = "out", address = 2, type = "uint16" }}
         rt.stop()
         cpu.close()
         out.close()
-    events = assert_log_complete(rt, tmp_path / "events.jsonl")
+    events = until_stop(assert_log_complete(rt, tmp_path / "events.jsonl"))
     # From the stop on (a slow first answer at start-up may already have been lost and retried).
     seq = safety_sequence([e for e in events if e.mono >= stopped_at], instance="valve", link="cpu")
     assert seq == ["link-lost", "hold-start", "safe-enter", "link-up", "safe-exit"]

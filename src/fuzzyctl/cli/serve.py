@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import signal
 import sys
 import threading
@@ -62,20 +63,26 @@ def serve(
     runtime = Runtime(cfg, api=api and cfg.api.enabled, token=not no_token)
     stop = threading.Event()
 
-    def on_signal(_signum: int, _frame: Any) -> None:
+    def on_signal(signum: int, _frame: Any) -> None:
+        if stop.is_set():
+            # A second SIGINT/SIGTERM while stopping: at once, without waiting for the links.
+            err_console.print("stopped at once: the safe values may not all be written", markup=False)
+            sys.stderr.flush()
+            os._exit(128 + signum)
         stop.set()
 
-    previous = signal.signal(signal.SIGTERM, on_signal)
     console = Console(highlight=False)
-    runtime.start()
-    prio = cfg.runtime.realtime_priority
-    if prio > 1:
-        # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
-        # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
-        from fuzzyctl.runtime.scheduler import set_fifo
-
-        set_fifo(prio - 1)
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
+    last: int | None = None
     try:
+        runtime.start()
+        prio = cfg.runtime.realtime_priority
+        if prio > 1:
+            # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
+            # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
+            from fuzzyctl.runtime.scheduler import set_fifo
+
+            set_fifo(prio - 1)
         if runtime.api_address is not None:
             host, port = runtime.api_address
             docs = " (docs: /api/v1/docs)" if cfg.api.docs else ""
@@ -104,8 +111,16 @@ def serve(
     except KeyboardInterrupt:
         last = None
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        stop.set()  # from here a signal means "exit at once"
+        if runtime.started and runtime.links:
+            err_console.print(
+                f"stopping: safe values to the field (at most {runtime.stop_bound():.3g} s; "
+                "Ctrl-C again to exit at once)",
+                markup=False,
+            )
         runtime.stop()
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
     if last is not None:
         _print_events(runtime, last)
     if runtime.scheduler.error is not None:

@@ -15,7 +15,10 @@ from __future__ import annotations
 import abc
 import asyncio
 import importlib
+import queue
+import threading
 from collections.abc import Awaitable, Mapping, Sequence
+from concurrent.futures import Executor, Future
 from enum import StrEnum
 from typing import Any, ClassVar, TypeVar
 
@@ -25,7 +28,16 @@ from fuzzyctl.diagnostics import FuzzyctlError
 
 T = TypeVar("T")
 
-__all__ = ["CONNECTION_TYPES", "Connector", "LinkError", "LinkState", "Point", "bounded", "create_connector"]
+__all__ = [
+    "CONNECTION_TYPES",
+    "Connector",
+    "DaemonExecutor",
+    "LinkError",
+    "LinkState",
+    "Point",
+    "bounded",
+    "create_connector",
+]
 
 
 class LinkState(StrEnum):
@@ -131,16 +143,18 @@ def create_connector(kind: str, name: str, options: Mapping[str, Any]) -> Connec
     return connector_class(kind).from_options(name, options)
 
 
-async def bounded(awaitable: Awaitable[T], timeout: float, what: str) -> T:
+async def bounded(awaitable: Awaitable[T], timeout: float, what: str, *, stated: float | None = None) -> T:
     """Await with a deadline that holds even when the awaited library swallows the
     cancellation (``asyncio.wait_for`` waits for the cancelled task to finish; a protocol
-    stack stuck in its own retry loop would then hang the link)."""
+    stack stuck in its own retry loop would then hang the link).  The error names
+    ``stated`` as the time allowed when given (the configured bound, of which ``timeout``
+    is what was left)."""
     task = asyncio.ensure_future(awaitable)
     done, _ = await asyncio.wait({task}, timeout=timeout)
     if not done:
         task.cancel()
         task.add_done_callback(_consume)
-        raise LinkError(f"{what}: no answer within {timeout:g} s")
+        raise LinkError(f"{what}: no answer within {timeout if stated is None else stated:g} s")
     return task.result()
 
 
@@ -151,3 +165,57 @@ def _consume(task: asyncio.Future[Any]) -> None:
 
 def chunks(items: Sequence[Any], size: int) -> list[Sequence[Any]]:
     return [items[i : i + size] for i in range(0, len(items), size)]
+
+
+class DaemonExecutor(Executor):
+    """Runs blocking protocol calls (python-snap7's sockets) on daemon
+    threads, started as needed up to ``max_workers``.  Unlike the default executor, whose
+    threads the interpreter joins at exit, a thread stuck on a dead peer until its socket
+    timeout does not hold the process once the runtime has given up on it (:func:`bounded`,
+    a link's ``stop_timeout``)."""
+
+    def __init__(self, max_workers: int = 16, name: str = "fuzzyctl-io-call") -> None:
+        self._max = max_workers
+        self._name = name
+        self._queue: queue.SimpleQueue[tuple[Future[Any], Any, tuple[Any, ...], dict[str, Any]] | None] = (
+            queue.SimpleQueue()
+        )
+        self._lock = threading.Lock()
+        self._idle = 0
+        self._threads = 0
+        self._closed = False
+
+    def submit(self, fn: Any, /, *args: Any, **kwargs: Any) -> Future[Any]:
+        future: Future[Any] = Future()
+        with self._lock:
+            if self._closed:
+                raise RuntimeError("the executor is shut down")
+            self._queue.put((future, fn, args, kwargs))
+            if self._idle == 0 and self._threads < self._max:
+                self._threads += 1
+                threading.Thread(target=self._work, name=self._name, daemon=True).start()
+        return future
+
+    def _work(self) -> None:
+        while True:
+            with self._lock:
+                self._idle += 1
+            item = self._queue.get()
+            with self._lock:
+                self._idle -= 1
+            if item is None:
+                return
+            future, fn, args, kwargs = item
+            if not future.set_running_or_notify_cancel():
+                continue
+            try:
+                future.set_result(fn(*args, **kwargs))
+            except BaseException as exc:  # handed to the awaiting coroutine
+                future.set_exception(exc)
+
+    def shutdown(self, wait: bool = True, *, cancel_futures: bool = False) -> None:
+        """Ends the idle threads; a busy one ends after its call (never waited for)."""
+        with self._lock:
+            self._closed = True
+            for _ in range(self._threads):
+                self._queue.put(None)

@@ -40,12 +40,17 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
-from fuzzyctl.io.base import Connector, LinkError, Point, bounded
+from fuzzyctl.io.base import Connector, DaemonExecutor, LinkError, Point, bounded
 from fuzzyctl.io.codec import real_from_bytes, real_to_bytes
 
 __all__ = ["FUZZY_DB", "FUZZY_DB_INTERNAL", "S7Client", "S7Options", "S7Point", "fuzzy_db_address"]
 
 logging.getLogger("snap7").setLevel(logging.CRITICAL)  # the runtime reports link state itself
+
+# python-snap7 blocks: its calls run on daemon threads, so that one stuck on a frozen PLC
+# until its socket timeout does not hold the process at exit (a runtime that stops gives
+# up on it after the link's stop_timeout).
+_CALLS = DaemonExecutor(name="fuzzyctl-s7")
 
 MAX_SPAN = 400  # bytes read in one request before we split (the client chunks by PDU anyway)
 
@@ -160,7 +165,8 @@ class S7Client(Connector):
 
     async def _run(self, what: str, fn: Any, *args: Any) -> Any:
         try:
-            return await bounded(asyncio.to_thread(fn, *args), self.options.timeout + 1, "no answer")
+            call = asyncio.get_running_loop().run_in_executor(_CALLS, fn, *args)
+            return await bounded(call, self.options.timeout + 1, "no answer")
         # snap7 raises its own errors, OSError, RuntimeError and struct errors on a broken
         # connection: all of them mean the link is unusable.
         except Exception as exc:
@@ -233,4 +239,4 @@ class S7Client(Connector):
         client, self._client = self._client, None
         if client is not None:
             with contextlib.suppress(Exception):  # a connection already broken
-                await asyncio.to_thread(client.disconnect)
+                await asyncio.get_running_loop().run_in_executor(_CALLS, client.disconnect)

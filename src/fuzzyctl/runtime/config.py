@@ -116,6 +116,13 @@ class ConnectionConfig(_Strict):
     )
     reconnect_min: float = Field(default=0.1, gt=0, le=60)
     reconnect_max: float = Field(default=5.0, gt=0, le=600)
+    stop_timeout: float = Field(
+        default=1.0,
+        ge=0,
+        le=60,
+        description="seconds the connection may take, when the runtime stops, to write the safe "
+        "values (connecting first when it is down) and close; 0: nothing is written at stop",
+    )
     options: dict[str, Any] = Field(default_factory=dict)
 
     @property

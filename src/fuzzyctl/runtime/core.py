@@ -31,7 +31,7 @@ from fuzzyctl.runtime.config import Config, ConfigError, InstanceConfig
 from fuzzyctl.runtime.events import EventLog
 from fuzzyctl.runtime.instance import Instance
 from fuzzyctl.runtime.kb import KnowledgeBaseSource, PreparedKB, prepare_kb, read_kb
-from fuzzyctl.runtime.links import Link
+from fuzzyctl.runtime.links import CLOSE_GRACE, Link
 from fuzzyctl.runtime.scheduler import RuntimeClock, Scheduler, auto_phases, set_fifo
 from fuzzyctl.webguard import LOOPBACK_NAMES
 
@@ -348,7 +348,37 @@ class Runtime:
         ]
         self._io_ready.set()
         await self._io_stop.wait()
-        await asyncio.gather(*link_tasks, return_exceptions=True)
+        # Each link writes its safe values and closes by its stop_by; all in parallel, so a
+        # dead peer costs its own stop_timeout once, not once per link after it.
+        await asyncio.gather(
+            *(link.stopped(task) for link, task in zip(self.links.values(), link_tasks, strict=True)),
+            return_exceptions=True,
+        )
+
+    def _begin_io_stop(self) -> None:
+        """On the I/O loop, between two of its steps (no exchange runs meanwhile): every
+        link's stop deadline (from here only the stop write writes outputs), every
+        instance's safe values into the cells, then the stop event."""
+        assert self._loop is not None and self._io_stop is not None
+        try:
+            now = self._loop.time()
+            for link in self.links.values():
+                link.stop_by = now + link.config.stop_timeout
+            t = self.clock.now()
+            for inst in self.instances.values():
+                try:
+                    inst.stop_safe(t)
+                except Exception as exc:  # one instance's bug must not keep the others from the field
+                    self.events.emit(
+                        "error", f"{inst.name}: at stop: {type(exc).__name__}: {exc}", level="error"
+                    )
+        finally:
+            self._io_stop.set()
+
+    def stop_bound(self) -> float:
+        """Seconds the field writes of a stop may take at most: the largest
+        ``stop_timeout`` (the links write in parallel) and the closing grace."""
+        return max((lk.config.stop_timeout for lk in self.links.values()), default=0.0) + 3 * CLOSE_GRACE
 
     def call_io(self, coro: Any, timeout: float = 10.0) -> Any:
         """Run a coroutine on the I/O loop from another thread and wait for its result."""
@@ -357,7 +387,9 @@ class Runtime:
         return asyncio.run_coroutine_threadsafe(coro, self._loop).result(timeout)
 
     def stop(self) -> None:
-        """Stop the cycles, close every connection and the API, flush the event log."""
+        """Stop the API and the cycles, put every instance's safe values (and safe INFO)
+        into its output cells, have every link write them and close (each within its
+        ``stop_timeout``), flush the event log (docs/runtime.md, "Stopping")."""
         if not self.started:
             self.events.close()
             return
@@ -367,9 +399,9 @@ class Runtime:
         self._stop.set()
         self.scheduler.join(10)
         if self._loop is not None and self._io_stop is not None:
-            self._loop.call_soon_threadsafe(self._io_stop.set)
+            self._loop.call_soon_threadsafe(self._begin_io_stop)
         if self._io_thread is not None:
-            self._io_thread.join(15)
+            self._io_thread.join(self.stop_bound() + 1.0)
         if self._api_socket is not None:
             self._api_socket.close()
         sys.setswitchinterval(self._switch_interval)

@@ -425,17 +425,45 @@ class Instance:
                 hold_time=hold,
             )
         if self.io_state is SafetyState.HOLD and now - self.io_since >= hold:
-            self._set_io(SafetyState.SAFE, now)
-            self.events.emit(
-                "safe-enter",
-                f"{self.name}: {problems.text()} for {hold:g} s; outputs at their safe values",
-                level="error",
-                instance=self.name,
+            self._go_safe(
+                now,
+                f"{problems.text()} for {hold:g} s",
+                "hold time elapsed",
                 links=problems.links + problems.late,
                 inputs=problems.inputs,
-                reason="hold time elapsed",
-                safe_values={o.name: o.safe for o in self.outputs},
             )
+
+    def _go_safe(self, now: float, why: str, reason: str, **data: Any) -> None:
+        """Enter the I/O state ``safe`` (``safe-enter`` with the safe values); the cycle
+        (or :meth:`stop_safe`) then sets the fault indication and writes the outputs."""
+        self._set_io(SafetyState.SAFE, now)
+        self.events.emit(
+            "safe-enter",
+            f"{self.name}: {why}; outputs at their safe values",
+            level="error",
+            instance=self.name,
+            reason=reason,
+            safe_values={o.name: o.safe for o in self.outputs},
+            **data,
+        )
+
+    def stop_safe(self, now: float) -> None:
+        """The runtime stops (its cycles have ended): the outputs' cells take the safe
+        values and INFO 16#41 (XFUZ: STATUS bit 15, ERROR) - the state a lost link ends
+        in after ``hold_time``, entered at once - for the links' last write."""
+        # The cycle thread has stopped and the API with it, so the lock is free; should a
+        # cycle be stuck in the block, the cells are set all the same (plain attributes).
+        locked = self.lock.acquire(timeout=1.0)
+        try:
+            if self.state is SafetyState.SAFE:
+                self._set_io(SafetyState.SAFE, now)  # already safe (start-up, lost link, block error)
+            else:
+                self._go_safe(now, "the runtime is stopping", "stop")
+            self.adapter.fault = "block" if self.error is not None else SafetyState.SAFE.value
+            self._write_outputs()
+        finally:
+            if locked:
+                self.lock.release()
 
     def _set_io(self, state: SafetyState, now: float) -> None:
         self.io_state, self.io_since = state, now

@@ -10,6 +10,11 @@ delays a cycle.
 On a failure the link goes down, closes the connector and reconnects with exponential
 back-off from ``reconnect_min`` to ``reconnect_max``.  It is up again only after a
 complete exchange, so an instance that sees the link up also sees fresh inputs.
+
+When the runtime stops, the instances have put their safe values into the output cells;
+each link then writes its output cells once more (connecting first if it is down) and
+closes, all of it by ``stop_by`` (the stop plus the connection's ``stop_timeout``), and
+logs what it wrote or why it could not (``stop-write``).
 """
 
 from __future__ import annotations
@@ -20,11 +25,15 @@ import math
 import time
 from dataclasses import dataclass, field
 
-from fuzzyctl.io.base import Connector, LinkError, LinkState, Point
+from fuzzyctl.io.base import Connector, LinkError, LinkState, Point, bounded
 from fuzzyctl.runtime.config import ConnectionConfig
 from fuzzyctl.runtime.events import EventLog
 
-__all__ = ["InCell", "Link", "OutCell"]
+__all__ = ["CLOSE_GRACE", "InCell", "Link", "OutCell"]
+
+CLOSE_GRACE = 0.2
+"""Seconds a link may take to close after its stop write (a peer that answered the write
+closes at once; a dead one is not waited for)."""
 
 
 class InCell:
@@ -85,6 +94,10 @@ class Link:
         self._out: dict[Point, OutCell] = {}
         self._mirror: dict[Point, OutCell] = {}
         self._lists: _Lists | None = None  # the bindings as parallel lists, made at the first exchange
+        self.stop_by: float | None = None
+        """The I/O loop's time by which the stop write must be done; set by the runtime
+        before it sets the stop event (None: ``stop_timeout`` from when the loop ends).
+        Once set, exchanges no longer write outputs: the stop write is the last one."""
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
@@ -138,6 +151,8 @@ class Link:
             now = time.perf_counter()
             for in_cell, v in zip(in_cells, values, strict=True):
                 in_cell.value, in_cell.stamp = v, now
+        if self.stop_by is not None:
+            return  # stopping: the outputs are written once more by the stop write only
         out_points: list[Point] = []
         out_values: list[float] = []
         sent: list[OutCell] = []
@@ -162,6 +177,14 @@ class Link:
         self.counters.exchanges += 1
         self.last_exchange = end = time.perf_counter()
         self.counters.last_exchange_ms = (end - t0) * 1e3
+
+    async def write_outputs(self) -> dict[str, float]:
+        """Write every output cell that has a value (not the parameter mirrors); returns
+        what was written, by point."""
+        items = [(p, c.value) for p, c in self._out.items() if c.value is not None]
+        if items:
+            await self.connector.write([p for p, _ in items], [v for _, v in items])
+        return {p.describe(): v for p, v in items}
 
     async def _connect(self) -> None:
         await self.connector.connect()
@@ -234,8 +257,84 @@ class Link:
                 await self.connector.close()
                 continue
             await _wait(stop, max(0.0, start + cfg.poll_interval - loop.time()))
-        await self.connector.close()
+        if self.stop_by is None:
+            self.stop_by = loop.time() + cfg.stop_timeout
+        await self._stop_write()
+        with contextlib.suppress(LinkError):
+            await bounded(self.connector.close(), max(self.stop_by - loop.time(), CLOSE_GRACE), "close")
         self._set_state(LinkState.CLOSED)
+
+    async def _stop_write(self) -> None:
+        """The last write of the output cells (the safe values), by ``stop_by``; a link
+        that is down connects once first (a server that is not serving does not)."""
+        if not self._out:
+            return
+        loop = asyncio.get_running_loop()
+        assert self.stop_by is not None
+        timeout = self.config.stop_timeout
+        t0 = loop.time()
+
+        async def go() -> dict[str, float]:
+            if not self.up:
+                if self.connector.server:
+                    raise LinkError("not serving")
+                await self.connector.close()
+                await self.connector.connect()
+            return await self.write_outputs()
+
+        if timeout == 0:
+            self.events.emit(
+                "stop-write",
+                f"{self.name}: at stop nothing written (stop_timeout = 0): the field keeps the last values",
+                level="warning",
+                link=self.name,
+                written={},
+            )
+            return
+        try:
+            if self.stop_by - t0 <= 0:
+                raise LinkError(f"no answer within {timeout:g} s")
+            what = "connect and write" if not self.up else "write"
+            written = await bounded(go(), self.stop_by - t0, what, stated=timeout)
+        except Exception as exc:  # whatever the protocol raised: not written, and said so
+            self.stop_failed(describe(exc))
+            return
+        shown = ", ".join(f"{k} = {v:g}" for k, v in written.items())
+        self.events.emit(
+            "stop-write",
+            f"{self.name}: at stop wrote {shown or 'nothing (no output has a value yet)'}",
+            link=self.name,
+            written=written,
+            seconds=round(loop.time() - t0, 6),
+        )
+
+    async def stopped(self, task: asyncio.Task[None]) -> None:
+        """Wait for :meth:`run` (``task``) to end after the stop event, at most until
+        ``stop_by`` plus :data:`CLOSE_GRACE`: an exchange or a connection attempt in
+        progress on a dead peer (bounded only by the protocol's timeout) is cut there."""
+        loop = asyncio.get_running_loop()
+        if self.stop_by is None:
+            self.stop_by = loop.time() + self.config.stop_timeout
+        # Past the close's own bound (stop_by, or CLOSE_GRACE after a late write): run() is stuck.
+        done, _ = await asyncio.wait({task}, timeout=max(0.0, self.stop_by - loop.time()) + 2 * CLOSE_GRACE)
+        if done:
+            return
+        task.cancel()
+        self.stop_failed(f"no answer within {self.config.stop_timeout:g} s (an exchange was in progress)")
+        with contextlib.suppress(Exception):  # closing a connection that hangs: not waited for
+            await bounded(self.connector.close(), CLOSE_GRACE, "close")
+        self._set_state(LinkState.CLOSED)
+
+    def stop_failed(self, why: str) -> None:
+        """Log that the stop write did not reach the field (``stop-write``, level error)."""
+        self.events.emit(
+            "stop-write",
+            f"{self.name}: at stop the safe values were NOT written: {why}",
+            level="error",
+            link=self.name,
+            written={},
+            error=why,
+        )
 
 
 def describe(exc: BaseException) -> str:
