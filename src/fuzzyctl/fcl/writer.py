@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
+from fuzzyctl.escape import fcl_comment, fcl_options
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.fcl.no_if import with_if_parts
@@ -62,25 +63,13 @@ def param_text(p: Param) -> str:
 
 
 def _comment_lines(comments: Iterable[str], indent: str) -> list[str]:
+    # Every comment passes fcl_comment (a model's comments are untrusted text: one from JSON,
+    # FPL or FLL could otherwise end the comment and add rules or blocks).
     out: list[str] = []
     for text in comments:
-        body = text
-        if text.startswith("//"):
-            body = text[2:].strip()
-        elif (text.startswith("/*") and text.endswith("*/")) or (
-            text.startswith("(*") and text.endswith("*)")
-        ):
-            body = text[2:-2].strip()
-        if "*)" in body or "(*" in body:
-            out.append(indent + text if "\n" not in text else text)
-            continue
-        lines = body.splitlines() or [""]
-        if len(lines) == 1:
-            out.append(f"{indent}(* {lines[0]} *)")
-        else:
-            out.append(f"{indent}(* " + lines[0])
-            out.extend(lines[1:-1])
-            out.append(lines[-1] + " *)")
+        first, *rest = fcl_comment(text).splitlines()
+        out.append(indent + first)
+        out.extend(rest)
     return out
 
 
@@ -281,7 +270,7 @@ def _rule_block(b: RuleBlock) -> list[str]:
 
 def _options(o: OptionsBlock) -> list[str]:
     end = "END_OPTION" if o.keyword == "OPTION" else "END_OPTIONS"
-    body = [INDENT * 2 + line if line else "" for line in o.text.splitlines()]
+    body = [INDENT * 2 + line if line else "" for line in fcl_options(o.text).splitlines()]
     return [f"{INDENT}{o.keyword}", *body, f"{INDENT}{end}", ""]
 
 
