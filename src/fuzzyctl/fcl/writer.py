@@ -16,6 +16,7 @@ from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.fcl.no_if import with_if_parts
 from fuzzyctl.fcl.parser import number_text
+from fuzzyctl.fcl.words import unwritable_words
 from fuzzyctl.model import (
     And,
     Binary,
@@ -312,7 +313,7 @@ def write_block(fb: FunctionBlock) -> str:
     """FCL text of one function block; a name FCL could not read back is an error (all such
     names are listed) rather than a file that does not load."""
     fb = with_if_parts(fb)  # rules without an IF part: IF ALWAYS THEN (fcl/no_if.py)
-    problems = unwritable_names(fb)
+    problems = unwritable_names(fb) + unwritable_words(fb)
     if problems:
         raise DiagnosticError(problems)
     out = [*_comment_lines(fb.comments, ""), "FUNCTION_BLOCK" + (f" {fb.name}" if fb.name else ""), ""]
