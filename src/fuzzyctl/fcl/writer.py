@@ -9,6 +9,7 @@ gives a model equal to the input (tested on every corpus file and on random mode
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.escape import fcl_comment, fcl_options
@@ -271,7 +272,7 @@ def _rule_block(b: RuleBlock) -> list[str]:
 
 def _options(o: OptionsBlock) -> list[str]:
     end = "END_OPTION" if o.keyword == "OPTION" else "END_OPTIONS"
-    body = [INDENT * 2 + line if line else "" for line in fcl_options(o.text).splitlines()]
+    body = [INDENT * 2 + line if line else "" for line in o.text.splitlines()]
     return [f"{INDENT}{o.keyword}", *body, f"{INDENT}{end}", ""]
 
 
@@ -313,6 +314,8 @@ def write_block(fb: FunctionBlock) -> str:
     """FCL text of one function block; a name FCL could not read back is an error (all such
     names are listed) rather than a file that does not load."""
     fb = with_if_parts(fb)  # rules without an IF part: IF ALWAYS THEN (fcl/no_if.py)
+    # OPTIONS text is free text: no END_OPTIONS inside, no control characters (escape.py)
+    fb = replace(fb, options=tuple(replace(o, text=fcl_options(o.text)) for o in fb.options))
     problems = unwritable_names(fb) + unwritable_words(fb)
     if problems:
         raise DiagnosticError(problems)
