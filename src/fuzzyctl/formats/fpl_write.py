@@ -9,6 +9,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
 from fuzzyctl.formats._common import identifier
 from fuzzyctl.formats._lower import rename
 from fuzzyctl.formats.fpl import ADDING_ACCU, SIEMENS_ACCU, is_fpl_name, leaves, shared_conclusions
+from fuzzyctl.formats.fpl_parse import MAX_NAME
 from fuzzyctl.model import (
     And,
     Condition,
@@ -228,10 +229,10 @@ def _singleton_width(dz: DefuzzifyBlock, variable: Variable | None) -> float:
 def _fpl_word(name: str, taken: set[str]) -> str:
     """``name`` when FPL reads it back as one name, else the nearest identifier: a name from
     another format may hold a space (MATLAB's), a newline or ``/*`` (JSON), which would end
-    the statement or open a comment."""
-    if is_fpl_name(name) and name not in taken:
+    the statement or open a comment; one longer than the reader takes is cut."""
+    if is_fpl_name(name) and len(name) <= MAX_NAME and name not in taken:
         return name
-    word = identifier(name, taken)
+    word = identifier(name[: MAX_NAME - 12], taken)
     return word if is_fpl_name(word) else identifier(f"{word}_fpl", taken)
 
 
@@ -277,7 +278,8 @@ def write_fpl(block: FunctionBlock | Document) -> str:
     out.append(f"FUZZY {base_name}")
     for rb_rule in base.rules if base else ():
         label = rb_rule.label
-        if not ((label.isascii() and label.isdigit()) or is_fpl_name(label)):  # FPL's number or word
+        # a label FPL reads back: a number or a word of at most MAX_NAME characters
+        if not ((label.isascii() and label.isdigit()) or is_fpl_name(label)) or len(label) > MAX_NAME:
             label = _fpl_word(label, labels)  # not one of the other labels
         out.append(f"RULE {label}")
         subconditions = list(leaves(rb_rule.condition))
