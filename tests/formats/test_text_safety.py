@@ -195,7 +195,8 @@ def _all_comments(doc: Document, text: str) -> Document:
             comments=c,
             variables=tuple(replace(v, comments=c) for v in fb.variables),
             fuzzify=tuple(
-                replace(b, comments=c, terms=tuple(replace(t, comments=c) for t in b.terms)) for b in fb.fuzzify
+                replace(b, comments=c, terms=tuple(replace(t, comments=c) for t in b.terms))
+                for b in fb.fuzzify
             ),
             defuzzify=tuple(
                 replace(b, comments=c, terms=tuple(replace(t, comments=c) for t in b.terms))
@@ -226,7 +227,11 @@ def _source(fmt: str, field: str | None, text: str) -> str:
         if field == "comment":
             data["comment"] = text
         return json.dumps(data)
-    return H.fill(H.TEMPLATES[fmt], field, text)
+    source = H.fill(H.TEMPLATES[fmt], field, text)
+    if fmt == "fll" and field == "QQvcmtQQ":  # a description under every variable too
+        source = re.sub(r"^((?:In|Out)putVariable: .*)$", r"\1\n  description: QQvcmtQQ", source, flags=re.M)
+        source = source.replace("QQvcmtQQ", text)
+    return source
 
 
 def _numbers(doc: Document) -> tuple[Any, ...]:
@@ -268,7 +273,9 @@ BENIGN_TEXT = {"QQcmtQQ": "a comment", "QQvcmtQQ": "a note"}
 
 
 def _cases() -> list[Any]:
-    return [pytest.param(fmt, field, id=f"{fmt}-{field.strip('Q')}") for fmt, fs in FIELDS.items() for field in fs]
+    return [
+        pytest.param(fmt, field, id=f"{fmt}-{field.strip('Q')}") for fmt, fs in FIELDS.items() for field in fs
+    ]
 
 
 @pytest.mark.parametrize(("fmt", "field"), _cases())
@@ -306,6 +313,7 @@ def test_hostile_comments_in_every_position_of_an_fcl_file() -> None:
     lines = H.fill(H.FCL, None, "").splitlines()
     plain = fuzzyctl.load("\n".join(lines), format="fcl")
     tried = 0
+    covered: set[int] = set()
     for key, text in HOSTILE.items():
         if key == "flood":
             continue  # the length is tested elsewhere; here it would only cost time
@@ -317,7 +325,9 @@ def test_hostile_comments_in_every_position_of_an_fcl_file() -> None:
         if not any(ch in text for ch in "\r\n"):
             forms.append(f"//{text}")
         for form in forms:
-            for at in range(1, len(lines)):
+            tried += 1
+            for at in range(1 + tried % 3, len(lines), 3):  # every line, over three forms
+                covered.add(at)
                 source = "\n".join([*lines[:at], form, *lines[at:]])
                 try:
                     doc = fuzzyctl.load(source, format="fcl")
@@ -326,8 +336,7 @@ def test_hostile_comments_in_every_position_of_an_fcl_file() -> None:
                 assert doc == plain
                 again = fuzzyctl.load(write(doc), format="fcl")
                 assert again == plain, (form[:60], at)  # equal models compute the same
-                tried += 1
-    assert tried > 500
+    assert tried > 50 and covered == set(range(1, len(lines)))
 
 
 # --------------------------------------------------------------------------- CLI and studio
@@ -364,7 +373,6 @@ def test_cli_convert_of_a_lone_surrogate_is_no_internal_error(tmp_path: Path) ->
 
 def test_fcl_writer_refuses_words_that_are_not_words() -> None:
     data = json.loads(H.json_model(_benign_fcl(), None, ""))
-    block = data["blocks"][0]
     evil = "MIN; END_RULEBLOCK END_FUNCTION_BLOCK FUNCTION_BLOCK evil END_FUNCTION_BLOCK (*"
     setters: list[Callable[[dict[str, Any]], None]] = [
         lambda b: b["rule_blocks"][0].__setitem__("and_op", evil),
@@ -392,7 +400,9 @@ def test_studio_import_then_save_runs_what_the_json_says(tmp_path: Path) -> None
     root.mkdir()
     client = TestClient(create_app(root), base_url="http://127.0.0.1:8770")
     raw = _smuggling_json().encode()
-    r = client.post("/api/import", json={"filename": "evil.json", "data_base64": base64.b64encode(raw).decode()})
+    r = client.post(
+        "/api/import", json={"filename": "evil.json", "data_base64": base64.b64encode(raw).decode()}
+    )
     assert r.status_code == 200, r.text
     imported = r.json()
     assert fuzzyctl.load(imported["text"], format="fcl") == _benign_fcl()

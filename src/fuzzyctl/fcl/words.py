@@ -20,10 +20,12 @@ from fuzzyctl.model import (
     Binary,
     Call,
     Condition,
+    DefuzzifyBlock,
     Degree,
     Expr,
     FunctionBlock,
     FunctionMF,
+    FuzzifyBlock,
     Is,
     MembershipFunction,
     Name,
@@ -95,7 +97,8 @@ def _block_words(fb: FunctionBlock) -> Iterator[tuple[str, str, str, Span | None
         yield "data type", v.data_type, "word", v.span
         if isinstance(v.initial, str):
             yield "initial value", v.initial, "word", v.span
-    for blk in [*fb.fuzzify, *fb.defuzzify]:
+    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    for blk in blocks:
         yield "variable", blk.variable, "name", blk.span
         for t in blk.terms:
             for p in _params(t.mf):
