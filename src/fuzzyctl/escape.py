@@ -126,7 +126,7 @@ def fcl_comment(text: str) -> str:
     else its body goes between ``(* *)`` with every ``*)``, ``(*``, ``*/`` and ``/*`` split by a
     space, so no text can end the comment and become FCL."""
     text = str(text)
-    safe = visible_text(text)
+    safe = visible_text(text)  # line ends as "\n", what a file cannot hold as <U+XXXX>
     body = safe
     if safe.startswith("//"):
         body = safe[2:].strip()
@@ -135,8 +135,8 @@ def fcl_comment(text: str) -> str:
     ):
         body = safe[2:-2].strip()
     if "*)" in body or "(*" in body:
-        if safe == text and _FCL_COMMENT.fullmatch(text):
-            return text  # one comment of FCL already, as the file had it
+        if safe == text.replace("\r\n", "\n").replace("\r", "\n") and _FCL_COMMENT.fullmatch(safe):
+            return safe  # one comment of FCL already, as the file had it (line ends "\n")
         body = _FCL_DELIMITERS.sub(lambda m: m.group() + " ", body)
     return f"(* {body} *)"
 

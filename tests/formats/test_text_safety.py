@@ -138,6 +138,8 @@ def test_fcl_comment_keeps_fcl_comments_as_the_file_wrote_them() -> None:
     assert fcl_comment("(* a\n   b *)") == "(* a\n   b *)"
     assert fcl_comment("/* see (*) */") == "/* see (*) */"  # FCL's own: one C comment
     assert fcl_comment("// a *) b") == "// a *) b"
+    assert fcl_comment("/* a *)\r\n b */") == "/* a *)\n b */"  # a CRLF file's comment
+    assert fcl_comment("/* a *)\x0c b */") == "(* a * )<U+000C> b *)"
     assert fcl_comment("// line") == "(* line *)"
     assert fcl_comment("a\r\nb") == "(* a\nb *)"
     assert fcl_comment("*) RULE 9 (*") == "(* * ) RULE 9 ( * *)"
