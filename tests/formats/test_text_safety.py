@@ -26,7 +26,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from hypothesis import given
+from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 import fuzzyctl
@@ -34,12 +34,13 @@ from fuzzyctl import formats
 from fuzzyctl.cli.app import main
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.escape import fcl_comment, fcl_options, json_text, one_line, visible_text
-from fuzzyctl.fcl import write
+from fuzzyctl.fcl import load_text, write
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.formats.json import dumps as json_dumps
 from fuzzyctl.model import Document, FunctionBlock, OptionsBlock
 from tests.codegen import hostile as H
+from tests.fcl.strategies import documents as random_documents
 
 #: The codegen injection strings, and what smuggles syntax into the interchange formats.
 HOSTILE: dict[str, str] = {
@@ -177,6 +178,18 @@ def test_json_text_reads_back_the_same(text: str) -> None:
     shown = visible_text(text)
     shown.encode("utf-8")
     assert not any(ch in _LINE_BREAKS for ch in shown)
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(random_documents, any_text)
+def test_random_models_with_hostile_comments_round_trip(doc: Document, text: str) -> None:
+    """Random valid models (tests/fcl/strategies.py) with ``text`` as the comment of every
+    element: the FCL read back is the same model, and holds exactly one comment per comment."""
+    hostile = _all_comments(doc, text)
+    written = write(hostile)
+    assert load_text(written).document == doc, written[:2000]
+    if not any(fb.options for fb in doc.blocks):  # OPTIONS text may look like a comment
+        assert len(_FCL_COMMENT.findall(written)) == len(_comments(hostile))
 
 
 # --------------------------------------------------------------------------- every reader, every writer
