@@ -120,6 +120,8 @@ def test_fcl_comment_is_one_comment_for_both_readers(text: str) -> None:
     assert not any(ch in _LINE_BREAKS for ch in comment)
     found = _FCL_COMMENT.match(comment)
     assert found is not None and found.end() == len(comment), comment
+    if comment != text.replace("\r\n", "\n").replace("\r", "\n"):  # not kept as the file had it
+        assert comment.startswith("(* ") and not re.search(r"\(\*|\*\)", comment[2:-2])  # nor nested
     for fast in (False, True):  # lark alone, and the fast reader with lark
         plain = parse_source(Source(_with_comment("")), fast=fast).document
         doc = parse_source(Source(_with_comment(comment)), fast=fast).document
