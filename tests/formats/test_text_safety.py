@@ -465,3 +465,11 @@ def test_generated_code_with_hostile_comments_is_still_one_block(tmp_path: Path)
         root = etree.fromstring(xml.encode("utf-8"))
         pous = root.findall(".//{*}pou")
         assert len(pous) == 1, key
+
+
+def test_fpl_comments_are_written_once() -> None:
+    """The FPL reader put its comments on the block and on the document: FCL had them twice
+    (the reproducer's smuggled block was 'defined twice')."""
+    doc = formats.read_text(H.fill(H.FPL, "QQcmtQQ", "one note"), "fpl").document
+    text, _ = formats.convert(doc, "fcl", lossy=True)
+    assert _FCL_COMMENT.findall(text) == ["(* one note *)"]
