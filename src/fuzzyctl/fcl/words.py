@@ -132,7 +132,11 @@ def unwritable_words(fb: FunctionBlock) -> list[Diagnostic]:
     """Operators, methods, hedges, data types, initial values, functions and the names rules
     and terms refer to that FCL would not read back as the same one word."""
     found: list[Diagnostic] = []
+    seen: set[tuple[str, str]] = set()  # rules repeat their names: each checked (and told) once
     for what, text, kind, span in _block_words(fb):
+        if (kind, text) in seen:
+            continue
+        seen.add((kind, text))
         ok = fcl_term(text) if kind == "name" else kind == "word" and _WORD.fullmatch(text) is not None
         if not ok:
             found.append(
