@@ -101,15 +101,20 @@ def _with_comment(comment: str) -> str:
 
 
 def _comments(doc: Document) -> list[str]:
-    """Every comment text the model holds, in no particular order."""
-    out = list(doc.comments)
+    """Every comment text the model holds, in no particular order (also those placed around
+    an element's keywords, where the model has ``placed_comments``)."""
+
+    def of(element: Any) -> list[str]:
+        return [*element.comments, *(text for _, text in getattr(element, "placed_comments", ()))]
+
+    out = of(doc)
     for fb in doc.blocks:
-        out.extend(fb.comments)
-        for elements in (fb.variables, fb.fuzzify, fb.defuzzify, fb.rule_blocks):
+        out.extend(of(fb))
+        for elements in (fb.variables, fb.fuzzify, fb.defuzzify, fb.rule_blocks, fb.options):
             for e in elements:
-                out.extend(e.comments)
+                out.extend(of(e) if hasattr(e, "comments") else [])
                 for inner in getattr(e, "terms", ()) or getattr(e, "rules", ()):
-                    out.extend(inner.comments)
+                    out.extend(of(inner))
     return sorted(out)
 
 
