@@ -433,7 +433,12 @@ def test_studio_import_then_save_runs_what_the_json_says(tmp_path: Path) -> None
 
     root = tmp_path / "project"
     root.mkdir()
-    client = TestClient(create_app(root), base_url="http://127.0.0.1:8770")
+    token = "text-safety-test-token-0123456789"
+    client = TestClient(
+        create_app(root, token=token),
+        base_url="http://127.0.0.1:8770",
+        headers={"Authorization": f"Bearer {token}"},
+    )
     raw = _smuggling_json().encode()
     r = client.post(
         "/api/import", json={"filename": "evil.json", "data_base64": base64.b64encode(raw).decode()}
