@@ -121,10 +121,11 @@ def fcl_comment(text: str) -> str:
     """``text`` (a model comment: the source text of an FCL comment with its delimiters, or the
     plain text another format gave) as exactly one FCL comment, which may span lines.
 
-    A comment already written as one FCL comment (``(* ... *)``, ``/* ... */``, ``// ...``) of
-    visible text is kept only if it has ``(*`` or ``*)`` inside (FCL's own ``/* a *) b */``);
-    else its body goes between ``(* *)`` with every ``*)``, ``(*``, ``*/`` and ``/*`` split by a
-    space, so no text can end the comment and become FCL."""
+    The body (the text without its ``(* *)``, ``/* */`` or ``//``) goes between ``(* *)``.  When
+    it holds ``(*`` or ``*)``, a comment that is already exactly one FCL comment of visible text
+    (FCL's own ``/* a *) b */``) is kept as written; any other text has every ``*)``, ``(*``,
+    ``*/`` and ``/*`` split by a space, so it can neither end the comment (and become FCL) nor
+    open another one in a reader that nests comments."""
     text = str(text)
     safe = visible_text(text)  # line ends as "\n", what a file cannot hold as <U+XXXX>
     body = safe
