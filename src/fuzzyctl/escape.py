@@ -14,6 +14,11 @@ IEC 61131-3 ST / SCL      :func:`st_comment` (body of ``(* *)``, also an SCL ``R
                           :func:`st_string` (a literal), :func:`st_ident` (refuses)
 XML (PLCopen TC6)         :func:`xml_text`, :func:`xml_attr`, :func:`xml_comment`
 Python                    :func:`py_str` (a literal), :func:`py_ident` (refuses)
+IEC 61131-7 FCL           :func:`fcl_comment` (a whole comment), :func:`fcl_options` (the text
+                          of an ``OPTIONS`` block); names are checked by the FCL writer
+line-based formats        :func:`one_line` (a name or description that must stay on its line:
+                          FLL, FIS)
+JSON                      :func:`json_text` (the written document, lone surrogates escaped)
 ========================  =====================================================================
 
 Comment bodies are one line of printable ASCII: ``*/``, ``/*``, ``(*``, ``*)`` and ``??``
@@ -22,6 +27,12 @@ NUL, U+2028, bidirectional controls - the "Trojan Source" trick - and any non-AS
 letter) is written as ``<U+XXXX>``, and the body is cut to :data:`MAX_COMMENT` characters.
 Identifiers are never rewritten (that could merge two names): what is not an identifier of
 the target is refused with :class:`CodegenError` naming it.
+
+Interchange formats keep more than generated code: comments may span lines and hold any
+letter, so :func:`fcl_comment` keeps newlines, tabs and printable Unicode and writes only the
+characters a reader could take for a line end or that a file cannot hold (other control
+characters, U+2028/U+2029, U+0085, the BOM, bidirectional controls, lone surrogates) as
+``<U+XXXX>``; ``\r\n`` and a lone ``\r`` become ``\n``.
 
 This module imports nothing of fuzzyctl but the error base class, so the engine (Python
 source of the specialised path), the code generators and the PLCopen writer share it.
@@ -73,6 +84,75 @@ def st_comment(text: str) -> str:
     ``REGION`` title, which runs to the end of the line): one line of printable ASCII with
     no ``(*``, ``*)``, ``/*`` or ``*/``."""
     return _one_line(text, MAX_COMMENT)
+
+
+# --------------------------------------------------------------------------- interchange formats
+
+# What a text of an interchange file may not hold as it is: control characters but tab and
+# newline, the other line ends (U+0085, U+2028, U+2029), format characters (BOM, the
+# bidirectional controls, zero-width ones), lone surrogates (no UTF-8 for them) and the two
+# noncharacters U+FFFE/U+FFFF.
+_UNSAFE_TEXT = re.compile(
+    "[\x00-\x08\x0b-\x1f\x7f-\x9f\u00ad\u061c\u180e\u200b-\u200f\u2028-\u202e"
+    "\u2060-\u206f\ufeff\ufff9-\ufffb\ufffe\uffff\ud800-\udfff]"
+)
+# One comment of FCL as the lark and the fast reader both end it (they do not nest).
+_FCL_COMMENT = re.compile(r"\(\*(?:(?!\*\)).)*\*\)|/\*(?:(?!\*/).)*\*/|//[^\n]*", re.S)
+# '*' next to ')' or '/' ends a comment, '(' or '/' before '*' opens one (in a reader that
+# nests): a space between them makes each inert.
+_FCL_DELIMITERS = re.compile(r"\*(?=[)/])|[(/](?=\*)")
+_END_OPTIONS = re.compile(r"\b(END)_(OPTIONS?)\b", re.I)
+
+
+def visible_text(text: str) -> str:
+    """``text`` with line ends as ``\\n`` (``\\r\\n`` and ``\\r`` too) and every character of
+    ``_UNSAFE_TEXT`` as ``<U+XXXX>``: newlines, tabs and printable Unicode are kept."""
+    text = str(text).replace("\r\n", "\n").replace("\r", "\n")
+    return _UNSAFE_TEXT.sub(lambda m: f"<U+{ord(m.group()):04X}>", text)
+
+
+def one_line(text: str) -> str:
+    """``text`` on one line: :func:`visible_text` with newlines and tabs as ``<U+000A>`` and
+    ``<U+0009>`` (a name or description of a line-based format, FLL or FIS)."""
+    return visible_text(text).replace("\n", "<U+000A>").replace("\t", "<U+0009>")
+
+
+def fcl_comment(text: str) -> str:
+    """``text`` (a model comment: the source text of an FCL comment with its delimiters, or the
+    plain text another format gave) as exactly one FCL comment, which may span lines.
+
+    The body (the text without its ``(* *)``, ``/* */`` or ``//``) goes between ``(* *)``.  When
+    it holds ``(*`` or ``*)``, a comment that is already exactly one FCL comment of visible text
+    (FCL's own ``/* a *) b */``) is kept as written; any other text has every ``*)``, ``(*``,
+    ``*/`` and ``/*`` split by a space, so it can neither end the comment (and become FCL) nor
+    open another one in a reader that nests comments."""
+    text = str(text)
+    safe = visible_text(text)  # line ends as "\n", what a file cannot hold as <U+XXXX>
+    body = safe
+    if safe.startswith("//"):
+        body = safe[2:].strip()
+    elif len(safe) >= 4 and (
+        (safe.startswith("/*") and safe.endswith("*/")) or (safe.startswith("(*") and safe.endswith("*)"))
+    ):
+        body = safe[2:-2].strip()
+    if "*)" in body or "(*" in body:
+        if safe == text.replace("\r\n", "\n").replace("\r", "\n") and _FCL_COMMENT.fullmatch(safe):
+            return safe  # one comment of FCL already, as the file had it (line ends "\n")
+        body = _FCL_DELIMITERS.sub(lambda m: m.group() + " ", body)
+    return f"(* {body} *)"
+
+
+def fcl_options(text: str) -> str:
+    """The text of an FCL ``OPTIONS`` block (vendor-specific, read up to the first word
+    ``END_OPTIONS``/``END_OPTION``): :func:`visible_text`, with such a word inside written
+    ``END<U+005F>OPTIONS`` so that it cannot end the block early."""
+    return _END_OPTIONS.sub(lambda m: f"{m.group(1)}<U+005F>{m.group(2)}", visible_text(text))
+
+
+def json_text(text: str) -> str:
+    """JSON text (written with ``ensure_ascii=False``) with each lone surrogate as its
+    ``\\uXXXX`` escape: JSON reads it back as the same string, and the file can be UTF-8."""
+    return re.sub("[\ud800-\udfff]", lambda m: f"\\u{ord(m.group()):04x}", text)
 
 
 # --------------------------------------------------------------------------- string literals

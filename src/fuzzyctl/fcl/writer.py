@@ -9,12 +9,15 @@ gives a model equal to the input (tested on every corpus file and on random mode
 from __future__ import annotations
 
 from collections.abc import Iterable
+from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
+from fuzzyctl.escape import fcl_comment, fcl_options
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.fcl.no_if import with_if_parts
 from fuzzyctl.fcl.parser import number_text
+from fuzzyctl.fcl.words import unwritable_words
 from fuzzyctl.model import (
     And,
     Binary,
@@ -62,25 +65,13 @@ def param_text(p: Param) -> str:
 
 
 def _comment_lines(comments: Iterable[str], indent: str) -> list[str]:
+    # Every comment passes fcl_comment (a model's comments are untrusted text: one from JSON,
+    # FPL or FLL could otherwise end the comment and add rules or blocks).
     out: list[str] = []
     for text in comments:
-        body = text
-        if text.startswith("//"):
-            body = text[2:].strip()
-        elif (text.startswith("/*") and text.endswith("*/")) or (
-            text.startswith("(*") and text.endswith("*)")
-        ):
-            body = text[2:-2].strip()
-        if "*)" in body or "(*" in body:
-            out.append(indent + text if "\n" not in text else text)
-            continue
-        lines = body.splitlines() or [""]
-        if len(lines) == 1:
-            out.append(f"{indent}(* {lines[0]} *)")
-        else:
-            out.append(f"{indent}(* " + lines[0])
-            out.extend(lines[1:-1])
-            out.append(lines[-1] + " *)")
+        first, *rest = fcl_comment(text).splitlines()
+        out.append(indent + first)
+        out.extend(rest)
     return out
 
 
@@ -323,7 +314,9 @@ def write_block(fb: FunctionBlock) -> str:
     """FCL text of one function block; a name FCL could not read back is an error (all such
     names are listed) rather than a file that does not load."""
     fb = with_if_parts(fb)  # rules without an IF part: IF ALWAYS THEN (fcl/no_if.py)
-    problems = unwritable_names(fb)
+    # OPTIONS text is free text: no END_OPTIONS inside, no control characters (escape.py)
+    fb = replace(fb, options=tuple(replace(o, text=fcl_options(o.text)) for o in fb.options))
+    problems = unwritable_names(fb) + unwritable_words(fb)
     if problems:
         raise DiagnosticError(problems)
     out = [*_comment_lines(fb.comments, ""), "FUNCTION_BLOCK" + (f" {fb.name}" if fb.name else ""), ""]

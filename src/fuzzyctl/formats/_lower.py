@@ -12,9 +12,12 @@ import math
 from collections.abc import Callable
 from dataclasses import replace
 
+from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
+from fuzzyctl.engine import operators as ops
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import identifier, is_identifier
 from fuzzyctl.model import (
+    DEFUZZ_METHODS,
     And,
     Binary,
     Call,
@@ -43,6 +46,7 @@ from fuzzyctl.model import (
     ShapeMF,
     SingletonMF,
     SingletonsMF,
+    Span,
     Term,
     Unary,
     VarKind,
@@ -178,6 +182,37 @@ def support(term: Term) -> tuple[float, float] | None:
     return None
 
 
+def _method(name: str) -> str:
+    if name not in DEFUZZ_METHODS:
+        raise KeyError(name)
+    return name
+
+
+def unknown_operators(fb: FunctionBlock) -> list[Diagnostic]:
+    """Operators and methods the engine does not know (JSON and the studio carry them as free
+    strings): the FIS and FLL writers look them up in their tables, so they are refused here,
+    with their place, as the engine refuses them."""
+    found: list[Diagnostic] = []
+
+    def check(what: str, value: str | None, resolve: Callable[[str], object], span: Span | None) -> None:
+        if value is None:
+            return
+        try:
+            resolve(value)
+        except KeyError:
+            found.append(error(f"unknown {what} {value[:60]!r}", span, code="operator-unknown"))
+
+    for rb in fb.rule_blocks:
+        check("AND operator", rb.and_op, lambda v: ops.resolve_pair(v, None), rb.span)
+        check("OR operator", rb.or_op, lambda v: ops.resolve_pair(None, v), rb.span)
+        check("activation", rb.act, ops.resolve_act, rb.span)
+        check("accumulation", rb.accu, ops.resolve_accu, rb.span)
+    for d in fb.defuzzify:
+        check("accumulation", d.accu, ops.resolve_accu, d.span)
+        check("defuzzification method", d.method, _method, d.span)
+    return found
+
+
 def prepare(
     document: Document, target: str, running_hedges: bool = True, reserved: frozenset[str] = frozenset()
 ) -> tuple[FunctionBlock, list[Loss], dict[str, str]]:
@@ -188,6 +223,9 @@ def prepare(
     Names that are not identifiers, or are ``reserved`` words of the target, are renamed."""
     losses: list[Loss] = []
     fb = document.main
+    problems = unknown_operators(fb)
+    if problems:
+        raise DiagnosticError(problems)
     # jFuzzyLogic's COGF is the weighted average of the terms' values (docs/engine.md)
     fb = replace(
         fb, defuzzify=tuple(replace(d, method="WTAVER") if d.method == "COGF" else d for d in fb.defuzzify)

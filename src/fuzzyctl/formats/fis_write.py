@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
 
+from fuzzyctl.escape import one_line
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number, hedge_power
 from fuzzyctl.formats._expr import format_expr
@@ -556,7 +557,7 @@ def write(document: Document) -> str:
         out.append(DIALECT_COMMENT)
     out += [
         "[System]",
-        f"Name='{(fb.name or '').replace(chr(39), '')}'",
+        f"Name='{one_line(fb.name or '').replace(chr(39), '')}'",  # free text, on its line
         f"Type='{fis_type}'",
         "Version=2.0",
         f"NumInputs={len(fb.inputs)}",

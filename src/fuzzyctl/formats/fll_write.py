@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from fuzzyctl.escape import one_line
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats._common import fmt_number
 from fuzzyctl.formats._expr import format_expr
@@ -192,7 +193,7 @@ def condition_text(condition: Condition, top: bool = True) -> str:
 def write(document: Document, *, resolution: int = RESOLUTION) -> str:
     """FLL text of a document that :func:`lower` returned."""
     fb = document.main
-    out = [f"Engine: {fb.name or ''}".rstrip()]
+    out = [f"Engine: {one_line(fb.name or '')}".rstrip()]  # names are free text: kept on their line
     for var in fb.inputs:
         blk = fb.fuzzify_block(var.name)
         out.append(f"InputVariable: {var.name}")
@@ -241,7 +242,7 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         for term in d.terms:
             out.append(f"  term: {term_text(term)}")
     for block in fb.rule_blocks:
-        out.append(f"RuleBlock: {block.name or ''}".rstrip())
+        out.append(f"RuleBlock: {one_line(block.name or '')}".rstrip())
         out.append(f"  enabled: {'true' if block.enabled else 'false'}")
         # "none" round-trips an absent operator; fuzzylite needs one where it is used, and our
         # engine's defaults (MIN, MAX, MIN) are then written out.

@@ -288,7 +288,8 @@ def parse_fpl(text: str, *, path: str | None = None) -> FplResult:
     parser = parse_project(text, path, diags, comments)
     block = _build(parser, path, comments) if parser is not None else None
     ok = block is not None and not any(d.is_error for d in diags)
-    doc = Document((block,), path=path, comments=tuple(comments)) if ok and block else None
+    # the comments are the block's (written before it): on the document too, FCL had them twice
+    doc = Document((block,), path=path) if ok and block else None
     return FplResult(doc, tuple(diags))
 
 

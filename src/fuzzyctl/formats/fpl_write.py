@@ -9,6 +9,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
 from fuzzyctl.formats._common import identifier
 from fuzzyctl.formats._lower import rename
 from fuzzyctl.formats.fpl import ADDING_ACCU, SIEMENS_ACCU, is_fpl_name, leaves, shared_conclusions
+from fuzzyctl.formats.fpl_parse import MAX_NAME
 from fuzzyctl.model import (
     And,
     Condition,
@@ -225,6 +226,16 @@ def _singleton_width(dz: DefuzzifyBlock, variable: Variable | None) -> float:
     return spread / 200.0 if spread > 0 else 0.01
 
 
+def _fpl_word(name: str, taken: set[str]) -> str:
+    """``name`` when FPL reads it back as one name, else the nearest identifier: a name from
+    another format may hold a space (MATLAB's), a newline or ``/*`` (JSON), which would end
+    the statement or open a comment; one longer than the reader takes is cut."""
+    if is_fpl_name(name) and len(name) <= MAX_NAME and name not in taken:
+        return name
+    word = identifier(name[: MAX_NAME - 12], taken)
+    return word if is_fpl_name(word) else identifier(f"{word}_fpl", taken)
+
+
 def write_fpl(block: FunctionBlock | Document) -> str:
     """FPL text for a function block (the first one of a document).
 
@@ -234,10 +245,7 @@ def write_fpl(block: FunctionBlock | Document) -> str:
     problems = [d for d in check_fpl(fb) if d.is_error]
     if problems:
         raise DiagnosticError(problems)
-    project = fb.name or "fuzzy"
-    if not is_fpl_name(project):  # a name with spaces (MATLAB's) is no FPL word
-        project = identifier(project, set())
-        project = project if is_fpl_name(project) else f"{project}_fpl"
+    project = _fpl_word(fb.name or "fuzzy", set())
     out: list[str] = ["/*FPL file written by fuzzyctl*/", f"PROJECT {project}"]
     for var in fb.variables:
         if var.kind is VarKind.LOCAL:
@@ -265,10 +273,15 @@ def write_fpl(block: FunctionBlock | Document) -> str:
             out += [f"MEMBER {name}", "POINTS " + " ".join(f"{_num(x)},{_num(y)}" for x, y in pts), "END"]
         out.append("END")
     base = fb.rule_blocks[0] if fb.rule_blocks else None
-    base_name = base.name if base and base.name else "rules"
+    base_name = _fpl_word(base.name if base and base.name else "rules", set())
+    labels = {r.label for r in base.rules} if base else set()
     out.append(f"FUZZY {base_name}")
     for rb_rule in base.rules if base else ():
-        out.append(f"RULE {rb_rule.label}")
+        label = rb_rule.label
+        # a label FPL reads back: a number or a word of at most MAX_NAME characters
+        if not ((label.isascii() and label.isdigit()) or is_fpl_name(label)) or len(label) > MAX_NAME:
+            label = _fpl_word(label, labels)  # not one of the other labels
+        out.append(f"RULE {label}")
         subconditions = list(leaves(rb_rule.condition))
         if subconditions:
             out.append("IF " + " AND ".join(f"({c.variable} is {c.term})" for c in subconditions))

@@ -22,6 +22,7 @@ from typing import Any
 
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, error
+from fuzzyctl.escape import json_text
 from fuzzyctl.formats import Format, Loaded
 
 FORMAT_NAME = "fuzzyctl-model"
@@ -94,7 +95,8 @@ def to_dict(document: m.Document) -> dict[str, Any]:
 
 
 def dumps(document: m.Document) -> str:
-    return _json.dumps(to_dict(document), indent=2, ensure_ascii=False, allow_nan=False) + "\n"
+    # json_text: a lone surrogate (a JSON comment may hold one) as its escape, so UTF-8 can hold it
+    return json_text(_json.dumps(to_dict(document), indent=2, ensure_ascii=False, allow_nan=False)) + "\n"
 
 
 class JsonModelError(ValueError):
