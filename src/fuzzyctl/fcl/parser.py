@@ -665,7 +665,7 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
     if document is not None:
         from fuzzyctl.fcl.comments import attach_comments
 
-        document = attach_comments(document, state.comments)
+        document = attach_comments(document, state.comments, source.text)
     return ParseResult(document, state.diagnostics, source, frozenset(state.spellings))
 
 
