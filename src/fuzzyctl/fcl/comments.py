@@ -151,13 +151,16 @@ class _Placer:
             prev = ch
         if i < len(children):
             nxt = children[i]
-        if prev is not None and (prev.kind == "variable" or (nxt is not None and nxt.kind == "variable")):
+        on_header = prev is None and p[0] == node.start[0]
+        if on_header and not _VAR_KEYWORD.search(self.text.between(node.start, p)):
+            return node.owner, "head"
+        if (prev is not None and prev.kind == "variable") or (nxt is not None and nxt.kind == "variable"):
             found = self.section(node, prev, nxt, c)
             if found is not None:
                 return found
         if prev is not None and prev.end[0] == p[0]:
             return _after(prev)
-        if prev is None and p[0] == node.start[0]:
+        if on_header:
             return node.owner, "head"
         if nxt is not None:
             return _before(nxt)
@@ -169,12 +172,16 @@ class _Placer:
         """The place of a comment next to a VAR_... section keyword, else ``None``."""
         p, q = (c.line, c.column), _end_of(c)
         if prev is not None and prev.kind == "variable":
-            closed = _END_VAR.search(self.text.between(prev.end, p)) is not None
-            if prev.end[0] == p[0]:
-                return prev.owner, "section.tail" if closed else "after"
-            opens = nxt is not None and _VAR_KEYWORD.search(self.text.between(q, nxt.start)) is not None
-            if not closed and (nxt is None or nxt.kind != "variable" or opens):
-                return prev.owner, "section.end"
+            gap = self.text.between(prev.end, p)
+            ends = list(_END_VAR.finditer(gap))
+            if ends and "\n" not in gap[ends[-1].end() :]:  # on the END_VAR line
+                return prev.owner, "section.tail"
+            if not ends:
+                if prev.end[0] == p[0]:
+                    return prev.owner, "after"
+                opens = nxt is not None and _VAR_KEYWORD.search(self.text.between(q, nxt.start)) is not None
+                if nxt is None or nxt.kind != "variable" or opens:
+                    return prev.owner, "section.end"
         if nxt is not None and nxt.kind == "variable":
             if _VAR_KEYWORD.search(self.text.between(q, nxt.start)):
                 return nxt.owner, "section.before"
