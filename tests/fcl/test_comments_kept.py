@@ -226,7 +226,9 @@ def placement(doc: Document) -> list[object]:
             parts.extend([rb, *rb.rules])
         for p in parts:
             placed = getattr(p, "placed_comments", ())
-            out.append((said(getattr(p, "comments", ())), [w for w, _ in placed], said(tuple(t for _, t in placed))))
+            out.append(
+                (said(getattr(p, "comments", ())), [w for w, _ in placed], said(tuple(t for _, t in placed)))
+            )
     return out
 
 
@@ -266,8 +268,9 @@ END_FUNCTION_BLOCK
 
 # ---------------------------------------------------------------------------- random places
 
-# Where a comment may go: any white space between two tokens outside comments and OPTIONS.
-_GAP = re.compile(r"\s+")
+# Where a comment may go: between two tokens (spaced or not) outside comments and OPTIONS,
+# not next to a sign (which may belong to the number).
+_TOKEN = re.compile(r"\d+(?:\.\d+)?(?:[eE][-+]?\d+)?|\w+|:=|\.\.|\S")
 _SKIP = re.compile(r"\(\*.*?\*\)|/\*.*?\*/|//[^\r\n]*|\bOPTIONS?\b.*?\bEND_OPTIONS?\b", re.S | re.I)
 EXAMPLE_FILES = sorted(p for p in EXAMPLES.glob("*.fcl"))
 _STYLES = ["(* C{n} *)", "/* C{n} */", "// C{n}\n", "(* C{n}\n   more of C{n} *)", "\n(* C{n} *)\n"]
@@ -275,8 +278,13 @@ _STYLES = ["(* C{n} *)", "/* C{n} */", "// C{n}\n", "(* C{n}\n   more of C{n} *)
 
 def _gaps(text: str) -> list[int]:
     skipped = [(m.start(), m.end()) for m in _SKIP.finditer(text)]
+    ends = [m.end() for m in _TOKEN.finditer(text)][:-1]
     return [
-        m.start() for m in _GAP.finditer(text) if not any(a <= m.start() < b for a, b in skipped) and m.start()
+        at
+        for at in ends
+        if not any(a <= at < b for a, b in skipped)
+        and text[at - 1] not in "+-"
+        and text[at : at + 1] not in "+-"
     ]
 
 
