@@ -6,6 +6,7 @@ than the parser, so that a comment the reader misplaces or the writer drops fail
 
 from __future__ import annotations
 
+import math
 import re
 from collections import Counter
 from pathlib import Path
@@ -361,3 +362,42 @@ def test_no_comment_lost_on_the_corpus() -> None:
             unstable += 1
     assert loaded > 200
     assert (losing, unstable) == (0, 0), f"of {loaded} files: {losing} lose comments, {unstable} not stable"
+
+
+# ---------------------------------------------------------------------------- cost
+
+
+def _commented(n: int) -> str:
+    rules = "\n".join(f"(* r{i} *)\nRULE {i} : IF x IS lo THEN y IS a; // t{i}" for i in range(1, n + 1))
+    names = "\n".join(f"(* v{i} *) v{i} : REAL; // w{i}" for i in range(n // 8))
+    return f"""FUNCTION_BLOCK f
+VAR_INPUT x : REAL; {names}
+END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM lo := (0, 1) (10, 0); END_FUZZIFY
+DEFUZZIFY y TERM a := 0; METHOD : COGS; END_DEFUZZIFY
+RULEBLOCK r
+{rules}
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_placing_comments_takes_time_in_proportion() -> None:
+    # a comment before and after every rule and declaration: 4 times the file, not 16 times
+    # the time (placing one comment looked through all the statements before it: 58 s for
+    # 20,000 rules)
+    import time
+
+    def cost(n: int) -> float:
+        text = _commented(n)
+        best = math.inf
+        for _ in range(2):
+            start = time.perf_counter()
+            out = write(load_text(text).raise_for_errors())
+            best = min(best, time.perf_counter() - start)
+        assert bodies(out) == bodies(text)
+        return best
+
+    small, large = cost(1000), cost(4000)
+    assert large < 8 * small + 0.5, (small, large)

@@ -52,6 +52,11 @@ class _Node:
     prefix: str = ""
     kind: str = "statement"  # statement | variable | block
     children: list[_Node] = field(default_factory=list)
+    starts: list[Pos] = field(default_factory=list)  # of the children, for bisection
+
+    def adopt(self, found: Sequence[_Node | None]) -> None:
+        self.children = sorted((n for n in found if n is not None), key=lambda n: n.start)
+        self.starts = [n.start for n in self.children]
 
 
 def _node(obj: Any, span: Span | None, prefix: str = "", kind: str = "statement") -> _Node | None:
@@ -68,7 +73,7 @@ def _block(obj: Any, items: Sequence[tuple[str, Span | None]], statements: Seque
         return None
     found = [_node(obj, span, prefix=f"{key}.") for key, span in items]
     found.extend(_node(s, s.span) for s in statements)
-    node.children = sorted((n for n in found if n is not None), key=lambda n: n.start)
+    node.adopt(found)
     return node
 
 
@@ -88,35 +93,49 @@ def _tree(doc: Document) -> list[_Node]:
         for rb in fb.rule_blocks:
             found.append(_block(rb, list(rb.item_spans), rb.rules))
         found.extend(_node(o, o.span) for o in fb.options)
-        node.children = sorted((n for n in found if n is not None), key=lambda n: n.start)
+        node.adopt(found)
         out.append(node)
     return out
 
 
 class _Text:
-    """The source with comments blanked out, to find the VAR_... keywords between two
-    positions (the sections are not in the model)."""
+    """Where the VAR_... and END_VAR keywords of the source are (outside comments): the
+    sections are not in the model.  Looked up by bisection, so that placing a comment costs
+    no more when there are many."""
 
     def __init__(self, text: str | None, comments: Sequence[CommentLike]) -> None:
-        self.starts = [0]
-        if text is None:
-            self.text = ""
-            return
-        self.starts.extend(i + 1 for i, ch in enumerate(text) if ch == "\n")
-        chars = list(text)
-        for c in comments:
+        self.text = text or ""
+        self.lines = [0, *(m.end() for m in re.finditer("\n", self.text))]
+        parts, last = [], 0
+        for c in comments:  # blanked, so that a keyword inside a comment is not found
             a = self.offset((c.line, c.column))
-            for i in range(a, min(a + len(c.text), len(chars))):
-                if chars[i] != "\n":
-                    chars[i] = " "
-        self.text = "".join(chars)
+            if a < last:
+                continue
+            parts.extend([self.text[last:a], re.sub(r"[^\n]", " ", c.text)])
+            last = a + len(c.text)
+        blank = "".join([*parts, self.text[last:]])
+        self.found = {
+            name: [(m.start(), m.end()) for m in pattern.finditer(blank)]
+            for name, pattern in (("var", _VAR_KEYWORD), ("end_var", _END_VAR))
+        }
+        self.found_starts = {name: [a for a, _ in found] for name, found in self.found.items()}
 
     def offset(self, pos: Pos) -> int:
-        line = min(max(pos[0], 1), len(self.starts))
-        return self.starts[line - 1] + pos[1] - 1
+        line = min(max(pos[0], 1), len(self.lines))
+        return self.lines[line - 1] + pos[1] - 1
 
-    def between(self, a: Pos, b: Pos) -> str:
-        return self.text[self.offset(a) : self.offset(b)] if self.text else ""
+    def last(self, keyword: str, a: Pos, b: Pos) -> int | None:
+        """The end offset of the last ``keyword`` (``"var"``, ``"end_var"``) between
+        positions ``a`` and ``b``, else ``None``."""
+        lo, hi = self.offset(a), self.offset(b)
+        i = bisect_right(self.found_starts[keyword], hi - 1) - 1
+        if i < 0 or self.found[keyword][i][0] < lo or self.found[keyword][i][1] > hi:
+            return None
+        return self.found[keyword][i][1]
+
+    def on_line(self, offset: int | None, b: Pos) -> bool:
+        """Whether a keyword ending at ``offset`` is on the line of position ``b``."""
+        return offset is not None and self.text.find("\n", offset, self.offset(b)) < 0
 
 
 def _end_of(c: CommentLike) -> Pos:
@@ -142,7 +161,7 @@ class _Placer:
         """The owner and place of comment ``c`` inside block ``node``."""
         p = (c.line, c.column)
         children = node.children
-        i = bisect_right([ch.start for ch in children], p)
+        i = bisect_right(node.starts, p)
         prev = nxt = None
         if i > 0:
             ch = children[i - 1]
@@ -152,7 +171,7 @@ class _Placer:
         if i < len(children):
             nxt = children[i]
         on_header = prev is None and p[0] == node.start[0]
-        if on_header and not _VAR_KEYWORD.search(self.text.between(node.start, p)):
+        if on_header and self.text.last("var", node.start, p) is None:
             return node.owner, "head"
         if (prev is not None and prev.kind == "variable") or (nxt is not None and nxt.kind == "variable"):
             found = self.section(node, prev, nxt, c)
@@ -171,23 +190,21 @@ class _Placer:
     ) -> tuple[int, str] | None:
         """The place of a comment next to a VAR_... section keyword, else ``None``."""
         p, q = (c.line, c.column), _end_of(c)
+        text = self.text
         if prev is not None and prev.kind == "variable":
-            gap = self.text.between(prev.end, p)
-            ends = list(_END_VAR.finditer(gap))
-            if ends and "\n" not in gap[ends[-1].end() :]:  # on the END_VAR line
+            closed = text.last("end_var", prev.end, p)
+            if text.on_line(closed, p):  # on the END_VAR line
                 return prev.owner, "section.tail"
-            if not ends:
+            if closed is None:
                 if prev.end[0] == p[0]:
                     return prev.owner, "after"
-                opens = nxt is not None and _VAR_KEYWORD.search(self.text.between(q, nxt.start)) is not None
+                opens = nxt is not None and text.last("var", q, nxt.start) is not None
                 if nxt is None or nxt.kind != "variable" or opens:
                     return prev.owner, "section.end"
         if nxt is not None and nxt.kind == "variable":
-            if _VAR_KEYWORD.search(self.text.between(q, nxt.start)):
+            if text.last("var", q, nxt.start) is not None:
                 return nxt.owner, "section.before"
-            gap = self.text.between(prev.end if prev is not None else node.start, p)
-            keywords = list(_VAR_KEYWORD.finditer(gap))
-            if keywords and "\n" not in gap[keywords[-1].end() :]:  # on the keyword's line
+            if text.on_line(text.last("var", prev.end if prev is not None else node.start, p), p):
                 return nxt.owner, "section.head"
         return None
 
