@@ -311,7 +311,7 @@ def _gaps(text: str) -> list[int]:
     return [
         at
         for at in ends
-        if not any(a <= at < b for a, b in skipped)
+        if not any(a <= at <= b for a, b in skipped)
         and text[at - 1] not in "+-"
         and text[at : at + 1] not in "+-"
     ]
@@ -443,3 +443,35 @@ def test_placing_comments_takes_time_in_proportion() -> None:
 
     small, large = cost(1000), cost(4000)
     assert large < 8 * small + 0.05, (small, large)
+
+
+@pytest.mark.extra("corpus")
+def test_comments_at_random_places_in_the_corpus_are_kept() -> None:
+    import random
+
+    rng = random.Random(25)
+    tried = 0
+    for path in CORPUS:
+        result = load_file(path)
+        gaps = _gaps(result.source.text) if result.ok else []
+        if not gaps:
+            continue
+        text = result.source.text
+        chosen = sorted(set(rng.sample(gaps, min(len(gaps), rng.randint(1, 10)))))
+        pieces, last = [], 0
+        for n, at in enumerate(chosen):
+            pieces.extend([text[last:at], " ", rng.choice(_STYLES).format(n=f"{n:02d}"), " "])
+            last = at
+        source = "".join([*pieces, text[last:]])
+        loaded = load_text(source)
+        assert loaded.ok, path.name
+        tried += 1
+        out = write(loaded.raise_for_errors())
+        assert bodies(out) == bodies(source), path.name
+        again = load_text(out).raise_for_errors()
+        assert write(again) == out and again == result.document, path.name
+        if in_written_order(result.raise_for_errors()):
+            assert labels(out) == labels(source), path.name
+        if not joins_sections(text, again):
+            assert placement(again) == placement(loaded.raise_for_errors()), path.name
+    assert tried > 200
