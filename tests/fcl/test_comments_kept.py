@@ -283,6 +283,23 @@ END_FUNCTION_BLOCK
     assert formatted(out) == out
 
 
+def test_comments_of_an_item_written_as_none_stay_where_it_was() -> None:
+    # ACCU : NONE; has no value in the model, so the writer leaves the item out: not its comments
+    source = """FUNCTION_BLOCK f
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM lo := (0, 1) (10, 0); END_FUZZIFY
+DEFUZZIFY y TERM a := 0; METHOD : COG; ACCU : NONE; (* C01 after ACCU NONE *) END_DEFUZZIFY
+RULEBLOCK r AND : MIN; OR : NONE; // C02 after OR NONE
+ACT : MIN; RULE 1 : IF x IS lo THEN y IS a; END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+    out = formatted(source)
+    found = places(out)
+    assert found["C01"] == ("", "END_DEFUZZIFY") and found["C02"] == ("", "ACT : MIN;")
+    assert formatted(out) == out
+
+
 def test_comments_in_the_ignored_text_after_the_last_block_are_kept() -> None:
     # jFuzzyLogic ignores text after END_FUNCTION_BLOCK, and so do we (with a warning): not
     # the comments in it

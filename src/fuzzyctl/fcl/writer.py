@@ -292,9 +292,7 @@ def _variable(v: Variable) -> list[str]:
 
 def _fuzzify(b: FuzzifyBlock) -> list[str]:
     inner = INDENT * 2
-    out: list[str] = []
-    if b.range is not None:
-        out.extend(_statement(b, _range(b.range), inner, "range."))
+    out = _item(b, "range", _range(b.range) if b.range is not None else None, inner)
     for t in b.terms:
         out.extend(_term(t, inner))
     return _block_lines(b, f"FUZZIFY {b.variable}", out, "END_FUZZIFY")
@@ -302,32 +300,31 @@ def _fuzzify(b: FuzzifyBlock) -> list[str]:
 
 def _defuzzify(b: DefuzzifyBlock) -> list[str]:
     inner = INDENT * 2
-    out: list[str] = []
-    if b.range is not None:
-        out.extend(_statement(b, _range(b.range), inner, "range."))
+    out = _item(b, "range", _range(b.range) if b.range is not None else None, inner)
     for t in b.terms:
         out.extend(_term(t, inner))
-    if b.method is not None:
-        out.extend(_statement(b, f"METHOD : {METHOD_SPELLING.get(b.method, b.method)};", inner, "method."))
-    if b.accu is not None:
-        out.extend(_statement(b, f"ACCU : {b.accu};", inner, "accu."))
-    if b.default is not None:
-        out.extend(_statement(b, _default(b.default), inner, "default."))
-    out.extend(_unwritten(b, ("range", "method", "accu", "default"), inner))
+    method = f"METHOD : {METHOD_SPELLING.get(b.method, b.method)};" if b.method is not None else None
+    out.extend(_item(b, "method", method, inner))
+    out.extend(_item(b, "accu", f"ACCU : {b.accu};" if b.accu is not None else None, inner))
+    out.extend(_item(b, "default", _default(b.default) if b.default is not None else None, inner))
+    out.extend(_other_items(b, ("range", "method", "accu", "default"), inner))
     return _block_lines(b, f"DEFUZZIFY {b.variable}", out, "END_DEFUZZIFY")
 
 
-def _unwritten(b: DefuzzifyBlock | RuleBlock, items: tuple[str, ...], indent: str) -> list[str]:
-    """The comments around an item the model has no value for (``METHOD : NONE;``), so
-    that none is lost: where the item stood, the end of the block."""
-    values = {k: getattr(b, k, None) for k in items}
-    lost = [place for place, _ in b.placed_comments if "." in place]
-    out: list[str] = []
-    for place in dict.fromkeys(lost):
-        item = place.split(".")[0]
-        if item not in values or values[item] is None:
-            out.extend(_comment_lines(comments_at(b, place), indent))
-    return out
+def _item(
+    b: DefuzzifyBlock | FuzzifyBlock | RuleBlock, item: str, text: str | None, indent: str
+) -> list[str]:
+    """A single-valued item of a block with its comments; where the model has no value for
+    it (``ACCU : NONE;``), its comments alone, where it stood among the items."""
+    if text is not None:
+        return _statement(b, text, indent, item + ".")
+    return _comment_lines((*comments_at(b, item + ".before"), *comments_at(b, item + ".after")), indent)
+
+
+def _other_items(b: DefuzzifyBlock | RuleBlock, items: tuple[str, ...], indent: str) -> list[str]:
+    """The comments of items this writer does not know (none today), so that none is lost."""
+    places = dict.fromkeys(p for p, _ in b.placed_comments if "." in p and p.split(".")[0] not in items)
+    return [line for p in places for line in _comment_lines(comments_at(b, p), indent)]
 
 
 def _rule_block(b: RuleBlock) -> list[str]:
@@ -340,11 +337,10 @@ def _rule_block(b: RuleBlock) -> list[str]:
         ("ACT", b.act, "act"),
         ("ACCU", b.accu, "accu"),
     ):
-        if value is not None:
-            out.extend(_statement(b, f"{keyword} : {value};", inner, item + "."))
+        out.extend(_item(b, item, f"{keyword} : {value};" if value is not None else None, inner))
     for r in b.rules:
         out.extend(_statement(r, rule_text(r), inner))
-    out.extend(_unwritten(b, ("and_op", "or_op", "act", "accu"), inner))
+    out.extend(_other_items(b, ("and_op", "or_op", "act", "accu"), inner))
     return _block_lines(b, header, out, "END_RULEBLOCK")
 
 
