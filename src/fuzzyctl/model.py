@@ -26,6 +26,29 @@ from enum import StrEnum
 from functools import cached_property
 from typing import TypeAlias
 
+# --------------------------------------------------------------------------- comments
+
+PlacedComments: TypeAlias = tuple[tuple[str, str], ...]
+"""``(place, text)`` pairs: the comments of an element written somewhere else than on the
+lines before it (those are its ``comments``).  Places: ``"after"`` (on its line, after
+it), ``"head"`` (after a block's header), ``"end"`` (on the lines before a block's END_
+keyword), ``"tail"`` (after the END_ keyword), ``"ITEM.before"`` / ``"ITEM.after"`` around
+a block's single-valued item (``method``, ``range``, ``and_op``, ...), and for a variable
+``"section.before"`` / ``"section.head"`` / ``"section.end"`` / ``"section.tail"`` (its
+VAR_... section, when it opens or closes one).  Filled by the FCL reader, written again by
+the FCL writer so that ``fmt`` keeps every comment where it was."""
+
+
+def comments_at(element: object, place: str) -> tuple[str, ...]:
+    """The comment texts of ``element`` at ``place`` (see :data:`PlacedComments`), in
+    source order; ``"before"`` gives its ``comments``."""
+    placed: PlacedComments = getattr(element, "placed_comments", ())
+    found = tuple(text for where, text in placed if where == place)
+    if place == "before":  # an element without ``comments`` (OPTIONS) keeps them here
+        return (*getattr(element, "comments", ()), *found)
+    return found
+
+
 # --------------------------------------------------------------------------- positions
 
 
@@ -283,6 +306,7 @@ class Term:
     mf: MembershipFunction
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
 
 # --------------------------------------------------------------------------- variables and blocks
@@ -314,6 +338,7 @@ class Variable:
     range: Range | None = None
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -327,6 +352,7 @@ class FuzzifyBlock:
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
     clamp: bool = False
     """Limit the input value to ``range`` before fuzzification (fuzzylite ``lock-range``)."""
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
@@ -365,6 +391,7 @@ class DefuzzifyBlock:
     """Limit the defuzzified value to ``range`` (fuzzylite ``lock-range``)."""
     item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
     """Where the single-valued items were written: ``("method", span)``, ``("accu", ...)``."""
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
@@ -472,6 +499,7 @@ class Rule:
     """Rule weight of MATLAB FIS and fuzzylite (``(0.5)``, ``with 0.5``): it multiplies the
     condition degree *before* activation, ``act(w * a, mu)``.  Unlike a WITH weight of a
     subconclusion (IEC 61131-7: ``w * act(a, mu)``) it differs from it under ACT MIN."""
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
 
 @dataclass(frozen=True)
@@ -496,6 +524,7 @@ class RuleBlock:
     item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
     """Where the operator items were written: ``("and_op", span)``, ``("or_op", ...)``,
     ``("act", ...)``, ``("accu", ...)``."""
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
     def item_span(self, item: str) -> Span | None:
         """The source position of ``item`` (``"and_op"``, ``"act"``, ...), else the block's."""
@@ -509,6 +538,7 @@ class OptionsBlock:
     text: str
     keyword: str = "OPTIONS"
     span: Span | None = field(default=None, compare=False, repr=False)
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
 
 # --------------------------------------------------------------------------- function block
@@ -526,6 +556,7 @@ class FunctionBlock:
     options: tuple[OptionsBlock, ...] = ()
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
+    placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
 
     def _of_kind(self, kind: VarKind) -> tuple[Variable, ...]:
         return tuple(v for v in self.variables if v.kind is kind)

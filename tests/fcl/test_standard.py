@@ -21,6 +21,7 @@ from fuzzyctl.model import (
     ShapeMF,
     SingletonMF,
     VarKind,
+    comments_at,
 )
 from tests.conftest import EXAMPLES
 
@@ -248,7 +249,8 @@ def test_crlf_bom_latin1_comments_and_options(tmp_path) -> None:  # type: ignore
     assert result.source.encoding == "latin-1"
     assert doc.main.inputs[0].name == "temp\u00e9"
     assert doc.main.options[0].text == "vendor_param = 3; (* kept *)"
-    assert doc.main.comments == ("// header", "(* iec *)")
+    assert doc.main.comments == ("// header",)  # before the block; the other after its header
+    assert comments_at(doc.main, "head") == ("(* iec *)",)
     bom = tmp_path / "bom.fcl"
     bom.write_bytes(text.encode("utf-8"))
     assert load_file(bom).raise_for_errors() == doc

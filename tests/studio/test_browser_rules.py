@@ -290,3 +290,41 @@ def test_500_rules_open_and_edit(page: Any, browser_project: Path) -> None:
     ARTIFACTS.mkdir(parents=True, exist_ok=True)
     (ARTIFACTS / "timings-500.json").write_text(json.dumps(timings, indent=2) + "\n")
     print("500 rules:", json.dumps(timings))
+
+
+COMMENTED = """FUNCTION_BLOCK commented
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM lo := (0, 1) (10, 0); TERM hi := (0, 0) (10, 1); END_FUZZIFY
+DEFUZZIFY y TERM a := 0; TERM b := 10; METHOD : COGS; DEFAULT := 0; END_DEFUZZIFY
+RULEBLOCK r
+    AND : MIN;
+    ACCU : MAX;
+    (* C01 before rule 1 *)
+    RULE 1 : IF x IS lo THEN y IS a; // C02 after rule 1
+    RULE 2 : IF x IS hi THEN y IS b; (* C03 after rule 2 *) (* C04 and another *)
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_text_editor_keeps_the_comments_of_the_rules(page: Any, browser_project: Path) -> None:
+    # a rule's comments stand before it and after it on its line, as in the file; edited
+    # as text, they are read again with the rules and written where they were
+    from tests.fcl.test_comments_kept import places
+
+    pg = page
+    (browser_project / "commented_rules.fcl").write_text(COMMENTED)
+    open_file(pg, "commented_rules.fcl")
+    rule_mode(pg, "text")
+    lines = pg.input_value("#rules-input").split("\n")
+    assert lines[0] == "(* C01 before rule 1 *)"
+    assert lines[1].endswith("THEN y IS a; // C02 after rule 1")
+    assert lines[2].endswith("THEN y IS b; (* C03 after rule 2 *) (* C04 and another *)")
+    pg.fill("#rules-input", "\n".join(lines).replace("THEN y IS b", "THEN y IS a"))
+    pg.wait_for_function("document.querySelector('#rules-text').dataset.ok === 'true'")
+    checked(pg)
+    found = places(fcl_text(pg))
+    assert found["C01"] == ("", "RULE 1 : IF x IS lo THEN y IS a;")
+    assert found["C02"][0] == "RULE 1 : IF x IS lo THEN y IS a;"
+    assert found["C03"][0] == found["C04"][0] == "RULE 2 : IF x IS hi THEN y IS a;"

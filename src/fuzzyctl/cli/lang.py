@@ -208,7 +208,7 @@ def _has_comments(fb: object) -> bool:
         items.extend(block.terms)
     for rb in fb.rule_blocks:
         items.extend(rb.rules)
-    return any(getattr(i, "comments", ()) for i in items)
+    return any(getattr(i, "comments", ()) or getattr(i, "placed_comments", ()) for i in items)
 
 
 @app.command()

@@ -665,7 +665,7 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
     if document is not None:
         from fuzzyctl.fcl.comments import attach_comments
 
-        document = attach_comments(document, state.comments)
+        document = attach_comments(document, state.comments, source.text)
     return ParseResult(document, state.diagnostics, source, frozenset(state.spellings))
 
 
@@ -716,6 +716,26 @@ def _merge_comments(state: ParseState, end: int | None) -> None:
         state.comments.sort(key=lambda c: (c.line, c.column))
 
 
+# The comment terminals of fcl.lark, to find the comments of text lark does not read.
+_COMMENTS = re.compile(r"\(\*.*?\*\)|/\*.*?\*/|//[^\r\n]*", re.S)
+
+
+def _ignored_comments(state: ParseState, pos: int) -> None:
+    """The comments of the text after the last END_FUNCTION_BLOCK, which is ignored: kept
+    (after the last block), so that ``fmt`` drops no comment with it."""
+    text = state.source.text
+    # line and line start counted on from one comment to the next (linear in the text)
+    line, at, start = text.count("\n", 0, pos) + 1, pos, text.rfind("\n", 0, pos) + 1
+    for m in _COMMENTS.finditer(text, pos):
+        line += text.count("\n", at, m.start())
+        start = max(start, text.rfind("\n", at, m.start()) + 1)
+        at = m.start()
+        state.comments.append(_Comment(m.group(0), line, at - start + 1, line + m.group(0).count("\n")))
+        line += m.group(0).count("\n")
+        start = max(start, text.rfind("\n", at, m.end()) + 1)
+        at = m.end()
+
+
 def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> Document | None:
     """Text after the last END_FUNCTION_BLOCK is ignored with a warning (jFuzzyLogic's
     ANTLR grammar stops there too); any other syntax error is not recovered.  ``text`` is
@@ -735,6 +755,7 @@ def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> 
     except UnexpectedInput:
         return None
     _merge_comments(state, pos)
+    _ignored_comments(state, pos)
     state.warn(
         "text after END_FUNCTION_BLOCK is ignored",
         Span(exc.token.line or 0, exc.token.column or 0),

@@ -52,6 +52,7 @@ from fuzzyctl.model import (
     Term,
     Unary,
     Variable,
+    comments_at,
 )
 
 INDENT = "    "
@@ -73,6 +74,46 @@ def _comment_lines(comments: Iterable[str], indent: str) -> list[str]:
         out.append(indent + first)
         out.extend(rest)
     return out
+
+
+def _trail(line: str, comments: Iterable[str], indent: str) -> list[str]:
+    """``line`` with ``comments`` after it on the same line (a multi-line comment goes on
+    from there; after a ``//`` comment, which runs to the end of the line, the next one
+    starts a line of its own)."""
+    out = [line]
+    open_line = True
+    for text in comments:
+        lines = _comment_lines([text], "")
+        if open_line:
+            out[-1] += " " + lines[0]
+        else:
+            out.append(indent + lines[0])
+        out.extend(lines[1:])
+        # a line comment runs to the end of the line: what follows starts a new one
+        open_line = len(lines) > 1 or "\n" in lines[0] or not lines[0].lstrip().startswith("//")
+    return out
+
+
+def _statement(element: object, text: str, indent: str, place: str = "") -> list[str]:
+    """A statement line with the comments written before it and after it on its line;
+    ``place``: the prefix of an item's places in its block (``"method."``)."""
+    return [
+        *_comment_lines(comments_at(element, place + "before"), indent),
+        *_trail(indent + text, comments_at(element, place + "after"), indent),
+    ]
+
+
+def _block_lines(block: object, header: str, body: list[str], end: str) -> list[str]:
+    """A block: comments before it, its header (with those after it), its body, the
+    comments before its END_ keyword and those after it."""
+    return [
+        *_comment_lines(comments_at(block, "before"), INDENT),
+        *_trail(INDENT + header, comments_at(block, "head"), INDENT),
+        *body,
+        *_comment_lines(comments_at(block, "end"), INDENT * 2),
+        *_trail(INDENT + end, comments_at(block, "tail"), INDENT),
+        "",
+    ]
 
 
 # --------------------------------------------------------------------------- expressions
@@ -123,7 +164,7 @@ def mf_text(mf: MembershipFunction) -> str:
 
 
 def _term(t: Term, indent: str) -> list[str]:
-    return [*_comment_lines(t.comments, indent), f"{indent}TERM {t.name} := {mf_text(t.mf)};"]
+    return _statement(t, f"TERM {t.name} := {mf_text(t.mf)};", indent)
 
 
 def _range(r: Range) -> str:
@@ -204,16 +245,28 @@ def _variables(fb: FunctionBlock) -> list[str]:
         else:
             runs.append([v])
     for group in runs:
-        out.append(f"{INDENT}{group[0].kind.value}")
-        out.extend(line for v in group for line in _variable(v))
-        out.append(f"{INDENT}END_VAR")
+        first, last = group[0], group[-1]
+        # the comments around the VAR_... keywords of the source; where the writer joins two
+        # sections of the same kind they go between the declarations
+        out.extend(_comment_lines(comments_at(first, "section.before"), INDENT))
+        out.extend(_trail(f"{INDENT}{first.kind.value}", comments_at(first, "section.head"), INDENT))
+        for v in group:
+            if v is not first:
+                out.extend(_comment_lines(comments_at(v, "section.before"), INDENT * 2))
+                out.extend(_comment_lines(comments_at(v, "section.head"), INDENT * 2))
+            out.extend(_variable(v))
+            if v is not last:
+                out.extend(_comment_lines(comments_at(v, "section.end"), INDENT * 2))
+                out.extend(_comment_lines(comments_at(v, "section.tail"), INDENT * 2))
+        out.extend(_comment_lines(comments_at(last, "section.end"), INDENT * 2))
+        out.extend(_trail(f"{INDENT}END_VAR", comments_at(last, "section.tail"), INDENT))
         out.append("")
     return out
 
 
 def _variable(v: Variable) -> list[str]:
     pad = INDENT * 2
-    text = f"{pad}{v.name} : {v.data_type}"
+    text = f"{v.name} : {v.data_type}"
     if v.initial is not None:
         if isinstance(v.initial, bool):
             text += f" := {'TRUE' if v.initial else 'FALSE'}"
@@ -225,55 +278,73 @@ def _variable(v: Variable) -> list[str]:
     if v.range is not None:
         # RANGE on the declaration line is jFuzzyLogic's; kept there so that it reads back.
         text += " " + _range(v.range)
-    return [*_comment_lines(v.comments, pad), text]
+    return _statement(v, text, pad)
 
 
 def _fuzzify(b: FuzzifyBlock) -> list[str]:
     inner = INDENT * 2
-    out = [*_comment_lines(b.comments, INDENT), f"{INDENT}FUZZIFY {b.variable}"]
-    if b.range is not None:
-        out.append(inner + _range(b.range))
+    out = _item(b, "range", _range(b.range) if b.range is not None else None, inner)
     for t in b.terms:
         out.extend(_term(t, inner))
-    out.extend([f"{INDENT}END_FUZZIFY", ""])
-    return out
+    return _block_lines(b, f"FUZZIFY {b.variable}", out, "END_FUZZIFY")
 
 
 def _defuzzify(b: DefuzzifyBlock) -> list[str]:
     inner = INDENT * 2
-    out = [*_comment_lines(b.comments, INDENT), f"{INDENT}DEFUZZIFY {b.variable}"]
-    if b.range is not None:
-        out.append(inner + _range(b.range))
+    out = _item(b, "range", _range(b.range) if b.range is not None else None, inner)
     for t in b.terms:
         out.extend(_term(t, inner))
-    if b.method is not None:
-        out.append(f"{inner}METHOD : {METHOD_SPELLING.get(b.method, b.method)};")
-    if b.accu is not None:
-        out.append(f"{inner}ACCU : {b.accu};")
-    if b.default is not None:
-        out.append(inner + _default(b.default))
-    out.extend([f"{INDENT}END_DEFUZZIFY", ""])
-    return out
+    method = f"METHOD : {METHOD_SPELLING.get(b.method, b.method)};" if b.method is not None else None
+    out.extend(_item(b, "method", method, inner))
+    out.extend(_item(b, "accu", f"ACCU : {b.accu};" if b.accu is not None else None, inner))
+    out.extend(_item(b, "default", _default(b.default) if b.default is not None else None, inner))
+    out.extend(_other_items(b, ("range", "method", "accu", "default"), inner))
+    return _block_lines(b, f"DEFUZZIFY {b.variable}", out, "END_DEFUZZIFY")
+
+
+def _item(
+    b: DefuzzifyBlock | FuzzifyBlock | RuleBlock, item: str, text: str | None, indent: str
+) -> list[str]:
+    """A single-valued item of a block with its comments; where the model has no value for
+    it (``ACCU : NONE;``), its comments alone, where it stood among the items."""
+    if text is not None:
+        return _statement(b, text, indent, item + ".")
+    return _comment_lines((*comments_at(b, item + ".before"), *comments_at(b, item + ".after")), indent)
+
+
+def _other_items(b: DefuzzifyBlock | RuleBlock, items: tuple[str, ...], indent: str) -> list[str]:
+    """The comments of items this writer does not know (none today), so that none is lost."""
+    places = dict.fromkeys(p for p, _ in b.placed_comments if "." in p and p.split(".")[0] not in items)
+    return [line for p in places for line in _comment_lines(comments_at(b, p), indent)]
 
 
 def _rule_block(b: RuleBlock) -> list[str]:
     inner = INDENT * 2
-    header = f"{INDENT}RULEBLOCK" + (f" {b.name}" if b.name is not None else "")
-    out = [*_comment_lines(b.comments, INDENT), header]
-    for keyword, value in (("AND", b.and_op), ("OR", b.or_op), ("ACT", b.act), ("ACCU", b.accu)):
-        if value is not None:
-            out.append(f"{inner}{keyword} : {value};")
+    header = "RULEBLOCK" + (f" {b.name}" if b.name is not None else "")
+    out: list[str] = []
+    for keyword, value, item in (
+        ("AND", b.and_op, "and_op"),
+        ("OR", b.or_op, "or_op"),
+        ("ACT", b.act, "act"),
+        ("ACCU", b.accu, "accu"),
+    ):
+        out.extend(_item(b, item, f"{keyword} : {value};" if value is not None else None, inner))
     for r in b.rules:
-        out.extend(_comment_lines(r.comments, inner))
-        out.append(inner + rule_text(r))
-    out.extend([f"{INDENT}END_RULEBLOCK", ""])
-    return out
+        out.extend(_statement(r, rule_text(r), inner))
+    out.extend(_other_items(b, ("and_op", "or_op", "act", "accu"), inner))
+    return _block_lines(b, header, out, "END_RULEBLOCK")
 
 
 def _options(o: OptionsBlock) -> list[str]:
     end = "END_OPTION" if o.keyword == "OPTION" else "END_OPTIONS"
     body = [INDENT * 2 + line if line else "" for line in o.text.splitlines()]
-    return [f"{INDENT}{o.keyword}", *body, f"{INDENT}{end}", ""]
+    return [
+        *_comment_lines(comments_at(o, "before"), INDENT),
+        f"{INDENT}{o.keyword}",
+        *body,
+        *_trail(f"{INDENT}{end}", comments_at(o, "after"), INDENT),
+        "",
+    ]
 
 
 def unwritable_names(fb: FunctionBlock) -> list[Diagnostic]:
@@ -319,7 +390,8 @@ def write_block(fb: FunctionBlock) -> str:
     problems = unwritable_names(fb) + unwritable_words(fb)
     if problems:
         raise DiagnosticError(problems)
-    out = [*_comment_lines(fb.comments, ""), "FUNCTION_BLOCK" + (f" {fb.name}" if fb.name else ""), ""]
+    header = "FUNCTION_BLOCK" + (f" {fb.name}" if fb.name else "")
+    out = [*_comment_lines(fb.comments, ""), *_trail(header, comments_at(fb, "head"), ""), ""]
     out.extend(_variables(fb))
     for f in fb.fuzzify:
         out.extend(_fuzzify(f))
@@ -329,7 +401,8 @@ def write_block(fb: FunctionBlock) -> str:
         out.extend(_rule_block(r))
     for o in fb.options:
         out.extend(_options(o))
-    out.append("END_FUNCTION_BLOCK")
+    out.extend(_comment_lines(comments_at(fb, "end"), INDENT))
+    out.extend(_trail("END_FUNCTION_BLOCK", comments_at(fb, "tail"), ""))
     return "\n".join(out) + "\n"
 
 

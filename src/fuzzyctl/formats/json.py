@@ -48,7 +48,7 @@ TAGS: dict[type, str] = {
     m.Or: "or",
 }
 CLASSES: dict[str, type] = {tag: cls for cls, tag in TAGS.items()}
-_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments", "item_spans", "grouped"})
+_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments", "placed_comments", "item_spans", "grouped"})
 
 
 def _number(value: float) -> float | str:

@@ -170,7 +170,7 @@ def parse_rules(fb: FunctionBlock, rule_block: int, text: str) -> dict[str, Any]
     skeleton = replace(
         fb,
         variables=(*fb.variables, declared),
-        rule_blocks=(replace(block, rules=(), comments=()),),
+        rule_blocks=(replace(block, rules=(), comments=(), placed_comments=()),),
         options=(),
     )
     written = analysis.fcl_text(Document((skeleton,))).split("\n")

@@ -18,13 +18,33 @@ export function setHost(h) {
   host = h;
 }
 
-/** The block's rules as lines; a rule's comments stand on the lines before it (the parser
- * attaches them to it again). */
+/** The comments written after a rule on its line, as text to append to it (a "//" one
+ * ends the line, so what follows it starts a new one). */
+function afterText(r) {
+  let text = "";
+  for (const [place, c] of r.placed_comments || []) {
+    if (place !== "after") continue;
+    text += (text.split("\n").pop().trimStart().startsWith("//") ? "\n" : " ") + c;
+  }
+  return text;
+}
+
+/** The lines a rule takes: its comments before it, its line, the lines its comments after
+ * it go on to. */
+function linesOf(r) {
+  let n = 1 + afterText(r).split("\n").length - 1;
+  for (const c of r.comments || []) n += c.split("\n").length;
+  return n;
+}
+
+/** The block's rules as lines; a rule's comments stand on the lines before it and after it
+ * on its line, as in the file (the parser attaches them to it again). */
 export function textOf(block) {
   const lines = [];
   block.rules.forEach((r, i) => {
     for (const c of r.comments || []) lines.push(...c.split("\n"));
-    lines.push((r.label === String(i + 1) ? ruleLine(r) : `RULE ${r.label} : ${ruleLine(r)}`) + ";");
+    const rule = (r.label === String(i + 1) ? ruleLine(r) : `RULE ${r.label} : ${ruleLine(r)}`) + ";";
+    lines.push(...(rule + afterText(r)).split("\n"));
   });
   return lines.join("\n");
 }
@@ -35,7 +55,8 @@ function reportDiagnostics() {
   let line = 0;
   for (const r of host.block().rules) {
     for (const c of r.comments || []) line += c.split("\n").length;
-    lineOf.push(++line);
+    lineOf.push(line + 1);
+    line += linesOf(r) - (r.comments || []).reduce((n, c) => n + c.split("\n").length, 0);
   }
   const out = [];
   for (const d of (state.report && state.report.diagnostics) || []) {
@@ -101,8 +122,10 @@ export function focusRule(index) {
   let line = 0;
   host.block().rules.forEach((r, i) => {
     if (i > index) return;
-    for (const c of r.comments || []) line += c.split("\n").length;
-    line += 1;
+    if (i === index) {
+      for (const c of r.comments || []) line += c.split("\n").length;
+      line += 1;
+    } else line += linesOf(r);
   });
   editor.goToLine(line);
 }
