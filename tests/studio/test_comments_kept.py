@@ -15,7 +15,7 @@ BASE = "http://127.0.0.1:8770"
 
 def test_open_then_save_keeps_every_comment_in_place(tmp_path: Path) -> None:
     (tmp_path / "everywhere.fcl").write_text(EVERYWHERE)
-    client = TestClient(create_app(tmp_path), base_url=BASE)
+    client = TestClient(create_app(tmp_path, token=None), base_url=BASE)
     r = client.post("/api/open", json={"path": "everywhere.fcl"})
     assert r.status_code == 200, r.text
     opened = r.json()
