@@ -106,6 +106,9 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             for _t, _a, w, _act in cs
         ]
     )
+    # a set the rule does not activate is left out, as the interpreter leaves it out: under
+    # MIN activation a function term below 0 would otherwise still reach the sum
+    live = A * W > 0.0
     acts = [act for _t, _a, _w, act in cs]
     is_min = np.array([act == "MIN" for act in acts])[:, None]
     by_kind: dict[str, list[int]] = {}
@@ -138,9 +141,11 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             c = a * mu
         else:
             c = np.stack([TNORMS[act].array(a[g], mu[g]) for g, act in enumerate(acts)])
-        c = W[:, r] * c
+        c = np.where(live[:, r], W[:, r] * c, 0.0)  # 0: what every accumulation leaves alone
         if accu == "MAX":
-            acc = c.max(axis=0)
+            # from the empty set, as interp.accumulated_function: a term below 0 is cut at 0
+            top = c.max(axis=0)
+            acc = np.maximum(top, 0.0)
         elif accu in ("SUM", "NSUM"):
             acc = c.sum(axis=0)
         else:
@@ -152,7 +157,7 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         clipped = is_min & (a < mu)
         if accu == "MAX":
             win = np.argmax(c, axis=0)
-            code = 2 * win + clipped[win, np.arange(len(x))]
+            code = np.where(top < 0.0, -1, 2 * win + clipped[win, np.arange(len(x))])
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
             if accu == "BSUM":
