@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -109,6 +110,41 @@ def integrate(
     KM = np.concatenate([d[3] for d in done])
     order = np.argsort(A, kind="stable")
     return A[order], B[order], K[order], KM[order]
+
+
+def kinks(branch: Callable[[FloatArray], list[Any]], cuts: Sequence[float], samples: int = 16) -> list[float]:
+    """Points between ``cuts`` where ``branch(x)`` (which piece of a formula x falls in)
+    changes: each interval sampled at ``samples`` points, each change located by bisection
+    to the float (a kink inside an interval can fool the error estimate)."""
+    out: list[float] = []
+    edges = sorted(set(cuts))
+    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
+        xs = np.linspace(lo, hi, samples)
+        codes = branch(xs)
+        for i in range(samples - 1):
+            if codes[i] != codes[i + 1]:
+                out += _changes(branch, float(xs[i]), float(xs[i + 1]), codes[i], codes[i + 1])
+    return out
+
+
+def _changes(branch: Callable[[FloatArray], list[Any]], a: float, b: float, ca: Any, cb: Any) -> list[float]:
+    found: list[float] = []
+    for _round in range(4):  # a -> b may pass through several pieces: one change per round
+        lo, hi = a, b
+        while True:
+            mid = 0.5 * (lo + hi)
+            if mid in (lo, hi):
+                break
+            if branch(np.array([mid]))[0] == ca:
+                lo = mid
+            else:
+                hi = mid
+        found.append(hi)
+        c_hi = branch(np.array([hi]))[0]
+        if c_hi == cb or hi >= b:
+            break
+        a, ca = hi, c_hi
+    return found
 
 
 def partial(f: Integrand, a: float, x: float) -> float:
