@@ -567,20 +567,28 @@ def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> Result:
         s = np.minimum(s, d)
         return np.asarray(b0 - s if reverse else a0 + s, dtype=np.float64)
 
+    tol = pwl.COA_TOL * total  # a zero gap: its middle (pwl.bisector)
+    enough = (half - tol)[:, None]
     cum = np.cumsum(areas, axis=1)
-    ok = (cum >= half[:, None]) & (areas > 0.0)
+    ok = (cum >= enough) & (areas > 0.0)
     i_left = np.argmax(ok, axis=1)
     before = (
         np.take_along_axis(cum, i_left[:, None], axis=1)[:, 0]
         - np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
     )
-    left = solve(i_left, half - before, False)
+    a_left = np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
+    whole = half - before >= a_left - tol
+    left = solve(i_left, np.where(whole, a_left, half - before), False)
+    left = np.where(whole, np.take_along_axis(x1, i_left[:, None], axis=1)[:, 0], left)
     rcum = np.cumsum(areas[:, ::-1], axis=1)[:, ::-1]
-    ok_r = (rcum >= half[:, None]) & (areas > 0.0)
+    ok_r = (rcum >= enough) & (areas > 0.0)
     i_right = areas.shape[1] - 1 - np.argmax(ok_r[:, ::-1], axis=1)
     before_r = (
         np.take_along_axis(rcum, i_right[:, None], axis=1)[:, 0]
         - np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
     )
-    right = solve(i_right, half - before_r, True)
+    a_right = np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
+    whole = half - before_r >= a_right - tol
+    right = solve(i_right, np.where(whole, a_right, half - before_r), True)
+    right = np.where(whole, np.take_along_axis(x0, i_right[:, None], axis=1)[:, 0], right)
     return np.where(fired, 0.5 * (left + right), np.nan), fired

@@ -25,6 +25,10 @@ from fuzzyctl.engine.plan import GridPlan
 
 #: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
 MAX_TOL = 1e-12
+#: Relative tolerance (of the whole area) within which CoA takes the area before a zero gap
+#: as half: the bisector is then not unique and CoA answers the middle of the gap (rounding
+#: in the running sums would otherwise pick one end of it).
+COA_TOL = 1e-12
 
 Piece = tuple[float, float, float, float, tuple[tuple[float, float], ...] | None]
 #: One activated set on one grid interval: (L, R, a, w, is_min) - the term goes linearly from
@@ -227,19 +231,22 @@ def bisector(pieces: Sequence[Piece], total: float) -> float:
     """Centre of area: the x splitting the area in two equal halves.  When a whole interval
     of solutions exists (a gap where the set is 0), its midpoint."""
     half = 0.5 * total
+    tol = COA_TOL * total
     areas = [piece_area_moment(p)[0] for p in pieces]
+    # the whole piece within tol: its end, not the quadratic (whose root near a 0 end moves
+    # by sqrt(rounding) there)
     cum = 0.0
     left = pieces[-1][1]
     for p, a in zip(pieces, areas, strict=True):
-        if a > 0.0 and cum + a >= half:
-            left = _solve_in_piece(p, half - cum)
+        if a > 0.0 and cum + a >= half - tol:
+            left = p[1] if half - cum >= a - tol else _solve_in_piece(p, half - cum)
             break
         cum += a
     cum = 0.0
     right = pieces[0][0]
     for p, a in zip(reversed(pieces), reversed(areas), strict=True):
-        if a > 0.0 and cum + a >= half:
-            right = _solve_in_piece(p, a - (half - cum))
+        if a > 0.0 and cum + a >= half - tol:
+            right = p[0] if half - cum >= a - tol else _solve_in_piece(p, a - (half - cum))
             break
         cum += a
     return 0.5 * (left + right)
