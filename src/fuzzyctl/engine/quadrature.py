@@ -94,6 +94,8 @@ def integrate(
         share = (b - a) / span
         tol = rtol * total * np.maximum(share, 1e-6)
         ok = (ek <= tol) & (ekm <= tol * scale) | ((b - a) <= 1e-13 * scale)
+        if not (np.isfinite(k).all() and np.isfinite(km).all()):
+            ok = np.ones_like(ok)  # NaN/inf (a 0/0 in a function term): no halving makes it a number
         if n_open + len(done) > MAX_INTERVALS:  # give up refining: keep the best estimate
             ok = np.ones_like(ok)
         done.append((a[ok], b[ok], k[ok], km[ok]))
@@ -114,37 +116,37 @@ def integrate(
 
 def kinks(branch: Callable[[FloatArray], list[Any]], cuts: Sequence[float], samples: int = 16) -> list[float]:
     """Points between ``cuts`` where ``branch(x)`` (which piece of a formula x falls in)
-    changes: each interval sampled at ``samples`` points, each change located by bisection
-    to the float (a kink inside an interval can fool the error estimate)."""
+    changes: each interval sampled at ``samples`` points, every change located by bisection
+    to the float (a kink inside an interval can fool the error estimate).  A gap between two
+    samples may pass several pieces: one is found per round, four rounds at most."""
+    edges = np.array(sorted(set(cuts)), dtype=np.float64)
+    t = np.linspace(0.0, 1.0, samples)
+    xs = (edges[:-1, None] + (edges[1:] - edges[:-1])[:, None] * t[None, :]).ravel()
+    codes = branch(xs)
+    gaps = [i for i in range(len(xs) - 1) if codes[i] != codes[i + 1] and xs[i] < xs[i + 1]]
+    lo = np.array([xs[i] for i in gaps])
+    hi = np.array([xs[i + 1] for i in gaps])
+    c_lo = [codes[i] for i in gaps]
+    c_end = [codes[i + 1] for i in gaps]
     out: list[float] = []
-    edges = sorted(set(cuts))
-    for lo, hi in zip(edges[:-1], edges[1:], strict=True):
-        xs = np.linspace(lo, hi, samples)
-        codes = branch(xs)
-        for i in range(samples - 1):
-            if codes[i] != codes[i + 1]:
-                out += _changes(branch, float(xs[i]), float(xs[i + 1]), codes[i], codes[i + 1])
-    return out
-
-
-def _changes(branch: Callable[[FloatArray], list[Any]], a: float, b: float, ca: Any, cb: Any) -> list[float]:
-    found: list[float] = []
-    for _round in range(4):  # a -> b may pass through several pieces: one change per round
-        lo, hi = a, b
-        while True:
-            mid = 0.5 * (lo + hi)
-            if mid in (lo, hi):
-                break
-            if branch(np.array([mid]))[0] == ca:
-                lo = mid
-            else:
-                hi = mid
-        found.append(hi)
-        c_hi = branch(np.array([hi]))[0]
-        if c_hi == cb or hi >= b:
+    for _round in range(4):
+        if not len(lo):
             break
-        a, ca = hi, c_hi
-    return found
+        end = hi.copy()
+        while True:  # all gaps at once, to the last bit
+            mid = 0.5 * (lo + hi)
+            open_ = (mid != lo) & (mid != hi)
+            if not open_.any():
+                break
+            same = np.array([c == c0 for c, c0 in zip(branch(mid), c_lo, strict=True)]) & open_
+            lo = np.where(same, mid, lo)
+            hi = np.where(same | ~open_, hi, mid)
+        out += [float(v) for v in hi]
+        c_hi = branch(hi)
+        more = [k for k in range(len(hi)) if c_hi[k] != c_end[k] and hi[k] < end[k]]
+        lo, hi = hi[more], end[more]
+        c_lo, c_end = [c_hi[k] for k in more], [c_end[k] for k in more]
+    return out
 
 
 def partial(f: Integrand, a: float, x: float) -> float:
@@ -199,6 +201,8 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         i = int(index)
         if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
             continue
+        if (i > 0 and ys[i - 1] == ys[i]) or (i + 1 < n and ys[i + 1] == ys[i]):
+            continue  # a node of a plateau (below: its edges), not a peak between nodes
         peaks.append(
             _golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i]))
         )

@@ -228,11 +228,16 @@ def integrate_rows(f: Any, m: int, a: Arr, b: Arr, r: Arr, cuts: Any, rtol: floa
     area = np.zeros(m)
     moment = np.zeros(m)
     count = np.bincount(r, minlength=m)
+    undefined = np.zeros(m, dtype=bool)
     while True:
         share = (b - a) / span
         tol = rtol * total[r] * np.maximum(share, 1e-6)
         ok = (ek <= tol) & (ekm <= tol * scale) | ((b - a) <= 1e-13 * scale)
         ok |= count[r] > quadrature.MAX_INTERVALS  # give up refining: keep the best estimate
+        # a row with NaN/inf (a 0/0 in a function term) has no number for an answer: no
+        # halving makes one, so its intervals stop here (memory stays proportionate to rows)
+        undefined |= np.bincount(r, weights=~(np.isfinite(k) & np.isfinite(km)), minlength=m) > 0
+        ok |= undefined[r]
         area += np.bincount(r[ok], weights=k[ok], minlength=m)
         moment += np.bincount(r[ok], weights=km[ok], minlength=m)
         if ok.all():
