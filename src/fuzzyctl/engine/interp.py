@@ -356,6 +356,11 @@ class Interpreter:
             return rec
         A, B, K, KM = quadrature.integrate(f, cuts, self.plan.options.quad_rtol)
         area = float(np.sum(K))
+        if not (math.isfinite(area) and math.isfinite(float(np.sum(KM)))):
+            # rules fired but a term is undefined there (a 0/0 in a function term): the
+            # output is NaN, not the DEFAULT of "no rule fired"
+            rec.fired = True
+            return rec
         if op.method in ("COG", "COA"):
             if not area > 0.0:
                 return rec

@@ -77,9 +77,11 @@ def smooth_output(
         a, b, r = _kinked_intervals(f, len(block), cuts)
         area, moment = integrate_rows(f, len(block), a, b, r, cuts, plan.options.quad_rtol)
         ok = area > 0.0
+        # rules fired but a term is undefined there: NaN, not the DEFAULT (interp._smooth)
+        undefined = ~(np.isfinite(area) & np.isfinite(moment))
         with np.errstate(all="ignore"):
-            value[block] = np.where(ok, moment / area, np.nan)
-        fired[block] = ok
+            value[block] = np.where(ok & ~undefined, moment / area, np.nan)
+        fired[block] = ok | undefined
     return value, fired
 
 
