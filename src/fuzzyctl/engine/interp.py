@@ -440,7 +440,9 @@ def activated_sets(
         out = []
         for term, params, h, a, w, act in resolved:
             if term.kind == "function":
-                mu = np.broadcast_to(np.asarray(eval_expr_np(term.expr, vals, [], x), dtype=np.float64), x.shape)
+                assert term.expr is not None
+                got = eval_expr_np(term.expr, vals, [], x)
+                mu = np.broadcast_to(np.asarray(got, dtype=np.float64), x.shape)
             else:
                 mu = shapes.membership_np(term.kind, params, h, x)
             out.append((mu, w * act(a, mu)))

@@ -293,10 +293,11 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
         s, e = p
         r = g.let(e - s, "R")
         with g.b.if_((s.lt(e).and_(s.le(x)).and_(x.le(e))).or_(s.gt(e).and_(e.le(x)).and_(x.le(s)))):
-            q = g.let(r * r - (x - e) * (x - e), "Q")
+            t = g.let((x - e) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
             with g.b.if_(q.lt(0.0)):
                 g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q) / _absv(g, r))
+            g.b.set(out, g.call("SQRT", q))
         with g.b.elif_((s.lt(e).and_(x.gt(e))).or_(s.gt(e).and_(x.lt(e)))):
             g.b.set(out, 1.0)
         with g.b.else_():
@@ -307,10 +308,11 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
         r = g.let(0.5 * (e - s), "R")
         c = g.let(s + r, "C")
         with g.b.if_(s.le(x).and_(x.le(e))):
-            q = g.let(r * r - (x - c) * (x - c), "Q")
+            t = g.let((x - c) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
             with g.b.if_(q.lt(0.0)):
                 g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q) / r)
+            g.b.set(out, g.call("SQRT", q))
         with g.b.else_():
             g.b.set(out, 0.0)
     else:

@@ -67,9 +67,7 @@ def ascii_plot(trace: OutputTrace, width: int = 64, height: int = 10) -> str:
     if mark is not None:
         rows.append("      " + " " * mark + f"^ {trace.name} = {trace.value:.6g}")
     else:
-        rows.append(
-            f"      {trace.name} = {trace.value:.6g}" + _why(trace)
-        )
+        rows.append(f"      {trace.name} = {trace.value:.6g}" + _why(trace))
     return "\n".join(rows)
 
 
