@@ -389,3 +389,24 @@ def test_clipped_sigmoid_products_match_a_dense_reference_on_every_path() -> Non
                 float(batch),
                 want,
             )
+
+
+def test_coa_of_a_zero_gap_between_smooth_sets_is_its_middle() -> None:
+    """Cosine sets (compact support [1, 3] and [7, 9]) of equal degree: the quadrature's CoA
+    answers the middle of the gap [3, 7] on every path (within 1e-9 of the range: in floating
+    point the cosine is exactly 0 from 3 - 3.4e-9 on, so the computed gap starts there)."""
+    text = FUNCTION_FLL.format(
+        left="Cosine 2.000 2.000", right="Cosine 8.000 2.000", aggregation="Maximum", defuzzifier="Bisector"
+    ).replace("range: 0.000 1.000\n  aggregation", "range: 0.000 10.000\n  aggregation")
+    text = text.replace(
+        "  term: left Triangle 0.000 0.300 0.600\n  term: right Triangle 0.400 0.700 1.000",
+        "  term: left Ramp 0.000 1.000\n  term: right Ramp 0.000 1.000",
+    )
+    doc = load(text, format="fll")
+    for backend in ("python", "interpreted"):
+        ctl = _quiet_compile(doc, backend)
+        for x in (0.3, 0.7, 0.123, 1.0):
+            got = ctl.evaluate({"obstacle": x})["steer"]  # type: ignore[attr-defined]
+            assert abs(got - 5.0) <= 1e-8, (backend, x, got)
+        batch = ctl.evaluate_batch({"obstacle": np.array([0.3, 0.7])})["steer"]  # type: ignore[attr-defined]
+        assert (abs(batch - 5.0) <= 1e-8).all(), (backend, batch)

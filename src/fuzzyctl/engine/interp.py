@@ -365,7 +365,11 @@ class Interpreter:
             if not area > 0.0:
                 return rec
             rec.fired = True
-            rec.value = float(np.sum(KM)) / area if op.method == "COG" else quadrature.bisector(f, A, B, K)
+            rec.value = (
+                float(np.sum(KM)) / area
+                if op.method == "COG"
+                else quadrature.bisector(f, A, B, K, self.plan.options.quad_rtol)
+            )
             return rec
         if not area > 0.0:
             return rec

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from fuzzyctl.engine.operators import fsum
+from fuzzyctl.engine.pwl import COA_TOL
 from fuzzyctl.engine.shapes import FloatArray
 
 _XGK = np.array(
@@ -156,21 +157,36 @@ def partial(f: Integrand, a: float, x: float) -> float:
     return float(k[0])
 
 
-def bisector(f: Integrand, A: FloatArray, B: FloatArray, K: FloatArray) -> float:
-    """Centre of area from accepted intervals."""
+def bisector(f: Integrand, A: FloatArray, B: FloatArray, K: FloatArray, rtol: float = 1e-10) -> float:
+    """Centre of area from accepted intervals: the middle of the points that halve the area -
+    one point, or a whole gap where the set is 0 (``pwl.bisector``: an area within a tolerance
+    of half counts as half - here ten times the quadrature's ``rtol``, what the areas are
+    known to - and a whole interval within it answers its end)."""
     total = float(np.sum(K))
     half = 0.5 * total
+    tol = max(COA_TOL, 10.0 * rtol) * total
     cum = np.cumsum(K)
-    i = int(np.searchsorted(cum, half))
-    i = min(i, len(K) - 1)
+    i = int(np.argmax((cum >= half - tol) & (K > 0.0)))
     before = float(cum[i - 1]) if i > 0 else 0.0
-    lo, hi = float(A[i]), float(B[i])
-    target = half - before
+    left = float(B[i]) if half - before >= K[i] - tol else _solve(f, float(A[i]), float(B[i]), half - before)
+    rcum = np.cumsum(K[::-1])[::-1]
+    j = len(K) - 1 - int(np.argmax(((rcum >= half - tol) & (K > 0.0))[::-1]))
+    after = float(rcum[j]) - float(K[j])
+    if half - after >= K[j] - tol:
+        right = float(A[j])
+    else:
+        right = _solve(f, float(A[j]), float(B[j]), float(K[j]) - (half - after))
+    return 0.5 * (left + right)
+
+
+def _solve(f: Integrand, a: float, b: float, target: float) -> float:
+    """The x in [a, b] (an accepted interval) where the area from ``a`` reaches ``target``."""
+    lo, hi = a, b
     for _ in range(100):
         mid = 0.5 * (lo + hi)
         if mid in (lo, hi):
             break
-        if partial(f, float(A[i]), mid) < target:
+        if partial(f, a, mid) < target:
             lo = mid
         else:
             hi = mid
