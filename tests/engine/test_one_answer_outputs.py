@@ -410,3 +410,26 @@ def test_coa_of_a_zero_gap_between_smooth_sets_is_its_middle() -> None:
             assert abs(got - 5.0) <= 1e-8, (backend, x, got)
         batch = ctl.evaluate_batch({"obstacle": np.array([0.3, 0.7])})["steer"]  # type: ignore[attr-defined]
         assert (abs(batch - 5.0) <= 1e-8).all(), (backend, batch)
+
+
+def test_mom_takes_a_rounded_crossing_next_to_a_vertex_for_that_vertex() -> None:
+    """Two maxima, at 1 and 2 (a triangle falling from 1 and one rising to 2 at the same
+    degree): MoM = 1.5.  A crossing computed 1.3e-15 left of 2 (rounding in the degrees)
+    reaches the height too; it is neither a plateau (MoM 2.0) nor a third point (1.67): it
+    is the vertex (valeriot90's mamdani.fis: 1.5 on one path, 2.0 on the other)."""
+    from fuzzyctl.engine import pwl
+
+    h = 1.1466298317900281e-23
+    x_near = 1.9999999999999987
+    pieces = [
+        (0.0, 1.0, 0.0, h, None),
+        (1.0, 1.5, h, 0.5 * h, None),
+        (1.5, x_near, 0.5 * h, h * (1 - 1.2e-15), None),
+        (x_near, 2.0, h * (1 - 1.2e-15), h, None),
+        (2.0, 5.0, 2.7e-77, 0.0, None),
+    ]
+    points = [(0.0, 0.0), (1.0, h), (2.0, h), (3.0, 0.0), (5.0, 0.0)]
+    _sup, lm, rm, mom = pwl.maxima(pieces, points)
+    assert (lm, rm) == (1.0, 2.0)
+    assert abs(mom - 1.5) <= 1e-9 * 5.0, mom
+    assert pwl.distinct_points([1.0, x_near, 2.0], 1e-12 * 5.0) == [1.0, x_near]

@@ -504,12 +504,13 @@ def _point_values(grid: GridPlan, groups: list[tuple[int, Arr, W, bool]], accu: 
     return np.stack(cols, axis=1)
 
 
-def _mean_distinct(x: Arr) -> Arr:
-    """Row-wise mean of the distinct non-NaN values."""
+def _mean_distinct(x: Arr, near: float) -> Arr:
+    """Row-wise mean of the distinct non-NaN values (within ``near`` of the one before: the
+    same point, ``pwl.distinct_points``)."""
     s = np.sort(x, axis=1)
     valid = ~np.isnan(s)
     first = np.ones_like(valid)
-    first[:, 1:] = s[:, 1:] != s[:, :-1]
+    first[:, 1:] = s[:, 1:] - s[:, :-1] > near
     keep = valid & first
     cnt = keep.sum(axis=1)
     with np.errstate(all="ignore"):
@@ -533,6 +534,7 @@ def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -
             np.where(hitg, gxb, -np.inf).max(axis=1),
         )
     else:
+        near = pwl.MAX_TOL * float(gx[-1] - gx[0])  # pwl.maxima
         plateau = hit0 & hit1 & (x1 > x0)
         length = np.where(plateau, x1 - x0, 0.0).sum(axis=1)
         mom = np.where(plateau, (x1 - x0) * 0.5 * (x0 + x1), 0.0).sum(axis=1)
@@ -540,7 +542,7 @@ def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -
             [np.where(hit0, x0, np.nan), np.where(hit1, x1, np.nan), np.where(hitg, gxb, np.nan)], axis=1
         )
         with np.errstate(all="ignore"):
-            value = np.where(length > 0.0, mom / length, _mean_distinct(pts))
+            value = np.where(length > near, mom / length, _mean_distinct(pts, near))
     return np.where(fired, value, np.nan), fired
 
 

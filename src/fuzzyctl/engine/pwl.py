@@ -266,8 +266,11 @@ def maxima(
     lm, rm = math.inf, -math.inf
     plateau_len = plateau_mom = 0.0
     isolated: set[float] = set()
-    # crossing points are computed, not given: accept values within MAX_TOL of the supremum
+    # crossing points are computed, not given: accept values within MAX_TOL of the supremum,
+    # and take points within MAX_TOL of the range for one (a crossing rounded 1e-15 from a
+    # vertex is no plateau and no second maximum)
     thr = sup * (1.0 - MAX_TOL)
+    near = MAX_TOL * (points[-1][0] - points[0][0]) if points else 0.0
     for x0, x1, v0, v1, _f in pieces:
         if v0 >= thr:
             lm = min(lm, x0)
@@ -285,12 +288,18 @@ def maxima(
             lm = min(lm, x)
             rm = max(rm, x)
             isolated.add(x)
+    distinct = distinct_points(sorted(isolated), near)
     mom = (
         plateau_mom / plateau_len
-        if plateau_len > 0.0
-        else (fsum(isolated) / len(isolated) if isolated else math.nan)
+        if plateau_len > near
+        else (fsum(distinct) / len(distinct) if distinct else math.nan)
     )
     return sup, lm, rm, mom
+
+
+def distinct_points(xs: Sequence[float], near: float) -> list[float]:
+    """Sorted ``xs`` without the points within ``near`` of the one before them."""
+    return [x for i, x in enumerate(xs) if i == 0 or x - xs[i - 1] > near]
 
 
 def defuzzify_pieces(
