@@ -1,0 +1,284 @@
+"""The cell decomposition of the input space and the rule degrees on it.
+
+Each input axis is cut at every breakpoint of the terms its rules read, at the ends of their
+supports and at every point where a condition leaf (term, hedges and NOT applied) crosses one
+of the levels the analysis asks about (``epsilon`` divided by the rule's weights, and one
+minus it).  Piecewise-linear leaves cross by linear interpolation between breakpoints (exact);
+hedged or smooth leaves by :func:`scipy.optimize.brentq` in brackets found on a sampling of
+the axis (``SAMPLES`` points plus the term's characteristic points; ``xtol`` ``XTOL`` times
+the axis width).  The cells of an axis are its cut points and the open intervals between
+them; the cells of the space are their products.  Inside one cell every leaf is on one side
+of every level, so under MIN/MAX (and, for "degree > 0", under every t-norm without zero
+divisors) each rule's "degree >= level" is constant on the cell: one representative point
+(the cut point, or the middle of the interval) decides it for the whole cell."""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from fuzzyctl.analyze.context import Context, FloatArray, constant, leaf_axis, leaf_values, term_points
+from fuzzyctl.engine import shapes
+from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
+from fuzzyctl.engine.plan import CAnd, CChained, CDegree, CNot, CondPlan, COr, CTerm, CTrue, Plan, Slot
+
+SAMPLES = 2049
+XTOL = 1e-12
+#: t-norms with T(a, b) > 0 whenever a, b > 0: "degree > 0" is decided cell by cell
+NO_ZERO_DIVISORS = frozenset({"MIN", "PROD", "HAMACHER", "EINSTEIN"})
+
+
+@dataclass
+class Axis:
+    """One input's cells: ``cuts`` sorted; cell ``2k`` is ``cuts[k]``, cell ``2k+1`` the open
+    interval ``(cuts[k], cuts[k+1])``.  An input no condition reads has one cell: its range."""
+
+    name: str
+    low: float
+    high: float
+    cuts: FloatArray
+    read: bool = True
+
+    @property
+    def reps(self) -> FloatArray:
+        if not self.read:
+            return np.array([0.5 * (self.low + self.high)])
+        c = self.cuts
+        out = np.empty(2 * len(c) - 1)
+        out[0::2] = c
+        out[1::2] = 0.5 * (c[:-1] + c[1:])
+        return out
+
+    @property
+    def widths(self) -> FloatArray:
+        if not self.read:
+            return np.array([self.high - self.low])
+        out = np.zeros(2 * len(self.cuts) - 1)
+        out[1::2] = np.diff(self.cuts)
+        return out
+
+    def bounds(self, first: int, last: int) -> tuple[float, float]:
+        """The closure of cells ``first..last``."""
+        if not self.read:
+            return (self.low, self.high)
+        return (float(self.cuts[first // 2]), float(self.cuts[(last + 1) // 2]))
+
+
+@dataclass
+class Grid:
+    """The rule degrees on the cells' representatives."""
+
+    axes: list[Axis]
+    best: dict[int, FloatArray]  # per output index: the highest degree a rule reaches it with
+    rule_max: FloatArray  # per rule: its highest degree anywhere
+    exact: bool
+    notes: list[str] = field(default_factory=list)
+
+
+def leaves(c: CondPlan) -> Iterator[CondPlan]:
+    stack = [c]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, CNot):
+            stack.append(node.operand)
+        elif isinstance(node, CAnd | COr):
+            stack.extend(node.operands)
+        else:
+            yield node
+
+
+def _ops(c: CondPlan) -> Iterator[str]:
+    stack = [c]
+    while stack:
+        node = stack.pop()
+        if isinstance(node, CNot):
+            stack.append(node.operand)
+        elif isinstance(node, CAnd | COr):
+            yield node.op
+            stack.extend(node.operands)
+
+
+def levels(ctx: Context, epsilon: float) -> list[float]:
+    """The degrees a leaf is compared with: epsilon over each rule's constant weights, the
+    firing threshold, and one minus each (a NOT turns ``>= c`` into ``<= 1 - c``)."""
+    plan = ctx.plan
+    out = {plan.options.firing_threshold} if plan.options.firing_threshold > 0 else set()
+    if epsilon > 0:
+        for r in plan.rules:
+            w = constant(r.weight)
+            for cp in r.conclusions:
+                wc = constant(cp.weight)
+                if w and wc:
+                    out.add(epsilon / (w * wc))
+    out |= {1.0 - c for c in out}
+    return sorted(c for c in out if 0.0 < c <= 1.0)
+
+
+def _crossings(g: FloatArray, xs: FloatArray, level: float, f: object, linear: bool) -> list[float]:
+    from scipy.optimize import brentq
+
+    found = list(xs[g == level])
+    d = g - level
+    idx = np.nonzero(d[:-1] * d[1:] < 0)[0]
+    tol = XTOL * max(1.0, float(xs[-1] - xs[0]))
+    for i in idx:
+        a, b = float(xs[i]), float(xs[i + 1])
+        if linear:
+            found.append(a + (b - a) * float(d[i] / (d[i] - d[i + 1])))
+        else:
+            found.append(float(brentq(lambda x: float(f(np.array([x]))[0]) - level, a, b, xtol=tol)))  # type: ignore[operator]
+    return found
+
+
+def _axis_cuts(plan: Plan, slot: int, low: float, high: float, axis_leaves: list[CondPlan], lv: list[float]) -> FloatArray:
+    cuts = [low, high]
+    for leaf in axis_leaves:
+        assert isinstance(leaf, CTerm | CDegree)
+        knots: list[float] = [low, high]
+        linear = isinstance(leaf, CDegree)
+        if isinstance(leaf, CTerm) and "any" not in leaf.hedges:
+            t = plan.fuzzy_inputs[leaf.var].terms[leaf.term]
+            pts = term_points(t)
+            knots += pts
+            cuts += pts
+            linear = t.pwl is not None and not leaf.hedges
+            if t.pwl is None and t.constant:
+                cuts += [s for s in shapes.support(t.kind, [float(p) for p in t.params], float(t.height))]  # type: ignore[arg-type]
+        xs = np.unique(np.clip(np.array(knots, dtype=np.float64), low, high))
+        if not linear:
+            xs = np.unique(np.concatenate([xs, np.linspace(low, high, SAMPLES)]))
+
+        def f(x: FloatArray, leaf: CondPlan = leaf) -> FloatArray:
+            return leaf_values(plan, leaf, x)  # type: ignore[arg-type]
+
+        g = f(xs)
+        for level in lv:
+            cuts += _crossings(g, xs, level, f, linear)
+    arr = np.unique(np.array([c for c in cuts if np.isfinite(c)], dtype=np.float64))
+    return arr[(arr >= low) & (arr <= high)]
+
+
+def build_axes(ctx: Context, epsilon: float) -> list[Axis]:
+    plan = ctx.plan
+    by_slot: dict[int, dict[CondPlan, None]] = {}
+    for r in plan.rules:
+        for leaf in leaves(r.condition):
+            slot = leaf_axis(plan, leaf)
+            if slot is not None:
+                by_slot.setdefault(slot, {})[leaf] = None
+    lv = levels(ctx, epsilon)
+    axes = []
+    for slot, name in enumerate(ctx.inputs):
+        low, high = ctx.ranges[slot]
+        if slot in by_slot:
+            axes.append(Axis(name, low, high, _axis_cuts(plan, slot, low, high, list(by_slot[slot]), lv)))
+        else:
+            axes.append(Axis(name, low, high, np.array([low, high]), read=False))
+    return axes
+
+
+def exactness(ctx: Context, epsilon: float) -> list[str]:
+    """Why the cell representatives might not decide a cell (empty: they do, exactly)."""
+    plan = ctx.plan
+    notes = []
+    ops = {op for r in plan.rules for op in _ops(r.condition)}
+    plain = {"MIN", "MAX"}
+    if epsilon == 0:
+        plain = NO_ZERO_DIVISORS | set(SNORMS)
+    if ops - plain:
+        notes.append(f"operators {', '.join(sorted(ops - plain))}: degrees are compared at one point per cell")
+    if plan.chained:
+        notes.append("chained variables: their degrees are compared at one point per cell")
+    if plan.selections:
+        notes.append("rule activation methods (First/Highest/...) are not applied: every rule counts")
+    if epsilon > 0 and any(cp.hedges for r in plan.rules for cp in r.conclusions):
+        notes.append("hedged conclusions: degrees are compared at one point per cell")
+    if any(isinstance(r.weight, Slot) or any(isinstance(cp.weight, Slot) for cp in r.conclusions) for r in plan.rules):
+        notes.append("weights given by inputs: degrees are compared at one point per cell")
+    return notes
+
+
+class _Evaluator:
+    """Rule degrees over the broadcast grid of representatives, in the engine's order."""
+
+    def __init__(self, ctx: Context, axes: list[Axis]) -> None:
+        self.plan = ctx.plan
+        n = len(axes)
+        self.reps = []
+        for k, a in enumerate(axes):
+            shape = [1] * n
+            shape[k] = -1
+            self.reps.append(a.reps.reshape(shape))
+        self.cache: dict[CondPlan, FloatArray] = {}
+        self.chained: list[list[FloatArray]] = [[np.zeros(())] * len(c.terms) for c in self.plan.chained]
+        self.bare: list[FloatArray] = [np.zeros(())] * len(self.plan.chained)
+
+    def value(self, p: float | Slot) -> FloatArray:
+        return self.reps[p.index] if isinstance(p, Slot) else np.asarray(float(p))
+
+    def cond(self, c: CondPlan) -> FloatArray:
+        if isinstance(c, CTerm | CDegree) and (isinstance(c, CTerm) or c.slot is not None):
+            got = self.cache.get(c)
+            if got is None:
+                slot = leaf_axis(self.plan, c)
+                assert slot is not None
+                rep = self.reps[slot]
+                got = leaf_values(self.plan, c, rep.ravel()).reshape(rep.shape)
+                self.cache[c] = got
+            return got
+        if isinstance(c, CDegree):
+            assert c.chained is not None
+            return self.bare[c.chained]
+        if isinstance(c, CChained):
+            d = self.chained[c.var][c.term] if "any" not in c.hedges else np.ones(())
+            for h in reversed(c.hedges):
+                d = shapes.hedge_np(h, d)
+            return 1.0 - d if c.negated else d
+        if isinstance(c, CNot):
+            return 1.0 - self.cond(c.operand)
+        if isinstance(c, CAnd | COr):
+            norm = (TNORMS if isinstance(c, CAnd) else SNORMS)[c.op].array
+            v = self.cond(c.operands[0])
+            for o in c.operands[1:]:
+                v = norm(v, self.cond(o))
+            return np.asarray(v)
+        assert isinstance(c, CTrue)
+        return np.ones(())
+
+    def rule(self, ri: int) -> FloatArray:
+        r = self.plan.rules[ri]
+        a = self.cond(r.condition)
+        if not (isinstance(r.weight, float | int) and r.weight == 1.0):
+            a = a * self.value(r.weight)
+        th = self.plan.options.firing_threshold
+        return np.where(a <= th, 0.0, a)
+
+
+def evaluate(ctx: Context, axes: list[Axis], epsilon: float) -> Grid:
+    """Every rule's degree at every cell's representative; per output the best one."""
+    plan = ctx.plan
+    ev = _Evaluator(ctx, axes)
+    shape = tuple(len(a.reps) for a in axes)
+    best = {o: np.zeros(shape) for o in range(len(plan.outputs))}
+    rule_max = np.zeros(len(plan.rules))
+    for ri in plan.order:
+        r = plan.rules[ri]
+        a = ev.rule(ri)
+        rule_max[ri] = float(np.max(a))
+        for cp in r.conclusions:
+            ah = a
+            for h in reversed(cp.hedges):
+                ah = shapes.hedge_np(h, ah)
+            contrib = ev.value(cp.weight) * ah
+            for o in cp.outputs:
+                np.maximum(best[o], contrib, out=best[o])
+            for ch in cp.chained:
+                accu = plan.chained[ch].accu
+                if cp.term is None:
+                    ev.bare[ch] = np.asarray(accumulate_np(accu, ev.bare[ch], contrib))
+                else:
+                    ev.chained[ch][cp.term] = np.asarray(accumulate_np(accu, ev.chained[ch][cp.term], contrib))
+    notes = exactness(ctx, epsilon)
+    return Grid(axes, best, rule_max, not notes, notes)
