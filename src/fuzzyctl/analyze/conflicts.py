@@ -21,6 +21,7 @@ from fuzzyctl.analyze.cells import Axis
 from fuzzyctl.analyze.context import Context
 from fuzzyctl.analyze.table import AxisLeaves, Row, leaf_matrix
 from fuzzyctl.engine import shapes
+from fuzzyctl.engine.explain import Explanation
 from fuzzyctl.engine.plan import TermPlan
 
 DEFAULT_DELTA = 0.5
@@ -108,12 +109,27 @@ def _output_conflicts(
         ub = np.minimum(weights[i][:, None], weights[None, :])
         for k in range(len(slots)):
             ub = np.minimum(ub, mm[k][mat[i, k][:, None], mat[None, :, k]])
-        cand = (ub > delta) & apart[terms[i]][:, terms] & (i[:, None] < np.arange(n)[None, :])
+        # (1e-9: the bound comes from interpolated crossings; 0.5 + 1 ulp is 0.5)
+        cand = (ub > delta + 1e-9) & apart[terms[i]][:, terms] & (i[:, None] < np.arange(n)[None, :])
         for a, b in zip(*np.nonzero(cand), strict=True):
             c = _verify(ctx, axes, rows[i[a]], rows[b], terms[i[a]], terms[b], slots, mat, tables, delta, o)
             if c is not None:
                 out.append(c)
     return out
+
+
+_EXPLAINED: dict[tuple[int, tuple[float, ...]], Explanation] = {}
+
+
+def explained(ctx: Context, point: dict[str, float]) -> Explanation:
+    """The engine's explanation at ``point`` (pairs meeting at one point share it)."""
+    key = (id(ctx), tuple(point.values()))
+    got = _EXPLAINED.get(key)
+    if got is None:
+        if len(_EXPLAINED) > 256:
+            _EXPLAINED.clear()
+        got = _EXPLAINED[key] = ctx.controller.explain(point)
+    return got
 
 
 def _verify(
@@ -136,7 +152,7 @@ def _verify(
         i, j = tab.of(r1.leaves.get(s)), tab.of(r2.leaves.get(s))
         point[axes[s].name] = tab.argmax_min(i, j)
         box[axes[s].name] = tab.above(i, j, delta)
-    ex = ctx.controller.explain(point)
+    ex = explained(ctx, point)
     joint = min(ex.rules[r1.rule].degree, ex.rules[r2.rule].degree)
     if not joint > delta:
         return None

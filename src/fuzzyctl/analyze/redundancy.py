@@ -73,9 +73,9 @@ def _group(ctx: Context, group: list[Row], tables: dict[int, AxisLeaves], dom: d
         cover &= dom[s][mat[:, k][:, None], mat[None, :, k]]
     subset = np.all((mat[:, None, :] == absent) | (mat[None, :, :] != absent), axis=2)  # b reads a subset of a
     weights = np.array([r.weight for r in group])
-    ops_ok = np.array(
-        [[len(b.leaves) <= 1 or b.op in ("MIN", a.op) for a in group] for b in group], dtype=bool
-    )
+    ops = np.array([r.op for r in group])
+    single = np.array([len(r.leaves) <= 1 or r.op == "MIN" for r in group])
+    ops_ok = single[:, None] | (ops[:, None] == ops[None, :])
     cover &= subset & (weights[:, None] >= weights[None, :]) & ops_ok
     np.fill_diagonal(cover, False)
     same = np.all(mat[:, None, :] == mat[None, :, :], axis=2) & (weights[:, None] == weights[None, :])

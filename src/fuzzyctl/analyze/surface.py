@@ -13,7 +13,7 @@ import numpy as np
 from fuzzyctl.analyze.context import Context, FloatArray
 from fuzzyctl.analyze.gaps import Gap
 
-MAX_POINTS = 40_000
+MAX_POINTS = 4096
 MAX_EXAMPLES = 5
 
 
