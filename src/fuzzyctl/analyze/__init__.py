@@ -61,7 +61,7 @@ def analyze(
             m.counterexamples = surf.counterexamples(ctx, sampled, d.output, d.input, d.sign)
             m.resolution = sampled.resolution
         mono.append(m)
-    facts = surf.facts(ctx, sampled, gap_list) if surface and sampled is not None else []
+    facts = surf.facts(ctx, sampled, gap_list, epsilon) if surface and sampled is not None else []
     notes = list(grid.notes)
     if len(rows) < len(plan.rules):
         notes.append(f"{len(plan.rules) - len(rows)} rule(s) are not plain conjunctions: left out of conflicts and redundancy")

@@ -68,7 +68,9 @@ def _in_gap(point: dict[str, float], gaps: list[Gap]) -> bool:
     return any(all(lo <= point[k] <= hi for k, (lo, hi) in g.box.items()) for g in gaps)
 
 
-def facts(ctx: Context, s: Sampled, gaps: list[Gap]) -> list[SurfaceFacts]:
+def facts(ctx: Context, s: Sampled, gaps: list[Gap], epsilon: float = 0.0) -> list[SurfaceFacts]:
+    """Range, largest slope and jumps of each output; the faces of gaps count as jumps
+    only for epsilon 0 (where the DEFAULT takes over: with epsilon > 0 rules still fire)."""
     out = []
     for name, y in s.values.items():
         finite = np.where(np.isfinite(y), y, np.nan)
@@ -78,7 +80,7 @@ def facts(ctx: Context, s: Sampled, gaps: list[Gap]) -> list[SurfaceFacts]:
         hi_i = np.unravel_index(int(np.nanargmax(finite)), y.shape)
         f = SurfaceFacts(name, float(y[lo_i]), _point(ctx, s, lo_i), float(y[hi_i]), _point(ctx, s, hi_i), 0.0, "", {})
         span = float(np.nanmax(finite) - np.nanmin(finite))
-        my_gaps = [g for g in gaps if g.output == name]
+        my_gaps = [g for g in gaps if g.output == name] if epsilon <= 0 else []
         for k, xs in enumerate(s.axes):
             if len(xs) < 2:
                 continue
