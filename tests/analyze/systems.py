@@ -72,8 +72,8 @@ def grid_system(seed: int, plant: bool = True, and_op: str | None = None) -> tup
         far = int(concl) + 2 if int(concl) + 2 < n_out else int(concl) - 2
         rules.append((f"{n + 3}", f"{cond} THEN out IS o{far}"))
         planted.conflicts.append((picks[2], f"{n + 3}"))
-        rules.append((f"{n + 4}", f"IF x IS a0 AND x IS a2 THEN out IS o0"))
-        rules.append((f"{n + 5}", f"IF y IS b0 AND x IS outside THEN out IS o1"))
+        rules.append((f"{n + 4}", "IF x IS a0 AND x IS a2 THEN out IS o0"))
+        rules.append((f"{n + 5}", "IF y IS b0 AND x IS outside THEN out IS o1"))
         planted.dead += [f"{n + 4}", f"{n + 5}"]
     if singleton:
         outs = [f"TERM o{m} := {m * 10.0 / (n_out - 1)};" for m in range(n_out)]
@@ -85,7 +85,12 @@ def grid_system(seed: int, plant: bool = True, and_op: str | None = None) -> tup
     xs = "\n        ".join(f"TERM a{m} := {pts};" for m, pts in enumerate(partition(p1)))
     ys = "\n        ".join(f"TERM b{m} := {pts};" for m, pts in enumerate(partition(p2)))
     extra_x = "\n        TERM outside := (20, 0) (21, 1) (22, 0);" if plant else ""
-    z = "\n    FUZZIFY z\n        TERM zall := (0, 1) (1, 1);\n        RANGE := (0.0 .. 1.0);\n    END_FUZZIFY" if plant else ""
+    z = (
+        "\n    FUZZIFY z\n        TERM zall := (0, 1) (1, 1);\n        RANGE := (0.0 .. 1.0);"
+        "\n    END_FUZZIFY"
+        if plant
+        else ""
+    )
     zvar = "\n        z : REAL;" if plant else ""
     body = "\n        ".join(f"RULE {lab} : {t};" for lab, t in rules)
     text = f"""FUNCTION_BLOCK planted
@@ -143,7 +148,11 @@ def random_system(seed: int) -> str:
                 spec = rng.choice(SMOOTH).format(m=c, s=round(w / 2, 2))
             ts.append(f"TERM {v}{m} := {spec};")
         terms[v] = [t.split()[1] for t in ts]
-        blocks.append(f"    FUZZIFY {v}\n        " + "\n        ".join(ts) + "\n        RANGE := (0.0 .. 10.0);\n    END_FUZZIFY")
+        blocks.append(
+            f"    FUZZIFY {v}\n        "
+            + "\n        ".join(ts)
+            + "\n        RANGE := (0.0 .. 10.0);\n    END_FUZZIFY"
+        )
     rules = []
     for r in range(rng.randint(2, 6)):
         a = f"x IS {'NOT ' if rng.random() < 0.15 else ''}{rng.choice(terms['x'])}"
@@ -170,7 +179,7 @@ def random_system(seed: int) -> str:
         AND : {ops[0]};
         OR : {ops[1]};
         ACCU : MAX;
-        {chr(10).join('        ' + r for r in rules).strip()}
+        {chr(10).join("        " + r for r in rules).strip()}
     END_RULEBLOCK
 END_FUNCTION_BLOCK
 """

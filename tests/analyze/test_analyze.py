@@ -18,9 +18,7 @@ from tests.conftest import ROOT
 def best_degree(ctl: fuzzyctl.engine.Controller, point: dict[str, float], output: str) -> float:
     """The highest degree a rule reaches ``output`` with, from the engine's explanation."""
     ex = ctl.explain(point)
-    return max(
-        [c.degree * c.weight for r in ex.rules for c in r.conclusions if c.variable == output] + [0.0]
-    )
+    return max([c.degree * c.weight for r in ex.rules for c in r.conclusions if c.variable == output] + [0.0])
 
 
 @pytest.mark.parametrize("seed", range(12))
@@ -36,7 +34,9 @@ def test_planted_defects_found_and_nothing_else(seed: int) -> None:
     assert r.gap_fraction == 0.0 and r.coverage_index == 0.0
     assert sorted(r.dead_rules) == sorted(planted.dead)
     red = {(x.rule, x.covered_by, x.kind) for x in r.redundant}
-    want = {(a, b, "duplicate") for a, b in planted.duplicates} | {(a, b, "subsumed") for a, b in planted.subsumed}
+    want = {(a, b, "duplicate") for a, b in planted.duplicates} | {
+        (a, b, "subsumed") for a, b in planted.subsumed
+    }
     assert red == want
     assert {c.rules for c in r.conflicts} == set(planted.conflicts)
     for c in r.conflicts:
@@ -62,7 +62,9 @@ def test_monotone_table_violation_and_proof() -> None:
     r = analyze(fuzzyctl.load(text), monotone=["out:+x"])
     assert r.monotonicity[0].proven and r.monotonicity[0].counterexamples == []
     # swap the conclusions of the first two rules of the table (a0 b0 -> o0, a0 b1 -> o1 become o1, o0)
-    bad = text.replace("b0 THEN out IS o0;", "b0 THEN out IS oX;").replace("b1 THEN out IS o1;", "b1 THEN out IS o0;")
+    bad = text.replace("b0 THEN out IS o0;", "b0 THEN out IS oX;").replace(
+        "b1 THEN out IS o1;", "b1 THEN out IS o0;"
+    )
     bad = bad.replace("oX;", "o1;")
     r = analyze(fuzzyctl.load(bad), monotone=["out:+y"])
     m = r.monotonicity[0]
@@ -105,8 +107,19 @@ def test_gap_boxes_do_not_overlap(seed: int) -> None:
             assert any(a.box[k][1] <= b.box[k][0] or b.box[k][1] <= a.box[k][0] for k in a.box)
 
 
-EXAMPLES = ["tank.fcl", "crane.fcl", "pendulum.fcl", "figure7.fcl", "tipper.fis", "dryer_chained.fcl",
-            "dimmer_chained.fll", "siemens_fpltest.fcl", "fpltest.fpl", "xfuz_debit.xfuz", "xfuz_3_3.xfuz"]
+EXAMPLES = [
+    "tank.fcl",
+    "crane.fcl",
+    "pendulum.fcl",
+    "figure7.fcl",
+    "tipper.fis",
+    "dryer_chained.fcl",
+    "dimmer_chained.fll",
+    "siemens_fpltest.fcl",
+    "fpltest.fpl",
+    "xfuz_debit.xfuz",
+    "xfuz_3_3.xfuz",
+]
 
 
 @pytest.mark.parametrize("name", EXAMPLES)
@@ -131,8 +144,18 @@ def test_json_keys() -> None:
     text, _ = grid_system(2)
     r = analyze(fuzzyctl.load(text), monotone=["out:+x"])
     j = json.loads(json.dumps(r.to_json(), allow_nan=False))
-    assert list(j) == ["block", "inputs", "gaps", "coverage_index", "gap_fraction", "conflicts",
-                       "dead_rules", "redundant", "unused_terms", "monotonicity"]
+    assert list(j) == [
+        "block",
+        "inputs",
+        "gaps",
+        "coverage_index",
+        "gap_fraction",
+        "conflicts",
+        "dead_rules",
+        "redundant",
+        "unused_terms",
+        "monotonicity",
+    ]
     assert set(j["gaps"][0]) == {"output", "box", "best_degree"}
     assert set(j["conflicts"][0]) == {"rules", "output", "box", "joint_degree"}
     assert set(j["redundant"][0]) == {"rule", "covered_by", "kind"}

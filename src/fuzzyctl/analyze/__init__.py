@@ -64,7 +64,10 @@ def analyze(
     facts = surf.facts(ctx, sampled, gap_list, epsilon) if surface and sampled is not None else []
     notes = list(grid.notes)
     if len(rows) < len(plan.rules):
-        notes.append(f"{len(plan.rules) - len(rows)} rule(s) are not plain conjunctions: left out of conflicts and redundancy")
+        notes.append(
+            f"{len(plan.rules) - len(rows)} rule(s) are not plain conjunctions: "
+            "left out of conflicts and redundancy"
+        )
     return Analysis(
         block=plan.name,
         inputs=dict(zip(ctx.inputs, ctx.ranges, strict=True)),

@@ -132,7 +132,9 @@ def _crossings(g: FloatArray, xs: FloatArray, level: float, f: object, linear: b
     return found
 
 
-def _axis_cuts(plan: Plan, slot: int, low: float, high: float, axis_leaves: list[CondPlan], lv: list[float]) -> FloatArray:
+def _axis_cuts(
+    plan: Plan, slot: int, low: float, high: float, axis_leaves: list[CondPlan], lv: list[float]
+) -> FloatArray:
     cuts = [low, high]
     for leaf in axis_leaves:
         assert isinstance(leaf, CTerm | CDegree)
@@ -184,18 +186,21 @@ def exactness(ctx: Context, epsilon: float) -> list[str]:
     plan = ctx.plan
     notes = []
     ops = {op for r in plan.rules for op in _ops(r.condition)}
-    plain = {"MIN", "MAX"}
-    if epsilon == 0:
-        plain = NO_ZERO_DIVISORS | set(SNORMS)
+    plain = NO_ZERO_DIVISORS | set(SNORMS) if epsilon == 0 else frozenset({"MIN", "MAX"})
     if ops - plain:
-        notes.append(f"operators {', '.join(sorted(ops - plain))}: degrees are compared at one point per cell")
+        notes.append(
+            f"operators {', '.join(sorted(ops - plain))}: degrees are compared at one point per cell"
+        )
     if plan.chained:
         notes.append("chained variables: their degrees are compared at one point per cell")
     if plan.selections:
         notes.append("rule activation methods (First/Highest/...) are not applied: every rule counts")
     if epsilon > 0 and any(cp.hedges for r in plan.rules for cp in r.conclusions):
         notes.append("hedged conclusions: degrees are compared at one point per cell")
-    if any(isinstance(r.weight, Slot) or any(isinstance(cp.weight, Slot) for cp in r.conclusions) for r in plan.rules):
+    if any(
+        isinstance(r.weight, Slot) or any(isinstance(cp.weight, Slot) for cp in r.conclusions)
+        for r in plan.rules
+    ):
         notes.append("weights given by inputs: degrees are compared at one point per cell")
     return notes
 
@@ -284,7 +289,9 @@ class _Evaluator:
         th = self.plan.options.firing_threshold
         return np.where(a <= th, 0.0, a)
 
-    def accumulate(self, store: list[FloatArray | None], k: int, accu: str, contrib: FloatArray, sl: tuple[slice, ...]) -> None:
+    def accumulate(
+        self, store: list[FloatArray | None], k: int, accu: str, contrib: FloatArray, sl: tuple[slice, ...]
+    ) -> None:
         if store[k] is None:
             store[k] = np.zeros(self.shape)
         arr = store[k]

@@ -17,7 +17,7 @@ from fuzzyctl.engine.plan import CDegree, CondPlan, CTerm, Plan, Slot, TermPlan
 
 if TYPE_CHECKING:
     from fuzzyctl.engine.controller import Controller
-    from fuzzyctl.model import Document, FunctionBlock
+    from fuzzyctl.model import Document, FunctionBlock, Span
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -59,9 +59,9 @@ def _input_range(plan: Plan, ctl: Controller, name: str) -> tuple[float, float]:
     """RANGE when declared, else the span of the terms' characteristic points (an input
     whose terms end in shoulders has no bound of its own), else [0, 1] (a degree input)."""
     info = ctl.inputs.get(name) if hasattr(ctl.inputs, "get") else None
-    if info is not None and info.low is not None and info.high is not None:
-        if math.isfinite(info.low) and math.isfinite(info.high) and info.low < info.high:
-            return (float(info.low), float(info.high))
+    lo, hi = (info.low, info.high) if info is not None else (None, None)
+    if lo is not None and hi is not None and math.isfinite(lo) and math.isfinite(hi) and lo < hi:
+        return (float(lo), float(hi))
     xs: list[float] = []
     for fi in plan.fuzzy_inputs:
         if fi.name == name:
@@ -82,8 +82,10 @@ def term_points(t: TermPlan) -> list[float]:
     return list(shapes.characteristic_points(t.kind, [float(p) for p in t.params]))  # type: ignore[arg-type]
 
 
-def _rule_names(fb: FunctionBlock, plan: Plan, path: str | None) -> tuple[tuple[str, ...], tuple[str | None, ...]]:
-    spans = {}
+def _rule_names(
+    fb: FunctionBlock, plan: Plan, path: str | None
+) -> tuple[tuple[str, ...], tuple[str | None, ...]]:
+    spans: dict[tuple[str | None, str], Span | None] = {}
     for rb, rule in fb.rules():
         spans.setdefault((rb.name, rule.label), rule.span)
     counts: dict[str, int] = {}

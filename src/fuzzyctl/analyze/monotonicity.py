@@ -54,11 +54,15 @@ def parse_declarations(specs: list[str], inputs: tuple[str, ...], outputs: list[
     for spec in specs:
         name, sep, rest = spec.partition(":")
         if not sep or name not in outputs:
-            raise FuzzyctlError(f"--monotone {spec!r}: expected OUTPUT:+input,-input with OUTPUT one of {', '.join(outputs)}")
+            raise FuzzyctlError(
+                f"--monotone {spec!r}: expected OUTPUT:+input,-input with OUTPUT one of {', '.join(outputs)}"
+            )
         for item in rest.split(","):
             item = item.strip()
             if len(item) < 2 or item[0] not in "+-" or item[1:] not in inputs:
-                raise FuzzyctlError(f"--monotone {spec!r}: {item!r} is not +INPUT or -INPUT (inputs: {', '.join(inputs)})")
+                raise FuzzyctlError(
+                    f"--monotone {spec!r}: {item!r} is not +INPUT or -INPUT (inputs: {', '.join(inputs)})"
+                )
             out.append(Declaration(name, item[1:], item[0]))
     return out
 
@@ -75,18 +79,24 @@ def centre(t: TermPlan, low: float, high: float) -> float:
     return 0.5 * float(top[0] + top[-1])
 
 
-def rule_table(ctx: Context, rows: list[Row], d: Declaration) -> tuple[list[tuple[str, str]], list[tuple[Row, int]]]:
+def rule_table(
+    ctx: Context, rows: list[Row], d: Declaration
+) -> tuple[list[tuple[str, str]], list[tuple[Row, int]]]:
     plan = ctx.plan
     o = next(k for k, op in enumerate(plan.outputs) if op.name == d.output)
     op = plan.outputs[o]
     lo, hi = (op.low, op.high) if op.low is not None and op.high is not None else (-1e300, 1e300)
-    out_c = [centre(t, lo, hi) if t.constant and t.kind not in ("linear", "function") else np.nan for t in op.terms]
+    out_c = [
+        centre(t, lo, hi) if t.constant and t.kind not in ("linear", "function") else np.nan for t in op.terms
+    ]
     slot = ctx.inputs.index(d.input)
     groups: dict[tuple[object, ...], list[tuple[float, float, Row]]] = {}
     used: list[tuple[Row, int]] = []
     for row in rows:
         term = next((cp.term for cp in plan.rules[row.rule].conclusions if o in cp.outputs), None)
-        if term is None or any(not isinstance(x, CTerm) or x.hedges or x.negated for x in row.leaves.values()):
+        if term is None or any(
+            not isinstance(x, CTerm) or x.hedges or x.negated for x in row.leaves.values()
+        ):
             continue
         used.append((row, term))
         leaf = row.leaves.get(slot)
@@ -112,7 +122,9 @@ def _partition_ok(ctx: Context, var: int, terms: list[int]) -> bool:
     ts = [fi.terms[k] for k in terms]
     if any(t.pwl is None for t in ts):
         return False
-    xs = np.unique(np.concatenate([np.linspace(lo, hi, 1025), np.clip([x for t in ts for x, _ in t.pwl or ()], lo, hi)]))
+    xs = np.unique(
+        np.concatenate([np.linspace(lo, hi, 1025), np.clip([x for t in ts for x, _ in t.pwl or ()], lo, hi)])
+    )
     ts.sort(key=lambda t: centre(t, lo, hi))
     vals: FloatArray = np.array([term_values(t, xs) for t in ts])
     if np.abs(vals.sum(axis=0) - 1.0).max() > 1e-9:
@@ -127,16 +139,26 @@ def proven(ctx: Context, used: list[tuple[Row, int]], d: Declaration) -> bool:
     op = next(op for op in plan.outputs if op.name == d.output)
     if op.kind == "singleton" and op.method != "COGS":
         return False
-    if op.kind == "ts" and (op.method != "WTAVER" or any(t.kind not in ("constant", "singleton") for t in op.terms)):
+    if op.kind == "ts" and (
+        op.method != "WTAVER" or any(t.kind not in ("constant", "singleton") for t in op.terms)
+    ):
         return False
     if op.kind not in ("singleton", "ts") or not used:
         return False
     slots = set(used[0][0].leaves)
     if any(set(r.leaves) != slots or r.weight != 1.0 or (len(slots) > 1 and r.op != "PROD") for r, _ in used):
         return False
-    if len(used) != sum(1 for r in plan.rules for cp in r.conclusions if any(plan.outputs[o].name == d.output for o in cp.outputs)):
+    if len(used) != sum(
+        1
+        for r in plan.rules
+        for cp in r.conclusions
+        if any(plan.outputs[o].name == d.output for o in cp.outputs)
+    ):
         return False
-    combos = {tuple(sorted((s, (lf.var, lf.term)) for s, lf in r.leaves.items())) for r, _ in used if all(isinstance(lf, CTerm) for lf in r.leaves.values())}  # type: ignore[union-attr]
+    combos = {
+        tuple(sorted((s, (lf.var, lf.term)) for s, lf in r.leaves.items() if isinstance(lf, CTerm)))
+        for r, _ in used
+    }
     per_slot: dict[int, set[int]] = {}
     for combo in combos:
         for s, (_v, t) in combo:

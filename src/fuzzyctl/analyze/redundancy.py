@@ -51,7 +51,9 @@ def _max_accumulation(ctx: Context, row: Row) -> bool:
     return True
 
 
-def find_redundant(ctx: Context, rows: list[Row], tables: dict[int, AxisLeaves], dead: set[int]) -> list[Redundant]:
+def find_redundant(
+    ctx: Context, rows: list[Row], tables: dict[int, AxisLeaves], dead: set[int]
+) -> list[Redundant]:
     groups: dict[tuple[object, ...], list[Row]] = {}
     for row in rows:
         if row.rule not in dead:
@@ -64,14 +66,18 @@ def find_redundant(ctx: Context, rows: list[Row], tables: dict[int, AxisLeaves],
     return sorted(out, key=lambda r: ctx.rule_names.index(r.rule))
 
 
-def _group(ctx: Context, group: list[Row], tables: dict[int, AxisLeaves], dom: dict[int, np.ndarray]) -> list[Redundant]:
+def _group(
+    ctx: Context, group: list[Row], tables: dict[int, AxisLeaves], dom: dict[int, np.ndarray]
+) -> list[Redundant]:
     slots, mat = leaf_matrix(group, tables)
     n = len(group)
     absent = np.array([len(tables[s].index) for s in slots], dtype=np.int64)
     cover = np.ones((n, n), dtype=bool)  # cover[b, a]: b's degree >= a's everywhere
     for k, s in enumerate(slots):
         cover &= dom[s][mat[:, k][:, None], mat[None, :, k]]
-    subset = np.all((mat[:, None, :] == absent) | (mat[None, :, :] != absent), axis=2)  # b reads a subset of a
+    subset = np.all(
+        (mat[:, None, :] == absent) | (mat[None, :, :] != absent), axis=2
+    )  # b reads a subset of a
     weights = np.array([r.weight for r in group])
     ops = np.array([r.op for r in group])
     single = np.array([len(r.leaves) <= 1 or r.op == "MIN" for r in group])
@@ -100,7 +106,9 @@ def find_unused(ctx: Context, dead: set[int]) -> list[UnusedTerm]:
     from fuzzyctl.engine.plan import CTerm
 
     plan = ctx.plan
-    read = {(leaf.var, leaf.term) for r in plan.rules for leaf in leaves(r.condition) if isinstance(leaf, CTerm)}
+    read = {
+        (leaf.var, leaf.term) for r in plan.rules for leaf in leaves(r.condition) if isinstance(leaf, CTerm)
+    }
     out = [
         UnusedTerm(fi.name, t.name, "never read")
         for v, fi in enumerate(plan.fuzzy_inputs)

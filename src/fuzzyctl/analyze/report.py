@@ -50,15 +50,24 @@ class Analysis:
         return {
             "block": self.block,
             "inputs": {k: [lo, hi] for k, (lo, hi) in self.inputs.items()},
-            "gaps": [{"output": g.output, "box": _box(g.box), "best_degree": g.best_degree} for g in self.gaps],
+            "gaps": [
+                {"output": g.output, "box": _box(g.box), "best_degree": g.best_degree} for g in self.gaps
+            ],
             "coverage_index": self.coverage_index,
             "gap_fraction": self.gap_fraction,
             "conflicts": [
-                {"rules": list(c.rules), "output": c.output, "box": _box(c.box), "joint_degree": c.joint_degree}
+                {
+                    "rules": list(c.rules),
+                    "output": c.output,
+                    "box": _box(c.box),
+                    "joint_degree": c.joint_degree,
+                }
                 for c in self.conflicts
             ],
             "dead_rules": list(self.dead_rules),
-            "redundant": [{"rule": r.rule, "covered_by": r.covered_by, "kind": r.kind} for r in self.redundant],
+            "redundant": [
+                {"rule": r.rule, "covered_by": r.covered_by, "kind": r.kind} for r in self.redundant
+            ],
             "unused_terms": [{"variable": u.variable, "term": u.term} for u in self.unused_terms],
             "monotonicity": [
                 {
@@ -79,12 +88,16 @@ class Analysis:
         def at(rule: str) -> str:
             return f"rule {rule}" + (f" ({w[rule]})" if w.get(rule) else "")
 
-        out = [f"gaps: {len(self.gaps)} box(es), {self.gap_fraction:.4g} of the input space; coverage index {self.coverage_index:.4g}"]
+        out = [
+            f"gaps: {len(self.gaps)} box(es), {self.gap_fraction:.4g} of the input space; "
+            f"coverage index {self.coverage_index:.4g}"
+        ]
         for g in self.gaps[:20]:
             box = ", ".join(f"{k} in [{lo:.6g}, {hi:.6g}]" for k, (lo, hi) in g.box.items())
             out.append(f"  {g.output}: {box} (best degree {g.best_degree:.3g})")
         out += [
-            f"conflict: {at(c.rules[0])} and {at(c.rules[1])} conclude {c.output} IS {c.terms[0]} / {c.terms[1]}, "
+            f"conflict: {at(c.rules[0])} and {at(c.rules[1])} conclude "
+            f"{c.output} IS {c.terms[0]} / {c.terms[1]}, "
             f"joint degree {c.joint_degree:.3g} at {c.point}"
             for c in self.conflicts
         ]
@@ -104,6 +117,9 @@ class Analysis:
                 f"surface {s.output}: min {s.low:.6g} at {s.low_at}, max {s.high:.6g} at {s.high_at}, "
                 f"largest slope {s.slope:.4g} per unit of {s.slope_input}"
             )
-            out += [f"  jump {j.values[0]:.6g} -> {j.values[1]:.6g} between {j.before} and {j.after}" for j in s.jumps[:5]]
+            out += [
+                f"  jump {j.values[0]:.6g} -> {j.values[1]:.6g} between {j.before} and {j.after}"
+                for j in s.jumps[:5]
+            ]
         out += [f"note: {n}" for n in self.notes]
         return out

@@ -76,9 +76,11 @@ def facts(ctx: Context, s: Sampled, gaps: list[Gap], epsilon: float = 0.0) -> li
         finite = np.where(np.isfinite(y), y, np.nan)
         if not np.isfinite(finite).any():
             continue
-        lo_i = np.unravel_index(int(np.nanargmin(finite)), y.shape)
-        hi_i = np.unravel_index(int(np.nanargmax(finite)), y.shape)
-        f = SurfaceFacts(name, float(y[lo_i]), _point(ctx, s, lo_i), float(y[hi_i]), _point(ctx, s, hi_i), 0.0, "", {})
+        lo_i = tuple(int(v) for v in np.unravel_index(int(np.nanargmin(finite)), y.shape))
+        hi_i = tuple(int(v) for v in np.unravel_index(int(np.nanargmax(finite)), y.shape))
+        f = SurfaceFacts(
+            name, float(y[lo_i]), _point(ctx, s, lo_i), float(y[hi_i]), _point(ctx, s, hi_i), 0.0, "", {}
+        )
         span = float(np.nanmax(finite) - np.nanmin(finite))
         my_gaps = [g for g in gaps if g.output == name] if epsilon <= 0 else []
         for k, xs in enumerate(s.axes):
@@ -87,7 +89,7 @@ def facts(ctx: Context, s: Sampled, gaps: list[Gap], epsilon: float = 0.0) -> li
             dy = np.diff(finite, axis=k)
             slope = np.abs(dy) / (xs[1] - xs[0])
             if np.isfinite(slope).any():
-                j = np.unravel_index(int(np.nanargmax(slope)), slope.shape)
+                j = tuple(int(v) for v in np.unravel_index(int(np.nanargmax(slope)), slope.shape))
                 if slope[j] > f.slope:
                     f.slope, f.slope_input, f.slope_at = float(slope[j]), ctx.inputs[k], _point(ctx, s, j)
             f.jumps += _jumps(ctx, s, name, k, dy, span, my_gaps)
@@ -96,7 +98,9 @@ def facts(ctx: Context, s: Sampled, gaps: list[Gap], epsilon: float = 0.0) -> li
     return out
 
 
-def _jumps(ctx: Context, s: Sampled, name: str, k: int, dy: FloatArray, span: float, gaps: list[Gap]) -> list[Jump]:
+def _jumps(
+    ctx: Context, s: Sampled, name: str, k: int, dy: FloatArray, span: float, gaps: list[Gap]
+) -> list[Jump]:
     y = s.values[name]
     big = np.abs(np.nan_to_num(dy, nan=math.inf)) > 0.25 * span if span > 0 else np.zeros(dy.shape, bool)
     found = []
@@ -122,7 +126,9 @@ def _jumps(ctx: Context, s: Sampled, name: str, k: int, dy: FloatArray, span: fl
     return found
 
 
-def counterexamples(ctx: Context, s: Sampled, output: str, input_name: str, sign: str) -> list[tuple[dict[str, float], dict[str, float]]]:
+def counterexamples(
+    ctx: Context, s: Sampled, output: str, input_name: str, sign: str
+) -> list[tuple[dict[str, float], dict[str, float]]]:
     """Neighbouring grid points along ``input_name`` where ``output`` moves against
     ``sign`` by more than 1e-9 of its range; each confirmed by the scalar evaluation."""
     y = s.values[output]
@@ -133,7 +139,7 @@ def counterexamples(ctx: Context, s: Sampled, output: str, input_name: str, sign
     tol = 1e-9 * max(span, 1e-300)
     dy = np.diff(y, axis=k) * (1.0 if sign == "+" else -1.0)
     bad = np.argwhere(dy < -tol)
-    order = np.argsort(dy[tuple(bad.T)]) if len(bad) else []
+    order = np.argsort(dy[tuple(bad.T)]) if len(bad) else np.zeros(0, dtype=np.int64)
     out: list[tuple[dict[str, float], dict[str, float]]] = []
     for idx in order[: MAX_EXAMPLES * 4]:
         a = tuple(int(v) for v in bad[idx])

@@ -79,7 +79,7 @@ class AxisLeaves:
     def dominates(self) -> np.ndarray:
         """``D[i, j]``: leaf i >= leaf j everywhere on the axis (1e-12 slack)."""
         v = self.values
-        return np.all(v[:, None, :] >= v[None, :, :] - 1e-12, axis=2)
+        return np.asarray(np.all(v[:, None, :] >= v[None, :, :] - 1e-12, axis=2))
 
     def above(self, i: int, j: int, delta: float) -> tuple[float, float]:
         """The hull of where min(leaf i, leaf j) > delta (the whole axis when empty)."""
