@@ -17,6 +17,10 @@ def _num(x: float) -> float | None:
     return float(x) if math.isfinite(x) else None
 
 
+def _pt(point: dict[str, float]) -> str:
+    return "(" + ", ".join(f"{k}={v:.6g}" for k, v in point.items()) + ")"
+
+
 def _box(box: dict[str, tuple[float, float]]) -> dict[str, list[float | None]]:
     return {k: [_num(lo), _num(hi)] for k, (lo, hi) in box.items()}
 
@@ -98,7 +102,7 @@ class Analysis:
         out += [
             f"conflict: {at(c.rules[0])} and {at(c.rules[1])} conclude "
             f"{c.output} IS {c.terms[0]} / {c.terms[1]}, "
-            f"joint degree {c.joint_degree:.3g} at {c.point}"
+            f"joint degree {c.joint_degree:.3g} at {_pt(c.point)}"
             for c in self.conflicts
         ]
         out += [f"dead: {at(r)} never fires" for r in self.dead_rules]
@@ -109,16 +113,17 @@ class Analysis:
             out.append(f"monotone {m.output} {m.declared}{m.input}: rule table {state}")
             out += [f"  rules {a} < {b} conclude against the declaration" for a, b in m.offending]
             if m.counterexamples:
-                out += [f"  surface: {a} -> {b}" for a, b in m.counterexamples]
+                out += [f"  surface: {_pt(a)} -> {_pt(b)}" for a, b in m.counterexamples]
             else:
                 out.append(f"  surface: no counterexample on a {m.resolution}-point-per-input grid")
         for s in self.surface:
             out.append(
-                f"surface {s.output}: min {s.low:.6g} at {s.low_at}, max {s.high:.6g} at {s.high_at}, "
+                f"surface {s.output}: min {s.low:.6g} at {_pt(s.low_at)}, "
+                f"max {s.high:.6g} at {_pt(s.high_at)}, "
                 f"largest slope {s.slope:.4g} per unit of {s.slope_input}"
             )
             out += [
-                f"  jump {j.values[0]:.6g} -> {j.values[1]:.6g} between {j.before} and {j.after}"
+                f"  jump {j.values[0]:.6g} -> {j.values[1]:.6g} between {_pt(j.before)} and {_pt(j.after)}"
                 for j in s.jumps[:5]
             ]
         out += [f"note: {n}" for n in self.notes]

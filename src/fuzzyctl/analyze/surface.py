@@ -93,7 +93,10 @@ def facts(ctx: Context, s: Sampled, gaps: list[Gap], epsilon: float = 0.0) -> li
                 if slope[j] > f.slope:
                     f.slope, f.slope_input, f.slope_at = float(slope[j]), ctx.inputs[k], _point(ctx, s, j)
             f.jumps += _jumps(ctx, s, name, k, dy, span, my_gaps)
-        f.jumps = f.jumps[:10]
+        f.jumps = sorted(
+            f.jumps,
+            key=lambda j: -abs(j.values[1] - j.values[0]) if all(map(math.isfinite, j.values)) else -math.inf,
+        )[:10]
         out.append(f)
     return out
 

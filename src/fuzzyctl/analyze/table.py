@@ -83,11 +83,19 @@ class AxisLeaves:
 
     def above(self, i: int, j: int, delta: float) -> tuple[float, float]:
         """The hull of where min(leaf i, leaf j) > delta (the whole axis when empty)."""
-        m = np.minimum(self.values[i], self.values[j]) > delta
-        if not m.any():
+        v = np.minimum(self.values[i], self.values[j]) - delta
+        idx = np.nonzero(v > 0)[0]
+        if not len(idx):
             return (self.axis.low, self.axis.high)
-        idx = np.nonzero(m)[0]
-        return (float(self.xs[idx[0]]), float(self.xs[idx[-1]]))
+        xs = self.xs
+        a, b = int(idx[0]), int(idx[-1])
+        lo, hi = float(xs[a]), float(xs[b])
+        # the crossing between the last sample below and the first above (linear there)
+        if a > 0:
+            lo = float(xs[a - 1] + (xs[a] - xs[a - 1]) * v[a - 1] / (v[a - 1] - v[a]))
+        if b + 1 < len(xs):
+            hi = float(xs[b] + (xs[b + 1] - xs[b]) * v[b] / (v[b] - v[b + 1]))
+        return (lo, hi)
 
     def argmax_min(self, i: int, j: int) -> float:
         m = np.minimum(self.values[i], self.values[j])
