@@ -20,11 +20,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from fuzzyctl.analyze.context import Context, FloatArray, constant, leaf_axis, leaf_values, term_points
+from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
 from fuzzyctl.engine.plan import CAnd, CChained, CDegree, CNot, CondPlan, COr, CTerm, CTrue, Plan, Slot
 
 SAMPLES = 2049
+#: refuse a decomposition larger than this many cells (8 bytes each, several arrays)
+MAX_CELLS = 20_000_000
 XTOL = 1e-12
 #: t-norms with T(a, b) > 0 whenever a, b > 0: "degree > 0" is decided cell by cell
 NO_ZERO_DIVISORS = frozenset({"MIN", "PROD", "HAMACHER", "EINSTEIN"})
@@ -302,6 +305,13 @@ class _Evaluator:
 def evaluate(ctx: Context, axes: list[Axis], epsilon: float) -> Grid:
     """Every rule's degree at every cell's representative; per output the best one."""
     plan = ctx.plan
+    cells = int(np.prod([len(a.reps) for a in axes], dtype=np.float64))
+    if cells > MAX_CELLS:
+        sizes = " x ".join(f"{a.name} {len(a.reps)}" for a in axes)
+        raise FuzzyctlError(
+            f"analyze: the input space splits into {cells:,} cells ({sizes}), more than {MAX_CELLS:,}; "
+            "analyse a block with fewer inputs or fewer distinct term breakpoints"
+        )
     ev = _Evaluator(ctx, axes)
     best = {o: np.zeros(ev.shape) for o in range(len(plan.outputs))}
     rule_max = np.zeros(len(plan.rules))
