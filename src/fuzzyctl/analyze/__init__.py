@@ -3,7 +3,9 @@ facts (docs/analyze.md).  ``fuzzyctl.analyze(model)`` returns an :class:`Analysi
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+import sys
+import types
+from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.analyze.report import Analysis
 
@@ -87,3 +89,15 @@ def analyze(
         notes=notes,
         rule_where=dict(zip(ctx.rule_names, ctx.rule_where, strict=True)),
     )
+
+
+class _CallableModule(types.ModuleType):
+    """Importing ``fuzzyctl.analyze.cells`` (or any submodule) binds the *package* to the
+    attribute ``fuzzyctl.analyze``, where users call the function: the package forwards a
+    call to :func:`analyze`, so ``fuzzyctl.analyze(model)`` works whatever was imported."""
+
+    def __call__(self, model: Document | FunctionBlock, **options: Any) -> Analysis:
+        return analyze(model, **options)
+
+
+sys.modules[__name__].__class__ = _CallableModule
