@@ -176,3 +176,18 @@ def test_cli(tmp_path: pytest.TempPathFactory, capsys: pytest.CaptureFixture[str
     assert "never fires" in out and f"{f}:" in out
     assert main(["analyze", str(f), "--monotone", "out:+nope"]) == 1
     assert "--monotone" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("name", ["grid49", "grid343", "gauss343"])
+def test_benchmark_grids_report_nothing(name: str) -> None:
+    """Full grids of Ruspini-like partitions (benchmarks/systems.py): no gap, no conflict
+    (neighbouring and diagonal cells conclude neighbouring or two-apart terms), nothing dead
+    or redundant, the table monotone in every input (the rule is a clamped sum)."""
+    from benchmarks.systems import SYSTEMS, fcl
+
+    system = SYSTEMS[name]
+    outs = "u:" + ",".join("+" + i for i in system.inputs)
+    r = analyze(fuzzyctl.load(fcl(system)), surface=False, monotone=[outs] if name != "grid49" else [])
+    assert (r.gaps, r.conflicts, r.dead_rules, r.redundant, r.unused_terms) == ([], [], [], [], [])
+    assert r.exact and r.coverage_index > 0.45
+    assert all(m.rule_table == "holds" for m in r.monotonicity)
