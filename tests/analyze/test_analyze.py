@@ -75,7 +75,7 @@ def test_monotone_table_violation_and_proof() -> None:
         assert a["y"] < b["y"] and ctl.evaluate(b)["out"] < ctl.evaluate(a)["out"]
 
 
-@pytest.mark.parametrize("seed", range(20))
+@pytest.mark.parametrize("seed", range(30))
 @pytest.mark.parametrize("epsilon", [0.0, 0.3])
 def test_gaps_against_brute_force(seed: int, epsilon: float) -> None:
     doc = fuzzyctl.load(random_system(seed))
