@@ -42,7 +42,7 @@ def analyze(
         raise FuzzyctlError(f"delta must be in [0, 1), got {delta}")
     ctx = build_context(model, block)
     plan = ctx.plan
-    axes = cells.build_axes(ctx, epsilon)
+    axes, coarse = cells.build_axes(ctx, epsilon)
     grid = cells.evaluate(ctx, axes, epsilon)
     outs = [(o, op.name) for o, op in enumerate(plan.outputs) if op.is_output]
     gap_list, fraction, coverage = gaps.find_gaps(grid, outs, epsilon)
@@ -65,6 +65,11 @@ def analyze(
         mono.append(m)
     facts = surf.facts(ctx, sampled, gap_list, epsilon) if surface and sampled is not None else []
     notes = list(grid.notes)
+    if coarse:
+        notes.append(
+            "smooth terms' peaks left out of the cells (too many): the gaps are still exact, the "
+            "coverage index is a coarse upper bound"
+        )
     if len(rows) < len(plan.rules):
         notes.append(
             f"{len(plan.rules) - len(rows)} rule(s) are not plain conjunctions: "

@@ -28,6 +28,8 @@ from fuzzyctl.engine.plan import CAnd, CChained, CDegree, CNot, CondPlan, COr, C
 SAMPLES = 2049
 #: refuse a decomposition larger than this many cells (8 bytes each, several arrays)
 MAX_CELLS = 20_000_000
+#: smooth terms' characteristic points are added as cuts while the cells stay below this
+OPTIONAL_CELLS = 2_000_000
 XTOL = 1e-12
 #: t-norms with T(a, b) > 0 whenever a, b > 0: "degree > 0" is decided cell by cell
 NO_ZERO_DIVISORS = frozenset({"MIN", "PROD", "HAMACHER", "EINSTEIN"})
@@ -137,8 +139,11 @@ def _crossings(g: FloatArray, xs: FloatArray, level: float, f: object, linear: b
 
 def _axis_cuts(
     plan: Plan, slot: int, low: float, high: float, axis_leaves: list[CondPlan], lv: list[float]
-) -> FloatArray:
+) -> tuple[FloatArray, FloatArray]:
+    """The cuts the gap sets need, and the optional ones (smooth terms' characteristic
+    points: they only sharpen the coverage index and the dead-rule check's resolution)."""
     cuts = [low, high]
+    optional: list[float] = []
     for leaf in axis_leaves:
         assert isinstance(leaf, CTerm | CDegree)
         knots: list[float] = [low, high]
@@ -147,7 +152,7 @@ def _axis_cuts(
             t = plan.fuzzy_inputs[leaf.var].terms[leaf.term]
             pts = term_points(t)
             knots += pts
-            cuts += pts
+            (cuts if t.pwl is not None else optional).extend(pts)
             linear = t.pwl is not None and not leaf.hedges
             if t.pwl is None and t.constant:
                 cuts += [s for s in shapes.support(t.kind, [float(p) for p in t.params], float(t.height))]  # type: ignore[arg-type]
@@ -162,10 +167,12 @@ def _axis_cuts(
         for level in lv:
             cuts += _crossings(g, xs, level, f, linear)
     arr = np.unique(np.array([c for c in cuts if np.isfinite(c)], dtype=np.float64))
-    return arr[(arr >= low) & (arr <= high)]
+    opt = np.unique(np.array([c for c in optional if np.isfinite(c)], dtype=np.float64))
+    return arr[(arr >= low) & (arr <= high)], opt[(opt > low) & (opt < high)]
 
 
-def build_axes(ctx: Context, epsilon: float) -> list[Axis]:
+def build_axes(ctx: Context, epsilon: float) -> tuple[list[Axis], bool]:
+    """The axes, and whether the optional cuts had to be left out."""
     plan = ctx.plan
     by_slot: dict[int, dict[CondPlan, None]] = {}
     for r in plan.rules:
@@ -175,13 +182,22 @@ def build_axes(ctx: Context, epsilon: float) -> list[Axis]:
                 by_slot.setdefault(slot, {})[leaf] = None
     lv = levels(ctx, epsilon)
     axes = []
+    extra = []
     for slot, name in enumerate(ctx.inputs):
         low, high = ctx.ranges[slot]
         if slot in by_slot:
-            axes.append(Axis(name, low, high, _axis_cuts(plan, slot, low, high, list(by_slot[slot]), lv)))
+            cuts, opt = _axis_cuts(plan, slot, low, high, list(by_slot[slot]), lv)
+            axes.append(Axis(name, low, high, cuts))
+            extra.append(opt)
         else:
             axes.append(Axis(name, low, high, np.array([low, high]), read=False))
-    return axes
+            extra.append(np.zeros(0))
+    with_extra = [np.union1d(a.cuts, e) if a.read else a.cuts for a, e in zip(axes, extra, strict=True)]
+    if np.prod([2.0 * len(c) - 1 for c in with_extra]) > OPTIONAL_CELLS:
+        return axes, any(len(e) for e in extra)
+    for a, c in zip(axes, with_extra, strict=True):
+        a.cuts = c
+    return axes, False
 
 
 def exactness(ctx: Context, epsilon: float) -> list[str]:
