@@ -118,17 +118,16 @@ def _output_conflicts(
     return out
 
 
-_EXPLAINED: dict[tuple[int, tuple[float, ...]], Explanation] = {}
-
-
 def explained(ctx: Context, point: dict[str, float]) -> Explanation:
     """The engine's explanation at ``point`` (pairs meeting at one point share it)."""
-    key = (id(ctx), tuple(point.values()))
-    got = _EXPLAINED.get(key)
+    cache = ctx.explained
+    key = tuple(point.values())
+    got = cache.get(key)
     if got is None:
-        if len(_EXPLAINED) > 256:
-            _EXPLAINED.clear()
-        got = _EXPLAINED[key] = ctx.controller.explain(point)
+        if len(cache) > 256:
+            cache.clear()
+        got = cache[key] = ctx.controller.explain(point)
+    assert isinstance(got, Explanation)
     return got
 
 

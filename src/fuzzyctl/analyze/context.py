@@ -5,7 +5,7 @@ membership, hedge and norm functions, never a second copy of their formulas)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -34,6 +34,8 @@ class Context:
     ranges: tuple[tuple[float, float], ...]  # per slot: the universe analysed
     rule_names: tuple[str, ...]  # per plan rule: as the file names it
     rule_where: tuple[str | None, ...]  # per plan rule: file:line (None: no span kept)
+    #: explanations by input point, shared by the checks that ask the engine at one point
+    explained: dict[tuple[float, ...], Any] = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def block_name(self) -> str | None:
