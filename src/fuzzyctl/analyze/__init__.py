@@ -53,7 +53,7 @@ def analyze(
     redundant = redundancy.find_redundant(ctx, rows, tabs, dead)
     unused = redundancy.find_unused(ctx, dead)
     decls = monotonicity.parse_declarations(list(monotone), ctx.inputs, [n for _o, n in outs])
-    sampled = surf.sample(ctx) if surface or decls else None
+    sampled = surf.sample(ctx) if (surface or decls) and ctx.inputs else None
     mono = []
     for d in decls:
         bad, used = monotonicity.rule_table(ctx, rows, d)

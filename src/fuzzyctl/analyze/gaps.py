@@ -29,6 +29,8 @@ def gap_mask(best: npt.NDArray[np.float64], epsilon: float) -> npt.NDArray[np.bo
 def merge_boxes(mask: npt.NDArray[np.bool_]) -> list[tuple[tuple[int, int], ...]]:
     """Cover the True cells by disjoint boxes of cells (greedy: grow along each axis in turn
     while the whole slab is True and not yet taken)."""
+    if mask.ndim == 0:  # a block without inputs: the whole (one-point) space or nothing
+        return [()] if bool(mask) else []
     free = mask.copy()
     free_flat = free.reshape(-1)  # a view: taking a box clears its cells here too
     flat = np.flatnonzero(mask)
@@ -80,5 +82,5 @@ def find_gaps(grid: Grid, outputs: list[tuple[int, str]], epsilon: float) -> tup
         shape[k] = -1
         volume = volume * a.widths.reshape(shape)
     total = float(np.prod([a.high - a.low for a in axes])) if axes else 1.0
-    fraction = float(np.sum(np.broadcast_to(volume, union.shape)[union])) / total if total > 0 else 0.0
+    fraction = float(np.sum(np.broadcast_to(volume, union.shape) * union)) / total if total > 0 else 0.0
     return gaps, min(1.0, max(0.0, fraction)), coverage
