@@ -195,7 +195,10 @@ def test_benchmark_grids_report_nothing(name: str) -> None:
 
 def test_block_without_inputs_or_rules() -> None:
     """No rule at all: the whole space is a gap (the output is always its DEFAULT)."""
-    text = "FUNCTION_BLOCK e\nVAR_OUTPUT out : REAL; END_VAR\nDEFUZZIFY out DEFAULT := 1; END_DEFUZZIFY\nEND_FUNCTION_BLOCK\n"
+    text = (
+        "FUNCTION_BLOCK e\nVAR_OUTPUT out : REAL; END_VAR\n"
+        "DEFUZZIFY out DEFAULT := 1; END_DEFUZZIFY\nEND_FUNCTION_BLOCK\n"
+    )
     r = analyze(fuzzyctl.load(text))
     assert r.to_json()["gaps"] == [{"output": "out", "box": {}, "best_degree": 0.0}]
     assert r.gap_fraction == 1.0 and r.coverage_index == 0.0

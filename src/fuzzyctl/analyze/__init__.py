@@ -65,6 +65,10 @@ def analyze(
         mono.append(m)
     facts = surf.facts(ctx, sampled, gap_list, epsilon) if surface and sampled is not None else []
     notes = list(grid.notes)
+    if any(sum(c.output == n for c in found) >= conflicts.MAX_CONFLICTS for _o, n in outs):
+        notes.append(
+            f"conflicts: the first {conflicts.MAX_CONFLICTS} of an output are listed, there are more"
+        )
     if coarse:
         notes.append(
             "smooth terms' peaks left out of the cells (too many): the gaps are still exact, the "
