@@ -119,9 +119,8 @@ class Analysis:
         for s in self.surface:
             out.append(
                 f"surface {s.output}: min {s.low:.6g} at {_pt(s.low_at)}, "
-                f"max {s.high:.6g} at {_pt(s.high_at)}, "(
-                    f"largest slope {s.slope:.4g} per unit of {s.slope_input}" if s.slope_input else "flat"
-                )
+                f"max {s.high:.6g} at {_pt(s.high_at)}, "
+                + (f"largest slope {s.slope:.4g} per unit of {s.slope_input}" if s.slope_input else "flat")
             )
             out += [
                 f"  jump {j.values[0]:.6g} -> {j.values[1]:.6g} between {_pt(j.before)} and {_pt(j.after)}"
