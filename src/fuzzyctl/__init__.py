@@ -12,7 +12,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
-    from fuzzyctl.analyze import analyze
+    from fuzzyctl.analysis import analyze
     from fuzzyctl.api import compile, load, plot_terms
 
 __version__ = "0.1.0"
@@ -23,7 +23,7 @@ def __getattr__(name: str) -> Any:
     import importlib
 
     if name == "analyze":  # static analysis of a rule base (docs/analyze.md)
-        return importlib.import_module("fuzzyctl.analyze").analyze
+        return importlib.import_module("fuzzyctl.analysis").analyze
     if name in ("compile", "load", "plot_terms"):
         return getattr(importlib.import_module("fuzzyctl.api"), name)
     # Lazy: tuning pulls in scipy, cma and Dask, which plain evaluation does not need.

@@ -40,7 +40,7 @@ def analyze(
     and dead rules, unused terms, monotonicity violations and the output surface's range,
     slope and jumps, before the controller meets the plant."""
     import fuzzyctl
-    from fuzzyctl.analyze import analyze as run
+    from fuzzyctl.analysis import analyze as run
 
     result = run(fuzzyctl.load(file), block=block, epsilon=epsilon, delta=delta, monotone=monotone or ())
     if as_json:

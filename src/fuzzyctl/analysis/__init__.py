@@ -3,11 +3,9 @@ facts (docs/analyze.md).  ``fuzzyctl.analyze(model)`` returns an :class:`Analysi
 
 from __future__ import annotations
 
-import sys
-import types
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
-from fuzzyctl.analyze.report import Analysis
+from fuzzyctl.analysis.report import Analysis
 
 if TYPE_CHECKING:
     from fuzzyctl.model import Document, FunctionBlock
@@ -30,9 +28,9 @@ def analyze(
     output would fall to DEFAULT).  ``delta``: conflicts are pairs firing together above it
     (default 0.5).  ``monotone``: declarations ``"valve:-temp,+pressure"``.  ``surface``:
     sample the output surface (min, max, slope, jumps, monotonicity counterexamples)."""
-    from fuzzyctl.analyze import cells, conflicts, gaps, monotonicity, redundancy, table
-    from fuzzyctl.analyze import surface as surf
-    from fuzzyctl.analyze.context import build_context
+    from fuzzyctl.analysis import cells, conflicts, gaps, monotonicity, redundancy, table
+    from fuzzyctl.analysis import surface as surf
+    from fuzzyctl.analysis.context import build_context
     from fuzzyctl.diagnostics import FuzzyctlError
 
     if not 0.0 <= epsilon <= 1.0:
@@ -99,14 +97,3 @@ def analyze(
         rule_where=dict(zip(ctx.rule_names, ctx.rule_where, strict=True)),
     )
 
-
-class _CallableModule(types.ModuleType):
-    """Importing ``fuzzyctl.analyze.cells`` (or any submodule) binds the *package* to the
-    attribute ``fuzzyctl.analyze``, where users call the function: the package forwards a
-    call to :func:`analyze`, so ``fuzzyctl.analyze(model)`` works whatever was imported."""
-
-    def __call__(self, model: Document | FunctionBlock, **options: Any) -> Analysis:
-        return analyze(model, **options)
-
-
-sys.modules[__name__].__class__ = _CallableModule

@@ -6,11 +6,11 @@ import math
 from dataclasses import dataclass, field
 from typing import Any
 
-from fuzzyctl.analyze.conflicts import Conflict
-from fuzzyctl.analyze.gaps import Gap
-from fuzzyctl.analyze.monotonicity import Monotonicity
-from fuzzyctl.analyze.redundancy import Redundant, UnusedTerm
-from fuzzyctl.analyze.surface import SurfaceFacts
+from fuzzyctl.analysis.conflicts import Conflict
+from fuzzyctl.analysis.gaps import Gap
+from fuzzyctl.analysis.monotonicity import Monotonicity
+from fuzzyctl.analysis.redundancy import Redundant, UnusedTerm
+from fuzzyctl.analysis.surface import SurfaceFacts
 
 
 def _num(x: float) -> float | None:

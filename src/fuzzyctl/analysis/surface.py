@@ -10,8 +10,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fuzzyctl.analyze.context import Context, FloatArray
-from fuzzyctl.analyze.gaps import Gap
+from fuzzyctl.analysis.context import Context, FloatArray
+from fuzzyctl.analysis.gaps import Gap
 
 MAX_POINTS = 4096
 MAX_EXAMPLES = 5

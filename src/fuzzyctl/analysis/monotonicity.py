@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fuzzyctl.analyze.context import Context, FloatArray, term_values
-from fuzzyctl.analyze.table import Row
+from fuzzyctl.analysis.context import Context, FloatArray, term_values
+from fuzzyctl.analysis.table import Row
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.plan import CTerm, TermPlan
 

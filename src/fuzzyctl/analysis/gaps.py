@@ -1,5 +1,5 @@
 """Gaps (completeness): where no rule of an output reaches ``epsilon``, as non-overlapping
-boxes merged from the cells of :mod:`fuzzyctl.analyze.cells`."""
+boxes merged from the cells of :mod:`fuzzyctl.analysis.cells`."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.analyze.cells import Axis, Grid
+from fuzzyctl.analysis.cells import Axis, Grid
 
 
 @dataclass(frozen=True)

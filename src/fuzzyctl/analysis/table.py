@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fuzzyctl.analyze.cells import SAMPLES, Axis
-from fuzzyctl.analyze.context import Context, FloatArray, constant, leaf_axis, leaf_values
+from fuzzyctl.analysis.cells import SAMPLES, Axis
+from fuzzyctl.analysis.context import Context, FloatArray, constant, leaf_axis, leaf_values
 from fuzzyctl.engine.plan import CAnd, CDegree, CondPlan, CTerm, CTrue
 
 

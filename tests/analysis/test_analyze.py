@@ -10,8 +10,8 @@ import numpy as np
 import pytest
 
 import fuzzyctl
-from fuzzyctl.analyze import analyze
-from tests.analyze.systems import grid_system, random_system
+from fuzzyctl.analysis import analyze
+from tests.analysis.systems import grid_system, random_system
 from tests.conftest import ROOT
 
 

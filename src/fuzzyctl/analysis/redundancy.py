@@ -8,7 +8,7 @@ that never fire, input terms no rule reads and output terms no live rule conclud
   everywhere (t-norms are monotone and T(a, 1) = a).  Reported only when every output it
   concludes accumulates with MAX: under a sum the covered rule still adds its share.
 * dead: the rule's degree is 0 (at most the firing threshold) at every cell of the
-  decomposition (:mod:`fuzzyctl.analyze.cells`)."""
+  decomposition (:mod:`fuzzyctl.analysis.cells`)."""
 
 from __future__ import annotations
 
@@ -16,8 +16,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fuzzyctl.analyze.context import Context
-from fuzzyctl.analyze.table import AxisLeaves, Row, leaf_matrix
+from fuzzyctl.analysis.context import Context
+from fuzzyctl.analysis.table import AxisLeaves, Row, leaf_matrix
 
 
 @dataclass(frozen=True)
@@ -102,7 +102,7 @@ def _group(
 
 
 def find_unused(ctx: Context, dead: set[int]) -> list[UnusedTerm]:
-    from fuzzyctl.analyze.cells import leaves
+    from fuzzyctl.analysis.cells import leaves
     from fuzzyctl.engine.plan import CTerm
 
     plan = ctx.plan

@@ -2,7 +2,7 @@
 of one output whose supports do not overlap.
 
 "Fire together" is the joint degree ``min(degree 1, degree 2)``.  For conjunctive rules
-(rows of :mod:`fuzzyctl.analyze.table`) its highest value is bounded by
+(rows of :mod:`fuzzyctl.analysis.table`) its highest value is bounded by
 ``min over inputs of max_x min(leaf 1, leaf 2)`` (equal to it under AND = MIN, where the
 maximum is separable); every pair above ``delta`` by that bound is evaluated by the engine
 at the point reaching it, and reported only when the engine's joint degree exceeds delta.
@@ -17,9 +17,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fuzzyctl.analyze.cells import Axis
-from fuzzyctl.analyze.context import Context, leaf_values
-from fuzzyctl.analyze.table import AxisLeaves, Row, leaf_matrix
+from fuzzyctl.analysis.cells import Axis
+from fuzzyctl.analysis.context import Context, leaf_values
+from fuzzyctl.analysis.table import AxisLeaves, Row, leaf_matrix
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.explain import Explanation
 from fuzzyctl.engine.operators import TNORMS

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fuzzyctl.analyze.context import Context, FloatArray, constant, leaf_axis, leaf_values, term_points
+from fuzzyctl.analysis.context import Context, FloatArray, constant, leaf_axis, leaf_values, term_points
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
