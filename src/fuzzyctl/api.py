@@ -151,12 +151,23 @@ def compile(
 
 
 def _refuse_reserved(model: Document | FunctionBlock) -> None:
-    from fuzzyctl.diagnostics import DiagnosticError, has_errors
+    from fuzzyctl import formats
+    from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, Severity, has_errors
     from fuzzyctl.fcl.reserved import check_reserved_words
     from fuzzyctl.model import Document
+    from fuzzyctl.validation import Placer, at_spans, validate
 
     doc = model if isinstance(model, Document) else Document((model,))
     found = check_reserved_words(doc, doc.path, strict=True)
+    # and what every reader accepts with a warning only (a WITH weight above 1), placed as
+    # the file's reader places it (a JSON model's spans are those of the file it came from)
+    place: Placer = at_spans
+    if doc.path:
+        try:
+            place = formats.for_path(doc.path).place
+        except FuzzyctlError:
+            pass
+    found += place([f for f in validate(doc, strict=True) if f.severity is Severity.ERROR], doc.path)
     if has_errors(found):
         raise DiagnosticError(found)
 

@@ -236,6 +236,8 @@ def _membership(
         xs, ys = params[0::2], params[1::2]
         if any(b < a for a, b in itertools.pairwise(xs)):
             raise rep.fail("'discretemf' points must be in ascending x", line, code="fis-params")
+        # one pair is a constant degree (fuzzylite); the model says it with two points (5.2.2)
+        xs, ys = (xs * 2, ys * 2) if len(xs) == 1 else (xs, ys)
         return PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     mapping = FIS_TYPES.get(kind_lower)
     if mapping is None or (

@@ -23,6 +23,7 @@ from typing import Any
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, error
 from fuzzyctl.formats import Format, Loaded
+from fuzzyctl.validation import at_json_paths
 
 FORMAT_NAME = "fuzzyctl-model"
 VERSION = 1
@@ -289,4 +290,5 @@ FORMAT = Format(
     description="fuzzyctl model as JSON (lossless; schema in fuzzyctl/formats/fuzzyctl-model.schema.json)",
     read=read,
     write=_write,
+    place=at_json_paths,
 )
