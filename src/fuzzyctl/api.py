@@ -8,6 +8,7 @@ lowered again (its plan is unpickled); the native backend finds its library by t
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import pickle
@@ -163,10 +164,8 @@ def _refuse_reserved(model: Document | FunctionBlock) -> None:
     # the file's reader places it (a JSON model's spans are those of the file it came from)
     place: Placer = at_spans
     if doc.path:
-        try:
+        with contextlib.suppress(FuzzyctlError):
             place = formats.for_path(doc.path).place
-        except FuzzyctlError:
-            pass
     found += place([f for f in validate(doc, strict=True) if f.severity is Severity.ERROR], doc.path)
     if has_errors(found):
         raise DiagnosticError(found)
