@@ -9,6 +9,7 @@ never writes an FCL that ``check`` refuses):
   jFuzzyLogic's ``SINGLETONS (x, y)`` keep one value);
 * the points of a points or singletons term are in ascending order of the variable value
   (5.2.2) and their membership degrees are in [0, 1];
+* a RANGE has its minimum at or below its maximum;
 * a WITH weight (and a FIS/fuzzylite rule weight) is a number >= 0; above 1 it is a warning
   (jFuzzyLogic multiplies by any weight, files written for it use them) and an error under
   ``strict`` (5.2.4 allows 0.0 to 1.0).
@@ -27,7 +28,7 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 from fuzzyctl.diagnostics import Diagnostic, Severity
-from fuzzyctl.model import Document, FunctionBlock, Point, PointsMF, Ref, SingletonsMF, Span, Term
+from fuzzyctl.model import Document, FunctionBlock, Point, PointsMF, Range, Ref, SingletonsMF, Span, Term
 
 PathItem = str | int
 
@@ -131,9 +132,18 @@ def _weight_finding(
     return None
 
 
+def _range_finding(rng: Range | None, owner: str, where: tuple[PathItem, ...]) -> Iterator[Finding]:
+    if rng is not None and rng.low > rng.high:
+        message = f"{owner}: RANGE({_num(rng.low)}..{_num(rng.high)}): the minimum is above the maximum"
+        yield Finding(Severity.ERROR, "bad-range", message, (*where, "range"), rng.span)
+
+
 def _block_findings(fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool) -> Iterator[Finding]:
+    for vi, v in enumerate(fb.variables):
+        yield from _range_finding(v.range, f"variable {v.name}", (*where, "variables", vi))
     for kind, blocks in (("fuzzify", fb.fuzzify), ("defuzzify", fb.defuzzify)):
         for bi, block in enumerate(blocks):
+            yield from _range_finding(block.range, f"{kind.upper()} {block.variable}", (*where, kind, bi))
             for ti, term in enumerate(block.terms):
                 if isinstance(term.mf, PointsMF | SingletonsMF):
                     yield from _point_findings(term, term.mf, (*where, kind, bi, "terms", ti, "mf"))
