@@ -6,6 +6,7 @@ writes a file that ``check`` refuses."""
 from __future__ import annotations
 
 import json
+
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
