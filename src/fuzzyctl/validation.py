@@ -28,7 +28,19 @@ from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
 
 from fuzzyctl.diagnostics import Diagnostic, Severity
-from fuzzyctl.model import Document, FunctionBlock, Point, PointsMF, Range, Ref, SingletonsMF, Span, Term
+from fuzzyctl.model import (
+    DefuzzifyBlock,
+    Document,
+    FunctionBlock,
+    FuzzifyBlock,
+    Point,
+    PointsMF,
+    Range,
+    Ref,
+    SingletonsMF,
+    Span,
+    Term,
+)
 
 PathItem = str | int
 
@@ -141,7 +153,11 @@ def _range_finding(rng: Range | None, owner: str, where: tuple[PathItem, ...]) -
 def _block_findings(fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool) -> Iterator[Finding]:
     for vi, v in enumerate(fb.variables):
         yield from _range_finding(v.range, f"variable {v.name}", (*where, "variables", vi))
-    for kind, blocks in (("fuzzify", fb.fuzzify), ("defuzzify", fb.defuzzify)):
+    groups: tuple[tuple[str, tuple[FuzzifyBlock | DefuzzifyBlock, ...]], ...] = (
+        ("fuzzify", fb.fuzzify),
+        ("defuzzify", fb.defuzzify),
+    )
+    for kind, blocks in groups:
         for bi, block in enumerate(blocks):
             yield from _range_finding(block.range, f"{kind.upper()} {block.variable}", (*where, kind, bi))
             for ti, term in enumerate(block.terms):

@@ -173,8 +173,8 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
                     "fpl-expr-term",
                 )
     for v in block.variables:
-        dz, fz = block.defuzzify_block(v.name), block.fuzzify_block(v.name)
-        rng = v.range or (fz.range if fz else None) or (dz.range if dz else None)
+        fzb, dzb = block.fuzzify_block(v.name), block.defuzzify_block(v.name)
+        rng = v.range or (fzb.range if fzb else None) or (dzb.range if dzb else None)
         if rng is not None and not rng.low < rng.high and v.kind is not VarKind.LOCAL:
             err(
                 f"{v.name}: RANGE ({rng.low:g} .. {rng.high:g}) cannot be written: FPL needs MIN below MAX",
