@@ -6,6 +6,7 @@ writes a file that ``check`` refuses."""
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 from hypothesis import HealthCheck, given, settings
@@ -14,6 +15,7 @@ from hypothesis import strategies as st
 import fuzzyctl
 from fuzzyctl import formats
 from fuzzyctl import model as m
+from fuzzyctl.cli import main
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError
 from fuzzyctl.engine.support import unsupported
 from fuzzyctl.fcl import load_text
@@ -256,3 +258,27 @@ def test_an_invalid_model_is_refused_the_same_way_by_every_reader(case: tuple[m.
         assert _first_error(caught.value).code == code, (fmt, text)
         refused.append(fmt)
     assert {"fcl", "json"} <= set(refused)
+
+
+@pytest.mark.parametrize("fmt", ["fcl", "json", "fll", "fis"])
+@pytest.mark.parametrize(
+    "command", [["check"], ["eval", "-s", "x=5"], ["codegen"], ["codegen", "--lang", "c"]], ids=str
+)
+def test_the_cli_strict_refuses_a_weight_above_1_in_every_format(
+    tmp_path: Path, fmt: str, command: list[str], capsys: pytest.CaptureFixture[str]
+) -> None:
+    """``--strict`` accepted WITH 1.5 (issue 25); now every command refuses it whatever the
+    format, and without ``--strict`` the same file runs (with a warning)."""
+    if command == ["check"] and fmt != "fcl":
+        return  # check reads FCL only
+    text, _line = _replace_once(_text(fmt, _model(weight=0.75)), "0.75", "1.75")
+    source = tmp_path / f"model.{fmt}"
+    source.write_text(text)
+    args = [command[0], str(source), *command[1:]]
+    if "c" in command:
+        args += ["-o", str(tmp_path)]
+    assert main(args) == 0, capsys.readouterr().err
+    capsys.readouterr()
+    assert main([*args, "--strict"]) == 1
+    err = capsys.readouterr().err
+    assert "weight 1.75 is above 1" in err and "internal error" not in err
