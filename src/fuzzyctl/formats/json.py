@@ -119,7 +119,10 @@ def _decode_float(value: Any, where: str) -> float:
     if isinstance(value, bool):
         raise JsonModelError(where, "expected a number, found a boolean")
     if isinstance(value, int | float):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:  # data not read by load_json (the studio's requests)
+            raise JsonModelError(where, "the number is too large (beyond 1.8e308)") from None
     if value in ("NaN", "Infinity", "-Infinity"):
         return {"NaN": math.nan, "Infinity": math.inf, "-Infinity": -math.inf}[value]
     raise JsonModelError(where, f"expected a number, found {value!r}")
