@@ -516,9 +516,9 @@ async function bars(record) {
   });
   const marks = [...tops].map(([x, t]) => ({ x, y: t.y, text: t.labels.join(", ") }));
   plot($("#rec-bars"), [
-    { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
-    { x: marks.map((m) => m.x), y: marks.map((m) => m.y), text: marks.map((m) => m.text), mode: "text", textposition: "top center", textfont: { size: 12, color: "#222" }, hoverinfo: "skip", name: "rules" },
+    { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), text: labels, textposition: "none", marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
     { x: [o.value], y: [-0.06 * top], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
+    { x: marks.map((m) => m.x), y: marks.map((m) => m.y), text: marks.map((m) => m.text), mode: "text", textposition: "top center", textfont: { size: 12, color: "#222" }, hoverinfo: "skip", name: "rules" },
   ], { xaxis: { range: [lo - 0.03 * (hi - lo), hi + 0.03 * (hi - lo)], zeroline: false, title: { text: `${output} = ${format(output, o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.25 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", showlegend: false, margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
   $("#rec-bars").dataset.value = String(o.value);
   $("#rec-bars").dataset.rules = JSON.stringify(labels.map((l, i) => [l, ys[i]]));
