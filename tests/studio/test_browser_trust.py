@@ -70,7 +70,7 @@ def test_recorder_axis_is_the_selected_curves_and_values_follow_the_source(
     assert (
         bars[0]["textposition"] == "none" and numbers["mode"] == "text" and numbers["textfont"]["size"] >= 11
     )
-    shot(pg, "27-recorder-shared-axis", doc=True)
+    shot(pg, "32-recorder-axis-per-quantity", doc=True)
 
     # test signals: the values shown are the running source's, never the finished crane run
     pg.select_option("#rec-source", "test")
@@ -112,7 +112,7 @@ def test_explain_labels_singletons_by_term_and_draws_no_zero_line(page: Any, bro
         name = mark["text"].split(" ")[0]
         assert terms[name] == pytest.approx(mark["x"])
     assert f"power = {expect:.1f}" in c["layout"]["annotations"][0]["text"]
-    shot(pg, "29-explain", doc=True)
+    shot(pg, "33-explain-singletons", doc=True)
 
 
 def test_save_keeps_the_file_basic_and_convertible(page: Any, browser_project: Path) -> None:
