@@ -56,6 +56,8 @@ def test_recorder_axis_is_the_selected_curves_and_values_follow_the_source(
     traces = {t["name"]: t for t in chart(pg, "#rec-chart")["data"]}
     lo, hi = axis["lo"], axis["hi"]
     assert traces["target"]["y"][-1] * (hi - lo) + lo == pytest.approx(target, abs=1e-9)
+    # curves of another quantity (degrees, percent) are dotted: the labels are not theirs
+    assert traces["target"]["line"]["dash"] == "solid" and traces["fb.angle"]["line"]["dash"] == "dot"
     # and fb.distance is target - position at every sample, on that same axis
     for i in range(0, len(traces["position"]["y"]), 17):
         d, t, p = (traces[n]["y"][i] * (hi - lo) + lo for n in ("fb.distance", "target", "position"))

@@ -410,16 +410,17 @@ function readingRecord() {
 function draw() {
   const r = rec();
   const shown = windowRecords();
-  const traces = r.curves.map((name, i) => {
-    const [lo, hi] = scale(name);
-    return { x: shown.map((x) => x.t), y: shown.map((x) => (typeof x.v[name] === "number" ? (x.v[name] - lo) / (hi - lo) : null)), mode: "lines", line: { color: COLORS[i], width: i === selectedCurve ? 2.5 : 1.5 }, name, hoverinfo: "skip" };
-  });
   const sel = r.curves[selectedCurve] || r.curves[0];
   const [lo, hi] = sel ? scale(sel) : [0, 1];
   const ticks = niceTicks(lo, hi, 5); // round values of the selected curve's scale
   const selColour = COLORS[Math.max(0, r.curves.indexOf(sel))];
-  // which curves the labels hold for: the selected one and those drawn on its scale
+  // which curves the labels hold for: the selected one and those drawn on its scale; the
+  // others (another quantity, or sharing off) are dotted: the labels are not theirs
   const onAxis = r.curves.filter((c) => sel && scale(c)[0] === lo && scale(c)[1] === hi);
+  const traces = r.curves.map((name, i) => {
+    const [a, b] = scale(name);
+    return { x: shown.map((x) => x.t), y: shown.map((x) => (typeof x.v[name] === "number" ? (x.v[name] - a) / (b - a) : null)), mode: "lines", line: { color: COLORS[i], width: i === selectedCurve ? 2.5 : 1.5, dash: onAxis.includes(name) ? "solid" : "dot" }, name, hoverinfo: "skip" };
+  });
   const stopped = !running;
   const reading = stopped && archive.length ? readingRecord() : null;
   const shapes = reading ? [{ type: "line", x0: reading.t, x1: reading.t, y0: -0.02, y1: 1.02, line: { color: "#333", width: 1.5 } }] : [];
