@@ -27,6 +27,7 @@ def fixed_creation_time(monkeypatch: pytest.MonkeyPatch) -> None:
     differ when a second passes between them (seen on a loaded machine)."""
     monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
 
+
 # name -> (the file the command writes, given a work directory; the arguments writing it)
 Command = Callable[[Path, Path, Path], list[str]]
 COMMANDS: dict[str, tuple[str, Command]] = {
