@@ -27,6 +27,14 @@ BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to
 CompatOpt = Annotated[
     str, typer.Option("--compat", help="Semantics: iec (default), fuzzylite, pyfuzzylite, jfuzzylogic.")
 ]
+OutOfRangeOpt = Annotated[
+    str,
+    typer.Option(
+        "--out-of-range",
+        help="An input outside its range (its RANGE, else its terms' span): warn (the result as "
+        "computed, and a warning), clamp (limit it first), raise (an error) or ignore.",
+    ),
+]
 StrictOpt = Annotated[
     bool,
     typer.Option(
@@ -65,6 +73,21 @@ def _parse_sets(pairs: list[str] | None) -> dict[str, float]:
         except ValueError:
             raise FuzzyctlError(f"input {name!r}: {raw.strip()!r} is not a number") from None
     return values
+
+
+def _checked_sets(ctl: Any, pairs: list[str] | None, mode: str) -> tuple[dict[str, float], str]:
+    """The --set values and the mode to evaluate them with: with --out-of-range warn, the CLI
+    prints a warning for each value outside its range and the controller says nothing more."""
+    from fuzzyctl.engine.ranges import check_mode, outside_lines
+
+    values = _parse_sets(pairs)
+    if check_mode(mode) != "warn":
+        return values, mode
+    from fuzzyctl.cli.app import err_console
+
+    for line in outside_lines(ctl.input_ranges, values):
+        err_console.print(f"warning: {line}", style="yellow", markup=False, highlight=False)
+    return values, "ignore"
 
 
 def _fmt(v: float) -> str:
@@ -127,6 +150,7 @@ def eval_(
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
+    out_of_range: OutOfRangeOpt = "warn",
     dask_in: DaskOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -166,11 +190,13 @@ def eval_(
             delimiter=delimiter,
             decimal=decimal,
             on_error=on_error,
+            out_of_range=out_of_range,
             as_table=as_table and output is None,
             warn=lambda text: err_console.print(f"warning: {text}", markup=False),
         )
         return
-    result = ctl.evaluate(_parse_sets(set_))
+    values, mode = _checked_sets(ctl, set_, out_of_range)
+    result = ctl.evaluate(values, out_of_range=mode)
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
     else:
@@ -222,10 +248,12 @@ def explain(
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
+    out_of_range: OutOfRangeOpt = "warn",
 ) -> None:
     """Evaluate once and show why: term degrees, rule degrees, accumulated sets, values."""
     ctl = _controller(file, block, compat, strict)
-    e = ctl.explain(_parse_sets(set_))
+    values, mode = _checked_sets(ctl, set_, out_of_range)
+    e = ctl.explain(values, out_of_range=mode)
     if png is not None:
         from fuzzyctl.engine.plot import save_png
 
