@@ -75,6 +75,14 @@ def record_table(title: str, figures: dict[str, str], width: int) -> Table:
     return table
 
 
+def split_names(values: list[str] | str | None) -> list[str]:
+    """A list option's names: ``a,b``, ``'a b'`` and the option repeated all give [a, b]."""
+    import re
+
+    items = [values] if isinstance(values, str) else (values or [])
+    return [n for v in items for n in re.split(r"[,\s]+", v) if n]
+
+
 def _version(value: bool) -> None:
     if value:
         typer.echo(f"fuzzyctl {__version__}")
@@ -96,11 +104,32 @@ def _register_commands() -> None:
     from fuzzyctl.cli import commands  # noqa: F401
 
 
+def _given_twice(argv: list[str]) -> None:
+    """learn and tune before -o/--output meant the file everywhere: ``--output COLUMN -o FILE``
+    now gives the file twice, which click would take silently (the last wins)."""
+    if not argv or argv[0] not in ("learn", "tune"):
+        return
+    given = [a for a in argv[1:] if a in ("-o", "--output") or a.startswith("--output=")]
+    if len(given) > 1:
+        from fuzzyctl.cli.tune import RENAMED
+
+        raise typer.BadParameter(f"given {len(given)} times: {RENAMED}", param_hint="-o/--output")
+
+
+def _renamed_hint(exc: Exception) -> None:
+    """A missing --target of learn/tune is most often the old ``--output COLUMN``: say so."""
+    # (typer vendors click: the class is matched by name, not imported from a private module)
+    param = getattr(exc, "param", None)
+    if type(exc).__name__ == "MissingParameter" and getattr(param, "name", None) == "target":
+        exc.message = "Name the column(s) with --target (-o/--output names the file written)"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; never lets a Python traceback reach the user."""
     _register_commands()
     command = typer.main.get_command(app)
     try:
+        _given_twice(sys.argv[1:] if argv is None else argv)
         result = command.main(args=argv, prog_name="fuzzyctl", standalone_mode=False)
     except typer.Exit as exc:
         return int(exc.exit_code or 0)
@@ -108,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
         err_console.print("aborted")
         return EXIT_ERRORS
     except typer.TyperException as exc:  # usage errors: bad option, missing argument, ...
+        _renamed_hint(exc)
         show = getattr(exc, "show", None)
         if callable(show):
             show(file=sys.stderr)

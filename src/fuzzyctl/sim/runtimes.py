@@ -35,7 +35,7 @@ class EngineRuntime:
     def __init__(self, model: Document | FunctionBlock, *, block: str | None = None) -> None:
         import fuzzyctl
 
-        self.controller = fuzzyctl.compile(model, block=block)
+        self.controller = fuzzyctl.compile(model, block=block, out_of_range="ignore")  # a plant may leave it
         self.name = "engine"
         self.inputs = tuple(self.controller.inputs)
         self.outputs = tuple(self.controller.outputs)

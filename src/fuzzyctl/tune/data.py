@@ -60,7 +60,7 @@ def _read_file(path: Path) -> Any:
         import pyarrow.csv as pacsv
         import pyarrow.parquet as pq
     except ImportError as exc:  # pragma: no cover - the tune extra brings pyarrow
-        raise InputError(f"reading {path} needs pyarrow: pip install 'fuzzyctl[tune]'") from exc
+        raise InputError(f"reading {path} needs pyarrow: pip install -e . (it is a core dependency)") from exc
     import pyarrow as pa
 
     try:

@@ -463,7 +463,8 @@ def _scores(
 
     # Evaluate what is written: the file read back, through the public compile().
     written = load_text(write(doc)).raise_for_errors()
-    ctl = fuzzyctl.compile(written, backend="python")
+    # (validation rows may lie outside the training rows' ranges: no warning)
+    ctl = fuzzyctl.compile(written, backend="python", out_of_range="ignore")
     out: dict[str, float] = {}
     for label, cols in (("training", train), ("validation", val)):
         if cols is None:
