@@ -42,7 +42,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
-        _require_file(path)  # before the extension is read: a typo in it is still a missing file
+        require_file(path)  # before the extension is read: a typo in it is still a missing file
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
         return _load_path(path, fmt, strict)
     from fuzzyctl import formats
@@ -112,7 +112,7 @@ def content_key(data: bytes, fmt: str) -> str:
     return h.hexdigest()[:32]
 
 
-def _require_file(path: Path) -> None:
+def require_file(path: Path) -> None:
     """ "no such file" (or "is a directory") for a path that names no file."""
     from fuzzyctl.diagnostics import DiagnosticError, error
 

@@ -53,6 +53,15 @@ err_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
 FORCE_HINT = "--force replaces it"
+FromOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--from",
+        help="Format of FILE: fcl, fis, fll, json, fpl, xfuz (default: its extension).",
+        show_default=False,
+    ),
+]
+"""The option every command that reads a model takes to name its format."""
 """How the commands that write files for the user override a read-only target."""
 
 

@@ -10,41 +10,16 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, app, err_console
+from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, FromOpt, app, err_console
 
 if TYPE_CHECKING:
     from fuzzyctl.fcl import LoadResult
 
 
-def _load(file: Path, strict: bool = False, compat: str = "iec"):  # type: ignore[no-untyped-def]
-    """Load and check ``file``; when the language checks pass, add what the engine reports
-    (features it will not evaluate, decisions worth knowing) so that ``check`` never says OK
-    to a file ``eval`` refuses (with the same ``--strict`` and ``--compat``)."""
-    from fuzzyctl.diagnostics import has_errors
-    from fuzzyctl.fcl import load_file
-    from fuzzyctl.gcpause import gc_paused
+def _load(file: Path, strict: bool = False, compat: str = "iec", fmt: str | None = None) -> LoadResult:
+    from fuzzyctl.checking import load_checked
 
-    result = load_file(file, strict=strict, compat=compat)
-    if result.document is None or has_errors(result.diagnostics):
-        return result
-    with gc_paused():
-        _add_engine_diagnostics(result, compat, strict)
-    return result
-
-
-def _add_engine_diagnostics(result: LoadResult, compat: str, strict: bool) -> None:
-    from dataclasses import replace
-
-    from fuzzyctl.engine.support import unsupported
-
-    # The engine validates models from every reader, so it re-finds some language errors;
-    # keep only what the language checks did not already say about the same line.
-    seen = {(d.code, d.span.line if d.span else None) for d in result.diagnostics}
-    assert result.document is not None
-    for fb in result.document.blocks:
-        for d in unsupported(fb, compat=compat, strict=strict):
-            if (d.code, d.span.line if d.span else None) not in seen:
-                result.diagnostics.append(replace(d, file=d.file or result.source.path))
+    return load_checked(file, format=fmt, strict=strict, compat=compat)
 
 
 @app.command()
@@ -52,7 +27,9 @@ def check(
     file: Annotated[
         Path | None,
         typer.Argument(
-            help="FCL file to check (with --conformance: a program to measure).", show_default=False
+            help="Model to check: FCL, FIS, FLL, JSON, FPL or XFUZ (with --conformance: an FCL "
+            "program to measure).",
+            show_default=False,
         ),
     ] = None,
     checklist: Annotated[
@@ -75,6 +52,7 @@ def check(
             "jfuzzylogic also warns about what jFuzzyLogic 3.3 would reject.",
         ),
     ] = "iec",
+    from_format: FromOpt = None,
     conformance_statement: Annotated[
         bool,
         typer.Option(
@@ -85,7 +63,9 @@ def check(
         ),
     ] = False,
 ) -> None:
-    """Validate an FCL file and report the conformance level it needs (exit 1 on errors)."""
+    """Validate a model and report the IEC 61131-7 conformance level it needs as FCL (exit 1
+    on errors).  FCL gets every check; another format gets the model's checks and the
+    engine's, and the report names the checks of FCL text it did not run."""
     from rich.console import Console
     from rich.table import Table
 
@@ -102,7 +82,7 @@ def check(
     if compat not in COMPAT_PROFILES:
         raise typer.BadParameter(f"unknown profile {compat!r} (known: {', '.join(COMPAT_PROFILES)})")
     try:
-        result = _load(file, strict, compat)
+        result = _load(file, strict, compat, from_format)
     except DiagnosticError as exc:
         if as_json:
             typer.echo(
@@ -114,7 +94,11 @@ def check(
             raise typer.Exit(EXIT_ERRORS) from None
         raise
     doc = result.document
+    from fuzzyctl.checking import FCL_ONLY, format_of
     from fuzzyctl.gcpause import gc_paused
+
+    fmt = format_of(file, from_format)
+    not_checked = [] if fmt == "fcl" else list(FCL_ONLY)
 
     with gc_paused():
         feats = conformance.features(doc, result.spellings) if result.ok and doc is not None else []
@@ -123,7 +107,9 @@ def check(
         report: dict[str, object] = {
             "file": str(file),
             "ok": result.ok,
+            "format": fmt,
             "diagnostics": [d.to_dict() for d in result.diagnostics],
+            "not_checked": not_checked,
         }
         if result.ok and doc is not None:
             report["level"] = str(lvl)
@@ -153,7 +139,12 @@ def check(
     warnings = sum(1 for d in result.diagnostics if d.severity is Severity.WARNING)
     names = ", ".join(fb.name or "(unnamed)" for fb in doc.blocks)
     out.print(f"{file}: OK ({warnings} warning(s)); function block(s): {names}", markup=False)
-    out.print(f"Conformance level needed: {lvl}", markup=False)
+    out.print(f"Conformance level needed{' as FCL' if not_checked else ''}: {lvl}", markup=False)
+    if not_checked:
+        skipped = "; ".join(not_checked)
+        out.print(
+            f"Checked the model read as {fmt.upper()}; not checked (FCL text only): {skipped}", soft_wrap=True
+        )
     if feats:
         table = Table(title="Features beyond the Basic level (Table 8)", title_justify="left")
         table.add_column("level", overflow="fold")
@@ -213,7 +204,9 @@ def _has_comments(fb: object) -> bool:
 
 @app.command()
 def fmt(
-    file: Annotated[Path, typer.Argument(help="FCL file to format.", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Model to print as FCL (FCL, FIS, FLL, JSON, ...).", show_default=False)
+    ],
     output: Annotated[
         Path | None, typer.Option("-o", "--output", help="Write to this file instead of standard output.")
     ] = None,
@@ -221,14 +214,21 @@ def fmt(
     force: Annotated[
         bool, typer.Option("--force", help="Replace the file written even when it is read-only.")
     ] = False,
+    from_format: FromOpt = None,
 ) -> None:
-    """Print an FCL file in canonical IEC 61131-7 form (exit 1 if it does not load)."""
+    """Print a model in canonical IEC 61131-7 FCL form (exit 1 if it does not load)."""
+    from fuzzyctl.checking import format_of
     from fuzzyctl.fcl import write
 
     if output is not None and in_place:
         err_console.print("error: use either --output or --in-place, not both", markup=False)
         raise typer.Exit(EXIT_USAGE)
-    result = _load(file)
+    result = _load(file, fmt=from_format)
+    if in_place and format_of(file, from_format) != "fcl":
+        err_console.print(
+            f"error: --in-place rewrites FCL files; {file} is not one (use -o FILE.fcl)", markup=False
+        )
+        raise typer.Exit(EXIT_USAGE)
     document = result.raise_for_errors()
     text = write(document)
     target = file if in_place else output

@@ -10,7 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import FromOpt, app
 from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
@@ -26,6 +26,9 @@ SetOpt = Annotated[
 BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to run (default: the first).")]
 CompatOpt = Annotated[
     str, typer.Option("--compat", help="Semantics: iec (default), fuzzylite, pyfuzzylite, jfuzzylogic.")
+]
+ModelArg = Annotated[
+    Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
 ]
 OutOfRangeOpt = Annotated[
     str,
@@ -45,11 +48,14 @@ StrictOpt = Annotated[
 ]
 
 
-def _controller(file: Path, block: str | None, compat: str, strict: bool = False) -> Any:
+def _controller(
+    file: Path, block: str | None, compat: str, strict: bool = False, fmt: str | None = None
+) -> Any:
     import fuzzyctl
     from fuzzyctl.cli.app import err_console
 
-    ctl = fuzzyctl.compile(fuzzyctl.load(file, strict=strict), block=block, compat=compat, strict=strict)
+    doc = fuzzyctl.load(file, strict=strict, format=fmt)
+    ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict)
     from fuzzyctl.diagnostics import render_all
 
     # what the engine settled with a warning (a universe from the terms, ...), capped: a file
@@ -96,7 +102,9 @@ def _fmt(v: float) -> str:
 
 @app.command("eval")
 def eval_(
-    file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+    ],
     set_: SetOpt = None,
     data: Annotated[
         str | None,
@@ -151,6 +159,7 @@ def eval_(
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
     out_of_range: OutOfRangeOpt = "warn",
+    from_format: FromOpt = None,
     dask_in: DaskOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -177,7 +186,7 @@ def eval_(
         raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
     if as_json and as_table:
         raise typer.BadParameter("use either --json or --table", param_hint="--table")
-    ctl = _controller(file, block, compat, strict)
+    ctl = _controller(file, block, compat, strict, from_format)
     if data is not None:
         from fuzzyctl.cli.app import err_console
         from fuzzyctl.cli.eval_data import evaluate_file
@@ -238,7 +247,9 @@ def _print_outputs(title: str, result: Mapping[str, float]) -> None:
 
 @app.command()
 def explain(
-    file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+    ],
     set_: SetOpt = None,
     png: Annotated[
         Path | None, typer.Option("--png", help="Also draw the accumulated output sets to a PNG file.")
@@ -249,9 +260,10 @@ def explain(
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
     out_of_range: OutOfRangeOpt = "warn",
+    from_format: FromOpt = None,
 ) -> None:
     """Evaluate once and show why: term degrees, rule degrees, accumulated sets, values."""
-    ctl = _controller(file, block, compat, strict)
+    ctl = _controller(file, block, compat, strict, from_format)
     values, mode = _checked_sets(ctl, set_, out_of_range)
     e = ctl.explain(values, out_of_range=mode)
     if png is not None:
