@@ -92,7 +92,7 @@ def try_quick(argv: list[str]) -> int | None:
             return None
     if not all(math.isfinite(v) for v in result.values()):
         return None  # an output without a value: the full command line says why and exits 1
-    from fuzzyctl.engine.ranges import outside_lines
+    from fuzzyctl.cli.quick_record import outside_lines
 
     for line in warnings:  # as cli/run.py's _controller (without its colour)
         print(line, file=sys.stderr)

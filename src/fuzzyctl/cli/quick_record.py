@@ -108,6 +108,17 @@ class QuickRecord:
         return {name: float(out[slot]) for name, slot in self.outputs}
 
 
+def outside_lines(ranges: dict[str, tuple[float, float]], values: dict[str, float]) -> list[str]:
+    """:func:`fuzzyctl.engine.ranges.outside_lines` without importing the engine package
+    (tests/cli/test_quick.py holds the two to the same text)."""
+    return [
+        f"input {n!r} = {v:g} is outside its range {ranges[n][0]:g}..{ranges[n][1]:g}: "
+        "the result is what the terms give there"
+        for n, v in values.items()
+        if n in ranges and not ranges[n][0] <= v <= ranges[n][1] and v == v
+    ]
+
+
 def lookup(file: Path, block: str | None, compat: str) -> tuple[QuickRecord | None, str | None]:
     """(the record for this file and these options or None, the key to save one under)."""
     if not _native_wanted():
