@@ -10,7 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import FromOpt, app
 
 WorkersOpt = Annotated[
     int | None,
@@ -82,6 +82,12 @@ def _print_table(title: str, rows: list[tuple[str, float, float]] | list[tuple[s
     for row in rows:
         table.add_row(row[0], *(_fmt(float(v)) for v in row[1:]))
     Console(highlight=False).print(table)
+
+
+def _load(file: Path, fmt: str) -> Any:
+    import fuzzyctl
+
+    return fuzzyctl.load(file, format=fmt)
 
 
 @app.command("learn")
@@ -236,6 +242,7 @@ def tune(
         Path | None, typer.Option("--report", help="Write a report directory (Markdown, JSON, PNG, HTML).")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
+    from_format: FromOpt = None,
 ) -> None:
     """Tune a fuzzy system against data or a closed-loop cost (Ctrl-C keeps the best so far)."""
     from rich.console import Console
@@ -268,7 +275,7 @@ def tune(
             progress.update(task, completed=done, total=total, best=_fmt(best))
 
         result = run(
-            file,
+            file if from_format is None else _load(file, from_format),
             data=data,
             output=split_names(target) or None,
             plant_config=plant_config,

@@ -25,7 +25,7 @@ def read_table(source: str | Path | Mapping[str, Any] | Any, *, what: str = "dat
     if isinstance(source, str | Path):
         path = Path(source)
         if not path.exists():
-            raise InputError(f"{what} file {str(path)!r} does not exist")
+            raise InputError(f"{path}: no such file ({what})")
         table = _read_file(path)
         where = str(path)
         cols = {name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names}
