@@ -230,6 +230,8 @@ def learn(
             seed,
         )
         notes.append(note)
+        if and_op.upper() != "MIN":
+            notes.append("the Siemens FUZZY block takes AND MIN: learn with --and min (and_op='min') for it")
     fb = _with_comment(fb, method, kind, inputs, output, n, and_op)
     doc = Document((fb,))
     scores = _scores(doc, parts_train, parts_val, inputs, output)
