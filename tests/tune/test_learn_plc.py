@@ -20,7 +20,8 @@ from tests.tune.conftest import surface
 
 def _csv(path: Path, cols: dict[str, np.ndarray]) -> Path:
     names = list(cols)
-    lines = [",".join(names)] + [",".join(repr(float(v)) for v in r) for r in zip(*cols.values(), strict=True)]
+    rows = zip(*cols.values(), strict=True)
+    lines = [",".join(names)] + [",".join(repr(float(v)) for v in r) for r in rows]
     path.write_text("\n".join(lines) + "\n")
     return path
 
@@ -38,7 +39,8 @@ def test_the_siemens_block_computes_what_the_learned_file_says(
     capsys.readouterr()
     assert main(["blocks", "check", str(out)]) == 0
     assert "warning" not in capsys.readouterr().err  # blocks check warned about ACCU MAX before
-    probe = {"x": np.random.default_rng(2).uniform(-5, 5, 60), "y": np.random.default_rng(3).uniform(-3, 3, 60)}
+    rng = np.random.default_rng(2)
+    probe = {"x": rng.uniform(-5, 5, 60), "y": rng.uniform(-3, 3, 60)}
     samples = _csv(tmp_path / "s.csv", probe)
     assert main(["blocks", "siemens", str(out), str(samples)]) == 0
     block = [float(r["z"]) for r in csv.DictReader(io.StringIO(capsys.readouterr().out))]

