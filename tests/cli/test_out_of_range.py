@@ -64,8 +64,8 @@ def test_data_files_count_per_column(tmp_path: Path, capsys: pytest.CaptureFixtu
     err = " ".join(capsys.readouterr().err.split())
     n_d = int(np.count_nonzero((distance < -4) | (distance > 20)))
     n_a = int(np.count_nonzero((angle < -15) | (angle > 15)))
-    assert f"{n_d} of 200 values of column 'distance'" in err
-    assert f"{n_a} of 200 values of column 'angle'" in err
+    assert f"column 'distance': {n_d} of 200 values outside the input's range -4..20" in err
+    assert f"column 'angle': {n_a} of 200 values outside the input's range -15..15" in err
     # the rows are the engine's numbers, unchanged
     got = np.loadtxt(out, delimiter=",", skiprows=1)[:, 2]
     with warnings.catch_warnings():

@@ -70,9 +70,8 @@ def evaluate_file(
             for name, n in outside.items():
                 lo, hi = ctl.input_ranges[name]
                 warn(
-                    f"{n} of {counts[2]} values of column {name!r} are outside the input's range "
-                    f"{lo:g}..{hi:g}: their results are what the terms give there "
-                    "(--out-of-range clamp limits them, raise stops at the first)"
+                    f"column {name!r}: {n} of {counts[2]} values outside the input's range "
+                    f"{lo:g}..{hi:g}, computed as its terms give them (see --out-of-range)"
                 )
         if warn is not None:
             bad_inputs, bad_outputs, rows = counts
