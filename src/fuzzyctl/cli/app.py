@@ -128,8 +128,9 @@ def _given_twice(argv: list[str]) -> None:
 def _renamed_hint(exc: Exception) -> None:
     """A missing --target of learn/tune is most often the old ``--output COLUMN``: say so."""
     # (typer vendors click: the class is matched by name, not imported from a private module)
-    param = getattr(exc, "param", None)
-    if type(exc).__name__ == "MissingParameter" and getattr(param, "name", None) == "target":
+    if not isinstance(exc, typer.BadParameter) or type(exc).__name__ != "MissingParameter":
+        return
+    if getattr(exc.param, "name", None) == "target":
         exc.message = "Name the column(s) with --target (-o/--output names the file written)"
 
 
