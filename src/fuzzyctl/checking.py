@@ -10,12 +10,15 @@ and what the engine reports; the checks of FCL text do not apply to it and are n
 
 from __future__ import annotations
 
+from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from fuzzyctl.diagnostics import has_errors
 from fuzzyctl.fcl import CheckContext, LoadResult
 from fuzzyctl.fcl.checks import providers
 from fuzzyctl.fcl.source import Source
+from fuzzyctl.model import FunctionBlock
 
 #: check providers about FCL text, not the model (fuzzyctl.fcl.checks)
 FCL_ONLY_PROVIDERS = ("reserved", "jfuzzylogic")
@@ -91,3 +94,84 @@ def add_engine_diagnostics(result: LoadResult, compat: str, strict: bool) -> Non
         for d in unsupported(fb, compat=compat, strict=strict):
             if (d.code, d.span.line if d.span else None) not in seen:
                 result.diagnostics.append(replace(d, file=d.file or result.source.path))
+
+
+@dataclass
+class CheckReport:
+    """What ``fuzzyctl check`` reports about one file: the load result with every
+    diagnostic, its format, the conformance features and level (when it loads) and, when
+    asked, the data check list of Table 11 per function block."""
+
+    file: Path
+    format: str
+    result: LoadResult
+    features: list[Any] = field(default_factory=list)
+    level: Any = None
+    checklists: dict[str, list[Any]] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.result.ok
+
+    @property
+    def not_checked(self) -> list[str]:
+        """The checks of FCL text that a model read from another format did not get."""
+        return [] if self.format == "fcl" else list(FCL_ONLY)
+
+    def to_dict(self) -> dict[str, object]:
+        out: dict[str, object] = {
+            "file": str(self.file),
+            "ok": self.ok,
+            "format": self.format,
+            "diagnostics": [d.to_dict() for d in self.result.diagnostics],
+            "not_checked": self.not_checked,
+        }
+        if self.ok:
+            out["level"] = str(self.level)
+            out["features"] = [f.__dict__ | {"level": str(f.level)} for f in self.features]
+            if self.checklists:
+                out["checklist"] = {
+                    name: {row.item: row.value for row in rows} for name, rows in self.checklists.items()
+                }
+        return out
+
+
+def check_file(
+    path: Path,
+    *,
+    format: str | None = None,
+    strict: bool = False,
+    compat: str = "iec",
+    checklist: bool = False,
+) -> CheckReport:
+    """Check ``path`` (:func:`load_checked`) and, when it loads, measure the conformance
+    level its model needs as FCL and (``checklist``) Table 11's data check list."""
+    from fuzzyctl.fcl import conformance
+    from fuzzyctl.gcpause import gc_paused
+
+    result = load_checked(path, format=format, strict=strict, compat=compat)
+    report = CheckReport(path, format_of(path, format), result)
+    doc = result.document
+    if not result.ok or doc is None:
+        return report
+    with gc_paused():
+        report.features = conformance.features(doc, result.spellings)
+    report.level = conformance.level(report.features)
+    if checklist:
+        report.checklists = {
+            fb.name or "": conformance.checklist(fb, bool(doc.comments) or has_comments(fb))
+            for fb in doc.blocks
+        }
+    return report
+
+
+def has_comments(fb: FunctionBlock) -> bool:
+    """Whether any element of ``fb`` carries a comment (an item of Table 11)."""
+    from fuzzyctl.fcl.checks import term_blocks
+
+    items: list[object] = [fb, *fb.variables, *fb.fuzzify, *fb.defuzzify, *fb.rule_blocks]
+    for block in term_blocks(fb):
+        items.extend(block.terms)
+    for rb in fb.rule_blocks:
+        items.extend(rb.rules)
+    return any(getattr(i, "comments", ()) for i in items)

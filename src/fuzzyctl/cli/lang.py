@@ -13,6 +13,7 @@ import typer
 from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, FromOpt, app, err_console
 
 if TYPE_CHECKING:
+    from fuzzyctl.checking import CheckReport
     from fuzzyctl.fcl import LoadResult
 
 
@@ -66,105 +67,76 @@ def check(
     """Validate a model and report the IEC 61131-7 conformance level it needs as FCL (exit 1
     on errors).  FCL gets every check; another format gets the model's checks and the
     engine's, and the report names the checks of FCL text it did not run."""
-    from rich.console import Console
-    from rich.table import Table
-
-    from fuzzyctl.diagnostics import DiagnosticError, Severity, more_line, select_shown
+    from fuzzyctl.checking import check_file
+    from fuzzyctl.diagnostics import DiagnosticError
     from fuzzyctl.engine.compile import COMPAT_PROFILES
-    from fuzzyctl.fcl import conformance
 
     if conformance_statement:
         _print_statement(file)
         raise typer.Exit(EXIT_OK)
     if file is None:
-        err_console.print("error: give an FCL file to check (or --conformance)", markup=False)
+        err_console.print("error: give a file to check (or --conformance)", markup=False)
         raise typer.Exit(EXIT_USAGE)
     if compat not in COMPAT_PROFILES:
         raise typer.BadParameter(f"unknown profile {compat!r} (known: {', '.join(COMPAT_PROFILES)})")
     try:
-        result = _load(file, strict, compat, from_format)
+        report = check_file(file, format=from_format, strict=strict, compat=compat, checklist=checklist)
     except DiagnosticError as exc:
-        if as_json:
-            typer.echo(
-                json.dumps(
-                    {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]},
-                    indent=2,
-                )
-            )
-            raise typer.Exit(EXIT_ERRORS) from None
-        raise
-    doc = result.document
-    from fuzzyctl.checking import FCL_ONLY, format_of
-    from fuzzyctl.gcpause import gc_paused
-
-    fmt = format_of(file, from_format)
-    not_checked = [] if fmt == "fcl" else list(FCL_ONLY)
-
-    with gc_paused():
-        feats = conformance.features(doc, result.spellings) if result.ok and doc is not None else []
-    lvl = conformance.level(feats)
+        if not as_json:
+            raise
+        failed = {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]}
+        typer.echo(json.dumps(failed, indent=2))
+        raise typer.Exit(EXIT_ERRORS) from None
     if as_json:
-        report: dict[str, object] = {
-            "file": str(file),
-            "ok": result.ok,
-            "format": fmt,
-            "diagnostics": [d.to_dict() for d in result.diagnostics],
-            "not_checked": not_checked,
-        }
-        if result.ok and doc is not None:
-            report["level"] = str(lvl)
-            report["features"] = [f.__dict__ | {"level": str(f.level)} for f in feats]
-            if checklist:
-                report["checklist"] = {
-                    fb.name or "": {
-                        row.item: row.value
-                        for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb))
-                    }
-                    for fb in doc.blocks
-                }
-        typer.echo(json.dumps(report, indent=2, default=str))
-        raise typer.Exit(EXIT_OK if result.ok else EXIT_ERRORS)
+        typer.echo(json.dumps(report.to_dict(), indent=2, default=str))
+    else:
+        _print_report(report)
+    raise typer.Exit(EXIT_OK if report.ok else EXIT_ERRORS)
 
+
+def _print_report(report: CheckReport) -> None:
+    """The diagnostics on stderr; for a file that loads, its level, features and check list."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from fuzzyctl.diagnostics import Severity, more_line, select_shown
+
+    result, file = report.result, report.file
     shown, rest = select_shown(result.diagnostics)
     for d in shown:
         style = {Severity.ERROR: "red", Severity.WARNING: "yellow", Severity.NOTE: "cyan"}[d.severity]
         err_console.print(d.render(result.source.text), style=style, markup=False, highlight=False)
     if rest:
         err_console.print(more_line(rest), markup=False, highlight=False)
-    if not result.ok or doc is None:
+    if not report.ok or result.document is None:
         errors = sum(1 for d in result.diagnostics if d.is_error)
         err_console.print(f"{file}: {errors} error(s)", markup=False)
-        raise typer.Exit(EXIT_ERRORS)
+        return
     out = Console(highlight=False, soft_wrap=False, width=max(100, Console().width))
     warnings = sum(1 for d in result.diagnostics if d.severity is Severity.WARNING)
-    names = ", ".join(fb.name or "(unnamed)" for fb in doc.blocks)
+    names = ", ".join(fb.name or "(unnamed)" for fb in result.document.blocks)
     out.print(f"{file}: OK ({warnings} warning(s)); function block(s): {names}", markup=False)
-    out.print(f"Conformance level needed{' as FCL' if not_checked else ''}: {lvl}", markup=False)
-    if not_checked:
-        skipped = "; ".join(not_checked)
-        out.print(
-            f"Checked the model read as {fmt.upper()}; not checked (FCL text only): {skipped}", soft_wrap=True
-        )
-    if feats:
+    skipped = report.not_checked
+    out.print(f"Conformance level needed{' as FCL' if skipped else ''}: {report.level}", markup=False)
+    if skipped:
+        head = f"Checked the model read as {report.format.upper()}; not checked (FCL text only)"
+        out.print(f"{head}: {'; '.join(skipped)}", soft_wrap=True, markup=False)
+    if report.features:
         table = Table(title="Features beyond the Basic level (Table 8)", title_justify="left")
-        table.add_column("level", overflow="fold")
-        table.add_column("table", overflow="fold")
-        table.add_column("language element", overflow="fold")
-        table.add_column("detail", overflow="fold")
-        for f in feats:
+        for col in ("level", "table", "language element", "detail"):
+            table.add_column(col, overflow="fold")
+        for f in report.features:
             table.add_row(str(f.level), f.table, f.element, f.detail)
         out.print(table)
-    if checklist:
-        for fb in doc.blocks:
-            table = Table(title=f"Data check list (Table 11): {fb.name or '(unnamed)'}", title_justify="left")
-            table.add_column("technical data", overflow="fold")
-            table.add_column("this file", justify="right", overflow="fold")
-            for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb)):
-                table.add_row(row.item, row.value)
-            out.print(table)
-        if any("*" in row.item for fb in doc.blocks for row in conformance.checklist(fb, False)):
-            out.print("* parametric shapes count their parameters as points", markup=False)
-    raise typer.Exit(EXIT_OK)
+    for name, rows in report.checklists.items():
+        table = Table(title=f"Data check list (Table 11): {name or '(unnamed)'}", title_justify="left")
+        table.add_column("technical data", overflow="fold")
+        table.add_column("this file", justify="right", overflow="fold")
+        for row in rows:
+            table.add_row(row.item, row.value)
+        out.print(table)
+    if any("*" in row.item for rows in report.checklists.values() for row in rows):
+        out.print("* parametric shapes count their parameters as points", markup=False)
 
 
 def _print_statement(file: Path | None) -> None:
@@ -187,19 +159,6 @@ def _print_statement(file: Path | None) -> None:
             bar.update(task, description=f"measuring {file.name}")
         measured = statement.measure([file]) if file is not None else None
     sys.stdout.write(statement.render(elements, limits, measured))
-
-
-def _has_comments(fb: object) -> bool:
-    from fuzzyctl.fcl.checks import term_blocks
-    from fuzzyctl.model import FunctionBlock
-
-    assert isinstance(fb, FunctionBlock)
-    items: list[object] = [fb, *fb.variables, *fb.fuzzify, *fb.defuzzify, *fb.rule_blocks]
-    for block in term_blocks(fb):
-        items.extend(block.terms)
-    for rb in fb.rule_blocks:
-        items.extend(rb.rules)
-    return any(getattr(i, "comments", ()) for i in items)
 
 
 @app.command()
