@@ -143,9 +143,10 @@ def compile(
 ) -> Controller:
     """Turn a model into a :class:`~fuzzyctl.engine.Controller` (see ``fuzzyctl.engine``).
 
-    ``model`` is a loaded document or function block, or a path (``compile("crane.fcl")``
-    is ``compile(load("crane.fcl"))``).  ``out_of_range`` is what an input outside its
-    declared RANGE does by default: ``"warn"`` (the result as computed, and an
+    ``model`` is a loaded document or function block, or what :func:`load` takes (a path:
+    ``compile("crane.fcl")`` is ``compile(load("crane.fcl"))``).  ``out_of_range`` is what
+    an input outside its range (declared, else its terms' span) does by default: ``"warn"``
+    (the result as computed, and an
     :class:`~fuzzyctl.engine.ranges.InputRangeWarning`), ``"clamp"``, ``"raise"`` or
     ``"ignore"`` (the controller's ``out_of_range``; each evaluation can override it).
 
@@ -166,8 +167,8 @@ def compile(
     from fuzzyctl.model import Document
 
     check_mode(out_of_range)
-    if isinstance(model, (str, Path)):
-        model = load(Path(model), strict=bool(options.get("strict")))
+    if isinstance(model, (str, Path)):  # a path, or FCL source text as load() takes it
+        model = load(model, strict=bool(options.get("strict")))
     if options.get("strict"):
         _refuse_reserved(model)
     with gc_paused():  # lowering and generating build large acyclic structures
