@@ -112,3 +112,19 @@ def test_the_quick_path_prints_the_same_warning() -> None:
     for _ in range(200):
         values = {"a": float(rng.uniform(-30, 40)), "b": float(rng.uniform(-1e-3, 2e-3)), "c": 1.0}
         assert quick_lines(ranges, values) == outside_lines(ranges, values)
+
+
+def test_the_quick_start_warns_as_the_full_command_line(tmp_path: Path) -> None:
+    """The console script answers simple evals from a cached record without the engine: the
+    first start (full path, records) and the second (from the record) print the warning the
+    full command line prints."""
+    from tests.cli.test_quick import _console, _full, _quick_env
+
+    env = _quick_env(tmp_path)
+    argv = ["eval", str(CRANE), "--set", "distance=300", "--set", "angle=-40", "--json"]
+    full = _full(argv, env)
+    assert full.returncode == 0 and "'angle' = -40 is outside its range -15..15" in full.stderr
+    first, second = _console(argv, env), _console(argv, env)
+    assert list((tmp_path / "cache" / "quick").glob("*.json")), "no record was written"
+    for run in (first, second):
+        assert (run.returncode, run.stdout, run.stderr) == (0, full.stdout, full.stderr)
