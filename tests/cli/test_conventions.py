@@ -35,7 +35,8 @@ def _surface_csv(path: Path, n: int = 120) -> Path:
 
 
 @pytest.mark.parametrize(
-    "inputs", [["--inputs", "x,y"], ["--inputs", "x y"], ["--inputs", "x", "--inputs", "y"]]
+    "inputs",
+    [["--inputs", "x,y"], ["--inputs", "x y"], ["--inputs", "x", "--inputs", "y"], ["--inputs", "x", "y"]],
 )
 def test_learn_takes_target_output_and_every_list_form(tmp_path: Path, inputs: list[str]) -> None:
     data = _surface_csv(tmp_path / "d.csv")
@@ -205,3 +206,19 @@ def test_eval_table_shows_the_first_rows_and_counts_the_rest(
     out = capsys.readouterr().out
     assert [1000 + i for i in range(n) if str(1000 + i) in out] == [1000 + i for i in range(TABLE_ROWS)]
     assert f"{n - TABLE_ROWS} more not shown" in " ".join(out.split())
+
+
+def test_list_values_after_one_flag_read_as_argparse_reads_them(tmp_path: Path) -> None:
+    from fuzzyctl.cli.app import spread_lists
+
+    data = str(_surface_csv(tmp_path / "d.csv", 20))
+    assert spread_lists(["learn", "--inputs", "x", "y", data, "--target", "z"]) == [
+        "learn", "--inputs", "x", "--inputs", "y", data, "--target", "z"
+    ]  # fmt: skip
+    assert spread_lists(["learn", "--json", data, "--inputs", "a", "b", "-o", "f"]) == [
+        "learn", "--json", data, "--inputs", "a", "--inputs", "b", "-o", "f"
+    ]  # fmt: skip
+    assert spread_lists(["tune", "m.fcl", "--target", "a", "b", "--seed", "3"])[2:6] == [
+        "--target", "a", "--target", "b"
+    ]  # fmt: skip
+    assert spread_lists(["eval", "m.fcl", "-s", "a=1", "b"]) == ["eval", "m.fcl", "-s", "a=1", "b"]

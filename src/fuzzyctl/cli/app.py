@@ -125,6 +125,50 @@ def _given_twice(argv: list[str]) -> None:
         raise typer.BadParameter(f"given {len(given)} times: {RENAMED}", param_hint="-o/--output")
 
 
+#: the list options of each command that take several values after one flag (as argparse's
+#: nargs="+"): ``--inputs a b`` is ``--inputs a --inputs b``
+LIST_OPTIONS = {"learn": ("--inputs",), "tune": ("--target",)}
+
+
+def spread_lists(argv: list[str]) -> list[str]:
+    """``learn --inputs a b ...`` as click takes it (``--inputs a --inputs b``): the words after
+    a list option up to the next option are its values, as argparse's ``nargs="+"`` reads
+    them - except an existing file when the command's file argument has not come yet
+    (``learn --inputs a b data.csv``)."""
+    if not argv or argv[0] not in LIST_OPTIONS:
+        return argv
+    from pathlib import Path
+
+    out, seen_positional, i = [argv[0]], False, 1
+    while i < len(argv):
+        a = argv[i]
+        out.append(a)
+        i += 1
+        if a == "--":
+            out.extend(argv[i:])
+            break
+        if a in LIST_OPTIONS[argv[0]] and i < len(argv):
+            out.append(argv[i])  # the first value, whatever it looks like
+            i += 1
+            while i < len(argv) and not argv[i].startswith("-"):
+                if not seen_positional and Path(argv[i]).is_file():
+                    break
+                out.extend([a, argv[i]])
+                i += 1
+        elif not a.startswith("-") and not _takes_value(out[-2]):
+            seen_positional = True
+    return out
+
+
+def _takes_value(option: str) -> bool:
+    """Whether the option before a word consumes it (every option of learn/tune but the
+    flags does)."""
+    return option.startswith("-") and "=" not in option and option not in _FLAGS
+
+
+_FLAGS = frozenset({"--json", "--keep-zero", "--move-zero", "--help"})
+
+
 def _renamed_hint(exc: Exception) -> None:
     """A missing --target of learn/tune is most often the old ``--output COLUMN``: say so."""
     # (typer vendors click: the class is matched by name, not imported from a private module)
@@ -139,8 +183,9 @@ def main(argv: list[str] | None = None) -> int:
     _register_commands()
     command = typer.main.get_command(app)
     try:
-        _given_twice(sys.argv[1:] if argv is None else argv)
-        result = command.main(args=argv, prog_name="fuzzyctl", standalone_mode=False)
+        args = spread_lists(sys.argv[1:] if argv is None else argv)
+        _given_twice(args)
+        result = command.main(args=args, prog_name="fuzzyctl", standalone_mode=False)
     except typer.Exit as exc:
         return int(exc.exit_code or 0)
     except typer.Abort:
