@@ -384,12 +384,11 @@ def smooth_driver(
 
 
 def activation_levels(act: str, k: int) -> list[tuple[int, str]]:
-    """Where ``act(h, mu)`` jumps or bends as a function of the term degree ``mu``: MIN bends
-    at mu = h, NIPMIN jumps at mu = 1 - h and bends at h, BDIF bends at 1 - h (the other
-    activations are smooth in mu, or DMIN: nonzero only where mu is exactly 1)."""
-    h = f"h[{k}]"
-    one_minus = f"1.0 - h[{k}]"
-    return {"MIN": [(k, h)], "NIPMIN": [(k, h), (k, one_minus)], "BDIF": [(k, one_minus)]}.get(act, [])
+    """``(k, C expression of h[k])`` for each level where activation ``act`` of set k jumps
+    or bends as a function of its term degree (:data:`fuzzyctl.engine.operators.ACT_LEVELS`)."""
+    from fuzzyctl.engine.operators import ACT_LEVELS
+
+    return [(k, f"{offset!r} + {slope!r} * h[{k}]") for offset, slope in ACT_LEVELS.get(act, ())]
 
 
 AM_MAX2 = r"""
