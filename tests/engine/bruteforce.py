@@ -129,10 +129,14 @@ def accumulated(fb: m.FunctionBlock, inputs: dict[str, float], out: str) -> tupl
     return f, len(sets)
 
 
-def integrate(f: Callable[[Arr], Arr], lo: float, hi: float, breaks: list[float], tol: float = 1e-14) -> list[tuple[float, float, float, float]]:
+def integrate(
+    f: Callable[[Arr], Arr], lo: float, hi: float, breaks: list[float], tol: float = 1e-14
+) -> list[tuple[float, float, float, float]]:
     """Accepted cells ``(a, b, area, moment)`` sorted by ``a``: adaptive Simpson with a
     Richardson step, absolute tolerance ``tol`` per unit of relative width."""
-    edges = np.unique(np.concatenate([np.linspace(lo, hi, (1 << 14) + 1), [b for b in breaks if lo < b < hi]]))
+    edges = np.unique(
+        np.concatenate([np.linspace(lo, hi, (1 << 14) + 1), [b for b in breaks if lo < b < hi]])
+    )
     a, b = edges[:-1], edges[1:]
     span = hi - lo
     scale = max(abs(lo), abs(hi), span)
@@ -190,7 +194,9 @@ def evaluate(
     f, _n = accumulated(fb, inputs, out)
     cells = integrate(f, lo, hi, _breaks(db))
     area = math.fsum(c[2] for c in cells)
-    if not area > 0.0:
+    # a set that is positive only on points (DMIN where a term peaks at exactly 1, a vertical
+    # edge) has no area; cells shrunk around such a point leave crumbs of ~1e-15
+    if not area > 1e-12 * (hi - lo):
         return math.nan
     method = (db.method or "COG").upper()
     if method == "COG":
@@ -200,7 +206,12 @@ def evaluate(
     return 0.5 * (_bisector(f, cells, area) + _bisector(f, cells, area, reverse=True))
 
 
-def _bisector(f: Callable[[Arr], Arr], cells: list[tuple[float, float, float, float]], area: float, reverse: bool = False) -> float:
+def _bisector(
+    f: Callable[[Arr], Arr],
+    cells: list[tuple[float, float, float, float]],
+    area: float,
+    reverse: bool = False,
+) -> float:
     """The first (or, reversed, the last) u where the area to its left (right) is half."""
     half = 0.5 * area
     cum = 0.0
@@ -213,7 +224,9 @@ def _bisector(f: Callable[[Arr], Arr], cells: list[tuple[float, float, float, fl
                 if x in (lo, hi):
                     break
                 u = np.linspace(a, x, 33) if not reverse else np.linspace(x, b, 33)
-                part = float(np.sum((u[1:] - u[:-1]) / 6.0 * (f(u[:-1]) + 4.0 * f(0.5 * (u[1:] + u[:-1])) + f(u[1:]))))
+                part = float(
+                    np.sum((u[1:] - u[:-1]) / 6.0 * (f(u[:-1]) + 4.0 * f(0.5 * (u[1:] + u[:-1])) + f(u[1:])))
+                )
                 if (part < half - cum) != reverse:
                     lo = x
                 else:

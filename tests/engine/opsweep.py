@@ -31,7 +31,9 @@ def _smooth(rng: np.random.Generator) -> m.MembershipFunction:
     c = float(np.round(rng.uniform(LO + 1, HI - 1), 3))
     if rng.uniform() < 0.5:
         return m.ShapeMF("gaussian", (c, float(np.round(rng.uniform(0.4, 2.0), 3))))
-    return m.ShapeMF("bell", (c, float(np.round(rng.uniform(0.5, 2.0), 3)), float(rng.choice([1.0, 2.0, 4.0]))))
+    return m.ShapeMF(
+        "bell", (c, float(np.round(rng.uniform(0.5, 2.0), 3)), float(rng.choice([1.0, 2.0, 4.0])))
+    )
 
 
 def system(seed: int, smooth: bool, method: str = "COG") -> m.FunctionBlock:
@@ -51,8 +53,11 @@ def system(seed: int, smooth: bool, method: str = "COG") -> m.FunctionBlock:
         for accu in ACCUS:
             out = f"y_{act}_{accu}".lower()
             variables.append(m.Variable(out, m.VarKind.OUTPUT))
+            # DMIN keeps a set only where the term is exactly 1: for a smooth peak that is the
+            # stretch where it rounds to 1.0 (ill-posed), so DMIN sweeps PWL terms only
+            smooth_here = smooth and act != "DMIN"
             terms = tuple(
-                m.Term(f"o{j}", _smooth(rng) if smooth and j != 1 else _pwl(rng)) for j in range(3)
+                m.Term(f"o{j}", _smooth(rng) if smooth_here and j != 1 else _pwl(rng)) for j in range(3)
             )
             defuzz.append(m.DefuzzifyBlock(out, terms, m.Range(LO, HI), method, m.Default(-1.0), accu=accu))
             for r in range(4):
@@ -62,12 +67,21 @@ def system(seed: int, smooth: bool, method: str = "COG") -> m.FunctionBlock:
                 cond: m.Condition = parts[0] if len(parts) == 1 else (m.And if r % 2 else m.Or)(tuple(parts))
                 w = None if r else float(np.round(rng.uniform(0.3, 1.0), 2))
                 rules.append(m.Rule(f"{len(rules) + 1}", cond, (m.Conclusion(out, f"o{r % 3}", w),)))
-        blocks.append(
-            m.RuleBlock(
-                f"b{k}", tuple(rules), ands[(k + seed) % len(ands)], ors[(k + 2 * seed) % len(ors)], act
-            )
+        # DMIN jumps where the rule degree is exactly 1: its block keeps MIN/MAX, whose degrees
+        # are the terms' own (1 + b - b may round to either side of 1 under ASUM)
+        and_op, or_op = (
+            ("MIN", "MAX")
+            if act == "DMIN"
+            else (ands[(k + seed) % len(ands)], ors[(k + 2 * seed) % len(ors)])
         )
-    return m.FunctionBlock("sweep", variables=tuple(variables), fuzzify=fuzzify, defuzzify=tuple(defuzz), rule_blocks=tuple(blocks))
+        blocks.append(m.RuleBlock(f"b{k}", tuple(rules), and_op, or_op, act))
+    return m.FunctionBlock(
+        "sweep",
+        variables=tuple(variables),
+        fuzzify=fuzzify,
+        defuzzify=tuple(defuzz),
+        rule_blocks=tuple(blocks),
+    )
 
 
 def inputs(seed: int, n: int) -> list[dict[str, float]]:

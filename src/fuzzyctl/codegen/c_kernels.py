@@ -315,14 +315,17 @@ static void {name}(const double *h, const double *w, double *value, unsigned cha
     span = cuts[{nc} - 1] - cuts[0];
     scale = fabs(cuts[0]) > fabs(cuts[{nc} - 1]) ? fabs(cuts[0]) : fabs(cuts[{nc} - 1]);
     scale = scale > span ? scale : span;
+    /* pieces of at most 1e-13 of the scale lie between two points found for one kink or
+       around a spike of no width (DMIN where a term is exactly 1): no area, and a node on
+       the spike would fire a set that has none */
     for (i = 0; i + 1 < np; i++) {{ /* the total, for the relative tolerance */
-        if (!(pts[i + 1] > pts[i])) continue;
+        if (!(pts[i + 1] - pts[i] > 1e-13 * scale)) continue;
         {name}_gk(pts[i], pts[i + 1], h, w, &k1, &e1, &m1, &em1);
         total += fabs(k1);
     }}
     total = total > 1e-300 ? total : 1e-300;
     for (i = 0; i + 1 < np; i++) {{
-        if (!(pts[i + 1] > pts[i])) continue;
+        if (!(pts[i + 1] - pts[i] > 1e-13 * scale)) continue;
         sa[0] = pts[i];
         sb[0] = pts[i + 1];
         top = 1;
