@@ -36,10 +36,22 @@ def _smooth(rng: np.random.Generator) -> m.MembershipFunction:
     )
 
 
-def system(seed: int, smooth: bool, method: str = "COG") -> m.FunctionBlock:
-    """Two inputs (three PWL terms each), one output ``y_<act>_<accu>`` per pair, each with
-    three terms (PWL, or with ``smooth`` Gaussian/bell ones too) and four random rules; rule
-    block k uses activation k and the AND/OR norms rotated by ``seed``."""
+def all_pairs() -> list[tuple[str, str]]:
+    return [(act, accu) for act in ACTS for accu in ACCUS]
+
+
+def some_pairs(seed: int) -> list[tuple[str, str]]:
+    """Nine pairs in which every activation and every accumulation appears."""
+    return [(ACTS[(i + seed) % len(ACTS)], ACCUS[i]) for i in range(len(ACCUS))]
+
+
+def system(
+    seed: int, smooth: bool, pairs: list[tuple[str, str]], methods: tuple[str, ...] = ("COG",)
+) -> m.FunctionBlock:
+    """Two inputs (three PWL terms each) and one output ``y_<act>_<accu>`` per pair, each with
+    three terms (PWL, or with ``smooth`` Gaussian/bell ones too), four random rules in a block
+    of its own with that activation and AND/OR norms rotated by ``seed``, and a method from
+    ``methods`` in turn."""
     rng = np.random.default_rng(seed)
     ins = ("x1", "x2")
     variables = [m.Variable(n, m.VarKind.INPUT) for n in ins]
@@ -48,32 +60,31 @@ def system(seed: int, smooth: bool, method: str = "COG") -> m.FunctionBlock:
     )
     defuzz, blocks = [], []
     ands, ors = sorted(TNORMS), sorted(SNORMS)
-    for k, act in enumerate(ACTS):
+    for k, (act, accu) in enumerate(pairs):
+        out = f"y_{act}_{accu}".lower()
+        variables.append(m.Variable(out, m.VarKind.OUTPUT))
+        # DMIN keeps a set only where the term is exactly 1: for a smooth peak that is the
+        # stretch where it rounds to 1.0 (ill-posed), so DMIN sweeps PWL terms only
+        smooth_here = smooth and act != "DMIN"
+        terms = tuple(
+            m.Term(f"o{j}", _smooth(rng) if smooth_here and j != 1 else _pwl(rng)) for j in range(3)
+        )
+        method = methods[k % len(methods)]
+        defuzz.append(m.DefuzzifyBlock(out, terms, m.Range(LO, HI), method, m.Default(-1.0), accu=accu))
         rules = []
-        for accu in ACCUS:
-            out = f"y_{act}_{accu}".lower()
-            variables.append(m.Variable(out, m.VarKind.OUTPUT))
-            # DMIN keeps a set only where the term is exactly 1: for a smooth peak that is the
-            # stretch where it rounds to 1.0 (ill-posed), so DMIN sweeps PWL terms only
-            smooth_here = smooth and act != "DMIN"
-            terms = tuple(
-                m.Term(f"o{j}", _smooth(rng) if smooth_here and j != 1 else _pwl(rng)) for j in range(3)
-            )
-            defuzz.append(m.DefuzzifyBlock(out, terms, m.Range(LO, HI), method, m.Default(-1.0), accu=accu))
-            for r in range(4):
-                parts: list[m.Condition] = [
-                    m.Is(ins[i], f"t{int(rng.integers(3))}") for i in range(int(rng.integers(1, 3)))
-                ]
-                cond: m.Condition = parts[0] if len(parts) == 1 else (m.And if r % 2 else m.Or)(tuple(parts))
-                w = None if r else float(np.round(rng.uniform(0.3, 1.0), 2))
-                rules.append(m.Rule(f"{len(rules) + 1}", cond, (m.Conclusion(out, f"o{r % 3}", w),)))
+        for r in range(4):
+            parts: list[m.Condition] = [
+                m.Is(ins[i], f"t{int(rng.integers(3))}") for i in range(int(rng.integers(1, 3)))
+            ]
+            cond: m.Condition = parts[0] if len(parts) == 1 else (m.And if r % 2 else m.Or)(tuple(parts))
+            w = None if r else float(np.round(rng.uniform(0.3, 1.0), 2))
+            rules.append(m.Rule(f"{r + 1}", cond, (m.Conclusion(out, f"o{r % 3}", w),)))
         # DMIN jumps where the rule degree is exactly 1: its block keeps MIN/MAX, whose degrees
         # are the terms' own (1 + b - b may round to either side of 1 under ASUM)
-        and_op, or_op = (
-            ("MIN", "MAX")
-            if act == "DMIN"
-            else (ands[(k + seed) % len(ands)], ors[(k + 2 * seed) % len(ors)])
-        )
+        if act == "DMIN":
+            and_op, or_op = "MIN", "MAX"
+        else:
+            and_op, or_op = ands[(k + seed) % len(ands)], ors[(k + 2 * seed) % len(ors)]
         blocks.append(m.RuleBlock(f"b{k}", tuple(rules), and_op, or_op, act))
     return m.FunctionBlock(
         "sweep",
