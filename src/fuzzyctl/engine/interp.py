@@ -358,6 +358,7 @@ class Interpreter:
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
         cuts = smooth_cuts(op, values, self.pv, contribs)
+        cuts += crossing_cuts(op, contribs, values, self.pv, sorted(set(cuts)))
         xs = np.linspace(op.low, op.high, 401)
         rec.samples = (xs, f(xs))
         if not contribs:
@@ -485,6 +486,31 @@ def smooth_cuts(
                 mu = functools.partial(shapes.membership_np, term.kind, params, height)
                 cuts += level_crossings(mu, lv, base)
     return cuts
+
+
+def crossing_cuts(
+    op: OutputPlan,
+    contribs: Sequence[tuple[int | None, float, float, str]],
+    values: Sequence[float],
+    pv: Any,
+    cuts: Sequence[float],
+) -> list[float]:
+    """Where two activated sets cross under MAX (and DMAX, NIPMAX: the largest changes) and,
+    under NIPMAX, where two of them sum to 1 (a jump to 1): kinks and jumps that the error
+    estimate of the quadrature can misjudge (a kink left inside an interval costs 1e-8)."""
+    accu = op.accu or "MAX"
+    if accu not in ("MAX", "DMAX", "NIPMAX") or len(contribs) < 2:
+        return []
+    if any(t is None or op.terms[t].kind == "function" for t, _a, _w, _act in contribs):
+        return []
+    sets = [accumulated_function(op, [c], values, pv) for c in contribs]
+    out: list[float] = []
+    for i, j in itertools.combinations(range(len(sets)), 2):
+        fi, fj = sets[i], sets[j]
+        out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) - fj(x), 0.0, cuts)
+        if accu == "NIPMAX":
+            out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) + fj(x), 1.0, cuts)
+    return out
 
 
 def level_crossings(mu: Any, level: float, cuts: Sequence[float], samples: int = 16) -> list[float]:
