@@ -92,7 +92,9 @@ def _cond(c: m.Condition, fb: m.FunctionBlock, inputs: dict[str, float], and_op:
         return 1.0 - d if c.negated else d
     if isinstance(c, m.Not):
         return 1.0 - _cond(c.operand, fb, inputs, and_op, or_op)
-    vals = [_cond(o, fb, inputs, and_op, or_op) for o in c.operands]  # type: ignore[attr-defined]
+    if isinstance(c, m.Degree):
+        return inputs[c.variable]
+    vals = [_cond(o, fb, inputs, and_op, or_op) for o in c.operands]
     f = TNORM[and_op] if isinstance(c, m.And) else SNORM[or_op]
     v = vals[0]
     for w in vals[1:]:
