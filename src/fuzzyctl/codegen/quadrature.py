@@ -142,9 +142,9 @@ def cog_bound(op: OutputPlan, n_sets: int, cal: Calibration, acts: frozenset[str
     outside = sorted(acts - BOUND_ACTS) + ([accu] if accu not in BOUND_ACCUS else [])
     if outside:
         return (
-            f"no a-priori error bound: {', '.join(outside)} make the set other than terms times "
-            f"constants, so the error depends on the rule degrees (the native backend of "
-            f"compile() integrates adaptively to 1e-10 relative)"
+            f"no a-priori error bound: with {', '.join(outside)} the set is not terms times "
+            f"constants between located kinks, so the error depends on the rule degrees (the "
+            f"native backend of compile() integrates adaptively to 1e-10 relative)"
         )
     tol = max(cal.worst, PANEL_TOL)
     return (
