@@ -364,6 +364,11 @@ class Interpreter:
         if not contribs:
             return rec
         A, B, K, KM = quadrature.integrate(f, cuts, self.plan.options.quad_rtol)
+        # intervals of no width (two cuts for one kink, a DMIN spike where a term is exactly 1)
+        # carry no area: a node on a spike would fire a set that has none
+        tiny = 1e-13 * max(abs(op.low), abs(op.high), op.high - op.low)
+        wide = np.greater(B - A, tiny)
+        A, B, K, KM = A[wide], B[wide], K[wide], KM[wide]
         area = float(np.sum(K))
         if op.method in ("COG", "COA"):
             if not area > 0.0:

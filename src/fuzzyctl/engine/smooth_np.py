@@ -155,8 +155,10 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             code = 2 * win + clipped[win, np.arange(len(x))]
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
-            if accu == "BSUM":
+            if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
                 code |= (acc >= 1.0).astype(np.int64) << 62
+            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
+                code ^= (np.argmax(c, axis=0).astype(np.int64) + 1) << 52
         return acc, code
 
     return f
