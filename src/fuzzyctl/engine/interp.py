@@ -357,8 +357,9 @@ class Interpreter:
         assert op.low is not None and op.high is not None
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
-        cuts = smooth_cuts(op, values, self.pv, contribs)
-        cuts += crossing_cuts(op, contribs, values, self.pv, sorted(set(cuts)))
+        sets = merged_max(contribs) if (op.accu or "MAX") == "MAX" else contribs
+        cuts = smooth_cuts(op, values, self.pv, sets)
+        cuts += crossing_cuts(op, sets, values, self.pv, sorted(set(cuts)))
         xs = np.linspace(op.low, op.high, 401)
         rec.samples = (xs, f(xs))
         if not contribs:
@@ -493,6 +494,22 @@ def smooth_cuts(
     return cuts
 
 
+#: Sets beyond which crossings are left to the adaptive quadrature (pairs grow as n^2).
+MAX_CROSSING_SETS = 24
+
+
+def merged_max(
+    contribs: Sequence[tuple[int | None, float, float, str]],
+) -> list[tuple[int | None, float, float, str]]:
+    """Under MAX, the sets of one term, activation and weight as one (``w * act(max a, mu)``:
+    every t-norm is non-decreasing): the same set, fewer kinks to look for."""
+    best: dict[tuple[int | None, float, str], float] = {}
+    for t, a, w, act in contribs:
+        key = (t, w, act)
+        best[key] = max(best.get(key, a), a)
+    return [(t, a, w, act) for (t, w, act), a in best.items()]
+
+
 def crossing_cuts(
     op: OutputPlan,
     contribs: Sequence[tuple[int | None, float, float, str]],
@@ -504,7 +521,7 @@ def crossing_cuts(
     under NIPMAX, where two of them sum to 1 (a jump to 1): kinks and jumps that the error
     estimate of the quadrature can misjudge (a kink left inside an interval costs 1e-8)."""
     accu = op.accu or "MAX"
-    if accu not in ("MAX", "DMAX", "NIPMAX") or len(contribs) < 2:
+    if accu not in ("MAX", "DMAX", "NIPMAX") or not 2 <= len(contribs) <= MAX_CROSSING_SETS:
         return []
     if any(t is None or op.terms[t].kind == "function" for t, _a, _w, _act in contribs):
         return []
