@@ -241,7 +241,7 @@ def compile_path(
         except DiagnosticError:
             key = None  # load() reports it
         hit = _cached_plan(key) if key is not None else None
-        ranges = _cached(f"plans/{key}.ranges.pickle") if hit is not None else None
+        ranges = _cached(f"ranges/{key}.pickle") if hit is not None else None
         if hit is not None and isinstance(ranges, dict):
             ctl = _controller(hit[0], backend, key, None, hit[1])
             ctl.input_ranges = ranges  # (the model, where they are declared, was not read)
@@ -249,7 +249,7 @@ def compile_path(
             return ctl
     ctl = compile(load(path, format=fmt), block=block, backend=backend, out_of_range=out_of_range, **options)
     if key is not None:
-        _store(f"plans/{key}.ranges.pickle", ctl.input_ranges)
+        _store(f"ranges/{key}.pickle", ctl.input_ranges)
     return ctl
 
 

@@ -213,18 +213,67 @@ def am_lines_code(max_lines: int) -> str:
 SMOOTH_SAMPLES = 8  # points per characteristic interval where the branch taken is compared
 SMOOTH_BISECTIONS = 40  # steps locating a kink
 SMOOTH_ROUNDS = 4  # kinks located between two samples at most
-SMOOTH_NODES = 8  # Gauss-Legendre nodes per piece between kinks
+SMOOTH_RTOL = 1e-10  # adaptive Gauss-Kronrod tolerance, relative (engine.quadrature's default)
+SMOOTH_DEPTH = 48  # halvings of one piece at most (a jump not at a located point: width 2^-48)
+SMOOTH_BUDGET = 40000  # Gauss-Kronrod panels per evaluation at most (bounded work)
 
 SMOOTH_DRIVER = r"""
+/* degree thresholds of single activated sets (ACT MIN, NIPMIN, BDIF): where term k crosses
+   level c between a and b; bisection to the last bit (a jump of NIPMIN, a kink of MIN) */
+static int {name}_cross(int k, double c, double a, double b, double *pt)
+{{
+    double fa = {mu}(k, a) - c, fb = {mu}(k, b) - c, lo = a, hi = b, mid;
+    int i;
+    if (!((fa < 0.0 && fb > 0.0) || (fa > 0.0 && fb < 0.0))) return 0;
+    for (i = 0; i < 1100; i++) {{
+        mid = 0.5 * (lo + hi);
+        if (!(mid > lo && mid < hi)) break;
+        if (({mu}(k, mid) - c < 0.0) == (fa < 0.0)) lo = mid;
+        else hi = mid;
+    }}
+    *pt = hi;
+    return 1;
+}}
+
+static int {name}_levels(double a, double b, const double *h, double *pts)
+{{
+    int n = 0;
+{level_calls}
+    (void)a; (void)b; (void)h; (void)pts;
+    return n;
+}}
+
+/* adaptive Gauss-Kronrod 7/15 (engine/quadrature.py's rule and acceptance test) on one piece */
+static void {name}_gk(double a, double b, const double *h, const double *w, double *k, double *ek,
+                      double *km, double *ekm)
+{{
+    static const double xs[15] = {{{nodes}}}, wk[15] = {{{wk}}}, wg[15] = {{{wg}}};
+    double c = 0.5 * (a + b), r = 0.5 * (b - a), kk = 0.0, gg = 0.0, kx = 0.0, gx = 0.0, x, y, code;
+    int j;
+    for (j = 0; j < 15; j++) {{
+        x = c + r * xs[j];
+        y = {set}(x, h, w, &code);
+        kk += wk[j] * y;
+        gg += wg[j] * y;
+        kx += wk[j] * y * x;
+        gx += wg[j] * y * x;
+    }}
+    *k = kk * r;
+    *km = kx * r;
+    *ek = fabs(kk - gg) * r;
+    *ekm = fabs(kx - gx) * r;
+}}
+
 /* CoG of a smooth accumulated set: the characteristic intervals are sampled, where the branch
-   the set takes changes (which set is the largest, whether it is clipped) the kink is located
-   by bisection, and every piece between kinks is integrated with a fixed Gauss-Legendre rule */
+   the set takes changes (which set is the largest, whether it is clipped, a bound reached)
+   the kink is located by bisection, thresholds of single sets exactly ({name}_cross); every
+   piece between them is integrated by adaptive Gauss-Kronrod to {rtol} relative */
 static void {name}(const double *h, const double *w, double *value, unsigned char *fired)
 {{
     static const double cuts[{nc}] = {{{cuts}}};
-    static const double glx[{ng}] = {{{glx}}}, glw[{ng}] = {{{glw}}};
-    double pts[{cap}], area = 0.0, mom = 0.0, code, c0, cx, cr, lo, hi, end, mid, cm, a, b, x, y, d;
-    int i, j, k, q, np = 0;
+    double pts[{cap}], area = 0.0, mom = 0.0, total = 0.0, code, c0, cx, cr, lo, hi, end, mid, cm, a, b, x;
+    double sa[{depth} + 2], sb[{depth} + 2], k1, e1, m1, em1, tol, span, scale, share;
+    int i, j, k, q, np = 0, top, budget = {budget};
     for (i = 0; i + 1 < {nc}; i++) {{
         a = cuts[i];
         b = cuts[i + 1];
@@ -232,12 +281,13 @@ static void {name}(const double *h, const double *w, double *value, unsigned cha
         {set}(a, h, w, &c0);
         for (j = 1; j < {samples}; j++) {{
             x = j + 1 < {samples} ? a + (b - a) * ((double)j / ({samples} - 1)) : b;
+            lo = a + (b - a) * ((double)(j - 1) / ({samples} - 1));
+            np += {name}_levels(lo, x, h, pts + np);
             {set}(x, h, w, &cx);
             if (cx != c0) {{
-                lo = a + (b - a) * ((double)(j - 1) / ({samples} - 1));
                 hi = x;
                 code = c0;
-                for (q = 0; q < {rounds} && np < {cap} - 1; q++) {{
+                for (q = 0; q < {rounds} && np < {cap} - {nlev} - 2; q++) {{
                     end = hi;
                     for (k = 0; k < {bisections}; k++) {{
                         mid = 0.5 * (lo + hi);
@@ -257,14 +307,45 @@ static void {name}(const double *h, const double *w, double *value, unsigned cha
         }}
     }}
     pts[np++] = cuts[{nc} - 1];
+    for (i = 1; i < np; i++) {{ /* insertion sort: the points are nearly in order */
+        x = pts[i];
+        for (j = i - 1; j >= 0 && pts[j] > x; j--) pts[j + 1] = pts[j];
+        pts[j + 1] = x;
+    }}
+    span = cuts[{nc} - 1] - cuts[0];
+    scale = fabs(cuts[0]) > fabs(cuts[{nc} - 1]) ? fabs(cuts[0]) : fabs(cuts[{nc} - 1]);
+    scale = scale > span ? scale : span;
+    /* pieces of at most 1e-13 of the scale lie between two points found for one kink or
+       around a spike of no width (DMIN where a term is exactly 1): no area, and a node on
+       the spike would fire a set that has none */
+    for (i = 0; i + 1 < np; i++) {{ /* the total, for the relative tolerance */
+        if (!(pts[i + 1] - pts[i] > 1e-13 * scale)) continue;
+        {name}_gk(pts[i], pts[i + 1], h, w, &k1, &e1, &m1, &em1);
+        total += fabs(k1);
+    }}
+    total = total > 1e-300 ? total : 1e-300;
     for (i = 0; i + 1 < np; i++) {{
-        d = pts[i + 1] - pts[i];
-        if (!(d > 0.0)) continue;
-        for (k = 0; k < {ng}; k++) {{
-            x = pts[i] + glx[k] * d;
-            y = {set}(x, h, w, &code) * glw[k] * d;
-            area += y;
-            mom += y * x;
+        if (!(pts[i + 1] - pts[i] > 1e-13 * scale)) continue;
+        sa[0] = pts[i];
+        sb[0] = pts[i + 1];
+        top = 1;
+        while (top > 0) {{
+            top--;
+            a = sa[top];
+            b = sb[top];
+            {name}_gk(a, b, h, w, &k1, &e1, &m1, &em1);
+            budget--;
+            share = (b - a) / span;
+            tol = {rtol} * total * (share > 1e-6 ? share : 1e-6);
+            if ((e1 <= tol && em1 <= tol * scale) || b - a <= 1e-13 * scale || top >= {depth}
+                || budget <= 0) {{
+                area += k1;
+                mom += m1;
+                continue;
+            }}
+            mid = 0.5 * (a + b);
+            sa[top] = mid; sb[top] = b; top++;
+            sa[top] = a; sb[top] = mid; top++;
         }}
     }}
     *fired = area > 0.0;
@@ -273,24 +354,44 @@ static void {name}(const double *h, const double *w, double *value, unsigned cha
 """
 
 
-def smooth_driver(name: str, set_fn: str, cuts: list[float], num: object) -> str:
-    """The C of one smooth output's CoG (``set_fn`` computes the set and its branch code)."""
-    nodes, weights = gauss_legendre(SMOOTH_NODES)
+def smooth_driver(
+    name: str, set_fn: str, mu_fn: str, levels: list[tuple[int, str]], cuts: list[float], num: object
+) -> str:
+    """The C of one smooth output's CoG: ``set_fn`` computes the set and its branch code,
+    ``mu_fn(k, x)`` the degree of set k's term, ``levels`` are ``(k, C expression of h)``: the
+    degrees of term k where set k jumps or bends (:func:`activation_levels`)."""
+    n_levels = len(levels)
+    from fuzzyctl.engine.quadrature import NODES, WG, WK
+
     fmt = num  # the renderer's literal printer
-    cap = (len(cuts) - 1) * (SMOOTH_SAMPLES * SMOOTH_ROUNDS + 1) + 2
+    cap = (len(cuts) - 1) * (SMOOTH_SAMPLES * (SMOOTH_ROUNDS + n_levels) + 1) + 2
     return SMOOTH_DRIVER.format(
         name=name,
         set=set_fn,
+        mu=mu_fn,
+        level_calls="\n".join(f"    n += {name}_cross({k}, {c}, a, b, pts + n);" for k, c in levels),
+        nlev=n_levels,
         nc=len(cuts),
         cuts=", ".join(fmt(c) for c in cuts),  # type: ignore[operator]
-        ng=SMOOTH_NODES,
-        glx=", ".join(repr(v) for v in nodes),
-        glw=", ".join(repr(v) for v in weights),
+        nodes=", ".join(repr(float(v)) for v in NODES),
+        wk=", ".join(repr(float(v)) for v in WK),
+        wg=", ".join(repr(float(v)) for v in WG),
         cap=cap,
         samples=SMOOTH_SAMPLES,
         rounds=SMOOTH_ROUNDS,
         bisections=SMOOTH_BISECTIONS,
+        rtol=repr(SMOOTH_RTOL),
+        depth=SMOOTH_DEPTH,
+        budget=SMOOTH_BUDGET,
     )
+
+
+def activation_levels(act: str, k: int) -> list[tuple[int, str]]:
+    """``(k, C expression of h[k])`` for each level where activation ``act`` of set k jumps
+    or bends as a function of its term degree (:data:`fuzzyctl.engine.operators.ACT_LEVELS`)."""
+    from fuzzyctl.engine.operators import ACT_LEVELS
+
+    return [(k, f"{offset!r} + {slope!r} * h[{k}]") for offset, slope in ACT_LEVELS.get(act, ())]
 
 
 AM_MAX2 = r"""

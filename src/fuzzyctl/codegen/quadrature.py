@@ -127,8 +127,25 @@ def calibrate(op: OutputPlan) -> Calibration:
     return Calibration(tuple(cuts), worst)
 
 
-def cog_bound(op: OutputPlan, n_sets: int, cal: Calibration) -> str:
-    """The documented bound, as text for the header."""
+#: Activations and accumulations under which every piece of the set between located kinks is
+#: a term times constants (or a constant): the premise of the calibrated bound.  Other norms
+#: bend the terms by the rule degree (Hamacher, Einstein), jump inside an interval where no
+#: branch code sees it (NIPMIN, NIPMAX, DMAX) or multiply sets (PROBOR).
+BOUND_ACTS = frozenset({"MIN", "PROD"})
+BOUND_ACCUS = frozenset({"MAX", "SUM", "NSUM", "BSUM"})
+
+
+def cog_bound(op: OutputPlan, n_sets: int, cal: Calibration, acts: frozenset[str] = BOUND_ACTS) -> str:
+    """The documented bound, as text for the header; where its premise does not hold
+    (:data:`BOUND_ACTS`, :data:`BOUND_ACCUS`), a sentence saying there is none."""
+    accu = op.accu or "MAX"
+    outside = sorted(acts - BOUND_ACTS) + ([accu] if accu not in BOUND_ACCUS else [])
+    if outside:
+        return (
+            f"no a-priori error bound: with {', '.join(outside)} the set is not terms times "
+            f"constants between located kinks, so the error depends on the rule degrees (the "
+            f"native backend of compile() integrates adaptively to 1e-10 relative)"
+        )
     tol = max(cal.worst, PANEL_TOL)
     return (
         f"area and moment within {n_sets} x {tol:.1e} x (high - low) of the exact integrals, so "

@@ -11,6 +11,7 @@ from __future__ import annotations
 import array
 import math
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 from fuzzyctl.codegen import c_helpers, c_kernels
 from fuzzyctl.codegen.c_kernels import ACCU_CODES
@@ -42,6 +43,9 @@ from fuzzyctl.engine.ir import (
 )
 from fuzzyctl.engine.plan import OutputPlan
 from fuzzyctl.escape import CodegenError, c_comment, c_ident
+
+if TYPE_CHECKING:
+    from fuzzyctl.engine.irgen import Gen
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 _COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
@@ -471,7 +475,7 @@ class _Native(_C):
         op = self.fp.plan.outputs[oi]
         assert op.low is not None and op.high is not None
         idx = len(self.extra)
-        set_fn, driver = f"fz_set{idx}", f"fz_smooth{idx}"
+        set_fn, mu_fn, driver = f"fz_set{idx}", f"fz_mu{idx}", f"fz_smooth{idx}"
         cuts = sorted(
             {
                 op.low,
@@ -485,16 +489,19 @@ class _Native(_C):
             }
         )
         self.extra.append(self.set_function(set_fn, op, sets))
-        self.extra.append(c_kernels.smooth_driver(driver, set_fn, cuts, self.num))
+        self.extra.append(self.mu_function(mu_fn, op, sets))
+        levels = [lv for k, (_t, act) in enumerate(sets) for lv in c_kernels.activation_levels(act, k)]
+        self.extra.append(c_kernels.smooth_driver(driver, set_fn, mu_fn, levels, cuts, self.num))
         return driver
 
     def set_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
         """``double name(double x, const double *h, const double *w, double *code)``: the
         accumulated set at x (``interp.accumulated_function``) and a code of the branch it
         took - under MAX 2k (+1 when clipped) for the largest set k, otherwise a sum of
-        2^k over the clipped sets (+0.5 where BSUM reaches 1)."""
+        2^k over the clipped sets (+0.5 where BSUM, NIPMAX or DMAX reach 1, plus the largest
+        set's index / 1024 under NIPMAX and DMAX)."""
         from fuzzyctl.engine import irterms as T
-        from fuzzyctl.engine.ir import Index, Pwl
+        from fuzzyctl.engine.ir import Index
         from fuzzyctl.engine.irgen import Gen
 
         g = Gen("c")
@@ -503,16 +510,9 @@ class _Native(_C):
         acc = g.let(0.0, "ACC")
         best = g.let(-1.0, "BEST")
         code = g.let(0.0, "CODE")
+        arg = g.let(0.0, "ARG")
         for k, (t, act) in enumerate(sets):
-            term = op.terms[t]
-            where = f"term {op.name}.{term.name}"
-            if term.pwl is not None:
-                mu: Ex = g.let(Pwl(x, term.pwl), "MU")
-            else:
-                ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
-                mu = T.smooth(g, term.kind, ps, x, where)
-                if float(term.height) != 1.0:  # type: ignore[arg-type]
-                    mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
+            mu = self._term_degree(g, op, t, x)
             h, w = Index("h", Int(k)), Index("w", Int(k))
             c = g.let(w * T.tnorm(g, act, h, mu), "C")
             if accu == "MAX":
@@ -528,18 +528,54 @@ class _Native(_C):
                 if act == "MIN" and k < 52:
                     with g.b.if_(h.lt(mu)):
                         g.b.set(code, code + float(2**k))
-        if accu == "BSUM":
+            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
+                with g.b.if_(c.gt(best)):
+                    g.b.set(best, c)
+                    g.b.set(arg, float(k + 1) / 1024.0)
+        if accu in ("NIPMAX", "DMAX"):
+            g.b.set(code, code + arg)
+        if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
             with g.b.if_(acc.ge(1.0)):
                 g.b.set(code, code + 0.5)
+        return self._set_c(g, name, "double x, const double *h, const double *w, double *code", code, acc)
+
+    def mu_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
+        """``double name(int k, double x)``: the degree of the term of activated set k at x."""
+        from fuzzyctl.engine.irgen import Gen
+
+        g = Gen("c")
+        x, kv = Var("x"), Var("k")
+        res = g.let(0.0, "RES")
+        for k, (t, _act) in enumerate(sets):
+            with g.b.if_(kv.eq(Int(k))):
+                g.b.set(res, self._term_degree(g, op, t, x))
+        return self._set_c(g, name, "int k, double x", None, res)
+
+    def _term_degree(self, g: Gen, op: OutputPlan, t: int, x: Var) -> Ex:
+        from fuzzyctl.engine import irterms as T
+        from fuzzyctl.engine.ir import Pwl
+
+        term = op.terms[t]
+        if term.pwl is not None:
+            return g.let(Pwl(x, term.pwl), "MU")
+        ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
+        mu = T.smooth(g, term.kind, ps, x, f"term {op.name}.{term.name}")
+        if float(term.height) != 1.0:  # type: ignore[arg-type]
+            mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
+        return mu
+
+    def _set_c(self, g: Gen, name: str, params: str, code: Var | None, result: Var) -> str:
         r = _Native(self.fp)
         r.pwl_funcs = self.pwl_funcs  # one set of breakpoint functions per file
         r.lines = []
         r.stmts(g.b.root, 1)
-        out = [f"static double {name}(double x, const double *h, const double *w, double *code)", "{"]
+        out = [f"static double {name}({params})", "{"]
         for d in g.decls:
             out.append(f"    {_ctype(d, 'double')} {d.name} = 0;")
         out += r.lines
-        out += [f"    *code = {code.name};", f"    return {acc.name};", "}", ""]
+        if code is not None:
+            out.append(f"    *code = {code.name};")
+        out += [f"    return {result.name};", "}", ""]
         self.uses.update(g.uses)
         return "\n".join(out)
 

@@ -8,6 +8,7 @@ output terms given by variables, smooth output sets).
 
 from __future__ import annotations
 
+import functools
 import itertools
 import math
 from collections.abc import Callable, Sequence
@@ -19,7 +20,15 @@ import numpy as np
 from fuzzyctl.engine import pwl, quadrature, selection, shapes
 from fuzzyctl.engine.expr import eval_expr, eval_expr_np
 from fuzzyctl.engine.grid import build_grid
-from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate, accumulate_np, clamp, fsum
+from fuzzyctl.engine.operators import (
+    SNORMS,
+    TNORMS,
+    accumulate,
+    accumulate_np,
+    activation_levels,
+    clamp,
+    fsum,
+)
 from fuzzyctl.engine.plan import (
     CAnd,
     CChained,
@@ -348,13 +357,22 @@ class Interpreter:
         assert op.low is not None and op.high is not None
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
-        cuts = smooth_cuts(op, values, self.pv, contribs)
+        sets = merged_max(contribs) if (op.accu or "MAX") == "MAX" else contribs
+        cuts = smooth_cuts(op, values, self.pv, sets)
+        cuts += crossing_cuts(op, sets, values, self.pv, sorted(set(cuts)))
+        # what the level and crossing cuts cannot foresee (a clipped Function term's kink):
+        # found by sampling the accumulated set's branch and bisecting each change
         cuts += quadrature.kinks(accumulated_branch(op, contribs, values, self.pv), cuts)
         xs = np.linspace(op.low, op.high, 401)
         rec.samples = (xs, f(xs))
         if not contribs:
             return rec
         A, B, K, KM = quadrature.integrate(f, cuts, self.plan.options.quad_rtol)
+        # intervals of no width (two cuts for one kink, a DMIN spike where a term is exactly 1)
+        # carry no area: a node on a spike would fire a set that has none
+        tiny = 1e-13 * max(abs(op.low), abs(op.high), op.high - op.low)
+        wide = np.greater(B - A, tiny)
+        A, B, K, KM = A[wide], B[wide], K[wide], KM[wide]
         area = float(np.sum(K))
         if not (math.isfinite(area) and math.isfinite(float(np.sum(KM)))):
             # rules fired but a term is undefined there (a 0/0 in a function term): the
@@ -485,9 +503,10 @@ def smooth_cuts(
     pv: Any,
     contribs: Sequence[tuple[int | None, float, float, str]] = (),
 ) -> list[float]:
-    """Where the accumulated set may bend: the terms' characteristic points and, for a
-    piecewise-linear term clipped by MIN activation, where its lines reach the rule's degree
-    (a plateau edge inside an interval can be too small for the error estimate to see)."""
+    """Where the accumulated set may bend or jump: the terms' characteristic points and where
+    an activated term crosses a level of its activation (``operators.ACT_LEVELS``: MIN clips at
+    the rule's degree, NIPMIN jumps at 1 - degree, ...): a plateau edge or a narrow plateau
+    inside an interval can be too small for the error estimate to see."""
     assert op.low is not None and op.high is not None
     cuts = [op.low, op.high]
     for t in op.terms:
@@ -495,14 +514,88 @@ def smooth_cuts(
         for c in shapes.characteristic_points(t.kind, params):
             if op.low < c < op.high:
                 cuts.append(c)
+    base = sorted(set(cuts))
     for ti, a, _w, act in contribs:
         term = op.terms[ti] if ti is not None else None
-        if term is None or act != "MIN" or term.kind not in shapes.PWL_KINDS:
+        levels = activation_levels(act, a)
+        if term is None or not levels or term.kind == "function":
             continue
-        pts = shapes.pwl_points(term.kind, [pv(p, values) for p in term.params], pv(term.height, values))
-        for (x0, y0), (x1, y1) in itertools.pairwise(pts or ()):
-            if x1 > x0 and min(y0, y1) < a < max(y0, y1):
-                c = x0 + (a - y0) * (x1 - x0) / (y1 - y0)
-                if op.low < c < op.high:
-                    cuts.append(c)
+        params = [pv(p, values) for p in term.params]
+        height = pv(term.height, values)
+        pts = shapes.pwl_points(term.kind, params, height) if term.kind in shapes.PWL_KINDS else None
+        for lv in levels:
+            if pts is not None:
+                for (x0, y0), (x1, y1) in itertools.pairwise(pts):
+                    if x1 > x0 and min(y0, y1) < lv < max(y0, y1):
+                        c = x0 + (lv - y0) * (x1 - x0) / (y1 - y0)
+                        if op.low < c < op.high:
+                            cuts.append(c)
+            else:
+                mu = functools.partial(shapes.membership_np, term.kind, params, height)
+                cuts += level_crossings(mu, lv, base)
     return cuts
+
+
+#: Sets beyond which crossings are left to the adaptive quadrature (pairs grow as n^2).
+MAX_CROSSING_SETS = 24
+
+
+def merged_max(
+    contribs: Sequence[tuple[int | None, float, float, str]],
+) -> list[tuple[int | None, float, float, str]]:
+    """Under MAX, the sets of one term, activation and weight as one (``w * act(max a, mu)``:
+    every t-norm is non-decreasing): the same set, fewer kinks to look for."""
+    best: dict[tuple[int | None, float, str], float] = {}
+    for t, a, w, act in contribs:
+        key = (t, w, act)
+        best[key] = max(best.get(key, a), a)
+    return [(t, a, w, act) for (t, w, act), a in best.items()]
+
+
+def crossing_cuts(
+    op: OutputPlan,
+    contribs: Sequence[tuple[int | None, float, float, str]],
+    values: Sequence[float],
+    pv: Any,
+    cuts: Sequence[float],
+) -> list[float]:
+    """Where two activated sets cross under MAX (and DMAX, NIPMAX: the largest changes) and,
+    under NIPMAX, where two of them sum to 1 (a jump to 1): kinks and jumps that the error
+    estimate of the quadrature can misjudge (a kink left inside an interval costs 1e-8)."""
+    accu = op.accu or "MAX"
+    if accu not in ("MAX", "DMAX", "NIPMAX") or not 2 <= len(contribs) <= MAX_CROSSING_SETS:
+        return []
+    if any(t is None or op.terms[t].kind == "function" for t, _a, _w, _act in contribs):
+        return []
+    sets = [accumulated_function(op, [c], values, pv) for c in contribs]
+    out: list[float] = []
+    for i, j in itertools.combinations(range(len(sets)), 2):
+        fi, fj = sets[i], sets[j]
+        out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) - fj(x), 0.0, cuts)
+        if accu == "NIPMAX":
+            out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) + fj(x), 1.0, cuts)
+    return out
+
+
+def level_crossings(mu: Any, level: float, cuts: Sequence[float], samples: int = 16) -> list[float]:
+    """Where the vectorised function ``mu`` crosses ``level`` between sorted ``cuts``: each
+    interval sampled at ``samples`` points, every sign change located by bisection to the
+    last bit."""
+    xs = np.concatenate(
+        [np.linspace(a, b, samples)[:-1] for a, b in itertools.pairwise(cuts) if b > a]
+        + [np.array(cuts[-1:])]
+    )
+    d = np.asarray(mu(xs), dtype=np.float64) - level
+    out = []
+    for j in np.flatnonzero(((d[:-1] < 0.0) & (d[1:] > 0.0)) | ((d[:-1] > 0.0) & (d[1:] < 0.0))):
+        lo, hi, below = float(xs[j]), float(xs[j + 1]), bool(d[j] < 0.0)
+        while True:
+            mid = 0.5 * (lo + hi)
+            if not lo < mid < hi:
+                break
+            if (float(mu(np.array([mid]))[0]) < level) == below:
+                lo = mid
+            else:
+                hi = mid
+        out.append(hi)
+    return out

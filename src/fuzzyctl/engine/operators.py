@@ -190,6 +190,29 @@ def resolve_pair(and_op: str | None, or_op: str | None) -> tuple[str, str]:
 ACT_ALIASES = {"EPROD": "EINSTEIN", "HPROD": "HAMACHER"}
 
 
+#: Where an activation, as a function of the term degree mu, jumps or bends: levels
+#: ``offset + slope * a`` for the rule degree a (MIN bends at mu = a, NIPMIN jumps at
+#: mu = 1 - a and bends at a, BDIF bends at 1 - a).  The others are smooth in mu, or (DMIN)
+#: nonzero only where mu is exactly 1.  Integrators cut the output range where a term
+#: crosses these levels, so that no jump, plateau or kink falls between their samples.
+ACT_LEVELS: dict[str, tuple[tuple[float, float], ...]] = {
+    "MIN": ((0.0, 1.0),),
+    "NIPMIN": ((0.0, 1.0), (1.0, -1.0)),
+    "BDIF": ((1.0, -1.0),),
+}
+
+
+def activation_levels(act: str, a: float) -> list[float]:
+    """The term degrees where ``act(a, mu)`` jumps or bends (:data:`ACT_LEVELS`), those
+    strictly inside (0, 1)."""
+    out = []
+    for offset, slope in ACT_LEVELS.get(act, ()):
+        lv = offset + slope * a
+        if 0.0 < lv < 1.0:
+            out.append(lv)
+    return out
+
+
 def resolve_act(act: str | None) -> str:
     a = ACT_ALIASES.get(act, act) if act else "MIN"
     if a not in TNORMS:

@@ -29,7 +29,7 @@ import numpy as np
 
 from fuzzyctl.engine import quadrature, shapes
 from fuzzyctl.engine.expr import eval_expr_np
-from fuzzyctl.engine.operators import TNORMS, accumulate_np
+from fuzzyctl.engine.operators import ACT_LEVELS, TNORMS, accumulate_np
 from fuzzyctl.engine.plan import OutputPlan, Plan
 
 Arr = Any
@@ -74,7 +74,7 @@ def smooth_output(
     for start in range(0, len(rows), BLOCK):  # blocks of rows keep the temporaries in cache
         block = rows[start : start + BLOCK]
         f = _integrand(op, cs, arrays, block)
-        a, b, r = _kinked_intervals(f, len(block), cuts)
+        a, b, r = _kinked_intervals(f, len(block), cuts, _level_points(op, cs, block, cuts))
         area, moment = integrate_rows(f, len(block), a, b, r, cuts, plan.options.quad_rtol)
         ok = area > 0.0
         # rules fired but a term is undefined there: NaN, not the DEFAULT (interp._smooth)
@@ -162,8 +162,10 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             code = np.where(top < 0.0, -1, 2 * win + clipped[win, np.arange(len(x))])
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
-            if accu == "BSUM":
+            if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
                 code |= (acc >= 1.0).astype(np.int64) << 62
+            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
+                code ^= (np.argmax(c, axis=0).astype(np.int64) + 1) << 52
         return acc, code
 
     return f
@@ -180,9 +182,43 @@ def _membership(term: Any, vals: list[Arr], rows: Arr, x: Arr, r: Arr) -> Arr:
     return shapes.membership_np(term.kind, params, float(term.height), x)
 
 
-def _kinked_intervals(f: Any, m: int, cuts: Arr) -> tuple[Arr, Arr, Arr]:
-    """Each row's characteristic intervals cut again at the kinks found (module docstring);
-    returns the intervals as flat arrays (start, end, row), ordered by row then x."""
+def _level_points(
+    op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], rows: Arr, cuts: Arr
+) -> tuple[Arr, Arr]:
+    """(x, row) where an activated term crosses a level of its activation (NIPMIN's jump,
+    MIN's and BDIF's kinks: ``operators.ACT_LEVELS``), to the last bit: a narrow plateau
+    between two samples has no branch change at them to be found by."""
+    t = np.linspace(0.0, 1.0, 2 * SAMPLES)
+    xs = (cuts[:-1, None] + (cuts[1:] - cuts[:-1])[:, None] * t[None, :]).ravel()
+    found_x, found_r = [np.zeros(0)], [np.zeros(0, dtype=np.int64)]
+    for ti, a, _w, act in cs:
+        term = op.terms[ti]
+        if term.kind == "function" or act not in ACT_LEVELS:
+            continue
+        params, height = [float(p) for p in term.params], float(term.height)  # type: ignore[arg-type]
+        mu_xs = shapes.membership_np(term.kind, params, height, xs)
+        for offset, slope in ACT_LEVELS.get(act, ()):
+            lv = offset + slope * a[rows]  # (m,)
+            d = mu_xs[None, :] - lv[:, None]
+            r, j = np.nonzero(((d[:, :-1] < 0.0) & (d[:, 1:] > 0.0)) | ((d[:, :-1] > 0.0) & (d[:, 1:] < 0.0)))
+            lo, hi, below, lvr = xs[j], xs[j + 1], d[r, j] < 0.0, lv[r]
+            for _ in range(1100):  # halvings until lo and hi are neighbours
+                mid = 0.5 * (lo + hi)
+                open_ = (mid > lo) & (mid < hi)
+                if not open_.any():
+                    break
+                left = (shapes.membership_np(term.kind, params, height, mid) < lvr) == below
+                lo = np.where(open_ & left, mid, lo)
+                hi = np.where(open_ & ~left, mid, hi)
+            found_x.append(hi)
+            found_r.append(r.astype(np.int64))
+    return np.concatenate(found_x), np.concatenate(found_r)
+
+
+def _kinked_intervals(f: Any, m: int, cuts: Arr, levels: tuple[Arr, Arr]) -> tuple[Arr, Arr, Arr]:
+    """Each row's characteristic intervals cut again at the kinks found (module docstring)
+    and at the ``levels`` points; returns the intervals as flat arrays (start, end, row),
+    ordered by row then x."""
     k0 = len(cuts) - 1
     t = np.linspace(0.0, 1.0, SAMPLES)
     xs = cuts[:-1, None] + (cuts[1:] - cuts[:-1])[:, None] * t[None, :]  # (k0, S)
@@ -212,8 +248,8 @@ def _kinked_intervals(f: Any, m: int, cuts: Arr) -> tuple[Arr, Arr, Arr]:
         lo, hi, rows_k, c_lo, c_hi = hi[more], end[more], rows_k[more], c_right[more], c_hi[more]
     kinks = np.concatenate([k for k, _r in found]) if found else np.zeros(0)
     rows_k = np.concatenate([r for _k, r in found]) if found else np.zeros(0, dtype=np.int64)
-    pts_x = np.concatenate([np.tile(cuts, m), kinks])
-    pts_r = np.concatenate([np.repeat(np.arange(m), len(cuts)), rows_k])
+    pts_x = np.concatenate([np.tile(cuts, m), kinks, levels[0]])
+    pts_r = np.concatenate([np.repeat(np.arange(m), len(cuts)), rows_k, levels[1]])
     order = np.lexsort((pts_x, pts_r))
     px, pr = pts_x[order], pts_r[order]
     keep = (pr[1:] == pr[:-1]) & (px[1:] > px[:-1])
