@@ -80,7 +80,7 @@ def _project_error() -> type[Exception]:
     return FuzzyctlError
 
 
-def _scale(op: Any, ref_values: Sequence[Value]) -> float:
+def output_scale(op: Any, ref_values: Sequence[Value]) -> float:
     """The output's range: RANGE (plan low/high), else the span of its terms' points, else
     max(1, |value|) over the reference's values."""
     lo, hi = op.low, op.high
@@ -169,7 +169,7 @@ def _quiet(fn: Callable[[], Any]) -> Any:
         return fn()
 
 
-def _sequential(
+def sequential(
     ctl: Any, names: Sequence[str], rows: Sequence[Sequence[float]], outs: Sequence[str]
 ) -> list[list[Value]]:
     """``evaluate`` row after row from a reset state; a refused row is ``"refused"``."""
@@ -341,7 +341,7 @@ def run_c(plan: Any, rows: Sequence[Sequence[float]]) -> tuple[list[list[float]]
     return out, header_bounds(files["fzd.h"])
 
 
-def _area(ref: Any, names: Sequence[str], row: Sequence[float], out: str) -> float | None:
+def accumulated_area(ref: Any, names: Sequence[str], row: Sequence[float], out: str) -> float | None:
     """The area of the reference's accumulated set for ``out`` at ``row`` (trapezoid rule on
     the breakpoints explain reports)."""
     with contextlib.suppress(Exception):
@@ -366,7 +366,7 @@ class Plan_:
     c: bool = False
 
 
-def _compile(model: Any, block: str | None, backend: str | None) -> Any:
+def compile_quiet(model: Any, block: str | None, backend: str | None) -> Any:
     import fuzzyctl
 
     err = _project_error()
@@ -412,10 +412,10 @@ def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: in
     """Every path against the reference on ``n`` vectors of ``model`` (a Document or a
     FunctionBlock); refusals are compared too."""
     result = DiffResult()
-    ref = _compile(model, block, "interpreted")
+    ref = compile_quiet(model, block, "interpreted")
     if ref is None:
         for backend in ("python", "native"):  # the same refusal: no finding
-            if _compile(model, block, backend) is not None:
+            if compile_quiet(model, block, backend) is not None:
                 result.compared.add(backend)
                 result.findings.append(Finding(f"disagree:{backend}", "compiles where the reference refuses"))
         return result
@@ -426,8 +426,8 @@ def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: in
     if not outs:
         return result
     rows = vectors(plan, rng, n)
-    want = _sequential(ref, names, rows, outs)
-    scales = [_scale(op, [r[j] for r in want]) for j, op in enumerate(ops)]
+    want = sequential(ref, names, rows, outs)
+    scales = [output_scale(op, [r[j] for r in want]) for j, op in enumerate(ops)]
     verdicts: dict[str, bool] = {}
     seen: dict[str, list[list[Value]]] = {}
 
@@ -437,35 +437,36 @@ def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: in
             seen[path] = got
         verdicts[path] = _compare(path, got, want, outs, scales, rows, result)
 
-    py = _compile(model, block, "python")
+    py = compile_quiet(model, block, "python")
     if py is None:
         result.compared.add("python")
         result.findings.append(Finding("disagree:python", "refused where the reference compiles"))
     else:
-        run("python", lambda: _sequential(py, names, rows, outs))
+        run("python", lambda: sequential(py, names, rows, outs))
         run("numpy", lambda: _batch(py, names, rows, outs))
-    nat = _compile(model, block, "native")
+    nat = compile_quiet(model, block, "native")
     if nat is not None:
         from fuzzyctl.codegen.native import NativeController
 
         if not isinstance(nat, NativeController):
             result.notes.add("native-fallback")
-        run("native", lambda: _sequential(nat, names, rows, outs))
+        run("native", lambda: sequential(nat, names, rows, outs))
         run("native-batch", lambda: _batch(nat, names, rows, outs))
-    auto = _compile(model, block, None)
+    auto = compile_quiet(model, block, None)
     if auto is not None:
         run("explain", lambda: _explain(auto, names, rows, outs))
     if extra.cli and extra.cli_path is not None:
         run("cli-set", lambda: _cli(extra.cli_path, extra.cli_fmt, block, names, rows, outs, data=False))  # type: ignore[arg-type]
         run("cli-data", lambda: _cli(extra.cli_path, extra.cli_fmt, block, names, rows, outs, data=True))  # type: ignore[arg-type]
     if extra.c:
-        _check_c(ref, model, block, plan, names, rows, outs, want, scales, result)
+        c_values = _check_c(model, block, plan, names, rows, outs, want, scales, result)
+        if c_values is not None:
+            seen["c"] = c_values
     _blame_reference(verdicts, seen, scales, result)
     return result
 
 
 def _check_c(
-    ref: Any,
     model: Any,
     block: str | None,
     plan: Any,
@@ -475,27 +476,31 @@ def _check_c(
     want: list[list[Value]],
     scales: Sequence[float],
     result: DiffResult,
-) -> None:
+) -> list[list[Value]] | None:
+    """Generated C against the reference (within the header's bound where it states one);
+    the C block's outputs."""
     if any(v == REFUSED for r in want for v in r):
-        return  # the C block has no refusal: it runs what it is given
+        return None  # the C block has no refusal: it runs what it is given
     got = run_c(plan, rows)
     if got is None:
-        return
+        return None
     values, bounds = got
-    fresh = _compile(model, block, "interpreted")
+    fresh = compile_quiet(model, block, "interpreted")
 
     def tol(k: int, j: int) -> float:
         kk = bounds.get(outs[j])
         if kk is None:
             return REL_TOL
-        area = _area(fresh, names, rows[k], outs[j])
+        area = accumulated_area(fresh, names, rows[k], outs[j])
         stated = kk * scales[j] / area if area and area > 0 else math.inf  # K (hi-lo)^2 / area, relative
         return max(REL_TOL, stated)
 
     def category(k: int, j: int) -> str:
         return "bound:c-header" if outs[j] in bounds else "disagree:c"
 
-    _compare("c", [list(map(float, r)) for r in values], want, outs, scales, rows, result, tol, category)
+    c_values: list[list[Value]] = [list(map(float, r)) for r in values]
+    _compare("c", c_values, want, outs, scales, rows, result, tol, category)
+    return c_values
 
 
 def _blame_reference(
@@ -515,8 +520,18 @@ def _blame_reference(
         for a_row, b_row in zip(first, seen[p], strict=True):
             if not all(agree(a, b, s) for a, b, s in zip(a_row, b_row, scales, strict=True)):
                 return
+    # the paths that give the consensus's numbers (explain, the CLI, C too) are not at fault
     blamed = {f"disagree:{p}" for p in core}
-    details = [f.detail for f in result.findings if f.category in blamed]
+    for p, rows in seen.items():
+        if p not in core and all(
+            agree(a, b, s)
+            for a_row, b_row in zip(first, rows, strict=False)
+            for a, b, s in zip(a_row, b_row, scales, strict=True)
+        ):
+            blamed |= {f"disagree:{p}"} | ({"bound:c-header"} if p == "c" else set())
+    details = [
+        f.detail for f in result.findings if f.category in blamed and f.category.startswith("disagree:")
+    ]
     result.findings = [f for f in result.findings if f.category not in blamed]
     result.findings.append(
         Finding("disagree:interpreted", f"{', '.join(core)} agree, the reference differs: {details[0]}")
