@@ -8,14 +8,20 @@ repeated lines, CR-only line ends, 200,000-character fields - and goes through w
 would do with it: ``fuzzyctl.load``, ``compile``, ``evaluate`` and ``evaluate_batch`` on
 ordinary and extreme inputs (which must agree: the same number, or both NaN), ``explain``, a
 conversion, code generation, and one CLI command (check / convert / eval / explain).
+Every model that loads is also checked path by path against the reference interpreter
+(:mod:`tests.fuzz.differential`), and ``--systems`` seeded random systems
+(:mod:`tests.fuzz.systems`) follow the mutants.  The run ends with a table of counts per
+source and path; each failure has a one-line replay command (``--replay``).
 
 A mutant fails when it raises anything but a :class:`~fuzzyctl.diagnostics.FuzzyctlError`
-(the API) or makes the CLI exit 3 ("crash"), when scalar and batch disagree ("disagree"),
+(the API) or makes the CLI exit 3 ("crash"), when a path disagrees with the reference
+interpreter (``tests.fuzz.differential``: "disagree", with a category per path),
 when it runs over ``--timeout`` CPU seconds ("hang"), or when the process grows over
 ``--memory`` MB ("memory").  Mutants run in worker processes so that a hang or a runaway
 allocation is contained; the verdict does not depend on scheduling.
 
-usage: python -m tests.fuzz.campaign [--mutants 3000] [--seed 1] [--corpus] [--workers 2]
+usage: python -m tests.fuzz.campaign [--mutants 3000] [--systems 300] [--seed 1] [--corpus]
+                                     [--workers 2] [--save DIR] [--replay FILE|system:S:K]
 """
 
 from __future__ import annotations
@@ -604,7 +610,7 @@ def campaign(
     seed: int,
     *,
     workers: int = 2,
-    timeout: float = 10.0,
+    timeout: float = 30.0,
     memory_mb: int = 500,
     save: Path | None = None,
     progress: bool = False,
@@ -748,7 +754,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--corpus", action="store_true", help="also mutate the shared real-world corpus")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--timeout", type=float, default=10.0, help="CPU seconds per mutant (default 10)")
+    ap.add_argument("--timeout", type=float, default=30.0, help="CPU seconds per model (default 30)")
     ap.add_argument("--memory", type=int, default=500, help="MB per worker process (default 500)")
     ap.add_argument("--save", type=Path, default=None, help="write failing mutants to this directory")
     ap.add_argument("--systems", type=int, default=0, help="random systems after the mutants (default 0)")
