@@ -353,7 +353,7 @@ def accumulated_area(ref: Any, names: Sequence[str], row: Sequence[float], out: 
         for o in e.outputs:
             if o.name == out and o.breakpoints:
                 bp = o.breakpoints
-                return sum((x1 - x0) * (y0 + y1) / 2 for (x0, y0), (x1, y1) in itertools.pairwise(bp))
+                return float(sum((x1 - x0) * (y0 + y1) / 2 for (x0, y0), (x1, y1) in itertools.pairwise(bp)))
     return None
 
 
@@ -513,7 +513,9 @@ def _blame_reference(
     """When at least two in-process paths ran, all disagree with the reference and agree
     among themselves, the reference is the odd one out: one ``disagree:interpreted`` finding
     replaces theirs."""
-    core = [p for p in ("python", "numpy", "native", "native-batch") if p in verdicts and p in seen]
+    core: list[str] = [
+        p for p in ("python", "numpy", "native", "native-batch") if p in verdicts and p in seen
+    ]
     if len(core) < 2:
         return
     result.compared.add("interpreted")
@@ -526,13 +528,13 @@ def _blame_reference(
                 return
     # the paths that give the consensus's numbers (explain, the CLI, C too) are not at fault
     blamed = {f"disagree:{p}" for p in core}
-    for p, rows in seen.items():
-        if p not in core and all(
+    for other, rows in seen.items():
+        if other not in core and all(
             agree(a, b, s)
             for a_row, b_row in zip(first, rows, strict=False)
             for a, b, s in zip(a_row, b_row, scales, strict=True)
         ):
-            blamed |= {f"disagree:{p}"} | ({"bound:c-header"} if p == "c" else set())
+            blamed |= {f"disagree:{other}"} | ({"bound:c-header"} if other == "c" else set())
     details = [
         f.detail for f in result.findings if f.category in blamed and f.category.startswith("disagree:")
     ]

@@ -199,8 +199,7 @@ def describe(fb: m.FunctionBlock) -> dict[str, Any]:
     rb, d = fb.rule_blocks[0], fb.defuzzify[0]
     shapes = {
         type(t.mf).__name__ if not isinstance(t.mf, m.ShapeMF) else t.mf.kind
-        for f in (*fb.fuzzify, *fb.defuzzify)
-        for t in f.terms
+        for t in (*(t for f in fb.fuzzify for t in f.terms), *(t for d in fb.defuzzify for t in d.terms))
     }
     return {
         "and": rb.and_op,
