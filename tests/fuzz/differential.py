@@ -404,7 +404,7 @@ def _compare(
                 result.findings.append(
                     Finding(
                         cat,
-                        f"{outs[j]} at row {list(rows[k])!r}: {path} {g!r}, reference {r!r} "
+                        f"{outs[j]} at row {list(rows[k])!r}: {path} {g!r}, expected {r!r} "
                         f"({diff:.3g} of the range {scales[j]:.6g})",
                     )
                 )
@@ -432,14 +432,12 @@ def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: in
     rows = vectors(plan, rng, n)
     want = sequential(ref, names, rows, outs)
     scales = [output_scale(op, [r[j] for r in want]) for j, op in enumerate(ops)]
-    verdicts: dict[str, bool] = {}
     seen: dict[str, list[list[Value]]] = {}
 
     def run(path: str, fn: Callable[[], list[list[Value]] | None]) -> None:
         got = _quiet(fn)
         if got is not None:
             seen[path] = got
-        verdicts[path] = _compare(path, got, want, outs, scales, rows, result)
 
     py = compile_quiet(model, block, "python")
     if py is None:
@@ -460,17 +458,63 @@ def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: in
     if auto is not None:
         run("explain", lambda: _explain(auto, names, rows, outs))
     if extra.cli and extra.cli_path is not None:
-        run("cli-set", lambda: _cli(extra.cli_path, extra.cli_fmt, block, names, rows, outs, data=False))  # type: ignore[arg-type]
-        run("cli-data", lambda: _cli(extra.cli_path, extra.cli_fmt, block, names, rows, outs, data=True))  # type: ignore[arg-type]
+        cli_path = extra.cli_path
+        run("cli-set", lambda: _cli(cli_path, extra.cli_fmt, block, names, rows, outs, data=False))
+        run("cli-data", lambda: _cli(cli_path, extra.cli_fmt, block, names, rows, outs, data=True))
+    c_rules = None
     if extra.c:
-        c_values = _check_c(model, block, plan, names, rows, outs, want, scales, result)
-        if c_values is not None:
-            seen["c"] = c_values
-    _blame_reference(verdicts, seen, scales, result)
+        c_run = _run_c_path(model, block, plan, names, rows, outs, want, scales)
+        if c_run is not None:
+            seen["c"], c_rules = c_run[0], c_run[1:]
+    expected, odd = _expected(seen, want, scales)
+    for path, got in seen.items():
+        tol, category = c_rules if path == "c" and c_rules is not None else (None, None)
+        _compare(path, got, expected, outs, scales, rows, result, tol, category)
+    if sum(p in seen for p in CORE) >= 2:
+        result.compared.add("interpreted")
+    if odd:
+        k, agreed = odd[0]
+        result.findings.append(
+            Finding(
+                "disagree:interpreted",
+                f"at row {list(rows[k])!r}: {', '.join(p for p in CORE if p in seen)} agree on {agreed!r}, "
+                f"the reference gives {want[k]!r} ({len(odd)} of {len(rows)} rows)",
+            )
+        )
     return result
 
 
-def _check_c(
+#: the in-process paths whose consensus can outvote the reference
+CORE = ("python", "numpy", "native", "native-batch")
+
+
+def _expected(
+    seen: dict[str, list[list[Value]]], want: list[list[Value]], scales: Sequence[float]
+) -> tuple[list[list[Value]], list[tuple[int, list[Value]]]]:
+    """The values every path is held to: the reference's, except on rows where at least two
+    in-process paths ran, all disagree with the reference and agree among themselves - there
+    the reference is the odd one out and their consensus stands (listed in the second item)."""
+    core = [p for p in CORE if p in seen]
+    if len(core) < 2:
+        return want, []
+
+    def same(a: Sequence[Value], b: Sequence[Value]) -> bool:
+        return all(agree(x, y, s) for x, y, s in zip(a, b, scales, strict=True))
+
+    expected, odd = list(want), []
+    for k, ref_row in enumerate(want):
+        vals = [seen[p][k] for p in core if k < len(seen[p])]
+        if (
+            len(vals) == len(core)
+            and not any(same(v, ref_row) for v in vals)
+            and all(same(v, vals[0]) for v in vals)
+        ):
+            expected[k] = vals[0]
+            odd.append((k, vals[0]))
+    return expected, odd
+
+
+def _run_c_path(
     model: Any,
     block: str | None,
     plan: Any,
@@ -479,10 +523,9 @@ def _check_c(
     outs: Sequence[str],
     want: list[list[Value]],
     scales: Sequence[float],
-    result: DiffResult,
-) -> list[list[Value]] | None:
-    """Generated C against the reference (within the header's bound where it states one);
-    the C block's outputs."""
+) -> tuple[list[list[Value]], Callable[[int, int], float], Callable[[int, int], str]] | None:
+    """The generated C block's outputs, the tolerance per (row, output) - the header's bound
+    where it states one, else 1e-9 of the range - and the verdict category."""
     if any(v == REFUSED for r in want for v in r):
         return None  # the C block has no refusal: it runs what it is given
     got = run_c(plan, rows)
@@ -502,43 +545,4 @@ def _check_c(
     def category(k: int, j: int) -> str:
         return "bound:c-header" if outs[j] in bounds else "disagree:c"
 
-    c_values: list[list[Value]] = [list(map(float, r)) for r in values]
-    _compare("c", c_values, want, outs, scales, rows, result, tol, category)
-    return c_values
-
-
-def _blame_reference(
-    verdicts: dict[str, bool], seen: dict[str, list[list[Value]]], scales: Sequence[float], result: DiffResult
-) -> None:
-    """When at least two in-process paths ran, all disagree with the reference and agree
-    among themselves, the reference is the odd one out: one ``disagree:interpreted`` finding
-    replaces theirs."""
-    core: list[str] = [
-        p for p in ("python", "numpy", "native", "native-batch") if p in verdicts and p in seen
-    ]
-    if len(core) < 2:
-        return
-    result.compared.add("interpreted")
-    if any(verdicts[p] for p in core):
-        return
-    first = seen[core[0]]
-    for p in core[1:]:
-        for a_row, b_row in zip(first, seen[p], strict=True):
-            if not all(agree(a, b, s) for a, b, s in zip(a_row, b_row, scales, strict=True)):
-                return
-    # the paths that give the consensus's numbers (explain, the CLI, C too) are not at fault
-    blamed = {f"disagree:{p}" for p in core}
-    for other, rows in seen.items():
-        if other not in core and all(
-            agree(a, b, s)
-            for a_row, b_row in zip(first, rows, strict=False)
-            for a, b, s in zip(a_row, b_row, scales, strict=True)
-        ):
-            blamed |= {f"disagree:{other}"} | ({"bound:c-header"} if other == "c" else set())
-    details = [
-        f.detail for f in result.findings if f.category in blamed and f.category.startswith("disagree:")
-    ]
-    result.findings = [f for f in result.findings if f.category not in blamed]
-    result.findings.append(
-        Finding("disagree:interpreted", f"{', '.join(core)} agree, the reference differs: {details[0]}")
-    )
+    return [list(map(float, r)) for r in values], tol, category
