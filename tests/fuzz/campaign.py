@@ -343,6 +343,9 @@ def _engine(doc: Any, m: Mutant, steps: list[str], findings: list[tuple[str, str
             ctl.reset()
             many = _api("evaluate_batch", ctl.evaluate_batch, {n: np.array([v]) for n, v in vec.items()})
             if one is not None and many is not None:
+                if any(len(many[name]) != 1 for name in one) and findings is not None:
+                    findings.append(("disagree:numpy", f"a batch of one row at {vec} gave {many!r}"))
+                    continue
                 for name, value in one.items():
                     if not _agree(float(value), float(many[name][0])) and findings is not None:
                         findings.append(
@@ -478,6 +481,12 @@ def _worker(conn: Connection, memory_mb: int) -> None:
                 out = run_one(m, Path(tmp))
             except MemoryError:
                 out = Outcome(m.index, "memory", "MemoryError")
+            except Exception as exc:  # the fuzzer's own checks tripped: still a finding, not a dead worker
+                tb = traceback.extract_tb(exc.__traceback__)[-1]
+                where = f"{Path(tb.filename).name}:{tb.lineno}"
+                out = Outcome(
+                    m.index, "crash", f"in the fuzzer at {where}: {type(exc).__name__}: {str(exc)[:200]}"
+                )
             out.rss_mb = _peak_rss_mb()
             conn.send(out)
 
@@ -664,15 +673,16 @@ def campaign(
                 if slot.mutant is None:
                     continue
                 if slot.conn.poll(0.02):
+                    m = slot.mutant  # (the slot may be replaced below)
                     try:
                         out: Outcome = slot.conn.recv()
                     except EOFError:  # the worker died (out of memory, a signal)
-                        out = Outcome(slot.mutant.index, "memory", "the worker process died")
+                        out = Outcome(m.index, "memory", "the worker process died")
                         slot.stop()
                         slots[k] = slot = _Slot(ctx, memory_mb)
                     if out.kind in ("ok", "refused") and out.rss_mb > memory_mb:
                         out.kind, out.detail = "memory", f"worker RSS {out.rss_mb:.0f} MB"
-                    record(slot.mutant, out)
+                    record(m, out)
                     if out.kind == "memory" or out.rss_mb > memory_mb:
                         slot.stop()
                         slots[k] = slot = _Slot(ctx, memory_mb)

@@ -202,6 +202,8 @@ def _batch(
         )
     except err:
         return [[REFUSED] * len(outs) for _ in rows]
+    if any(len(got[o]) != len(rows) for o in outs):  # a wrong shape is a disagreement on every row
+        return [[f"{len(got[o])} values for {len(rows)} rows" for o in outs] for _ in rows]
     return [[float(got[o][k]) for o in outs] for k in range(len(rows))]
 
 
