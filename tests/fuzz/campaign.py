@@ -405,7 +405,7 @@ def _differential(doc: Any, m: Mutant, path: Path, steps: list[str], out: Outcom
 
     rng = random.Random(m.plan + 3)
     for fb in doc.blocks[:2]:
-        extra = differential.Plan_(
+        extra = differential.ExtraPaths(
             cli_path=path if not m.text.startswith("// ") else None,
             cli_fmt=m.fmt,
             cli=m.full or rng.random() < m.rates[1],

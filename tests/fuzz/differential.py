@@ -363,7 +363,7 @@ def accumulated_area(ref: Any, names: Sequence[str], row: Sequence[float], out: 
 
 
 @dataclass
-class Plan_:
+class ExtraPaths:
     """What :func:`check` is asked to run besides the in-process API paths."""
 
     cli_path: Path | None = None  # the model as a file the CLI reads
@@ -414,7 +414,7 @@ def _compare(
     return True
 
 
-def check(model: Any, block: str | None, rng: random.Random, extra: Plan_, n: int = 8) -> DiffResult:
+def check(model: Any, block: str | None, rng: random.Random, extra: ExtraPaths, n: int = 8) -> DiffResult:
     """Every path against the reference on ``n`` vectors of ``model`` (a Document or a
     FunctionBlock); refusals are compared too."""
     result = DiffResult()

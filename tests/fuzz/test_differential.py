@@ -99,7 +99,7 @@ def test_a_wrong_path_is_caught_and_named(monkeypatch: pytest.MonkeyPatch) -> No
     """A python backend off by 1e-8 of the range (10 times the tolerance) is reported as
     ``disagree:python`` and nothing else; the correct model gives no finding."""
     fb = _tipper()
-    assert D.check(fb, None, random.Random(1), D.Plan_()).findings == []
+    assert D.check(fb, None, random.Random(1), D.ExtraPaths()).findings == []
     real = D.compile_quiet
 
     def skewed(model: Any, block: str | None, backend: str | None) -> Any:
@@ -110,7 +110,7 @@ def test_a_wrong_path_is_caught_and_named(monkeypatch: pytest.MonkeyPatch) -> No
         return ctl
 
     monkeypatch.setattr(D, "compile_quiet", skewed)
-    res = D.check(fb, None, random.Random(1), D.Plan_())
+    res = D.check(fb, None, random.Random(1), D.ExtraPaths())
     assert {f.category for f in res.findings} == {"disagree:python"}, res.findings
     assert {"python", "numpy", "native", "native-batch", "explain", "interpreted"} <= res.compared
 
@@ -126,7 +126,7 @@ def test_the_reference_is_blamed_when_every_other_path_agrees(monkeypatch: pytes
         return rows
 
     monkeypatch.setattr(D, "sequential", skewed)
-    res = D.check(fb, None, random.Random(1), D.Plan_())
+    res = D.check(fb, None, random.Random(1), D.ExtraPaths())
     assert [f.category for f in res.findings] == ["disagree:interpreted"], res.findings
 
 
