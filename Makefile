@@ -65,7 +65,7 @@ test: lint typecheck pytest
 # and differential fuzzer (issues 14.5, 25.2) on FUZZ_MUTANTS mutants of the examples, the vendored
 # files and, when ../shared is there, the real-world corpus, then FUZZ_SYSTEMS random systems:
 # every backend, explain, the CLI and generated C against the reference interpreter (make test
-# runs a fixed sample of 80 + 24). A failure prints a one-line replay command.
+# runs a fixed sample of 80 + 16). A failure prints a one-line replay command.
 FUZZ_MUTANTS ?= 3000
 FUZZ_SYSTEMS ?= 300
 FUZZ_SEED ?= $(shell date +%s)

@@ -18,7 +18,7 @@ from tests.fuzz.campaign import campaign, seeds
 # keeps the suite's share to about a minute of one core.  FUZZYCTL_FUZZ_MUTANTS and
 # FUZZYCTL_FUZZ_SYSTEMS raise it.
 MUTANTS = int(os.environ.get("FUZZYCTL_FUZZ_MUTANTS", "80"))
-SYSTEMS = int(os.environ.get("FUZZYCTL_FUZZ_SYSTEMS", "24"))
+SYSTEMS = int(os.environ.get("FUZZYCTL_FUZZ_SYSTEMS", "16"))
 
 
 def test_no_mutant_or_random_system_disagrees_crashes_hangs_or_runs_away() -> None:
