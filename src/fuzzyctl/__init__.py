@@ -32,3 +32,17 @@ def __getattr__(name: str) -> Any:
         except ModuleNotFoundError:
             pass
     raise AttributeError(f"module 'fuzzyctl' has no attribute {name!r}")
+
+
+def _rich_display() -> None:
+    # In a Jupyter kernel: controllers, variables and explanations display as HTML
+    # (fuzzyctl.display; cheap: registered by name, nothing imported until shown).
+    import sys
+
+    if "IPython" in sys.modules:
+        from fuzzyctl.display import register
+
+        register()
+
+
+_rich_display()
