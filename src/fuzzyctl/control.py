@@ -50,8 +50,11 @@ class Integral:
     ``[low, high]`` (the limit is also the anti-windup: ``U`` never runs past it), starting at
     ``initial``.  The same parameters as ``fuzzyctl simulate``'s ``fuzzy_pi`` structure.
 
+    ```python
     >>> Integral(gain=2.0, low=0.0, high=100.0).clip(150.0)
     100.0
+
+    ```
     """
 
     gain: float = 1.0
@@ -97,10 +100,13 @@ def iosys(
     integrated value.  ``dt=0``: continuous time; ``dt > 0``: sampled every ``dt`` s, the
     integrator a forward sum ``U += gain * output * dt`` as in ``fuzzyctl simulate``.
 
+    ```python
     >>> import control, fuzzyctl.control
     >>> sys = fuzzyctl.control.iosys("examples/tank.fcl", integrate={"dheat": 1.0}, dt=1.0)
     >>> sys.input_labels, sys.output_labels, sys.state_labels
     (['error', 'rate'], ['dheat'], ['dheat'])
+
+    ```
     """
     ctl = _compile(controller, block)
     ins, outs = list(ctl.inputs), list(ctl.outputs)
@@ -153,10 +159,13 @@ def initial_state(system: Any, integrate: Mapping[str, Integral | float]) -> np.
     """The integrators' ``initial`` values in the order of ``system``'s states (for
     ``control.input_output_response(..., X0=...)``).
 
+    ```python
     >>> import fuzzyctl.control as fc
     >>> sys = fc.iosys("examples/tank.fcl", integrate={"dheat": fc.Integral(initial=5.0)})
     >>> fc.initial_state(sys, {"dheat": fc.Integral(initial=5.0)})
     array([5.])
+
+    ```
     """
     values = {k: v.clip(v.initial) if isinstance(v, Integral) else 0.0 for k, v in integrate.items()}
     return np.array([values.get(s, 0.0) for s in system.state_labels])
@@ -187,10 +196,13 @@ def nonlinearity(
     The map must not keep state between calls (an output with ``DEFAULT := NC`` that no rule
     reaches would): the describing function assumes a static map.
 
+    ```python
     >>> import control, fuzzyctl.control
     >>> N = fuzzyctl.control.nonlinearity("tests/data/control/saturation.fcl")
-    XX
+    >>> round(control.describing_function(N, 2.0)[0].real, 3)   # the saturation's: 0.609
     np.float64(0.609)
+
+    ```
     """
     ctl = _compile(controller, block)
     if len(ctl.inputs) != 1:

@@ -5,11 +5,14 @@ the terms plotted, the explain chart) and PNG.
 display formatters these types by name (nothing is imported until an object is shown, and the
 engine's classes stay free of display code).  The same HTML is available outside Jupyter:
 
+```python
 >>> import fuzzyctl
 >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/tank.fcl"))
 >>> html = controller_html(ctl)
 >>> "<table" in html and "RULE" in html and "data:image/png;base64," in html
 True
+
+```
 """
 
 from __future__ import annotations
@@ -58,10 +61,13 @@ def _num(v: float | str | None) -> str:
 def figure_png(fig: Figure) -> bytes:
     """A matplotlib figure as PNG bytes (the figure is closed: a notebook shows it once).
 
+    ```python
     >>> import fuzzyctl
     >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/tank.fcl"))
     >>> figure_png(ctl.inputs["error"].plot())[:4]
     b'\\x89PNG'
+
+    ```
     """
     import matplotlib.pyplot as plt
 
@@ -89,10 +95,13 @@ def variable_png(variable: VariableInfo) -> bytes:
 def variable_html(variable: VariableInfo, *, plot: bool = True) -> str:
     """A variable: role, range, its terms as a table and plotted.
 
+    ```python
     >>> import fuzzyctl
     >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/tank.fcl"))
     >>> "<td>pos_big</td>" in variable_html(ctl.inputs["error"], plot=False)
     True
+
+    ```
     """
     rng = f"{_num(variable.low)} .. {_num(variable.high)}" if variable.range else "(from the terms)"
     extra = f", {html.escape(variable.method)}" if variable.method else ""
@@ -134,10 +143,13 @@ def explanation_html(explanation: Explanation, *, plot: bool = True) -> str:
     """One evaluation explained: inputs, term degrees, the rules that fired, the outputs and
     the explain chart.
 
+    ```python
     >>> import fuzzyctl
     >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/tank.fcl"))
     >>> "fired" in explanation_html(ctl.explain(error=5, rate=0), plot=False)
     True
+
+    ```
     """
     ins = [[html.escape(k), _num(v)] for k, v in explanation.inputs.items()]
     terms = [[html.escape(t.variable), html.escape(t.term), _num(t.degree)] for t in explanation.terms]
