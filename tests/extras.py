@@ -47,6 +47,7 @@ EXTRA_SUITES: dict[str, ExtraSuite] = {
         ExtraSuite("jfl_oracle", "tools/jfuzzylogic/jfl", "live jFuzzyLogic 3.3 as an oracle"),
         ExtraSuite("matiec", "tools/matiec-src.tar.gz", "matiec, the IEC 61131-3 compiler of OpenPLC"),
         ExtraSuite("plcopen", "tools/plcopen/tc6_xml_v201.xsd", "PLCopen TC6 XML 2.01 schema"),
+        ExtraSuite("repro", "repro/README.md", "reproducers of issue 25 (some carry corpus terms)"),
     )
 }
 

@@ -19,7 +19,7 @@ from fuzzyctl.diagnostics import (
     render_all,
     warning,
 )
-from fuzzyctl.limits import max_input_bytes, read_input
+from fuzzyctl.limits import MAX_JSON_DEPTH, max_input_bytes, read_input
 from fuzzyctl.model import Span
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
@@ -196,3 +196,27 @@ def test_fpl_never_echoes_a_long_token_nor_reads_inf(
     (diag,) = [d for d in err.value.diagnostics if d.is_error]
     assert diag.message.startswith(message) and len(diag.message) < 100
     assert diag.span is not None and diag.span.line == (7 if "TYPE" in old else 9 if "MAX" in old else 11)
+
+
+def test_load_json_reads_spelt_non_numbers_and_refuses_overflowing_literals_at_their_place() -> None:
+    """Every JSON reader goes through ``load_json`` (issue 25): NaN / Infinity spelt out are
+    read as such; a literal beyond the double range is refused at its line and column, as the
+    FCL reader refuses it, never read as an infinity or kept as an integer no float holds."""
+    import math
+
+    from fuzzyctl.limits import load_json
+
+    data = load_json("[NaN, Infinity, -Infinity, 1.5, 7]")
+    assert math.isnan(data[0]) and data[1:3] == [math.inf, -math.inf] and data[3:] == [1.5, 7]
+    for literal in ("1e400", "-1e400", "9" * 309, "-" + "9" * 309, "9" * 5001):
+        with pytest.raises(DiagnosticError) as caught:
+            load_json(f'{{"a":\n  [0, {literal}]}}', "t.json")
+        (found,) = caught.value.diagnostics
+        assert found.code == "number-range" and found.span is not None
+        assert (found.span.line, found.span.column) == (2, 7), found.render()
+    assert load_json("[" + "9" * 308 + "]")[0] == int("9" * 308)  # below 1.8e308: a number
+    text = "[" * (MAX_JSON_DEPTH + 1) + "]" * (MAX_JSON_DEPTH + 1)
+    with pytest.raises(DiagnosticError) as caught:
+        load_json(text, "t.json")
+    (found,) = caught.value.diagnostics
+    assert found.code == "json-depth" and found.span is not None and found.span.column == MAX_JSON_DEPTH + 1

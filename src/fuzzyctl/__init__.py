@@ -1,7 +1,8 @@
 """fuzzyctl: IEC 61131-7 fuzzy control for PLC engineers.
 
 The public entry points are :func:`fuzzyctl.load` and :func:`fuzzyctl.compile`; see
-``fuzzyctl.api``.  ``fuzzyctl.tune(...)``, ``fuzzyctl.learn(...)`` and
+``fuzzyctl.api``; :func:`fuzzyctl.analyze` checks a rule base (docs/analyze.md).
+``fuzzyctl.tune(...)``, ``fuzzyctl.learn(...)`` and
 ``fuzzyctl.evaluate_dataframe(...)`` (docs/tune.md) are imported on first use.  Importing the
 package is cheap: everything is imported when first used (the start of a command matters).
 """
@@ -11,15 +12,18 @@ from __future__ import annotations
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
+    from fuzzyctl.analysis import analyze
     from fuzzyctl.api import compile, load, plot_terms
 
 __version__ = "0.1.0"
-__all__ = ["__version__", "compile", "evaluate_dataframe", "learn", "load", "plot_terms", "tune"]
+__all__ = ["__version__", "analyze", "compile", "evaluate_dataframe", "learn", "load", "plot_terms", "tune"]
 
 
 def __getattr__(name: str) -> Any:
     import importlib
 
+    if name == "analyze":  # static analysis of a rule base (docs/analyze.md)
+        return importlib.import_module("fuzzyctl.analysis").analyze
     if name in ("compile", "load", "plot_terms"):
         return getattr(importlib.import_module("fuzzyctl.api"), name)
     # Lazy: tuning pulls in scipy, cma and Dask, which plain evaluation does not need.

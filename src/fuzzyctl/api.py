@@ -8,6 +8,7 @@ lowered again (its plan is unpickled); the native backend finds its library by t
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import os
 import pickle
@@ -36,7 +37,8 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
 
     ``format`` (``"fcl"``, ...) overrides detection by file extension; text that is not an
     existing path is parsed as FCL unless ``format`` says otherwise.  ``strict``: refuse, as
-    a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7).
+    a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7),
+    and in every format a WITH (or rule) weight above 1 (5.2.4).
     Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
     when the input is not valid.
 
@@ -54,13 +56,21 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        return _load_path(path, fmt, strict)
+        doc = _load_path(path, fmt, strict)
+        if strict and fmt != "fcl" and (found := _strict_findings(doc)):  # FCL's reader said it
+            from fuzzyctl.diagnostics import DiagnosticError
+
+            raise DiagnosticError(found)
+        return doc
     from fuzzyctl import formats
     from fuzzyctl.diagnostics import DiagnosticError, error
     from fuzzyctl.fcl import load_text
 
     if fmt not in (None, "fcl"):
-        return formats.read_text(str(path_or_text), fmt).document
+        doc = formats.read_text(str(path_or_text), fmt).document
+        if strict and (found := _strict_findings(doc)):
+            raise DiagnosticError(found)
+        return doc
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
@@ -178,9 +188,24 @@ def _refuse_reserved(model: Document | FunctionBlock) -> None:
     from fuzzyctl.model import Document
 
     doc = model if isinstance(model, Document) else Document((model,))
-    found = check_reserved_words(doc, doc.path, strict=True)
+    found = check_reserved_words(doc, doc.path, strict=True) + _strict_findings(doc)
     if has_errors(found):
         raise DiagnosticError(found)
+
+
+def _strict_findings(doc: Document) -> list[Diagnostic]:
+    """What every reader accepts with a warning and ``strict`` refuses (a WITH weight above
+    1), placed as the file's reader places it (a JSON model's spans are those of the file it
+    came from)."""
+    from fuzzyctl import formats
+    from fuzzyctl.diagnostics import FuzzyctlError, Severity
+    from fuzzyctl.validation import Placer, at_spans, validate
+
+    place: Placer = at_spans
+    if doc.path:
+        with contextlib.suppress(FuzzyctlError):
+            place = formats.for_path(doc.path).place
+    return place([f for f in validate(doc, strict=True) if f.severity is Severity.ERROR], doc.path)
 
 
 def compile_path(

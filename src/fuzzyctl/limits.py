@@ -14,6 +14,8 @@
   a RecursionError); JSON may nest :data:`MAX_JSON_DEPTH` levels.
 * :data:`MAX_DIGITS` - the longest number literal read (Python refuses to convert
   integers over 4300 digits; a literal that long is an error with its place).
+  :func:`load_json` reads JSON under both limits for every JSON reader (the model's and the
+  XFUZ tables').
 
 The limits are documented in docs/limits.md.
 """
@@ -21,10 +23,14 @@ The limits are documented in docs/limits.md.
 
 from __future__ import annotations
 
+import json
 import math
 import os
+import re
 import stat
+import sys
 from pathlib import Path
+from typing import Any
 
 from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, Diagnostic, DiagnosticError, error
 from fuzzyctl.model import (
@@ -41,6 +47,7 @@ from fuzzyctl.model import (
     Not,
     Or,
     Range,
+    Span,
     Unary,
 )
 
@@ -82,6 +89,7 @@ __all__ = [
     "check_text",
     "depth",
     "expr_depth",
+    "load_json",
     "max_input_bytes",
     "read_input",
     "shorten",
@@ -244,3 +252,101 @@ def _ranges(fb: FunctionBlock) -> list[tuple[str, Range]]:
     out += [(f"FUZZIFY {b.variable}", b.range) for b in fb.fuzzify if b.range is not None]
     out += [(f"DEFUZZIFY {b.variable}", b.range) for b in fb.defuzzify if b.range is not None]
     return out
+
+
+def _line_column(text: str, position: int) -> Span:
+    line = text.count("\n", 0, position) + 1
+    return Span(line, position - (text.rfind("\n", 0, position) + 1) + 1)
+
+
+def _deep_position(text: str) -> int:
+    """Where ``text`` opens its (MAX_JSON_DEPTH + 1)-th nested array or object (0 when it
+    never does): only called for a document already found too deep."""
+    level, in_string, escaped = 0, False, False
+    for i, ch in enumerate(text):
+        if in_string:
+            if escaped:
+                escaped = False
+            elif ch == "\\":
+                escaped = True
+            elif ch == '"':
+                in_string = False
+        elif ch == '"':
+            in_string = True
+        elif ch in "[{":
+            level += 1
+            if level > MAX_JSON_DEPTH:
+                return i
+        elif ch in "]}":
+            level -= 1
+    return 0
+
+
+_NUMBER = re.compile(r"-?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+
+
+class _Spelt(float):
+    """A ``NaN`` / ``Infinity`` the JSON text spells out (not a literal that overflowed)."""
+
+
+def _json_problem(data: Any) -> str | None:
+    """``"depth"`` when ``data`` nests deeper than :data:`MAX_JSON_DEPTH`, ``"range"`` when
+    it holds a number literal beyond 1.8e308 (read as an infinity or an integer no float
+    holds), else ``None`` (measured without recursion: the readers' decoders recurse; only
+    containers go on the stack, leaves are tested by their exact type, which is what keeps
+    this a fraction of ``json.loads``'s own time)."""
+    top = sys.float_info.max
+    stack = [(data, 1)]
+    while stack:
+        item, level = stack.pop()
+        if level > MAX_JSON_DEPTH:
+            return "depth"
+        for value in item.values() if type(item) is dict else item if type(item) is list else ():
+            kind = type(value)
+            if kind is dict or kind is list:
+                stack.append((value, level + 1))
+            # an int is compared exactly (no conversion); a float read from a literal is only
+            # infinite when it overflowed (spelt NaN / Infinity are _Spelt, not float)
+            elif (kind is float or kind is int) and not -top <= value <= top:
+                return "range"
+    return None
+
+
+def _large_number(text: str) -> re.Match[str] | None:
+    """The first number literal of ``text`` beyond 1.8e308 or :data:`MAX_DIGITS` digits long."""
+    for found in _NUMBER.finditer(text):
+        literal = found.group()
+        if len(literal) > MAX_DIGITS or not math.isfinite(float(literal)):
+            return found
+    return None
+
+
+def load_json(text: str, path: str | None = None, code: str = "json-syntax") -> Any:
+    """``json.loads(text)`` under the limits every reader has, or :class:`DiagnosticError`
+    at the place: invalid JSON (line:column), nesting deeper than :data:`MAX_JSON_DEPTH` (at
+    the bracket that goes deeper), a number beyond 1.8e308 (``1e400``, 401 digits: what the
+    FCL reader refuses) or of more than :data:`MAX_DIGITS` digits (at the number); ``code``
+    is the code of a syntax error.  ``NaN`` and ``Infinity`` spelt out are read as such."""
+    problem: str | None
+    try:
+        data = json.loads(text, parse_constant=lambda name: _Spelt(name.lower().replace("infinity", "inf")))
+    except json.JSONDecodeError as exc:
+        raise DiagnosticError(
+            [error(f"invalid JSON: {exc.msg}", Span(exc.lineno, exc.colno), code=code, file=path)], text
+        ) from None
+    except RecursionError:  # the json module's own limit, far above ours
+        problem = "depth"
+    except ValueError:  # an integer literal of more than 4300 digits
+        problem = "range"
+    else:
+        problem = _json_problem(data)
+    if problem is None:
+        return data
+    if problem == "depth":
+        where = _line_column(text, _deep_position(text))
+        message = f"the JSON nests more than {MAX_JSON_DEPTH} levels deep"
+        raise DiagnosticError([error(message, where, code="json-depth", file=path)], text)
+    found = _large_number(text)
+    at = _line_column(text, found.start()) if found else None
+    message = f"the number {shorten(found.group()) if found else ''} is too large (beyond 1.8e308)"
+    raise DiagnosticError([error(message, at, code="number-range", file=path)], text)

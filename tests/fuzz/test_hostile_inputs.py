@@ -90,8 +90,8 @@ REFUSED = [
     ("inf in a FIS rule", fis(rule="inf, 1 (1) : 1"), "fis", 28, ["not a term number"]),
     ("nan in a FIS rule", fis(rule="nan, 1 (1) : 1"), "fis", 28, ["not a term number"]),
     ("5001-digit number in FIS", fis(params="[0 " + "9" * 5001 + " 10]"), "fis", 17, ["too large"]),
-    ("100,000-deep JSON", "[" * 100_000 + "]" * 100_000, "json", None, ["nests"]),
-    ("5001-digit JSON integer", '{"a": ' + "9" * 5001 + "}", "json", None, ["digits"]),
+    ("100,000-deep JSON", "[" * 100_000 + "]" * 100_000, "json", 1, ["nests"]),
+    ("5001-digit JSON integer", '{"a": ' + "9" * 5001 + "}", "json", 1, ["too large", "5001 characters"]),
 ]  # fmt: skip
 
 

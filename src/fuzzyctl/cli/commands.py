@@ -1,6 +1,7 @@
 """Imports every command module so that each registers its commands on the app."""
 
 from fuzzyctl.cli import (
+    analyze,  # noqa: F401  (analyze: static checks of a rule base)
     blocks,  # noqa: F401  (fuzzyctl blocks ...)
     codegen,  # noqa: F401  (fuzzyctl codegen)
     convert,  # noqa: F401

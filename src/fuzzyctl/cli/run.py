@@ -170,15 +170,26 @@ def eval_(
             warn=lambda text: err_console.print(f"warning: {text}", markup=False),
         )
         return
-    result = ctl.evaluate(_parse_sets(set_))
+    values = _parse_sets(set_)
+    result = ctl.evaluate(values)
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
     else:
         _print_outputs(ctl.name or file.name, result)
-    _fail_without_value(ctl, result)
+    _fail_without_value(ctl, result, values)
 
 
-def _fail_without_value(ctl: Any, result: Mapping[str, float]) -> None:
+def _fired(ctl: Any, values: Mapping[str, float]) -> dict[str, bool]:
+    """Whether any rule fired for each output: an explanation of the same inputs (it
+    advances the NC state; the command ends after it)."""
+    try:
+        e = ctl.explain(values)
+    except Exception:  # only the wording of an error depends on it
+        return {}
+    return {o.name: o.fired for o in e.outputs}
+
+
+def _fail_without_value(ctl: Any, result: Mapping[str, float], values: Mapping[str, float]) -> None:
     """An output that is NaN or infinite is no value for a field device: say why and exit 1,
     so a script never takes ``null``/``nan`` for a result (issue 14.6)."""
     missing = [k for k, v in result.items() if not math.isfinite(v)]
@@ -186,12 +197,15 @@ def _fail_without_value(ctl: Any, result: Mapping[str, float]) -> None:
         return
     from fuzzyctl.cli.app import err_console
 
+    fired = _fired(ctl, values)
     for name in missing:
         info = ctl.outputs.get(name)
         default = getattr(info, "default", None)
         why = (
             "no rule fired and its DEFAULT is NaN"
-            if default is not None and math.isnan(default)
+            if default is not None and math.isnan(default) and not fired.get(name, True)
+            else "rules fired but the result is not a finite number (a term is NaN or infinite there)"
+            if fired.get(name, False)
             else "the result is not a finite number"
         )
         err_console.print(f"error: output {name!r} has no value ({_fmt(result[name])}): {why}", markup=False)
@@ -269,7 +283,7 @@ def explain(
             f"{o.value:.10g}",
             o.method,
             o.accumulation or "per rule",
-            "yes" if o.fired else "no (default)",
+            ("yes" if math.isfinite(o.value) else "yes (undefined: NaN)") if o.fired else "no (default)",
         )
     con.print(outs)
     for o in e.outputs:

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen
 from fuzzyctl.codegen.ir import Ex, Index, Var, ex, not_
+from fuzzyctl.engine.pwl import COA_TOL, MAX_TOL
 
 METHODS = {"COG": 1, "COA": 2, "LM": 3, "RM": 4, "MOM": 5}
 ACCUS = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
@@ -74,10 +75,11 @@ def candidate(c: Ctx, x: Ex) -> None:
             b.set(st["LMX"], x)
         with b.if_(x.gt(st["RMX"])):
             b.set(st["RMX"], x)
-        with b.if_(x.ne(st["LASTX"])):
+        # within MAX_TOL of the range of the point before: the same point (pwl.distinct_points)
+        with b.if_((x - st["LASTX"]).gt(MAX_TOL * (c.v["HIGH"] - c.v["LOW"]))):
             b.set(st["ISUM"], st["ISUM"] + x)
             b.set(st["ICNT"], st["ICNT"] + 1)
-            b.set(st["LASTX"], x)
+        b.set(st["LASTX"], x)
 
 
 def interval(c: Ctx, x0: Var, x1: Var) -> None:
@@ -291,13 +293,21 @@ def _piece(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
                     b.set(found, st["FOUNDR"])
                     b.set(cum, st["CUMR"])
                 with b.if_(not_(found)):
-                    with b.if_(pa.gt(0.0).and_((cum + pa).ge(st["HALF"]))):
+                    # within COA_TOL of half before a zero gap: the gap's middle, and the
+                    # whole piece within it: its end (pwl.bisector)
+                    tol = g.let(st["HALF"] * (2.0 * COA_TOL), "CTOL")
+                    with b.if_(pa.gt(0.0).and_((cum + pa).ge(st["HALF"] - tol))):
                         r = g.temp(hint="RR")
+                        whole = g.let((st["HALF"] - cum).ge(pa - tol), "WHOLE", "BOOL")
                         with b.if_(ps.eq(2)):
                             b.set(r, st["HALF"] - cum)
                         with b.else_():
                             b.set(r, pa - (st["HALF"] - cum))
                         x = _solve(c, xa, xb, v0, v1, pdx, r)
+                        with b.if_(whole.and_(ps.eq(2))):
+                            b.set(x, xb)
+                        with b.elif_(whole):
+                            b.set(x, xa)
                         with b.if_(ps.eq(2)):
                             b.set(st["LEFT"], x)
                             b.set(st["FOUNDL"], True)
@@ -422,7 +432,7 @@ def finish(c: Ctx, value: Index, fired: Index) -> None:
             b.set(value, st["RMX"])
     if "MOM" in c.methods:
         with branch(mc.eq(METHODS["MOM"])):
-            with b.if_(st["PLEN"].gt(0.0)):
+            with b.if_(st["PLEN"].gt(MAX_TOL * (v["HIGH"] - v["LOW"]))):  # pwl.maxima
                 b.set(value, st["PMOM"] / st["PLEN"])
             with b.elif_(st["ICNT"].gt(0)):
                 b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -349,17 +349,27 @@ class Interpreter:
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
         cuts = smooth_cuts(op, values, self.pv, contribs)
+        cuts += quadrature.kinks(accumulated_branch(op, contribs, values, self.pv), cuts)
         xs = np.linspace(op.low, op.high, 401)
         rec.samples = (xs, f(xs))
         if not contribs:
             return rec
         A, B, K, KM = quadrature.integrate(f, cuts, self.plan.options.quad_rtol)
         area = float(np.sum(K))
+        if not (math.isfinite(area) and math.isfinite(float(np.sum(KM)))):
+            # rules fired but a term is undefined there (a 0/0 in a function term): the
+            # output is NaN, not the DEFAULT of "no rule fired"
+            rec.fired = True
+            return rec
         if op.method in ("COG", "COA"):
             if not area > 0.0:
                 return rec
             rec.fired = True
-            rec.value = float(np.sum(KM)) / area if op.method == "COG" else quadrature.bisector(f, A, B, K)
+            rec.value = (
+                float(np.sum(KM)) / area
+                if op.method == "COG"
+                else quadrature.bisector(f, A, B, K, self.plan.options.quad_rtol)
+            )
             return rec
         if not area > 0.0:
             return rec
@@ -407,36 +417,66 @@ def accumulated_function(
 ) -> quadrature.Integrand:
     """mu(u) of a Mamdani output as a vectorised function (for quadrature and plots)."""
     accu = op.accu or "MAX"
+    sets = activated_sets(op, contribs, values, pv)
+
+    def f(x: Any) -> Any:
+        acc = np.zeros_like(x)
+        for _mu, c in sets(x):
+            acc = accumulate_np(accu, acc, c)
+        return acc
+
+    return f
+
+
+def activated_sets(
+    op: OutputPlan, contribs: Sequence[tuple[int | None, float, float, str]], values: Sequence[float], pv: Any
+) -> Callable[[Any], list[tuple[Any, Any]]]:
+    """``x -> [(mu, w * act(a, mu)), ...]``: each activated set's term and activated degree."""
     resolved = []
     for t, a, w, act in contribs:
         assert t is not None
         term = op.terms[t]
-        resolved.append(
-            (
-                term.kind,
-                [pv(p, values) for p in term.params],
-                pv(term.height, values),
-                a,
-                w,
-                TNORMS[act].array,
-            )
-        )
-
-    exprs = [op.terms[t].expr if t is not None else None for t, _a, _w, _act in contribs]
+        params = [pv(p, values) for p in term.params]
+        resolved.append((term, params, pv(term.height, values), a, w, TNORMS[act].array))
     vals = list(values)
 
-    def f(x: Any) -> Any:
-        acc = np.zeros_like(x)
-        for (kind, params, h, a, w, act), ex in zip(resolved, exprs, strict=True):
-            if kind == "function":
-                assert ex is not None
-                mu = np.broadcast_to(np.asarray(eval_expr_np(ex, vals, [], x), dtype=np.float64), x.shape)
+    def sets(x: Any) -> list[tuple[Any, Any]]:
+        out = []
+        for term, params, h, a, w, act in resolved:
+            if term.kind == "function":
+                assert term.expr is not None
+                got = eval_expr_np(term.expr, vals, [], x)
+                mu = np.broadcast_to(np.asarray(got, dtype=np.float64), x.shape)
             else:
-                mu = shapes.membership_np(kind, params, h, x)
-            acc = accumulate_np(accu, acc, w * act(a, mu))
-        return acc
+                mu = shapes.membership_np(term.kind, params, h, x)
+            out.append((mu, w * act(a, mu)))
+        return out
 
-    return f
+    return sets
+
+
+def accumulated_branch(
+    op: OutputPlan, contribs: Sequence[tuple[int | None, float, float, str]], values: Sequence[float], pv: Any
+) -> Callable[[Any], list[tuple[int, ...]]]:
+    """Which piece of its formula the accumulated set takes at each x: for each set under MIN
+    activation whether its term is below the degree (the clipping edge), under MAX which set
+    is largest and whether it is below 0 (a function term), under BSUM whether the sum is
+    cut at 1.  Where this changes the set bends: the quadrature is cut there."""
+    accu = op.accu or "MAX"
+    sets = activated_sets(op, contribs, values, pv)
+    clip = [(k, a) for k, (_t, a, _w, act) in enumerate(contribs) if act == "MIN"]
+
+    def branch(x: Any) -> list[tuple[int, ...]]:
+        ss = sets(x)
+        cols = [ss[k][0] < a for k, a in clip]
+        if ss and accu == "MAX":
+            c = np.stack([c for _mu, c in ss])
+            cols += [np.argmax(c, axis=0), c.max(axis=0) < 0.0]
+        elif ss and accu == "BSUM":
+            cols.append(sum(c for _mu, c in ss) >= 1.0)
+        return [tuple(int(v) for v in row) for row in zip(*cols, strict=True)] if cols else [()] * len(x)
+
+    return branch
 
 
 def smooth_cuts(

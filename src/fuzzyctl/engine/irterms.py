@@ -235,16 +235,21 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
             g.b.set(right, 1.0)
         g.b.set(out, left * right)
     elif kind == "bell":
+        # IEEE pow at the centre (u = 0), as fuzzylite and numpy: 0^e is 0 for e > 0, 1 for
+        # e = 0 and +inf for e < 0 (a negative slope is 0 at its centre); ST has no pow(0, e)
         u = _absv(g, (x - p[0]) / p[1])
         expo = g.let(2.0 * p[2], "E")
-        pw = g.temp(hint="W")
         with g.b.if_(u.gt(0.0)):
-            g.b.set(pw, g.call("POW", u, expo) if g.target != "st" else g.call("EXP", expo * g.call("LN", u)))
-        with g.b.elif_(expo.eq(0.0)):
-            g.b.set(pw, 1.0)
-        with g.b.else_():
-            g.b.set(pw, 0.0)
-        g.b.set(out, 1.0 / (1.0 + pw))
+            pw = g.call("POW", u, expo) if g.target != "st" else g.call("EXP", expo * g.call("LN", u))
+            g.b.set(out, 1.0 / (1.0 + pw))
+        with g.b.elif_(u.eq(0.0).and_(expo.gt(0.0))):
+            g.b.set(out, 1.0)
+        with g.b.elif_(u.eq(0.0).and_(expo.eq(0.0))):
+            g.b.set(out, 0.5)
+        with g.b.elif_(u.eq(0.0).and_(expo.lt(0.0))):
+            g.b.set(out, 0.0)
+        with g.b.else_():  # NaN in, NaN out
+            g.b.set(out, u + expo)
     elif kind == "sigmoid":
         g.b.set(out, _sig(g, x, p[0], p[1]))
     elif kind in ("dsigmoid", "dsigmoid_pos", "psigmoid"):
@@ -288,10 +293,11 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
         s, e = p
         r = g.let(e - s, "R")
         with g.b.if_((s.lt(e).and_(s.le(x)).and_(x.le(e))).or_(s.gt(e).and_(e.le(x)).and_(x.le(s)))):
-            q = g.let(r * r - (x - e) * (x - e), "Q")
+            t = g.let((x - e) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
             with g.b.if_(q.lt(0.0)):
                 g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q) / _absv(g, r))
+            g.b.set(out, g.call("SQRT", q))
         with g.b.elif_((s.lt(e).and_(x.gt(e))).or_(s.gt(e).and_(x.lt(e)))):
             g.b.set(out, 1.0)
         with g.b.else_():
@@ -302,10 +308,11 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
         r = g.let(0.5 * (e - s), "R")
         c = g.let(s + r, "C")
         with g.b.if_(s.le(x).and_(x.le(e))):
-            q = g.let(r * r - (x - c) * (x - c), "Q")
+            t = g.let((x - c) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
             with g.b.if_(q.lt(0.0)):
                 g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q) / r)
+            g.b.set(out, g.call("SQRT", q))
         with g.b.else_():
             g.b.set(out, 0.0)
     else:

@@ -504,12 +504,13 @@ def _point_values(grid: GridPlan, groups: list[tuple[int, Arr, W, bool]], accu: 
     return np.stack(cols, axis=1)
 
 
-def _mean_distinct(x: Arr) -> Arr:
-    """Row-wise mean of the distinct non-NaN values."""
+def _mean_distinct(x: Arr, near: float) -> Arr:
+    """Row-wise mean of the distinct non-NaN values (within ``near`` of the one before: the
+    same point, ``pwl.distinct_points``)."""
     s = np.sort(x, axis=1)
     valid = ~np.isnan(s)
     first = np.ones_like(valid)
-    first[:, 1:] = s[:, 1:] != s[:, :-1]
+    first[:, 1:] = s[:, 1:] - s[:, :-1] > near
     keep = valid & first
     cnt = keep.sum(axis=1)
     with np.errstate(all="ignore"):
@@ -533,6 +534,7 @@ def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -
             np.where(hitg, gxb, -np.inf).max(axis=1),
         )
     else:
+        near = pwl.MAX_TOL * float(gx[-1] - gx[0])  # pwl.maxima
         plateau = hit0 & hit1 & (x1 > x0)
         length = np.where(plateau, x1 - x0, 0.0).sum(axis=1)
         mom = np.where(plateau, (x1 - x0) * 0.5 * (x0 + x1), 0.0).sum(axis=1)
@@ -540,7 +542,7 @@ def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -
             [np.where(hit0, x0, np.nan), np.where(hit1, x1, np.nan), np.where(hitg, gxb, np.nan)], axis=1
         )
         with np.errstate(all="ignore"):
-            value = np.where(length > 0.0, mom / length, _mean_distinct(pts))
+            value = np.where(length > near, mom / length, _mean_distinct(pts, near))
     return np.where(fired, value, np.nan), fired
 
 
@@ -567,20 +569,28 @@ def _coa(x0: Arr, x1: Arr, v0: Arr, v1: Arr) -> Result:
         s = np.minimum(s, d)
         return np.asarray(b0 - s if reverse else a0 + s, dtype=np.float64)
 
+    tol = pwl.COA_TOL * total  # a zero gap: its middle (pwl.bisector)
+    enough = (half - tol)[:, None]
     cum = np.cumsum(areas, axis=1)
-    ok = (cum >= half[:, None]) & (areas > 0.0)
+    ok = (cum >= enough) & (areas > 0.0)
     i_left = np.argmax(ok, axis=1)
     before = (
         np.take_along_axis(cum, i_left[:, None], axis=1)[:, 0]
         - np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
     )
-    left = solve(i_left, half - before, False)
+    a_left = np.take_along_axis(areas, i_left[:, None], axis=1)[:, 0]
+    whole = half - before >= a_left - tol
+    left = solve(i_left, np.where(whole, a_left, half - before), False)
+    left = np.where(whole, np.take_along_axis(x1, i_left[:, None], axis=1)[:, 0], left)
     rcum = np.cumsum(areas[:, ::-1], axis=1)[:, ::-1]
-    ok_r = (rcum >= half[:, None]) & (areas > 0.0)
+    ok_r = (rcum >= enough) & (areas > 0.0)
     i_right = areas.shape[1] - 1 - np.argmax(ok_r[:, ::-1], axis=1)
     before_r = (
         np.take_along_axis(rcum, i_right[:, None], axis=1)[:, 0]
         - np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
     )
-    right = solve(i_right, half - before_r, True)
+    a_right = np.take_along_axis(areas, i_right[:, None], axis=1)[:, 0]
+    whole = half - before_r >= a_right - tol
+    right = solve(i_right, np.where(whole, a_right, half - before_r), True)
+    right = np.where(whole, np.take_along_axis(x0, i_right[:, None], axis=1)[:, 0], right)
     return np.where(fired, 0.5 * (left + right), np.nan), fired

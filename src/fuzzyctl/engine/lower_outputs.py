@@ -9,7 +9,7 @@ from fuzzyctl.engine import operators as ops
 from fuzzyctl.engine import shapes, universe
 from fuzzyctl.engine.grid import build_grid
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
-from fuzzyctl.engine.plan import Contribution, OutputPlan, PParam, RulePlan, Slot, TermPlan
+from fuzzyctl.engine.plan import Contribution, GridPlan, OutputPlan, PParam, RulePlan, Slot, TermPlan
 
 METHOD_ALIASES = {
     "MM": "MOM",
@@ -245,9 +245,22 @@ def _mamdani_output(
     if exact and all(t.constant for t in tps):
         used = {c.term for c in contributions if c.term is not None}
         grid = build_grid([t.pwl for t in tps if t.pwl is not None], low, high, used)
+        if not _finite_grid(grid):
+            # closed forms whose coefficients overflow (a term rising 2e-308 over 2e-308, points
+            # at 1e300): the integrals are taken numerically, as for curved terms
+            grid, exact = None, False
     return OutputPlan(
         var.name, "mamdani", meth, acc, tps, tuple(contributions), default, no_change, low, high, exact, grid
     )
+
+
+def _finite_grid(grid: GridPlan) -> bool:
+    """Whether every number of ``grid``'s closed forms is finite (each becomes a literal of
+    the generated evaluator, which has no infinite literals)."""
+    numbers = [*grid.xs, *(c for bands in grid.min_bands for _lo, _hi, ac, mc in bands for c in (*ac, *mc))]
+    numbers += [c for area_moment in grid.full for c in area_moment]
+    numbers += [v for rows in (grid.left, grid.right, grid.point) for row in rows for v in row]
+    return all(math.isfinite(v) for v in numbers)
 
 
 def _universe(

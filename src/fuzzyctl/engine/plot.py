@@ -67,10 +67,17 @@ def ascii_plot(trace: OutputTrace, width: int = 64, height: int = 10) -> str:
     if mark is not None:
         rows.append("      " + " " * mark + f"^ {trace.name} = {trace.value:.6g}")
     else:
-        rows.append(
-            f"      {trace.name} = {trace.value:.6g}" + ("" if trace.fired else " (no rule fired: default)")
-        )
+        rows.append(f"      {trace.name} = {trace.value:.6g}" + _why(trace))
     return "\n".join(rows)
+
+
+def _why(trace: OutputTrace) -> str:
+    """Why an output has the value it has, when that is not the accumulated set's."""
+    if not trace.fired:
+        return " (no rule fired: default)"
+    if not math.isfinite(trace.value):
+        return " (rules fired; a term is NaN or infinite there)"
+    return ""
 
 
 def explanation_figure(explanation: Explanation) -> Figure:

@@ -25,6 +25,10 @@ from fuzzyctl.engine.plan import GridPlan
 
 #: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
 MAX_TOL = 1e-12
+#: Relative tolerance (of the whole area) within which CoA takes the area before a zero gap
+#: as half: the bisector is then not unique and CoA answers the middle of the gap (rounding
+#: in the running sums would otherwise pick one end of it).
+COA_TOL = 1e-12
 
 Piece = tuple[float, float, float, float, tuple[tuple[float, float], ...] | None]
 #: One activated set on one grid interval: (L, R, a, w, is_min) - the term goes linearly from
@@ -227,19 +231,22 @@ def bisector(pieces: Sequence[Piece], total: float) -> float:
     """Centre of area: the x splitting the area in two equal halves.  When a whole interval
     of solutions exists (a gap where the set is 0), its midpoint."""
     half = 0.5 * total
+    tol = COA_TOL * total
     areas = [piece_area_moment(p)[0] for p in pieces]
+    # the whole piece within tol: its end, not the quadratic (whose root near a 0 end moves
+    # by sqrt(rounding) there)
     cum = 0.0
     left = pieces[-1][1]
     for p, a in zip(pieces, areas, strict=True):
-        if a > 0.0 and cum + a >= half:
-            left = _solve_in_piece(p, half - cum)
+        if a > 0.0 and cum + a >= half - tol:
+            left = p[1] if half - cum >= a - tol else _solve_in_piece(p, half - cum)
             break
         cum += a
     cum = 0.0
     right = pieces[0][0]
     for p, a in zip(reversed(pieces), reversed(areas), strict=True):
-        if a > 0.0 and cum + a >= half:
-            right = _solve_in_piece(p, a - (half - cum))
+        if a > 0.0 and cum + a >= half - tol:
+            right = p[0] if half - cum >= a - tol else _solve_in_piece(p, a - (half - cum))
             break
         cum += a
     return 0.5 * (left + right)
@@ -259,8 +266,11 @@ def maxima(
     lm, rm = math.inf, -math.inf
     plateau_len = plateau_mom = 0.0
     isolated: set[float] = set()
-    # crossing points are computed, not given: accept values within MAX_TOL of the supremum
+    # crossing points are computed, not given: accept values within MAX_TOL of the supremum,
+    # and take points within MAX_TOL of the range for one (a crossing rounded 1e-15 from a
+    # vertex is no plateau and no second maximum)
     thr = sup * (1.0 - MAX_TOL)
+    near = MAX_TOL * (points[-1][0] - points[0][0]) if points else 0.0
     for x0, x1, v0, v1, _f in pieces:
         if v0 >= thr:
             lm = min(lm, x0)
@@ -278,12 +288,18 @@ def maxima(
             lm = min(lm, x)
             rm = max(rm, x)
             isolated.add(x)
+    distinct = distinct_points(sorted(isolated), near)
     mom = (
         plateau_mom / plateau_len
-        if plateau_len > 0.0
-        else (fsum(isolated) / len(isolated) if isolated else math.nan)
+        if plateau_len > near
+        else (fsum(distinct) / len(distinct) if distinct else math.nan)
     )
     return sup, lm, rm, mom
+
+
+def distinct_points(xs: Sequence[float], near: float) -> list[float]:
+    """Sorted ``xs`` without the points within ``near`` of the one before them."""
+    return [x for i, x in enumerate(xs) if i == 0 or x - xs[i - 1] > near]
 
 
 def defuzzify_pieces(

@@ -14,10 +14,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
 from fuzzyctl.engine.operators import fsum
+from fuzzyctl.engine.pwl import COA_TOL
 from fuzzyctl.engine.shapes import FloatArray
 
 _XGK = np.array(
@@ -93,6 +95,8 @@ def integrate(
         share = (b - a) / span
         tol = rtol * total * np.maximum(share, 1e-6)
         ok = (ek <= tol) & (ekm <= tol * scale) | ((b - a) <= 1e-13 * scale)
+        if not (np.isfinite(k).all() and np.isfinite(km).all()):
+            ok = np.ones_like(ok)  # NaN/inf (a 0/0 in a function term): no halving makes it a number
         if n_open + len(done) > MAX_INTERVALS:  # give up refining: keep the best estimate
             ok = np.ones_like(ok)
         done.append((a[ok], b[ok], k[ok], km[ok]))
@@ -111,6 +115,41 @@ def integrate(
     return A[order], B[order], K[order], KM[order]
 
 
+def kinks(branch: Callable[[FloatArray], list[Any]], cuts: Sequence[float], samples: int = 16) -> list[float]:
+    """Points between ``cuts`` where ``branch(x)`` (which piece of a formula x falls in)
+    changes: each interval sampled at ``samples`` points, every change located by bisection
+    to the float (a kink inside an interval can fool the error estimate).  A gap between two
+    samples may pass several pieces: one is found per round, four rounds at most."""
+    edges = np.array(sorted(set(cuts)), dtype=np.float64)
+    t = np.linspace(0.0, 1.0, samples)
+    xs = (edges[:-1, None] + (edges[1:] - edges[:-1])[:, None] * t[None, :]).ravel()
+    codes = branch(xs)
+    gaps = [i for i in range(len(xs) - 1) if codes[i] != codes[i + 1] and xs[i] < xs[i + 1]]
+    lo = np.array([xs[i] for i in gaps])
+    hi = np.array([xs[i + 1] for i in gaps])
+    c_lo = [codes[i] for i in gaps]
+    c_end = [codes[i + 1] for i in gaps]
+    out: list[float] = []
+    for _round in range(4):
+        if not len(lo):
+            break
+        end = hi.copy()
+        while True:  # all gaps at once, to the last bit
+            mid = 0.5 * (lo + hi)
+            open_ = (mid != lo) & (mid != hi)
+            if not open_.any():
+                break
+            same = np.array([c == c0 for c, c0 in zip(branch(mid), c_lo, strict=True)]) & open_
+            lo = np.where(same, mid, lo)
+            hi = np.where(same | ~open_, hi, mid)
+        out += [float(v) for v in hi]
+        c_hi = branch(hi)
+        more = [k for k in range(len(hi)) if c_hi[k] != c_end[k] and hi[k] < end[k]]
+        lo, hi = hi[more], end[more]
+        c_lo, c_end = [c_hi[k] for k in more], [c_end[k] for k in more]
+    return out
+
+
 def partial(f: Integrand, a: float, x: float) -> float:
     """One 15-point Kronrod estimate of the integral of ``f`` over ``[a, x]`` (``x`` inside an
     accepted interval, where the rule is accurate)."""
@@ -118,21 +157,36 @@ def partial(f: Integrand, a: float, x: float) -> float:
     return float(k[0])
 
 
-def bisector(f: Integrand, A: FloatArray, B: FloatArray, K: FloatArray) -> float:
-    """Centre of area from accepted intervals."""
+def bisector(f: Integrand, A: FloatArray, B: FloatArray, K: FloatArray, rtol: float = 1e-10) -> float:
+    """Centre of area from accepted intervals: the middle of the points that halve the area -
+    one point, or a whole gap where the set is 0 (``pwl.bisector``: an area within a tolerance
+    of half counts as half - here ten times the quadrature's ``rtol``, what the areas are
+    known to - and a whole interval within it answers its end)."""
     total = float(np.sum(K))
     half = 0.5 * total
+    tol = max(COA_TOL, 10.0 * rtol) * total
     cum = np.cumsum(K)
-    i = int(np.searchsorted(cum, half))
-    i = min(i, len(K) - 1)
+    i = int(np.argmax((cum >= half - tol) & (K > 0.0)))
     before = float(cum[i - 1]) if i > 0 else 0.0
-    lo, hi = float(A[i]), float(B[i])
-    target = half - before
+    left = float(B[i]) if half - before >= K[i] - tol else _solve(f, float(A[i]), float(B[i]), half - before)
+    rcum = np.cumsum(K[::-1])[::-1]
+    j = len(K) - 1 - int(np.argmax(((rcum >= half - tol) & (K > 0.0))[::-1]))
+    after = float(rcum[j]) - float(K[j])
+    if half - after >= K[j] - tol:
+        right = float(A[j])
+    else:
+        right = _solve(f, float(A[j]), float(B[j]), float(K[j]) - (half - after))
+    return 0.5 * (left + right)
+
+
+def _solve(f: Integrand, a: float, b: float, target: float) -> float:
+    """The x in [a, b] (an accepted interval) where the area from ``a`` reaches ``target``."""
+    lo, hi = a, b
     for _ in range(100):
         mid = 0.5 * (lo + hi)
         if mid in (lo, hi):
             break
-        if partial(f, float(A[i]), mid) < target:
+        if partial(f, a, mid) < target:
             lo = mid
         else:
             hi = mid
@@ -163,6 +217,8 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
         i = int(index)
         if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
             continue
+        if (i > 0 and ys[i - 1] == ys[i]) or (i + 1 < n and ys[i + 1] == ys[i]):
+            continue  # a node of a plateau (below: its edges), not a peak between nodes
         peaks.append(
             _golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i]))
         )

@@ -248,14 +248,16 @@ def _smooth(kind: str, p: Sequence[float], x: float) -> float:
         s, e = p
         r = e - s
         if (s < e and s <= x <= e) or (s > e and e <= x <= s):
-            return math.sqrt(max(r * r - (x - e) * (x - e), 0.0)) / abs(r)
+            t = (x - e) / r  # sqrt(r^2 - (x-e)^2) / |r| without squaring r (1e300 overflows)
+            return math.sqrt(max(1.0 - t * t, 0.0))
         return 1.0 if (s < e and x > e) or (s > e and x < e) else 0.0
     if kind == "semiellipse":
         s, e = min(p), max(p)
         r = 0.5 * (e - s)
         c = s + r
         if s <= x <= e:
-            return math.sqrt(max(r * r - (x - c) * (x - c), 0.0)) / r
+            t = (x - c) / r  # as arc: r^2 would overflow
+            return math.sqrt(max(1.0 - t * t, 0.0))
         return 0.0
     raise ValueError(f"unknown shape kind {kind!r}")
 
@@ -333,7 +335,8 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
         s, e = p
         r = e - s
         inside = ((s < e) & (s <= x) & (x <= e)) | ((s > e) & (e <= x) & (x <= s))
-        arc = np.sqrt(np.maximum(r * r - (x - e) * (x - e), 0.0)) / np.abs(r)
+        t = (x - e) / r  # as _smooth
+        arc = np.sqrt(np.maximum(1.0 - t * t, 0.0))
         beyond = ((s < e) & (x > e)) | ((s > e) & (x < e))
         return np.where(inside, arc, np.where(beyond, 1.0, 0.0))
     if kind == "semiellipse":
@@ -341,7 +344,8 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
         r = 0.5 * (e - s)
         c = s + r
         inside = (x >= s) & (x <= e)
-        return np.where(inside, np.sqrt(np.maximum(r * r - (x - c) * (x - c), 0.0)) / r, 0.0)
+        t = (x - c) / r  # as _smooth
+        return np.where(inside, np.sqrt(np.maximum(1.0 - t * t, 0.0)), 0.0)
     raise ValueError(f"unknown shape kind {kind!r}")
 
 
@@ -395,7 +399,9 @@ def _membership_np(kind: str, params: Sequence[Any], height: Any, x: FloatArray)
         for xi, yi in zip(params[0::2], params[1::2], strict=True):
             best = np.where(x == xi, np.maximum(best, yi), best)
         return np.asarray(best * height, dtype=np.float64)
-    return np.asarray(height * _smooth_np(kind, params, x), dtype=np.float64)
+    # numpy scalars: a Python float operand would raise where IEEE gives inf (2 / w, w = 0)
+    p64 = [np.float64(p) if np.ndim(p) == 0 else p for p in params]
+    return np.asarray(height * _smooth_np(kind, p64, x), dtype=np.float64)
 
 
 def _pwl_dynamic(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -> FloatArray:

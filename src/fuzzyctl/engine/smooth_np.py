@@ -77,9 +77,11 @@ def smooth_output(
         a, b, r = _kinked_intervals(f, len(block), cuts)
         area, moment = integrate_rows(f, len(block), a, b, r, cuts, plan.options.quad_rtol)
         ok = area > 0.0
+        # rules fired but a term is undefined there: NaN, not the DEFAULT (interp._smooth)
+        undefined = ~(np.isfinite(area) & np.isfinite(moment))
         with np.errstate(all="ignore"):
-            value[block] = np.where(ok, moment / area, np.nan)
-        fired[block] = ok
+            value[block] = np.where(ok & ~undefined, moment / area, np.nan)
+        fired[block] = ok | undefined
     return value, fired
 
 
@@ -106,6 +108,9 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             for _t, _a, w, _act in cs
         ]
     )
+    # a set the rule does not activate is left out, as the interpreter leaves it out: under
+    # MIN activation a function term below 0 would otherwise still reach the sum
+    live = A * W > 0.0
     acts = [act for _t, _a, _w, act in cs]
     is_min = np.array([act == "MIN" for act in acts])[:, None]
     by_kind: dict[str, list[int]] = {}
@@ -138,9 +143,11 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
             c = a * mu
         else:
             c = np.stack([TNORMS[act].array(a[g], mu[g]) for g, act in enumerate(acts)])
-        c = W[:, r] * c
+        c = np.where(live[:, r], W[:, r] * c, 0.0)  # 0: what every accumulation leaves alone
         if accu == "MAX":
-            acc = c.max(axis=0)
+            # from the empty set, as interp.accumulated_function: a term below 0 is cut at 0
+            top = c.max(axis=0)
+            acc = np.maximum(top, 0.0)
         elif accu in ("SUM", "NSUM"):
             acc = c.sum(axis=0)
         else:
@@ -152,7 +159,7 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         clipped = is_min & (a < mu)
         if accu == "MAX":
             win = np.argmax(c, axis=0)
-            code = 2 * win + clipped[win, np.arange(len(x))]
+            code = np.where(top < 0.0, -1, 2 * win + clipped[win, np.arange(len(x))])
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
             if accu == "BSUM":
@@ -223,11 +230,16 @@ def integrate_rows(f: Any, m: int, a: Arr, b: Arr, r: Arr, cuts: Any, rtol: floa
     area = np.zeros(m)
     moment = np.zeros(m)
     count = np.bincount(r, minlength=m)
+    undefined = np.zeros(m, dtype=bool)
     while True:
         share = (b - a) / span
         tol = rtol * total[r] * np.maximum(share, 1e-6)
         ok = (ek <= tol) & (ekm <= tol * scale) | ((b - a) <= 1e-13 * scale)
         ok |= count[r] > quadrature.MAX_INTERVALS  # give up refining: keep the best estimate
+        # a row with NaN/inf (a 0/0 in a function term) has no number for an answer: no
+        # halving makes one, so its intervals stop here (memory stays proportionate to rows)
+        undefined |= np.bincount(r, weights=~(np.isfinite(k) & np.isfinite(km)), minlength=m) > 0
+        ok |= undefined[r]
         area += np.bincount(r[ok], weights=k[ok], minlength=m)
         moment += np.bincount(r[ok], weights=km[ok], minlength=m)
         if ok.all():

@@ -52,13 +52,38 @@ def span_rule(kind: str) -> str:
     return SPAN_RULES.get(kind, "the hull of its parameters")
 
 
+def _div(a: float, b: float) -> float:
+    """``a / b`` as Java (and jFuzzyLogic) computes it: a zero divisor gives an infinity (or
+    NaN for 0 / 0), never an exception (a Bell of slope 0, a sigmoid of slope 0)."""
+    try:
+        return a / b
+    except ZeroDivisionError:
+        return math.nan if a == 0.0 or math.isnan(a) else math.copysign(math.inf, a) * math.copysign(1.0, b)
+
+
+def _pow(base: float, exponent: float) -> float:
+    """``base ** exponent``, infinite where it overflows (Java's Math.pow)."""
+    try:
+        return math.pow(base, exponent)
+    except OverflowError:
+        return math.inf
+
+
 def span(kind: str, params: Sequence[float]) -> tuple[float, float]:
     """The universe jFuzzyLogic gives one term (``kind`` and canonical ``params`` of
     :data:`fuzzyctl.model.SHAPES`; ``points``/``singletons`` as ``x0, y0, x1, y1, ...``).
 
     Written as jFuzzyLogic's ``estimateUniverse`` writes it, so that the sample points of its
     1000-point defuzzification are reproduced to the last bit.  May be infinite (a shoulder
-    at -inf) or reversed (a negative width); callers check."""
+    at -inf, a slope of 0) or reversed (a negative width); callers check.  A span that is not
+    a number (a Bell of slope 0 and width 0) is the whole line."""
+    low, high = _span(kind, params)
+    if math.isnan(low) or math.isnan(high):
+        return -math.inf, math.inf
+    return low, high
+
+
+def _span(kind: str, params: Sequence[float]) -> tuple[float, float]:
     p = [float(v) for v in params]
     if kind in ("points", "singletons"):
         return p[0], p[-2]
@@ -75,15 +100,15 @@ def span(kind: str, params: Sequence[float]) -> tuple[float, float]:
         return p[0] - 4.0 * p[1], p[2] + 4.0 * p[3]
     if kind == "bell":
         c, w, b = p
-        delta = math.pow(999.0, 1.0 / (2.0 * b)) * w
+        delta = _pow(999.0, _div(1.0, 2.0 * b)) * w
         return c - delta, c + delta
     if kind == "sigmoid":
         c, s = p
-        return c - 9.0 / abs(s), c + 9.0 / abs(s)
+        return c - _div(9.0, abs(s)), c + _div(9.0, abs(s))
     if kind in ("dsigmoid", "dsigmoid_pos", "psigmoid"):
         c1, s1, c2, s2 = p
-        min1, max1 = c1 - 9.0 / abs(s1), c1 + 9.0 / abs(s1)
-        min2, max2 = c2 - 9.0 / abs(s2), c2 + 9.0 / abs(s2)
+        min1, max1 = c1 - _div(9.0, abs(s1)), c1 + _div(9.0, abs(s1))
+        min2, max2 = c2 - _div(9.0, abs(s2)), c2 + _div(9.0, abs(s2))
         return (min1 if min1 < min2 else min2), (max1 if max1 > max2 else max2)
     if kind == "cosine":
         c, w = p

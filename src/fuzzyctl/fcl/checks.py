@@ -8,7 +8,6 @@ reports."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
@@ -39,6 +38,7 @@ from fuzzyctl.model import (
     VarKind,
     walk_condition,
 )
+from fuzzyctl.validation import at_spans, validate
 
 
 @dataclass
@@ -233,32 +233,7 @@ def _check_terms(terms: tuple[Term, ...], variable: str, r: _Reporter) -> None:
             )
         else:
             seen[t.name] = t.span
-        mf = t.mf
-        if isinstance(mf, PointsMF | SingletonsMF):
-            xs = [p.x for p in mf.points]
-            for i in range(1, len(xs)):
-                a, b = xs[i - 1], xs[i]
-                if not isinstance(a, Ref) and not isinstance(b, Ref) and b < a:
-                    r.error(
-                        f"TERM {t.name}: points not in ascending order ({_num(a)} then {_num(b)})",
-                        mf.points[i].span or t.span,
-                        "points-not-ascending",
-                        hint="5.2.2: the points shall be given in ascending order of the variable value",
-                    )
-                    break
-            for p in mf.points:
-                if not isinstance(p.y, Ref) and not (0.0 <= p.y <= 1.0):
-                    r.error(
-                        f"TERM {t.name}: membership degree {_num(p.y)} is outside [0, 1]",
-                        p.span or t.span,
-                        "degree-out-of-range",
-                    )
-        if isinstance(mf, PointsMF) and not mf.points:
-            r.error(f"TERM {t.name} has no points", t.span, "empty-term")
-
-
-def _num(x: float) -> str:
-    return f"{x:g}"
+    # the points of each term: fuzzyctl.validation (one validation for every reader)
 
 
 def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None:
@@ -428,24 +403,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         wvar.span,
                         "weight-out-of-range",
                     )
-            elif w is not None and math.isnan(w):
-                r.error(
-                    f"RULE {rule.label}: weight is not a number", c.span or rule.span, "weight-out-of-range"
-                )
-            elif w is not None and w < 0.0:
-                r.error(
-                    f"RULE {rule.label}: weight {w:g} is negative; 5.2.4 allows 0.0 to 1.0",
-                    c.span or rule.span,
-                    "weight-out-of-range",
-                )
-            elif w is not None and w > 1.0:
-                # jFuzzyLogic multiplies by any weight; files written for it use weights > 1.
-                r.warning(
-                    f"RULE {rule.label}: weight {w:g} is above 1; 5.2.4 allows 0.0 to 1.0 "
-                    "(used as written, as jFuzzyLogic does)",
-                    c.span or rule.span,
-                    "weight-out-of-range",
-                )
+            # a numeric weight: fuzzyctl.validation (one validation for every reader)
 
 
 def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
@@ -522,9 +480,16 @@ def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
     return check_reserved_words(doc, ctx.file, bool(ctx.options.get("strict")))
 
 
+def check_model(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+    """The rules every reader applies (:mod:`fuzzyctl.validation`: points, degrees, weights),
+    at FCL's own positions; ``strict``: a weight above 1 is an error."""
+    return at_spans(validate(doc, strict=bool(ctx.options.get("strict"))), ctx.file)
+
+
 register_provider("declarations", check_declarations)
 register_provider("rules", check_rules)
 register_provider("functions", check_functions)
+register_provider("model", check_model)
 
 
 def check_jfl(doc: Document, ctx: CheckContext) -> list[Diagnostic]:

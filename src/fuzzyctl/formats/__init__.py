@@ -25,6 +25,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
 from fuzzyctl.files import write_atomic
 from fuzzyctl.gcpause import gc_paused
 from fuzzyctl.model import Document
+from fuzzyctl.validation import Placer, at_spans
 
 
 @dataclass(frozen=True)
@@ -78,6 +79,11 @@ class Format:
     """What the writer says in a nearest form of its own rather than as the model does: not a
     loss (the written file computes the same), but worth a warning to whoever reads the file
     with another tool (FCL: a rule without an IF part becomes ``IF ALWAYS THEN``)."""
+    place: Placer = field(default=at_spans)
+    """Where this format's diagnostics put what :func:`fuzzyctl.validation.validate` finds:
+    at the spans the reader kept (file:line:column), or at JSON paths."""
+    validates: bool = False
+    """The reader runs :func:`fuzzyctl.validation.validate` itself (FCL, among its checks)."""
 
     def losses(self, document: Document) -> list[Loss]:
         """What this format cannot express of ``document`` (empty: a lossless write)."""
@@ -167,6 +173,7 @@ def decode(data: bytes) -> str:
 def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
     """Parse ``text`` as ``format``."""
     from fuzzyctl.limits import check_document, check_text
+    from fuzzyctl.validation import validate
 
     fmt = get(format)
     if fmt.read is None:
@@ -176,7 +183,12 @@ def read_text(text: str, format: str, *, path: str | None = None) -> Loaded:
     too_deep = check_document(loaded.document, path)
     if too_deep:  # refused here, before anything walks the trees recursively
         raise DiagnosticError(too_deep, text)
-    return loaded
+    if fmt.validates:
+        return loaded
+    found = fmt.place(validate(loaded.document), path)  # the same rules for every reader
+    if any(d.is_error for d in found):
+        raise DiagnosticError(found, text)
+    return Loaded(loaded.document, (*loaded.diagnostics, *found)) if found else loaded
 
 
 def read_path(path: str | Path, format: str | None = None) -> Loaded:

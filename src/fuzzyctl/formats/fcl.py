@@ -133,7 +133,11 @@ def _fcl_identifier(name: str, taken: set[str]) -> str:
 
 def _as_points(mf: MembershipFunction) -> MembershipFunction:
     """A triangle or trapezoid with numeric, finite vertices as the IEC point list it is
-    (Basic level, Table 8; the engine evaluates both the same); anything else unchanged."""
+    (Basic level, Table 8; the engine evaluates both the same); a list of one point (made
+    through the API: no reader accepts one) as that point twice, the same constant degree
+    written as 5.2.2 asks (two points at least); anything else unchanged."""
+    if isinstance(mf, PointsMF) and len(mf.points) == 1:
+        return PointsMF(mf.points * 2)
     if not isinstance(mf, ShapeMF) or mf.kind not in ("triangle", "trapezoid"):
         return mf
     values = (*mf.params, mf.height)
@@ -280,4 +284,5 @@ FORMAT = Format(
     write=_write if _available else None,
     lower=lower,
     notes=notes,
+    validates=True,
 )

@@ -20,7 +20,6 @@ The writer lives in :mod:`fuzzyctl.formats.fis_write`.
 
 from __future__ import annotations
 
-import itertools
 import math
 import re
 from dataclasses import dataclass, field, replace
@@ -234,8 +233,8 @@ def _membership(
         if len(params) < 2:
             raise rep.fail("'discretemf' needs x y pairs", line, code="fis-params")
         xs, ys = params[0::2], params[1::2]
-        if any(b < a for a, b in itertools.pairwise(xs)):
-            raise rep.fail("'discretemf' points must be in ascending x", line, code="fis-params")
+        # one pair is a constant degree (fuzzylite); the model says it with two points (5.2.2)
+        xs, ys = (xs * 2, ys * 2) if len(xs) == 1 else (xs, ys)
         return PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     mapping = FIS_TYPES.get(kind_lower)
     if mapping is None or (

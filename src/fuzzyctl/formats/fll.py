@@ -22,7 +22,6 @@ The writer lives in :mod:`fuzzyctl.formats.fll_write`.
 
 from __future__ import annotations
 
-import itertools
 import math
 import re
 from dataclasses import dataclass, field
@@ -207,8 +206,8 @@ def _term(
         if len(params) < 2:
             raise rep.fail(f"Discrete {name!r} needs x y pairs", line, code="fll-term")
         xs, ys = params[0::2], params[1::2]
-        if any(b < a for a, b in itertools.pairwise(xs)):
-            raise rep.fail(f"Discrete {name!r}: x values must ascend", line, code="fll-term")
+        # one pair is a constant degree (fuzzylite); the model says it with two points (5.2.2)
+        xs, ys = (xs * 2, ys * 2) if len(xs) == 1 else (xs, ys)
         mf = PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     else:
         mapping = FLL_TYPES.get(cls)

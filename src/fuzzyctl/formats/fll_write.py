@@ -90,7 +90,11 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
                     "FLL has no IEC NSUM accumulation (fuzzylite's NormalizedSum normalises pairwise)",
                 )
             )
-    return Document((replace(fb, rule_blocks=tuple(blocks)),), document.path), losses
+    # what is written instead (--lossy): UnboundedSum, which NSUM only scales by a constant
+    # (the same centroid; a weighted average writes SUM already)
+    blocks = [replace(b, accu="SUM") if b.accu == "NSUM" else b for b in blocks]
+    defuzzify = tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify)
+    return Document((replace(fb, rule_blocks=tuple(blocks), defuzzify=defuzzify),), document.path), losses
 
 
 def _replace_block(fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock) -> FunctionBlock:

@@ -95,7 +95,8 @@ def _input_points(points: Sequence[tuple[float, float]], low: float, high: float
     pts = list(points)
     if len(pts) == 1:
         x, y = pts[0]
-        pts = [(x, 0.0), (x, y), (x, 0.0)] if y > 0 else pts
+        # a point of degree 0 is 0 everywhere: two points, as 5.2.2 asks
+        pts = [(x, 0.0), (x, y), (x, 0.0)] if y > 0 else [(x, y), (x, y)]
     else:
         if pts[0][1] > 0 and pts[0][0] > low:
             pts.insert(0, (pts[0][0], 0.0))

@@ -3,6 +3,7 @@ cannot express, and the lowering ``fuzzyctl convert --lossy`` uses."""
 
 from __future__ import annotations
 
+import itertools
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
@@ -39,7 +40,16 @@ def _num(x: float) -> str:
 
 
 def _as_points(mf: MembershipFunction) -> list[tuple[float, float]] | None:
-    """Points of a piecewise-linear term, or None when FPL cannot hold it."""
+    """Points of a piecewise-linear term, or None when FPL cannot hold it (also a triangle,
+    trapezoid or rectangle whose vertices are out of order: the FPL reader refuses points
+    that are not in increasing x order)."""
+    points = _points_of(mf)
+    if points is None or any(b[0] < a[0] for a, b in itertools.pairwise(points)):
+        return None
+    return points
+
+
+def _points_of(mf: MembershipFunction) -> list[tuple[float, float]] | None:
     if isinstance(mf, PointsMF):
         if not all(is_constant(p.x) and is_constant(p.y) for p in mf.points):
             return None
@@ -164,6 +174,14 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
                     "fpl-expr-term",
                 )
     for v in block.variables:
+        fzb, dzb = block.fuzzify_block(v.name), block.defuzzify_block(v.name)
+        rng = v.range or (fzb.range if fzb else None) or (dzb.range if dzb else None)
+        if rng is not None and not rng.low < rng.high and v.kind is not VarKind.LOCAL:
+            err(
+                f"{v.name}: RANGE ({rng.low:g} .. {rng.high:g}) cannot be written: FPL needs MIN below MAX",
+                rng.span or v.span,
+                "fpl-expr-range",
+            )
         if v.kind is VarKind.OUTPUT and block.defuzzify_block(v.name) is None:
             err(f"output {v.name} has no DEFUZZIFY block", v.span, "fpl-expr-output")
     return diags
@@ -267,7 +285,7 @@ def write_fpl(block: FunctionBlock | Document) -> str:
         if rng is None:
             xs = [x for _, pts in members for x, _ in pts]
             rng = Range(min(xs), max(xs)) if xs else None
-        if rng is not None:
+        if rng is not None and rng.low < rng.high:  # check_fpl says a degenerate one is dropped
             out += [f"MIN {_num(rng.low)}", f"MAX {_num(rng.high)}"]
         for name, pts in members:
             out += [f"MEMBER {name}", "POINTS " + " ".join(f"{_num(x)},{_num(y)}" for x, y in pts), "END"]

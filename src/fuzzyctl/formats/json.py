@@ -24,6 +24,7 @@ from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, error
 from fuzzyctl.escape import json_text
 from fuzzyctl.formats import Format, Loaded
+from fuzzyctl.validation import at_json_paths
 
 FORMAT_NAME = "fuzzyctl-model"
 VERSION = 1
@@ -120,7 +121,10 @@ def _decode_float(value: Any, where: str) -> float:
     if isinstance(value, bool):
         raise JsonModelError(where, "expected a number, found a boolean")
     if isinstance(value, int | float):
-        return float(value)
+        try:
+            return float(value)
+        except OverflowError:  # data not read by load_json (the studio's requests)
+            raise JsonModelError(where, "the number is too large (beyond 1.8e308)") from None
     if value in ("NaN", "Infinity", "-Infinity"):
         return {"NaN": math.nan, "Infinity": math.inf, "-Infinity": -math.inf}[value]
     raise JsonModelError(where, f"expected a number, found {value!r}")
@@ -232,46 +236,10 @@ def schema() -> dict[str, Any]:
     return loaded
 
 
-def _line_of(text: str, position: int) -> tuple[int, int]:
-    line = text.count("\n", 0, position) + 1
-    column = position - (text.rfind("\n", 0, position) + 1) + 1
-    return line, column
-
-
-def _too_deep(data: Any) -> bool:
-    """Whether ``data`` nests deeper than :data:`fuzzyctl.limits.MAX_JSON_DEPTH` (measured
-    without recursion: the decoder below recurses)."""
-    from fuzzyctl.limits import MAX_JSON_DEPTH
-
-    stack = [(data, 1)]
-    while stack:
-        item, level = stack.pop()
-        if level > MAX_JSON_DEPTH:
-            return True
-        if isinstance(item, dict):
-            stack.extend((v, level + 1) for v in item.values())
-        elif isinstance(item, list):
-            stack.extend((v, level + 1) for v in item)
-    return False
-
-
 def read(text: str, path: str | None = None) -> Loaded:
-    from fuzzyctl.limits import MAX_JSON_DEPTH
+    from fuzzyctl.limits import load_json
 
-    deep = error(f"the JSON nests more than {MAX_JSON_DEPTH} levels deep", code="json-depth", file=path)
-    try:
-        data = _json.loads(text)
-    except _json.JSONDecodeError as exc:
-        line, column = _line_of(text, exc.pos)
-        raise DiagnosticError(
-            [error(f"invalid JSON: {exc.msg}", m.Span(line, column), code="json-syntax", file=path)], text
-        ) from None
-    except RecursionError:  # the json module's own limit, far above ours
-        raise DiagnosticError([deep], text) from None
-    except ValueError as exc:  # an integer literal of more than 4300 digits
-        raise DiagnosticError([error(f"invalid JSON: {exc}", code="json-syntax", file=path)], text) from None
-    if _too_deep(data):
-        raise DiagnosticError([deep], text)
+    data = load_json(text, path)  # the nesting and number limits of every reader
     try:
         document = from_dict(data)
     except JsonModelError as exc:
@@ -291,4 +259,5 @@ FORMAT = Format(
     description="fuzzyctl model as JSON (lossless; schema in fuzzyctl/formats/fuzzyctl-model.schema.json)",
     read=read,
     write=_write,
+    place=at_json_paths,
 )

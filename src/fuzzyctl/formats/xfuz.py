@@ -61,6 +61,7 @@ from fuzzyctl.formats.xfuz_tables import (
     slot_kind,
     slot_label,
 )
+from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -156,13 +157,9 @@ def _is_int(v: Any) -> bool:
 
 
 def _read_json(text: str, path: str | None) -> XfuzConstants:
-    try:
-        data = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise DiagnosticError(
-            [error(f"not valid JSON: {exc.msg}", Span(exc.lineno, exc.colno), code="xfuz-json", file=path)],
-            text,
-        ) from None
+    from fuzzyctl.limits import load_json
+
+    data = load_json(text, path, "xfuz-json")  # the nesting and number limits of every reader
     diags: list[Diagnostic] = []
     if not isinstance(data, dict):
         raise DiagnosticError(
@@ -239,7 +236,8 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
         try:
             number = int(value, 0) if value.lower().startswith(("0x", "-0x")) else int(value)
         except ValueError:
-            diags.append(error(f"value {value!r} is not an integer", span, code="xfuz-csv", file=path))
+            message = f"value {shorten(value)!r} is not an integer"
+            diags.append(error(message, span, code="xfuz-csv", file=path))
             continue
         key = (table, index.upper())
         if key in seen:
@@ -259,10 +257,10 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
             else:
                 consts[index.upper()] = number
         elif table in sizes:
-            if not index.isdigit() or int(index) >= sizes[table]:
+            if not (index.isascii() and index.isdigit() and len(index) <= 6) or int(index) >= sizes[table]:
                 diags.append(
                     error(
-                        f"{table} index {index!r} is not 0..{sizes[table] - 1}",
+                        f"{table} index {shorten(index)!r} is not 0..{sizes[table] - 1}",
                         span,
                         code="xfuz-csv",
                         file=path,

@@ -120,7 +120,20 @@ def _int_point(value: Param, what: str, span: Span | None, diags: list[Diagnosti
 def _abcd(
     mf: MembershipFunction, what: str, span: Span | None, diags: list[Diagnostic]
 ) -> tuple[int, int, int, int] | None:
-    """A term as the four XFUZ abscissae (None and an error when it has another shape)."""
+    """A term as the four XFUZ abscissae (None and an error when it has another shape, or
+    abscissae out of order: a triangle 2 0 4 is no XFUZ term, and the XFUZ reader refuses
+    it as every reader does points out of order)."""
+    abcd = _abscissae(mf, what, span, diags)
+    if abcd is not None and not abcd[0] <= abcd[1] <= abcd[2] <= abcd[3]:
+        message = f"{what}: the abscissae {', '.join(map(str, abcd))} are not in ascending order"
+        diags.append(error(message, span, code="xfuz-expr-term"))
+        return None
+    return abcd
+
+
+def _abscissae(
+    mf: MembershipFunction, what: str, span: Span | None, diags: list[Diagnostic]
+) -> tuple[int, int, int, int] | None:
     if isinstance(mf, ShapeMF) and mf.kind in ("triangle", "trapezoid", "rectangle") and mf.height == 1.0:
         p = [_int_point(x, what, span, diags) for x in mf.params]
         if mf.kind == "triangle":

@@ -45,13 +45,19 @@ def document_from_json(data: dict[str, Any]) -> Document:
     """The model from its JSON form; a malformed one is a :class:`FuzzyctlError` naming
     the JSON path."""
     from fuzzyctl.formats import json as fjson
+    from fuzzyctl.validation import at_json_paths, validate
 
     try:
-        return fjson.from_dict(data)
+        document = fjson.from_dict(data)
     except DiagnosticError:
         raise
     except (ValueError, TypeError, KeyError) as exc:
         raise FuzzyctlError(f"invalid model: {exc}") from None
+    # the rules every reader applies (issue 25): what the studio evaluates and saves, check accepts
+    refused = [d for d in at_json_paths(validate(document)) if d.is_error]
+    if refused:
+        raise DiagnosticError(refused)
+    return document
 
 
 def document_to_json(document: Document) -> dict[str, Any]:
