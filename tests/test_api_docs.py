@@ -19,7 +19,7 @@ import fuzzyctl
 from tests.conftest import ROOT
 
 #: modules whose docstring examples are part of the reference (docs/api.md)
-MODULES = ["fuzzyctl.api", "fuzzyctl.tune", "fuzzyctl.control", "fuzzyctl.display"]
+MODULES = ["fuzzyctl.api", "fuzzyctl.tune", "fuzzyctl.analysis", "fuzzyctl.control", "fuzzyctl.display"]
 
 
 @pytest.fixture
@@ -70,7 +70,9 @@ def test_reference_builds_strict(tmp_path: Path) -> None:
     page = (tmp_path / "site" / "api" / "index.html").read_text()
     # every public name of the top level has its section, its example rendered as code
     for name in [n for n in fuzzyctl.__all__ if n != "__version__"]:
-        module = "api" if name in ("load", "compile", "plot_terms") else "tune"
+        module = {"load": "api", "compile": "api", "plot_terms": "api", "analyze": "analysis"}.get(
+            name, "tune"
+        )
         assert f'id="fuzzyctl.{module}.{name}"' in page, name
     assert 'id="fuzzyctl.control.iosys"' in page and 'id="fuzzyctl.display.controller_html"' in page
     assert "&gt;&gt;&gt;" in page and "<blockquote>" not in page  # doctests as code, not quotes

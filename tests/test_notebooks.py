@@ -32,9 +32,10 @@ def html_of(cell: dict[str, object]) -> str:
 
 def test_tour_runs_and_displays() -> None:
     cells = run("tour.ipynb")
-    controller, variable, _, explanation, loop = cells[0], cells[1], cells[2], cells[3], cells[4]
+    controller, variable, _, explanation, analysis, loop = cells
     assert "FUNCTION_BLOCK" in html_of(controller) and "<code>RULE 1" in html_of(controller)
     assert html_of(controller).count("data:image/png;base64,") == 3  # error, rate, dheat plotted
     assert "<td>pos_big</td>" in html_of(variable) and "data:image/png" in html_of(variable)
     assert "rules fired</b> (1 of 25)" in html_of(explanation)
+    assert "<td>gaps</td><td>0</td>" in html_of(analysis)
     assert "60" in str(loop["outputs"][-1]["data"]["text/plain"])  # type: ignore[index]

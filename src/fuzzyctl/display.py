@@ -1,4 +1,4 @@
-"""Rich displays in Jupyter: a controller, a variable or an explanation shown as HTML (tables,
+"""Rich displays in Jupyter: a controller, a variable, an explanation or an analysis shown as HTML (tables,
 the terms plotted, the explain chart) and PNG.
 
 ``import fuzzyctl`` in an IPython kernel calls :func:`register`, which teaches IPython's
@@ -26,11 +26,13 @@ from typing import TYPE_CHECKING, Any
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
 
+    from fuzzyctl.analysis.report import Analysis
     from fuzzyctl.engine.controller import Controller
     from fuzzyctl.engine.explain import Explanation
     from fuzzyctl.engine.variables import VariableInfo
 
 __all__ = [
+    "analysis_html",
     "controller_html",
     "explanation_html",
     "explanation_png",
@@ -47,6 +49,7 @@ _TYPES = {
     ("fuzzyctl.engine.controller", "Controller"): "controller_html",
     ("fuzzyctl.engine.variables", "VariableInfo"): "variable_html",
     ("fuzzyctl.engine.explain", "Explanation"): "explanation_html",
+    ("fuzzyctl.analysis.report", "Analysis"): "analysis_html",
 }
 
 
@@ -169,6 +172,32 @@ def explanation_html(explanation: Explanation, *, plot: bool = True) -> str:
     if plot:
         parts.append(_img(explanation_png(explanation), "explain chart"))
     return "<div>" + "".join(parts) + "</div>"
+
+
+def analysis_html(analysis: Analysis) -> str:
+    """The findings of :func:`fuzzyctl.analyze`: counts as a table, then each finding (rules
+    at file:line) as text.
+
+    ```python
+    >>> import fuzzyctl
+    >>> html = analysis_html(fuzzyctl.analyze(fuzzyctl.load("examples/tank.fcl")))
+    >>> "<td>gaps</td><td>0</td>" in html and "surface dheat" in html
+    True
+
+    ```
+    """
+    counts = [
+        ["gaps", str(len(analysis.gaps))],
+        ["gap fraction", _num(analysis.gap_fraction)],
+        ["coverage index", _num(analysis.coverage_index)],
+        ["conflicts", str(len(analysis.conflicts))],
+        ["dead rules", str(len(analysis.dead_rules))],
+        ["redundant rules", str(len(analysis.redundant))],
+        ["unused terms", str(len(analysis.unused_terms))],
+    ]
+    title = f"<b>analysis of {html.escape(analysis.block or '')}</b>"
+    findings = html.escape("\n".join(analysis.lines()))
+    return f"<div>{title}{_table(['finding', 'count'], counts)}<pre>{findings}</pre></div>"
 
 
 def register(ip: Any = None) -> bool:
