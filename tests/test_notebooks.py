@@ -39,3 +39,16 @@ def test_tour_runs_and_displays() -> None:
     assert "rules fired</b> (1 of 25)" in html_of(explanation)
     assert "<td>gaps</td><td>0</td>" in html_of(analysis)
     assert "60" in str(loop["outputs"][-1]["data"]["text/plain"])  # type: ignore[index]
+
+
+def test_jupyter_page_examples() -> None:
+    import doctest
+    import os
+
+    cwd = os.getcwd()
+    os.chdir(ROOT)
+    try:
+        result = doctest.testfile(str(ROOT / "docs" / "jupyter.md"), module_relative=False)
+    finally:
+        os.chdir(cwd)
+    assert result.attempted >= 5 and result.failed == 0
