@@ -33,6 +33,9 @@ from fuzzyctl.diagnostics import InputError
 
 if TYPE_CHECKING:
     from fuzzyctl.engine.controller import Controller
+    from fuzzyctl.model import Document, FunctionBlock
+
+    ControllerLike = Controller | Document | FunctionBlock | str | Path
 
 try:
     import control as _ct
@@ -71,7 +74,7 @@ class Integral:
         return min(max(value, self.low), self.high)
 
 
-def _compile(controller: Any, block: str | None) -> Controller:
+def _compile(controller: ControllerLike, block: str | None) -> Controller:
     import fuzzyctl
     from fuzzyctl.engine.controller import Controller
 
@@ -84,7 +87,7 @@ def _compile(controller: Any, block: str | None) -> Controller:
 
 
 def iosys(
-    controller: Any,
+    controller: ControllerLike,
     *,
     integrate: Mapping[str, Integral | float] | None = None,
     dt: float = 0,
@@ -187,7 +190,7 @@ class FuzzyNonlinearity(_ct.DescribingFunctionNonlinearity):  # type: ignore[mis
 
 
 def nonlinearity(
-    controller: Any, *, output: str | None = None, block: str | None = None
+    controller: ControllerLike, *, output: str | None = None, block: str | None = None
 ) -> FuzzyNonlinearity:
     """A one-input controller as a :class:`control.DescribingFunctionNonlinearity`, for
     ``control.describing_function(N, A)`` and the limit cycles of
