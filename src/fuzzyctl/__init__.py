@@ -19,6 +19,11 @@ __version__ = "0.1.0"
 __all__ = ["__version__", "analyze", "compile", "evaluate_dataframe", "learn", "load", "plot_terms", "tune"]
 
 
+def __dir__() -> list[str]:
+    """The lazy names too, so that ``dir(fuzzyctl)`` and tab completion show them."""
+    return sorted({*__all__, *(n for n in globals() if n.startswith("__"))})
+
+
 def __getattr__(name: str) -> Any:
     import importlib
 

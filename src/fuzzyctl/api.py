@@ -55,6 +55,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
+        require_file(path)  # before the extension is read: a typo in it is still a missing file
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
         doc = _load_path(path, fmt, strict)
         if strict and fmt != "fcl" and (found := _strict_findings(doc)):  # FCL's reader said it
@@ -132,6 +133,16 @@ def content_key(data: bytes, fmt: str) -> str:
     return h.hexdigest()[:32]
 
 
+def require_file(path: Path) -> None:
+    """ "no such file" (or "is a directory") for a path that names no file."""
+    from fuzzyctl.diagnostics import DiagnosticError, error
+
+    if not path.exists():
+        raise DiagnosticError([error("no such file", file=str(path), code="no-file")])
+    if path.is_dir():
+        raise DiagnosticError([error("is a directory, not a file", file=str(path), code="no-file")])
+
+
 def _looks_like_path(value: str) -> bool:
     """Text holding a newline, ';' or ':=', starting with '{' or '[', or longer than any path
     is source; anything else is taken as a path (a missing file is then reported as such,
@@ -144,9 +155,21 @@ def _looks_like_path(value: str) -> bool:
 
 
 def compile(
-    model: Document | FunctionBlock, *, block: str | None = None, backend: str | None = None, **options: Any
+    model: Document | FunctionBlock | str | Path,
+    *,
+    block: str | None = None,
+    backend: str | None = None,
+    out_of_range: str = "warn",
+    **options: Any,
 ) -> Controller:
     """Turn a model into a :class:`~fuzzyctl.engine.Controller` (see ``fuzzyctl.engine``).
+
+    ``model`` is a loaded document or function block, or what :func:`load` takes (a path:
+    ``compile("crane.fcl")`` is ``compile(load("crane.fcl"))``).  ``out_of_range`` is what
+    an input outside its range (declared, else its terms' span) does by default: ``"warn"``
+    (the result as computed, and an
+    :class:`~fuzzyctl.engine.ranges.InputRangeWarning`), ``"clamp"``, ``"raise"`` or
+    ``"ignore"`` (the controller's ``out_of_range``; each evaluation can override it).
 
     ``block`` names the function block of a document (default: the first); ``backend`` is
     ``"auto"`` (the default, or ``$FUZZYCTL_BACKEND``: native when a C compiler is present
@@ -171,15 +194,21 @@ def compile(
 
     ```
     """
+    from fuzzyctl.engine.ranges import check_mode
     from fuzzyctl.gcpause import gc_paused
     from fuzzyctl.model import Document
 
+    check_mode(out_of_range)
+    if isinstance(model, (str, Path)):  # a path, or FCL source text as load() takes it
+        model = load(model, strict=bool(options.get("strict")))
     if options.get("strict"):
         _refuse_reserved(model)
     with gc_paused():  # lowering and generating build large acyclic structures
         plan, key, found = _plan(model, block, options)
         fb = model.block(block) if isinstance(model, Document) else model
-        return _controller(plan, backend, key, fb, found)
+        ctl = _controller(plan, backend, key, fb, found)
+    ctl.out_of_range = out_of_range
+    return ctl
 
 
 def _refuse_reserved(model: Document | FunctionBlock) -> None:
@@ -214,6 +243,7 @@ def compile_path(
     block: str | None = None,
     backend: str | None = None,
     format: str | None = None,
+    out_of_range: str = "warn",
     **options: Any,
 ) -> Controller:
     """``compile(load(path), ...)``, answered from the caches without reading the model when
@@ -223,6 +253,7 @@ def compile_path(
 
     path = Path(path)
     fmt = (format or "").lower() or (path.suffix.lower().lstrip(".") or "fcl")
+    key = None
     if cache.enabled():
         from fuzzyctl.diagnostics import DiagnosticError
         from fuzzyctl.limits import read_input
@@ -232,9 +263,16 @@ def compile_path(
         except DiagnosticError:
             key = None  # load() reports it
         hit = _cached_plan(key) if key is not None else None
-        if hit is not None:
-            return _controller(hit[0], backend, key, None, hit[1])
-    return compile(load(path, format=fmt), block=block, backend=backend, **options)
+        ranges = _cached(f"plans/{key}.ranges.pickle") if hit is not None else None
+        if hit is not None and isinstance(ranges, dict):
+            ctl = _controller(hit[0], backend, key, None, hit[1])
+            ctl.input_ranges = ranges  # (the model, where they are declared, was not read)
+            ctl.out_of_range = out_of_range
+            return ctl
+    ctl = compile(load(path, format=fmt), block=block, backend=backend, out_of_range=out_of_range, **options)
+    if key is not None:
+        _store(f"plans/{key}.ranges.pickle", ctl.input_ranges)
+    return ctl
 
 
 def _controller(

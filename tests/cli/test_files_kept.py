@@ -19,6 +19,15 @@ from fuzzyctl.cli.app import main
 from tests.conftest import EXAMPLES
 
 SOURCE = EXAMPLES / "figure7.fcl"
+
+
+@pytest.fixture(autouse=True)
+def fixed_creation_time(monkeypatch: pytest.MonkeyPatch) -> None:
+    """PLCopen XML carries its creation time: the reference and the run under test would
+    differ when a second passes between them (seen on a loaded machine)."""
+    monkeypatch.setenv("SOURCE_DATE_EPOCH", "1700000000")
+
+
 # name -> (the file the command writes, given a work directory; the arguments writing it)
 Command = Callable[[Path, Path, Path], list[str]]
 COMMANDS: dict[str, tuple[str, Command]] = {

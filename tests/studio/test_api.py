@@ -117,7 +117,7 @@ def test_requests_are_validated(client: TestClient) -> None:
     assert r.status_code == 422 and "nam" in r.json()["detail"]
 
 
-def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(
+def test_save_is_atomic_keeps_settings_beside_the_file_and_detects_changes(
     client: TestClient, project: Path
 ) -> None:
     first = opened(client, "crane.fcl")
@@ -130,7 +130,7 @@ def test_save_is_atomic_keeps_settings_in_options_and_detects_changes(
     )
     assert r.status_code == 200, r.text
     saved = (project / "copy.fcl").read_text()
-    assert "OPTIONS" in saved and "STUDIO" in saved
+    assert "OPTIONS" not in saved and "STUDIO" not in saved  # the view settings: test_viewsettings.py
     assert not [p for p in project.iterdir() if p.name.startswith(".copy.fcl")]  # no temporary file left
     again = opened(client, "copy.fcl")
     assert again["settings"]["ranges"] == {"distance": [-5.0, 25.0]}

@@ -167,7 +167,8 @@ def test_new_project_rules_surface_recorder_save_and_reload(page: Any, browser_p
     assert [r.label for r in saved.rule_blocks[0].rules] == ["1", "2", "3"]
     zero = saved.fuzzify_block("temp").term("zero")
     assert zero is not None and zero.mf.points[1].x == moved  # type: ignore[union-attr]
-    assert "STUDIO" in (browser_project / "mixer.fcl").read_text()
+    assert "STUDIO" not in (browser_project / "mixer.fcl").read_text()  # beside it (issue 27)
+    assert (browser_project / ".fuzzyctl-studio" / "mixer.fcl.json").is_file()
     pg.reload()
     pg.wait_for_selector("body[data-ready=true]")
     open_file(pg, "mixer.fcl")

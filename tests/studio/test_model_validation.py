@@ -36,7 +36,7 @@ def _first_points(document: dict[str, Any]) -> list[dict[str, Any]]:
 
 @pytest.mark.parametrize("change", ["degree", "ascending", "huge"])
 def test_an_invalid_model_is_refused_with_its_json_path_and_not_saved(project: Path, change: str) -> None:
-    client = TestClient(create_app(project, file="crane.fcl"), base_url=BASE)
+    client = TestClient(create_app(project, file="crane.fcl", token=None), base_url=BASE)
     r = client.post("/api/open", json={"path": "crane.fcl"})
     assert r.status_code == 200, r.text
     document = r.json()["document"]

@@ -35,7 +35,7 @@ def test_acceptance_smooth_two_input_function_with_default_options(tmp_path: Pat
     """The issue's acceptance figure: checking RMSE well under 5 % of the target's range."""
     train = _csv(tmp_path / "train.csv", surface(400, seed=1))
     out = tmp_path / "learned.fcl"
-    assert main(["learn", str(train), "--inputs", "x,y", "--output", "z", "-o", str(out), "--json"]) == 0
+    assert main(["learn", str(train), "--inputs", "x,y", "--target", "z", "-o", str(out), "--json"]) == 0
     checking = surface(2000, seed=2)  # fresh points, never seen by learn
     doc = fuzzyctl.load(out)
     span = float(np.ptp(checking["z"]))
@@ -111,7 +111,7 @@ def test_clustering_is_seeded_and_fits() -> None:
 def test_learned_file_works_with_codegen_and_plc_blocks(tmp_path: Path) -> None:
     train = _csv(tmp_path / "t.csv", surface(200, seed=8))
     out = tmp_path / "m.fcl"
-    args = ["learn", str(train), "--inputs", "x,y", "--output", "z", "--type", "mamdani", "--and", "min"]
+    args = ["learn", str(train), "--inputs", "x,y", "--target", "z", "--type", "mamdani", "--and", "min"]
     assert main([*args, "--terms", "3", "--out-terms", "5", "-o", str(out), "--json"]) == 0
     doc = fuzzyctl.load(out)
     assert load_text(write(doc)).raise_for_errors() == doc
@@ -127,12 +127,12 @@ def test_cli_errors_name_the_problem(tmp_path: Path, capsys: pytest.CaptureFixtu
     cols["k"] = np.ones(50)
     train = _csv(tmp_path / "t.csv", cols)
     out = str(tmp_path / "o.fcl")
-    assert main(["learn", str(train), "--inputs", "x,w", "--output", "z", "-o", out]) == 1
+    assert main(["learn", str(train), "--inputs", "x,w", "--target", "z", "-o", out]) == 1
     assert "no column 'w'" in capsys.readouterr().err
-    assert main(["learn", str(train), "--inputs", "x,k", "--output", "z", "-o", out]) == 1
+    assert main(["learn", str(train), "--inputs", "x,k", "--target", "z", "-o", out]) == 1
     assert "'k' is constant" in capsys.readouterr().err
-    assert main(["learn", str(tmp_path / "none.csv"), "--inputs", "x", "--output", "z", "-o", out]) == 1
-    assert "does not exist" in capsys.readouterr().err
+    assert main(["learn", str(tmp_path / "none.csv"), "--inputs", "x", "--target", "z", "-o", out]) == 1
+    assert "no such file" in capsys.readouterr().err
     with pytest.raises(InputError, match="--method"):
         fuzzyctl.learn(cols, inputs=["x"], output="z", method="bogus")
 
@@ -141,7 +141,7 @@ def test_cli_json_reports_both_errors(tmp_path: Path, capsys: pytest.CaptureFixt
     train = _csv(tmp_path / "t.csv", surface(100, seed=10))
     check = _csv(tmp_path / "c.csv", surface(100, seed=11))
     out = tmp_path / "o.fcl"
-    args = ["learn", str(train), "--inputs", "x,y", "--output", "z", "-o", str(out), "--json"]
+    args = ["learn", str(train), "--inputs", "x,y", "--target", "z", "-o", str(out), "--json"]
     assert main([*args, "--validation-data", str(check)]) == 0
     info = json.loads(capsys.readouterr().out)
     assert info["training rows"] == 100 and info["validation rows"] == 100

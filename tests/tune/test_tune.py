@@ -148,7 +148,7 @@ def test_cli_tune_data_and_errors(
     assert "Tuned by fuzzyctl tune (lsq" in out.read_text()
     assert main([*args, "--free", "speed"]) == 1
     assert "--free 'speed'" in capsys.readouterr().err
-    assert main([*args, "--output", "force"]) == 1
+    assert main([*args, "--target", "force"]) == 1
     assert "not an output" in capsys.readouterr().err
     assert main(["tune", str(moved), "-o", str(out)]) == 2
     assert main([*args, "--optimizer", "pso"]) == 1

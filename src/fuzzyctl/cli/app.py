@@ -53,6 +53,15 @@ err_console = Console(stderr=True, highlight=False, soft_wrap=True)
 
 EXIT_OK, EXIT_ERRORS, EXIT_USAGE, EXIT_INTERNAL = 0, 1, 2, 3
 FORCE_HINT = "--force replaces it"
+FromOpt = Annotated[
+    str | None,
+    typer.Option(
+        "--from",
+        help="Format of FILE: fcl, fis, fll, json, fpl, xfuz (default: its extension).",
+        show_default=False,
+    ),
+]
+"""The option every command that reads a model takes to name its format."""
 """How the commands that write files for the user override a read-only target."""
 
 
@@ -73,6 +82,14 @@ def record_table(title: str, figures: dict[str, str], width: int) -> Table:
     for name, value in figures.items():
         table.add_row(name, value)
     return table
+
+
+def split_names(values: list[str] | str | None) -> list[str]:
+    """A list option's names: ``a,b``, ``'a b'`` and the option repeated all give [a, b]."""
+    import re
+
+    items = [values] if isinstance(values, str) else (values or [])
+    return [n for v in items for n in re.split(r"[,\s]+", v) if n]
 
 
 def _version(value: bool) -> None:
@@ -96,18 +113,86 @@ def _register_commands() -> None:
     from fuzzyctl.cli import commands  # noqa: F401
 
 
+def _given_twice(argv: list[str]) -> None:
+    """learn and tune before -o/--output meant the file everywhere: ``--output COLUMN -o FILE``
+    now gives the file twice, which click would take silently (the last wins)."""
+    if not argv or argv[0] not in ("learn", "tune"):
+        return
+    given = [a for a in argv[1:] if a in ("-o", "--output") or a.startswith("--output=")]
+    if len(given) > 1:
+        from fuzzyctl.cli.tune import RENAMED
+
+        raise typer.BadParameter(f"given {len(given)} times: {RENAMED}", param_hint="-o/--output")
+
+
+#: the list options of each command that take several values after one flag (as argparse's
+#: nargs="+"): ``--inputs a b`` is ``--inputs a --inputs b``
+LIST_OPTIONS = {"learn": ("--inputs",), "tune": ("--target",)}
+
+
+def spread_lists(argv: list[str]) -> list[str]:
+    """``learn --inputs a b ...`` as click takes it (``--inputs a --inputs b``): the words after
+    a list option up to the next option are its values, as argparse's ``nargs="+"`` reads
+    them - except an existing file when the command's file argument has not come yet
+    (``learn --inputs a b data.csv``)."""
+    if not argv or argv[0] not in LIST_OPTIONS:
+        return argv
+    from pathlib import Path
+
+    out, seen_positional, i = [argv[0]], False, 1
+    while i < len(argv):
+        a = argv[i]
+        out.append(a)
+        i += 1
+        if a == "--":
+            out.extend(argv[i:])
+            break
+        if a in LIST_OPTIONS[argv[0]] and i < len(argv):
+            out.append(argv[i])  # the first value, whatever it looks like
+            i += 1
+            while i < len(argv) and not argv[i].startswith("-"):
+                if not seen_positional and Path(argv[i]).is_file():
+                    break
+                out.extend([a, argv[i]])
+                i += 1
+        elif not a.startswith("-") and not _takes_value(out[-2]):
+            seen_positional = True
+    return out
+
+
+def _takes_value(option: str) -> bool:
+    """Whether the option before a word consumes it (every option of learn/tune but the
+    flags does)."""
+    return option.startswith("-") and "=" not in option and option not in _FLAGS
+
+
+_FLAGS = frozenset({"--json", "--keep-zero", "--move-zero", "--help"})
+
+
+def _renamed_hint(exc: Exception) -> None:
+    """A missing --target of learn/tune is most often the old ``--output COLUMN``: say so."""
+    # (typer vendors click: the class is matched by name, not imported from a private module)
+    if not isinstance(exc, typer.BadParameter) or type(exc).__name__ != "MissingParameter":
+        return
+    if getattr(exc.param, "name", None) == "target":
+        exc.message = "Name the column(s) with --target (-o/--output names the file written)"
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; never lets a Python traceback reach the user."""
     _register_commands()
     command = typer.main.get_command(app)
     try:
-        result = command.main(args=argv, prog_name="fuzzyctl", standalone_mode=False)
+        args = spread_lists(sys.argv[1:] if argv is None else argv)
+        _given_twice(args)
+        result = command.main(args=args, prog_name="fuzzyctl", standalone_mode=False)
     except typer.Exit as exc:
         return int(exc.exit_code or 0)
     except typer.Abort:
         err_console.print("aborted")
         return EXIT_ERRORS
     except typer.TyperException as exc:  # usage errors: bad option, missing argument, ...
+        _renamed_hint(exc)
         show = getattr(exc, "show", None)
         if callable(show):
             show(file=sys.stderr)

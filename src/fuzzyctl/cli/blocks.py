@@ -14,7 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app, err_console
+from fuzzyctl.cli.app import FromOpt, app, err_console
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, InputError
 
 blocks_app = typer.Typer(
@@ -34,9 +34,7 @@ app.add_typer(blocks_app, name="blocks")
 
 SamplesArg = Annotated[
     Path,
-    typer.Argument(
-        help="CSV of samples: header row, then one row per cycle.", exists=True, dir_okay=False, readable=True
-    ),
+    typer.Argument(help="CSV of samples: header row, then one row per cycle.", show_default=False),
 ]
 OutputOpt = Annotated[
     Path | None,
@@ -50,11 +48,13 @@ OutputOpt = Annotated[
 JsonOpt = Annotated[bool, typer.Option("--json", help="Print a JSON list of cycles instead of CSV.")]
 
 
-def _load(path: Path) -> Any:
+def _load(path: Path, fmt: str | None = None) -> Any:
     """A controller (Document) from any format the registry reads."""
+    from fuzzyctl.api import require_file
     from fuzzyctl.formats import read_path
 
-    loaded = read_path(path)
+    require_file(path)
+    loaded = read_path(path, fmt)
     for d in loaded.diagnostics:
         if d.severity.value == "warning":
             err_console.print(d.render(), markup=False)
@@ -62,6 +62,9 @@ def _load(path: Path) -> Any:
 
 
 def _read_samples(path: Path) -> tuple[list[str], list[tuple[int, dict[str, str]]]]:
+    from fuzzyctl.api import require_file
+
+    require_file(path)
     text = path.read_text(encoding="utf-8-sig")
     reader = csv.reader(io.StringIO(text))
     rows = [(n, r) for n, r in enumerate(reader, start=1) if r and any(c.strip() for c in r)]
@@ -125,7 +128,6 @@ def siemens(
         Path,
         typer.Argument(
             help="Controller: .fpl, .fcl or any format fuzzyctl reads.",
-            exists=True,
             dir_okay=False,
             readable=True,
         ),
@@ -139,6 +141,7 @@ def siemens(
             "--no-profile", help="Run a controller that breaks the siemens profile with its own semantics."
         ),
     ] = False,
+    from_format: FromOpt = None,
 ) -> None:
     """Run the Siemens FUZZY block (FB30), one call per sample row.
 
@@ -151,7 +154,7 @@ def siemens(
     from fuzzyctl.blocks.siemens import FuzzyFB
 
     try:
-        fb = FuzzyFB(_load(application), check_profile=not no_profile)
+        fb = FuzzyFB(_load(application, from_format), check_profile=not no_profile)
     except DiagnosticError as exc:
         raise _located(exc.diagnostics, application) from None
     for d in _located(fb.diagnostics, application).diagnostics:
@@ -189,7 +192,6 @@ def xfuz(
         Path,
         typer.Argument(
             help="XFUZ tables (.xfuz: JSON or CSV layout) or a controller in any format fuzzyctl reads.",
-            exists=True,
             dir_okay=False,
             readable=True,
         ),
@@ -212,6 +214,7 @@ def xfuz(
         ),
     ] = False,
     degre: Annotated[bool, typer.Option("--degre", help="Add the rule activation bytes DEGRE0..")] = False,
+    from_format: FromOpt = None,
 ) -> None:
     """Run the Schneider XFUZ block, one call (task cycle) per sample row.
 
@@ -230,7 +233,7 @@ def xfuz(
     if knowledge_base.suffix.lower() == ".xfuz":
         constants = read_tables(text, path=str(knowledge_base))
     else:
-        document = _load(knowledge_base)
+        document = _load(knowledge_base, from_format)
         constants, diags = constants_from_model(document)
         for d in diags:
             err_console.print(d.render(), markup=False)
@@ -312,9 +315,7 @@ def xfuz(
 def check(
     application: Annotated[
         Path,
-        typer.Argument(
-            help="Controller in any format fuzzyctl reads.", exists=True, dir_okay=False, readable=True
-        ),
+        typer.Argument(help="Controller in any format fuzzyctl reads.", show_default=False),
     ],
     as_json: JsonOpt = False,
     bipolar: Annotated[
@@ -325,13 +326,16 @@ def check(
             "its MIN and MAX must be symmetric (manual 3.2, 3.3).  Repeat for several.",
         ),
     ] = None,
+    from_format: FromOpt = None,
 ) -> None:
     """Check a controller against the siemens profile (limits of the S7 FUZZY block).
 
     Exit status 1 when it does not fit (errors), 0 otherwise (warnings are printed)."""
     from fuzzyctl.blocks.siemens import check_siemens
 
-    diags = _located(check_siemens(_load(application), bipolar=bipolar or ()), application).diagnostics
+    diags = _located(
+        check_siemens(_load(application, from_format), bipolar=bipolar or ()), application
+    ).diagnostics
     if as_json:
         typer.echo(json.dumps([d.to_dict() for d in diags], indent=1))
     else:

@@ -9,7 +9,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import FORCE_HINT, app, err_console
+from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console
 
 
 class Lang(StrEnum):
@@ -30,7 +30,7 @@ class Dialect(StrEnum):
 def codegen(
     source: Annotated[
         Path,
-        typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", exists=True, dir_okay=False),
+        typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", show_default=False),
     ],
     lang: Annotated[
         Lang,
@@ -97,6 +97,7 @@ def codegen(
     force: Annotated[
         bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
     ] = False,
+    from_format: FromOpt = None,
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
@@ -117,10 +118,10 @@ def codegen(
         parse_default(default)
     except CodegenError as exc:
         raise typer.BadParameter(str(exc), param_hint="--default") from None
+    doc = fuzzyctl.load(source, strict=strict, format=from_format)
     if lang is Lang.plcopen:
-        _plcopen(source, output, dialect, lreal, single, block, strict, default, force)
+        _plcopen(doc, output, dialect, lreal, single, block, strict, default, force)
         return
-    doc = fuzzyctl.load(source, strict=strict)
     report: list[Generated] = []
     if lang is Lang.st:
         text = generate_st(
@@ -181,7 +182,7 @@ def _json_report(
 
 
 def _plcopen(
-    source: Path,
+    doc: Any,
     output: Path | None,
     dialect: Dialect | None,
     lreal: bool,
@@ -192,7 +193,6 @@ def _plcopen(
     force: bool = False,
 ) -> None:
     """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
-    import fuzzyctl
     from fuzzyctl.codegen import generate_plcopen
     from fuzzyctl.formats import write_atomic
 
@@ -202,7 +202,6 @@ def _plcopen(
         raise typer.BadParameter(
             "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
         )
-    doc = fuzzyctl.load(source, strict=strict)
     xml = generate_plcopen(
         doc,
         block=block,

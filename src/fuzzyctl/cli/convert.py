@@ -12,7 +12,7 @@ from fuzzyctl.cli.app import FORCE_HINT, app, err_console
 
 @app.command()
 def convert(
-    source: Annotated[Path, typer.Argument(help="File to read.", exists=True, dir_okay=False, readable=True)],
+    source: Annotated[Path, typer.Argument(help="File to read.", show_default=False)],
     target: Annotated[Path, typer.Argument(help="File to write (replaced atomically).", dir_okay=False)],
     from_format: Annotated[
         str | None,
@@ -36,7 +36,9 @@ def convert(
     A conversion that would change what the system computes fails and lists, one line each,
     what the target format cannot express; --lossy writes it anyway without those elements."""
     from fuzzyctl import formats
+    from fuzzyctl.api import require_file
 
+    require_file(source)  # before the extension is read: "no such file", not "unknown format"
     loaded = formats.read_path(source, from_format)
     for diagnostic in loaded.diagnostics:
         err_console.print(diagnostic.render(), markup=False)

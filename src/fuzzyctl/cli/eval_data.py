@@ -26,6 +26,8 @@ from fuzzyctl.tables import Batch, TableReader, TableWriter, format_of, numbers
 PROGRESS_BYTES = 8 << 20
 PROGRESS_ROWS = 200_000
 ON_ERROR = ("nan", "fail")
+#: rows ``--table`` prints (the rest is counted: -o FILE writes them all)
+TABLE_ROWS = 20
 
 
 def evaluate_file(
@@ -37,13 +39,20 @@ def evaluate_file(
     delimiter: str | None = None,
     decimal: str | None = None,
     on_error: str = "nan",
+    out_of_range: str = "warn",
     as_table: bool = False,
     warn: Any = None,
 ) -> None:
     """Evaluate ``ctl`` on every row of ``source`` and write the result to ``output`` (a path,
-    ``-`` or None for stdout).  ``warn(text)`` receives the warnings (counts of NaN rows)."""
+    ``-`` or None for stdout).  ``warn(text)`` receives the warnings (counts of NaN rows, of
+    values outside their range per column).  ``out_of_range`` as in ``Controller.evaluate``
+    ("warn": counted here, per column)."""
+    from fuzzyctl.engine.ranges import check_mode
+
     if on_error not in ON_ERROR:
         raise InputError(f"--on-error must be one of {', '.join(ON_ERROR)}, not {on_error!r}")
+    check_mode(out_of_range)
+    outside: dict[str, int] = {}
     reader = TableReader(source, delimiter=delimiter, decimal=decimal)
     try:
         used = _input_columns(ctl, reader)
@@ -51,15 +60,20 @@ def evaluate_file(
         if fmt == "parquet" and output in (None, "-"):
             raise InputError("Parquet output needs a file: -o FILE.parquet")
         renamed = {o: (f"{o}_computed" if o in reader.header else o) for o in ctl.outputs}
+        mode = (on_error, out_of_range, outside)
         if as_table:
-            _print_table(ctl, reader, used, renamed, on_error)
-            counts = None
+            counts = _print_table(ctl, reader, used, renamed, mode)
         else:
             with _sink(output) as sink:
-                counts = _stream(
-                    ctl, reader, used, renamed, TableWriter(sink, fmt, reader.delimiter), on_error
+                counts = _stream(ctl, reader, used, renamed, TableWriter(sink, fmt, reader.delimiter), mode)
+        if warn is not None:
+            for name, n in outside.items():
+                lo, hi = ctl.input_ranges[name]
+                warn(
+                    f"column {name!r}: {n} of {counts[2]} values outside the input's range "
+                    f"{lo:g}..{hi:g}, computed as its terms give them (see --out-of-range)"
                 )
-        if counts is not None and warn is not None:
+        if warn is not None:
             bad_inputs, bad_outputs, rows = counts
             if bad_inputs:
                 warn(
@@ -103,9 +117,16 @@ def _sink(output: str | None) -> Iterator[IO[bytes]]:
         yield handle
 
 
+#: (--on-error, --out-of-range, the counts of values outside their range by column)
+Mode = tuple[str, str, dict[str, int]]
+
+
 def _evaluate(
-    ctl: Any, reader: TableReader, batch: Batch, used: list[str], on_error: str
+    ctl: Any, reader: TableReader, batch: Batch, used: list[str], mode: Mode
 ) -> tuple[dict[str, np.ndarray[Any, np.dtype[np.float64]]], int]:
+    from fuzzyctl.engine.ranges import count_outside, outside_message
+
+    on_error, out_of_range, outside = mode
     values, invalid = numbers(reader, batch, used)
     if invalid.any() and on_error == "fail":
         row = int(np.flatnonzero(invalid)[0])
@@ -119,9 +140,20 @@ def _evaluate(
     if not values and ctl.plan.inputs:  # every input has a default value: one row each all the same
         spec = ctl.plan.inputs[0]
         values = {spec.name: np.full(batch.columns.num_rows, float(spec.default))}
+    counts = count_outside(ctl.input_ranges, values) if out_of_range in ("warn", "raise") else {}
+    if counts and out_of_range == "raise":
+        name = next(iter(counts))
+        lo, hi = ctl.input_ranges[name]
+        row = int(np.flatnonzero((values[name] < lo) | (values[name] > hi))[0])
+        where = f"{reader.line_of(batch.first_row + row)}: column {reader.header.index(name) + 1}"
+        raise InputError(f"{where}: {outside_message(name, float(values[name][row]), (lo, hi))}")
+    for name, n in counts.items():
+        outside[name] = outside.get(name, 0) + n
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")  # counted and reported once, by the caller
-        out = ctl.evaluate_batch(values, on_invalid="nan")
+        out = ctl.evaluate_batch(
+            values, on_invalid="nan", out_of_range="clamp" if out_of_range == "clamp" else "ignore"
+        )
     return out, int(np.count_nonzero(invalid))
 
 
@@ -131,7 +163,7 @@ def _stream(
     used: list[str],
     renamed: dict[str, str],
     writer: TableWriter,
-    on_error: str,
+    mode: Mode,
 ) -> tuple[int, int, int]:
     from rich.progress import BarColumn, DownloadColumn, Progress, TextColumn, TimeRemainingColumn
 
@@ -149,7 +181,7 @@ def _stream(
     with Progress(*columns, TimeRemainingColumn(), disable=not show, transient=True) as progress:
         task = progress.add_task(f"read, evaluate, write {Path(reader.name).name}", total=total)
         for batch in reader.batches():
-            out, invalid = _evaluate(ctl, reader, batch, used, on_error)
+            out, invalid = _evaluate(ctl, reader, batch, used, mode)
             bad_inputs += invalid
             finite = np.ones(batch.columns.num_rows, bool)
             for v in out.values():
@@ -172,8 +204,10 @@ def _empty(reader: TableReader) -> Any:
 
 
 def _print_table(
-    ctl: Any, reader: TableReader, used: list[str], renamed: dict[str, str], on_error: str
-) -> None:
+    ctl: Any, reader: TableReader, used: list[str], renamed: dict[str, str], mode: Mode
+) -> tuple[int, int, int]:
+    """The first :data:`TABLE_ROWS` rows as a table, and how many it left out (counted, not
+    evaluated); returns the counts as :func:`_stream` does, for the rows shown."""
     from rich.console import Console
     from rich.table import Table
 
@@ -182,12 +216,24 @@ def _print_table(
         table.add_column(h, justify="right", overflow="fold")
     for k in ctl.outputs:
         table.add_column(renamed[k], justify="right", overflow="fold")
+    shown = bad = rest = 0
     for batch in reader.batches():
-        out, _invalid = _evaluate(ctl, reader, batch, used, on_error)
+        take = min(batch.columns.num_rows, TABLE_ROWS - shown)
+        rest += batch.columns.num_rows - take
+        if take <= 0:
+            continue
+        if take < batch.columns.num_rows:
+            batch = Batch(batch.columns.slice(0, take), batch.first_row)
+        out, invalid = _evaluate(ctl, reader, batch, used, mode)
+        bad += invalid
         cells = [batch.columns.column(h).to_pylist() for h in reader.header]
-        for r in range(batch.columns.num_rows):
+        for r in range(take):
             table.add_row(
                 *("" if c[r] is None else str(c[r]) for c in cells),
                 *(f"{out[k][r]:.10g}" for k in ctl.outputs),
             )
+        shown += take
+    if rest:
+        table.caption = f"first {shown} rows; {rest} more not shown (-o FILE writes every row)"
     Console(highlight=False).print(table)
+    return bad, 0, shown

@@ -10,41 +10,17 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
-from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, app, err_console
+from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, FromOpt, app, err_console
 
 if TYPE_CHECKING:
+    from fuzzyctl.checking import CheckReport
     from fuzzyctl.fcl import LoadResult
 
 
-def _load(file: Path, strict: bool = False, compat: str = "iec"):  # type: ignore[no-untyped-def]
-    """Load and check ``file``; when the language checks pass, add what the engine reports
-    (features it will not evaluate, decisions worth knowing) so that ``check`` never says OK
-    to a file ``eval`` refuses (with the same ``--strict`` and ``--compat``)."""
-    from fuzzyctl.diagnostics import has_errors
-    from fuzzyctl.fcl import load_file
-    from fuzzyctl.gcpause import gc_paused
+def _load(file: Path, strict: bool = False, compat: str = "iec", fmt: str | None = None) -> LoadResult:
+    from fuzzyctl.checking import load_checked
 
-    result = load_file(file, strict=strict, compat=compat)
-    if result.document is None or has_errors(result.diagnostics):
-        return result
-    with gc_paused():
-        _add_engine_diagnostics(result, compat, strict)
-    return result
-
-
-def _add_engine_diagnostics(result: LoadResult, compat: str, strict: bool) -> None:
-    from dataclasses import replace
-
-    from fuzzyctl.engine.support import unsupported
-
-    # The engine validates models from every reader, so it re-finds some language errors;
-    # keep only what the language checks did not already say about the same line.
-    seen = {(d.code, d.span.line if d.span else None) for d in result.diagnostics}
-    assert result.document is not None
-    for fb in result.document.blocks:
-        for d in unsupported(fb, compat=compat, strict=strict):
-            if (d.code, d.span.line if d.span else None) not in seen:
-                result.diagnostics.append(replace(d, file=d.file or result.source.path))
+    return load_checked(file, format=fmt, strict=strict, compat=compat)
 
 
 @app.command()
@@ -52,7 +28,9 @@ def check(
     file: Annotated[
         Path | None,
         typer.Argument(
-            help="FCL file to check (with --conformance: a program to measure).", show_default=False
+            help="Model to check: FCL, FIS, FLL, JSON, FPL or XFUZ (with --conformance: an FCL "
+            "program to measure).",
+            show_default=False,
         ),
     ] = None,
     checklist: Annotated[
@@ -75,6 +53,7 @@ def check(
             "jfuzzylogic also warns about what jFuzzyLogic 3.3 would reject.",
         ),
     ] = "iec",
+    from_format: FromOpt = None,
     conformance_statement: Annotated[
         bool,
         typer.Option(
@@ -85,95 +64,79 @@ def check(
         ),
     ] = False,
 ) -> None:
-    """Validate an FCL file and report the conformance level it needs (exit 1 on errors)."""
-    from rich.console import Console
-    from rich.table import Table
-
-    from fuzzyctl.diagnostics import DiagnosticError, Severity, more_line, select_shown
+    """Validate a model and report the IEC 61131-7 conformance level it needs as FCL (exit 1
+    on errors).  FCL gets every check; another format gets the model's checks and the
+    engine's, and the report names the checks of FCL text it did not run."""
+    from fuzzyctl.checking import check_file
+    from fuzzyctl.diagnostics import DiagnosticError
     from fuzzyctl.engine.compile import COMPAT_PROFILES
-    from fuzzyctl.fcl import conformance
 
     if conformance_statement:
         _print_statement(file)
         raise typer.Exit(EXIT_OK)
     if file is None:
-        err_console.print("error: give an FCL file to check (or --conformance)", markup=False)
+        err_console.print("error: give a file to check (or --conformance)", markup=False)
         raise typer.Exit(EXIT_USAGE)
     if compat not in COMPAT_PROFILES:
         raise typer.BadParameter(f"unknown profile {compat!r} (known: {', '.join(COMPAT_PROFILES)})")
     try:
-        result = _load(file, strict, compat)
+        report = check_file(file, format=from_format, strict=strict, compat=compat, checklist=checklist)
     except DiagnosticError as exc:
-        if as_json:
-            typer.echo(
-                json.dumps(
-                    {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]},
-                    indent=2,
-                )
-            )
-            raise typer.Exit(EXIT_ERRORS) from None
-        raise
-    doc = result.document
-    from fuzzyctl.gcpause import gc_paused
-
-    with gc_paused():
-        feats = conformance.features(doc, result.spellings) if result.ok and doc is not None else []
-    lvl = conformance.level(feats)
+        if not as_json:
+            raise
+        failed = {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]}
+        typer.echo(json.dumps(failed, indent=2))
+        raise typer.Exit(EXIT_ERRORS) from None
     if as_json:
-        report: dict[str, object] = {
-            "file": str(file),
-            "ok": result.ok,
-            "diagnostics": [d.to_dict() for d in result.diagnostics],
-        }
-        if result.ok and doc is not None:
-            report["level"] = str(lvl)
-            report["features"] = [f.__dict__ | {"level": str(f.level)} for f in feats]
-            if checklist:
-                report["checklist"] = {
-                    fb.name or "": {
-                        row.item: row.value
-                        for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb))
-                    }
-                    for fb in doc.blocks
-                }
-        typer.echo(json.dumps(report, indent=2, default=str))
-        raise typer.Exit(EXIT_OK if result.ok else EXIT_ERRORS)
+        typer.echo(json.dumps(report.to_dict(), indent=2, default=str))
+    else:
+        _print_report(report)
+    raise typer.Exit(EXIT_OK if report.ok else EXIT_ERRORS)
 
+
+def _print_report(report: CheckReport) -> None:
+    """The diagnostics on stderr; for a file that loads, its level, features and check list."""
+    from rich.console import Console
+    from rich.table import Table
+
+    from fuzzyctl.diagnostics import Severity, more_line, select_shown
+
+    result, file = report.result, report.file
     shown, rest = select_shown(result.diagnostics)
     for d in shown:
         style = {Severity.ERROR: "red", Severity.WARNING: "yellow", Severity.NOTE: "cyan"}[d.severity]
         err_console.print(d.render(result.source.text), style=style, markup=False, highlight=False)
     if rest:
         err_console.print(more_line(rest), markup=False, highlight=False)
-    if not result.ok or doc is None:
+    if not report.ok or result.document is None:
         errors = sum(1 for d in result.diagnostics if d.is_error)
         err_console.print(f"{file}: {errors} error(s)", markup=False)
-        raise typer.Exit(EXIT_ERRORS)
+        return
     out = Console(highlight=False, soft_wrap=False, width=max(100, Console().width))
     warnings = sum(1 for d in result.diagnostics if d.severity is Severity.WARNING)
-    names = ", ".join(fb.name or "(unnamed)" for fb in doc.blocks)
+    names = ", ".join(fb.name or "(unnamed)" for fb in result.document.blocks)
     out.print(f"{file}: OK ({warnings} warning(s)); function block(s): {names}", markup=False)
-    out.print(f"Conformance level needed: {lvl}", markup=False)
-    if feats:
+    skipped = report.not_checked
+    out.print(f"Conformance level needed{' as FCL' if skipped else ''}: {report.level}", markup=False)
+    if skipped:
+        head = f"Checked the model read as {report.format.upper()}; not checked (FCL text only)"
+        out.print(f"{head}: {'; '.join(skipped)}", soft_wrap=True, markup=False)
+    if report.features:
         table = Table(title="Features beyond the Basic level (Table 8)", title_justify="left")
-        table.add_column("level", overflow="fold")
-        table.add_column("table", overflow="fold")
-        table.add_column("language element", overflow="fold")
-        table.add_column("detail", overflow="fold")
-        for f in feats:
+        for col in ("level", "table", "language element", "detail"):
+            table.add_column(col, overflow="fold")
+        for f in report.features:
             table.add_row(str(f.level), f.table, f.element, f.detail)
         out.print(table)
-    if checklist:
-        for fb in doc.blocks:
-            table = Table(title=f"Data check list (Table 11): {fb.name or '(unnamed)'}", title_justify="left")
-            table.add_column("technical data", overflow="fold")
-            table.add_column("this file", justify="right", overflow="fold")
-            for row in conformance.checklist(fb, bool(doc.comments) or _has_comments(fb)):
-                table.add_row(row.item, row.value)
-            out.print(table)
-        if any("*" in row.item for fb in doc.blocks for row in conformance.checklist(fb, False)):
-            out.print("* parametric shapes count their parameters as points", markup=False)
-    raise typer.Exit(EXIT_OK)
+    for name, rows in report.checklists.items():
+        table = Table(title=f"Data check list (Table 11): {name or '(unnamed)'}", title_justify="left")
+        table.add_column("technical data", overflow="fold")
+        table.add_column("this file", justify="right", overflow="fold")
+        for row in rows:
+            table.add_row(row.item, row.value)
+        out.print(table)
+    if any("*" in row.item for rows in report.checklists.values() for row in rows):
+        out.print("* parametric shapes count their parameters as points", markup=False)
 
 
 def _print_statement(file: Path | None) -> None:
@@ -198,22 +161,11 @@ def _print_statement(file: Path | None) -> None:
     sys.stdout.write(statement.render(elements, limits, measured))
 
 
-def _has_comments(fb: object) -> bool:
-    from fuzzyctl.fcl.checks import term_blocks
-    from fuzzyctl.model import FunctionBlock
-
-    assert isinstance(fb, FunctionBlock)
-    items: list[object] = [fb, *fb.variables, *fb.fuzzify, *fb.defuzzify, *fb.rule_blocks]
-    for block in term_blocks(fb):
-        items.extend(block.terms)
-    for rb in fb.rule_blocks:
-        items.extend(rb.rules)
-    return any(getattr(i, "comments", ()) or getattr(i, "placed_comments", ()) for i in items)
-
-
 @app.command()
 def fmt(
-    file: Annotated[Path, typer.Argument(help="FCL file to format.", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Model to print as FCL (FCL, FIS, FLL, JSON, ...).", show_default=False)
+    ],
     output: Annotated[
         Path | None, typer.Option("-o", "--output", help="Write to this file instead of standard output.")
     ] = None,
@@ -221,14 +173,21 @@ def fmt(
     force: Annotated[
         bool, typer.Option("--force", help="Replace the file written even when it is read-only.")
     ] = False,
+    from_format: FromOpt = None,
 ) -> None:
-    """Print an FCL file in canonical IEC 61131-7 form (exit 1 if it does not load)."""
+    """Print a model in canonical IEC 61131-7 FCL form (exit 1 if it does not load)."""
+    from fuzzyctl.checking import format_of
     from fuzzyctl.fcl import write
 
     if output is not None and in_place:
         err_console.print("error: use either --output or --in-place, not both", markup=False)
         raise typer.Exit(EXIT_USAGE)
-    result = _load(file)
+    result = _load(file, fmt=from_format)
+    if in_place and format_of(file, from_format) != "fcl":
+        err_console.print(
+            f"error: --in-place rewrites FCL files; {file} is not one (use -o FILE.fcl)", markup=False
+        )
+        raise typer.Exit(EXIT_USAGE)
     document = result.raise_for_errors()
     text = write(document)
     target = file if in_place else output

@@ -76,7 +76,7 @@ def try_quick(argv: list[str]) -> int | None:
     record, key = quick_record.lookup(file, block, compat)
     result = record.run(values) if record is not None else None
     if record is not None and result is not None:
-        title, warnings = record.title, record.warnings
+        title, warnings, ranges = record.title, record.warnings, record.ranges
     else:
         try:
             from fuzzyctl.api import compile_path
@@ -86,13 +86,18 @@ def try_quick(argv: list[str]) -> int | None:
             title, warnings = f"{ctl.name or file.name}", render_all(ctl.warnings)
             if key is not None:
                 quick_record.save(key, ctl, title)
-            result = ctl.evaluate(values)
+            ranges = ctl.input_ranges
+            result = ctl.evaluate(values, out_of_range="ignore")  # warned about below
         except Exception:  # every error is reported by the full command line
             return None
     if not all(math.isfinite(v) for v in result.values()):
         return None  # an output without a value: the full command line says why and exits 1
+    from fuzzyctl.cli.quick_record import outside_lines
+
     for line in warnings:  # as cli/run.py's _controller (without its colour)
         print(line, file=sys.stderr)
+    for line in outside_lines(ranges, values):  # as cli/run.py's _checked_sets
+        print(f"warning: {line}", file=sys.stderr)
     if as_json:
         import json
 

@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any
 
 #: bump when the record's layout changes (old records are then never read)
-_LAYOUT = 1
+_LAYOUT = 2
 #: no format reads more (fuzzyctl.limits: JSON's limit, the largest), without importing it
 _LARGEST_INPUT = 96 * 1024 * 1024
 
@@ -73,6 +73,10 @@ class QuickRecord:
         self.n_results: int = int(data["n_results"])
         self.library: str = data["library"]
         self.warnings: list[str] = [str(w) for w in data["warnings"]]
+        #: input name -> (low, high): the ranges the full path warns about (engine/ranges.py)
+        self.ranges: dict[str, tuple[float, float]] = {
+            str(n): (float(lo), float(hi)) for n, (lo, hi) in data["ranges"].items()
+        }
 
     def run(self, values: dict[str, float]) -> dict[str, float] | None:
         """The outputs for ``values``, or None where the full path must answer."""
@@ -102,6 +106,17 @@ class QuickRecord:
         out = (ctypes.c_double * max(1, self.n_results))()
         lib.fz_eval(inst_p, buf, out)
         return {name: float(out[slot]) for name, slot in self.outputs}
+
+
+def outside_lines(ranges: dict[str, tuple[float, float]], values: dict[str, float]) -> list[str]:
+    """:func:`fuzzyctl.engine.ranges.outside_lines` without importing the engine package
+    (tests/cli/test_quick.py holds the two to the same text)."""
+    return [
+        f"input {n!r} = {v:g} is outside its range {ranges[n][0]:g}..{ranges[n][1]:g}: "
+        "the result is what the terms give there"
+        for n, v in values.items()
+        if n in ranges and not ranges[n][0] <= v <= ranges[n][1] and v == v
+    ]
 
 
 def lookup(file: Path, block: str | None, compat: str) -> tuple[QuickRecord | None, str | None]:
@@ -135,6 +150,7 @@ def save(key: str, ctl: Any, title: str) -> None:
         "n_results": n_results,
         "library": str(ctl.library),
         "warnings": render_all(ctl.warnings),
+        "ranges": {n: list(r) for n, r in ctl.input_ranges.items()},
     }
     from fuzzyctl import cache
 

@@ -10,7 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import FromOpt, app
 from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
@@ -27,6 +27,17 @@ BlockOpt = Annotated[str | None, typer.Option("--block", help="Function block to
 CompatOpt = Annotated[
     str, typer.Option("--compat", help="Semantics: iec (default), fuzzylite, pyfuzzylite, jfuzzylogic.")
 ]
+ModelArg = Annotated[
+    Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+]
+OutOfRangeOpt = Annotated[
+    str,
+    typer.Option(
+        "--out-of-range",
+        help="An input outside its range (its RANGE, else its terms' span): warn (the result as "
+        "computed, and a warning), clamp (limit it first), raise (an error) or ignore.",
+    ),
+]
 StrictOpt = Annotated[
     bool,
     typer.Option(
@@ -37,11 +48,14 @@ StrictOpt = Annotated[
 ]
 
 
-def _controller(file: Path, block: str | None, compat: str, strict: bool = False) -> Any:
+def _controller(
+    file: Path, block: str | None, compat: str, strict: bool = False, fmt: str | None = None
+) -> Any:
     import fuzzyctl
     from fuzzyctl.cli.app import err_console
 
-    ctl = fuzzyctl.compile(fuzzyctl.load(file, strict=strict), block=block, compat=compat, strict=strict)
+    doc = fuzzyctl.load(file, strict=strict, format=fmt)
+    ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict)
     from fuzzyctl.diagnostics import render_all
 
     # what the engine settled with a warning (a universe from the terms, ...), capped: a file
@@ -67,13 +81,30 @@ def _parse_sets(pairs: list[str] | None) -> dict[str, float]:
     return values
 
 
+def _checked_sets(ctl: Any, pairs: list[str] | None, mode: str) -> tuple[dict[str, float], str]:
+    """The --set values and the mode to evaluate them with: with --out-of-range warn, the CLI
+    prints a warning for each value outside its range and the controller says nothing more."""
+    from fuzzyctl.engine.ranges import check_mode, outside_lines
+
+    values = _parse_sets(pairs)
+    if check_mode(mode) != "warn":
+        return values, mode
+    from fuzzyctl.cli.app import err_console
+
+    for line in outside_lines(ctl.input_ranges, values):
+        err_console.print(f"warning: {line}", style="yellow", markup=False, highlight=False)
+    return values, "ignore"
+
+
 def _fmt(v: float) -> str:
     return repr(float(v)) if math.isfinite(v) else ("nan" if math.isnan(v) else ("inf" if v > 0 else "-inf"))
 
 
 @app.command("eval")
 def eval_(
-    file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+    ],
     set_: SetOpt = None,
     data: Annotated[
         str | None,
@@ -127,6 +158,8 @@ def eval_(
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
+    out_of_range: OutOfRangeOpt = "warn",
+    from_format: FromOpt = None,
     dask_in: DaskOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -153,7 +186,7 @@ def eval_(
         raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
     if as_json and as_table:
         raise typer.BadParameter("use either --json or --table", param_hint="--table")
-    ctl = _controller(file, block, compat, strict)
+    ctl = _controller(file, block, compat, strict, from_format)
     if data is not None:
         from fuzzyctl.cli.app import err_console
         from fuzzyctl.cli.eval_data import evaluate_file
@@ -166,12 +199,13 @@ def eval_(
             delimiter=delimiter,
             decimal=decimal,
             on_error=on_error,
+            out_of_range=out_of_range,
             as_table=as_table and output is None,
             warn=lambda text: err_console.print(f"warning: {text}", markup=False),
         )
         return
-    values = _parse_sets(set_)
-    result = ctl.evaluate(values)
+    values, mode = _checked_sets(ctl, set_, out_of_range)
+    result = ctl.evaluate(values, out_of_range=mode)
     if as_json:
         typer.echo(json.dumps({k: (v if math.isfinite(v) else None) for k, v in result.items()}))
     else:
@@ -226,7 +260,9 @@ def _print_outputs(title: str, result: Mapping[str, float]) -> None:
 
 @app.command()
 def explain(
-    file: Annotated[Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL or JSON).", show_default=False)],
+    file: Annotated[
+        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+    ],
     set_: SetOpt = None,
     png: Annotated[
         Path | None, typer.Option("--png", help="Also draw the accumulated output sets to a PNG file.")
@@ -236,10 +272,13 @@ def explain(
     block: BlockOpt = None,
     compat: CompatOpt = "iec",
     strict: StrictOpt = False,
+    out_of_range: OutOfRangeOpt = "warn",
+    from_format: FromOpt = None,
 ) -> None:
     """Evaluate once and show why: term degrees, rule degrees, accumulated sets, values."""
-    ctl = _controller(file, block, compat, strict)
-    e = ctl.explain(_parse_sets(set_))
+    ctl = _controller(file, block, compat, strict, from_format)
+    values, mode = _checked_sets(ctl, set_, out_of_range)
+    e = ctl.explain(values, out_of_range=mode)
     if png is not None:
         from fuzzyctl.engine.plot import save_png
 

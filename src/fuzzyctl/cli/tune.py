@@ -10,7 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import FromOpt, app
 
 WorkersOpt = Annotated[
     int | None,
@@ -40,14 +40,28 @@ ValidationDataOpt = Annotated[
 ]
 
 
-def _need_extra() -> None:
-    import importlib.util
+OldOutOpt = Annotated[
+    Path | None,
+    typer.Option("--out", hidden=True, help="Old spelling of -o/--output (one release).", show_default=False),
+]
 
-    missing = [m for m in ("cma", "pyarrow", "distributed") if importlib.util.find_spec(m) is None]
-    if missing:
-        from fuzzyctl.diagnostics import FuzzyctlError
 
-        raise FuzzyctlError(f"this needs the tune extra ({', '.join(missing)}): pip install 'fuzzyctl[tune]'")
+#: what learn and tune say when an invocation reads as the old spelling
+RENAMED = "-o/--output now names the file written (it was -o/--out); name the column(s) with --target"
+
+
+def _output_file(output: Path | None, old: Path | None) -> Path:
+    """-o/--output FILE, or the old --out FILE with a note (kept for one release)."""
+    from fuzzyctl.cli.app import err_console
+
+    if old is not None:
+        if output is not None:
+            raise typer.BadParameter(RENAMED, param_hint="--out")
+        err_console.print("note: --out is now -o/--output (--out goes in the next release)", markup=False)
+        return old
+    if output is None:
+        raise typer.BadParameter("name the file to write: -o/--output FILE", param_hint="-o/--output")
+    return output
 
 
 def _fmt(v: float) -> str:
@@ -70,16 +84,29 @@ def _print_table(title: str, rows: list[tuple[str, float, float]] | list[tuple[s
     Console(highlight=False).print(table)
 
 
+def _load(file: Path, fmt: str) -> Any:
+    import fuzzyctl
+
+    return fuzzyctl.load(file, format=fmt)
+
+
 @app.command("learn")
 def learn(
     data: Annotated[Path, typer.Argument(help="CSV or Parquet file with a header row.", show_default=False)],
     inputs: Annotated[
-        str, typer.Option("--inputs", help="Input columns, comma-separated.", show_default=False)
+        list[str],
+        typer.Option(
+            "--inputs", help="Input columns: a,b or 'a b' (or --inputs a --inputs b).", show_default=False
+        ),
     ],
-    output: Annotated[str, typer.Option("--output", help="The output column.", show_default=False)],
-    out: Annotated[
-        Path, typer.Option("-o", "--out", help="Write the learned system here (FCL).", show_default=False)
+    target: Annotated[
+        str, typer.Option("--target", help="The column to learn (the system's output).", show_default=False)
     ],
+    output: Annotated[
+        Path | None,
+        typer.Option("-o", "--output", help="Write the learned system here (FCL).", show_default=False),
+    ] = None,
+    old_out: OldOutOpt = None,
     method: Annotated[str, typer.Option("--method", help="grid (partition) or cluster (k-means).")] = "grid",
     kind: Annotated[str, typer.Option("--type", help="tsk (Takagi-Sugeno) or mamdani (singletons).")] = "tsk",
     terms: Annotated[
@@ -106,16 +133,17 @@ def learn(
     as_json: Annotated[bool, typer.Option("--json", help="Print the errors as JSON.")] = False,
 ) -> None:
     """Learn a fuzzy system from data: grid partition or clustering, consequents by least squares."""
-    _need_extra()
+    from fuzzyctl.cli.app import split_names
     from fuzzyctl.tune.learning import learn as run
 
-    names = [s.strip() for s in inputs.split(",") if s.strip()]
+    out = _output_file(output, old_out)
+    names = split_names(inputs)
     if not names:
         raise typer.BadParameter("name at least one input column", param_hint="--inputs")
     result = run(
         data,
         inputs=names,
-        output=output,
+        output=target,
         method=method,
         kind=kind,
         terms=terms,
@@ -142,18 +170,20 @@ def tune(
     file: Annotated[
         Path, typer.Argument(help="The fuzzy system to tune (FCL, FIS, FLL or JSON).", show_default=False)
     ],
-    out: Annotated[
-        Path, typer.Option("-o", "--out", help="Write the tuned system here (FCL).", show_default=False)
-    ],
+    output: Annotated[
+        Path | None,
+        typer.Option("-o", "--output", help="Write the tuned system here (FCL).", show_default=False),
+    ] = None,
+    old_out: OldOutOpt = None,
     data: Annotated[
         Path | None,
         typer.Option("--data", help="CSV/Parquet of inputs and target outputs.", show_default=False),
     ] = None,
-    output: Annotated[
-        str | None,
+    target: Annotated[
+        list[str] | None,
         typer.Option(
-            "--output",
-            help="Target column(s), comma-separated (default: every output in the data).",
+            "--target",
+            help="Target column(s): a,b or 'a b' (default: every output in the data).",
             show_default=False,
         ),
     ] = None,
@@ -212,14 +242,16 @@ def tune(
         Path | None, typer.Option("--report", help="Write a report directory (Markdown, JSON, PNG, HTML).")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
+    from_format: FromOpt = None,
 ) -> None:
     """Tune a fuzzy system against data or a closed-loop cost (Ctrl-C keeps the best so far)."""
-    _need_extra()
     from rich.console import Console
     from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
+    from fuzzyctl.cli.app import split_names
     from fuzzyctl.tune.api import tune as run
 
+    out = _output_file(output, old_out)
     if budget < 1:
         raise typer.BadParameter(f"must be at least 1, got {budget}", param_hint="--budget")
     if workers is not None and scheduler is not None:
@@ -243,9 +275,9 @@ def tune(
             progress.update(task, completed=done, total=total, best=_fmt(best))
 
         result = run(
-            file,
+            file if from_format is None else _load(file, from_format),
             data=data,
-            output=[s.strip() for s in output.split(",")] if output else None,
+            output=split_names(target) or None,
             plant_config=plant_config,
             cost=cost,
             free=free,

@@ -269,8 +269,15 @@ class NativeController(Controller):
         slots = [(n, k if self._plc else i) for k, (n, i) in enumerate(self._names)]
         return slots, self._n_res
 
-    def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
-        values = self._values(merge_inputs(inputs, values_by_name))
+    def evaluate(
+        self,
+        inputs: Mapping[str, Any] | None = None,
+        /,
+        *,
+        out_of_range: str | None = None,
+        **values_by_name: Any,
+    ) -> dict[str, float]:
+        values = self._values(merge_inputs(inputs, values_by_name), out_of_range)
         buf = self._in1
         for i, v in enumerate(values):
             buf[i] = v

@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.diagnostics import Diagnostic, InputError
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.engine.ranges import check_columns, check_mode, check_values, declared_ranges
 from fuzzyctl.engine.variables import VariableMap, inputs_of, outputs_of
 
 if TYPE_CHECKING:  # numpy, the interpreter and explanations are imported when first used
@@ -44,6 +45,11 @@ class Controller:
         self._state: list[float | None] = [None] * len(plan.outputs)
         self._required = tuple(i.name for i in plan.inputs if i.default is None)
         self._degree = tuple(i.degree for i in plan.inputs)
+        #: name -> (low, high) of each input that declares a RANGE (engine/ranges.py)
+        self.input_ranges: dict[str, tuple[float, float]] = declared_ranges(self.inputs)
+        #: what an input outside its RANGE does when a call does not say: "warn" (the
+        #: result as computed, and an InputRangeWarning), "clamp", "raise" or "ignore"
+        self.out_of_range = "warn"
         #: what compiling decided with a warning (a universe taken from the terms, a term
         #: defined twice, ...): :class:`~fuzzyctl.diagnostics.Diagnostic` objects
         self.warnings: tuple[Diagnostic, ...] = ()
@@ -99,7 +105,7 @@ class Controller:
 
     # ------------------------------------------------------------------ inputs
 
-    def _values(self, inputs: Mapping[str, Any]) -> list[float]:
+    def _values(self, inputs: Mapping[str, Any], out_of_range: str | None = None) -> list[float]:
         _check_names(inputs, self.inputs)
         values: list[float] = []
         for i, spec in enumerate(self.plan.inputs):
@@ -113,14 +119,29 @@ class Controller:
             if self._degree[i] and not 0.0 <= v <= 1.0:
                 raise InputError(f"input {spec.name!r} is used as a degree and must be in [0, 1], got {v}")
             values.append(v)
-        return values
+        return self._in_range(values, out_of_range)
+
+    def _in_range(self, values: list[float], mode: str | None) -> list[float]:
+        """The input values after the RANGE check (engine/ranges.py): unchanged unless
+        ``mode`` (default: :attr:`out_of_range`) is "clamp"."""
+        mode = self.out_of_range if mode is None else check_mode(mode)
+        return check_values(self.input_ranges, tuple(self.inputs), values, mode)
 
     # ------------------------------------------------------------------ evaluation
 
-    def evaluate(self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any) -> dict[str, float]:
+    def evaluate(
+        self,
+        inputs: Mapping[str, Any] | None = None,
+        /,
+        *,
+        out_of_range: str | None = None,
+        **values_by_name: Any,
+    ) -> dict[str, float]:
         """Evaluate once: ``evaluate({"temp": 20.0, ...})`` or ``evaluate(temp=20.0, ...)`` ->
-        ``{"valve": 35.7, ...}``.  Values are real numbers (numpy scalars and 0-d arrays too)."""
-        values = self._values(merge_inputs(inputs, values_by_name))
+        ``{"valve": 35.7, ...}``.  Values are real numbers (numpy scalars and 0-d arrays too).
+        ``out_of_range`` ("warn", "clamp", "raise", "ignore"; default :attr:`out_of_range`):
+        what an input outside its declared RANGE does (docs/engine.md)."""
+        values = self._values(merge_inputs(inputs, values_by_name), out_of_range)
         fast = self._fast
         res: list[float] | None = None
         if self._jfl is not None:
@@ -147,13 +168,18 @@ class Controller:
         return {o.name: r.value for o, r in zip(self.plan.outputs, rec.outputs, strict=True) if o.is_output}
 
     def explain(
-        self, inputs: Mapping[str, Any] | None = None, /, **values_by_name: Any
+        self,
+        inputs: Mapping[str, Any] | None = None,
+        /,
+        *,
+        out_of_range: str | None = None,
+        **values_by_name: Any,
     ) -> explain_mod.Explanation:
         """Evaluate once and return every intermediate result (this counts as an evaluation:
-        the NC state advances); ``.plot()`` draws it."""
+        the NC state advances); ``.plot()`` draws it.  ``out_of_range`` as in :meth:`evaluate`."""
         from fuzzyctl.engine import explain as explain_mod
 
-        values = self._values(merge_inputs(inputs, values_by_name))
+        values = self._values(merge_inputs(inputs, values_by_name), out_of_range)
         rec = (
             self._jfl.record(values, self._state)
             if self._jfl is not None
@@ -163,14 +189,15 @@ class Controller:
         return explain_mod.build(self.plan, named, rec)
 
     def evaluate_batch(
-        self, data: Any, *, chunk: int = 16384, on_invalid: str = "raise"
+        self, data: Any, *, chunk: int = 16384, on_invalid: str = "raise", out_of_range: str | None = None
     ) -> dict[str, npt.NDArray[np.float64]]:
         """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
         arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays.
 
         ``on_invalid``: ``"raise"`` (default) refuses a NaN or infinite input with the row;
         ``"nan"`` gives NaN outputs for such rows, skips them (the NC state carries over them
-        from the previous valid row) and warns with their count (:class:`InvalidRowsWarning`)."""
+        from the previous valid row) and warns with their count (:class:`InvalidRowsWarning`).
+        ``out_of_range`` as in :meth:`evaluate`; "warn" warns once, with a count per input."""
         import numpy as np
 
         if on_invalid not in ("raise", "nan"):
@@ -199,6 +226,8 @@ class Controller:
                             f"(row {int(bad[0])}: {arr[bad[0]]})"
                         )
             arrays.append(arr)
+        mode = self.out_of_range if out_of_range is None else check_mode(out_of_range)
+        arrays = check_columns(self.input_ranges, tuple(self.inputs), arrays, mode)
         n = n or 0
         full = [
             a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))

@@ -132,9 +132,27 @@ def _unknown(keys: Any, allowed: set[str], what: str) -> None:
         )
 
 
+def _not_a_model(path: Path) -> None:
+    """A fuzzy system given where a loop configuration belongs (``simulate crane.fcl``) is
+    said as such, not as the TOML error its first line gives."""
+    from fuzzyctl.api import require_file
+    from fuzzyctl.formats import available
+
+    require_file(path)
+    suffix = path.suffix.lower()
+    fmt = next((f for f in available() if suffix in f.extensions and f.name != "toml"), None)
+    if fmt is not None and suffix != ".toml":
+        raise InputError(
+            f"{path} is a fuzzy system ({fmt.name.upper()}), not a loop configuration: simulate "
+            "takes a TOML file whose [controller] names the system and whose [plant] says what it "
+            "controls (docs/sim.md; examples/crane.toml runs examples/crane.fcl)"
+        )
+
+
 def load_config(path: str | Path) -> SimConfig:
     """Read and validate a loop configuration file."""
     path = Path(path)
+    _not_a_model(path)
     try:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except tomllib.TOMLDecodeError as exc:

@@ -104,7 +104,9 @@ def _probe_size(text: str, what: str, check: Callable[[Document], bool] | None =
     if check is not None and not check(doc):
         raise RuntimeError(f"statement: the Table 11 probe for {what} is not what it says")
     try:
-        out = fuzzyctl.compile(doc).evaluate(dict.fromkeys((v.name for v in doc.main.inputs), 1.0))
+        out = fuzzyctl.compile(doc, out_of_range="ignore").evaluate(
+            dict.fromkeys((v.name for v in doc.main.inputs), 1.0)
+        )
     except Exception as exc:  # an engine refusal is the answer
         return f"{what}: refused ({str(exc).splitlines()[0]})"
     if not all(math.isfinite(v) or math.isnan(v) for v in out.values()):

@@ -107,7 +107,7 @@ def measure(paths: Iterable[str | Path], *, rows: int = 10_000) -> list[Measurem
         data = {v.name: rng.uniform(*_universe(doc, v.name), rows) for v in fb.inputs}
         tracemalloc.start()
         base = tracemalloc.get_traced_memory()[0]
-        ctl = fuzzyctl.compile(doc)
+        ctl = fuzzyctl.compile(doc, out_of_range="ignore")
         kept = tracemalloc.get_traced_memory()[0] - base
         tracemalloc.stop()
         points = [{k: float(v[i]) for k, v in data.items()} for i in range(200)]
@@ -120,7 +120,7 @@ def measure(paths: Iterable[str | Path], *, rows: int = 10_000) -> list[Measurem
         batch_us = _best(functools.partial(ctl.evaluate_batch, data), 3) / rows * 1e6
         native_us = None
         try:
-            nat = fuzzyctl.compile(doc, backend="native")
+            nat = fuzzyctl.compile(doc, backend="native", out_of_range="ignore")
             if type(nat).__name__ == "NativeController":
                 nat.evaluate_batch(data)
                 native_us = _best(functools.partial(nat.evaluate_batch, data), 5) / rows * 1e6

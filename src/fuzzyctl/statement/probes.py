@@ -592,7 +592,7 @@ def run_probe(probe: Probe) -> ProbeResult:
             f"fuzzyctl check finds {sorted((str(v), k) for k, v in found.items())}"
         )
     try:
-        out = fuzzyctl.compile(doc).evaluate(_values(doc))
+        out = fuzzyctl.compile(doc, out_of_range="ignore").evaluate(_values(doc))
         value = out[doc.main.outputs[0].name]
         supported, reason = math.isfinite(value) or math.isnan(value), ""
     except Exception as exc:  # every refusal of the engine is an answer here

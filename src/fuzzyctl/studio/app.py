@@ -39,7 +39,7 @@ from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
 from fuzzyctl.files import ReadOnlyError, check_writable
 from fuzzyctl.model import Document, FunctionBlock
-from fuzzyctl.studio import analysis, api_editing, online
+from fuzzyctl.studio import analysis, api_editing, online, viewsettings
 from fuzzyctl.studio.project import (
     MAX_FILE,
     FileProblem,
@@ -50,7 +50,6 @@ from fuzzyctl.studio.project import (
     save_atomically,
     sha256,
     split_settings,
-    with_settings,
 )
 from fuzzyctl.studio.schemas import (
     DownloadBody,
@@ -248,6 +247,7 @@ def create_app(
                     **report.to_dict(),
                 }
             document, settings = split_settings(report.document)
+            settings = viewsettings.merged(project.root, rel, settings)
         else:
             document, settings = split_settings(read_text(text, suffix.lstrip("."), path=rel).document)
             report = analysis.check_text(analysis.fcl_text(document), rel)
@@ -325,19 +325,23 @@ def create_app(
 
     @app.post("/api/save")
     def save(body: SaveBody) -> Any:
-        """Write the model as FCL (with the studio settings in an OPTIONS block),
-        atomically.  Refused when the file changed on disk since it was opened."""
+        """Write the model as FCL, atomically; the view settings go to a sidecar
+        (studio/viewsettings.py), never into the file.  Refused when the file changed on
+        disk since it was opened."""
         if not body.path.lower().endswith(".fcl"):
             raise PathError("projects are FCL files: the name must end in .fcl")
         check_save_name(body.path)
         path = project.resolve(body.path)
         check_save_name(project.relative(path))  # a symbolic link into .git/ is refused too
         document, _fb = model_of(body)
-        text = analysis.fcl_text(with_settings(document, settings_of(body)))
+        text = analysis.fcl_text(document)  # the user's file only: view settings beside it
         try:
-            return saved(body, path, text)
+            result = saved(body, path, text)
         except OSError as exc:
             raise os_problem(exc, body.path, "save") from None
+        if isinstance(result, dict):
+            viewsettings.write_settings(project.root, project.relative(path), settings_of(body))
+        return result
 
     def saved(body: SaveBody, path: Path, text: str) -> Any:
         check_writable(path)  # told at once, not after "Replace it?"

@@ -25,7 +25,7 @@ def read_table(source: str | Path | Mapping[str, Any] | Any, *, what: str = "dat
     if isinstance(source, str | Path):
         path = Path(source)
         if not path.exists():
-            raise InputError(f"{what} file {str(path)!r} does not exist")
+            raise InputError(f"{path}: no such file ({what})")
         table = _read_file(path)
         where = str(path)
         cols = {name: table.column(name).to_numpy(zero_copy_only=False) for name in table.column_names}
@@ -60,7 +60,7 @@ def _read_file(path: Path) -> Any:
         import pyarrow.csv as pacsv
         import pyarrow.parquet as pq
     except ImportError as exc:  # pragma: no cover - the tune extra brings pyarrow
-        raise InputError(f"reading {path} needs pyarrow: pip install 'fuzzyctl[tune]'") from exc
+        raise InputError(f"reading {path} needs pyarrow: pip install -e . (it is a core dependency)") from exc
     import pyarrow as pa
 
     try:

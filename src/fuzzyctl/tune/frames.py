@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.diagnostics import FuzzyctlError, InputError
+from fuzzyctl.diagnostics import InputError
 from fuzzyctl.model import Document, FunctionBlock
 
 # Controllers compiled in this (worker) process, by the token of the scorer that built them.
@@ -47,7 +47,7 @@ class Scorer:
         if ctl is None:
             import fuzzyctl
 
-            ctl = fuzzyctl.compile(self.model, block=self.block, **self.options)
+            ctl = fuzzyctl.compile(self.model, block=self.block, out_of_range="ignore", **self.options)
             if len(_COMPILED) > 16:
                 _COMPILED.clear()
             _COMPILED[self.token] = ctl
@@ -186,8 +186,6 @@ def score_to_parquet(
 
 
 def require_dask() -> None:
-    try:
-        import dask.dataframe  # noqa: F401
-        import pyarrow  # noqa: F401
-    except ImportError as exc:
-        raise FuzzyctlError("--dask needs the tune extra: pip install 'fuzzyctl[tune]'") from exc
+    from fuzzyctl.extras import require
+
+    require(("dask", "distributed", "pandas", "pyarrow"), "--dask")

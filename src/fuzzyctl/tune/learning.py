@@ -72,10 +72,11 @@ SHAPES = ("triangle", "gauss")
 _NAMES = {
     2: ("low", "high"),
     3: ("low", "medium", "high"),
-    4: ("very_low", "low", "high", "very_high"),
-    5: ("very_low", "low", "medium", "high", "very_high"),
-    7: ("lowest", "very_low", "low", "medium", "high", "very_high", "highest"),
+    4: ("lowest", "low", "high", "highest"),
+    5: ("lowest", "low", "medium", "high", "highest"),
+    7: ("lowest", "lower", "low", "medium", "high", "higher", "highest"),
 }
+# (at most 7 characters: the Siemens configuration tool takes 7, its manual 6.4)
 _OUT_NAMES = {
     3: ("negative", "zero", "positive"),
     5: ("nb", "ns", "ze", "ps", "pb"),
@@ -116,6 +117,21 @@ def default_terms(method: str, inputs: int) -> int:
 
 def _sig(v: float, digits: int = 8) -> float:
     return float(f"{v:.{digits}g}")
+
+
+def readable_range(lo: float, hi: float) -> tuple[float, float]:
+    """``lo..hi`` rounded outward to two significant digits of its span: the data's
+    0.00438..9.99467 becomes 0..10, -2.96505..2.99416 becomes -3..3 (what a person would write,
+    and what the grid's points then follow)."""
+    if not hi > lo:
+        return lo, hi
+    e = math.floor(math.log10(hi - lo)) - 1
+    step = 10.0**e
+    digits = max(0, -e)
+    tol = 1e-9  # a bound on the division's rounding: 0.7 / 0.1 is 6.999999999999999
+    low = float(f"{math.floor(lo / step + tol) * step:.{digits}f}")
+    high = float(f"{math.ceil(hi / step - tol) * step:.{digits}f}")
+    return min(low, lo), max(high, hi)
 
 
 def _names(n: int, prefix: str = "t") -> tuple[str, ...]:
@@ -188,7 +204,7 @@ def learn(
     y = parts_train[output]
     y_lo, y_hi = float(np.min(y)), float(np.max(y))
     pad = 0.1 * (y_hi - y_lo) or 1.0
-    out_range = Range(_sig(y_lo - pad, 6), _sig(y_hi + pad, 6))
+    out_range = Range(*readable_range(y_lo - pad, y_hi + pad))
     block_name = name or "learned"
     variables = (*(Variable(i, VarKind.INPUT) for i in inputs), Variable(output, VarKind.OUTPUT))
     # Per-rule consequents first (Takagi-Sugeno, or zero-order for the Mamdani grouping).
@@ -214,6 +230,8 @@ def learn(
             seed,
         )
         notes.append(note)
+        if and_op.upper() != "MIN":
+            notes.append("the Siemens FUZZY block takes AND MIN: learn with --and min (and_op='min') for it")
     fb = _with_comment(fb, method, kind, inputs, output, n, and_op)
     doc = Document((fb,))
     scores = _scores(doc, parts_train, parts_val, inputs, output)
@@ -229,7 +247,7 @@ def _grid(
     fuzz = []
     names_per_input = []
     for i in inputs:
-        lo, hi = _sig(float(np.min(cols[i])), 6), _sig(float(np.max(cols[i])), 6)
+        lo, hi = readable_range(float(np.min(cols[i])), float(np.max(cols[i])))
         centres = [_sig(lo + (hi - lo) * k / (n - 1), 8) for k in range(n)]
         centres[0], centres[-1] = lo, hi
         names = _names(n)
@@ -278,7 +296,7 @@ def _clusters(
     order = np.lexsort(centres[:, ::-1].T)  # by the first input, then the next ...
     fuzz = []
     for d, i in enumerate(inputs):
-        lo, hi = _sig(float(np.min(cols[i])), 6), _sig(float(np.max(cols[i])), 6)
+        lo, hi = readable_range(float(np.min(cols[i])), float(np.max(cols[i])))
         floor = (hi - lo) / (2.0 * k)
         ts = []
         for rank, ci in enumerate(order):
@@ -304,6 +322,7 @@ def _assemble(
     order: int,
     conclusions: Sequence[str] | None,
     out_terms: Sequence[Term] | None = None,
+    accu: str = "MAX",
 ) -> FunctionBlock:
     inputs = [v.name for v in variables if v.kind is VarKind.INPUT]
     rules = []
@@ -316,8 +335,11 @@ def _assemble(
         mf = (lambda: ShapeMF("linear", (0.0,) * (len(inputs) + 1))) if order else (lambda: SingletonMF(0.0))
         out_terms = [Term(f"r{r + 1}", mf()) for r in range(len(antecedents))]
     method = "WTAVER" if order else "COGS"
-    defz = DefuzzifyBlock(output, tuple(out_terms), out_range, method, Default(0.0))
-    rb = RuleBlock("rules", tuple(rules), and_op=and_op, accu="MAX")
+    # Shared singletons (Mamdani) keep the last value when no rule fires, as the PLC blocks do
+    # (a grid partition always fires a rule; the DEFAULT would never be used)
+    default = Default(no_change=True) if conclusions is not None else Default(0.0)
+    defz = DefuzzifyBlock(output, tuple(out_terms), out_range, method, default)
+    rb = RuleBlock("rules", tuple(rules), and_op=and_op, accu=accu)
     return FunctionBlock(name, variables, tuple(fuzz), (defz,), (rb,))
 
 
@@ -388,6 +410,7 @@ def _mamdani(
 ) -> tuple[FunctionBlock, str]:
     from scipy.optimize import lsq_linear
 
+    plc = and_op.upper() == "MIN"  # what the Siemens FUZZY block takes
     z = np.clip(theta, out_range.low, out_range.high)
     k = max(1, min(out_terms, len(np.unique(np.round(z, 12)))))
     if k < len(z):
@@ -415,6 +438,7 @@ def _mamdani(
         0,
         [names[a] for a in assign],
         terms,
+        "SUM" if plc else "MAX",  # the sum the PLC blocks compute, as the gradient takes it
     )
     phi, _ = _design(fb2, cols, inputs, output)
     used = phi.any(axis=0)
@@ -437,6 +461,10 @@ def _mamdani(
         0,
         [rename[names[a]] for a in assign],
         terms,
+        # ACCU NSUM: the IEC sum the Siemens block computes; under CoGS its normalisation
+        # cancels, so the file computes exactly the SUM fitted above.  (With AND PROD, which
+        # the block does not take, MAX fits examples/surface.csv better: validation RMSE 0.055 vs 0.077.)
+        "NSUM" if plc else "MAX",
     )
     return fb3, f"{len(antecedents)} rules share {k} output singletons"
 
@@ -463,7 +491,8 @@ def _scores(
 
     # Evaluate what is written: the file read back, through the public compile().
     written = load_text(write(doc)).raise_for_errors()
-    ctl = fuzzyctl.compile(written, backend="python")
+    # (validation rows may lie outside the training rows' ranges: no warning)
+    ctl = fuzzyctl.compile(written, backend="python", out_of_range="ignore")
     out: dict[str, float] = {}
     for label, cols in (("training", train), ("validation", val)):
         if cols is None:

@@ -176,6 +176,9 @@ def run(
 
 
 def _cmaes(ev: Evaluator, u0: Arr, seed: int, opts: dict[str, Any]) -> str:
+    from fuzzyctl.extras import require
+
+    require(("cma",), "the CMA-ES optimiser (--optimizer cmaes)")
     import cma
 
     rng = np.random.default_rng(seed)
@@ -206,6 +209,9 @@ def _cmaes(ev: Evaluator, u0: Arr, seed: int, opts: dict[str, Any]) -> str:
 
 
 def _cmaes_1d(ev: Evaluator, u0: Arr, seed: int) -> str:
+    from fuzzyctl.extras import require
+
+    require(("cma",), "the CMA-ES optimiser (--optimizer cmaes)")
     import cma
 
     rng = np.random.default_rng(seed)

@@ -85,12 +85,11 @@ class DaskExecutor:
 
 
 def _import_distributed() -> Any:
-    try:
-        import distributed
-    except ImportError as exc:  # pragma: no cover - the tune extra brings it
-        raise FuzzyctlError(
-            "running on Dask needs dask.distributed: pip install 'fuzzyctl[tune]' (or use --workers 0)"
-        ) from exc
+    from fuzzyctl.extras import require
+
+    require(("distributed",), "running on Dask workers (--workers 0 runs in this process)")
+    import distributed
+
     return distributed
 
 

@@ -243,7 +243,7 @@ class FuzzyFB:
             if limits is not None:
                 x = min(max(x, limits[0]), limits[1])  # 1.5: clamped to MIN/MAX
             values[name] = x
-        result = self._controller.evaluate(values)
+        result = self._controller.evaluate(values, out_of_range="ignore")
         for j, name in enumerate(self._outputs, start=1):
             y = float(result[name])
             if not math.isnan(y):  # 1.5: no rule fired -> the last value stays

@@ -27,6 +27,13 @@ export function modelRule(blockName, label) {
   return null;
 }
 
+/** [value, term name] of the singleton terms of ``output``. */
+function singletonNames(output) {
+  const b = fb();
+  const d = b && b.defuzzify.find((x) => x.variable === output);
+  return d ? d.terms.filter((t) => t.mf.type === "singleton" && typeof t.mf.value === "number").map((t) => [t.mf.value, t.name]) : [];
+}
+
 function renderInputs() {
   const row = $("#ex-inputs");
   row.replaceChildren();
@@ -80,12 +87,28 @@ export async function run() {
   );
   const o = e.outputs.find((x) => x.name === output) || e.outputs[0];
   if (!o) return;
-  const traces = [];
-  if (o.breakpoints && o.breakpoints.length) traces.push({ x: o.breakpoints.map((p) => p[0]), y: o.breakpoints.map((p) => p[1]), mode: "lines", fill: "tozeroy", line: { color: COLORS[0] }, name: "accumulated set" });
-  for (const [x, mu] of o.singletons || []) traces.push({ x: [x, x], y: [0, mu], mode: "lines+markers", line: { color: COLORS[0], width: 4 }, name: `singleton ${fmt(x)}` });
   const [lo, hi] = range(o.name);
-  traces.push({ x: [o.value, o.value], y: [0, 1.05], mode: "lines", line: { color: COLORS[1], dash: "dash" }, name: `${o.name} = ${fmtVar(o.name, o.value)}` });
-  plot($("#ex-chart"), traces, { xaxis: { range: [Math.min(lo, o.value ?? lo), Math.max(hi, o.value ?? hi)], title: { text: `${o.name} = ${fmtVar(o.name, o.value)} (${o.method})` }, nticks: 10 }, yaxis: { range: [0, 1.1], title: { text: "degree" } }, showlegend: false, margin: { l: 55, r: 20, t: 10, b: 45 } });
+  const value = o.value;
+  const label = `${o.name} = ${fmtVar(o.name, value)}`;
+  // the result first, so that a singleton at the same place is drawn over it; its marker
+  // below the axis and its label above the chart read apart from the singletons
+  const traces = [];
+  if (typeof value === "number") traces.push({ x: [value, value], y: [0, 1.08], mode: "lines", line: { color: COLORS[1], dash: "dot", width: 1.5 }, hoverinfo: "skip", name: label });
+  if (o.breakpoints && o.breakpoints.length) traces.push({ x: o.breakpoints.map((p) => p[0]), y: o.breakpoints.map((p) => p[1]), mode: "lines", fill: "tozeroy", line: { color: COLORS[0] }, name: "accumulated set" });
+  const names = singletonNames(o.name);
+  const marks = [];
+  for (const [x, mu] of o.singletons || []) {
+    if (!(mu > 0)) continue; // an unfired singleton has no bar (no line at 0 that reads as one)
+    const term = names.filter(([v]) => Math.abs(v - x) <= 1e-9 * Math.max(1, Math.abs(x))).map(([, n]) => n).join("/") || fmt(x);
+    traces.push({ x: [x, x], y: [0, mu], mode: "lines+markers", line: { color: COLORS[0], width: 5 }, marker: { size: 7 }, hoverinfo: "skip", name: term });
+    marks.push({ x, y: mu, text: `${term} ${deg(mu)}` });
+  }
+  if (marks.length) traces.push({ x: marks.map((m) => m.x), y: marks.map((m) => m.y), text: marks.map((m) => m.text), mode: "text", textposition: "top center", textfont: { size: 13, color: "#111" }, hoverinfo: "skip", name: "terms" });
+  if (typeof value === "number") traces.push({ x: [value], y: [-0.045], mode: "markers", marker: { symbol: "triangle-up", size: 15, color: COLORS[1] }, hoverinfo: "skip", name: "result" });
+  const pad = 0.03 * (hi - lo);
+  const annotations = typeof value === "number" ? [{ x: value, y: 1.17, text: `<b>${label}</b>`, showarrow: false, font: { color: COLORS[1], size: 14 }, bgcolor: "#fff", bordercolor: COLORS[1], borderpad: 3 }] : [];
+  plot($("#ex-chart"), traces, { xaxis: { range: [Math.min(lo, value ?? lo) - pad, Math.max(hi, value ?? hi) + pad], zeroline: false, title: { text: `${o.name} (${o.method}); ▲ the result` }, nticks: 11, showgrid: true }, yaxis: { range: [-0.09, 1.25], tickvals: [0, 0.25, 0.5, 0.75, 1], zeroline: true, zerolinecolor: "#888", title: { text: "degree" } }, annotations, showlegend: false, margin: { l: 55, r: 20, t: 10, b: 45 } });
+  $("#ex-chart").dataset.labels = JSON.stringify(marks);
   $("#ex-chart").dataset.value = String(o.value);
 }
 

@@ -1,6 +1,7 @@
 // The studio's shell: views, the file menu, the check panel, keyboard shortcuts.
 import { get, post } from "./api.js";
-import { state, on, emit, load, changed, recheck, body, newDocument, status, cleanSettings } from "./state.js";
+import { state, on, emit, load, changed, recheck, body, newDocument, status, undo, redo, history } from "./state.js";
+import { matlabSummary } from "./matlab.js";
 import { $, el, confirmDialog, openDialog, fillDiagnostics } from "./ui.js";
 import * as diagram from "./diagram.js";
 import * as variable from "./variable.js";
@@ -17,8 +18,23 @@ import { setShapes } from "./terms.js";
 const views = { project: diagram, variable, rules, ruleviewer, text, surface, recorder, explain, online: onlineView };
 let current = "project";
 
+// views that need a model: disabled, saying why, while the file opened does not read
+const NEEDS_MODEL = ["project", "variable", "rules", "ruleviewer", "surface", "recorder", "explain"];
+let origin = null; // the format the model was read from (fis: a MATLAB file)
+
+function gateViews() {
+  const why = state.doc ? null : "the file has errors: fix them in the FCL text (the first is selected there), then this view works";
+  for (const tab of document.querySelectorAll('[role="tab"]')) {
+    const off = why !== null && NEEDS_MODEL.includes(tab.dataset.view);
+    tab.disabled = off;
+    tab.setAttribute("aria-disabled", String(off));
+    tab.title = off ? why : tab.dataset.keys || tab.title;
+  }
+}
+
 export function show(view) {
   if (!views[view]) return;
+  if (!state.doc && NEEDS_MODEL.includes(view) && document.body.dataset.broken === "true") return;
   current = view;
   for (const tab of document.querySelectorAll('[role="tab"]')) {
     const selected = tab.dataset.view === view;
@@ -46,13 +62,16 @@ function renderReport(report) {
   const detail = $("#level-detail");
   detail.replaceChildren();
   if (report.level) {
-    detail.append(el("p", {}, `Conformance level: ${report.level}`));
-    if (report.features && report.features.length) {
-      const ul = el("ul", { class: "features" });
-      for (const f of report.features) ul.append(el("li", {}, `${f.level} (${f.table}): ${f.element} — ${f.detail}`));
-      detail.append(ul);
+    const features = report.features || [];
+    const list = el("ul", { class: "features" }, ...features.map((f) => el("li", {}, `${f.level} (${f.table}): ${f.element} — ${f.detail}`)));
+    if (origin === "fis" && state.doc) {
+      // a MATLAB user reads the file's [System] settings, not the IEC standard's tables
+      detail.append(matlabSummary(state.doc.blocks[state.block]));
+      if (features.length) detail.append(el("details", { class: "conformance" }, el("summary", {}, `As IEC 61131-7 FCL: level ${report.level} (${features.length} item(s))`), list));
+    } else {
+      detail.append(el("p", {}, `Conformance level: ${report.level}`));
+      if (features.length) detail.append(list);
     }
-    if (state.settings && Object.keys(cleanSettings()).length) detail.append(el("p", { class: "hint" }, "The saved file also holds the studio's view settings in an OPTIONS block (an Open-level element); exports and downloads leave it out."));
   }
   const losses = (report.fcl_losses || []).map((l) => ({ severity: "warning", message: `saving as FCL drops: ${l}`, element: null }));
   fillDiagnostics($("#all-diags"), [...report.diagnostics, ...losses]);
@@ -111,10 +130,15 @@ export async function openPath(path) {
   try {
     const result = await post("/api/open", { path });
     if (!result.document) {
+      // the file does not read: open it at its first error, the views that need a model off
+      document.body.dataset.broken = "true";
       load({ ...result, document: null });
+      emit("report", state.report);
       emit("rawtext", result.text);
-      status(`${path} has errors: fix them in the FCL text`, "error");
+      const first = (result.diagnostics || []).find((d) => d.severity === "error" && d.line);
       show("text");
+      if (first) emit("show", { view: "text", target: { line: first.line } });
+      status(`${path} has errors${first ? ` (the first at line ${first.line}, selected)` : ""}: fix them in the FCL text; the other views open once it reads`, "error");
       return;
     }
     load(result, { path: result.path, sha: result.sha256 });
@@ -207,6 +231,10 @@ async function exportFile() {
 
 // --- start ---------------------------------------------------------------------------
 
+function textField(target) {
+  return target instanceof HTMLTextAreaElement || (target instanceof HTMLInputElement && ["text", "search"].includes(target.type));
+}
+
 function bindShell() {
   $("#btn-new").addEventListener("click", newProject);
   $("#btn-open").addEventListener("click", openFile);
@@ -238,6 +266,11 @@ function bindShell() {
     } else if ((e.ctrlKey || e.metaKey) && key === "o") {
       e.preventDefault();
       openFile();
+    } else if ((e.ctrlKey || e.metaKey) && (key === "z" || key === "y") && !textField(e.target)) {
+      // the model's undo; a text field keeps its own (the browser's) while it is edited
+      e.preventDefault();
+      if (key === "y" || e.shiftKey) redo() || status("nothing to redo");
+      else undo() || status("nothing to undo");
     } else if (e.altKey && key === "n") {
       e.preventDefault();
       newProject();
@@ -254,6 +287,24 @@ function bindShell() {
   on("report", renderReport);
   on("dirty", renderTitle);
   on("loaded", renderTitle);
+  on("loaded", (result) => {
+    origin = result.format || ((result.imported_from || "").match(/\.([a-z0-9]+)$/i) || [])[1]?.toLowerCase() || null;
+    if (result.document) document.body.dataset.broken = "false";
+    gateViews();
+  });
+  on("model", () => {
+    if (state.doc && document.body.dataset.broken === "true") document.body.dataset.broken = "false";
+    gateViews();
+  });
+  for (const tab of tabs) tab.dataset.keys = tab.title;
+  $("#btn-undo").addEventListener("click", () => undo() || status("nothing to undo"));
+  $("#btn-redo").addEventListener("click", () => redo() || status("nothing to redo"));
+  on("history", (h) => {
+    $("#btn-undo").disabled = !h.undo.length;
+    $("#btn-redo").disabled = !h.redo.length;
+    document.body.dataset.undo = String(h.undo.length);
+    document.body.dataset.redo = String(h.redo.length);
+  });
   on("loaded", renderBlocks);
   $("#fb-select").addEventListener("change", (e) => {
     state.block = +e.target.value;

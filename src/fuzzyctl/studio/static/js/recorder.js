@@ -43,12 +43,17 @@ const archiveRecords = () => Math.min(MAX_RECORDS, Math.round(archiveLength() / 
  * configuration ([plot] panels: a setpoint beside its measurement). */
 function unitOf(name) {
   if (source() !== "sim" || !sim) return null;
-  const units = sim.info.units || {};
-  if (units[name]) return units[name];
+  const own = columnUnit(name);
+  if (own) return own;
   const config = configs.find((c) => c.path === rec().loop) || {};
   const base = name.startsWith("fb.") ? name.slice(3) : null;
   const mapped = base && ((config.inputs || {})[base] || (config.outputs || {})[base]);
-  if (typeof mapped === "string" && units[mapped.trim()]) return units[mapped.trim()];
+  return typeof mapped === "string" ? expressionUnit(mapped, columnUnit) : null;
+}
+
+function columnUnit(name) {
+  const units = sim.info.units || {};
+  if (units[name]) return units[name];
   for (const panel of sim.info.panels || []) {
     if (!panel.includes(name)) continue;
     const mate = panel.find((c) => units[c]);
@@ -56,6 +61,18 @@ function unitOf(name) {
   }
   return null;
 }
+
+/** The unit of a sum or difference of columns of one unit ("target - position": m), else
+ * null (a product or a mix of units has no unit the recorder could share an axis with). */
+function expressionUnit(text, unitOfColumn) {
+  if (!/^[\sA-Za-z0-9_.+\-()]+$/.test(text)) return null;
+  const names = text.match(/[A-Za-z_][A-Za-z0-9_.]*/g) || [];
+  const found = new Set(names.map((n) => unitOfColumn(n)));
+  return names.length && found.size === 1 && !found.has(null) ? [...found][0] : null;
+}
+
+/** Curves of one quantity share an axis unless the user turned it off. */
+const sharing = () => rec().shared !== false;
 
 function format(name, v) {
   const [lo, hi] = ownScale(name);
@@ -77,7 +94,7 @@ function fuzzyName(name) {
 /** The range a curve is drawn over: shared with the curves of the same quantity when the
  * shared axis is on. */
 function scale(name) {
-  if (!rec().shared) return ownScale(name);
+  if (!sharing()) return ownScale(name);
   const unit = unitOf(name);
   const key = unit || (isFuzzy(name) ? `range ${ownScale(name).join(" ")}` : null);
   if (!key) return ownScale(name);
@@ -318,7 +335,9 @@ async function sample() {
     const n = Math.min(due, 500);
     if (source() === "test") {
       const times = Array.from({ length: n }, (_, i) => (k + i) * dt());
-      const res = await post("/api/record", body({ signals: rec().signals || {}, times, length: length(), reset: k === 0 }));
+      // every input's signal as its button shows it (an input never set: the middle of its range)
+      const signals = Object.fromEntries(inputs().map((v) => [v.name, signalOf(v.name)]));
+      const res = await post("/api/record", body({ signals, times, length: length(), reset: k === 0 }));
       if (session !== running) return; // stopped meanwhile: the recording ended at Stop
       res.t.forEach((t, i) => push(t, Object.fromEntries(Object.entries(res.values).map(([name, vs]) => [name, vs[i]]))));
     } else if (source() === "sim") {
@@ -391,19 +410,23 @@ function readingRecord() {
 function draw() {
   const r = rec();
   const shown = windowRecords();
-  const traces = r.curves.map((name, i) => {
-    const [lo, hi] = scale(name);
-    return { x: shown.map((x) => x.t), y: shown.map((x) => (typeof x.v[name] === "number" ? (x.v[name] - lo) / (hi - lo) : null)), mode: "lines", line: { color: COLORS[i], width: i === selectedCurve ? 2.5 : 1.5 }, name, hoverinfo: "skip" };
-  });
   const sel = r.curves[selectedCurve] || r.curves[0];
   const [lo, hi] = sel ? scale(sel) : [0, 1];
   const ticks = niceTicks(lo, hi, 5); // round values of the selected curve's scale
+  const selColour = COLORS[Math.max(0, r.curves.indexOf(sel))];
+  // which curves the labels hold for: the selected one and those drawn on its scale; the
+  // others (another quantity, or sharing off) are dotted: the labels are not theirs
+  const onAxis = r.curves.filter((c) => sel && scale(c)[0] === lo && scale(c)[1] === hi);
+  const traces = r.curves.map((name, i) => {
+    const [a, b] = scale(name);
+    return { x: shown.map((x) => x.t), y: shown.map((x) => (typeof x.v[name] === "number" ? (x.v[name] - a) / (b - a) : null)), mode: "lines", line: { color: COLORS[i], width: i === selectedCurve ? 2.5 : 1.5, dash: onAxis.includes(name) ? "solid" : "dot" }, name, hoverinfo: "skip" };
+  });
   const stopped = !running;
   const reading = stopped && archive.length ? readingRecord() : null;
   const shapes = reading ? [{ type: "line", x0: reading.t, x1: reading.t, y0: -0.02, y1: 1.02, line: { color: "#333", width: 1.5 } }] : [];
   plot($("#rec-chart"), traces, {
     xaxis: { range: [t0, t0 + length()], title: { text: "time [s]" } },
-    yaxis: { range: [-0.03, 1.03], tickvals: ticks.map((v) => (v - lo) / (hi - lo)), ticktext: ticks.map((v) => num(v)), title: { text: sel ? `${sel}${unitOf(sel) ? ` [${unitOf(sel)}]` : ""}${rec().shared ? " (shared axis)" : ""}` : "" } },
+    yaxis: { range: [-0.03, 1.03], tickvals: ticks.map((v) => (v - lo) / (hi - lo)), ticktext: ticks.map((v) => num(v)), tickfont: { color: selColour }, title: { text: sel ? `${onAxis.join(", ")}${unitOf(sel) ? ` [${unitOf(sel)}]` : ""}` : "", font: { color: selColour } } },
     shapes,
     margin: { l: 60, r: 15, t: 10, b: 40 },
   }, { staticPlot: true });
@@ -418,7 +441,11 @@ function draw() {
   scroll.max = String(Math.max(0, Math.round((span - length()) / dt())));
   scroll.disabled = running !== null || +scroll.max === 0;
   $("#rec-read").disabled = running !== null || !archive.length;
-  if (reading) values(reading);
+  // the values follow the source: the reading line when stopped, the newest record while running
+  $("#rec-values caption").textContent = reading ? "Values at the reading line" : running ? "Values now (running)" : "Values at the reading line";
+  if (last) values(last);
+  else $("#rec-values tbody").replaceChildren();
+  $("#rec-chart").dataset.axis = JSON.stringify({ curve: sel || null, lo, hi, unit: sel ? unitOf(sel) : null, curves: onAxis });
 }
 
 function values(record) {
@@ -478,12 +505,25 @@ async function bars(record) {
   const width = (hi - lo) / 60;
   const base = bases(xs, ys, stacks(b, output));
   const top = Math.max(1, ...ys.map((y, i) => y + base[i]));
+  // the rule numbers above each bar (or stack), horizontal and full size: inside a bar
+  // 1/60 of the range wide they were unreadable
+  const tops = new Map();
+  xs.forEach((x, i) => {
+    if (!(ys[i] > 1e-12)) return;
+    const t = tops.get(x) || { y: 0, labels: [] };
+    t.y = Math.max(t.y, base[i] + ys[i]);
+    t.labels.push(labels[i]);
+    tops.set(x, t);
+  });
+  const marks = [...tops].map(([x, t]) => ({ x, y: t.y, text: t.labels.join(", ") }));
   plot($("#rec-bars"), [
-    { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), text: labels, textposition: "inside", insidetextanchor: "start", marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
+    { type: "bar", x: xs, y: ys, base, width: xs.map(() => width), text: labels, textposition: "none", marker: { color: COLORS[0], line: { color: "#fff", width: 1 } }, hoverinfo: "skip" },
     { x: [o.value], y: [-0.06 * top], mode: "markers", marker: { symbol: "triangle-up", size: 14, color: COLORS[1] }, hoverinfo: "skip" },
-  ], { xaxis: { range: [lo, hi], title: { text: `${output} = ${format(output, o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.05 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
+    { x: marks.map((m) => m.x), y: marks.map((m) => m.y), text: marks.map((m) => m.text), mode: "text", textposition: "top center", textfont: { size: 12, color: "#222" }, hoverinfo: "skip", name: "rules" },
+  ], { xaxis: { range: [lo - 0.03 * (hi - lo), hi + 0.03 * (hi - lo)], zeroline: false, title: { text: `${output} = ${format(output, o.value)} (centre of gravity ▲)` } }, yaxis: { range: [-0.12 * top, 1.25 * top], title: { text: "rule effectiveness" } }, barmode: "overlay", showlegend: false, margin: { l: 60, r: 15, t: 10, b: 40 } }, { staticPlot: true });
   $("#rec-bars").dataset.value = String(o.value);
   $("#rec-bars").dataset.rules = JSON.stringify(labels.map((l, i) => [l, ys[i]]));
+  $("#rec-bars").dataset.labels = JSON.stringify(marks);
 }
 
 // --- start / stop ----------------------------------------------------------------------
@@ -491,6 +531,7 @@ async function bars(record) {
 async function start() {
   stop();
   archive = [];
+  $("#rec-values tbody").replaceChildren(); // nothing of an earlier run or source
   t0 = 0;
   simTime = -0.1 * (source() === "online" ? 1 : +$("#rec-speed").value);
   k = 0;
@@ -557,12 +598,14 @@ function layout() {
 export function init() {
   $("#rec-source").addEventListener("change", () => {
     stop();
+    archive = []; // another source: the records of the one before do not belong to it
+    t0 = 0;
     layout();
   });
   $("#rec-length").addEventListener("change", (e) => setLength(parseFloat(e.target.value)));
   $("#rec-archive").addEventListener("change", (e) => setArchive(parseFloat(e.target.value)));
   $("#rec-shared").addEventListener("change", (e) => {
-    rec().shared = e.target.checked || undefined;
+    rec().shared = e.target.checked ? undefined : false;
     draw();
   });
   on("model", () => !$("#view-recorder").hidden && source() === "test" && outputsNow());
@@ -619,7 +662,7 @@ export function init() {
 export function shown() {
   if (!state.doc) return;
   setLength(length());
-  $("#rec-shared").checked = !!rec().shared;
+  $("#rec-shared").checked = sharing();
   layout();
 }
 

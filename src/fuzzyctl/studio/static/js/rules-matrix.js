@@ -210,4 +210,12 @@ export function suits() {
   return inputs().length >= 2 && outputs().length >= 1 && !!fb();
 }
 
+/** Whether every rule of the block has a cell in the matrix (no OR, NOT, other inputs...):
+ * only then is the matrix the view a file opens on. */
+export function holdsAll() {
+  if (!suits() || !host) return false;
+  pickAxes();
+  return index(host.block()).outside === 0;
+}
+
 export { axes as matrixAxes };

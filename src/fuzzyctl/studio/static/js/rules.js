@@ -61,8 +61,10 @@ async function parseRule(line, field) {
 
 function defaultMode() {
   const saved = localStorage.getItem(MODE_KEY);
-  if (saved && ["matrix", "rows", "columns", "text"].includes(saved) && (saved !== "matrix" || matrix.suits())) return saved;
-  return matrix.suits() && state.doc && fb().rule_blocks.every((r) => r.rules.length <= 400) && fb().variables.filter((v) => v.kind === "VAR_INPUT").length === 2 ? "matrix" : "rows";
+  // the matrix only when it shows every rule (a MATLAB file's OR rules are not cells)
+  const matrixFits = matrix.holdsAll();
+  if (saved && ["matrix", "rows", "columns", "text"].includes(saved) && (saved !== "matrix" || matrixFits)) return saved;
+  return matrixFits && state.doc && fb().rule_blocks.every((r) => r.rules.length <= 400) && fb().variables.filter((v) => v.kind === "VAR_INPUT").length === 2 ? "matrix" : "rows";
 }
 
 function setMode(next) {

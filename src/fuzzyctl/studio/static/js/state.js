@@ -66,6 +66,7 @@ let again = false; // the model changed while it was
  * (a 500-rule model takes a while to check, edits must not queue up behind each other). */
 let changes = 0; // model changes so far; a check reports which of them it saw
 export function changed(what = "model", { quiet = false, delay = 150 } = {}) {
+  remember(what);
   state.dirty = true;
   changes++;
   document.body.dataset.changes = String(changes);
@@ -166,13 +167,73 @@ export function load(result, { path = result.path, sha = result.sha256 } = {}) {
   state.sha = sha;
   state.dirty = false;
   state.report = { ok: result.ok, diagnostics: result.diagnostics || [], level: result.level, features: result.features || [], text: result.text, ranges: result.ranges || {}, curves: result.curves || {}, fcl_losses: result.fcl_losses || [] };
+  history.undo = [];
+  history.redo = [];
+  history.current = snapshot();
   emit("loaded", result);
+  emit("history", history);
   emit("model", "all");
   emit("dirty", false);
   // an opened or imported file comes checked, with its curves; a new project is checked now
   if (result.curves) emit("report", state.report);
   else recheck();
 }
+
+// --- undo / redo -------------------------------------------------------------------
+// Every edit goes through changed(): the model (and the view settings) before it is kept,
+// so Ctrl+Z / Ctrl+Y step through every edit whichever view made it.  Edits of one kind
+// within HISTORY_MERGE_MS (a point dragged, a number typed) are one step.
+
+const HISTORY_MAX = 200;
+const HISTORY_MERGE_MS = 600;
+export const history = { undo: [], redo: [], current: null, last: { what: null, at: 0 } };
+
+function snapshot() {
+  return state.doc ? JSON.stringify({ doc: state.doc, settings: state.settings || {} }) : null;
+}
+
+/** Keep the model before an edit made outside changed() (the FCL text). */
+export function remember(what) {
+  const now = snapshot();
+  if (now === null || now === history.current) return;
+  const merge = what === history.last.what && Date.now() - history.last.at < HISTORY_MERGE_MS && history.undo.length;
+  if (!merge && history.current !== null) {
+    history.undo.push(history.current);
+    if (history.undo.length > HISTORY_MAX) history.undo.shift();
+  }
+  history.redo = [];
+  history.current = now;
+  history.last = { what, at: Date.now() };
+  emit("history", history);
+}
+
+function restore(from, to) {
+  if (state.textError !== null) return false; // the FCL text holds its own edits
+  const target = from.pop();
+  if (target === undefined) return false;
+  to.push(history.current);
+  history.current = target;
+  history.last = { what: null, at: 0 };
+  const { doc, settings } = JSON.parse(target);
+  state.doc = doc;
+  state.settings = settings;
+  if (state.block >= doc.blocks.length) state.block = 0;
+  state.dirty = true;
+  changes++;
+  document.body.dataset.changes = String(changes);
+  if (inFlight) again = true;
+  emit("model", "undo");
+  emit("dirty", true);
+  emit("history", history);
+  clearTimeout(timer);
+  timer = setTimeout(recheck, 50);
+  return true;
+}
+
+/** Take back the last edit (Ctrl+Z); false when there is none. */
+export const undo = () => restore(history.undo, history.redo);
+/** Do again the edit taken back last (Ctrl+Y, Ctrl+Shift+Z). */
+export const redo = () => restore(history.redo, history.undo);
 
 // --- new terms ----------------------------------------------------------------------
 

@@ -1,7 +1,7 @@
 // The FCL text editor: syntax highlighting, line numbers and a mark in the gutter at
 // every diagnostic, live diagnostics from `fuzzyctl check`, and the model updated whenever
 // the text checks without errors.
-import { state, on, emit, recheck } from "./state.js";
+import { state, on, emit, recheck, remember } from "./state.js";
 import { post } from "./api.js";
 import { $, fillDiagnostics } from "./ui.js";
 import { CodeEditor, highlight } from "./code.js";
@@ -24,6 +24,7 @@ async function parse(text) {
       own = true;
       state.doc = result.document;
       if (result.settings && Object.keys(result.settings).length) state.settings = result.settings;
+      remember("text");
       state.dirty = true;
       emit("model", "text");
       emit("dirty", true);
@@ -64,6 +65,10 @@ export function init() {
   });
   on("loaded", () => {
     state.textError = null;
+  });
+  // an undo or redo: the editor shows the model's text once the check has written it
+  on("model", (what) => {
+    if (what === "undo") state.textError = null;
   });
 }
 
