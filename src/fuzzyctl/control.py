@@ -83,7 +83,10 @@ def _compile(controller: ControllerLike, block: str | None) -> Controller:
             raise InputError("block: give it only with a model or a file, not a compiled Controller")
         return controller
     model = fuzzyctl.load(controller) if isinstance(controller, str | Path) else controller
-    return fuzzyctl.compile(model, block=block)
+    # "ignore", not compile's "warn": the same numbers, but a simulation or a describing
+    # function calls the map thousands of times, far outside the ranges by design (an
+    # amplitude sweep), and one warning per call would bury the output
+    return fuzzyctl.compile(model, block=block, out_of_range="ignore")
 
 
 def iosys(
@@ -93,6 +96,7 @@ def iosys(
     dt: float = 0,
     name: str | None = None,
     block: str | None = None,
+    out_of_range: str | None = None,
 ) -> Any:
     """The controller as a :class:`control.NonlinearIOSystem`.
 
@@ -102,6 +106,9 @@ def iosys(
     that output: the system gets a state of that name and its output ``dheat`` is the
     integrated value.  ``dt=0``: continuous time; ``dt > 0``: sampled every ``dt`` s, the
     integrator a forward sum ``U += gain * output * dt`` as in ``fuzzyctl simulate``.
+    ``out_of_range`` (``"clamp"``, ``"warn"``, ``"raise"``, ``"ignore"``; docs/engine.md):
+    what an input outside its range does; default: the controller's own setting, and
+    ``"ignore"`` (the engine's numbers, no warning per call) for a model compiled here.
 
     ```python
     >>> import control, fuzzyctl.control
@@ -127,7 +134,8 @@ def iosys(
     where = {o: i for i, o in enumerate(states)}
 
     def fuzzy(u: Any) -> dict[str, float]:
-        return ctl.evaluate(dict(zip(ins, (float(v) for v in np.atleast_1d(u)), strict=True)))
+        values = dict(zip(ins, (float(v) for v in np.atleast_1d(u)), strict=True))
+        return ctl.evaluate(values, out_of_range=out_of_range)
 
     def after_cycle(x: Any, f: Mapping[str, float]) -> np.ndarray:
         # the integrators' values after one period (discrete time)
@@ -178,26 +186,36 @@ class FuzzyNonlinearity(_ct.DescribingFunctionNonlinearity):  # type: ignore[mis
     """A one-input, one-output fuzzy map ``u = f(e)`` as python-control's static
     nonlinearity (its describing function is computed numerically by python-control)."""
 
-    def __init__(self, controller: Controller, input: str, output: str) -> None:
+    def __init__(
+        self, controller: Controller, input: str, output: str, out_of_range: str | None = None
+    ) -> None:
         super().__init__()
         self.controller, self.input, self.output = controller, input, output
+        self.out_of_range = out_of_range
 
     def __call__(self, x: float) -> float:
-        return float(self.controller.evaluate({self.input: float(x)})[self.output])
+        out = self.controller.evaluate({self.input: float(x)}, out_of_range=self.out_of_range)
+        return float(out[self.output])
 
     def _isstatic(self) -> bool:
         return True
 
 
 def nonlinearity(
-    controller: ControllerLike, *, output: str | None = None, block: str | None = None
+    controller: ControllerLike,
+    *,
+    output: str | None = None,
+    block: str | None = None,
+    out_of_range: str | None = None,
 ) -> FuzzyNonlinearity:
     """A one-input controller as a :class:`control.DescribingFunctionNonlinearity`, for
     ``control.describing_function(N, A)`` and the limit cycles of
     ``control.describing_function_response(G, N, amplitudes)``.
 
     The map must not keep state between calls (an output with ``DEFAULT := NC`` that no rule
-    reaches would): the describing function assumes a static map.
+    reaches would): the describing function assumes a static map.  ``out_of_range`` as
+    for :func:`iosys` (an amplitude sweep goes past the input's range by design: the map
+    there is what the terms give, e.g. the saturation of shoulder terms).
 
     ```python
     >>> import control, fuzzyctl.control
@@ -222,4 +240,4 @@ def nonlinearity(
         output = outs[0]
     elif output not in outs:
         raise InputError(f"output {output!r} is not an output of {ctl.name} (outputs: {', '.join(outs)})")
-    return FuzzyNonlinearity(ctl, next(iter(ctl.inputs)), output)
+    return FuzzyNonlinearity(ctl, next(iter(ctl.inputs)), output, out_of_range)

@@ -150,3 +150,18 @@ def test_missing_python_control_names_the_extra() -> None:
         [sys.executable, "-c", code], capture_output=True, text=True, timeout=60, check=True
     )
     assert done.stdout.count("pip install 'fuzzyctl[control]'") == 2, done.stdout + done.stderr
+
+
+def test_out_of_range_is_quiet_by_default_and_can_clamp() -> None:
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a sweep far past the range: no warning per call
+        N = fc.nonlinearity(DATA / "saturation.fcl")
+        assert N(10.0) == 1.0 and fc.iosys(DATA / "rate.fcl").output(0, [], [5.0])[0] == 0.8
+    # clamp: the input limited to [-2, 2] first, as a PLC block's input limiter
+    ctl = fuzzyctl.compile(fuzzyctl.load(DATA / "rate.fcl"), out_of_range="ignore")
+    K = fc.iosys(DATA / "rate.fcl", out_of_range="clamp")
+    assert K.output(0, [], [5.0])[0] == ctl.evaluate(error=2.0)["rate"]
+    with pytest.raises(InputError):
+        fc.iosys(DATA / "rate.fcl", out_of_range="raise").output(0, [], [5.0])
