@@ -40,7 +40,18 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7),
     and in every format a WITH (or rule) weight above 1 (5.2.4).
     Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
-    when the input is not valid."""
+    when the input is not valid.
+
+    ```python
+    >>> import fuzzyctl
+    >>> doc = fuzzyctl.load("examples/tank.fcl")
+    >>> [fb.name for fb in doc.blocks]
+    ['tank']
+    >>> fuzzyctl.load("FUNCTION_BLOCK empty END_FUNCTION_BLOCK").blocks[0].name   # text, not a path
+    'empty'
+
+    ```
+    """
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
@@ -171,7 +182,18 @@ def compile(
     reading refuses and the engine otherwise settles with a warning: an output without RANGE
     whose terms do not fall to 0, identifiers that are Table 7 keywords; the warnings it
     settles with are the controller's ``warnings``.  Raises
-    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
+    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate.
+
+    ```python
+    >>> import fuzzyctl
+    >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/figure7.fcl"))
+    >>> list(ctl.inputs), list(ctl.outputs)
+    (['temp', 'pressure'], ['valve'])
+    >>> round(ctl.evaluate(temp=10, pressure=60)["valve"], 10)   # IEC 61131-7 figure 7
+    51.8518518519
+
+    ```
+    """
     from fuzzyctl.engine.ranges import check_mode
     from fuzzyctl.gcpause import gc_paused
     from fuzzyctl.model import Document
@@ -364,7 +386,17 @@ def _store(rel: str, obj: Any) -> None:
 def plot_terms(variable: VariableInfo, *, points: int = 1001, ax: Axes | None = None) -> Figure:
     """The membership functions of a variable as a labelled matplotlib Figure:
     ``fuzzyctl.plot_terms(ctl.inputs["temp"]).savefig("temp.png")`` (as scikit-fuzzy's
-    ``view()`` or simpful's ``plot_variable``)."""
+    ``view()`` or simpful's ``plot_variable``).
+
+    ```python
+    >>> import fuzzyctl
+    >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/figure7.fcl"))
+    >>> fig = fuzzyctl.plot_terms(ctl.inputs["temp"])
+    >>> [line.get_label() for line in fig.axes[0].get_lines()]
+    ['cold', 'hot']
+
+    ```
+    """
     from fuzzyctl.engine.plot import plot_terms as draw
 
     return draw(variable, points=points, ax=ax)

@@ -27,7 +27,16 @@ def analyze(
     ``epsilon``: a rule "fires" when its degree is >= epsilon (0, the default: > 0, where the
     output would fall to DEFAULT).  ``delta``: conflicts are pairs firing together above it
     (default 0.5).  ``monotone``: declarations ``"valve:-temp,+pressure"``.  ``surface``:
-    sample the output surface (min, max, slope, jumps, monotonicity counterexamples)."""
+    sample the output surface (min, max, slope, jumps, monotonicity counterexamples).
+
+    ```python
+    >>> import fuzzyctl
+    >>> found = fuzzyctl.analyze(fuzzyctl.load("examples/tank.fcl"))
+    >>> found.gaps, found.conflicts, found.dead_rules      # the 25 rules cover every input
+    ([], [], [])
+
+    ```
+    """
     from fuzzyctl.analysis import cells, conflicts, gaps, monotonicity, redundancy, table
     from fuzzyctl.analysis import surface as surf
     from fuzzyctl.analysis.context import build_context
