@@ -10,7 +10,7 @@ import pyarrow.parquet as pq
 import pytest
 
 import fuzzyctl
-from fuzzyctl.analysis import coverage
+from fuzzyctl.analysis import coverage, usage
 from tests.analysis.systems import random_system
 from tests.conftest import ROOT
 
@@ -65,7 +65,7 @@ def write_csv(path: Path, rows: list[dict[str, float]], prefix: str = "") -> Pat
     return path
 
 
-def check(cov: coverage.Coverage, ref: dict[str, object], n: int) -> None:
+def check(cov: usage.Coverage, ref: dict[str, object], n: int) -> None:
     assert cov.rows == n
     for r in cov.rules:
         label = r.rule.split(".")[-1]
@@ -89,7 +89,7 @@ def test_counts_match_explain_on_random_systems(seed: int, tmp_path: Path) -> No
     doc = fuzzyctl.load(random_system(seed))
     rows = points(doc, 150, seed)
     for eps in (0.0, 0.3):
-        cov = coverage.coverage(doc, write_csv(tmp_path / "log.csv", rows), epsilon=eps)
+        cov = coverage(doc, write_csv(tmp_path / "log.csv", rows), epsilon=eps)
         check(cov, brute(doc, rows, eps), len(rows))
 
 
@@ -97,16 +97,16 @@ def test_known_gap_rows_csv_parquet_and_glob(tmp_path: Path) -> None:
     doc = fuzzyctl.load(HEATER)
     rows = [{"temp": 30.0, "flow": f} for f in (0.0, 2.5, 5.0)]  # temp = 30: the gap
     rows += [{"temp": 15.0, "flow": 1.0}, {"temp": 60.0, "flow": 1.0}]  # 60: outside RANGE
-    cov = coverage.coverage(doc, write_csv(tmp_path / "a.csv", rows))
+    cov = coverage(doc, write_csv(tmp_path / "a.csv", rows))
     assert cov.gap_rows == {"valve": 3}
     assert cov.out_of_range == {"temp": 1, "flow": 0}
     assert "7" in cov.never_fired
     check(cov, brute(doc, rows), len(rows))
     table = pa.table({"ctl.temp": [r["temp"] for r in rows], "ctl.flow": [r["flow"] for r in rows]})
     pq.write_table(table, tmp_path / "b.parquet")
-    cov_pq = coverage.coverage(doc, tmp_path / "b.parquet")
+    cov_pq = coverage(doc, tmp_path / "b.parquet")
     assert cov_pq.to_json()["rules"] == cov.to_json()["rules"]
-    both = coverage.coverage(doc, str(tmp_path / "*.*"))
+    both = coverage(doc, str(tmp_path / "*.*"))
     assert both.rows == 2 * len(rows) and both.gap_rows == {"valve": 6}
     assert [r.fired for r in both.rules] == [2 * r.fired for r in cov.rules]
 
@@ -117,4 +117,4 @@ def test_missing_column_is_a_clear_error(tmp_path: Path) -> None:
     p = tmp_path / "x.csv"
     p.write_text("temp,speed\n1,2\n")
     with pytest.raises(FuzzyctlError, match="flow"):
-        coverage.coverage(fuzzyctl.load(HEATER), p)
+        coverage(fuzzyctl.load(HEATER), p)

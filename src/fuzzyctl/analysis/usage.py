@@ -219,3 +219,18 @@ def plot(cov: Coverage, path: Path) -> Path:
     fig.tight_layout()
     fig.savefig(path, dpi=100)
     return path
+
+
+def lines(cov: Coverage) -> list[str]:
+    """The summary under the table: never-fired rules, gap rows, rows outside a RANGE."""
+    out = [f"coverage: {cov.rows} rows from {len(cov.sources)} file(s), columns " + ", ".join(
+        f"{k}<-{v}" if k != v else k for k, v in cov.columns.items()
+    )]
+    if cov.invalid_rows:
+        out.append(f"  {cov.invalid_rows} row(s) with an empty, NaN or infinite input skipped")
+    for r in cov.rules:
+        if r.fired == 0:
+            out.append(f"  never fired: rule {r.rule}" + (f" ({r.where})" if r.where else ""))
+    out += [f"  {n} row(s) in a gap of {o} (no rule fired)" for o, n in cov.gap_rows.items() if n]
+    out += [f"  {n} row(s) with {i} outside its RANGE" for i, n in cov.out_of_range.items() if n]
+    return out
