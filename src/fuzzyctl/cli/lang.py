@@ -84,6 +84,14 @@ def check(
             "time and memory of FILE on this machine.",
         ),
     ] = False,
+    analyze: Annotated[
+        bool,
+        typer.Option(
+            "--analyze",
+            help="Also report the rule-base analysis (gaps, dead, conflicting, redundant rules, "
+            "unused terms) at file:line; with --strict gaps and dead rules are errors.",
+        ),
+    ] = False,
 ) -> None:
     """Validate an FCL file and report the conformance level it needs (exit 1 on errors)."""
     from rich.console import Console
@@ -113,6 +121,8 @@ def check(
             )
             raise typer.Exit(EXIT_ERRORS) from None
         raise
+    if analyze:
+        _add_analysis(result, strict)
     doc = result.document
     from fuzzyctl.gcpause import gc_paused
 
@@ -174,6 +184,16 @@ def check(
         if any("*" in row.item for fb in doc.blocks for row in conformance.checklist(fb, False)):
             out.print("* parametric shapes count their parameters as points", markup=False)
     raise typer.Exit(EXIT_OK)
+
+
+def _add_analysis(result: LoadResult, strict: bool) -> None:
+    """``check --analyze``: the analysis' findings join the diagnostics (fuzzyctl.analysis.findings)."""
+    if not result.ok:
+        return
+    from fuzzyctl.analysis import findings
+
+    assert result.document is not None
+    result.diagnostics.extend(findings.diagnostics(result.document, strict=strict))
 
 
 def _print_statement(file: Path | None) -> None:
