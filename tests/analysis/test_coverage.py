@@ -118,3 +118,104 @@ def test_missing_column_is_a_clear_error(tmp_path: Path) -> None:
     p.write_text("temp,speed\n1,2\n")
     with pytest.raises(FuzzyctlError, match="flow"):
         coverage(fuzzyctl.load(HEATER), p)
+
+
+def test_simulate_trace_and_eval_output_are_accepted(tmp_path: Path) -> None:
+    """A ``fuzzyctl simulate`` CSV (controller inputs as fb.NAME beside the plant's signals)
+    and an ``eval --data`` output (inputs as NAME, outputs appended), made by the commands."""
+    import csv
+
+    from fuzzyctl.cli.app import main
+
+    assert main(["simulate", str(ROOT / "examples" / "crane.toml"), "-o", str(tmp_path), "--no-png", "--no-html"]) == 0
+    trace = tmp_path / "crane.csv"
+    with trace.open() as fh:
+        table = list(csv.DictReader(fh))
+    doc = fuzzyctl.load(ROOT / "examples" / "crane.fcl")
+    rows = [{"distance": float(r["fb.distance"]), "angle": float(r["fb.angle"])} for r in table]
+    cov = coverage(doc, trace)
+    assert cov.columns == {"distance": "fb.distance", "angle": "fb.angle"}
+    check(cov, brute(doc, rows), len(rows))
+    # eval --data writes the inputs back under their own names, then the outputs
+    src = write_csv(tmp_path / "in.csv", rows[:40])
+    out = tmp_path / "evaluated.csv"
+    assert main(["eval", str(ROOT / "examples" / "crane.fcl"), "--data", str(src), "-o", str(out)]) == 0
+    cov = coverage(doc, out)
+    assert cov.columns == {"distance": "distance", "angle": "angle"}
+    check(cov, brute(doc, rows[:40]), 40)
+
+
+def test_cli_json_table_and_plots(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """analyze --data --json adds "coverage" and keeps the other keys; --plot writes one map
+    per input pair and the coverage chart."""
+    import json
+
+    from fuzzyctl.analysis import analyze
+    from fuzzyctl.cli.app import main
+
+    doc = fuzzyctl.load(HEATER)
+    rows = [{"temp": 30.0, "flow": 1.0}, {"temp": 15.0, "flow": 1.0}]
+    log = write_csv(tmp_path / "log.csv", rows)
+    assert main(["analyze", str(HEATER), "--data", str(log), "--json", "--plot", str(tmp_path / "png")]) == 0
+    obj = json.loads(capsys.readouterr().out)
+    plain = analyze(doc).to_json()
+    assert {k: obj[k] for k in plain} == json.loads(json.dumps(plain))
+    assert obj["coverage"]["rows"] == 2 and obj["coverage"]["gap_rows"] == {"valve": 1}
+    assert sorted(p.name for p in (tmp_path / "png").iterdir()) == ["coverage.png", "map_temp_flow.png"]
+
+
+def test_pair_maps_one_per_pair(tmp_path: Path) -> None:
+    from fuzzyctl.analysis import analyze, plots
+
+    doc = fuzzyctl.load(random_system(3))
+    a = analyze(doc, surface=False)
+    files = plots.pair_maps(doc, a, tmp_path)
+    n = len(a.inputs)
+    assert len(files) == n * (n - 1) // 2 and all(f.stat().st_size > 1000 for f in files)
+    assert all(f.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" for f in files)
+
+
+CHECKED = """\
+FUNCTION_BLOCK h
+VAR_INPUT t : REAL; END_VAR
+VAR_OUTPUT v : REAL; END_VAR
+FUZZIFY t
+  TERM lo := (0, 1) (10, 0);
+  TERM hi := (20, 0) (30, 1);
+  RANGE := (0 .. 30);
+END_FUZZIFY
+DEFUZZIFY v
+  TERM a := 0; TERM b := 1;
+  METHOD : CoGS; DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK r
+  AND : MIN;
+  RULE 1 : IF t IS lo THEN v IS a;
+  RULE 2 : IF t IS hi THEN v IS b;
+  RULE 3 : IF t IS lo AND t IS hi THEN v IS b;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_check_analyze_at_file_line_and_strict(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    """A gap (10 < t < 20) at the output's line 3, the dead rule 3 at line 17; warnings
+    (exit 0), errors under --strict (exit 1), and in --json."""
+    import json
+
+    from fuzzyctl.cli.app import main
+
+    f = tmp_path / "h.fcl"
+    f.write_text(CHECKED)
+    assert main(["check", str(f), "--analyze"]) == 0
+    err = capsys.readouterr().err
+    assert f"{f}:3:" in err and "warning: gap" in err
+    assert f"{f}:17:" in err and "warning: dead rule: rule 3" in err
+    assert main(["check", str(f), "--analyze", "--strict"]) == 1
+    err = capsys.readouterr().err
+    assert "error: gap" in err and "error: dead rule" in err
+    assert main(["check", str(f), "--analyze", "--json"]) == 0
+    diags = json.loads(capsys.readouterr().out)["diagnostics"]
+    assert {(d["code"], d["line"]) for d in diags} >= {("analyze-gap", 3), ("analyze-dead", 17)}
+    assert main(["check", str(f)]) == 0
+    assert "gap" not in capsys.readouterr().err

@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 
 #: separators a logger puts between a prefix and an input's name (``ctl.temp``, ``in_temp``)
 PREFIX_SEPARATORS = (".", "_", "/", ":")
+#: the prefix of the fuzzy block's signals in a ``fuzzyctl simulate`` trace
+SIMULATE_PREFIX = "fb."
 
 
 @dataclass
@@ -89,12 +91,14 @@ def expand(data: str | Path | list[str | Path]) -> list[str]:
 
 
 def match_columns(inputs: tuple[str, ...], header: list[str], source: str) -> dict[str, str]:
-    """Each input's column: its own name, else (case-insensitively) the one column that ends
-    with a separator and its name (a recorder's or simulation's prefix)."""
+    """Each input's column: ``fb.NAME`` (what ``fuzzyctl simulate`` records as the fuzzy
+    block's input, beside the plant's own signals), else its own name, else
+    (case-insensitively) the one column that ends with a separator and its name (a logger's
+    prefix)."""
     got: dict[str, str] = {}
     for name in inputs:
-        if name in header:
-            got[name] = name
+        if SIMULATE_PREFIX + name in header or name in header:
+            got[name] = SIMULATE_PREFIX + name if SIMULATE_PREFIX + name in header else name
             continue
         low = name.lower()
         cands = [h for h in header if h.lower() == low]
