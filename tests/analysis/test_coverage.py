@@ -127,7 +127,12 @@ def test_simulate_trace_and_eval_output_are_accepted(tmp_path: Path) -> None:
 
     from fuzzyctl.cli.app import main
 
-    assert main(["simulate", str(ROOT / "examples" / "crane.toml"), "-o", str(tmp_path), "--no-png", "--no-html"]) == 0
+    assert (
+        main(
+            ["simulate", str(ROOT / "examples" / "crane.toml"), "-o", str(tmp_path), "--no-png", "--no-html"]
+        )
+        == 0
+    )
     trace = tmp_path / "crane.csv"
     with trace.open() as fh:
         table = list(csv.DictReader(fh))

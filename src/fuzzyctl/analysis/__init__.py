@@ -101,7 +101,6 @@ def analyze(
     )
 
 
-
 def coverage(
     model: Document | FunctionBlock,
     data: str | Path | list[str | Path],

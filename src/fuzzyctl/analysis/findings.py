@@ -55,7 +55,11 @@ def diagnostics(
                 )
             )
         for r in res.dead_rules:
-            out.append(Diagnostic(hard, f"dead rule{where}: rule {r} can never fire", rules.get(r), file, "analyze-dead"))
+            out.append(
+                Diagnostic(
+                    hard, f"dead rule{where}: rule {r} can never fire", rules.get(r), file, "analyze-dead"
+                )
+            )
         for c in res.conflicts:
             out.append(
                 Diagnostic(

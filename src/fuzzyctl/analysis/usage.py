@@ -227,9 +227,10 @@ def plot(cov: Coverage, path: Path) -> Path:
 
 def lines(cov: Coverage) -> list[str]:
     """The summary under the table: never-fired rules, gap rows, rows outside a RANGE."""
-    out = [f"coverage: {cov.rows} rows from {len(cov.sources)} file(s), columns " + ", ".join(
-        f"{k}<-{v}" if k != v else k for k, v in cov.columns.items()
-    )]
+    out = [
+        f"coverage: {cov.rows} rows from {len(cov.sources)} file(s), columns "
+        + ", ".join(f"{k}<-{v}" if k != v else k for k, v in cov.columns.items())
+    ]
     if cov.invalid_rows:
         out.append(f"  {cov.invalid_rows} row(s) with an empty, NaN or infinite input skipped")
     for r in cov.rules:

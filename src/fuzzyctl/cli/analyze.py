@@ -58,7 +58,6 @@ def analyze(
     slope and jumps, before the controller meets the plant."""
     import fuzzyctl
     from fuzzyctl.analysis import analyze as run
-
     from fuzzyctl.analysis import usage as cov_mod
 
     model = fuzzyctl.load(file)
@@ -89,8 +88,8 @@ def analyze(
 
 
 def _plots(model: object, result: object, cov: object, out_dir: Path, block: str | None) -> list[Path]:
-    from fuzzyctl.analysis import usage as cov_mod
     from fuzzyctl.analysis import plots
+    from fuzzyctl.analysis import usage as cov_mod
 
     written = plots.pair_maps(model, result, out_dir, block=block)  # type: ignore[arg-type]
     if cov is not None:
