@@ -197,11 +197,12 @@ def table(cov: Coverage) -> Any:
     from rich.table import Table
 
     t = Table(title=f"coverage over {cov.rows} rows", header_style="bold")
-    for c in ("rule", "where", "fired", "dominated", "mean", "max"):
-        t.add_column(c, justify="left" if c in ("rule", "where") else "right")
+    for c in ("rule", "line", "fired", "dominated", "mean", "max"):
+        t.add_column(c, justify="left" if c == "rule" else "right")
     for r in cov.rules:
         mean = r.total / cov.rows if cov.rows else 0.0
-        t.add_row(r.rule, r.where or "", str(r.fired), str(r.dominated), f"{mean:.3g}", f"{r.max_degree:.3g}")
+        line = r.where.rsplit(":", 1)[-1] if r.where else ""  # the file is in the header
+        t.add_row(r.rule, line, str(r.fired), str(r.dominated), f"{mean:.3g}", f"{r.max_degree:.3g}")
     return t
 
 
