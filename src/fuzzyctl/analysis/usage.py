@@ -107,7 +107,7 @@ def match_columns(inputs: tuple[str, ...], header: list[str], source: str) -> di
             why = "no column" if not cands else f"several columns ({', '.join(cands)})"
             raise InputError(
                 f"{source}: {why} for input {name!r} (columns: {', '.join(header)}); name it {name!r} "
-                "or PREFIX.{name}"
+                f"or PREFIX.{name}"
             )
         got[name] = cands[0]
     return got
