@@ -32,13 +32,17 @@ BACKENDS = ("auto", "native", "python", "interpreted")
 _KEYS: OrderedDict[int, tuple[Document, str]] = OrderedDict()
 
 
-def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = False) -> Document:
+def load(
+    path_or_text: str | Path, *, format: str | None = None, strict: bool = False, compat: str = "iec"
+) -> Document:
     """Read a fuzzy system from a file path or from source text.
 
     ``format`` (``"fcl"``, ...) overrides detection by file extension; text that is not an
     existing path is parsed as FCL unless ``format`` says otherwise.  ``strict``: refuse, as
     a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7),
-    and in every format a WITH (or rule) weight above 1 (5.2.4).
+    and in every format a WITH (or rule) weight above 1 (5.2.4).  ``compat``: read FCL as
+    that tool's profile does (``"jfuzzylogic"`` takes a term of one point, with a warning,
+    as jFuzzyLogic runs it; IEC 61131-7 5.2.2 asks for two).
     Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
     when the input is not valid.
 
@@ -57,7 +61,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
         path = Path(path_or_text)
         require_file(path)  # before the extension is read: a typo in it is still a missing file
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        doc = _load_path(path, fmt, strict)
+        doc = _load_path(path, fmt, strict, compat)
         if strict and fmt != "fcl" and (found := _strict_findings(doc)):  # FCL's reader said it
             from fuzzyctl.diagnostics import DiagnosticError
 
@@ -75,7 +79,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
-    return load_text(text, strict=strict).raise_for_errors()
+    return load_text(text, strict=strict, compat=compat).raise_for_errors()
 
 
 #: Files up to this size have their parsed document cached on disk.  Above it, pickling the
@@ -85,7 +89,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
 DOCUMENT_CACHE_MAX_BYTES = 256 * 1024
 
 
-def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
+def _load_path(path: Path, fmt: str, strict: bool = False, compat: str = "iec") -> Document:
     from fuzzyctl import cache
     from fuzzyctl.diagnostics import DiagnosticError
 
@@ -99,7 +103,9 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
         except DiagnosticError:
             data = None  # the reader reports it with its place
         if data is not None:
-            key = content_key(data, fmt + (":strict" if strict else ""))
+            key = content_key(
+                data, fmt + (":strict" if strict else "") + (f":{compat}" if compat != "iec" else "")
+            )
             small = len(data) <= DOCUMENT_CACHE_MAX_BYTES
             doc = _cached(f"documents/{key}.pickle") if small else None
             from fuzzyctl.model import Document
@@ -111,7 +117,7 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
     if fmt == "fcl":
         from fuzzyctl.fcl import load_file
 
-        doc = load_file(path, strict=strict).raise_for_errors()
+        doc = load_file(path, strict=strict, compat=compat).raise_for_errors()
     else:
         from fuzzyctl import formats
 
