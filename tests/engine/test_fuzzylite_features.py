@@ -437,3 +437,43 @@ def test_rule_activation_with_chained_inference_is_reported() -> None:
         ),
     )
     assert any(d.code == "rule-activation-chained" for d in unsupported(chained))
+
+
+def test_highest_tie_on_a_gaussians_last_bit_is_one_answer_on_every_path() -> None:
+    # exp(-1/8) (Gaussian 1 2 at x = 0) is one ulp apart in libm and numpy's vector exp on
+    # common CPUs; ASUM(1, g) = 1 + g - g is then 1.0 under libm and 0.999... under numpy, so
+    # "Highest 1" against a rule of degree exactly 1 picked rule 1 (o1: 4/3) in the scalar
+    # paths and rule 2 (o0: 1) in the batch path.  Brute force: the degrees as libm gives them.
+    g = math.exp(-(1.0 * 1.0) / (2.0 * 2.0 * 2.0))
+    rule1, rule2 = 1.0 + g - 1.0 * g, 1.0
+    want = 4.0 / 3.0 if rule1 >= rule2 else 1.0  # the earlier rule on a tie
+    fz = m.FuzzifyBlock(
+        "x0",
+        (
+            m.Term("t0", m.ShapeMF("triangle", (0.0, 1.0, 2.0))),
+            m.Term("t1", m.ShapeMF("gaussian", (1.0, 2.0))),
+        ),
+    )
+    df = m.DefuzzifyBlock(
+        "y",
+        (
+            m.Term("o0", m.ShapeMF("triangle", (0.0, 1.0, 2.0))),
+            m.Term("o1", m.ShapeMF("triangle", (0.0, 1.0, 3.0))),
+        ),
+        m.Range(LO, HI),
+        "COG",
+        m.Default(math.nan),
+    )
+    rules = (
+        m.Rule("1", m.Or((m.Is("x0", "t0", True), m.Is("x0", "t1"))), (m.Conclusion("y", "o1"),)),
+        m.Rule("2", m.Is("x0", "t0", True), (m.Conclusion("y", "o0"),)),
+    )
+    fb = m.FunctionBlock(
+        "tie",
+        variables=(m.Variable("x0", m.VarKind.INPUT), m.Variable("y", m.VarKind.OUTPUT)),
+        fuzzify=(fz,),
+        defuzzify=(df,),
+        rule_blocks=(m.RuleBlock("rb", rules, "PROD", "ASUM", "MIN", "MAX", rule_activation="Highest 1"),),
+    )
+    fast, ref, batch = _three_paths(fb, [[0.0]] * 6)
+    assert fast == ref == batch == [pytest.approx(want, abs=1e-12)] * 6
