@@ -48,7 +48,7 @@ BISECTIONS = 46  # halvings locating a kink (to 2^-46 ~ 1.4e-14 of the sample sp
 ROUNDS = 8  # kinks located between two samples at most
 NODES = 8  # Gauss-Legendre nodes of the generation-time calibration
 QTOL = 1e-12  # Gauss-Kronrod acceptance per unit of width (area; moment: times the range)
-STACK = 48  # pending panels at most (halvings of one piece: STACK / 2)
+STACK = 48  # pending panels at most (depth first: STACK - 2 nested halvings of one piece)
 QCAP = 4000  # panels per evaluation at most (15 evaluations of the set each)
 PIECE_MIN = 1e-13  # pieces narrower than this share of the range are not integrated
 CODE_BITS = 50  # branch comparisons coded exactly (LREAL mantissa)
@@ -142,7 +142,7 @@ def cog_bound(op: OutputPlan, n_sets: int, cal: Calibration, acts: frozenset[str
         f"{QTOL:.0e} x width x (high - low) (moment), so |CoG error| <= "
         f"{2 * QTOL:.0e} x (high - low)^2 / area (+ kinks located to 2^-{BISECTIONS} of "
         f"the sample spacing), unless INFO = 16#04: more than {QCAP} panels of 15 points "
-        f"per evaluation (or {STACK // 2} halvings of one piece) were needed"
+        f"per evaluation (or {STACK - 2} nested halvings of one piece) were needed"
     )
 
 
@@ -275,8 +275,8 @@ def _integrate(
     """Area and moment of the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod
     7/15: a panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width
     (area; times the range for the moment), else halved - at most :data:`QCAP` panels per
-    evaluation and :data:`STACK` pending ones; a panel accepted short of the tolerance sets
-    ``capped``."""
+    evaluation and :data:`STACK` pending ones (depth first: STACK - 2 nested halvings); a
+    panel accepted short of the tolerance sets ``capped``."""
     from fuzzyctl.engine.quadrature import NODES as GKX
     from fuzzyctl.engine.quadrature import WG as GKG
     from fuzzyctl.engine.quadrature import WK as GKK
