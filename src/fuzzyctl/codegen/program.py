@@ -318,7 +318,7 @@ class _Builder(RuleBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         cal = Q.calibrate(op)
-        bound = Q.cog_bound(op, max(1, len(sets)), cal, frozenset(s.act for s in sets))
+        bound = Q.cog_bound()
         self.notes.append(
             f"output {op.name}: smooth set, CoG by adaptive Gauss-Kronrod 7/15 on "
             f"{len(cal.cuts) - 1} intervals, split at located kinks: {bound}"

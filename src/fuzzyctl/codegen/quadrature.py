@@ -1,5 +1,5 @@
 """Centre of gravity of a smooth output (Gaussian, bell, sigmoid, ... terms, or operators that
-bend straight lines) in the generated block, exact to a tolerance fixed at generation time.
+bend straight lines) in the generated block, to the tolerance its header states.
 
 An accumulated set of smooth terms has no closed-form integral.  The generated code does what
 the native evaluator does (:data:`fuzzyctl.codegen.c_kernels.SMOOTH_DRIVER`), written in the
@@ -9,21 +9,26 @@ IR so that Structured Text (``EXP`` is an IEC 61131-3 standard function) and C s
    (peaks, joins, support ends: :func:`fuzzyctl.engine.shapes.characteristic_points`), its
    corners when piecewise linear, and the panels the calibration below adds;
 2. each interval is sampled at :data:`SAMPLES` points; where the branch the set takes changes
-   between two samples (which activated set is the largest, whether it is clipped, whether a
-   bounded sum reached 1) the kink is located by :data:`BISECTIONS` halvings (several kinks
-   between two samples: up to :data:`ROUNDS`);
-3. every piece between breakpoints and kinks is smooth and is integrated with the
-   :data:`NODES`-point Gauss-Legendre rule (area and first moment).
+   between two samples the kink is located by :data:`BISECTIONS` halvings (several kinks
+   between two samples: up to :data:`ROUNDS`).  The branch code has one bit per comparison
+   that decides a branch: each term against the degrees where its activation jumps or bends
+   (:data:`fuzzyctl.engine.operators.ACT_LEVELS`, the table the engine's integrators cut at:
+   MIN bends at the rule degree a, NIPMIN jumps at 1 - a and bends at a, BDIF bends at
+   1 - a), which set is largest (MAX, NIPMAX), where NIPMAX's sum reaches 1, where DMAX meets
+   two nonzero sets, where a bounded sum reaches 1.  Terms are monotonic between the
+   breakpoints, so each crosses a level at most once per interval;
+3. every piece between breakpoints and kinks is smooth and is integrated by adaptive
+   Gauss-Kronrod 7/15 (area and first moment): a panel is accepted when the Kronrod and
+   Gauss values agree to :data:`QTOL` per unit of width (:data:`QTOL_REAL` in REAL builds),
+   else halved, with at most :data:`QCAP` panels per evaluation and :data:`STACK` pending -
+   the bounded work a PLC cycle needs.  A panel accepted short of the tolerance (cap
+   reached) sets INFO 16#04.
 
-Calibration (generation time): each interval is halved until, for every term of the output,
-the ``NODES``-point rule and the ``2*NODES``-point rule agree on the term's area and first
-moment over the interval to :data:`PANEL_TOL` times the interval's width (times the range
-for the moment).  A piece is part of an interval and the integrand on a piece is a term
-scaled by constants (MIN/PROD activation, MAX/SUM/BSUM accumulation), so the area and the
-moment of the set are then within ``n * PANEL_TOL * (high - low)`` (``n`` activated sets) and
-the CoG within :func:`cog_bound` of the exact value - a bound written in the header of the
-generated code and checked against the engine by the tests.  In REAL (32-bit) arithmetic
-rounding (about 1e-6 of the range) dominates it.
+Calibration (generation time) halves each interval until the :data:`NODES`-point and
+``2*NODES``-point Gauss-Legendre rules agree on every term to :data:`PANEL_TOL`: it makes the
+sampling of step 2 dense where terms are narrow.  The error aimed at (:func:`cog_bound`, in
+the header) is ``2 QTOL (high - low)^2 / area`` on the CoG; tests compare it with the
+observed difference to the reference interpreter.
 """
 
 from __future__ import annotations
@@ -48,6 +53,7 @@ BISECTIONS = 46  # halvings locating a kink (to 2^-46 ~ 1.4e-14 of the sample sp
 ROUNDS = 8  # kinks located between two samples at most
 NODES = 8  # Gauss-Legendre nodes of the generation-time calibration
 QTOL = 1e-12  # Gauss-Kronrod acceptance per unit of width (area; moment: times the range)
+QTOL_REAL = 1e-5  # the same in REAL (32-bit float) builds, where rounding is ~1e-7
 STACK = 48  # pending panels at most (depth first: STACK - 2 nested halvings of one piece)
 QCAP = 4000  # panels per evaluation at most (15 evaluations of the set each)
 PIECE_MIN = 1e-13  # pieces narrower than this share of the range are not integrated
@@ -133,16 +139,16 @@ def calibrate(op: OutputPlan) -> Calibration:
     return Calibration(tuple(cuts), worst)
 
 
-def cog_bound(op: OutputPlan, n_sets: int, cal: Calibration, acts: frozenset[str] = frozenset()) -> str:
+def cog_bound() -> str:
     """The error the generated CoG aims at, as text for the header (checked against the
-    reference interpreter by tests/codegen/test_gen_accuracy.py)."""
-    del n_sets, cal, acts  # the adaptive rule's tolerance does not depend on them
+    reference interpreter by tests/codegen/test_gen_accuracy.py and test_realsys.py)."""
     return (
         f"each panel accepted when Kronrod and Gauss agree to {QTOL:.0e} x width (area) and "
-        f"{QTOL:.0e} x width x (high - low) (moment), so |CoG error| <= "
-        f"{2 * QTOL:.0e} x (high - low)^2 / area (+ kinks located to 2^-{BISECTIONS} of "
-        f"the sample spacing), unless INFO = 16#04: more than {QCAP} panels of 15 points "
-        f"per evaluation (or {STACK - 2} nested halvings of one piece) were needed"
+        f"{QTOL:.0e} x width x (high - low) (moment), so |CoG error| <= {2 * QTOL:.0e} x "
+        f"(high - low)^2 / area (in a REAL (float) build {QTOL_REAL:.0e} and {2 * QTOL_REAL:.0e}), "
+        f"kinks located to 2^-{BISECTIONS} of the sample spacing; unless INFO = 16#04: more "
+        f"than {QCAP} panels of 15 points per evaluation (or {STACK - 2} nested halvings of "
+        f"one piece) were needed"
     )
 
 
@@ -303,6 +309,12 @@ def _integrate(
         tuple(0.5 * float(v) for v in GKG),
         "Gauss weights (0 off the 7 Gauss nodes)",
     )
+    # the program is precision-neutral; in REAL (float) 1e-10 vanishes beside 1 and the
+    # tolerance must be one REAL can reach, else every panel would run to the cap
+    tol = g.let(QTOL, "QTOL")
+    probe = g.let(Num(1.0) + Num(1e-10), "QE")  # stored: rounded to the variable's type
+    with b.if_(probe.eq(1.0)):
+        b.set(tol, QTOL_REAL)
     sl, sr = g.array("QSL", "REAL", STACK), g.array("QSR", "REAL", STACK)
     sp = g.let(0, "QSP", "INT")
     used = g.let(0, "QUSED", "DINT")
@@ -327,7 +339,7 @@ def _integrate(
                 b.set(ga, ga + wg[kv] * y)
                 b.set(gm, gm + wg[kv] * ym)
             b.set(used, used + 1)
-            ok = g.call("ABS", ka - ga).le(QTOL).and_(g.call("ABS", km - gm).le(QTOL * width))
+            ok = g.call("ABS", ka - ga).le(tol).and_(g.call("ABS", km - gm).le(tol * width))
             room = (
                 sp.lt(STACK - 2).and_(used.lt(QCAP)).and_((u + 0.5 * d).gt(u)).and_((u + 0.5 * d).lt(u + d))
             )
