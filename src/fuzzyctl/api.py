@@ -143,7 +143,13 @@ def require_file(path: Path) -> None:
     """ "no such file" (or "is a directory") for a path that names no file."""
     from fuzzyctl.diagnostics import DiagnosticError, error
 
-    if not path.exists():
+    try:
+        exists = path.exists()
+    except OSError as exc:  # a name too long for the file system, say
+        raise DiagnosticError(
+            [error(f"cannot read: {exc.strerror}", file=str(path), code="no-file")]
+        ) from None
+    if not exists:
         raise DiagnosticError([error("no such file", file=str(path), code="no-file")])
     if path.is_dir():
         raise DiagnosticError([error("is a directory, not a file", file=str(path), code="no-file")])
@@ -153,11 +159,19 @@ def _looks_like_path(value: str) -> bool:
     """Text holding a newline, ';' or ':=', starting with '{' or '[', or longer than any path
     is source; anything else is taken as a path (a missing file is then reported as such,
     not parsed as FCL)."""
-    if any(c in value for c in "\n\r\0;") or ":=" in value or len(value) > 4096:
+    # line ends of any kind (the FLL reader takes U+2028, U+0085, ...) mean source text
+    if (
+        any(c in value for c in "\n\r\0;\v\f\x1c\x1d\x1e\x85\u2028\u2029")
+        or ":=" in value
+        or len(value) > 4096
+    ):
         return False
     if value.lstrip()[:1] in ("{", "["):  # JSON, a FIS section
         return False
-    return "FUNCTION_BLOCK" not in value.upper() or Path(value).exists()
+    try:
+        return "FUNCTION_BLOCK" not in value.upper() or Path(value).exists()
+    except OSError:  # not a name the file system takes: source text
+        return False
 
 
 def compile(
