@@ -25,5 +25,5 @@ def test_text_with_any_line_end_is_source_not_a_path(line_end: str) -> None:
 
 
 def test_a_name_too_long_for_the_file_system_is_a_diagnostic() -> None:
-    with pytest.raises(DiagnosticError, match="cannot read|no such file"):
+    with pytest.raises(DiagnosticError, match=r"cannot read|no such file"):
         fuzzyctl.load("x" * 300)
