@@ -61,14 +61,17 @@ pytest: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
 
 test: lint typecheck pytest
 
-# Property tests with fresh random examples (make test replays a fixed set), then the
-# mutation fuzzer (issue 14.5) on FUZZ_MUTANTS mutants of the examples, the vendored files and,
-# when ../shared is there, the real-world corpus (make test runs a fixed sample of 80).
+# Property tests with fresh random examples (make test replays a fixed set), then the mutation
+# and differential fuzzer (issues 14.5, 25.2) on FUZZ_MUTANTS mutants of the examples, the vendored
+# files and, when ../shared is there, the real-world corpus, then FUZZ_SYSTEMS random systems:
+# every backend, explain, the CLI and generated C against the reference interpreter (make test
+# runs a fixed sample of 80 + 16). A failure prints a one-line replay command.
 FUZZ_MUTANTS ?= 3000
+FUZZ_SYSTEMS ?= 300
 FUZZ_SEED ?= $(shell date +%s)
 fuzz: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
 	HYPOTHESIS_PROFILE=fuzz $(BIN)/pytest -q $$(grep -rl '@given' tests)
-	$(BIN)/python -m tests.fuzz.campaign --mutants $(FUZZ_MUTANTS) --seed $(FUZZ_SEED) \
+	$(BIN)/python -m tests.fuzz.campaign --mutants $(FUZZ_MUTANTS) --systems $(FUZZ_SYSTEMS) --seed $(FUZZ_SEED) \
 		$$($(BIN)/python -c 'import tests.extras as e; print("--corpus" if e.suite("corpus").available else "")' 2>/dev/null) \
 		--save build/fuzz-failures
 

@@ -8,21 +8,29 @@ repeated lines, CR-only line ends, 200,000-character fields - and goes through w
 would do with it: ``fuzzyctl.load``, ``compile``, ``evaluate`` and ``evaluate_batch`` on
 ordinary and extreme inputs (which must agree: the same number, or both NaN), ``explain``, a
 conversion, code generation, and one CLI command (check / convert / eval / explain).
+Every model that loads is also checked path by path against the reference interpreter
+(:mod:`tests.fuzz.differential`), and ``--systems`` seeded random systems
+(:mod:`tests.fuzz.systems`) follow the mutants.  The run ends with a table of counts per
+source and path; each failure has a one-line replay command (``--replay``).
 
 A mutant fails when it raises anything but a :class:`~fuzzyctl.diagnostics.FuzzyctlError`
-(the API) or makes the CLI exit 3 ("crash"), when scalar and batch disagree ("disagree"),
+(the API) or makes the CLI exit 3 ("crash"), when a path disagrees with the reference
+interpreter (``tests.fuzz.differential``: "disagree", with a category per path),
 when it runs over ``--timeout`` CPU seconds ("hang"), or when the process grows over
 ``--memory`` MB ("memory").  Mutants run in worker processes so that a hang or a runaway
 allocation is contained; the verdict does not depend on scheduling.
 
-usage: python -m tests.fuzz.campaign [--mutants 3000] [--seed 1] [--corpus] [--workers 2]
+usage: python -m tests.fuzz.campaign [--mutants 3000] [--systems 300] [--seed 1] [--corpus]
+                                     [--workers 2] [--save DIR] [--replay FILE|system:S:K]
 """
 
 from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import io
+import itertools
 import math
 import multiprocessing as mp
 import os
@@ -217,6 +225,9 @@ class Mutant:
     ops: tuple[str, ...]
     text: str
     plan: int  # which secondary actions run (conversion target, codegen, CLI command)
+    system: Any = None  # a random FunctionBlock (tests.fuzz.systems) instead of a mutated file
+    full: bool = False  # run every differential path (a replay), not a sample of the costly ones
+    rates: tuple[float, float] = (0.1, 0.25)  # share of loaded models through generated C, the CLI
 
 
 def mutants(all_seeds: list[Seed], n: int, seed: int) -> Iterator[Mutant]:
@@ -233,6 +244,23 @@ def mutants(all_seeds: list[Seed], n: int, seed: int) -> Iterator[Mutant]:
         yield Mutant(index, s.name, s.fmt, tuple(done), text, rng.randrange(1 << 30))
 
 
+def random_systems(n: int, seed: int, first_index: int = 0) -> Iterator[Mutant]:
+    """``n`` random systems (:mod:`tests.fuzz.systems`), written as fuzzyctl JSON for the
+    CLI and for replay."""
+    from fuzzyctl.formats import json as fj
+    from fuzzyctl.model import Document
+    from tests.fuzz import systems
+
+    rng = random.Random(f"systems:{seed}")
+    for k in range(n):
+        fb = systems.system(k, seed)
+        try:
+            text = fj.dumps(Document((fb,)))
+        except Exception as exc:  # a model the JSON writer refuses: still evaluated in-process
+            text = f"// the JSON writer refused this system: {exc}"
+        yield Mutant(first_index + k, f"random system {k}", "json", (), text, rng.randrange(1 << 30), fb)
+
+
 # --------------------------------------------------------------------------- running one
 
 
@@ -243,6 +271,9 @@ class Outcome:
     detail: str = ""
     rss_mb: float = 0.0
     steps: list[str] = field(default_factory=list)
+    loaded: bool = False
+    compared: set[str] = field(default_factory=set)  # differential paths compared
+    findings: list[tuple[str, str]] = field(default_factory=list)  # (category, detail)
 
 
 class _Failure(Exception):
@@ -290,7 +321,9 @@ def _agree(a: float, b: float) -> bool:
     return abs(a - b) <= 1e-6 * max(1.0, abs(a), abs(b))
 
 
-def _engine(doc: Any, m: Mutant, steps: list[str]) -> None:
+def _engine(doc: Any, m: Mutant, steps: list[str], findings: list[tuple[str, str]] | None = None) -> None:
+    """compile (default backend), evaluate and evaluate_batch on ordinary and extreme inputs
+    (1e20, 1e308: they must agree, to 1e-6 relative), explain: for crashes first."""
     import numpy as np
 
     import fuzzyctl
@@ -310,11 +343,18 @@ def _engine(doc: Any, m: Mutant, steps: list[str]) -> None:
             ctl.reset()
             many = _api("evaluate_batch", ctl.evaluate_batch, {n: np.array([v]) for n, v in vec.items()})
             if one is not None and many is not None:
+                if any(len(many[name]) != 1 for name in one) and findings is not None:
+                    findings.append(("disagree:numpy", f"a batch of one row at {vec} gave {many!r}"))
+                    continue
                 for name, value in one.items():
-                    if not _agree(float(value), float(many[name][0])):
-                        raise _Failure(
-                            "disagree", f"{name} at {vec}: evaluate {value!r}, batch {many[name][0]!r}"
+                    if not _agree(float(value), float(many[name][0])) and findings is not None:
+                        findings.append(
+                            (
+                                "disagree:scalar-batch",
+                                f"{name} at {vec}: evaluate {value!r}, batch {many[name][0]!r}",
+                            )
                         )
+                        break
             if k == 0:
                 ctl.reset()
                 _api("explain", ctl.explain, vec)
@@ -358,22 +398,65 @@ def _cli(m: Mutant, path: Path, steps: list[str]) -> None:
         raise _Failure("crash", f"cli {cmd} exit {code}: {(lines[0] if lines else '')[:300]}")
 
 
+def _differential(doc: Any, m: Mutant, path: Path, steps: list[str], out: Outcome) -> None:
+    """Every backend, explain, (sampled) the CLI and generated C against the reference
+    interpreter (:mod:`tests.fuzz.differential`) on the first two blocks."""
+    from tests.fuzz import differential
+
+    rng = random.Random(m.plan + 3)
+    for fb in doc.blocks[:2]:
+        extra = differential.ExtraPaths(
+            cli_path=path if not m.text.startswith("// ") else None,
+            cli_fmt=m.fmt,
+            cli=m.full or rng.random() < m.rates[1],
+            c=m.full or rng.random() < m.rates[0],
+        )
+        steps.append(f"differential {fb.name}" + (" +cli" if extra.cli else "") + (" +c" if extra.c else ""))
+        try:
+            res = differential.check(doc, fb.name if len(doc.blocks) > 1 else None, rng, extra)
+        except RecursionError as exc:
+            raise _Failure("crash", f"differential: RecursionError: {str(exc)[:200]}") from exc
+        except Exception as exc:
+            tb = traceback.extract_tb(exc.__traceback__)[-1]
+            where = f"{Path(tb.filename).name}:{tb.lineno}"
+            raise _Failure(
+                "crash", f"differential: {type(exc).__name__} at {where}: {str(exc)[:200]}"
+            ) from exc
+        out.compared |= res.compared | res.notes
+        out.findings += [(f.category, f"[{fb.name}] {f.detail}") for f in res.findings]
+
+
 def run_one(m: Mutant, workdir: Path) -> Outcome:
     import fuzzyctl
+    from fuzzyctl.model import Document
 
     steps: list[str] = ["load"]
+    out = Outcome(m.index, "refused", steps=steps)
     try:
-        doc = _api("load", fuzzyctl.load, m.text, format=m.fmt)
-        if doc is not None:
-            _engine(doc, m, steps)
-            _secondary(doc, m, steps)
         ext = {"xfuz": ".xfuz"}.get(m.fmt, "." + m.fmt)
         path = workdir / f"mutant{ext}"
         path.write_text(m.text, encoding="utf-8", errors="surrogatepass")
-        _cli(m, path, steps)
+        doc = (
+            Document((m.system,))
+            if m.system is not None
+            else _api("load", fuzzyctl.load, m.text, format=m.fmt)
+        )
+        if doc is not None:
+            out.loaded = True
+            _engine(doc, m, steps, out.findings)
+            _differential(doc, m, path, steps, out)
+            _secondary(doc, m, steps)
+        if m.system is None:
+            _cli(m, path, steps)
     except _Failure as f:
-        return Outcome(m.index, f.kind, str(f), steps=steps)
-    return Outcome(m.index, "ok" if doc is not None else "refused", steps=steps)
+        out.kind, out.detail = f.kind, str(f)
+        return out
+    if out.findings:
+        out.kind = "disagree"
+        out.detail = "\n    ".join(f"{c}: {d}" for c, d in out.findings)
+    else:
+        out.kind = "ok" if out.loaded else "refused"
+    return out
 
 
 # --------------------------------------------------------------------------- workers
@@ -398,6 +481,12 @@ def _worker(conn: Connection, memory_mb: int) -> None:
                 out = run_one(m, Path(tmp))
             except MemoryError:
                 out = Outcome(m.index, "memory", "MemoryError")
+            except Exception as exc:  # the fuzzer's own checks tripped: still a finding, not a dead worker
+                tb = traceback.extract_tb(exc.__traceback__)[-1]
+                where = f"{Path(tb.filename).name}:{tb.lineno}"
+                out = Outcome(
+                    m.index, "crash", f"in the fuzzer at {where}: {type(exc).__name__}: {str(exc)[:200]}"
+                )
             out.rss_mb = _peak_rss_mb()
             conn.send(out)
 
@@ -456,6 +545,46 @@ class Report:
     peak_rss_mb: float = 0.0
     seconds: float = 0.0
     started: float = field(default_factory=time.monotonic)
+    #: (source, row) -> models: source "mutants" or "systems"; rows "tried", "loaded",
+    #: "compared", "disagreeing", "compared:<path>" and each finding category
+    table: Counter[tuple[str, str]] = field(default_factory=Counter)
+    seed: int = 0
+    saved: dict[int, Path] = field(default_factory=dict)  # index -> the file written under --save
+
+    def tally(self, m: Mutant, out: Outcome) -> None:
+        src = "systems" if m.system is not None else "mutants"
+        self.table[src, "tried"] += 1
+        self.table[src, "loaded"] += out.loaded
+        self.table[src, "compared"] += bool(out.compared)
+        self.table[src, "disagreeing"] += bool(out.findings)
+        for path in out.compared:
+            self.table[src, f"compared:{path}"] += 1
+        for cat in {c for c, _ in out.findings}:
+            self.table[src, cat] += 1
+
+    def counts_table(self) -> str:
+        """Models per source: tried, loaded, compared; per path compared and disagreeing."""
+        from tests.fuzz.differential import PATHS
+
+        rows = [("tried", "tried"), ("loaded", "loaded"), ("compared (any path)", "compared"),
+                ("disagreeing (any)", "disagreeing")]  # fmt: skip
+        cats = sorted({r for _, r in self.table if ":" in r and not r.startswith("compared:")})
+        lines = [f"{'':34}{'mutants':>10}{'systems':>10}"]
+        for label, key in rows:
+            lines.append(f"{label:34}{self.table['mutants', key]:>10}{self.table['systems', key]:>10}")
+        for extra in sorted({r[9:] for _, r in self.table if r.startswith("compared:")} - set(PATHS)):
+            lines.append(
+                f"{extra + ' (models)':34}{self.table['mutants', 'compared:' + extra]:>10}"
+                f"{self.table['systems', 'compared:' + extra]:>10}"
+            )
+        for p in PATHS:
+            for label, key in ((f"{p}: compared", f"compared:{p}"), (f"{p}: disagreeing", f"disagree:{p}")):
+                lines.append(f"{label:34}{self.table['mutants', key]:>10}{self.table['systems', key]:>10}")
+        for cat in cats:
+            if cat.startswith("disagree:") and cat[9:] in PATHS:
+                continue
+            lines.append(f"{cat:34}{self.table['mutants', cat]:>10}{self.table['systems', cat]:>10}")
+        return "\n".join(lines)
 
     @property
     def crashed(self) -> int:
@@ -475,7 +604,10 @@ class Report:
     def describe(self, limit: int = 12) -> str:
         lines = []
         for m, o in self.failures[:limit]:
-            lines.append(f"#{m.index} {o.kind}: {m.seed} ({m.fmt}) + {'; '.join(m.ops)}\n    {o.detail}")
+            lines.append(
+                f"#{m.index} {o.kind}: {m.seed} ({m.fmt}) + {'; '.join(m.ops)}\n    {o.detail}\n"
+                f"    replay: {replay_command(m, self.seed, self.saved.get(m.index))}"
+            )
         if len(self.failures) > limit:
             lines.append(f"... and {len(self.failures) - limit} more")
         return "\n".join(lines)
@@ -487,18 +619,25 @@ def campaign(
     seed: int,
     *,
     workers: int = 2,
-    timeout: float = 10.0,
+    timeout: float = 30.0,
     memory_mb: int = 500,
     save: Path | None = None,
     progress: bool = False,
+    n_systems: int = 0,
+    rates: tuple[float, float] = (0.1, 0.25),
 ) -> Report:
     """Run ``n`` mutants over ``workers`` processes; a mutant over ``timeout`` CPU seconds
     (or 30 times that in wall time: the machine may be shared) is a hang, one that leaves
-    its worker over ``memory_mb`` resident a memory failure (the worker is replaced)."""
+    its worker over ``memory_mb`` resident a memory failure (the worker is replaced).
+    ``n_systems`` random systems follow the mutants; ``rates``: the share of loaded models
+    also run through generated C and through the CLI (the costly paths)."""
     ctx = mp.get_context("spawn")
-    report = Report()
+    report = Report(seed=seed)
     start = time.monotonic()
-    todo = mutants(all_seeds, n, seed)
+    todo = (
+        dataclasses.replace(m, rates=rates)
+        for m in itertools.chain(mutants(all_seeds, n, seed), random_systems(n_systems, seed, n))
+    )
     slots = [_Slot(ctx, memory_mb) for _ in range(workers)]
     pending = True
 
@@ -506,11 +645,19 @@ def campaign(
         report.tried += 1
         report.counts[out.kind] += 1
         report.peak_rss_mb = max(report.peak_rss_mb, out.rss_mb)
+        report.tally(m, out)
         if out.kind in ("crash", "disagree", "hang", "memory"):
             report.failures.append((m, out))
             if save is not None:
                 save.mkdir(parents=True, exist_ok=True)
-                (save / f"mutant-{seed}-{m.index}.{m.fmt}").write_text(m.text, errors="surrogatepass")
+                kind = "system" if m.system is not None else "mutant"
+                target = save / f"{kind}-{seed}-{m.index}-p{m.plan}.{m.fmt}"
+                target.write_text(m.text, errors="surrogatepass")
+                target.with_suffix(target.suffix + ".txt").write_text(
+                    f"{m.seed} + {'; '.join(m.ops)}\n{out.kind}: {out.detail}\n"
+                    f"replay: {replay_command(m, seed, target)}\n"
+                )
+                report.saved[m.index] = target
         if progress and report.tried % 100 == 0:
             print(f"  {report.summary()}", file=sys.stderr, flush=True)
 
@@ -526,15 +673,16 @@ def campaign(
                 if slot.mutant is None:
                     continue
                 if slot.conn.poll(0.02):
+                    m = slot.mutant  # (the slot may be replaced below)
                     try:
                         out: Outcome = slot.conn.recv()
                     except EOFError:  # the worker died (out of memory, a signal)
-                        out = Outcome(slot.mutant.index, "memory", "the worker process died")
+                        out = Outcome(m.index, "memory", "the worker process died")
                         slot.stop()
                         slots[k] = slot = _Slot(ctx, memory_mb)
                     if out.kind in ("ok", "refused") and out.rss_mb > memory_mb:
                         out.kind, out.detail = "memory", f"worker RSS {out.rss_mb:.0f} MB"
-                    record(slot.mutant, out)
+                    record(m, out)
                     if out.kind == "memory" or out.rss_mb > memory_mb:
                         slot.stop()
                         slots[k] = slot = _Slot(ctx, memory_mb)
@@ -568,16 +716,66 @@ def campaign(
     return report
 
 
+def replay_command(m: Mutant, seed: int, saved: Path | None = None) -> str:
+    """One command line (from the repository root) that runs ``m`` again, every path on."""
+    if m.system is not None:
+        what = f"system:{seed}:{m.seed.rsplit(' ', 1)[1]}"
+    elif saved is not None:
+        what = str(saved)
+    else:
+        what = f"mutant:{seed}:{m.index}  (with --corpus if the run had it)"
+    return f"python -m tests.fuzz.campaign --replay {what}"
+
+
+def replay(spec: str, corpus: bool = False) -> Mutant:
+    """The model ``spec`` names: ``system:SEED:K``, ``mutant:SEED:INDEX`` or a file saved
+    under ``--save`` (``KIND-SEED-INDEX-pPLAN.EXT``), with every differential path on."""
+    kind, _, rest = spec.partition(":")
+    if kind == "system":
+        s, k = (int(v) for v in rest.split(":"))
+        m = list(random_systems(k + 1, s))[-1]
+    elif kind == "mutant":
+        s, k = (int(v) for v in rest.split(":"))
+        m = list(mutants(seeds(corpus), k + 1, s))[-1]
+    else:
+        path = Path(spec)
+        plan = re.search(r"-p(\d+)\.", path.name)
+        fmt = _fmt_of(path) or "fcl"
+        m = Mutant(0, str(path), fmt, (), _decode(path), int(plan.group(1)) if plan else 0)
+    return dataclasses.replace(m, full=True)
+
+
+def _replay_main(spec: str, corpus: bool) -> int:
+    import warnings
+
+    warnings.simplefilter("ignore")
+    m = replay(spec, corpus)
+    with tempfile.TemporaryDirectory(prefix="fuzzyctl-replay-") as tmp:
+        out = run_one(m, Path(tmp))
+    print(f"{m.seed}: {out.kind}; compared: {', '.join(sorted(out.compared)) or '-'}")
+    if out.detail:
+        print(f"    {out.detail}")
+    return 1 if out.kind in ("crash", "disagree", "hang", "memory") else 0
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--mutants", type=int, default=3000)
     ap.add_argument("--seed", type=int, default=1)
     ap.add_argument("--corpus", action="store_true", help="also mutate the shared real-world corpus")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--timeout", type=float, default=10.0, help="CPU seconds per mutant (default 10)")
+    ap.add_argument("--timeout", type=float, default=30.0, help="CPU seconds per model (default 30)")
     ap.add_argument("--memory", type=int, default=500, help="MB per worker process (default 500)")
     ap.add_argument("--save", type=Path, default=None, help="write failing mutants to this directory")
+    ap.add_argument("--systems", type=int, default=0, help="random systems after the mutants (default 0)")
+    ap.add_argument("--c-rate", type=float, default=0.1, help="share of loaded models through generated C")
+    ap.add_argument("--cli-rate", type=float, default=0.25, help="share of loaded models through the CLI")
+    ap.add_argument(
+        "--replay", default=None, help="run one model again: a saved file, system:SEED:K, mutant:SEED:N"
+    )
     args = ap.parse_args(argv)
+    if args.replay:
+        return _replay_main(args.replay, args.corpus)
     report = campaign(
         seeds(args.corpus),
         args.mutants,
@@ -587,7 +785,10 @@ def main(argv: list[str] | None = None) -> int:
         memory_mb=args.memory,
         save=args.save,
         progress=True,
+        n_systems=args.systems,
+        rates=(args.c_rate, args.cli_rate),
     )
+    print(report.counts_table())
     print(report.summary())
     if report.failures:
         print(report.describe(limit=200))
