@@ -166,6 +166,30 @@ def _poly_value(factors: tuple[tuple[float, float], ...], s: float) -> float:
     return acc
 
 
+#: Scaling of tiny firing degrees (see :func:`tiny_degree_scale`): while the largest degree
+#: is below the first number, every degree is multiplied by the second (a power of two).
+#: From any degree >= 2^-1074 the steps end in [2^-124, 2^-60); nothing above 2^-124 moves.
+TINY_STEPS = ((2.0**-572, 2.0**512), (2.0**-316, 2.0**256), (2.0**-188, 2.0**128), (2.0**-124, 2.0**64))
+
+
+def tiny_degree_scale(top: float) -> float:
+    """The power of two by which a Mamdani output whose largest firing degree is ``top``
+    scales all its degrees (1.0 unless 0 < top < 2^-124): the steps of :data:`TINY_STEPS`.
+
+    Areas and moments are products of degrees, widths and positions: at subnormal degrees
+    they keep a few bits or underflow, and the paths split (1.0, 0.5 or 0.75 for a set that is
+    a rectangle in effect).  Scaling every degree by the same power of two is exact and keeps
+    each accumulated set's shape: only where a MIN-clipped edge crosses the level moves, by
+    less than 2^-60 of that edge's run, far below 1e-9 of any range.  Every path (interpreter,
+    numpy, the generated Python and C of the fast program) applies the same steps."""
+    scale = 1.0
+    for below, factor in TINY_STEPS:
+        if top < below:
+            top *= factor
+            scale *= factor
+    return scale
+
+
 def piece_area_moment(p: Piece) -> tuple[float, float]:
     """Exact area and first moment of one piece."""
     x0, x1, v0, v1, factors = p
