@@ -217,11 +217,11 @@ class FastBuilder(RuleBuilder):
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
                 g.b.set(top, h)
-        for below, factor in pwl.TINY_STEPS:
-            with g.b.if_(top.lt(below)):
-                g.b.set(top, top * factor)
+        with g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT):
+            with g.b.if_(top.lt(pwl.TINY_BELOW)):
+                g.b.set(top, top * pwl.TINY_FACTOR)
                 for h in hs:
-                    g.b.set(h, h * factor)
+                    g.b.set(h, h * pwl.TINY_FACTOR)
         return [(t, h, w, act) for (t, _a, w, act), h in zip(contribs, hs, strict=True)]
 
     def _ts_output(

@@ -185,8 +185,8 @@ def _scale_tiny(contribs: list[tuple[int | None, Arr, Any, str]], n: int) -> lis
         return contribs
     top = np.max(np.stack([np.broadcast_to(a, (n,)) for _t, a, _w, _act in contribs]), axis=0)
     scale = np.ones(n)
-    for below, factor in pwl.TINY_STEPS:
-        step = np.where(top < below, factor, 1.0)
+    for _ in range(pwl.TINY_COUNT):
+        step = np.where((top > 0.0) & (top < pwl.TINY_BELOW), pwl.TINY_FACTOR, 1.0)
         top = top * step
         scale = scale * step
     return [(t, a * scale, w, act) for t, a, w, act in contribs]

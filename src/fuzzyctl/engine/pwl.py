@@ -166,15 +166,18 @@ def _poly_value(factors: tuple[tuple[float, float], ...], s: float) -> float:
     return acc
 
 
-#: Scaling of tiny firing degrees (see :func:`tiny_degree_scale`): while the largest degree
-#: is below the first number, every degree is multiplied by the second (a power of two).
-#: From any degree >= 2^-1074 the steps end in [2^-124, 2^-60); nothing above 2^-124 moves.
-TINY_STEPS = ((2.0**-572, 2.0**512), (2.0**-316, 2.0**256), (2.0**-188, 2.0**128), (2.0**-124, 2.0**64))
+#: Scaling of tiny firing degrees (see :func:`tiny_degree_scale`): up to TINY_COUNT times,
+#: while the largest degree is below TINY_BELOW, every degree is multiplied by TINY_FACTOR (a
+#: power of two).  From any degree >= 2^-1074 the steps end in [2^-124, 2^-60); nothing at or
+#: above 2^-124 moves.  Both constants are normal single-precision floats (REAL targets).
+TINY_BELOW = 2.0**-124
+TINY_FACTOR = 2.0**64
+TINY_COUNT = 16
 
 
 def tiny_degree_scale(top: float) -> float:
     """The power of two by which a Mamdani output whose largest firing degree is ``top``
-    scales all its degrees (1.0 unless 0 < top < 2^-124): the steps of :data:`TINY_STEPS`.
+    scales all its degrees (1.0 unless 0 < top < 2^-124): the steps of :data:`TINY_BELOW`.
 
     Areas and moments are products of degrees, widths and positions: at subnormal degrees
     they keep a few bits or underflow, and the paths split (1.0, 0.5 or 0.75 for a set that is
@@ -183,10 +186,12 @@ def tiny_degree_scale(top: float) -> float:
     less than 2^-60 of that edge's run, far below 1e-9 of any range.  Every path (interpreter,
     numpy, the generated Python and C of the fast program) applies the same steps."""
     scale = 1.0
-    for below, factor in TINY_STEPS:
-        if top < below:
-            top *= factor
-            scale *= factor
+    if not top > 0.0:  # nothing fired (or NaN): nothing to scale
+        return scale
+    for _ in range(TINY_COUNT):
+        if top < TINY_BELOW:
+            top *= TINY_FACTOR
+            scale *= TINY_FACTOR
     return scale
 
 
