@@ -37,7 +37,9 @@ def test_batch_without_inputs_has_rows(backend: str) -> None:
 
 
 def test_rows_must_match_the_columns() -> None:
-    ctl = fuzzyctl.compile(fuzzyctl.load(FCL.replace("VAR_OUTPUT", "VAR_INPUT x : REAL; END_VAR\nVAR_OUTPUT")))
+    ctl = fuzzyctl.compile(
+        fuzzyctl.load(FCL.replace("VAR_OUTPUT", "VAR_INPUT x : REAL; END_VAR\nVAR_OUTPUT"))
+    )
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         assert len(ctl.evaluate_batch({"x": np.array([1.0, 2.0])}, rows=2)["y"]) == 2

@@ -198,7 +198,8 @@ static int fz_rem_pio2_big(double x, double *r)
         limb[7 + s] += carry;
     }
     fbits = 32 * (k0 + 7) - e; /* the binary point sits below bit fbits */
-    q = (int)(((limb[fbits >> 5] >> (fbits & 31)) & 1U) | (((limb[(fbits + 1) >> 5] >> ((fbits + 1) & 31)) & 1U) << 1));
+    q = (int)((limb[fbits >> 5] >> (fbits & 31)) & 1U);
+    q |= (int)((limb[(fbits + 1) >> 5] >> ((fbits + 1) & 31)) & 1U) << 1;
     for (pos = fbits - 1; pos >= fbits - 159; pos--) { /* 159 bits: f >= 2^-62 keeps 97 */
         unsigned long long bit = (limb[pos >> 5] >> (pos & 31)) & 1U;
         if (pos >= fbits - 53) {

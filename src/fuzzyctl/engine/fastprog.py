@@ -217,11 +217,10 @@ class FastBuilder(RuleBuilder):
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
                 g.b.set(top, h)
-        with g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT):
-            with g.b.if_(top.lt(pwl.TINY_BELOW)):
-                g.b.set(top, top * pwl.TINY_FACTOR)
-                for h in hs:
-                    g.b.set(h, h * pwl.TINY_FACTOR)
+        with g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(top.lt(pwl.TINY_BELOW)):
+            g.b.set(top, top * pwl.TINY_FACTOR)
+            for h in hs:
+                g.b.set(h, h * pwl.TINY_FACTOR)
         return [(t, h, w, act) for (t, _a, w, act), h in zip(contribs, hs, strict=True)]
 
     def _ts_output(

@@ -179,7 +179,9 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
     return f
 
 
-def _scale_tiny(contribs: list[tuple[int | None, Arr, Any, str]], n: int) -> list[tuple[int | None, Arr, Any, str]]:
+def _scale_tiny(
+    contribs: list[tuple[int | None, Arr, Any, str]], n: int
+) -> list[tuple[int | None, Arr, Any, str]]:
     """``pwl.tiny_degree_scale`` row by row (the same power-of-two steps, exact)."""
     if not contribs:
         return contribs
