@@ -204,7 +204,8 @@ def _scale_tiny(g: Gen, ga: Var, g0: int, g1: int) -> None:
     for i in range(g0 + 1, g1 + 1):
         with b.if_(ga[i].gt(top)):
             b.set(top, ga[i])
-    with b.for_(g.counter("K"), 1, pwl.TINY_COUNT), b.if_(top.lt(pwl.TINY_BELOW)):
+    low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
+    with b.if_(low), b.for_(g.counter("K"), 1, pwl.TINY_COUNT), b.if_(low):
         b.set(top, top * pwl.TINY_FACTOR)
         with b.for_(g.counter("I"), g0, g1) as gi:
             b.set(ga[gi], ga[gi] * pwl.TINY_FACTOR)

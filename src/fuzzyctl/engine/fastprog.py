@@ -217,7 +217,8 @@ class FastBuilder(RuleBuilder):
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
                 g.b.set(top, h)
-        with g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(top.lt(pwl.TINY_BELOW)):
+        low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
+        with g.b.if_(low), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
             g.b.set(top, top * pwl.TINY_FACTOR)
             for h in hs:
                 g.b.set(h, h * pwl.TINY_FACTOR)
