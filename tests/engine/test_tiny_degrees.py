@@ -84,3 +84,47 @@ def test_the_scale_is_a_power_of_two_and_leaves_normal_degrees() -> None:
         scaled = top * pwl.tiny_degree_scale(top)
         assert 2.0**-124 <= scaled < 2.0**-60
         assert scaled / pwl.tiny_degree_scale(top) == top  # exact
+
+
+SINGLETONS = """
+FUNCTION_BLOCK s
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x
+    TERM dark := TRIAN 0 0.25 0.5;
+    TERM dim := TRIAN 0 0.5 1;
+END_FUZZIFY
+DEFUZZIFY y
+    RANGE(0..1);
+    TERM a := 0.3;
+    TERM b := 0.9;
+    METHOD : {method};
+    DEFAULT := 0;
+END_DEFUZZIFY
+RULEBLOCK rb
+    AND : MIN;
+    ACT : MIN;
+    ACCU : MAX;
+    RULE 1 : IF x IS dark THEN y IS a;
+{rule2}END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+@pytest.mark.parametrize("method", ["COGS", "COG"])
+@pytest.mark.parametrize("both", [False, True])
+def test_singletons_at_subnormal_degrees(method: str, both: bool) -> None:
+    # weights 4u (a = 0.3) and 2u (b = 0.9): 0.3 alone (0.25 before: 0.3 * 4u rounds to 1u),
+    # (4 * 0.3 + 2 * 0.9) / 6 = 0.5 together
+    rule2 = "    RULE 2 : IF x IS dim THEN y IS b;\n" if both else ""
+    doc = fuzzyctl.load(SINGLETONS.replace("{method}", method).replace("{rule2}", rule2))
+    want = 0.5 if both else 0.3
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        for backend in ("interpreted", "python", "native"):
+            ctl = fuzzyctl.compile(doc, backend=backend)
+            assert ctl.evaluate({"x": TINY})["y"] == pytest.approx(want, abs=1e-12), backend
+            assert ctl.evaluate_batch({"x": np.array([TINY])})["y"][0] == pytest.approx(want, abs=1e-12)
+        got = D.run_c(fuzzyctl.compile(doc, backend="interpreted").plan, [[TINY]])
+    if got is not None:
+        assert got[0][0][0] == pytest.approx(want, abs=1e-12)

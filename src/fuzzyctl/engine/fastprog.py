@@ -44,7 +44,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
 
-from fuzzyctl.engine import pwl, shapes
+from fuzzyctl.engine import shapes
 from fuzzyctl.engine.ir import Ex, Kernel, Num, Program, Pwl, Var, ex
 from fuzzyctl.engine.irgen import CodegenError, Gen
 from fuzzyctl.engine.irrules import Contrib, Literals, Params, RuleBuilder
@@ -194,8 +194,8 @@ class FastBuilder(RuleBuilder):
             g.b.add(Kernel("HOLD", (out,), (out, ex(True)), (oi, 0.0, False, None)))
             values[oi] = out
             return
-        if op.kind == "mamdani" and contribs:
-            contribs = self._scale_tiny(contribs)
+        if op.kind == "mamdani":  # singleton outputs scale in RuleBuilder.singleton
+            contribs = self.scale_tiny(contribs)
         if op.kind == "singleton":
             value, fired = self.singleton(op, contribs)
         elif op.kind == "ts":
@@ -207,22 +207,6 @@ class FastBuilder(RuleBuilder):
         default = op.default if op.default is not None else 0.0
         g.b.add(Kernel("HOLD", (out,), (value, fired), (oi, default, op.no_change, op.clamp)))
         values[oi] = out
-
-    def _scale_tiny(self, contribs: list[Contrib]) -> list[Contrib]:
-        """``pwl.tiny_degree_scale`` in the program: the same power-of-two steps on the
-        largest degree, applied to every degree of the output (exact)."""
-        g = self.g
-        hs = [g.let(a, "H") for _t, a, _w, _act in contribs]
-        top = g.let(hs[0], "TOP")
-        for h in hs[1:]:
-            with g.b.if_(h.gt(top)):
-                g.b.set(top, h)
-        low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
-        with g.b.if_(low), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
-            g.b.set(top, top * pwl.TINY_FACTOR)
-            for h in hs:
-                g.b.set(h, h * pwl.TINY_FACTOR)
-        return [(t, h, w, act) for (t, _a, w, act), h in zip(contribs, hs, strict=True)]
 
     def _ts_output(
         self, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
