@@ -9,7 +9,7 @@ BIN    := $(VENV)/bin
 # venv of their own, never in .venv (which has the numpy users get)
 PEERS  := .venv-peers
 
-.PHONY: run simulate docs-img studio-img test fuzz lint typecheck pytest system-deps clean
+.PHONY: run simulate docs docs-img studio-img test fuzz lint typecheck pytest system-deps clean
 STUDIO_PORT ?= 8770
 
 $(BIN)/python:
@@ -77,3 +77,8 @@ fuzz: $(VENV)/.installed-dev $(PEERS)/.installed system-deps
 
 clean:
 	rm -rf $(VENV) $(PEERS) .pytest_cache .mypy_cache .ruff_cache
+
+# The API reference (docstrings, mkdocstrings) with docs/*.md as its guide pages, in build/site;
+# strict: a broken link or cross-reference fails (tests/test_api_docs.py builds it too).
+docs: $(VENV)/.installed-dev
+	$(BIN)/python -m mkdocs build --strict

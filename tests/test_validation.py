@@ -127,6 +127,20 @@ def test_a_term_of_one_point_is_refused_in_fcl_and_json_singletons_still_load() 
     assert fuzzyctl.compile(document).evaluate({"x": 0.0})["y"] == pytest.approx(5.0)
 
 
+def test_the_jfuzzylogic_profile_reads_a_term_of_one_point_with_a_warning() -> None:
+    """jFuzzyLogic runs a one-point list (a constant degree): under its profile the term is a
+    warning, elsewhere the error of 5.2.2; the CLI's --compat reads the file the same way."""
+    text, _line = _replace_once(
+        _text("fcl", _model()), "TERM odd := (0, 0) (3.25, 0.375) (6, 1) (10, 0);", "TERM odd := (5, 1);"
+    )
+    with pytest.raises(DiagnosticError):
+        fuzzyctl.load(text)
+    document = fuzzyctl.load(text, compat="jfuzzylogic")
+    found = validate(document, compat="jfuzzylogic")
+    assert [(f.code, f.severity.name) for f in found] == [("too-few-points", "WARNING")]
+    assert [f.severity.name for f in validate(document)] == ["ERROR"]
+
+
 @pytest.mark.parametrize("fmt", ["fis", "fll"])
 def test_a_discrete_term_of_one_pair_is_the_constant_fuzzylite_reads(fmt: str) -> None:
     """fuzzylite's Discrete (and MATLAB's discretemf) of one pair is that degree everywhere:

@@ -38,6 +38,21 @@ def __getattr__(name: str) -> Any:
     if not name.startswith("_"):  # a subpackage not imported yet (fuzzyctl.engine, ...)
         try:
             return importlib.import_module(f"fuzzyctl.{name}")
-        except ModuleNotFoundError:
-            pass
+        except ModuleNotFoundError as exc:
+            if exc.name != f"fuzzyctl.{name}":  # the module is there, a dependency is not:
+                raise  # its message names the extra to install (fuzzyctl.control)
     raise AttributeError(f"module 'fuzzyctl' has no attribute {name!r}")
+
+
+def _rich_display() -> None:
+    # In a Jupyter kernel: controllers, variables, explanations and analyses display as HTML
+    # (fuzzyctl.display; cheap: registered by name, nothing imported until shown).
+    import sys
+
+    if "IPython" in sys.modules:
+        from fuzzyctl.display import register
+
+        register()
+
+
+_rich_display()

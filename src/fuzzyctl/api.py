@@ -32,21 +32,36 @@ BACKENDS = ("auto", "native", "python", "interpreted")
 _KEYS: OrderedDict[int, tuple[Document, str]] = OrderedDict()
 
 
-def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = False) -> Document:
+def load(
+    path_or_text: str | Path, *, format: str | None = None, strict: bool = False, compat: str = "iec"
+) -> Document:
     """Read a fuzzy system from a file path or from source text.
 
     ``format`` (``"fcl"``, ...) overrides detection by file extension; text that is not an
     existing path is parsed as FCL unless ``format`` says otherwise.  ``strict``: refuse, as
     a strict IEC 61131-7 tool would, FCL whose identifiers are reserved keywords (Table 7),
-    and in every format a WITH (or rule) weight above 1 (5.2.4).
+    and in every format a WITH (or rule) weight above 1 (5.2.4).  ``compat``: read FCL as
+    that tool's profile does (``"jfuzzylogic"`` takes a term of one point, with a warning,
+    as jFuzzyLogic runs it; IEC 61131-7 5.2.2 asks for two).
     Raises :class:`fuzzyctl.diagnostics.DiagnosticError` with file:line:column diagnostics
-    when the input is not valid."""
+    when the input is not valid.
+
+    ```python
+    >>> import fuzzyctl
+    >>> doc = fuzzyctl.load("examples/tank.fcl")
+    >>> [fb.name for fb in doc.blocks]
+    ['tank']
+    >>> fuzzyctl.load("FUNCTION_BLOCK empty END_FUNCTION_BLOCK").blocks[0].name   # text, not a path
+    'empty'
+
+    ```
+    """
     fmt = (format or "").lower() or None
     if isinstance(path_or_text, Path) or _looks_like_path(path_or_text):
         path = Path(path_or_text)
         require_file(path)  # before the extension is read: a typo in it is still a missing file
         fmt = fmt or (path.suffix.lower().lstrip(".") or "fcl")
-        doc = _load_path(path, fmt, strict)
+        doc = _load_path(path, fmt, strict, compat)
         if strict and fmt != "fcl" and (found := _strict_findings(doc)):  # FCL's reader said it
             from fuzzyctl.diagnostics import DiagnosticError
 
@@ -64,7 +79,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
     text = str(path_or_text)
     if not text.strip():
         raise DiagnosticError([error("empty input: no FUNCTION_BLOCK", code="empty")])
-    return load_text(text, strict=strict).raise_for_errors()
+    return load_text(text, strict=strict, compat=compat).raise_for_errors()
 
 
 #: Files up to this size have their parsed document cached on disk.  Above it, pickling the
@@ -74,7 +89,7 @@ def load(path_or_text: str | Path, *, format: str | None = None, strict: bool = 
 DOCUMENT_CACHE_MAX_BYTES = 256 * 1024
 
 
-def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
+def _load_path(path: Path, fmt: str, strict: bool = False, compat: str = "iec") -> Document:
     from fuzzyctl import cache
     from fuzzyctl.diagnostics import DiagnosticError
 
@@ -88,7 +103,9 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
         except DiagnosticError:
             data = None  # the reader reports it with its place
         if data is not None:
-            key = content_key(data, fmt + (":strict" if strict else ""))
+            key = content_key(
+                data, fmt + (":strict" if strict else "") + (f":{compat}" if compat != "iec" else "")
+            )
             small = len(data) <= DOCUMENT_CACHE_MAX_BYTES
             doc = _cached(f"documents/{key}.pickle") if small else None
             from fuzzyctl.model import Document
@@ -100,7 +117,7 @@ def _load_path(path: Path, fmt: str, strict: bool = False) -> Document:
     if fmt == "fcl":
         from fuzzyctl.fcl import load_file
 
-        doc = load_file(path, strict=strict).raise_for_errors()
+        doc = load_file(path, strict=strict, compat=compat).raise_for_errors()
     else:
         from fuzzyctl import formats
 
@@ -171,7 +188,18 @@ def compile(
     reading refuses and the engine otherwise settles with a warning: an output without RANGE
     whose terms do not fall to 0, identifiers that are Table 7 keywords; the warnings it
     settles with are the controller's ``warnings``.  Raises
-    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate."""
+    :class:`~fuzzyctl.diagnostics.DiagnosticError` for what the engine cannot evaluate.
+
+    ```python
+    >>> import fuzzyctl
+    >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/figure7.fcl"))
+    >>> list(ctl.inputs), list(ctl.outputs)
+    (['temp', 'pressure'], ['valve'])
+    >>> round(ctl.evaluate(temp=10, pressure=60)["valve"], 10)   # IEC 61131-7 figure 7
+    51.8518518519
+
+    ```
+    """
     from fuzzyctl.engine.ranges import check_mode
     from fuzzyctl.gcpause import gc_paused
     from fuzzyctl.model import Document
@@ -364,7 +392,17 @@ def _store(rel: str, obj: Any) -> None:
 def plot_terms(variable: VariableInfo, *, points: int = 1001, ax: Axes | None = None) -> Figure:
     """The membership functions of a variable as a labelled matplotlib Figure:
     ``fuzzyctl.plot_terms(ctl.inputs["temp"]).savefig("temp.png")`` (as scikit-fuzzy's
-    ``view()`` or simpful's ``plot_variable``)."""
+    ``view()`` or simpful's ``plot_variable``).
+
+    ```python
+    >>> import fuzzyctl
+    >>> ctl = fuzzyctl.compile(fuzzyctl.load("examples/figure7.fcl"))
+    >>> fig = fuzzyctl.plot_terms(ctl.inputs["temp"])
+    >>> [line.get_label() for line in fig.axes[0].get_lines()]
+    ['cold', 'hot']
+
+    ```
+    """
     from fuzzyctl.engine.plot import plot_terms as draw
 
     return draw(variable, points=points, ax=ax)

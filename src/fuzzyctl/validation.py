@@ -67,8 +67,13 @@ def _num(x: float) -> str:
     return f"{x:g}"
 
 
+#: Tools whose profile (``compat=``) reads a term of one point, as a constant degree: under
+#: them that term is a warning, not an error (jFuzzyLogic 3.3 runs such files).
+ONE_POINT_TOOLS = frozenset({"jfuzzylogic"})
+
+
 def _point_findings(
-    term: Term, mf: PointsMF | SingletonsMF, where: tuple[PathItem, ...]
+    term: Term, mf: PointsMF | SingletonsMF, where: tuple[PathItem, ...], compat: str = "iec"
 ) -> Iterator[Finding]:
     points: tuple[Point, ...] = mf.points
     if isinstance(mf, PointsMF) and len(points) < 2:
@@ -76,7 +81,7 @@ def _point_findings(
             yield Finding(Severity.ERROR, "empty-term", f"TERM {term.name} has no points", where, term.span)
         else:
             yield Finding(
-                Severity.ERROR,
+                Severity.WARNING if compat in ONE_POINT_TOOLS else Severity.ERROR,
                 "too-few-points",
                 f"TERM {term.name} has one point; a membership function needs at least two (5.2.2)",
                 (*where, "points", 0),
@@ -150,7 +155,9 @@ def _range_finding(rng: Range | None, owner: str, where: tuple[PathItem, ...]) -
         yield Finding(Severity.ERROR, "bad-range", message, (*where, "range"), rng.span)
 
 
-def _block_findings(fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool) -> Iterator[Finding]:
+def _block_findings(
+    fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool, compat: str = "iec"
+) -> Iterator[Finding]:
     for vi, v in enumerate(fb.variables):
         yield from _range_finding(v.range, f"variable {v.name}", (*where, "variables", vi))
     groups: tuple[tuple[str, tuple[FuzzifyBlock | DefuzzifyBlock, ...]], ...] = (
@@ -162,7 +169,7 @@ def _block_findings(fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool
             yield from _range_finding(block.range, f"{kind.upper()} {block.variable}", (*where, kind, bi))
             for ti, term in enumerate(block.terms):
                 if isinstance(term.mf, PointsMF | SingletonsMF):
-                    yield from _point_findings(term, term.mf, (*where, kind, bi, "terms", ti, "mf"))
+                    yield from _point_findings(term, term.mf, (*where, kind, bi, "terms", ti, "mf"), compat)
     for ri, rb in enumerate(fb.rule_blocks):
         for ui, rule in enumerate(rb.rules):
             at: tuple[PathItem, ...] = (*where, "rule_blocks", ri, "rules", ui)
@@ -186,12 +193,13 @@ def _block_findings(fb: FunctionBlock, where: tuple[PathItem, ...], strict: bool
                         yield found
 
 
-def validate(document: Document, *, strict: bool = False) -> list[Finding]:
+def validate(document: Document, *, strict: bool = False, compat: str = "iec") -> list[Finding]:
     """Every rule of this module that ``document`` breaks (errors and warnings), in model
-    order; ``strict``: a weight above 1 is an error."""
+    order; ``strict``: a weight above 1 is an error; ``compat``: a tool's profile
+    (:data:`ONE_POINT_TOOLS` read a term of one point)."""
     out: list[Finding] = []
     for i, fb in enumerate(document.blocks):
-        out.extend(_block_findings(fb, ("blocks", i), strict))
+        out.extend(_block_findings(fb, ("blocks", i), strict, compat))
     return out
 
 
@@ -211,4 +219,4 @@ def at_json_paths(findings: Sequence[Finding], file: str | None = None) -> list[
 Placer = Callable[[Sequence[Finding], "str | None"], list[Diagnostic]]
 """How a reader turns findings into diagnostics at its own positions."""
 
-__all__ = ["Finding", "Placer", "at_json_paths", "at_spans", "validate"]
+__all__ = ["ONE_POINT_TOOLS", "Finding", "Placer", "at_json_paths", "at_spans", "validate"]

@@ -62,7 +62,7 @@ def ours(
     """Our outputs on the system's rows (successive evaluations, as the oracle does), the
     scale of each output's error and its method, and why we refuse it if we do."""
     try:
-        c = fuzzyctl.compile(fuzzyctl.load(system.text), compat=compat)
+        c = fuzzyctl.compile(fuzzyctl.load(system.text, compat=compat), compat=compat)
     except FuzzyctlError as exc:
         return None, {}, str(exc).splitlines()[0]
     got = c.evaluate_batch({name: [r[name] for r in system.rows] for name in c.inputs})

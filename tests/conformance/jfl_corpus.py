@@ -58,7 +58,7 @@ def compare_corpus(files: list[Path]) -> tuple[Stats, list[str], list[str]]:
     ours_refuse = []
     for f in files:
         try:
-            ctl = fuzzyctl.compile(fuzzyctl.load(f), compat="jfuzzylogic")
+            ctl = fuzzyctl.compile(fuzzyctl.load(f, compat="jfuzzylogic"), compat="jfuzzylogic")
         except FuzzyctlError:
             ours_refuse.append(f)
             continue

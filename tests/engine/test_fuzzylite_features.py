@@ -230,7 +230,29 @@ def test_agrees_with_pyfuzzylite_and_the_three_paths_agree(
     want = _pyfuzzylite(text, names, rows)
     tol = 1e-9 if fb.defuzzify[0].method == "WTAVER" else 1e-5 * (HI - LO)
     for got, expected, row in zip(ref, want, rows, strict=True):
-        assert _same(got, expected, tol), (got, expected, row, text)
+        assert _same(got, expected, tol) or _knife_edge(fb, row), (got, expected, row, text)
+
+
+def _knife_edge(fb: m.FunctionBlock, row: list[float]) -> bool:
+    """Whether the rule selection of ``row`` is decided by the last bit of a degree: two
+    degrees (or a degree and a threshold, or 0) within a few ulps.  pyfuzzylite computes exp
+    with numpy's vector code, we with libm on every path (one answer); they differ in the last
+    bit on a few percent of arguments, which can flip such a tie (not an error of either)."""
+    block = fb.rule_blocks[0]
+    if block.rule_activation is None:
+        return False
+    words = block.rule_activation.split()
+    marks = [0.0] + ([float(words[-1])] if words[0] == "Threshold" or len(words) == 3 else [])
+    weights = {r.label: float(r.weight) if isinstance(r.weight, float) else 1.0 for r in block.rules}
+    names = [v.name for v in fb.inputs]
+    explained = fuzzyctl.compile(fb, backend="interpreted").explain(dict(zip(names, row, strict=True)))
+    degrees = [(t.condition or 0.0) * weights[t.label] for t in explained.rules if t.block == block.name]
+    values = degrees + marks
+    return any(
+        abs(a - b) <= 8 * math.ulp(max(abs(a), abs(b), 1e-300))
+        for i, a in enumerate(values)
+        for b in values[i + 1 :]
+    )
 
 
 # --------------------------------------------------------------------------- closed forms
@@ -437,3 +459,44 @@ def test_rule_activation_with_chained_inference_is_reported() -> None:
         ),
     )
     assert any(d.code == "rule-activation-chained" for d in unsupported(chained))
+
+
+def test_highest_tie_on_a_gaussians_last_bit_is_one_answer_on_every_path() -> None:
+    # exp(-1/8) (Gaussian 1 2 at x = 0) is one ulp apart in libm and numpy's vector exp on
+    # common CPUs; ASUM(1, g) = 1 + g - g is then 1.0 under libm and 0.999... under numpy, so
+    # "Highest 1" against a rule of degree exactly 1 picked rule 1 (o1: 4/3) in the scalar
+    # paths and rule 2 (o0: 1) in the batch path.  Brute force: the degrees as libm gives them.
+    g = math.exp(-(1.0 * 1.0) / (2.0 * 2.0 * 2.0))
+    rule1, rule2 = 1.0 + g - 1.0 * g, 1.0
+    want = 4.0 / 3.0 if rule1 >= rule2 else 1.0  # the earlier rule on a tie
+    fz = m.FuzzifyBlock(
+        "x0",
+        (
+            m.Term("t0", m.ShapeMF("triangle", (0.0, 1.0, 2.0))),
+            m.Term("t1", m.ShapeMF("gaussian", (1.0, 2.0))),
+        ),
+    )
+    df = m.DefuzzifyBlock(
+        "y",
+        (
+            m.Term("o0", m.ShapeMF("triangle", (0.0, 1.0, 2.0))),
+            m.Term("o1", m.ShapeMF("triangle", (0.0, 1.0, 3.0))),
+        ),
+        m.Range(LO, HI),
+        "COG",
+        m.Default(math.nan),
+    )
+    rules = (
+        m.Rule("1", m.Or((m.Is("x0", "t0", True), m.Is("x0", "t1"))), (m.Conclusion("y", "o1"),)),
+        m.Rule("2", m.Is("x0", "t0", True), (m.Conclusion("y", "o0"),)),
+    )
+    fb = m.FunctionBlock(
+        "tie",
+        variables=(m.Variable("x0", m.VarKind.INPUT), m.Variable("y", m.VarKind.OUTPUT)),
+        fuzzify=(fz,),
+        defuzzify=(df,),
+        rule_blocks=(m.RuleBlock("rb", rules, "PROD", "ASUM", "MIN", "MAX", rule_activation="Highest 1"),),
+    )
+    fast, ref, batch = _three_paths(fb, [[0.0]] * 6)
+    assert fast == ref == batch == [pytest.approx(want, abs=1e-12)] * 6
+    assert _knife_edge(fb, [0.0])  # pyfuzzylite (numpy's exp) may take the other rule here

@@ -12,6 +12,8 @@ from typing import Any
 import pytest
 from fastapi.testclient import TestClient
 
+import fuzzyctl
+import fuzzyctl.diagnostics
 from fuzzyctl.studio import create_app
 from tests.conftest import EXAMPLES
 
@@ -52,3 +54,30 @@ def test_an_invalid_model_is_refused_with_its_json_path_and_not_saved(project: P
     assert 400 <= r.status_code < 500, r.text
     assert "$.blocks[0].fuzzify[0].terms[" in r.text or "too large" in r.text, r.text
     assert not (project / "copy.fcl").exists()
+
+
+@pytest.mark.parametrize("change", ["degree", "ascending"])
+def test_check_answers_an_invalid_model_with_its_report(project: Path, change: str) -> None:
+    # /api/check is how the editors learn what is wrong while the user edits: an invalid
+    # model is its ordinary answer (200, ok false), the error tied to the term as the FCL
+    # reader's validation reports it, so the page shows it next to the term (a 422 made the
+    # browser log an error and the editor show nothing).  Saving it is still refused (above).
+    client = TestClient(create_app(project, file="crane.fcl", token=None), base_url=BASE)
+    document = client.post("/api/open", json={"path": "crane.fcl"}).json()["document"]
+    variable = document["blocks"][0]["fuzzify"][0]["variable"]
+    term = next(t for t in document["blocks"][0]["fuzzify"][0]["terms"] if t["mf"]["type"] == "points")
+    points = _first_points(document)
+    if change == "degree":
+        points[0]["y"] = 1.5
+    else:
+        points[0]["x"], points[1]["x"] = points[1]["x"] + 1.0, points[0]["x"]
+    r = client.post("/api/check", json={"document": document})
+    assert r.status_code == 200, r.text
+    report = r.json()
+    assert report["ok"] is False
+    errors = [d for d in report["diagnostics"] if d["severity"] == "error"]
+    code = {"degree": "degree-out-of-range", "ascending": "points-not-ascending"}[change]
+    assert [d["element"] for d in errors if d["code"] == code] == [f"term:{variable}:{term['name']}"], errors
+    # the FCL text the check read is refused by the CLI's reader too: one validation
+    with pytest.raises(fuzzyctl.diagnostics.DiagnosticError):
+        fuzzyctl.load(report["text"])

@@ -8,9 +8,12 @@ from typing import TYPE_CHECKING
 from fuzzyctl.analysis.report import Analysis
 
 if TYPE_CHECKING:
+    from pathlib import Path
+
+    from fuzzyctl.analysis.usage import Coverage
     from fuzzyctl.model import Document, FunctionBlock
 
-__all__ = ["Analysis", "analyze"]
+__all__ = ["Analysis", "analyze", "coverage"]
 
 
 def analyze(
@@ -27,7 +30,16 @@ def analyze(
     ``epsilon``: a rule "fires" when its degree is >= epsilon (0, the default: > 0, where the
     output would fall to DEFAULT).  ``delta``: conflicts are pairs firing together above it
     (default 0.5).  ``monotone``: declarations ``"valve:-temp,+pressure"``.  ``surface``:
-    sample the output surface (min, max, slope, jumps, monotonicity counterexamples)."""
+    sample the output surface (min, max, slope, jumps, monotonicity counterexamples).
+
+    ```python
+    >>> import fuzzyctl
+    >>> found = fuzzyctl.analyze(fuzzyctl.load("examples/tank.fcl"))
+    >>> found.gaps, found.conflicts, found.dead_rules      # the 25 rules cover every input
+    ([], [], [])
+
+    ```
+    """
     from fuzzyctl.analysis import cells, conflicts, gaps, monotonicity, redundancy, table
     from fuzzyctl.analysis import surface as surf
     from fuzzyctl.analysis.context import build_context
@@ -97,3 +109,18 @@ def analyze(
         rule_where=dict(zip(ctx.rule_names, ctx.rule_where, strict=True)),
     )
 
+
+def coverage(
+    model: Document | FunctionBlock,
+    data: str | Path | list[str | Path],
+    *,
+    block: str | None = None,
+    epsilon: float = 0.0,
+) -> Coverage:
+    """How the rules were used over the rows of a log (CSV/Parquet file, directory or glob):
+    per rule how often it fired (degree >= epsilon; 0: > 0) and dominated (the highest degree
+    for an output it concludes), its mean and max degree; rows in a gap or outside a RANGE
+    (docs/analyze.md, "Coverage from data")."""
+    from fuzzyctl.analysis import usage
+
+    return usage.coverage(model, data, block=block, epsilon=epsilon)

@@ -354,3 +354,50 @@ def evaluate(ctx: Context, axes: list[Axis], epsilon: float) -> Grid:
                     ev.accumulate(ev.chained[ch], cp.term, accu, contrib, sl)
     notes = exactness(ctx, epsilon)
     return Grid(axes, best, rule_max, not notes, notes)
+
+
+class _RowEvaluator(_Evaluator):
+    """The same evaluation on scattered points (rows of a log) instead of a grid: every
+    array is one value per row, so leaves and norms combine elementwise."""
+
+    def __init__(self, ctx: Context, columns: list[FloatArray]) -> None:
+        m = len(columns[0]) if columns else 0
+        super().__init__(ctx, [])
+        self.n = 1
+        self.shape = (m,)
+        self.reps = columns
+        self.chained = [[None] * len(c.terms) for c in self.plan.chained]
+        self.full = (slice(0, m),)
+
+    def _shaped(self, v: FloatArray, axis: int, sl: tuple[slice, ...]) -> FloatArray:
+        return v
+
+    def region(self, c: CondPlan) -> tuple[slice, ...] | None:
+        return self.full
+
+
+def row_degrees(ctx: Context, columns: list[FloatArray]) -> tuple[FloatArray, dict[int, FloatArray]]:
+    """Each rule's degree (weight applied, 0 at or below the firing threshold) at each row,
+    shape (rules, rows), and per output the best contribution; ``columns`` holds one array per
+    input slot.  Same leaves, norms and chaining as :func:`evaluate`."""
+    plan = ctx.plan
+    ev = _RowEvaluator(ctx, columns)
+    m = ev.shape[0]
+    degrees = np.zeros((len(plan.rules), m))
+    best = {o: np.zeros(m) for o in range(len(plan.outputs))}
+    for ri in plan.order:
+        r = plan.rules[ri]
+        a = np.broadcast_to(ev.rule(ri, ev.full), (m,))
+        degrees[ri] = a
+        for cp in r.conclusions:
+            ah = a
+            for h in reversed(cp.hedges):
+                ah = shapes.hedge_np(h, ah)
+            contrib = np.broadcast_to(ev.value(cp.weight, ev.full) * ah, (m,))
+            for o in cp.outputs:
+                np.maximum(best[o], contrib, out=best[o])
+            for ch in cp.chained:
+                accu = plan.chained[ch].accu
+                store = ev.bare if cp.term is None else ev.chained[ch]
+                ev.accumulate(store, ch if cp.term is None else cp.term, accu, contrib, ev.full)
+    return degrees, best

@@ -35,16 +35,40 @@ def analyze(
     as_json: Annotated[
         bool, typer.Option("--json", help="Print the JSON object of docs/analyze.md.")
     ] = False,
+    data: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--data",
+            help="Coverage from a log: a CSV/Parquet file, a directory or a glob (repeatable).",
+            show_default=False,
+        ),
+    ] = None,
+    plot: Annotated[
+        Path | None,
+        typer.Option(
+            "--plot",
+            help="Write PNGs to DIR: a best-rule-degree map per input pair (and coverage.png with --data).",
+            file_okay=False,
+            show_default=False,
+        ),
+    ] = None,
 ) -> None:
     """Find where no rule fires (gaps), rules that contradict each other, duplicate, subsumed
     and dead rules, unused terms, monotonicity violations and the output surface's range,
     slope and jumps, before the controller meets the plant."""
     import fuzzyctl
     from fuzzyctl.analysis import analyze as run
+    from fuzzyctl.analysis import usage as cov_mod
 
-    result = run(fuzzyctl.load(file), block=block, epsilon=epsilon, delta=delta, monotone=monotone or ())
+    model = fuzzyctl.load(file)
+    result = run(model, block=block, epsilon=epsilon, delta=delta, monotone=monotone or ())
+    cov = cov_mod.coverage(model, list(data), block=block, epsilon=epsilon) if data else None
+    pngs = _plots(model, result, cov, plot, block) if plot is not None else []
     if as_json:
-        typer.echo(json.dumps(result.to_json(), allow_nan=False, default=str))
+        obj = result.to_json()
+        if cov is not None:
+            obj["coverage"] = cov.to_json()
+        typer.echo(json.dumps(obj, allow_nan=False, default=str))
         return
     from rich.console import Console
 
@@ -55,3 +79,19 @@ def analyze(
     )
     for line in result.lines():
         console.print(line, markup=False)
+    if cov is not None:
+        console.print(cov_mod.table(cov))
+        for line in cov_mod.lines(cov):
+            console.print(line, markup=False)
+    for png in pngs:
+        console.print(f"wrote {png}", markup=False)
+
+
+def _plots(model: object, result: object, cov: object, out_dir: Path, block: str | None) -> list[Path]:
+    from fuzzyctl.analysis import plots
+    from fuzzyctl.analysis import usage as cov_mod
+
+    written = plots.pair_maps(model, result, out_dir, block=block)  # type: ignore[arg-type]
+    if cov is not None:
+        written.append(cov_mod.plot(cov, out_dir / "coverage.png"))  # type: ignore[arg-type]
+    return written

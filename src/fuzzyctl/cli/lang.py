@@ -63,6 +63,14 @@ def check(
             "time and memory of FILE on this machine.",
         ),
     ] = False,
+    analyze: Annotated[
+        bool,
+        typer.Option(
+            "--analyze",
+            help="Also report the rule-base analysis (gaps, dead, conflicting, redundant rules, "
+            "unused terms) at file:line; with --strict gaps and dead rules are errors.",
+        ),
+    ] = False,
 ) -> None:
     """Validate a model and report the IEC 61131-7 conformance level it needs as FCL (exit 1
     on errors).  FCL gets every check; another format gets the model's checks and the
@@ -87,6 +95,8 @@ def check(
         failed = {"file": str(file), "ok": False, "diagnostics": [d.to_dict() for d in exc.diagnostics]}
         typer.echo(json.dumps(failed, indent=2))
         raise typer.Exit(EXIT_ERRORS) from None
+    if analyze:
+        _add_analysis(report.result, strict)
     if as_json:
         typer.echo(json.dumps(report.to_dict(), indent=2, default=str))
     else:
@@ -137,6 +147,16 @@ def _print_report(report: CheckReport) -> None:
         out.print(table)
     if any("*" in row.item for rows in report.checklists.values() for row in rows):
         out.print("* parametric shapes count their parameters as points", markup=False)
+
+
+def _add_analysis(result: LoadResult, strict: bool) -> None:
+    """``check --analyze``: the analysis' findings join the diagnostics (fuzzyctl.analysis.findings)."""
+    if not result.ok:
+        return
+    from fuzzyctl.analysis import findings
+
+    assert result.document is not None
+    result.diagnostics.extend(findings.diagnostics(result.document, strict=strict))
 
 
 def _print_statement(file: Path | None) -> None:

@@ -54,7 +54,7 @@ def _controller(
     import fuzzyctl
     from fuzzyctl.cli.app import err_console
 
-    doc = fuzzyctl.load(file, strict=strict, format=fmt)
+    doc = fuzzyctl.load(file, strict=strict, format=fmt, compat=compat)
     ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict)
     from fuzzyctl.diagnostics import render_all
 

@@ -35,6 +35,7 @@ from fuzzyctl.engine.plan import OutputPlan, Plan, Slot, TermPlan
 INFO_OK = 0x00
 INFO_DISABLED = 0x01  # ENABLE = FALSE: outputs keep their values
 INFO_DEFAULT = 0x02  # no rule fired for at least one output: DEFAULT or the previous value
+INFO_QUADRATURE = 0x04  # a smooth output's CoG reached its iteration cap short of its tolerance
 INFO_DEGREE_RANGE = 0x31  # an input used as a degree (or WITH weight) is outside [0, 1]
 
 
@@ -45,6 +46,7 @@ class _Builder(RuleBuilder):
     def __init__(self, plan: Plan, target: Target) -> None:
         super().__init__(plan, Gen(target))
         self.notes: list[str] = []  # header lines: how smooth outputs are integrated
+        self.capped: dict[str, Var] = {}  # smooth output -> TRUE when its quadrature hit the cap
 
     def pwl_points(self, t: TermPlan, xs: Params, ys: Params, where: str) -> list[tuple[Ex, Ex]]:
         """A piecewise-linear term as breakpoints (x, y) in the engine's order
@@ -153,6 +155,9 @@ class _Builder(RuleBuilder):
                 op = plan.outputs[oi]
                 with b.region(f"output {op.name}"):
                     val, fired = results[oi] if oi in results else self._output(oi, op, contribs[oi], values)
+                    if op.name in self.capped:
+                        with b.if_(self.capped[op.name].and_(info.eq(Int(INFO_OK)))):
+                            b.set(info, Int(INFO_QUADRATURE))
                     if op.kind == "degree":
                         b.set(outs[oi], val)
                     else:
@@ -313,12 +318,14 @@ class _Builder(RuleBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         cal = Q.calibrate(op)
-        bound = Q.cog_bound(op, max(1, len(sets)), cal, frozenset(s.act for s in sets))
+        bound = Q.cog_bound()
         self.notes.append(
-            f"output {op.name}: smooth set, CoG by {Q.NODES}-point Gauss-Legendre on "
+            f"output {op.name}: smooth set, CoG by adaptive Gauss-Kronrod 7/15 on "
             f"{len(cal.cuts) - 1} intervals, split at located kinks: {bound}"
         )
-        return Q.smooth_cog(self.g, op, sets, cal)
+        value, fired, capped = Q.smooth_cog(self.g, op, sets, cal)
+        self.capped[op.name] = capped
+        return value, fired
 
     def _mamdani(self, op: OutputPlan, contribs: list[Contrib]) -> ExactOutput:
         g = self.g
@@ -365,6 +372,7 @@ def _info_comment() -> str:
     return (
         f"16#{INFO_OK:02X} ok, 16#{INFO_DISABLED:02X} ENABLE is FALSE (outputs unchanged), "
         f"16#{INFO_DEFAULT:02X} no rule fired for an output (DEFAULT or previous value), "
+        f"16#{INFO_QUADRATURE:02X} a smooth output's CoG hit its iteration cap (may miss its stated bound), "
         f"16#{INFO_DEGREE_RANGE:02X} a degree input is outside 0..1 (outputs unchanged)"
     )
 

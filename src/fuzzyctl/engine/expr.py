@@ -10,6 +10,7 @@ from typing import Any
 
 import numpy as np
 
+from fuzzyctl.engine import libm_np
 from fuzzyctl.engine.plan import EX, EBinary, ECall, EInput, ENum, EOutput, EUnary, ExprPlan
 
 _COMPARE: dict[str, Any] = {
@@ -86,19 +87,19 @@ def eval_expr(e: ExprPlan, values: Sequence[float], outputs: Sequence[float], x:
 
 
 _NP_FUNCS: dict[str, Any] = {
-    "sin": np.sin,
-    "cos": np.cos,
-    "tan": np.tan,
-    "asin": np.arcsin,
-    "acos": np.arccos,
-    "atan": np.arctan,
-    "sinh": np.sinh,
-    "cosh": np.cosh,
-    "tanh": np.tanh,
-    "exp": np.exp,
-    "log": np.log,
-    "ln": np.log,
-    "log10": np.log10,
+    "sin": libm_np.sin,
+    "cos": libm_np.cos,
+    "tan": libm_np.tan,
+    "asin": libm_np.asin,
+    "acos": libm_np.acos,
+    "atan": libm_np.atan,
+    "sinh": libm_np.sinh,
+    "cosh": libm_np.cosh,
+    "tanh": libm_np.tanh,
+    "exp": libm_np.exp,
+    "log": libm_np.log,
+    "ln": libm_np.log,
+    "log10": libm_np.log10,
     "sqrt": np.sqrt,
     "abs": np.abs,
     "fabs": np.abs,
@@ -106,8 +107,8 @@ _NP_FUNCS: dict[str, Any] = {
     "ceil": np.ceil,
     "round": np.round,
     "sign": np.sign,
-    "pow": np.power,
-    "atan2": np.arctan2,
+    "pow": libm_np.pow_,
+    "atan2": libm_np.atan2,
     "fmod": np.fmod,
     "min": np.minimum,
     "max": np.maximum,

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.engine import kernels_np
+from fuzzyctl.engine import kernels_np, libm_np
 from fuzzyctl.engine.fastprog import FastProgram
 from fuzzyctl.engine.ir import (
     Assign,
@@ -54,19 +54,20 @@ from fuzzyctl.escape import py_str
 Batch = Callable[[list[Any], list[float | None], int], list[Any]]
 
 _OPS = {"=": "==", "<>": "!="}
+# transcendental functions as libm computes them: the scalar paths call it (libm_np says why)
 _FUNCS = {
-    "EXP": "_np.exp",
+    "EXP": "_libm.exp",
     "SQRT": "_np.sqrt",
-    "LN": "_np.log",
-    "LOG": "_np.log10",
+    "LN": "_libm.log",
+    "LOG": "_libm.log10",
     "ABS": "_np.abs",
-    "SIN": "_np.sin",
-    "COS": "_np.cos",
-    "TAN": "_np.tan",
-    "ASIN": "_np.arcsin",
-    "ACOS": "_np.arccos",
-    "ATAN": "_np.arctan",
-    "POW": "_np.power",
+    "SIN": "_libm.sin",
+    "COS": "_libm.cos",
+    "TAN": "_libm.tan",
+    "ASIN": "_libm.asin",
+    "ACOS": "_libm.acos",
+    "ATAN": "_libm.atan",
+    "POW": "_libm.pow_",
     "TO_REAL": "_real",
 }
 
@@ -117,6 +118,7 @@ class _Np:
         self.lines: list[str] = []
         self.env: dict[str, Any] = {
             "_np": np,
+            "_libm": libm_np,
             "_w": np.where,
             "_and": np.logical_and,
             "_or": np.logical_or,

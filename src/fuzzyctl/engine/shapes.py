@@ -22,6 +22,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from fuzzyctl.engine import libm_np
+
 FloatArray = npt.NDArray[np.float64]
 Points = tuple[tuple[float, float], ...]
 
@@ -264,7 +266,7 @@ def _smooth(kind: str, p: Sequence[float], x: float) -> float:
 
 def _sig_np(x: Any, c: Any, s: Any) -> Any:
     with np.errstate(over="ignore"):
-        return 1.0 / (1.0 + np.exp(-s * (x - c)))
+        return 1.0 / (1.0 + libm_np.exp(-s * (x - c)))
 
 
 def _sshape_np(x: Any, s: Any, e: Any) -> Any:
@@ -287,7 +289,7 @@ def _zshape_np(x: Any, s: Any, e: Any) -> Any:
 
 def _gauss_np(x: Any, m: Any, sd: Any) -> Any:
     d = x - m
-    return np.exp(-(d * d) / (2.0 * sd * sd))
+    return libm_np.exp(-(d * d) / (2.0 * sd * sd))
 
 
 def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
@@ -299,7 +301,7 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
         return a * b
     if kind == "bell":
         c, w, s = p
-        return 1.0 / (1.0 + np.abs((x - c) / w) ** (2.0 * s))
+        return 1.0 / (1.0 + libm_np.pow_(np.abs((x - c) / w), 2.0 * s))
     if kind == "sigmoid":
         return _sig_np(x, p[0], p[1])
     if kind == "dsigmoid":
@@ -311,7 +313,7 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
     if kind == "cosine":
         c, w = p
         inside = (x >= c - 0.5 * w) & (x <= c + 0.5 * w)
-        return np.where(inside, 0.5 * (1.0 + np.cos(2.0 / w * np.pi * (x - c))), 0.0)
+        return np.where(inside, 0.5 * (1.0 + libm_np.cos(2.0 / w * np.pi * (x - c))), 0.0)
     if kind == "sshape":
         return _sshape_np(x, p[0], p[1])
     if kind == "zshape":
@@ -320,7 +322,7 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
         return _sshape_np(x, p[0], p[1]) * _zshape_np(x, p[2], p[3])
     if kind == "spike":
         c, w = p
-        return np.exp(-np.abs(10.0 / w * (x - c)))
+        return libm_np.exp(-np.abs(10.0 / w * (x - c)))
     if kind == "concave":
         i, e = p
         with np.errstate(invalid="ignore", divide="ignore"):
@@ -330,7 +332,7 @@ def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
     if kind == "cosine_half":
         c, hw = p
         inside = (x >= c - np.abs(hw)) & (x <= c + np.abs(hw))
-        return np.where(inside, 0.5 * (1.0 + np.cos(np.pi * (x - c) / hw)), 0.0)
+        return np.where(inside, 0.5 * (1.0 + libm_np.cos(np.pi * (x - c) / hw)), 0.0)
     if kind == "arc":
         s, e = p
         r = e - s

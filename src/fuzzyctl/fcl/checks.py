@@ -483,7 +483,8 @@ def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
 def check_model(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
     """The rules every reader applies (:mod:`fuzzyctl.validation`: points, degrees, weights),
     at FCL's own positions; ``strict``: a weight above 1 is an error."""
-    return at_spans(validate(doc, strict=bool(ctx.options.get("strict"))), ctx.file)
+    compat = str(ctx.options.get("compat") or "iec")
+    return at_spans(validate(doc, strict=bool(ctx.options.get("strict")), compat=compat), ctx.file)
 
 
 register_provider("declarations", check_declarations)

@@ -21,21 +21,57 @@ if TYPE_CHECKING:
 
 
 def tune(*args: Any, **kwargs: Any) -> TuneResult:
-    """See :func:`fuzzyctl.tune.api.tune`."""
+    """Tune a function block's parameters against data or a closed loop (docs/tune.md;
+    the options are those of :func:`fuzzyctl.tune.api.tune`).
+
+    ```python
+    >>> import numpy as np, fuzzyctl
+    >>> x = np.linspace(-1, 1, 41)
+    >>> data = {"x": x, "y": x**2}
+    >>> learned = fuzzyctl.learn(data, inputs=["x"], output="y", terms=3)
+    >>> result = fuzzyctl.tune(learned.document, data=data, budget=20, workers=0)
+    >>> result.optimizer, result.after <= result.before
+    ('lsq', True)
+
+    ```
+    """
     from fuzzyctl.tune.api import tune as _tune
 
     return _tune(*args, **kwargs)
 
 
 def learn(*args: Any, **kwargs: Any) -> LearnResult:
-    """See :func:`fuzzyctl.tune.learning.learn`."""
+    """Learn a fuzzy system from a table (docs/tune.md; the options are those of
+    :func:`fuzzyctl.tune.learning.learn`).
+
+    ```python
+    >>> import numpy as np, fuzzyctl
+    >>> x = np.linspace(-1, 1, 41)
+    >>> learned = fuzzyctl.learn({"x": x, "y": 2 * x + 1}, inputs=["x"], output="y", terms=3)
+    >>> learned.rules, learned.scores["training RMSE"] < 1e-6     # a line is fitted exactly
+    (3, True)
+
+    ```
+    """
     from fuzzyctl.tune.learning import learn as _learn
 
     return _learn(*args, **kwargs)
 
 
 def evaluate_dataframe(*args: Any, **kwargs: Any) -> Any:
-    """See :func:`fuzzyctl.tune.frames.evaluate_dataframe`."""
+    """A lazy ``dask.dataframe`` with the controller's outputs appended (docs/tune.md; see
+    :func:`fuzzyctl.tune.frames.evaluate_dataframe`).
+
+    ```python
+    >>> import dask.dataframe as dd, pandas as pd, fuzzyctl
+    >>> frame = pd.DataFrame({"temp": [10.0, 3.0], "pressure": [60.0, 55.0]})
+    >>> scored = fuzzyctl.evaluate_dataframe(dd.from_pandas(frame, npartitions=1),
+    ...                                      fuzzyctl.load("examples/figure7.fcl"))
+    >>> scored.compute(scheduler="sync")["valve"].round(6).tolist()   # as Controller.evaluate
+    [51.851852, 100.0]
+
+    ```
+    """
     from fuzzyctl.tune.frames import evaluate_dataframe as _evaluate
 
     return _evaluate(*args, **kwargs)

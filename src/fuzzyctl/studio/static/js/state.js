@@ -105,7 +105,10 @@ export async function recheck() {
     document.body.dataset.checkedChanges = String(seen);
   } catch (err) {
     if (mine !== seq || again) return;
-    state.report = { ok: false, diagnostics: [{ severity: "error", message: err.message, element: null }], level: null, ranges: (state.report || {}).ranges || {}, curves: (state.report || {}).curves || {} };
+    // a refusal that lists its diagnostics (422 of an invalid model) shows them, else its message
+    const listed = err.payload && Array.isArray(err.payload.diagnostics) && err.payload.diagnostics.length ? err.payload.diagnostics : null;
+    const diagnostics = listed || [{ severity: "error", message: err.message, element: null }];
+    state.report = { ok: false, diagnostics, level: null, ranges: (state.report || {}).ranges || {}, curves: (state.report || {}).curves || {} };
     emit("report", state.report);
   } finally {
     inFlight = false;
