@@ -117,9 +117,9 @@ def test_unary_helpers_match_python_math(lib: ctypes.CDLL) -> None:
     report = {}
     for name, f in UNARY.items():
         x = xs
-        if name in ("fz_sin", "fz_cos", "fz_tan"):  # the reduction is exact below 1e6
-            x = np.concatenate([xs[np.abs(xs) < 1e6], rng.uniform(-1e6, 1e6, 20_000)])
-            x = x[np.isfinite(x)]
+        if name in ("fz_sin", "fz_cos", "fz_tan"):  # both reductions and their seam at 2^19
+            seam = 524288.0 + np.arange(-64, 65) * 0.125
+            x = np.concatenate([xs, rng.uniform(-1e6, 1e6, 20_000), seam, -seam])
         if name in ("fz_floor", "fz_ceil", "fz_rint"):  # math's versions return ints
             x = np.concatenate([x[np.isfinite(x)], rng.integers(-50, 50, 2000) / 4.0])
         got = _call(lib, name, x)
@@ -134,6 +134,19 @@ def test_unary_helpers_match_python_math(lib: ctypes.CDLL) -> None:
     print("\nhelpers, worst relative error:", {k: f"{v:.1e}" for k, v in report.items()})
     bad = {k: v for k, v in report.items() if not v <= TOL}
     assert not bad, bad
+
+
+def test_sin_cos_of_huge_arguments_are_libms(lib: ctypes.CDLL) -> None:
+    """Payne-Hanek beyond 2^19: relative to the value itself (no argument-scale allowance),
+    including the double nearest a multiple of pi/2 (Kahan-McDonald's worst case, whose
+    reduced argument is about 2^-61) and the fuzzer's sin(1e20)."""
+    rng = np.random.default_rng(5)
+    hard = [6381956970095103.0 * 2.0**797, 1e20, 1e22, 4e15, 1.7976931348623157e308, 2.0**53]
+    x = np.concatenate([10.0 ** rng.uniform(5.7, 308, 20_000), hard])
+    x = np.concatenate([x, -x])
+    for name, f in (("fz_sin", math.sin), ("fz_cos", math.cos)):
+        got, want = _call(lib, name, x), _want(f, x)
+        assert _worst(got, want, np.zeros_like(x)) <= 4e-15, name
 
 
 def test_binary_helpers_match_python_math(lib: ctypes.CDLL) -> None:

@@ -198,8 +198,8 @@ def _batch(
     err = _project_error()
     ctl.reset()
     try:
-        got = ctl.evaluate_batch(
-            {n: np.array([r[i] for r in rows], dtype=float) for i, n in enumerate(names)}
+        got = ctl.evaluate_batch(  # rows=: a model without inputs has no column to count
+            {n: np.array([r[i] for r in rows], dtype=float) for i, n in enumerate(names)}, rows=len(rows)
         )
     except err:
         return [[REFUSED] * len(outs) for _ in rows]
@@ -465,7 +465,8 @@ def check(model: Any, block: str | None, rng: random.Random, extra: ExtraPaths, 
     if extra.cli and extra.cli_path is not None:
         cli_path = extra.cli_path
         run("cli-set", lambda: _cli(cli_path, extra.cli_fmt, block, names, rows, outs, data=False))
-        run("cli-data", lambda: _cli(cli_path, extra.cli_fmt, block, names, rows, outs, data=True))
+        if names:  # a CSV cannot carry rows without columns: eval --data refuses it, clearly
+            run("cli-data", lambda: _cli(cli_path, extra.cli_fmt, block, names, rows, outs, data=True))
     c_rules = None
     if extra.c:
         c_run = _run_c_path(model, block, plan, names, rows, outs, want, scales)

@@ -31,6 +31,27 @@ def _h(name: str, needs: tuple[str, ...], uses_exp: bool, code: str) -> Helper:
     return Helper(name, needs, uses_exp, code.strip("\n"))
 
 
+def _two_over_pi_words() -> str:
+    """2/pi's first 1280 bits as 40 C words of 32 bits, from an integer Machin formula (no
+    transcribed constant to get wrong)."""
+    bits = 1500
+    one = 1 << bits
+
+    def arctan_inv(k: int) -> int:
+        total, term, n, sign = 0, one // k, 1, 1
+        while term:
+            total += sign * (term // n)
+            term //= k * k
+            n, sign = n + 2, -sign
+        return total
+
+    pi = 16 * arctan_inv(5) - 4 * arctan_inv(239)
+    frac = (2 * one * one) // pi
+    words = [(frac >> (bits - 32 * (k + 1))) & 0xFFFFFFFF for k in range(40)]
+    rows = [", ".join(f"0x{w:08X}UL" for w in words[i : i + 6]) for i in range(0, 40, 6)]
+    return ",\n    ".join(rows)
+
+
 # The constants are the usual fdlibm splits: ln 2 and pi/2 as sums of a short head (exact
 # when multiplied by a small integer) and a tail, so the argument reductions lose nothing.
 HELPERS: dict[str, Helper] = {
@@ -144,12 +165,70 @@ static double fz_pow(double a, double p)
 }""",
         ),
         _h(
-            "fz_sincos",
+            "fz_rem_pio2_big",
             (),
             False,
             """
-/* sin and cos together: x = n pi/2 + r by a three-part Cody-Waite reduction (exact for
-   |x| < 1e6), Taylor polynomials on |r| <= pi/4 (relative 1e-17), quadrant from n. */
+/* Payne-Hanek reduction for |x| >= 2^19, where Cody-Waite runs out of exact bits: x = M 2^E
+   (M a 53-bit integer); only the bits of 2/pi that reach below 2^2 after scaling matter, so
+   M times 224 of them (from word k0 on) gives x 2/pi mod 4 in fixed point, exactly to 2^-130.
+   Returns the quadrant, *r = x - n pi/2 in [-pi/4, pi/4] (an error of about 1 ulp). */
+static const unsigned long fz_two_over_pi[40] = {
+    FZ_TWO_OVER_PI_WORDS
+};
+static int fz_rem_pio2_big(double x, double *r)
+{
+    unsigned long long limb[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}, cur, carry, mw[2], top = 0, mid = 0, low = 0;
+    double m = x, f, tail;
+    int e = 0, k0, t, s, pos, fbits, q;
+    while (m >= 1.8446744073709552e19) { m *= 5.421010862427522e-20; e += 64; }
+    while (m >= 9007199254740992.0) { m *= 0.5; e += 1; }
+    while (m < 4503599627370496.0) { m *= 2.0; e -= 1; }
+    cur = (unsigned long long)m; /* x = cur 2^e, cur in [2^52, 2^53) */
+    mw[0] = cur & 0xFFFFFFFFULL;
+    mw[1] = cur >> 32;
+    k0 = e >= 2 ? (e - 2) / 32 : 0;
+    for (s = 0; s < 2; s++) { /* limb = cur * (words k0 .. k0+6), little-endian 32-bit limbs */
+        carry = 0;
+        for (t = 0; t < 7; t++) {
+            cur = (unsigned long long)fz_two_over_pi[k0 + 6 - t] * mw[s] + limb[t + s] + carry;
+            limb[t + s] = cur & 0xFFFFFFFFULL;
+            carry = cur >> 32;
+        }
+        limb[7 + s] += carry;
+    }
+    fbits = 32 * (k0 + 7) - e; /* the binary point sits below bit fbits */
+    q = (int)((limb[fbits >> 5] >> (fbits & 31)) & 1U);
+    q |= (int)((limb[(fbits + 1) >> 5] >> ((fbits + 1) & 31)) & 1U) << 1;
+    for (pos = fbits - 1; pos >= fbits - 159; pos--) { /* 159 bits: f >= 2^-62 keeps 97 */
+        unsigned long long bit = (limb[pos >> 5] >> (pos & 31)) & 1U;
+        if (pos >= fbits - 53) {
+            top = 2 * top + bit;
+        } else if (pos >= fbits - 106) {
+            mid = 2 * mid + bit;
+        } else {
+            low = 2 * low + bit;
+        }
+    }
+    tail = (double)mid * 1.232595164407831e-32 + (double)low * 1.3684555315672042e-48;
+    f = (double)top * 1.1102230246251565e-16;
+    if (f >= 0.5) { /* round to the nearest quadrant: f - 1 is exact (Sterbenz) */
+        f -= 1.0;
+        q += 1;
+    }
+    f += tail;
+    *r = f * 1.5707963267948966 + f * 6.123233995736766e-17;
+    return q & 3;
+}""".replace("FZ_TWO_OVER_PI_WORDS", _two_over_pi_words()),
+        ),
+        _h(
+            "fz_sincos",
+            ("fz_rem_pio2_big",),
+            False,
+            """
+/* sin and cos together: x = n pi/2 + r by a four-part Cody-Waite reduction below 2^19 (exact
+   there), by fz_rem_pio2_big above; Taylor polynomials on |r| <= pi/4 (relative 1e-17),
+   quadrant from n.  Accurate to a few ulp over the whole double range, like libm. */
 static void fz_sincos(double x, double *sn, double *cs)
 {
     double r, z, s, c;
@@ -159,15 +238,20 @@ static void fz_sincos(double x, double *sn, double *cs)
         *sn = *cs = x - x;
         return;
     }
-    if (x > 4.0e15 || x < -4.0e15) { /* beyond the reduction: no meaningful phase left */
-        *sn = *cs = NAN;
-        return;
+    if (x >= 524288.0 || x <= -524288.0) {
+        q = fz_rem_pio2_big(x >= 0.0 ? x : -x, &r);
+        if (x < 0.0) { /* sin(-x) = -sin x: reflect the reduced argument and the quadrant */
+            r = -r;
+            q = (4 - q) & 3;
+        }
+        n = q;
+    } else {
+        n = (long long)(x * 6.36619772367581382433e-01 + (x >= 0.0 ? 0.5 : -0.5));
+        r = x - (double)n * 1.57079632673412561417e+00;
+        r = r - (double)n * 6.07710050630396597660e-11;
+        r = r - (double)n * 2.02226624871116645580e-21;
+        r = r - (double)n * 8.47842766036889956997e-32;
     }
-    n = (long long)(x * 6.36619772367581382433e-01 + (x >= 0.0 ? 0.5 : -0.5));
-    r = x - (double)n * 1.57079632673412561417e+00;
-    r = r - (double)n * 6.07710050630396597660e-11;
-    r = r - (double)n * 2.02226624871116645580e-21;
-    r = r - (double)n * 8.47842766036889956997e-32;
     z = r * r;
     s = -1.0 / 121645100408832000.0;
     s = 1.0 / 355687428096000.0 + z * s;

@@ -35,6 +35,7 @@ from fuzzyctl.codegen.pieces import (
     finish,
     interval,
 )
+from fuzzyctl.engine import pwl
 from fuzzyctl.engine.pwl import MAX_TOL, gauss_legendre
 
 
@@ -124,6 +125,8 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     for i, gr in enumerate(groups):
         b.set(ga[i], gr.a)
         b.set(gw[i], gr.w)
+    for g0, g1 in zip(out_g0, out_g1, strict=True):
+        _scale_tiny(g, ga, g0, g1)
 
     tab = {
         "T0": _const(g, "OT0", "INT", out_t0),
@@ -188,6 +191,24 @@ def _work_variables(
     }
     gl = _gl_tables(g, max_groups) if probor else None
     return v, arrays, st, gl
+
+
+def _scale_tiny(g: Gen, ga: Var, g0: int, g1: int) -> None:
+    """``pwl.tiny_degree_scale`` on one output's degrees ``ga[g0..g1]``: the same
+    power-of-two steps as every other path, so subnormal degrees do not underflow the
+    areas and moments (exact scaling)."""
+    if g1 < g0:
+        return
+    b = g.b
+    top = g.let(ga[g0], "TOP")
+    for i in range(g0 + 1, g1 + 1):
+        with b.if_(ga[i].gt(top)):
+            b.set(top, ga[i])
+    low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
+    with b.if_(low), b.for_(g.counter("K"), 1, pwl.TINY_COUNT), b.if_(low):
+        b.set(top, top * pwl.TINY_FACTOR)
+        with b.for_(g.counter("I"), g0, g1) as gi:
+            b.set(ga[gi], ga[gi] * pwl.TINY_FACTOR)
 
 
 def _each_output(

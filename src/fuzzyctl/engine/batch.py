@@ -23,6 +23,7 @@ class BatchEvaluator:
         """Every plan output (plan order) for the input columns ``vals`` (plan input order);
         ``state`` holds the previous outputs (NC) and is updated."""
         self._ctl._state = state
-        out = self._ctl._batch_chunk(list(vals))
+        rows = len(vals[0]) if len(vals) else 1  # a plan without inputs: one evaluation
+        out = self._ctl._batch_chunk(list(vals), rows)
         state[:] = self._ctl._state
         return out

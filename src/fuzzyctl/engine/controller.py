@@ -189,7 +189,13 @@ class Controller:
         return explain_mod.build(self.plan, named, rec)
 
     def evaluate_batch(
-        self, data: Any, *, chunk: int = 16384, on_invalid: str = "raise", out_of_range: str | None = None
+        self,
+        data: Any,
+        *,
+        chunk: int = 16384,
+        on_invalid: str = "raise",
+        out_of_range: str | None = None,
+        rows: int | None = None,
     ) -> dict[str, npt.NDArray[np.float64]]:
         """Evaluate many samples: ``data`` maps input names to equal-length sequences (a dict of
         arrays, a pandas/polars DataFrame, ...).  Returns a dict of float64 arrays.
@@ -197,7 +203,11 @@ class Controller:
         ``on_invalid``: ``"raise"`` (default) refuses a NaN or infinite input with the row;
         ``"nan"`` gives NaN outputs for such rows, skips them (the NC state carries over them
         from the previous valid row) and warns with their count (:class:`InvalidRowsWarning`).
-        ``out_of_range`` as in :meth:`evaluate`; "warn" warns once, with a count per input."""
+        ``out_of_range`` as in :meth:`evaluate`; "warn" warns once, with a count per input.
+
+        ``rows``: the number of rows when no column gives it (a model without inputs, or every
+        input left to its default): by default a DataFrame's length, else one row (what
+        :meth:`evaluate` gives); with columns it must equal their length."""
         import numpy as np
 
         if on_invalid not in ("raise", "nan"):
@@ -228,7 +238,7 @@ class Controller:
             arrays.append(arr)
         mode = self.out_of_range if out_of_range is None else check_mode(out_of_range)
         arrays = check_columns(self.input_ranges, tuple(self.inputs), arrays, mode)
-        n = n or 0
+        n = _row_count(data, n, rows)
         full = [
             a if a is not None else np.full(n, float(self.plan.inputs[i].default or 0.0))
             for i, a in enumerate(arrays)
@@ -254,17 +264,17 @@ class Controller:
         result = {o.name: np.empty(n) for o in self.plan.outputs}
         for start in range(0, n, chunk):
             part = [a[start : start + chunk] for a in full]
-            out = self._batch_chunk(part)
+            out = self._batch_chunk(part, min(chunk, n - start))
             for o, arr in zip(self.plan.outputs, out, strict=True):
                 result[o.name][start : start + chunk] = arr
         return {k: v for k, v in result.items() if k in self.outputs}
 
-    def _batch_chunk(self, part: list[npt.NDArray[np.float64]]) -> list[npt.NDArray[np.float64]]:
+    def _batch_chunk(self, part: list[npt.NDArray[np.float64]], m: int) -> list[npt.NDArray[np.float64]]:
+        """``m`` rows (the count is given: a model without inputs has no column to tell it)."""
         import numpy as np
 
-        m = len(part[0]) if part else 0
         if self._jfl is not None:
-            got: list[npt.NDArray[np.float64]] = self._jfl.run(part, self._state, m or 1)
+            got: list[npt.NDArray[np.float64]] = self._jfl.run(part, self._state, m)
             return got
         batch = self._batch
         if batch is not None:
@@ -328,6 +338,23 @@ def _number(name: str, raw: Any) -> float:
     if not -_INF < v < _INF:
         raise InputError(f"input {name!r} must be a finite number, got {v}")
     return v
+
+
+def _row_count(data: Any, n: int | None, rows: int | None) -> int:
+    """The batch's rows: the columns' length, else ``rows``, else a DataFrame's length, else 1
+    (a batch of a model without inputs is one evaluation per row, like ``evaluate({})``)."""
+    if rows is not None and (isinstance(rows, bool) or not isinstance(rows, int) or rows < 0):
+        raise InputError(f"rows must be a non-negative integer, not {rows!r}")
+    if n is not None:
+        if rows is not None and rows != n:
+            raise InputError(f"rows={rows} but the input columns have {n} values")
+        return n
+    if rows is not None:
+        return rows
+    shape = getattr(data, "shape", None)
+    if not isinstance(data, Mapping) and isinstance(shape, tuple) and shape:
+        return int(shape[0])
+    return 1
 
 
 def _columns(data: Any) -> dict[str, Any]:

@@ -194,6 +194,8 @@ class FastBuilder(RuleBuilder):
             g.b.add(Kernel("HOLD", (out,), (out, ex(True)), (oi, 0.0, False, None)))
             values[oi] = out
             return
+        if op.kind == "mamdani":  # singleton outputs scale in RuleBuilder.singleton
+            contribs = self.scale_tiny(contribs)
         if op.kind == "singleton":
             value, fired = self.singleton(op, contribs)
         elif op.kind == "ts":

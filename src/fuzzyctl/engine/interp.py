@@ -255,6 +255,9 @@ class Interpreter:
             return OutputRecord(v, True)
         if op.kind == "ts":
             return self._ts(op, contribs, values, outs)
+        scale = pwl.tiny_degree_scale(max((a for _t, a, _w, _act in contribs), default=0.0))
+        if scale != 1.0:  # subnormal degrees: one exact rescaling, every path alike
+            contribs = [(t, a * scale, w, act) for t, a, w, act in contribs]
         if op.kind == "singleton":
             return self._singleton(op, contribs, values)
         if op.exact:

@@ -23,7 +23,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 
 from fuzzyctl.engine import irterms as T
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine import pwl, shapes
 from fuzzyctl.engine.ir import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.engine.irgen import Gen
 from fuzzyctl.engine.lower_terms import uses_x
@@ -308,8 +308,27 @@ class RuleBuilder:
                 T.accumulate_into(g, op.accu or "MAX", v, T.mul(w, a))
         return v, ex(True)
 
+    def scale_tiny(self, contribs: list[Contrib]) -> list[Contrib]:
+        """``pwl.tiny_degree_scale`` in the program: the same power-of-two steps on the
+        largest degree, applied to every degree of the output (exact)."""
+        if not contribs:
+            return contribs
+        g = self.g
+        hs = [g.let(a, "H") for _t, a, _w, _act in contribs]
+        top = g.let(hs[0], "TOP")
+        for h in hs[1:]:
+            with g.b.if_(h.gt(top)):
+                g.b.set(top, h)
+        low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
+        with g.b.if_(low), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
+            g.b.set(top, top * pwl.TINY_FACTOR)
+            for h in hs:
+                g.b.set(h, h * pwl.TINY_FACTOR)
+        return [(t, h, w, act) for (t, _a, w, act), h in zip(contribs, hs, strict=True)]
+
     def singleton(self, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         g = self.g
+        contribs = self.scale_tiny(contribs)
         b = g.b
         accu = op.accu or "MAX"
         sx = self.new_params(f"{op.name}_S", "OS", f"{op.name}: singleton positions")

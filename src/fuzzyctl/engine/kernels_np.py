@@ -168,6 +168,7 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         ]
         if op.kind == "ts":
             return _ts(op, contribs, vals, outs, n)
+        contribs = _scale_tiny(contribs, n)
         if op.exact and op.grid is not None and not (op.accu == "PROBOR" and op.method == "COA"):
             groups = [(t or 0, a, w, act == "MIN") for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
@@ -176,6 +177,21 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         return smooth_output(plan, op, [(t or 0, a, w, act) for t, a, w, act in contribs], vals, outs, n)
 
     return f
+
+
+def _scale_tiny(
+    contribs: list[tuple[int | None, Arr, Any, str]], n: int
+) -> list[tuple[int | None, Arr, Any, str]]:
+    """``pwl.tiny_degree_scale`` row by row (the same power-of-two steps, exact)."""
+    if not contribs:
+        return contribs
+    top = np.max(np.stack([np.broadcast_to(a, (n,)) for _t, a, _w, _act in contribs]), axis=0)
+    scale = np.ones(n)
+    for _ in range(pwl.TINY_COUNT):
+        step = np.where((top > 0.0) & (top < pwl.TINY_BELOW), pwl.TINY_FACTOR, 1.0)
+        top = top * step
+        scale = scale * step
+    return [(t, a * scale, w, act) for t, a, w, act in contribs]
 
 
 def _ts(
