@@ -23,7 +23,12 @@ IN_TERMS = {"a": (0.0, 1.0, 4.0, 6.0), "b": (2.0, 3.5, 5.0, 8.0), "c": (5.0, 8.0
 OUT_TERMS = {"o0": (0.5, 2.0, 5.5, 7.0), "o1": (1.0, 3.0, 6.0, 9.0), "o2": (4.0, 7.0, 7.0, 9.5)}
 # a partial set first, then two sets at exactly 1 on [3, 5.5]: the order that broke
 RULES = [("a", "o2", 0.4), ("a", "o0", None), ("b", "o1", None), ("c", "o1", 0.7), ("b", "o0", 0.9)]
-PAIRS = [("HAMACHER", "HAMACHER"), ("EINSTEIN", "EINSTEIN"), ("HAMACHER", "EINSTEIN"), ("EINSTEIN", "HAMACHER")]
+PAIRS = [
+    ("HAMACHER", "HAMACHER"),
+    ("EINSTEIN", "EINSTEIN"),
+    ("HAMACHER", "EINSTEIN"),
+    ("EINSTEIN", "HAMACHER"),
+]
 # both plateaus (degrees exactly 1), just below 1, partial, and one term alone
 XS = [3.7, 4.5, 4.0 - 1e-12, 3.5 + 1e-13, 2.7, 5.5, 7.3, 0.3, 9.5]
 
@@ -45,7 +50,8 @@ def system() -> m.FunctionBlock:
         m.RuleBlock(
             f"b{k}",
             tuple(
-                m.Rule(f"{i + 1}", m.Is("x", t), (m.Conclusion(o, ot, w),)) for i, (t, ot, w) in enumerate(RULES)
+                m.Rule(f"{i + 1}", m.Is("x", t), (m.Conclusion(o, ot, w),))
+                for i, (t, ot, w) in enumerate(RULES)
             ),
             "MIN",
             "MAX",
@@ -53,7 +59,9 @@ def system() -> m.FunctionBlock:
         )
         for k, (o, (act, _accu)) in enumerate(zip(outs, PAIRS, strict=True))
     )
-    return m.FunctionBlock("rational", variables=variables, fuzzify=fuzzify, defuzzify=defuzz, rule_blocks=blocks)
+    return m.FunctionBlock(
+        "rational", variables=variables, fuzzify=fuzzify, defuzzify=defuzz, rule_blocks=blocks
+    )
 
 
 def _mu(p: tuple[float, ...], x: Fraction) -> Fraction:
