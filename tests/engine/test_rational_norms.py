@@ -101,7 +101,7 @@ def exact_cog(x: float, act: str, accu: str) -> float:
     opts = {"points": points, "limit": 500, "epsabs": 1e-14, "epsrel": 1e-13}
     area = quad(f, LO, HI, **opts)[0]
     moment = quad(lambda u: u * f(u), LO, HI, **opts)[0]
-    return moment / area
+    return float(moment / area)
 
 
 def test_rational_norms_agree_on_every_path_with_an_exact_integration(tmp_path: Path) -> None:
