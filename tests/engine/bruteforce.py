@@ -35,9 +35,8 @@ def _ham_t(a: Arr, b: Arr) -> Arr:
 
 
 def _ham_s(a: Arr, b: Arr) -> Arr:
-    d = 1.0 - a * b
-    with np.errstate(all="ignore"):
-        return np.where(d == 0.0, 1.0, (a + b - 2.0 * a * b) / np.where(d == 0.0, 1.0, d))
+    # 1 - T(1-a, 1-b): (a+b-2ab)/(1-ab) cancels catastrophically as a, b -> 1
+    return 1.0 - _ham_t(1.0 - a, 1.0 - b)
 
 
 TNORM: dict[str, Fn] = {

@@ -22,7 +22,9 @@ from fuzzyctl.engine.shapes import power_of
 # The two helpers the Hamacher templates call, as templates themselves (operators._ham_t/_s).
 _HELPERS = {
     "_ham_t": "(({a} * {b}) / ({a} + {b} - {a} * {b}) if {a} + {b} - {a} * {b} != 0.0 else 0.0)",
-    "_ham_s": "(({a} + {b} - 2.0 * {a} * {b}) / (1.0 - {a} * {b}) if {a} * {b} != 1.0 else 1.0)",
+    # 1 - T(1-a, 1-b), the stable form of (a+b-2ab)/(1-ab) (see operators._ham_s)
+    "_ham_s": "(1.0 - ((1.0 - {a}) * (1.0 - {b})) / ((1.0 - {a}) + (1.0 - {b}) - (1.0 - {a}) * (1.0 - {b}))"
+    " if (1.0 - {a}) + (1.0 - {b}) - (1.0 - {a}) * (1.0 - {b}) != 0.0 else 1.0)",
 }
 _BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}
 _CMPOPS = {ast.Lt: "<", ast.Gt: ">", ast.LtE: "<=", ast.GtE: ">=", ast.Eq: "=", ast.NotEq: "<>"}

@@ -50,7 +50,11 @@ def _ham_t(a: float, b: float) -> float:
 
 
 def _ham_s(a: float, b: float) -> float:
-    return (a + b - 2.0 * a * b) / (1.0 - a * b) if a * b != 1.0 else 1.0
+    # the dual of _ham_t, 1 - T(1-a, 1-b): the textbook (a+b-2ab)/(1-ab) cancels
+    # catastrophically as a, b -> 1 (0.9999999999999999 with 1.0 gave 2.27, off [0, 1])
+    p, q = 1.0 - a, 1.0 - b
+    s = p + q - p * q
+    return 1.0 - p * q / s if s != 0.0 else 1.0
 
 
 def _ham_t_np(a: Any, b: Any) -> Any:
@@ -60,9 +64,7 @@ def _ham_t_np(a: Any, b: Any) -> Any:
 
 
 def _ham_s_np(a: Any, b: Any) -> Any:
-    d = 1.0 - a * b
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(d != 0.0, (a + b - 2.0 * a * b) / np.where(d != 0.0, d, 1.0), 1.0)
+    return 1.0 - _ham_t_np(1.0 - a, 1.0 - b)
 
 
 TNORMS: dict[str, Norm] = {
