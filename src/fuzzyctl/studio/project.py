@@ -1,5 +1,6 @@
 """Projects on disk: the project directory the studio may touch, FCL files saved
-atomically, and the studio's own settings kept in an OPTIONS block of the FCL file.
+atomically, and the reading of the studio settings older versions kept in an OPTIONS block
+of the FCL file (new settings live in a sidecar: studio/viewsettings.py).
 
 Every path the browser sends is relative to the project directory and is refused when it
 leaves it (``..``, an absolute path, a symbolic link pointing outside, a NUL byte).
@@ -18,11 +19,11 @@ from typing import Any
 
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.files import write_atomic
-from fuzzyctl.model import Document, FunctionBlock, OptionsBlock
+from fuzzyctl.model import Document
 
 STUDIO_KEYWORD = "STUDIO"
-"""An OPTIONS block whose text is ``STUDIO {json}`` holds the studio's view settings
-(curve selection, test signals, display ranges, 3D axes); the knowledge base never sees it."""
+"""An OPTIONS block whose text is ``STUDIO {json}`` held the studio's view settings in files
+saved by older versions; they are read (``split_settings``) and moved to the sidecar on Save."""
 
 _STUDIO_LINE = re.compile(r"^\s*STUDIO\s+(\{.*\})\s*;?\s*$", re.DOTALL)
 NAME_MAX = 255
@@ -168,18 +169,3 @@ def split_settings(document: Document) -> tuple[Document, dict[str, Any]]:
                     settings = value
         blocks.append(replace(fb, options=tuple(kept)))
     return replace(document, blocks=tuple(blocks)), settings
-
-
-def with_settings(document: Document, settings: dict[str, Any] | None) -> Document:
-    """The document with ``settings`` in an OPTIONS block of its first function block
-    (replacing an older one); no block when there are no settings."""
-    bare, _old = split_settings(document)
-    if not settings:
-        return bare
-    encoded = json.dumps(settings, separators=(",", ":"), sort_keys=True, ensure_ascii=True)
-    if re.search(r"END_OPTIONS?|\(\*|\*\)", encoded, re.IGNORECASE):
-        raise FuzzyctlError("studio settings may not contain END_OPTIONS or comment brackets")
-    text = f"\n        {STUDIO_KEYWORD} {encoded};\n    "
-    first: FunctionBlock = bare.blocks[0]
-    first = replace(first, options=(*first.options, OptionsBlock(text)))
-    return replace(bare, blocks=(first, *bare.blocks[1:]))
