@@ -82,27 +82,24 @@ class Grid:
     notes: list[str] = field(default_factory=list)
 
 
-def leaves(c: CondPlan) -> Iterator[CondPlan]:
+def _nodes(c: CondPlan) -> Iterator[CondPlan]:
+    """Every node of a condition, without recursion (conditions may nest deeply)."""
     stack = [c]
     while stack:
         node = stack.pop()
+        yield node
         if isinstance(node, CNot):
             stack.append(node.operand)
         elif isinstance(node, CAnd | COr):
             stack.extend(node.operands)
-        else:
-            yield node
+
+
+def leaves(c: CondPlan) -> Iterator[CondPlan]:
+    return (node for node in _nodes(c) if not isinstance(node, CNot | CAnd | COr))
 
 
 def _ops(c: CondPlan) -> Iterator[str]:
-    stack = [c]
-    while stack:
-        node = stack.pop()
-        if isinstance(node, CNot):
-            stack.append(node.operand)
-        elif isinstance(node, CAnd | COr):
-            yield node.op
-            stack.extend(node.operands)
+    return (node.op for node in _nodes(c) if isinstance(node, CAnd | COr))
 
 
 def levels(ctx: Context, epsilon: float) -> list[float]:
