@@ -11,8 +11,8 @@ from pathlib import Path
 from fuzzyctl.blocks.schneider import XfuzFB
 from fuzzyctl.blocks.siemens import FuzzyFB
 from fuzzyctl.blocks.task import CyclicTask
-from fuzzyctl.formats.fpl import read_fpl
-from fuzzyctl.formats.xfuz import read_tables
+from fuzzyctl.formats.fpl.reader import read_fpl
+from fuzzyctl.formats.xfuz.reader import read_tables
 
 EXAMPLES = Path(__file__).resolve().parent.parent / "examples"
 

@@ -394,7 +394,7 @@ def _fll_more(shape: str, size: int) -> str:
 def _json_doc() -> dict[str, object]:
     sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "src"))
     import fuzzyctl
-    from fuzzyctl.formats import json as fj
+    from fuzzyctl.formats.json import writer as fj
 
     return fj.to_dict(fuzzyctl.load(FCL_HEAD + "RULE 1 : IF a IS lo THEN y IS lo;\n" + FCL_TAIL))
 

@@ -1,9 +1,10 @@
 """Limits on what fuzzyctl reads, so that no input can take unbounded time or memory.
 
-* :func:`max_input_bytes` - the largest model file read, per format
-  (:data:`FORMAT_MAX_INPUT_BYTES`): 1.5 MiB of FCL or FLL (the 10,000-rule 8-input system
-  is 1.31 / 1.19 MiB), 512 KiB of FIS, 1 MiB of FPL and of XFUZ, 96 MiB of JSON (which
-  spells out every span: that 10,000-rule system is 43.5 MB of JSON).
+* :func:`max_input_bytes` - the largest model file read, per format (each format's
+  ``max_bytes`` in the registry, :mod:`fuzzyctl.formats`): 1.5 MiB of FCL or FLL (the
+  10,000-rule 8-input system is 1.31 / 1.19 MiB), 512 KiB of FIS, 1 MiB of FPL and of
+  XFUZ, 96 MiB of JSON (which spells out every span: that 10,000-rule system is 43.5 MB of
+  JSON).
   ``FUZZYCTL_MAX_INPUT_BYTES`` sets one limit for every format.  A larger file is refused
   before it is read, with a diagnostic saying the size and the limit; reading time is
   linear in the size below it.
@@ -53,27 +54,7 @@ from fuzzyctl.model import (
 
 MiB = 1024 * 1024
 DEFAULT_MAX_INPUT_BYTES = 8 * MiB
-#: Each format's limit: every shape of file at the limit is read (accepted or refused) well
-#: within the 5 s of issue 14 (benchmarks/large_inputs.py; docs/limits.md has the figures).
-FORMAT_MAX_INPUT_BYTES = {
-    # the 10,000-rule 8-input system is 1.31 MiB; the largest real FCL file we know 290 KB
-    "fcl": MiB * 3 // 2,
-    # JSON spells out every span (that 10,000-rule system is 43.5 MB) and is read by C
-    "json": 12 * DEFAULT_MAX_INPUT_BYTES,
-    # FLL's terse lines make the most model per byte (a Function term or a nested rule costs
-    # three times what an FCL rule of that length does); the 10,000-rule system is 1.19 MiB,
-    # the largest real FLL file 14 KB
-    "fll": MiB * 3 // 2,
-    # FIS rules are dense (8 bytes each): 512 KiB is 65,000 rules (a 10,000-rule 4-input
-    # FIS file is 191 KB, the largest real one 179 KB)
-    "fis": MiB // 2,
-    # the largest project S7 Fuzzy Control allows (8 inputs of 7 terms, 4 outputs of 9, 200
-    # rules; Siemens manual 1.3) is a 77 KB FPL file, 346 KB with 56 conditions a rule
-    "fpl": MiB,
-    # an XFUZ block's tables are fixed in size (ESV 62, FA 576, RG 384 words): the examples
-    # are 4 KB
-    "xfuz": MiB,
-}
+
 MAX_NESTING = 100
 MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
 MAX_DIGITS = 400
@@ -113,7 +94,12 @@ def max_input_bytes(format: str | None = None) -> int:
         limit = 0
     if limit > 0:
         return limit
-    return FORMAT_MAX_INPUT_BYTES.get((format or "").lower(), DEFAULT_MAX_INPUT_BYTES)
+    if not format:
+        return DEFAULT_MAX_INPUT_BYTES
+    from fuzzyctl import formats  # the registry holds each format's limit
+
+    fmt = formats.find(format)
+    return DEFAULT_MAX_INPUT_BYTES if fmt is None else fmt.max_bytes
 
 
 def _mib(n: int) -> str:

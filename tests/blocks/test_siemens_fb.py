@@ -9,7 +9,7 @@ import pytest
 from fuzzyctl.blocks.siemens import FuzzyFB, Info, fuzzy_ai, fuzzy_ao
 from fuzzyctl.diagnostics import DiagnosticError, InputError
 from fuzzyctl.fcl import parse_fcl
-from fuzzyctl.formats.fpl import read_fpl
+from fuzzyctl.formats.fpl.reader import read_fpl
 from tests.conftest import EXAMPLES
 
 

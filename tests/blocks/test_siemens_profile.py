@@ -8,7 +8,7 @@ from dataclasses import replace
 from fuzzyctl.blocks.siemens import LIMITS, check_siemens
 from fuzzyctl.blocks.siemens.profile import input_shape
 from fuzzyctl.diagnostics import Severity
-from fuzzyctl.formats.fpl import read_fpl
+from fuzzyctl.formats.fpl.reader import read_fpl
 from fuzzyctl.model import (
     And,
     Conclusion,

@@ -12,7 +12,7 @@ import pytest
 from fuzzyctl.blocks.schneider import XfuzConstants, XfuzFB
 from fuzzyctl.blocks.siemens import FuzzyFB, fuzzy_ai, fuzzy_ao
 from fuzzyctl.blocks.task import CycleContext, CyclicTask, SimulatedClock
-from fuzzyctl.formats.fpl import read_fpl
+from fuzzyctl.formats.fpl.reader import read_fpl
 from tests.blocks.manual_3_3 import ESV, FA, RG, words
 from tests.conftest import EXAMPLES
 

@@ -10,7 +10,7 @@ import pytest
 
 from fuzzyctl.blocks.schneider import XfuzConstants, XfuzFB
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.formats.xfuz_tables import encode_name
+from fuzzyctl.formats.xfuz.tables import encode_name
 from tests.blocks.manual_3_3 import ESV, FA, RG, words
 
 ESV_DISCR6 = {**ESV, 24: 6}  # Ouverture 0..10 with Discr 6: 10 >= 2 * (6 - 1)

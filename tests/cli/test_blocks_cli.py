@@ -11,7 +11,7 @@ import pytest
 
 from fuzzyctl import formats, load
 from fuzzyctl.cli.app import main
-from fuzzyctl.formats.xfuz import read_tables
+from fuzzyctl.formats.xfuz.reader import read_tables
 from tests.conftest import EXAMPLES
 
 

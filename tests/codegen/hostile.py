@@ -241,7 +241,7 @@ def fill(template: str, field: str | None, text: str) -> str:
 def json_model(fcl_document: Any, field: str | None, text: str) -> str:
     """The fuzzyctl JSON of the FCL template with ``field`` replaced in every string value
     (JSON carries names, labels and comments as free strings: no reader grammar in the way)."""
-    from fuzzyctl.formats import json as fj
+    from fuzzyctl.formats.json import writer as fj
 
     def walk(value: Any) -> Any:
         if isinstance(value, str):

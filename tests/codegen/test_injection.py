@@ -23,7 +23,7 @@ from typing import Any
 import pytest
 
 import fuzzyctl
-import fuzzyctl.formats.json  # used as fuzzyctl.formats.json (the registry imports it lazily)
+import fuzzyctl.formats.json.writer  # used as fuzzyctl.formats.json.writer (the registry imports it lazily)
 from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError, generate_c, generate_st, lower_block
 from fuzzyctl.codegen.native import NativeController
@@ -200,7 +200,8 @@ def test_evaluator_renderers_refuse_a_name_that_is_not_an_identifier(target: str
 
 def _labelled(labels: list[str]) -> Document:
     """The tank example with hostile rule labels, rule-block and term names (JSON: free text)."""
-    data = fuzzyctl.formats.json.to_dict(fuzzyctl.load(Path(__file__).parents[2] / "examples" / "tank.fcl"))
+    tank = fuzzyctl.load(Path(__file__).parents[2] / "examples" / "tank.fcl")
+    data = fuzzyctl.formats.json.writer.to_dict(tank)
     block = data["blocks"][0]
     rules = block["rule_blocks"][0]["rules"]
     for k, label in enumerate(labels):
@@ -238,7 +239,7 @@ def test_native_backend_on_every_hostile_label(private_cache: Path) -> None:
 
 def test_cli_codegen_on_a_hostile_model(private_cache: Path, capsys: pytest.CaptureFixture[str]) -> None:
     src = private_cache / "evil.json"
-    src.write_text(json.dumps(fuzzyctl.formats.json.to_dict(_labelled([H.HOSTILE["issue-14"]]))))
+    src.write_text(json.dumps(fuzzyctl.formats.json.writer.to_dict(_labelled([H.HOSTILE["issue-14"]]))))
     assert main(["codegen", str(src), "--lang", "c", "-o", str(private_cache / "gen")]) == 0
     c_file = (private_cache / "gen" / "tank.c").read_text()
     assert list(H.c_tokens(c_file)) == list(

@@ -114,11 +114,11 @@ def test_fuzzylite_agrees_on_our_exports(path: Path, tmp_path: Path) -> None:
     tol = _tolerances(fb)
     compared = 0
     for fmt in ("fll", "fis"):
-        lowered, losses = get(fmt).lower(document)
+        adapted, losses = get(fmt).adapt(document)
         if losses or (fmt == "fis" and "hybrid" in path.parts):
             continue
         export = tmp_path / f"ours.{fmt}"
-        export.write_text(get(fmt).write(lowered))
+        export.write_text(get(fmt).write(adapted))
         ours = _evaluate(export, fmt, inputs, names, tmp_path)
         assert ours is not None, f"fuzzylite cannot read our {fmt} export of {path.name}"
         both_nan = np.isnan(reference) & np.isnan(ours)
@@ -206,13 +206,13 @@ def test_our_engine_agrees_with_fuzzylite_on_our_exports(
     label = "engine vs fuzzylite CLI, outputs"
     outputs = [o for o in controller.plan.outputs if o.is_output]
     for fmt in ("fll", "fis"):
-        lowered, losses = get(fmt).lower(document)
+        adapted, losses = get(fmt).adapt(document)
         if losses:
             for _ in outputs:
                 record_property("roundtrip", f"{label} ({fmt})\tnot expressible\t")
             continue
-        reason = _unreadable_by_fuzzylite6(lowered.main, fmt)
-        text = get(fmt).write(lowered)
+        reason = _unreadable_by_fuzzylite6(adapted.main, fmt)
+        text = get(fmt).write(adapted)
         export = tmp_path / f"ours.{fmt}"
         export.write_text(text)
         theirs = _evaluate(export, fmt, inputs, names, tmp_path)

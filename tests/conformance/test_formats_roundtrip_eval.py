@@ -133,12 +133,12 @@ def test_round_trip_keeps_evaluation(path: str, source: Path, record_property: p
     documents = [original]
     for target in targets:
         fmt = get(target)
-        lowered, losses = fmt.lower(documents[-1])
+        adapted, losses = fmt.adapt(documents[-1])
         if losses:
             reasons = {re.sub(r"'[^']*'|\b\d+(\.\d+)?\b", "…", loss.reason) for loss in losses}
             report(f"not expressible in {target}", "\x1f".join(sorted(reasons)))
             return
-        documents.append(fmt.read(fmt.write(lowered), None).document)
+        documents.append(fmt.read(fmt.write(adapted), None).document)
     try:
         first = fuzzyctl.compile(original)
     except (DiagnosticError, FuzzyctlError) as exc:

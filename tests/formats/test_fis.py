@@ -12,8 +12,9 @@ import pytest
 import fuzzyctl
 from fuzzyctl import formats
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import fis, get
-from fuzzyctl.formats._common import unique_name
+from fuzzyctl.formats import get
+from fuzzyctl.formats.common.basics import unique_name
+from fuzzyctl.formats.fis import reader as fis
 from fuzzyctl.model import And, Conclusion, Is, Or, PointsMF, ShapeMF
 from tests.conftest import DATA, EXAMPLES
 
@@ -214,14 +215,14 @@ def test_an_expression_nested_a_million_deep_is_refused_with_its_place() -> None
 def test_written_fis_reads_back_equal() -> None:
     original = doc("1 -2, 2 (0.5) : 1\n0 1, 1 (1) : 2\n1.2 2, 1 (1) : 1\n").document
     fmt = get("fis")
-    lowered, losses = fmt.lower(original)
+    adapted, losses = fmt.adapt(original)
     assert losses == []
-    again = fis.read(fmt.write(lowered)).document
+    again = fis.read(fmt.write(adapted)).document
     assert again.main == original.main
 
 
 def test_points_become_trimf_or_discretemf() -> None:
-    from fuzzyctl.formats.fis_write import _mf_text
+    from fuzzyctl.formats.fis.writer import _mf_text
     from fuzzyctl.model import Point, Term
 
     tri = Term("t", PointsMF((Point(0.0, 0.0), Point(1.0, 1.0), Point(3.0, 0.0))))

@@ -9,7 +9,8 @@ import pytest
 import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import convert, fll, get, read_text
+from fuzzyctl.formats import convert, get, read_text
+from fuzzyctl.formats.fll import reader as fll
 from fuzzyctl.model import And, Is, Or, PointsMF, ShapeMF
 
 SYSTEM = """Engine: demo
@@ -131,11 +132,11 @@ def test_errors_point_at_line() -> None:
 def test_written_fll_reads_back_equal_and_undoes_running_hedges() -> None:
     original = read().document
     fmt = get("fll")
-    lowered, losses = fmt.lower(original)
+    adapted, losses = fmt.adapt(original)
     assert losses == []
-    text = fmt.write(lowered)
+    text = fmt.write(adapted)
     assert "then y is very big and z is seldom l" in text
-    assert fll.read(text).document.main == lowered.main
+    assert fll.read(text).document.main == adapted.main
 
 
 def test_names_that_are_fll_hedges_or_keywords_are_renamed() -> None:

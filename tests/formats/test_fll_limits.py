@@ -7,8 +7,9 @@ from __future__ import annotations
 import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import fll, read_text
-from fuzzyctl.formats._expr import ExprError, parse_expr
+from fuzzyctl.formats import read_text
+from fuzzyctl.formats.common.expr import ExprError, parse_expr
+from fuzzyctl.formats.fll import reader as fll
 from fuzzyctl.limits import MAX_NESTING
 from fuzzyctl.model import And, Call, Is, Name, Num, Or
 

@@ -12,8 +12,8 @@ import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, Severity
 from fuzzyctl.formats import convert, read_text
-from fuzzyctl.formats.fpl import parse_fpl, read_fpl
-from fuzzyctl.formats.fpl_write import check_fpl, write_fpl
+from fuzzyctl.formats.fpl.reader import parse_fpl, read_fpl
+from fuzzyctl.formats.fpl.writer import check_fpl, write_fpl
 from fuzzyctl.model import (
     And,
     Conclusion,

@@ -12,9 +12,10 @@ from pathlib import Path
 import pytest
 
 from fuzzyctl.diagnostics import Diagnostic
-from fuzzyctl.formats import fpl_parse
-from fuzzyctl.formats.fpl import leaves, parse_fpl, read_fpl
-from fuzzyctl.formats.fpl_parse import MAX_UNEXPECTED
+from fuzzyctl.formats.fpl import parse as fpl_parse
+from fuzzyctl.formats.fpl.names import leaves
+from fuzzyctl.formats.fpl.parse import MAX_UNEXPECTED
+from fuzzyctl.formats.fpl.reader import parse_fpl, read_fpl
 from fuzzyctl.limits import max_input_bytes
 from fuzzyctl.model import And, Document, Span
 

@@ -9,12 +9,12 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import json as fj
+from fuzzyctl.formats.json import names, reader, writer
 from fuzzyctl.model import Document, FunctionBlock
 
 from .strategies import documents
 
-VALIDATOR = jsonschema.Draft202012Validator(fj.schema())
+VALIDATOR = jsonschema.Draft202012Validator(names.schema())
 
 
 def _same_everywhere(a: object, b: object) -> bool:
@@ -38,22 +38,22 @@ def _same_everywhere(a: object, b: object) -> bool:
 
 
 def test_schema_is_a_valid_schema() -> None:
-    jsonschema.Draft202012Validator.check_schema(fj.schema())
+    jsonschema.Draft202012Validator.check_schema(names.schema())
 
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(documents)
 def test_any_model_round_trips_and_validates(document: Document) -> None:
-    text = fj.dumps(document)
+    text = writer.dumps(document)
     data = json.loads(text)
     VALIDATOR.validate(data)
-    back = fj.read(text).document
+    back = reader.read(text).document
     assert back == document
     assert _same_everywhere(back, document)
 
 
 def test_layout_is_the_documented_one() -> None:
-    data = fj.to_dict(Document((FunctionBlock("fb"),)))
+    data = writer.to_dict(Document((FunctionBlock("fb"),)))
     assert data == {
         "format": "fuzzyctl-model",
         "version": 1,
@@ -70,9 +70,9 @@ def test_errors_name_the_json_path() -> None:
         "blocks": [{"name": "x", "variables": [{"name": "v", "kind": "IN"}]}],
     }
     with pytest.raises(DiagnosticError, match=r"\$\.blocks\[0\]\.variables\[0\]\.kind"):
-        fj.read(json.dumps(bad))
+        reader.read(json.dumps(bad))
     with pytest.raises(DiagnosticError) as err:
-        fj.read('{"format": "fuzzyctl-model",\n "version": }')
+        reader.read('{"format": "fuzzyctl-model",\n "version": }')
     assert err.value.diagnostics[0].span is not None and err.value.diagnostics[0].span.line == 2
     with pytest.raises(DiagnosticError, match="version"):
-        fj.read('{"format": "fuzzyctl-model", "version": 99, "blocks": []}')
+        reader.read('{"format": "fuzzyctl-model", "version": 99, "blocks": []}')

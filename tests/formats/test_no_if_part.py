@@ -17,8 +17,8 @@ from fuzzyctl.blocks.siemens import FuzzyFB
 from fuzzyctl.fcl import conformance, load_text
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source
-from fuzzyctl.formats.fpl import read_fpl
-from fuzzyctl.formats.xfuz_write import constants_from_model, lower_xfuz
+from fuzzyctl.formats.fpl.reader import read_fpl
+from fuzzyctl.formats.xfuz.writer import adapt_xfuz, constants_from_model
 from fuzzyctl.model import Degree, Document
 from tests.conftest import EXAMPLES
 
@@ -128,14 +128,14 @@ def test_generated_c_computes_the_rule_without_if_part(
 
 def test_xfuz_tables_hold_it_as_an_always_true_predicate() -> None:
     doc = biased()
-    lowered, _losses = lower_xfuz(doc)
-    constants, diags = constants_from_model(lowered)
+    adapted, _losses = adapt_xfuz(doc)
+    constants, diags = constants_from_model(adapted)
     assert not [d for d in diags if d.is_error]
     (note,) = formats.get("xfuz").notes(doc)
     assert "INPi IS ALWAYS" in note.reason
     block = XfuzFB(constants)
     block.MAN_AUTO, block.START = 1, 1
-    names = [r.label for r in lowered.main.rule_blocks[0].rules]
+    names = [r.label for r in adapted.main.rule_blocks[0].rules]
     k = names.index("bias")
     for temp in (0, 9, 30, -32768, 32767):  # 1 for every input word
         block["INP1"], block["INP2"] = temp, 65

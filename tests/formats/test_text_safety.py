@@ -37,7 +37,7 @@ from fuzzyctl.escape import fcl_comment, fcl_options, json_text, one_line, visib
 from fuzzyctl.fcl import load_text, write
 from fuzzyctl.fcl.parser import parse_source
 from fuzzyctl.fcl.source import Source
-from fuzzyctl.formats.json import dumps as json_dumps
+from fuzzyctl.formats.json.writer import dumps as json_dumps
 from fuzzyctl.model import Document, FunctionBlock, OptionsBlock
 from tests.codegen import hostile as H
 from tests.fcl.strategies import documents as random_documents

@@ -59,9 +59,9 @@ def _block(
 
 
 def _through(fb: m.FunctionBlock, fmt: str) -> tuple[m.Document, str]:
-    lowered, losses = get(fmt).lower(m.Document((fb,)))
+    adapted, losses = get(fmt).adapt(m.Document((fb,)))
     assert not losses, losses
-    text = get(fmt).write(lowered)
+    text = get(fmt).write(adapted)
     return read_text(text, fmt).document, text
 
 
@@ -109,7 +109,7 @@ def test_mixed_and_or_under_min_max_becomes_one_rule_per_disjunct() -> None:
 def test_mixed_and_or_under_prod_is_a_loss() -> None:
     cond = m.And((m.Or((m.Is("a", "lo"), m.Is("b", "hi"))), m.Is("a", "hi")))
     fb = _block((m.Rule("1", cond, (m.Conclusion("y", "small"),)),), and_op="PROD")
-    _lowered, losses = get("fis").lower(m.Document((fb,)))
+    _adapted, losses = get("fis").adapt(m.Document((fb,)))
     assert any("one AND or OR" in loss.reason for loss in losses)
 
 
@@ -138,7 +138,7 @@ def test_weighted_average_accumulating_with_max() -> None:
         m.Rule("3", m.Is("a", "lo"), (m.Conclusion("y", "small"),)),
     )
     fb = _block(rules, out_terms=terms, method="COGS", default=m.Default(0.0), accu=None)
-    _lowered, losses = get("fis").lower(m.Document((fb,)))
+    _adapted, losses = get("fis").adapt(m.Document((fb,)))
     assert any("accumulate with MAX" in loss.reason for loss in losses)
     again, text = _through(fb, "fll")
     assert "aggregation: Maximum" in text
@@ -155,9 +155,9 @@ def test_octave_consequent_hedge_is_written_as_octave_reads_it() -> None:
         m.Rule("2", m.Is("a", "lo"), (m.Conclusion("y", "d"),)),
     )
     fb = _block(rules, out_terms=terms, method="WTAVER", default=m.Default(7.5), accu=None)
-    lowered, losses = get("fis").lower(m.Document((fb,)))
+    adapted, losses = get("fis").adapt(m.Document((fb,)))
     assert not losses
-    text = get("fis").write(lowered)
+    text = get("fis").write(adapted)
     assert not text.startswith("%") and "2.30, 1.30" in text.replace(" 0,", ",")
     again = read_text(text, "fis").document
     assert again.main.rule_blocks[0].rules[0].conclusions[0].hedges == ("pow:0.3333333333333333",)
@@ -252,9 +252,9 @@ MF2='d':'constant',[0]
 
 
 def _fis_losses(fb: m.FunctionBlock) -> list[str]:
-    lowered, losses = get("fis").lower(m.Document((fb,)))
+    adapted, losses = get("fis").adapt(m.Document((fb,)))
     if losses:  # what is written without them must still read back
-        read_text(get("fis").write(lowered), "fis")
+        read_text(get("fis").write(adapted), "fis")
     return [f"{loss.element}: {loss.reason}" for loss in losses]
 
 

@@ -8,8 +8,8 @@ from hypothesis import strategies as st
 
 from fuzzyctl.fcl import parse_fcl, write
 from fuzzyctl.fcl.identifiers import fcl_name
-from fuzzyctl.formats.xfuz import model_from_constants
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats.xfuz.reader import model_from_constants
+from fuzzyctl.formats.xfuz.tables import (
     KnowledgeBase,
     XfuzConstants,
     XMembership,
@@ -18,7 +18,7 @@ from fuzzyctl.formats.xfuz_tables import (
     decode_kb,
     encode_kb,
 )
-from fuzzyctl.formats.xfuz_write import constants_from_model
+from fuzzyctl.formats.xfuz.writer import constants_from_model
 from fuzzyctl.model import Document
 
 # Names that are FCL keywords ("if", "is", "term", ...) are left out: the XFUZ reader renames

@@ -9,15 +9,15 @@ from dataclasses import replace
 import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats.xfuz import model_from_constants, read_tables, read_xfuz, write_tables
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats.xfuz.reader import model_from_constants, read_tables, read_xfuz
+from fuzzyctl.formats.xfuz.tables import (
     StatusBit,
     XfuzConstants,
     decode_kb,
     decode_name,
     encode_name,
 )
-from fuzzyctl.formats.xfuz_write import constants_from_model, write_xfuz
+from fuzzyctl.formats.xfuz.writer import constants_from_model, write_tables, write_xfuz
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -379,7 +379,7 @@ def test_xfuz_3_3_tables_to_fcl_text_and_back_give_the_same_words() -> None:
 
 
 def test_xfuz_two_intermediate_variables_under_one_name_keep_their_labels() -> None:
-    from fuzzyctl.formats.xfuz_tables import KnowledgeBase, XMembership, XRule, XVariable, encode_kb
+    from fuzzyctl.formats.xfuz.tables import KnowledgeBase, XMembership, XRule, XVariable, encode_kb
 
     kb = KnowledgeBase(
         (

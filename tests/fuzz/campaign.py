@@ -92,7 +92,7 @@ def seeds(corpus: bool = False) -> list[Seed]:
             continue
         out.append(Seed(str(p.relative_to(ROOT)) if p.is_relative_to(ROOT) else p.name, fmt, _decode(p)))
     import fuzzyctl
-    from fuzzyctl.formats import json as fj
+    from fuzzyctl.formats.json import writer as fj
 
     for p in sorted((ROOT / "examples").glob("*.fcl")):
         text = fj.dumps(fuzzyctl.load(p))
@@ -247,7 +247,7 @@ def mutants(all_seeds: list[Seed], n: int, seed: int) -> Iterator[Mutant]:
 def random_systems(n: int, seed: int, first_index: int = 0) -> Iterator[Mutant]:
     """``n`` random systems (:mod:`tests.fuzz.systems`), written as fuzzyctl JSON for the
     CLI and for replay."""
-    from fuzzyctl.formats import json as fj
+    from fuzzyctl.formats.json import writer as fj
     from fuzzyctl.model import Document
     from tests.fuzz import systems
 

@@ -12,7 +12,7 @@ import pytest
 from fastapi.testclient import TestClient
 
 import fuzzyctl
-from fuzzyctl.formats.json import encode, to_dict
+from fuzzyctl.formats.json.writer import encode, to_dict
 from fuzzyctl.model import SHAPES, Document, ShapeMF
 from fuzzyctl.studio import create_app
 from tests.conftest import EXAMPLES, data_path

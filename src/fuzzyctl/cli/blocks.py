@@ -225,8 +225,8 @@ def xfuz(
     O1_CALC..O6_CALC, STATUS, STATUS_BITS, ERROR, INFERRED (1 when the rules ran)."""
     from fuzzyctl.blocks.schneider import XfuzFB
     from fuzzyctl.blocks.task import CyclicTask
-    from fuzzyctl.formats.xfuz import read_tables
-    from fuzzyctl.formats.xfuz_write import constants_from_model, slot_labels
+    from fuzzyctl.formats.xfuz.reader import read_tables
+    from fuzzyctl.formats.xfuz.writer import constants_from_model, slot_labels
 
     names: dict[str, str] = {}
     text = knowledge_base.read_text(encoding="utf-8-sig")

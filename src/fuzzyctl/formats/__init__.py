@@ -6,11 +6,18 @@ Every file format fuzzyctl reads or writes is a :class:`Format` in :data:`REGIST
 present, ``fpl`` and ``xfuz`` (PLC tools).  :func:`fuzzyctl.api.load` and ``fuzzyctl
 convert`` go through this registry and nothing else.
 
-A format module exposes ``FORMAT: Format``.  ``lower(doc)`` turns a model into what the
-format can say, returning the list of :class:`Loss` it had to accept; a conversion is
-lossless exactly when that list is empty.  Meaning-preserving rewrites (renaming a
-``LDL-Level`` to ``LDL_Level`` for FCL, a point list that is a triangle to ``trimf``) are
-not losses.
+Each format is a subpackage of one shape: ``fuzzyctl/formats/<name>/`` with ``reader.py``,
+``writer.py`` and ``names.py`` (what both use; the reader and the writer never import each
+other), and an ``__init__.py`` that exposes ``FORMAT: Format`` and loads the reader and
+writer on first use.  What several formats share is in :mod:`fuzzyctl.formats.common`.
+``adapt(doc)`` turns a model into what the format can say, returning the list of
+:class:`Loss` it had to accept; a conversion is lossless exactly when that list is empty.
+Meaning-preserving rewrites (renaming a ``LDL-Level`` to ``LDL_Level`` for FCL, a point list
+that is a triangle to ``trimf``) are not losses.
+
+This registry is the one list of formats: each format's name, extensions, size limit and
+description live in its ``FORMAT``, and the CLI's help, the studio's file list and dialogs,
+the runtime API and :func:`fuzzyctl.limits.max_input_bytes` are built from it.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ from pathlib import Path
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
 from fuzzyctl.files import write_atomic
 from fuzzyctl.gcpause import gc_paused
+from fuzzyctl.limits import DEFAULT_MAX_INPUT_BYTES
 from fuzzyctl.model import Document
 from fuzzyctl.validation import Placer, at_spans
 
@@ -53,8 +61,9 @@ class Loaded:
 Reader = Callable[[str, "str | None"], Loaded]
 """``read(text, path) -> Loaded``; raises :class:`DiagnosticError` on invalid input."""
 Writer = Callable[[Document], str]
-"""``write(document) -> text``; expects a document :attr:`Format.lower` accepted."""
-Lowerer = Callable[[Document], "tuple[Document, list[Loss]]"]
+"""``write(document) -> text``; expects a document :attr:`Format.adapt` returned."""
+Adapter = Callable[[Document], "tuple[Document, list[Loss]]"]
+"""``adapt(document) -> (document, losses)``: the model in what the format can say."""
 
 
 def _nothing_lost(document: Document) -> tuple[Document, list[Loss]]:
@@ -67,14 +76,19 @@ def _no_notes(document: Document) -> list[Loss]:
 
 @dataclass(frozen=True)
 class Format:
-    """A file format: name, file extensions, reader, writer and expressibility check."""
+    """A file format: name, file extensions, size limit, reader, writer and expressibility
+    check."""
 
     name: str
     extensions: tuple[str, ...]
     description: str
     read: Reader | None = None
     write: Writer | None = None
-    lower: Lowerer = field(default=_nothing_lost)
+    adapt: Adapter = field(default=_nothing_lost)
+    max_bytes: int = DEFAULT_MAX_INPUT_BYTES
+    """The largest file read (:func:`fuzzyctl.limits.max_input_bytes`): every shape of file at
+    the limit is read (accepted or refused) well within the 5 s of issue 14
+    (benchmarks/large_inputs.py; docs/limits.md has the figures)."""
     notes: Callable[[Document], list[Loss]] = field(default=_no_notes)
     """What the writer says in a nearest form of its own rather than as the model does: not a
     loss (the written file computes the same), but worth a warning to whoever reads the file
@@ -87,24 +101,17 @@ class Format:
 
     def losses(self, document: Document) -> list[Loss]:
         """What this format cannot express of ``document`` (empty: a lossless write)."""
-        return self.lower(document)[1]
+        return self.adapt(document)[1]
 
 
 REGISTRY: dict[str, Format] = {}
 """Registered formats by name.  Use :func:`get` and :func:`available`, which load the
 built-in ones on first use."""
 
-# Module that provides each built-in format, imported lazily (heavy parsers stay unloaded
-# until a file of that kind is used).  Optional ones may be absent from an installation.
-_BUILTIN: dict[str, str] = {
-    "fcl": "fuzzyctl.formats.fcl",
-    "fis": "fuzzyctl.formats.fis",
-    "fll": "fuzzyctl.formats.fll",
-    "json": "fuzzyctl.formats.json",
-    "fpl": "fuzzyctl.formats.fpl",
-    "xfuz": "fuzzyctl.formats.xfuz",
-}
-KNOWN_NAMES: tuple[str, ...] = tuple(_BUILTIN)
+KNOWN_NAMES: tuple[str, ...] = ("fcl", "fis", "fll", "json", "fpl", "xfuz")
+"""The built-in formats, each the subpackage ``fuzzyctl.formats.<name>`` (optional ones may be
+absent from an installation).  Their ``__init__`` modules are small: a reader or writer is
+imported when a file of that kind is used."""
 
 
 def register(fmt: Format) -> None:
@@ -112,11 +119,14 @@ def register(fmt: Format) -> None:
     REGISTRY[fmt.name] = fmt
 
 
-def _load_builtin(name: str) -> Format | None:
+def find(name: str) -> Format | None:
+    """The format called ``name`` (any case, with or without a dot), None when unknown or not
+    available here."""
+    name = name.lower().lstrip(".")
     if name in REGISTRY:
         return REGISTRY[name]
-    module_name = _BUILTIN.get(name)
-    if module_name is None or importlib.util.find_spec(module_name) is None:
+    module_name = f"{__name__}.{name}"
+    if name not in KNOWN_NAMES or importlib.util.find_spec(module_name) is None:
         return None
     module = importlib.import_module(module_name)
     fmt = getattr(module, "FORMAT", None)
@@ -128,19 +138,19 @@ def _load_builtin(name: str) -> Format | None:
 
 def available() -> list[Format]:
     """Every format that can be used here, built-in ones first."""
-    for name in _BUILTIN:
-        _load_builtin(name)
+    for name in KNOWN_NAMES:
+        find(name)
     return list(REGISTRY.values())
 
 
 def get(name: str) -> Format:
     """The format called ``name``; a clear error when it is unknown or not available."""
     key = name.lower().lstrip(".")
-    fmt = _load_builtin(key)
+    fmt = find(key)
     if fmt is not None:
         return fmt
     usable = ", ".join(f.name for f in available())
-    if key in _BUILTIN:
+    if key in KNOWN_NAMES:
         raise FuzzyctlError(f"format {key!r} is not available in this installation (available: {usable})")
     raise FuzzyctlError(f"unknown format {name!r} (available: {usable})")
 
@@ -151,13 +161,25 @@ def for_path(path: str | Path) -> Format:
     for fmt in available():
         if suffix in fmt.extensions:
             return fmt
-    if suffix.lstrip(".") in _BUILTIN:
+    if suffix.lstrip(".") in KNOWN_NAMES:
         return get(suffix.lstrip("."))  # known but missing: let get() say so
     known = ", ".join(ext for f in available() for ext in f.extensions)
     raise FuzzyctlError(
         f"cannot tell the format of {str(path)!r} from its extension (known: {known}); "
         "name it with --from/--to"
     )
+
+
+def extensions() -> tuple[str, ...]:
+    """Every file extension of the formats available here (``.fcl``, ``.fis``, ...), in the
+    registry's order: what the CLI's help, the studio's file list and dialogs offer."""
+    return tuple(ext for f in available() for ext in f.extensions)
+
+
+def names_text(last: str = ", ") -> str:
+    """The built-in formats' names for a help text: ``fcl, fis, ..., xfuz`` (``last`` joins
+    the last two)."""
+    return ", ".join(KNOWN_NAMES[:-1]) + last + KNOWN_NAMES[-1]
 
 
 def decode(data: bytes) -> str:
@@ -209,10 +231,10 @@ def convert(document: Document, format: str, *, lossy: bool = False) -> tuple[st
     fmt = get(format)
     if fmt.write is None:
         raise FuzzyctlError(f"format {fmt.name!r} can be read but not written")
-    lowered, losses = fmt.lower(document)
+    adapted, losses = fmt.adapt(document)
     if losses and not lossy:
         raise LossError(fmt.name, losses)
-    return fmt.write(lowered), losses
+    return fmt.write(adapted), losses
 
 
 class LossError(FuzzyctlError):
@@ -239,8 +261,11 @@ __all__ = [
     "available",
     "convert",
     "decode",
+    "extensions",
+    "find",
     "for_path",
     "get",
+    "names_text",
     "read_path",
     "read_text",
     "register",

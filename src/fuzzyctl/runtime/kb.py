@@ -94,9 +94,9 @@ def prepare_kb(
         return PreparedKB(source, document, block, inputs, outputs, labels, warnings)
     if style != "xfuz":
         raise FuzzyctlError(f"unknown block style {style!r} (siemens or xfuz)")
-    from fuzzyctl.formats.xfuz import read_tables
-    from fuzzyctl.formats.xfuz_tables import decode_kb
-    from fuzzyctl.formats.xfuz_write import constants_from_model, slot_labels
+    from fuzzyctl.formats.xfuz.reader import read_tables
+    from fuzzyctl.formats.xfuz.tables import decode_kb
+    from fuzzyctl.formats.xfuz.writer import constants_from_model, slot_labels
 
     diags: list[Diagnostic] = []
     if source.format == "xfuz":

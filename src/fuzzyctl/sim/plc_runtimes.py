@@ -153,7 +153,7 @@ class XfuzRuntime:
         output_scale: Mapping[str, float] | None = None,
     ) -> None:
         from fuzzyctl.diagnostics import DiagnosticError
-        from fuzzyctl.formats.xfuz_write import constants_from_model, slot_labels
+        from fuzzyctl.formats.xfuz.writer import constants_from_model, slot_labels
 
         fb = _main(model, block)
         self.block_name = fb.name or ""

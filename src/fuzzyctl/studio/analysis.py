@@ -46,11 +46,11 @@ def document_from_json(data: dict[str, Any], *, validated: bool = True) -> Docum
     the JSON path, an invalid one (points out of order, a degree above 1) a
     :class:`DiagnosticError` with the JSON paths.  ``validated=False`` leaves the validation
     to the caller: ``/api/check``, whose answer for an invalid model is its report."""
-    from fuzzyctl.formats import json as fjson
+    from fuzzyctl.formats.json.reader import from_dict
     from fuzzyctl.validation import at_json_paths, validate
 
     try:
-        document = fjson.from_dict(data)
+        document = from_dict(data)
     except DiagnosticError:
         raise
     except (ValueError, TypeError, KeyError) as exc:
@@ -65,9 +65,9 @@ def document_from_json(data: dict[str, Any], *, validated: bool = True) -> Docum
 
 
 def document_to_json(document: Document) -> dict[str, Any]:
-    from fuzzyctl.formats import json as fjson
+    from fuzzyctl.formats.json.writer import to_dict
 
-    return fjson.to_dict(document)
+    return to_dict(document)
 
 
 def fcl_text(document: Document) -> str:

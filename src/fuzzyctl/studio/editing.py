@@ -25,7 +25,7 @@ from typing import Any
 
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.fcl.no_if import always_name
-from fuzzyctl.formats.json import encode
+from fuzzyctl.formats.json.writer import encode
 from fuzzyctl.model import Degree, Document, FunctionBlock, SingletonMF, Term, Variable, VarKind
 from fuzzyctl.studio import analysis
 

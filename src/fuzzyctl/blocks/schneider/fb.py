@@ -31,7 +31,7 @@ from typing import Any
 
 from fuzzyctl.blocks.schneider.inference import InferenceResult, XfuzInference, to_word
 from fuzzyctl.diagnostics import InputError
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats.xfuz.tables import (
     ERROR_BITS,
     INT16_MAX,
     INT16_MIN,

@@ -32,7 +32,7 @@ from numpy.typing import NDArray
 from fuzzyctl.engine.operators import TNORMS, accumulate, accumulate_np
 from fuzzyctl.engine.sampled import mean_of_maxima, sampled_centroid, weighted_mean
 from fuzzyctl.engine.shapes import Points, pwl_points, pwl_value, pwl_value_np
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats.xfuz.tables import (
     INT16_MAX,
     INT16_MIN,
     KnowledgeBase,

@@ -28,7 +28,7 @@ import re
 from collections.abc import Iterable
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
-from fuzzyctl.formats.fpl import ADDING_ACCU, shared_conclusions
+from fuzzyctl.formats.fpl.names import ADDING_ACCU, shared_conclusions
 from fuzzyctl.model import (
     And,
     Condition,

@@ -15,7 +15,7 @@ from dataclasses import replace
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.engine import operators as ops
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import identifier, is_identifier
+from fuzzyctl.formats.common.basics import identifier, is_identifier
 from fuzzyctl.model import (
     DEFUZZ_METHODS,
     And,

@@ -12,7 +12,7 @@ import re
 from collections.abc import Iterator
 from typing import Any
 
-from fuzzyctl.formats._common import fmt_number
+from fuzzyctl.formats.common.basics import fmt_number
 from fuzzyctl.limits import shorten
 from fuzzyctl.model import Binary, Call, Expr, Name, Num, Unary
 

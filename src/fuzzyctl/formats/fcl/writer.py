@@ -1,25 +1,22 @@
-"""FCL (IEC 61131-7) in the format registry.
+"""Writing FCL (IEC 61131-7) for the format registry.
 
-The FCL reader and writer belong to :mod:`fuzzyctl.fcl`; this module only adapts their
-public functions to the registry and says what FCL cannot express of a model that came from
-another format (a MATLAB/fuzzylite rule weight under ACT MIN, fuzzylite's lock-range, ...).
-It uses ``fuzzyctl.fcl.load_text`` (parse and check) and ``fuzzyctl.fcl.write``.
+The FCL writer belongs to :mod:`fuzzyctl.fcl` (``fuzzyctl.fcl.write``); this module says what
+FCL cannot express of a model that came from another format (a MATLAB/fuzzylite rule weight
+under ACT MIN, fuzzylite's lock-range, ...) and rewrites what FCL says differently.
 """
 
 from __future__ import annotations
 
-import importlib
-import importlib.util
 import itertools
 import math
 import re
 from dataclasses import replace
-from typing import Any
 
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
-from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats._common import hedge_power, identifier
-from fuzzyctl.formats._lower import rename
+from fuzzyctl.formats import Loss
+from fuzzyctl.formats.common.adapt import rename
+from fuzzyctl.formats.common.basics import hedge_power, identifier
+from fuzzyctl.formats.fcl.names import fcl_api
 from fuzzyctl.model import (
     POWER_HEDGE_PREFIX,
     And,
@@ -38,15 +35,6 @@ from fuzzyctl.model import (
 )
 
 _POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
-
-
-def _fcl_api() -> Any | None:
-    if importlib.util.find_spec("fuzzyctl.fcl") is None:
-        return None
-    module = importlib.import_module("fuzzyctl.fcl")
-    if not (hasattr(module, "load_text") and hasattr(module, "write")):
-        return None
-    return module
 
 
 def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule, losses: list[Loss]) -> Rule:
@@ -177,7 +165,7 @@ def _basic_level(fb: FunctionBlock) -> FunctionBlock:
     return replace(fb, variables=variables, fuzzify=fuzzify, defuzzify=defuzzify)
 
 
-def lower(document: Document) -> tuple[Document, list[Loss]]:
+def adapt(document: Document) -> tuple[Document, list[Loss]]:
     """Rewrite what FCL says differently, report what it cannot say at all."""
     losses: list[Loss] = []
     blocks = []
@@ -258,31 +246,13 @@ def notes(document: Document) -> list[Loss]:
     return out
 
 
-def _read(text: str, path: str | None) -> Loaded:
-    api = _fcl_api()
-    assert api is not None
-    result = api.load_text(text, path)
-    document = result.raise_for_errors()
-    assert isinstance(document, Document)
-    return Loaded(document, tuple(d for d in result.diagnostics if not d.is_error))
-
-
-def _write(document: Document) -> str:
-    api = _fcl_api()
+def write(document: Document) -> str:
+    """FCL text of a document that :func:`adapt` returned (:func:`fuzzyctl.fcl.write`)."""
+    api = fcl_api()
     assert api is not None
     text = api.write(document)
     assert isinstance(text, str)
     return text
 
 
-_available = _fcl_api() is not None
-FORMAT = Format(
-    name="fcl",
-    extensions=(".fcl",),
-    description="IEC 61131-7 Fuzzy Control Language",
-    read=_read if _available else None,
-    write=_write if _available else None,
-    lower=lower,
-    notes=notes,
-    validates=True,
-)
+__all__ = ["adapt", "notes", "write"]

@@ -15,7 +15,7 @@ not clamped to their range.  Two dialects differ in details, told apart by the f
   membership types (``rampmf``, ``discretemf``, ``function``, a trailing height) are
   accepted.
 
-The writer lives in :mod:`fuzzyctl.formats.fis_write`.
+The writer lives in :mod:`fuzzyctl.formats.fis.writer`; what both use, in :mod:`.names`.
 """
 
 from __future__ import annotations
@@ -25,11 +25,12 @@ import re
 from dataclasses import dataclass, field, replace
 
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.formats import Format, Loaded
-from fuzzyctl.formats._common import Reporter, parse_count, parse_number
-from fuzzyctl.formats._expr import ExprError, names_in, parse_expr
-from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
-from fuzzyctl.formats.fis_rules import TS_KINDS, is_ts_term, numbers, rules
+from fuzzyctl.formats import Loaded
+from fuzzyctl.formats.common.basics import Reporter, parse_count, parse_number
+from fuzzyctl.formats.common.expr import ExprError, names_in, parse_expr
+from fuzzyctl.formats.common.terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
+from fuzzyctl.formats.fis.names import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
+from fuzzyctl.formats.fis.rules import TS_KINDS, is_ts_term, numbers, rules
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -47,47 +48,6 @@ from fuzzyctl.model import (
     Variable,
     VarKind,
 )
-
-AND_METHODS = {
-    "min": "MIN",
-    "prod": "PROD",
-    "bounded_difference": "BDIF",
-    "drastic_product": "DMIN",
-    "einstein_product": "EINSTEIN",
-    "hamacher_product": "HAMACHER",
-    "nilpotent_minimum": "NIPMIN",
-}
-OR_METHODS = {
-    "max": "MAX",
-    "probor": "ASUM",
-    "bounded_sum": "BSUM",
-    "drastic_sum": "DMAX",
-    "einstein_sum": "EINSTEIN",
-    "hamacher_sum": "HAMACHER",
-    "nilpotent_maximum": "NIPMAX",
-}
-AGG_METHODS = {
-    "max": "MAX",
-    "sum": "SUM",
-    "probor": "PROBOR",
-    "bounded_sum": "BSUM",
-    "drastic_sum": "DMAX",
-    "einstein_sum": "EINSTEIN",
-    "hamacher_sum": "HAMACHER",
-    "nilpotent_maximum": "NIPMAX",
-}
-DEFUZZ_METHODS = {
-    "centroid": "COG",
-    "bisector": "COA",
-    "mom": "MOM",
-    "som": "LM",
-    "lom": "RM",
-    "wtaver": "WTAVER",
-    "wtsum": "WTSUM",
-    # A user-defined function of the Octave toolkit's demos: the centroid by integration,
-    # which is what our COG computes exactly.
-    "centroid_integral": "COG",
-}
 
 
 @dataclass
@@ -285,7 +245,7 @@ def _number(digits: str) -> tuple[int, int] | tuple[int, int, str]:
 
 
 class _UniqueNames:
-    """Term names made unique as :func:`~fuzzyctl.formats._common.unique_name` makes them
+    """Term names made unique as :func:`~fuzzyctl.formats.common.basics.unique_name` makes them
     (``name``, ``name_2``, ``name_3``...), remembering where each name's search stopped:
     100,000 terms of one name would otherwise take 5 * 10**9 lookups."""
 
@@ -590,29 +550,4 @@ def _default(var: _Var, rep: Reporter, dialect: str) -> Default:
     return Default((var.range.low + var.range.high) / 2.0, lock_previous)
 
 
-def _read(text: str, path: str | None) -> Loaded:
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.fis_write import write
-
-    return write(document)
-
-
-def _lower(document: Document) -> tuple[Document, list]:  # type: ignore[type-arg]
-    from fuzzyctl.formats.fis_write import lower
-
-    return lower(document)
-
-
-FORMAT = Format(
-    name="fis",
-    extensions=(".fis",),
-    description="MATLAB / Octave Fuzzy Logic Toolbox FIS (and fuzzylite's FIS export)",
-    read=_read,
-    write=_write,
-    lower=_lower,
-)
-
-__all__ = ["FORMAT", "DiagnosticError", "read"]
+__all__ = ["DiagnosticError", "read"]

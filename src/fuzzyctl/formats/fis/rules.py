@@ -16,8 +16,9 @@ from functools import lru_cache
 from typing import Protocol
 
 from fuzzyctl.diagnostics import warning
-from fuzzyctl.formats._common import Reporter, parse_number, power_hedge
-from fuzzyctl.formats._expr import eval_constant, parse_expr
+from fuzzyctl.formats.common.basics import Reporter, parse_number, power_hedge
+from fuzzyctl.formats.common.expr import eval_constant, parse_expr
+from fuzzyctl.formats.fis.names import FUZZYLITE_HEDGE_CODES
 from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
     And,
@@ -33,14 +34,6 @@ from fuzzyctl.model import (
     Term,
 )
 
-# fuzzylite's hedge codes (FisImporter::translateProposition); "any" is resolved apart.
-FUZZYLITE_HEDGE_CODES: dict[int, tuple[str, ...]] = {
-    1: ("seldom",),
-    5: ("somewhat",),
-    20: ("very",),
-    30: ("extremely",),
-    40: ("very", "very"),
-}
 ANY_CODE = 99
 TS_KINDS = frozenset({"constant", "linear"})
 

@@ -15,9 +15,7 @@ from dataclasses import dataclass, replace
 
 from fuzzyctl.escape import one_line
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import fmt_number, hedge_power
-from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import (
+from fuzzyctl.formats.common.adapt import (
     SUM_LIKE,
     is_point_output,
     point_accumulation,
@@ -29,9 +27,22 @@ from fuzzyctl.formats._lower import (
     uncumulate,
     with_range,
 )
-from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
-from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
-from fuzzyctl.formats.fis_rules import FUZZYLITE_HEDGE_CODES
+from fuzzyctl.formats.common.basics import fmt_number, hedge_power
+from fuzzyctl.formats.common.expr import format_expr
+from fuzzyctl.formats.common.terms import (
+    FIS_OF_KIND,
+    FIS_TYPES,
+    MATLAB_TYPES,
+    MONOTONIC_KINDS,
+    fis_shape_problem,
+)
+from fuzzyctl.formats.fis.names import (
+    AGG_METHODS,
+    AND_METHODS,
+    DEFUZZ_METHODS,
+    FUZZYLITE_HEDGE_CODES,
+    OR_METHODS,
+)
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
@@ -209,7 +220,7 @@ def _ises(condition: Condition | None) -> list[Is]:
     return []
 
 
-def lower(document: Document) -> tuple[Document, list[Loss]]:
+def adapt(document: Document) -> tuple[Document, list[Loss]]:
     """The model as a FIS can state it, and what had to be dropped."""
     fb, losses, _ = prepare(document, "FIS", running_hedges=False)
     if _needs_fuzzylite(fb):  # fuzzylite reads conclusion hedges as running ones
@@ -538,7 +549,7 @@ def _mf_text(term: Term) -> str:
 
 
 def write(document: Document) -> str:
-    """FIS text of a document that :func:`lower` returned."""
+    """FIS text of a document that :func:`adapt` returned."""
     fb = document.main
     fuzzylite = _needs_fuzzylite(fb)
     block = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock(None, ())
@@ -657,4 +668,4 @@ def _rule_text(fb: FunctionBlock, rule: Rule, inputs: Sequence[object], fuzzylit
     return f"{' '.join(ante)}, {' '.join(cons)} ({fmt_number(weight)}) : {connection}"
 
 
-__all__ = ["Point", "lower", "write"]
+__all__ = ["Point", "adapt", "write"]

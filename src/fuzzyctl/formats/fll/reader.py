@@ -17,7 +17,7 @@ Semantics follow fuzzylite's C++ sources, which the ``.fld`` datasets were made 
 * Version 5 spellings: ``accumulation:`` for ``aggregation:``, ``activation: <TNorm>`` for
   ``implication:``, ``lock-valid`` for ``lock-previous``.
 
-The writer lives in :mod:`fuzzyctl.formats.fll_write`.
+The writer lives in :mod:`fuzzyctl.formats.fll.writer`; what both use, in :mod:`.names`.
 """
 
 from __future__ import annotations
@@ -26,12 +26,12 @@ import math
 import re
 from dataclasses import dataclass, field
 
-from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats._common import Reporter, parse_number
-from fuzzyctl.formats._expr import ExprError, parse_function
-from fuzzyctl.formats._fll_rules import HEDGE_WORDS as HEDGE_WORDS  # the writer avoids them as names
-from fuzzyctl.formats._fll_rules import Lookup, RuleError, parse_rule
-from fuzzyctl.formats._terms import FLL_TYPES
+from fuzzyctl.formats import Loaded
+from fuzzyctl.formats.common.basics import Reporter, parse_number
+from fuzzyctl.formats.common.expr import ExprError, parse_function
+from fuzzyctl.formats.common.terms import FLL_TYPES
+from fuzzyctl.formats.fll.names import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.formats.fll.rules import Lookup, RuleError, parse_rule
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -53,45 +53,6 @@ from fuzzyctl.model import (
     Variable,
     VarKind,
 )
-
-TNORMS = {
-    "Minimum": "MIN",
-    "AlgebraicProduct": "PROD",
-    "BoundedDifference": "BDIF",
-    "DrasticProduct": "DMIN",
-    "EinsteinProduct": "EINSTEIN",
-    "HamacherProduct": "HAMACHER",
-    "NilpotentMinimum": "NIPMIN",
-}
-SNORMS_OR = {
-    "Maximum": "MAX",
-    "AlgebraicSum": "ASUM",
-    "BoundedSum": "BSUM",
-    "DrasticSum": "DMAX",
-    "EinsteinSum": "EINSTEIN",
-    "HamacherSum": "HAMACHER",
-    "NilpotentMaximum": "NIPMAX",
-}
-SNORMS_ACCU = {
-    "Maximum": "MAX",
-    "AlgebraicSum": "PROBOR",
-    "BoundedSum": "BSUM",
-    "DrasticSum": "DMAX",
-    "EinsteinSum": "EINSTEIN",
-    "HamacherSum": "HAMACHER",
-    "NilpotentMaximum": "NIPMAX",
-    "UnboundedSum": "SUM",
-}
-DEFUZZIFIERS = {
-    "Centroid": "COG",
-    "Bisector": "COA",
-    "SmallestOfMaximum": "LM",
-    "LargestOfMaximum": "RM",
-    "MeanOfMaximum": "MOM",
-    "WeightedAverage": "WTAVER",
-    "WeightedSum": "WTSUM",
-}
-KEYWORDS = frozenset({"if", "then", "and", "or", "is", "with"})
 
 _LINE = re.compile(r"^(?P<indent>\s*)(?P<key>[A-Za-z][A-Za-z-]*)\s*:\s?(?P<value>.*)$")
 
@@ -468,29 +429,3 @@ def _norm(value: str, table: dict[str, str], rep: Reporter, number: int, key: st
     if value not in table:
         raise rep.fail(f"unknown {key} {value!r} (known: {', '.join(table)}, none)", number, code="fll-value")
     return table[value]
-
-
-def _read(text: str, path: str | None) -> Loaded:
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.fll_write import write
-
-    return write(document)
-
-
-def _lower(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.fll_write import lower
-
-    return lower(document)
-
-
-FORMAT = Format(
-    name="fll",
-    extensions=(".fll",),
-    description="fuzzylite language (fuzzylite 5/6, pyfuzzylite 8)",
-    read=_read,
-    write=_write,
-    lower=_lower,
-)

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import re
 
-from fuzzyctl.formats._common import parse_number
+from fuzzyctl.formats.common.basics import parse_number
+from fuzzyctl.formats.fll.names import HEDGE_WORDS
 from fuzzyctl.limits import MAX_NESTING
 from fuzzyctl.model import And, Conclusion, Condition, Is, Or, Rule, Span
 
-HEDGE_WORDS = frozenset({"not", "very", "somewhat", "extremely", "seldom", "any"})
 # the one string object of each hedge word, shared by every proposition that names it
 _HEDGES = {word: word for word in HEDGE_WORDS}
 _CONCLUSION_HEDGES = HEDGE_WORDS - {"any", "not"}

@@ -7,9 +7,7 @@ from dataclasses import replace
 
 from fuzzyctl.escape import one_line
 from fuzzyctl.formats import Loss
-from fuzzyctl.formats._common import fmt_number
-from fuzzyctl.formats._expr import format_expr
-from fuzzyctl.formats._lower import (
+from fuzzyctl.formats.common.adapt import (
     SUM_LIKE,
     point_accumulation,
     prepare,
@@ -18,8 +16,10 @@ from fuzzyctl.formats._lower import (
     uncumulate,
     with_range,
 )
-from fuzzyctl.formats._terms import FLL_OF_KIND, FLL_TYPES
-from fuzzyctl.formats.fll import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.formats.common.basics import fmt_number
+from fuzzyctl.formats.common.expr import format_expr
+from fuzzyctl.formats.common.terms import FLL_OF_KIND, FLL_TYPES
+from fuzzyctl.formats.fll.names import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -49,7 +49,7 @@ RESOLUTION = 1000
 exact; fuzzylite approximates with this many midpoint samples)."""
 
 
-def lower(document: Document) -> tuple[Document, list[Loss]]:
+def adapt(document: Document) -> tuple[Document, list[Loss]]:
     """The model as FLL can state it, and what had to be dropped."""
     # a variable or term called "very" or "then" would read as a hedge or a keyword
     fb, losses, _ = prepare(document, "FLL", reserved=HEDGE_WORDS | KEYWORDS)
@@ -195,7 +195,7 @@ def condition_text(condition: Condition, top: bool = True) -> str:
 
 
 def write(document: Document, *, resolution: int = RESOLUTION) -> str:
-    """FLL text of a document that :func:`lower` returned."""
+    """FLL text of a document that :func:`adapt` returned."""
     fb = document.main
     out = [f"Engine: {one_line(fb.name or '')}".rstrip()]  # names are free text: kept on their line
     for var in fb.inputs:

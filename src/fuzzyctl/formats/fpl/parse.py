@@ -22,10 +22,11 @@ from sys import intern
 from typing import NamedTuple, NoReturn
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
+from fuzzyctl.formats.fpl.names import KEYWORDS, MAX_NAME, OBJECTS, STRUCTURAL
 from fuzzyctl.limits import MAX_NESTING, shorten
 from fuzzyctl.model import And, Conclusion, Condition, Is, Span
 
-__all__ = ["KEYWORDS", "MAX_UNEXPECTED", "is_fpl_name", "lex_errors", "parse_project"]
+__all__ = ["MAX_UNEXPECTED", "lex_errors", "parse_project"]
 
 # --------------------------------------------------------------------------- lexer
 
@@ -53,44 +54,6 @@ _CLEAN_UNCOMMENTED = re.compile(_UNNAMED.sub("(?:", rf"(?:(?!){_OTHERS}|\s+)*+")
 #: How many unexpected characters are reported one by one; after that the lexer stops
 #: with one error saying so (a binary file or another format would give one per byte).
 MAX_UNEXPECTED = 1000
-
-# Objects that own an END (skipping a tolerated object counts these to find its END).
-_OBJECTS = {
-    "PROJECT",
-    "PACKAGE",
-    "VAR",
-    "MEMBER",
-    "FUZZY",
-    "RULE",
-    "CONNECT",
-    "OPTIONS",
-    "SOURCE",
-    "FRAGMENT",
-}
-# Words that end the arguments of a tolerated attribute (MAP, INITIALLY, DEFAULT).
-_STRUCTURAL = _OBJECTS | {
-    "END",
-    "TYPE",
-    "MIN",
-    "MAX",
-    "POINTS",
-    "IF",
-    "THEN",
-    "FROM",
-    "TO",
-    "MAP",
-    "INITIALLY",
-    "DEFAULT",
-}
-# Words FPL reads as keywords wherever they stand (upper-cased): no name may be one of them.
-KEYWORDS = frozenset(_STRUCTURAL | {"IS", "AND", "OR", "NOT"})
-_WORD = re.compile(r"[^\W\d]\w*")
-
-
-def is_fpl_name(name: str) -> bool:
-    """True when FPL reads ``name`` back as one name (a word, not a keyword)."""
-    return _WORD.fullmatch(name) is not None and name.upper() not in KEYWORDS
-
 
 # The manual's texts for the tolerated elements (Siemens 1.3, "Tolerated FPL Elements").
 _TOLERATED_ATTRIBUTES = {
@@ -179,7 +142,6 @@ _new_token = tuple.__new__  # a token made without NamedTuple's Python-level __n
 # commas, no comments.  Anything else - and names that are keywords - takes the general
 # path (Parser.parse_rule), which reads these the same way.
 #: the longest name read (S7 Fuzzy Control's names are far shorter; a diagnostic quotes names)
-MAX_NAME = 255
 _NAME = rf"[A-Za-z_][A-Za-z0-9_]{{0,{MAX_NAME - 1}}}(?!\w)"
 _IS = rf"{_NAME}\s+[Ii][Ss]\s+{_NAME}"
 _LEAF = rf"(?:\(\s*{_IS}\s*\)|{_IS})"
@@ -346,7 +308,7 @@ class Parser:
         word = tok.upper
         if word in _TOLERATED_ATTRIBUTES:
             self.advance()
-            while self.tok.kind != "eof" and self.tok.upper not in _STRUCTURAL and self.tok.kind != "code":
+            while self.tok.kind != "eof" and self.tok.upper not in STRUCTURAL and self.tok.kind != "code":
                 self.advance()
             self.note(_TOLERATED_ATTRIBUTES[word], tok, Severity.WARNING, "fpl-tolerated")
             return True
@@ -359,7 +321,7 @@ class Parser:
                     self.fail(f"{word} object is not closed by END", tok)
                 if nxt.upper == "END":
                     depth -= 1
-                elif nxt.upper in _OBJECTS:
+                elif nxt.upper in OBJECTS:
                     depth += 1
             self.note(_TOLERATED_OBJECTS[word], tok, Severity.NOTE, "fpl-tolerated")
             return True

@@ -36,17 +36,16 @@ from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
-from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats.fpl_parse import KEYWORDS, FplVar, Parser, is_fpl_name, parse_project
+from fuzzyctl.formats import Loaded
+from fuzzyctl.formats.fpl.names import SIEMENS_ACCU, leaves
+from fuzzyctl.formats.fpl.parse import FplVar, Parser, parse_project
 from fuzzyctl.model import (
-    And,
     Condition,
     Default,
     DefuzzifyBlock,
     Document,
     FunctionBlock,
     FuzzifyBlock,
-    Is,
     MembershipFunction,
     Point,
     PointsMF,
@@ -60,23 +59,7 @@ from fuzzyctl.model import (
     VarKind,
 )
 
-NAME = "fpl"
-EXTENSIONS = (".fpl",)
-
-__all__ = [
-    "ADDING_ACCU",
-    "EXTENSIONS",
-    "FORMAT",
-    "KEYWORDS",
-    "NAME",
-    "SIEMENS_ACCU",
-    "FplResult",
-    "is_fpl_name",
-    "leaves",
-    "parse_fpl",
-    "read_fpl",
-    "shared_conclusions",
-]
+__all__ = ["FplResult", "parse_fpl", "read", "read_fpl"]
 
 # --------------------------------------------------------------------------- model building
 
@@ -216,41 +199,6 @@ def _build(p: Parser, file: str | None, comments: list[str]) -> FunctionBlock:
     )
 
 
-SIEMENS_ACCU = "NSUM"
-"""The IEC accumulation that computes what Fuzzy Control computes (1.4): the sum of the
-rules' degrees per output term (NSUM's normalisation cancels in a centre of gravity)."""
-
-ADDING_ACCU = frozenset({"NSUM", "SUM"})
-"""Accumulations that add the rules' degrees without a bound, as Fuzzy Control does."""
-
-
-def shared_conclusions(block: FunctionBlock) -> list[tuple[str, str, list[Rule]]]:
-    """``(output, term, rules)`` for every output term that two or more rules conclude.
-
-    Only there does the accumulation matter for singleton outputs: one rule per term gives
-    the same degrees under MAX, BSUM, NSUM or SUM, so the Siemens sum (1.4) equals an
-    IEC ``ACCU : MAX`` program exactly when this list is empty."""
-    seen: dict[tuple[str, str], list[Rule]] = {}
-    for _rb, rule in block.rules():
-        for c in rule.conclusions:
-            if c.term is not None:
-                seen.setdefault((c.variable, c.term), []).append(rule)
-    return [(v, t, rules) for (v, t), rules in seen.items() if len(rules) > 1]
-
-
-def leaves(cond: Condition | None) -> Iterator[Is]:
-    """The ``v IS t`` subconditions of an AND-only condition, left to right."""
-    # A stack, not nested generators: a leaf deep in the parentheses would pass through
-    # one generator per level.
-    stack = [cond]
-    while stack:
-        item = stack.pop()
-        if isinstance(item, Is):
-            yield item
-        elif isinstance(item, And):
-            stack.extend(reversed(item.operands))
-
-
 def _condition_vars(cond: Condition | None) -> Iterator[str]:
     for leaf in leaves(cond):
         yield leaf.variable
@@ -308,31 +256,9 @@ def read_fpl(text: str, *, path: str | None = None) -> Document:
 # --------------------------------------------------------------------------- registry
 
 
-def _read(text: str, path: str | None) -> Loaded:
+def read(text: str, path: str | None = None) -> Loaded:
+    """The registry's reader: the model and the warnings met on the way."""
     result = parse_fpl(text, path=path)
     if result.document is None:
         raise DiagnosticError(result.diagnostics, text)
     return Loaded(result.document, result.diagnostics)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.fpl_write import write_fpl
-
-    return write_fpl(document)
-
-
-def _lower(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.fpl_write import lower_fpl
-
-    lowered, losses = lower_fpl(document)
-    return lowered, [Loss(element, reason) for element, reason in losses]
-
-
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "FPL of Siemens S7 Fuzzy Control (Togai InfraLogic subset, Siemens manual 1.3)",
-    read=_read,
-    write=_write,
-    lower=_lower,
-)

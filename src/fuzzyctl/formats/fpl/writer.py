@@ -1,5 +1,5 @@
 """Writing FPL for Siemens S7 Fuzzy Control (manual 1.3): the writer, what the subset
-cannot express, and the lowering ``fuzzyctl convert --lossy`` uses."""
+cannot express, and the adapting ``fuzzyctl convert --lossy`` uses."""
 
 from __future__ import annotations
 
@@ -7,10 +7,16 @@ import itertools
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
-from fuzzyctl.formats._common import identifier
-from fuzzyctl.formats._lower import rename
-from fuzzyctl.formats.fpl import ADDING_ACCU, SIEMENS_ACCU, is_fpl_name, leaves, shared_conclusions
-from fuzzyctl.formats.fpl_parse import MAX_NAME
+from fuzzyctl.formats.common.adapt import rename
+from fuzzyctl.formats.common.basics import identifier
+from fuzzyctl.formats.fpl.names import (
+    ADDING_ACCU,
+    MAX_NAME,
+    SIEMENS_ACCU,
+    is_fpl_name,
+    leaves,
+    shared_conclusions,
+)
 from fuzzyctl.model import (
     And,
     Condition,
@@ -32,7 +38,7 @@ from fuzzyctl.model import (
     is_constant,
 )
 
-__all__ = ["check_fpl", "lower_fpl", "write_fpl"]
+__all__ = ["adapt_fpl", "check_fpl", "write_fpl"]
 
 
 def _num(x: float) -> str:
@@ -328,7 +334,7 @@ def _fpl_condition(cond: Condition | None) -> bool:
     return isinstance(cond, And) and all(_fpl_condition(c) for c in cond.operands)
 
 
-def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
+def adapt_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     """``document`` reduced to what FPL can say, and what was dropped as ``(element,
     reason)`` pairs: further function blocks, rule blocks and intermediate variables,
     weights, DEFAULT values (Fuzzy Control keeps the last value), other operators, rules
@@ -388,7 +394,7 @@ def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
                 rule_activation=None,
             )
         )
-    lowered = replace(
+    adapted = replace(
         fb,
         variables=tuple(v for v in fb.variables if v.name not in local_names),
         fuzzify=tuple(fuzzify),
@@ -396,5 +402,5 @@ def lower_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
         rule_blocks=tuple(rule_blocks),
     )
     # names FPL cannot read back (MATLAB's "dV*", "Rear Left", a variable "If") are renamed
-    lowered, _renames = rename(lowered, is_fpl_name, is_fpl_name)
-    return Document((lowered,), path=document.path, comments=document.comments), losses
+    adapted, _renames = rename(adapted, is_fpl_name, is_fpl_name)
+    return Document((adapted,), path=document.path, comments=document.comments), losses

@@ -1,4 +1,4 @@
-"""fuzzyctl's own JSON form of the model: complete, versioned, lossless.
+"""Reading fuzzyctl's own JSON form of the model: complete, versioned, lossless.
 
 Every field of every model class is written under its Python name, so ``model -> JSON ->
 model`` gives an equal model (source spans and comments included).  Objects that can be one
@@ -6,98 +6,23 @@ of several classes carry a ``"type"`` tag (see :data:`TAGS`); numbers that JSON 
 are the strings ``"NaN"``, ``"Infinity"``, ``"-Infinity"``.  A reader fills fields a file
 leaves out with the model's defaults, so a tool may write only what it knows.  The layout
 is described by the JSON Schema shipped next to this module
-(``fuzzyctl-model.schema.json``) and documented in ``docs/formats.md``.
+(``fuzzyctl-model.schema.json``) and documented in ``docs/formats.md``.  The writer is
+:mod:`.writer`; what both use is in :mod:`.names`.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import json as _json
 import math
 import types
 import typing
 from enum import Enum
-from importlib import resources
 from typing import Any
 
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, error
-from fuzzyctl.escape import json_text
-from fuzzyctl.formats import Format, Loaded
-from fuzzyctl.validation import at_json_paths
-
-FORMAT_NAME = "fuzzyctl-model"
-VERSION = 1
-SCHEMA_FILE = "fuzzyctl-model.schema.json"
-
-TAGS: dict[type, str] = {
-    m.Ref: "ref",
-    m.PointsMF: "points",
-    m.SingletonMF: "singleton",
-    m.SingletonsMF: "singletons",
-    m.ShapeMF: "shape",
-    m.FunctionMF: "function",
-    m.Num: "num",
-    m.Name: "name",
-    m.Unary: "unary",
-    m.Binary: "binary",
-    m.Call: "call",
-    m.Is: "is",
-    m.Degree: "degree",
-    m.Not: "not",
-    m.And: "and",
-    m.Or: "or",
-}
-CLASSES: dict[str, type] = {tag: cls for cls, tag in TAGS.items()}
-_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments", "placed_comments", "item_spans", "grouped"})
-
-
-def _number(value: float) -> float | str:
-    if math.isnan(value):
-        return "NaN"
-    if math.isinf(value):
-        return "Infinity" if value > 0 else "-Infinity"
-    return value
-
-
-def encode(obj: Any) -> Any:
-    """The JSON-ready value of a model object."""
-    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
-        out: dict[str, Any] = {}
-        tag = TAGS.get(type(obj))
-        if tag:
-            out["type"] = tag
-        for f in dataclasses.fields(obj):
-            value = getattr(obj, f.name)
-            if f.name in _OPTIONAL_WHEN_EMPTY and not value:
-                continue
-            if isinstance(obj, m.Document) and f.name == "path":
-                continue  # where the file was, not what it says
-            if isinstance(obj, m.Variable) and f.name == "initial" and isinstance(value, str):
-                out[f.name] = {"text": value}  # keeps a text initial value apart from "NaN"
-                continue
-            out[f.name] = encode(value)
-        return out
-    if isinstance(obj, Enum):
-        return obj.value
-    if isinstance(obj, bool) or obj is None or isinstance(obj, str):
-        return obj
-    if isinstance(obj, int | float):
-        return _number(float(obj)) if isinstance(obj, float) else obj
-    if isinstance(obj, tuple | list):
-        return [encode(v) for v in obj]
-    raise TypeError(f"cannot encode {type(obj).__name__}")
-
-
-def to_dict(document: m.Document) -> dict[str, Any]:
-    """The whole document as a JSON-ready dict (``format``, ``version``, ``blocks``...)."""
-    body = encode(document)
-    return {"format": FORMAT_NAME, "version": VERSION, **body}
-
-
-def dumps(document: m.Document) -> str:
-    # json_text: a lone surrogate (a JSON comment may hold one) as its escape, so UTF-8 can hold it
-    return json_text(_json.dumps(to_dict(document), indent=2, ensure_ascii=False, allow_nan=False)) + "\n"
+from fuzzyctl.formats import Loaded
+from fuzzyctl.formats.json.names import CLASSES, FORMAT_NAME, VERSION
 
 
 class JsonModelError(ValueError):
@@ -228,15 +153,8 @@ def from_dict(data: Any) -> m.Document:
     return document
 
 
-def schema() -> dict[str, Any]:
-    """The JSON Schema of this format (draft 2020-12)."""
-    text = resources.files("fuzzyctl.formats").joinpath(SCHEMA_FILE).read_text(encoding="utf-8")
-    loaded = _json.loads(text)
-    assert isinstance(loaded, dict)
-    return loaded
-
-
 def read(text: str, path: str | None = None) -> Loaded:
+    """The model of JSON ``text``; an error names the JSON path where it does not fit."""
     from fuzzyctl.limits import load_json
 
     data = load_json(text, path)  # the nesting and number limits of every reader
@@ -249,15 +167,4 @@ def read(text: str, path: str | None = None) -> Loaded:
     return Loaded(dataclasses.replace(document, path=path))
 
 
-def _write(document: m.Document) -> str:
-    return dumps(document)
-
-
-FORMAT = Format(
-    name="json",
-    extensions=(".json",),
-    description="fuzzyctl model as JSON (lossless; schema in fuzzyctl/formats/fuzzyctl-model.schema.json)",
-    read=read,
-    write=_write,
-    place=at_json_paths,
-)
+__all__ = ["JsonModelError", "decode", "from_dict", "read"]

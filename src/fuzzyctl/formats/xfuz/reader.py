@@ -36,7 +36,6 @@ from __future__ import annotations
 
 import csv
 import io
-import json
 import re
 from collections.abc import Iterator
 from dataclasses import replace
@@ -44,8 +43,9 @@ from typing import Any
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
 from fuzzyctl.fcl.identifiers import fcl_name
-from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats import Loaded
+from fuzzyctl.formats.xfuz.names import CONSTANT_KEYS, DEFAULTS, FORMAT_TAG
+from fuzzyctl.formats.xfuz.tables import (
     ESV_SIZE,
     FA_SIZE,
     OPEN_HIGH,
@@ -57,9 +57,7 @@ from fuzzyctl.formats.xfuz_tables import (
     XfuzConstants,
     XMembership,
     decode_kb,
-    esv_offsets,
     slot_kind,
-    slot_label,
 )
 from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
@@ -86,40 +84,12 @@ from fuzzyctl.model import (
     VarKind,
 )
 
-NAME = "xfuz"
-EXTENSIONS = (".xfuz",)
-FORMAT_TAG = "xfuz-tables"
-
-__all__ = [
-    "EXTENSIONS",
-    "FORMAT",
-    "NAME",
-    "model_from_constants",
-    "read_tables",
-    "read_xfuz",
-    "write_tables",
-]
-
-_CONSTANT_KEYS = (
-    "OP_CONJ",
-    "OP_ET",
-    "OP_IMPL",
-    "OP_AGREG",
-    "OP_DEFUZ",
-    "OUT_PT",
-    "CONTASK$",
-    "T_OFB$",
-    *(f"O{i}_DEF$" for i in range(1, 7)),
-)
-_DEFAULTS = {"CONTASK$": 1, "T_OFB$": 200}
-
-
 # --------------------------------------------------------------------------- table files
 
 
 def _constants_from_mapping(values: dict[str, int], tables: dict[str, list[int]]) -> XfuzConstants:
     def get(key: str) -> int:
-        return values.get(key, _DEFAULTS.get(key, 0))
+        return values.get(key, DEFAULTS.get(key, 0))
 
     # A table that is not given at all keeps the block's default (an empty base).
     given = {name.lower(): tuple(words) for name, words in tables.items()}
@@ -135,21 +105,6 @@ def _constants_from_mapping(values: dict[str, int], tables: dict[str, list[int]]
         o_def=tuple(get(f"O{i}_DEF$") for i in range(1, 7)),
         **given,
     )
-
-
-def _constants_mapping(c: XfuzConstants) -> dict[str, int]:
-    values = {
-        "OP_CONJ": c.op_conj,
-        "OP_ET": c.op_et,
-        "OP_IMPL": c.op_impl,
-        "OP_AGREG": c.op_agreg,
-        "OP_DEFUZ": c.op_defuz,
-        "OUT_PT": int(c.out_pt),
-        "CONTASK$": int(c.contask),
-        "T_OFB$": c.t_ofb,
-    }
-    values.update({f"O{i + 1}_DEF$": v for i, v in enumerate(c.o_def)})
-    return values
 
 
 def _is_int(v: Any) -> bool:
@@ -174,10 +129,10 @@ def _read_json(text: str, path: str | None) -> XfuzConstants:
         diags.append(error("constants must be an object", code="xfuz-json", file=path))
         consts = {}
     for key, value in consts.items():
-        if key not in _CONSTANT_KEYS:
+        if key not in CONSTANT_KEYS:
             diags.append(
                 error(
-                    f"unknown constant {key!r} (known: {', '.join(_CONSTANT_KEYS)})",
+                    f"unknown constant {key!r} (known: {', '.join(CONSTANT_KEYS)})",
                     code="xfuz-json",
                     file=path,
                 )
@@ -252,7 +207,7 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
             continue
         seen[key] = lineno
         if table == "CONST":
-            if index.upper() not in _CONSTANT_KEYS:
+            if index.upper() not in CONSTANT_KEYS:
                 diags.append(error(f"unknown constant {index!r}", span, code="xfuz-csv", file=path))
             else:
                 consts[index.upper()] = number
@@ -300,76 +255,7 @@ def read_tables(text: str, *, path: str | None = None) -> XfuzConstants:
     return _read_csv(text, path)
 
 
-def _notes(c: XfuzConstants) -> dict[tuple[str, int], str]:
-    notes: dict[tuple[str, int], str] = {}
-    for slot in range(18):
-        label = slot_label(slot)
-        if slot < 8:
-            notes[("ESV", 2 * slot)], notes[("ESV", 2 * slot + 1)] = f"{label} BorneInf", f"{label} BorneSup"
-        else:
-            base = 16 + 3 * (slot - 8) if slot < 14 else 34 + 3 * (slot - 14)
-            for k, what in enumerate(("BorneInf", "BorneSup", "Discr")):
-                notes[("ESV", base + k)] = f"{label} {what}"
-            if slot >= 14:
-                for k in range(4):
-                    notes[("ESV", 46 + 4 * (slot - 14) + k)] = f"{label} Nom({2 * k + 1}-{2 * k + 2})"
-    for n in range(64):
-        for k, what in enumerate(
-            ("Nom(1-2)", "Nom(3-4)", "Nom(5-6)", "Nom(7-8)", "Variable", "xA", "xB", "xC", "xD")
-        ):
-            notes[("FA", 9 * n + k)] = f"FA{n} {what}"
-    for r in range(64):
-        for k, what in enumerate(("Pred1", "Pred2", "Pred3", "Pred4", "Concl1", "Concl2")):
-            notes[("RG", 6 * r + k)] = f"REG{r} {what}"
-    return notes
-
-
-def _used_ranges(c: XfuzConstants) -> Iterator[tuple[str, int]]:
-    """The words worth writing: every non-zero word, whole records of used functions and
-    rules, and the terminators."""
-    kb = decode_kb(c)
-    keep: set[tuple[str, int]] = set()
-    for name, words in (("ESV", c.esv), ("FA", c.fa), ("RG", c.rg)):
-        keep.update((name, k) for k, w in enumerate(words) if w)
-    for v in kb.variables:
-        keep.update(("ESV", k) for k in esv_offsets(v.slot) if k is not None)
-    for mf in kb.memberships:
-        keep.update(("FA", 9 * mf.number + k) for k in range(9))
-    for rule in kb.rules:
-        keep.update(("RG", 6 * rule.number + k) for k in range(6))
-    order = {"ESV": 0, "FA": 1, "RG": 2}
-    yield from sorted(keep, key=lambda t: (order[t[0]], t[1]))
-
-
-def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
-    """Table file text in the ``json`` or ``csv`` layout."""
-    if layout == "json":
-        body = {
-            "format": FORMAT_TAG,
-            "version": 1,
-            "constants": _constants_mapping(constants),
-            "ESV": list(constants.esv),
-            "FA": list(constants.fa),
-            "RG": list(constants.rg),
-        }
-        text = json.dumps(body, indent=1)
-        # One table per line is easier to read and diff than one word per line.
-        return (
-            re.sub(r"\[\s+([-\d,\s]+?)\s+\]", lambda m: "[" + re.sub(r"\s+", " ", m.group(1)) + "]", text)
-            + "\n"
-        )
-    if layout != "csv":
-        raise ValueError(f"layout must be 'json' or 'csv', not {layout!r}")
-    out = io.StringIO()
-    w = csv.writer(out, lineterminator="\n")
-    w.writerow(["table", "index", "value", "note"])
-    for key, value in _constants_mapping(constants).items():
-        w.writerow(["CONST", key, value, ""])
-    notes = _notes(constants)
-    tables = {"ESV": constants.esv, "FA": constants.fa, "RG": constants.rg}
-    for table, index in _used_ranges(constants):
-        w.writerow([table, index, tables[table][index], notes.get((table, index), "")])
-    return out.getvalue()
+__all__ = ["model_from_constants", "read", "read_tables", "read_xfuz"]
 
 
 # --------------------------------------------------------------------------- tables -> model
@@ -617,48 +503,7 @@ def read_xfuz(text: str, *, path: str | None = None) -> Document:
     return _decode(text, path)[0]
 
 
-# --------------------------------------------------------------------------- registry
-
-
-def _read(text: str, path: str | None) -> Loaded:
+def read(text: str, path: str | None = None) -> Loaded:
+    """The registry's reader: the model and the warnings of decoding it."""
     document, diags = _decode(text, path)
     return Loaded(document, tuple(diags))
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.xfuz_write import write_xfuz
-
-    return write_xfuz(document)
-
-
-def _lower(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.xfuz_write import lower_xfuz
-
-    lowered, losses = lower_xfuz(document)
-    return lowered, [Loss(element, reason) for element, reason in losses]
-
-
-def _format_notes(document: Document) -> list[Loss]:
-    """A rule without an IF part (Siemens 1.5) has a predicate in RG: ``INPi IS ALWAYS``."""
-    fb = document.main
-    labels = [rule.label for _rb, rule in fb.rules() if rule.condition is None]
-    if not labels or not fb.inputs:
-        return []
-    return [
-        Loss(
-            f"rule(s) {', '.join(repr(x) for x in labels)}",
-            "no IF part (degree 1): written with the predicate 'INPi IS ALWAYS', a function open on "
-            "both sides (1 for every input word) on the first input, one of the 64 of FA",
-        )
-    ]
-
-
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "Schneider XFUZ knowledge-base tables ESV/FA/RG and constants (JSON or CSV layout)",
-    read=_read,
-    write=_write,
-    lower=_lower,
-    notes=_format_notes,
-)

@@ -2,7 +2,7 @@
 RG[384] (manual chapter 3.2), their decoding into a structure, the consistency checks of
 section 2.8 with the STATUS bit each one raises, and the encoding back into words.
 
-This sits in ``formats`` because both the XFUZ table reader/writer (``formats/xfuz.py``)
+This sits in ``formats`` because both the XFUZ table reader/writer (``formats/xfuz/reader.py``)
 and the XFUZ block (``blocks/schneider``) need it, and imports point down the stack.
 
 Word layout (3.2):

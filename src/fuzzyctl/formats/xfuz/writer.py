@@ -1,16 +1,21 @@
 """Encoding a fuzzyctl model (an FCL program, ...) into XFUZ constants: slots, terms as
 the four abscissae, rules as FA numbers, and what the tables cannot hold.
 
-See :mod:`fuzzyctl.formats.xfuz` for the mapping and the ``XFUZ`` OPTIONS lines."""
+See :mod:`fuzzyctl.formats.xfuz.reader` for the mapping and the ``XFUZ`` OPTIONS lines."""
 
 from __future__ import annotations
 
+import csv
+import io
+import json
 import math
 import re
+from collections.abc import Iterator
 from dataclasses import dataclass, replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
-from fuzzyctl.formats.xfuz_tables import (
+from fuzzyctl.formats.xfuz.names import FORMAT_TAG, constants_mapping
+from fuzzyctl.formats.xfuz.tables import (
     DISCR_MAX,
     MAX_RULES,
     OPEN_HIGH,
@@ -22,8 +27,10 @@ from fuzzyctl.formats.xfuz_tables import (
     XRule,
     XVariable,
     check_kb,
+    decode_kb,
     encode_kb,
     encode_name,
+    esv_offsets,
     slot_kind,
     slot_label,
 )
@@ -54,11 +61,13 @@ from fuzzyctl.model import (
 
 __all__ = [
     "ALWAYS",
+    "adapt_xfuz",
     "check_xfuz",
     "constants_from_model",
-    "lower_xfuz",
+    "notes",
     "slot_labels",
     "with_always_predicate",
+    "write_tables",
     "write_xfuz",
 ]
 
@@ -500,12 +509,100 @@ def write_xfuz(block: FunctionBlock | Document, *, layout: str = "json") -> str:
     constants, diags = constants_from_model(block)
     if any(d.is_error for d in diags):
         raise DiagnosticError([d for d in diags if d.severity is not Severity.NOTE])
-    from fuzzyctl.formats.xfuz import write_tables
-
     return write_tables(constants, layout=layout)
 
 
-# --------------------------------------------------------------------------- lowering
+# --------------------------------------------------------------------------- table files
+
+
+def _notes(c: XfuzConstants) -> dict[tuple[str, int], str]:
+    notes: dict[tuple[str, int], str] = {}
+    for slot in range(18):
+        label = slot_label(slot)
+        if slot < 8:
+            notes[("ESV", 2 * slot)], notes[("ESV", 2 * slot + 1)] = f"{label} BorneInf", f"{label} BorneSup"
+        else:
+            base = 16 + 3 * (slot - 8) if slot < 14 else 34 + 3 * (slot - 14)
+            for k, what in enumerate(("BorneInf", "BorneSup", "Discr")):
+                notes[("ESV", base + k)] = f"{label} {what}"
+            if slot >= 14:
+                for k in range(4):
+                    notes[("ESV", 46 + 4 * (slot - 14) + k)] = f"{label} Nom({2 * k + 1}-{2 * k + 2})"
+    for n in range(64):
+        for k, what in enumerate(
+            ("Nom(1-2)", "Nom(3-4)", "Nom(5-6)", "Nom(7-8)", "Variable", "xA", "xB", "xC", "xD")
+        ):
+            notes[("FA", 9 * n + k)] = f"FA{n} {what}"
+    for r in range(64):
+        for k, what in enumerate(("Pred1", "Pred2", "Pred3", "Pred4", "Concl1", "Concl2")):
+            notes[("RG", 6 * r + k)] = f"REG{r} {what}"
+    return notes
+
+
+def _used_ranges(c: XfuzConstants) -> Iterator[tuple[str, int]]:
+    """The words worth writing: every non-zero word, whole records of used functions and
+    rules, and the terminators."""
+    kb = decode_kb(c)
+    keep: set[tuple[str, int]] = set()
+    for name, words in (("ESV", c.esv), ("FA", c.fa), ("RG", c.rg)):
+        keep.update((name, k) for k, w in enumerate(words) if w)
+    for v in kb.variables:
+        keep.update(("ESV", k) for k in esv_offsets(v.slot) if k is not None)
+    for mf in kb.memberships:
+        keep.update(("FA", 9 * mf.number + k) for k in range(9))
+    for rule in kb.rules:
+        keep.update(("RG", 6 * rule.number + k) for k in range(6))
+    order = {"ESV": 0, "FA": 1, "RG": 2}
+    yield from sorted(keep, key=lambda t: (order[t[0]], t[1]))
+
+
+def write_tables(constants: XfuzConstants, *, layout: str = "json") -> str:
+    """Table file text in the ``json`` or ``csv`` layout."""
+    if layout == "json":
+        body = {
+            "format": FORMAT_TAG,
+            "version": 1,
+            "constants": constants_mapping(constants),
+            "ESV": list(constants.esv),
+            "FA": list(constants.fa),
+            "RG": list(constants.rg),
+        }
+        text = json.dumps(body, indent=1)
+        # One table per line is easier to read and diff than one word per line.
+        return (
+            re.sub(r"\[\s+([-\d,\s]+?)\s+\]", lambda m: "[" + re.sub(r"\s+", " ", m.group(1)) + "]", text)
+            + "\n"
+        )
+    if layout != "csv":
+        raise ValueError(f"layout must be 'json' or 'csv', not {layout!r}")
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow(["table", "index", "value", "note"])
+    for key, value in constants_mapping(constants).items():
+        w.writerow(["CONST", key, value, ""])
+    notes = _notes(constants)
+    tables = {"ESV": constants.esv, "FA": constants.fa, "RG": constants.rg}
+    for table, index in _used_ranges(constants):
+        w.writerow([table, index, tables[table][index], notes.get((table, index), "")])
+    return out.getvalue()
+
+
+def notes(document: Document) -> list[tuple[str, str]]:
+    """A rule without an IF part (Siemens 1.5) has a predicate in RG: ``INPi IS ALWAYS``."""
+    fb = document.main
+    labels = [rule.label for _rb, rule in fb.rules() if rule.condition is None]
+    if not labels or not fb.inputs:
+        return []
+    return [
+        (
+            f"rule(s) {', '.join(repr(x) for x in labels)}",
+            "no IF part (degree 1): written with the predicate 'INPi IS ALWAYS', a function open on "
+            "both sides (1 for every input word) on the first input, one of the 64 of FA",
+        )
+    ]
+
+
+# --------------------------------------------------------------------------- adapting
 
 Conjunct = list[tuple[Is, bool]]
 
@@ -575,7 +672,7 @@ def _rounded(mf: MembershipFunction) -> MembershipFunction:
     return mf
 
 
-def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
+def adapt_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     """``document`` reduced to what the XFUZ tables hold, and what changes on the way as
     ``(element, reason)`` pairs.  Exact rewrites are not losses: OR split into rules (OR is
     MAX), more than 2 conclusions split into rules.  Losses: what is dropped (further rule
@@ -712,7 +809,7 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
             (f"rule block {rb.name}", "XFUZ has no disabled rule blocks or rule activation methods")
         )
         rules = rules if rb.enabled else []
-    lowered_rb = replace(
+    adapted_rb = replace(
         rb,
         rules=tuple(rules),
         and_op=and_op,
@@ -722,7 +819,7 @@ def lower_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
         enabled=True,
         rule_activation=None,
     )
-    lowered = replace(fb, fuzzify=fuzzify, defuzzify=tuple(defuzzify), rule_blocks=(lowered_rb,))
-    _, diags = constants_from_model(lowered)
+    adapted = replace(fb, fuzzify=fuzzify, defuzzify=tuple(defuzzify), rule_blocks=(adapted_rb,))
+    _, diags = constants_from_model(adapted)
     losses += [(f"line {d.span.line}" if d.span else "program", d.message) for d in diags if d.is_error]
-    return Document((lowered,), path=document.path), losses
+    return Document((adapted,), path=document.path), losses

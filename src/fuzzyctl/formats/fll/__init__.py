@@ -1,0 +1,41 @@
+"""fuzzylite language (FLL) files: :mod:`.reader` (with the rule lines in :mod:`.rules`),
+:mod:`.writer`, and the names both use in :mod:`.names`.  The reader and writer load on
+first use."""
+
+from __future__ import annotations
+
+from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.limits import MiB
+from fuzzyctl.model import Document
+
+
+def _read(text: str, path: str | None) -> Loaded:
+    from fuzzyctl.formats.fll.reader import read
+
+    return read(text, path)
+
+
+def _write(document: Document) -> str:
+    from fuzzyctl.formats.fll.writer import write
+
+    return write(document)
+
+
+def _adapt(document: Document) -> tuple[Document, list[Loss]]:
+    from fuzzyctl.formats.fll.writer import adapt
+
+    return adapt(document)
+
+
+FORMAT = Format(
+    name="fll",
+    extensions=(".fll",),
+    description="fuzzylite language (fuzzylite 5/6, pyfuzzylite 8)",
+    read=_read,
+    write=_write,
+    adapt=_adapt,
+    # FLL's terse lines make the most model per byte (a Function term or a nested rule costs
+    # three times what an FCL rule of that length does); the 10,000-rule system is 1.19 MiB,
+    # the largest real FLL file 14 KB
+    max_bytes=MiB * 3 // 2,
+)
