@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 from rich.console import Console
 
-from fuzzyctl import __version__
+from fuzzyctl import __version__, formats
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 
 if TYPE_CHECKING:
@@ -57,7 +57,7 @@ FromOpt = Annotated[
     str | None,
     typer.Option(
         "--from",
-        help="Format of FILE: fcl, fis, fll, json, fpl, xfuz (default: its extension).",
+        help=f"Format of FILE: {formats.names_text()} (default: its extension).",
         show_default=False,
     ),
 ]

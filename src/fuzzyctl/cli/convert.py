@@ -7,6 +7,7 @@ from typing import Annotated
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import FORCE_HINT, app, err_console
 
 
@@ -17,7 +18,7 @@ def convert(
     from_format: Annotated[
         str | None,
         typer.Option(
-            "--from", help="Format of SOURCE (fcl, fis, fll, fpl, xfuz, json); default: its extension."
+            "--from", help=f"Format of SOURCE ({formats.names_text()}); default: its extension."
         ),
     ] = None,
     to_format: Annotated[
@@ -35,7 +36,6 @@ def convert(
 
     A conversion that would change what the system computes fails and lists, one line each,
     what the target format cannot express; --lossy writes it anyway without those elements."""
-    from fuzzyctl import formats
     from fuzzyctl.api import require_file
 
     require_file(source)  # before the extension is read: "no such file", not "unknown format"

@@ -41,7 +41,7 @@ from fastapi.responses import JSONResponse
 from fastapi.security import HTTPAuthorizationCredentials, HTTPBearer
 from pydantic import BaseModel, ConfigDict, Field, StringConstraints
 
-from fuzzyctl import __version__
+from fuzzyctl import __version__, formats
 from fuzzyctl.runtime.service import Service, ServiceError, short
 from fuzzyctl.webguard import LOOPBACK_NAMES, Guard, Refusal, bearer_token, token_matches
 
@@ -120,7 +120,7 @@ class ValueBody(_Body):
 
 class DownloadBody(_Body):
     text: str = Field(min_length=1, max_length=5_000_000, description="the knowledge base source")
-    format: str = Field(default="fcl", max_length=16, description="fcl, fpl, xfuz, fis, fll or json")
+    format: str = Field(default="fcl", max_length=16, description=formats.names_text(" or "))
 
 
 class Health(BaseModel):

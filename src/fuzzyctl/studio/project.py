@@ -31,7 +31,8 @@ NAME_MAX = 255
 MAX_FILE = 16 * 1024 * 1024
 """The largest file the studio opens (the request-body limit: the model travels back)."""
 PROJECT_EXTENSIONS = (".fcl",)
-LISTED_EXTENSIONS = (".fcl", ".fis", ".fll", ".json", ".fpl", ".xfuz", ".toml")
+LOOP_EXTENSIONS = (".toml",)
+"""Loop configurations (``fuzzyctl simulate``), listed beside the formats of the registry."""
 MAX_LISTED = 2000
 
 
@@ -120,11 +121,14 @@ class ProjectDir:
     def listing(self) -> list[dict[str, Any]]:
         """Files the studio can open (FCL, the other formats, loop configurations), sorted,
         hidden files and directories left out."""
+        from fuzzyctl import formats
+
+        listed = (*formats.extensions(), *LOOP_EXTENSIONS)
         out: list[dict[str, Any]] = []
         for dirpath, dirnames, filenames in os.walk(self.root):
             dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and d != "__pycache__")
             for name in sorted(filenames):
-                if name.startswith(".") or not name.lower().endswith(LISTED_EXTENSIONS):
+                if name.startswith(".") or not name.lower().endswith(listed):
                     continue
                 full = Path(dirpath) / name
                 if not full.resolve().is_relative_to(self.root):
