@@ -185,6 +185,15 @@ class DiagnosticError(FuzzyctlError):
         return "\n".join(render_all(self.diagnostics, self.source, limit))
 
 
+class OptionError(FuzzyctlError):
+    """Options that do not go together, or an option's value the library refuses before it
+    starts; ``option`` names it (``--lang``), as the CLI's usage error does."""
+
+    def __init__(self, message: str, option: str) -> None:
+        super().__init__(message)
+        self.option = option
+
+
 class InputError(FuzzyctlError, ValueError):
     """A bad value given to an evaluation (missing input, NaN, not a number); the message
     names the parameter."""

@@ -5,13 +5,15 @@ Exit codes: 0 success, 1 the input has errors, 2 usage error, 3 internal error (
 from __future__ import annotations
 
 import sys
+from collections.abc import Iterator
+from contextlib import contextmanager
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 
 from fuzzyctl import __version__, formats
-from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
+from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, OptionError
 
 if TYPE_CHECKING:
     from rich.table import Table
@@ -82,6 +84,16 @@ def record_table(title: str, figures: dict[str, str], width: int) -> Table:
     for name, value in figures.items():
         table.add_row(name, value)
     return table
+
+
+@contextmanager
+def usage_errors() -> Iterator[None]:
+    """A library's :class:`~fuzzyctl.diagnostics.OptionError` as the command's usage error
+    (exit 2, the usage line, the option named), raised inside the command's context."""
+    try:
+        yield
+    except OptionError as exc:
+        raise typer.BadParameter(str(exc), param_hint=exc.option) from None
 
 
 def split_names(values: list[str] | str | None) -> list[str]:

@@ -3,13 +3,14 @@ function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen
 
 from __future__ import annotations
 
+import json
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated, Any
+from typing import Annotated
 
 import typer
 
-from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console
+from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console, usage_errors
 
 
 class Lang(StrEnum):
@@ -101,117 +102,30 @@ def codegen(
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
-    import fuzzyctl
-    from fuzzyctl.codegen import generate_c, generate_st
-    from fuzzyctl.files import check_writable
-    from fuzzyctl.formats import write_atomic
+    from fuzzyctl.codegen.emit import emit
 
-    if lang is Lang.c and (dialect is not None or lreal):
-        raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
-    if lang is Lang.st and single:
-        raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
-    from fuzzyctl.codegen.api import Generated
-    from fuzzyctl.codegen.defaults import parse_default
-    from fuzzyctl.escape import CodegenError
-
-    try:
-        parse_default(default)
-    except CodegenError as exc:
-        raise typer.BadParameter(str(exc), param_hint="--default") from None
-    doc = fuzzyctl.load(source, strict=strict, format=from_format)
-    if lang is Lang.plcopen:
-        _plcopen(doc, output, dialect, lreal, single, block, strict, default, force)
-        return
-    report: list[Generated] = []
-    if lang is Lang.st:
-        text = generate_st(
-            doc,
-            block=block,
-            dialect=(dialect or Dialect.codesys).value,
+    with usage_errors():
+        emitted = emit(
+            source,
+            lang.value,
+            output,
+            dialect=None if dialect is None else dialect.value,
             lreal=lreal,
-            strict=strict,
-            default=default,
-            report=report,
+            single=single,
             testbench=testbench,
+            block=block,
+            default=default,
+            strict=strict,
+            force=force,
+            hint=FORCE_HINT,
+            format=from_format,
         )
-        if output is None:
-            if as_json:
-                _json_report(lang, report, text=text)
-            else:
-                typer.echo(text, nl=False)
-            return
-        write_atomic(output, text, force=force, hint=FORCE_HINT)
-        _done(as_json, lang, report, [output])
-        return
-    files = generate_c(
-        doc, block=block, single=single, strict=strict, testbench=testbench, default=default, report=report
-    )
-    out_dir = output or Path(".")
-    if out_dir.exists() and not out_dir.is_dir():
-        raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")
-    out_dir.mkdir(parents=True, exist_ok=True)
-    if not force:  # every file checked before any is written: no half-replaced set
-        for name in files:
-            check_writable(out_dir / name, hint=FORCE_HINT)
-    for name, text in files.items():
-        write_atomic(out_dir / name, text, force=force, hint=FORCE_HINT)
-    _done(as_json, lang, report, [out_dir / n for n in files])
-
-
-def _done(as_json: bool, lang: Lang, report: list[Any], written: list[Path]) -> None:
-    if as_json:
-        _json_report(lang, report, written=written)
+    if as_json and emitted.reports:
+        typer.echo(json.dumps(emitted.to_dict(), indent=2))
+    elif emitted.text is not None:
+        typer.echo(emitted.text, nl=False)
     else:
-        err_console.print(f"wrote {', '.join(str(p) for p in written)}", markup=False)
-        for gen in report:
+        err_console.print(f"wrote {', '.join(str(p) for p in emitted.written)}", markup=False)
+        for gen in emitted.blocks:
             for r in gen.renames:
                 err_console.print(f"renamed {r.comment()}", markup=False)
-
-
-def _json_report(
-    lang: Lang, report: list[Any], text: str | None = None, written: list[Path] | None = None
-) -> None:
-    import json
-
-    out: dict[str, Any] = {"lang": lang.value, "blocks": [g.to_dict() for g in report]}
-    if text is not None:
-        out["text"] = text
-    if written is not None:
-        out["written"] = [str(p) for p in written]
-    typer.echo(json.dumps(out, indent=2))
-
-
-def _plcopen(
-    doc: Any,
-    output: Path | None,
-    dialect: Dialect | None,
-    lreal: bool,
-    single: bool,
-    block: str | None,
-    strict: bool,
-    default: str | None = None,
-    force: bool = False,
-) -> None:
-    """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
-    from fuzzyctl.codegen import generate_plcopen
-    from fuzzyctl.formats import write_atomic
-
-    if single:
-        raise typer.BadParameter("--float applies to --lang c (use --lreal)", param_hint="--lang")
-    if dialect is Dialect.scl:
-        raise typer.BadParameter(
-            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
-        )
-    xml = generate_plcopen(
-        doc,
-        block=block,
-        dialect=(dialect or Dialect.codesys).value,
-        lreal=lreal,
-        strict=strict,
-        default=default,
-    )
-    if output is None:
-        typer.echo(xml, nl=False)
-        return
-    write_atomic(output, xml, force=force, hint=FORCE_HINT)
-    err_console.print(f"wrote {output}", markup=False)

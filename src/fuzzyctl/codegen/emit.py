@@ -1,0 +1,158 @@
+"""What ``fuzzyctl codegen`` produces: the code of one target (``st``, ``plcopen`` or ``c``),
+printed or written where asked, and its JSON report.  The CLI and the Python API both call
+:func:`emit`; the generators themselves are :func:`~fuzzyctl.codegen.generate_st`,
+:func:`~fuzzyctl.codegen.generate_plcopen` and :func:`~fuzzyctl.codegen.generate_c`."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from fuzzyctl.diagnostics import OptionError
+from fuzzyctl.model import Document
+
+if TYPE_CHECKING:
+    from fuzzyctl.codegen.api import Generated
+
+LANGS = ("st", "plcopen", "c")
+"""The targets, as ``--lang`` names them."""
+DEFAULT_DIALECT = "codesys"
+READ_ONLY_HINT = "make it writable to replace it"
+"""What a read-only file to replace is told (the CLI says ``--force replaces it``)."""
+
+
+@dataclass
+class Emitted:
+    """The outcome of :func:`emit`: the text when nothing was written (``st`` and ``plcopen``
+    without an output file), else the files written; ``blocks`` is what the generator
+    changed to express each block (``plcopen`` reports none)."""
+
+    lang: str
+    blocks: list[Generated] = field(default_factory=list)
+    text: str | None = None
+    written: list[Path] = field(default_factory=list)
+
+    @property
+    def reports(self) -> bool:
+        """Whether this target has a JSON report (PLCopen XML has none: ``--json`` is not
+        one of its options)."""
+        return self.lang != "plcopen"
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON report: the target, each block's renames and notes, and the text or the
+        files written."""
+        out: dict[str, Any] = {"lang": self.lang, "blocks": [g.to_dict() for g in self.blocks]}
+        if self.text is not None:
+            out["text"] = self.text
+        else:
+            out["written"] = [str(p) for p in self.written]
+        return out
+
+
+def check_options(lang: str, *, dialect: str | None, lreal: bool, single: bool, default: str | None) -> None:
+    """Refuse options that do not apply to ``lang`` before anything is read
+    (:class:`OptionError` names the option)."""
+    from fuzzyctl.codegen.defaults import parse_default
+    from fuzzyctl.escape import CodegenError
+
+    if lang == "c" and (dialect is not None or lreal):
+        raise OptionError("--dialect and --lreal apply to --lang st and plcopen", "--lang")
+    if lang == "st" and single:
+        raise OptionError("--float applies to --lang c (use --lreal for ST)", "--lang")
+    try:
+        parse_default(default)
+    except CodegenError as exc:
+        raise OptionError(str(exc), "--default") from None
+
+
+def emit(
+    model: Document | str | Path,
+    lang: str,
+    output: Path | None = None,
+    *,
+    dialect: str | None = None,
+    lreal: bool = False,
+    single: bool = False,
+    testbench: int = 0,
+    block: str | None = None,
+    default: str | None = None,
+    strict: bool = False,
+    force: bool = False,
+    hint: str = READ_ONLY_HINT,
+    format: str | None = None,
+) -> Emitted:
+    """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
+    are checked first) and write it: ``st`` and ``plcopen`` to the file
+    ``output`` (None: the text is returned), ``c`` into the directory ``output`` (default: the
+    current one), every file checked writable before any is replaced."""
+    import fuzzyctl
+    from fuzzyctl.codegen import generate_c, generate_plcopen, generate_st
+
+    check_options(lang, dialect=dialect, lreal=lreal, single=single, default=default)
+    document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
+    if lang == "plcopen":
+        if single:
+            raise OptionError("--float applies to --lang c (use --lreal)", "--lang")
+        if dialect == "scl":
+            raise OptionError(
+                "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", "--dialect"
+            )
+        xml = generate_plcopen(
+            document,
+            block=block,
+            dialect=dialect or DEFAULT_DIALECT,
+            lreal=lreal,
+            strict=strict,
+            default=default,
+        )
+        return _text_or_file(Emitted("plcopen"), xml, output, force, hint)
+    emitted = Emitted(lang)
+    if lang == "st":
+        text = generate_st(
+            document,
+            block=block,
+            dialect=dialect or DEFAULT_DIALECT,
+            lreal=lreal,
+            strict=strict,
+            default=default,
+            report=emitted.blocks,
+            testbench=testbench,
+        )
+        return _text_or_file(emitted, text, output, force, hint)
+    files = generate_c(
+        document,
+        block=block,
+        single=single,
+        strict=strict,
+        testbench=testbench,
+        default=default,
+        report=emitted.blocks,
+    )
+    emitted.written = _write_files(files, output or Path("."), force, hint)
+    return emitted
+
+
+def _text_or_file(emitted: Emitted, text: str, output: Path | None, force: bool, hint: str) -> Emitted:
+    from fuzzyctl.files import write_atomic
+
+    if output is None:
+        emitted.text = text
+    else:
+        write_atomic(output, text, force=force, hint=hint)
+        emitted.written = [output]
+    return emitted
+
+
+def _write_files(files: dict[str, str], out_dir: Path, force: bool, hint: str) -> list[Path]:
+    from fuzzyctl.files import check_writable, write_atomic
+
+    if out_dir.exists() and not out_dir.is_dir():
+        raise OptionError(f"{out_dir} is not a directory", "-o")
+    out_dir.mkdir(parents=True, exist_ok=True)
+    if not force:  # every file checked before any is written: no half-replaced set
+        for name in files:
+            check_writable(out_dir / name, hint=hint)
+    for name, text in files.items():
+        write_atomic(out_dir / name, text, force=force, hint=hint)
+    return [out_dir / name for name in files]
