@@ -176,16 +176,7 @@ def eval_(
             file, dask_in, out_dir, block=block, compat=compat, workers=workers, scheduler=scheduler
         )
         return
-    if workers is not None or scheduler is not None:
-        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
-    if data is not None and set_:
-        raise typer.BadParameter("use either --set or --data", param_hint="--set")
-    if data is None and output is not None:
-        raise typer.BadParameter("--output needs --data", param_hint="--output")
-    if decimal not in (None, ".", ","):
-        raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
-    if as_json and as_table:
-        raise typer.BadParameter("use either --json or --table", param_hint="--table")
+    _check_eval(workers, scheduler, data, set_, output, decimal, as_json, as_table)
     ctl = _controller(file, block, compat, strict, from_format)
     if data is not None:
         from fuzzyctl.cli.app import err_console
@@ -211,6 +202,29 @@ def eval_(
     else:
         _print_outputs(ctl.name or file.name, result)
     _fail_without_value(ctl, result, values)
+
+
+def _check_eval(
+    workers: int | None,
+    scheduler: str | None,
+    data: str | None,
+    set_: list[str] | None,
+    output: str | None,
+    decimal: str | None,
+    as_json: bool,
+    as_table: bool,
+) -> None:
+    """The options of ``eval`` without --dask that do not go together."""
+    if workers is not None or scheduler is not None:
+        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
+    if data is not None and set_:
+        raise typer.BadParameter("use either --set or --data", param_hint="--set")
+    if data is None and output is not None:
+        raise typer.BadParameter("--output needs --data", param_hint="--output")
+    if decimal not in (None, ".", ","):
+        raise typer.BadParameter(f"expected '.' or ',', got {decimal!r}", param_hint="--decimal")
+    if as_json and as_table:
+        raise typer.BadParameter("use either --json or --table", param_hint="--table")
 
 
 def _fired(ctl: Any, values: Mapping[str, float]) -> dict[str, bool]:
@@ -287,52 +301,7 @@ def explain(
         typer.echo(json.dumps(e.to_dict(), indent=2))
         return
     from rich.console import Console
-    from rich.table import Table
 
-    from fuzzyctl.engine.plot import ascii_plot
+    from fuzzyctl.console import explanation_views
 
-    con = Console(highlight=False)
-    inputs = Table(title="inputs")
-    inputs.add_column("input", overflow="fold")
-    inputs.add_column("value", justify="right", overflow="fold")
-    for k, v in e.inputs.items():
-        inputs.add_row(k, f"{v:.10g}")
-    con.print(inputs)
-    terms = Table(title="fuzzification (degree of each term)")
-    for col in ("variable", "term", "degree"):
-        terms.add_column(col, justify="right" if col == "degree" else "left", overflow="fold")
-    for t in (*e.terms, *e.chained):
-        terms.add_row(t.variable, t.term, f"{t.degree:.6g}")
-    con.print(terms)
-    rules = Table(title="rules (condition degree, then each conclusion)")
-    for col in ("block", "rule", "degree", "conclusion", "weight"):
-        rules.add_column(col, justify="right" if col in ("degree", "weight") else "left", overflow="fold")
-    for r in e.rules:
-        concl = ", ".join(f"{c.variable} IS {c.term}" if c.term else c.variable for c in r.conclusions)
-        weights = ", ".join(f"{c.weight:g}" for c in r.conclusions)
-        style = "" if r.fired else "dim"
-        rules.add_row(r.block or "", r.label, f"{r.degree:.6g}", concl, weights, style=style)
-    con.print(rules)
-    outs = Table(title="outputs")
-    for col in ("output", "value", "method", "accumulation", "fired"):
-        outs.add_column(col, justify="right" if col == "value" else "left", overflow="fold")
-    for o in e.outputs:
-        outs.add_row(
-            o.name,
-            f"{o.value:.10g}",
-            o.method,
-            o.accumulation or "per rule",
-            ("yes" if math.isfinite(o.value) else "yes (undefined: NaN)") if o.fired else "no (default)",
-        )
-    con.print(outs)
-    for o in e.outputs:
-        if o.kind == "ts" and o.weights:
-            ts = Table(title=f"{o.name}: Takagi-Sugeno terms")
-            for col in ("term", "weight", "z"):
-                ts.add_column(col, justify="left" if col == "term" else "right", overflow="fold")
-            for name, w, z in o.weights:
-                ts.add_row(name, f"{w:.6g}", f"{z:.6g}")
-            con.print(ts)
-        elif o.kind in ("mamdani", "singleton"):
-            con.print(f"[bold]{o.name}[/bold]: accumulated set")
-            con.print(ascii_plot(o, width=width), markup=False)
+    Console(highlight=False).print(*explanation_views(e, width=width), sep="\n")

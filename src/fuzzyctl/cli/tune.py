@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -245,35 +247,12 @@ def tune(
     from_format: FromOpt = None,
 ) -> None:
     """Tune a fuzzy system against data or a closed-loop cost (Ctrl-C keeps the best so far)."""
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
-
     from fuzzyctl.cli.app import split_names
     from fuzzyctl.tune.api import tune as run
 
     out = _output_file(output, old_out)
-    if budget < 1:
-        raise typer.BadParameter(f"must be at least 1, got {budget}", param_hint="--budget")
-    if workers is not None and scheduler is not None:
-        raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
-    if (data is None) == (plant_config is None):
-        raise typer.BadParameter("give either --data or --plant", param_hint="--data")
-    console = Console(stderr=True)
-    with Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("best {task.fields[best]}"),
-        TimeElapsedColumn(),
-        console=console,
-        transient=True,
-        disable=as_json,
-    ) as progress:
-        task = progress.add_task(f"tuning {file.name}", total=budget, best="-")
-
-        def tick(done: int, total: int, best: float) -> None:
-            progress.update(task, completed=done, total=total, best=_fmt(best))
-
+    _check_tune(budget, workers, scheduler, data, plant_config)
+    with _progress(f"tuning {file.name}", budget, hidden=as_json) as tick:
         result = run(
             file if from_format is None else _load(file, from_format),
             data=data,
@@ -294,15 +273,47 @@ def tune(
             keep_zero=keep_zero,
             progress=tick,
         )
-    result.write_fcl(out)
-    files: dict[str, Any] = {"fcl": str(out)}
-    if report is not None:
-        files.update({k: str(v) for k, v in result.write_report(report).items()})
+    files = result.save(out, report=report)
     if as_json:
-        from fuzzyctl.tune.report import as_dict
-
-        typer.echo(json.dumps({**as_dict(result), "files": files}))
+        typer.echo(json.dumps(result.to_dict(files)))
         return
+    _print_tuned(result, out, report)
+
+
+def _check_tune(budget: int, workers: int | None, scheduler: str | None, data: Any, plant: Any) -> None:
+    if budget < 1:
+        raise typer.BadParameter(f"must be at least 1, got {budget}", param_hint="--budget")
+    if workers is not None and scheduler is not None:
+        raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
+    if (data is None) == (plant is None):
+        raise typer.BadParameter("give either --data or --plant", param_hint="--data")
+
+
+@contextmanager
+def _progress(description: str, total: int, *, hidden: bool) -> Iterator[Callable[[int, int, float], None]]:
+    """A progress bar on stderr (none with ``hidden``); yields the optimiser's callback."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    with Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        MofNCompleteColumn(),
+        TextColumn("best {task.fields[best]}"),
+        TimeElapsedColumn(),
+        console=Console(stderr=True),
+        transient=True,
+        disable=hidden,
+    ) as progress:
+        task = progress.add_task(description, total=total, best="-")
+
+        def tick(done: int, total: int, best: float) -> None:
+            progress.update(task, completed=done, total=total, best=_fmt(best))
+
+        yield tick
+
+
+def _print_tuned(result: Any, out: Path, report: Path | None) -> None:
     status = " (interrupted: best so far kept)" if result.interrupted else ""
     _print_table(
         f"{result.cost_name}: {_fmt(result.before)} -> {_fmt(result.after)}{status}",

@@ -65,6 +65,21 @@ class TuneResult:
 
         return write_report(self, Path(directory))
 
+    def save(self, path: str | Path, report: str | Path | None = None) -> dict[str, str]:
+        """Write the tuned FCL to ``path`` and, given ``report``, the report directory; the
+        files written by kind (``fcl``, ``md``, ``json``, ...)."""
+        files = {"fcl": str(self.write_fcl(path))}
+        if report is not None:
+            files.update({k: str(v) for k, v in self.write_report(report).items()})
+        return files
+
+    def to_dict(self, files: dict[str, str] | None = None) -> dict[str, Any]:
+        """What ``fuzzyctl tune --json`` prints: the run (costs, changes, history) and the
+        files written."""
+        from fuzzyctl.tune.report import as_dict
+
+        return {**as_dict(self), "files": dict(files or {})}
+
 
 def _document(model: Document | FunctionBlock | str | Path) -> Document:
     import fuzzyctl
