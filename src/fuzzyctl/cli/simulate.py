@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated
 
@@ -50,7 +52,6 @@ def simulate(
     """Simulate a closed loop; print its quality figures and write CSV, PNG and HTML (all three
     into the current directory unless options name which; --json writes only what is named)."""
     from rich.console import Console
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
 
     from fuzzyctl.sim.config import load_config
     from fuzzyctl.sim.experiment import simulate as run
@@ -61,56 +62,47 @@ def simulate(
     if duration is not None and not (duration > 0 and math.isfinite(duration)):
         raise typer.BadParameter(f"must be > 0, got {duration}", param_hint="--duration")
     cfg = load_config(config)
-    console = Console(stderr=True)
-    with Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TextColumn("{task.percentage:>3.0f}%"),
-        TimeRemainingColumn(),
-        console=console,
-        transient=True,
-        disable=as_json,
-    ) as progress:
-        task = progress.add_task(f"simulating {cfg.title}", total=1)
-
-        def tick(done: int, total: int) -> None:
-            progress.update(task, completed=done, total=total)
-
+    with _progress(f"simulating {cfg.title}", hidden=as_json) as tick:
         result = run(cfg, runtime=runtime, cycle=cycle, duration=duration, progress=tick)
-
     write_outputs(result, **_targets(config, out_dir, csv, png, html, no_csv, no_png, no_html, as_json))
-    q = result.quality
     if as_json:
-        doc = {
-            "title": cfg.title,
-            "runtime": result.runtime,
-            "cycle": result.cycle,
-            "duration": float(result.trace["t"][-1]),
-            "quality": None if q is None else {k: _json_number(v) for k, v in q.as_dict().items()},
-            "files": {k: str(v) for k, v in result.files.items()},
-        }
-        typer.echo(json.dumps(doc))
+        typer.echo(json.dumps(result.to_dict()))
         return
     out = Console(highlight=False)
     out.print(
         f"{cfg.title}: {result.runtime}, cycle {result.cycle:g} s, {result.trace['t'][-1]:g} s simulated"
     )
-    if q is not None:
-        settle = "never" if math.isinf(q.settling_time) else f"{q.settling_time:.2f} s"
-        figures = {
-            "ISE": f"{q.ise:.4g}",
-            "IAE": f"{q.iae:.4g}",
-            "ITAE": f"{q.itae:.4g}",
-            "overshoot": f"{q.overshoot:.3g}",
-            "overshoot %": f"{q.overshoot_percent:.2f}",
-            "settling time": settle,
-            "final error": f"{q.final_error:.3g}",
-        }
-        out.print(record_table(f"quality of {q.signal} (setpoint {q.setpoint:g})", figures, out.width))
+    if (q := result.quality) is not None:
+        out.print(
+            record_table(f"quality of {q.signal} (setpoint {q.setpoint:g})", result.figures(), out.width)
+        )
         limits = "".join(f", |{k}| <= {v:g}" for k, v in cfg.quality.limits.items()) if cfg.quality else ""
         out.print(f"settling: |{q.signal} - setpoint| <= {q.band:g}{limits} from then on")
     for kind, path in result.files.items():
         out.print(f"{kind}: {path}", soft_wrap=True)  # a path must stay copyable: never broken
+
+
+@contextmanager
+def _progress(description: str, *, hidden: bool) -> Iterator[Callable[[int, int], None]]:
+    """A progress bar on stderr (none with ``hidden``); yields the loop's callback."""
+    from rich.console import Console
+    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+
+    with Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TextColumn("{task.percentage:>3.0f}%"),
+        TimeRemainingColumn(),
+        console=Console(stderr=True),
+        transient=True,
+        disable=hidden,
+    ) as progress:
+        task = progress.add_task(description, total=1)
+
+        def tick(done: int, total: int) -> None:
+            progress.update(task, completed=done, total=total)
+
+        yield tick
 
 
 def _targets(
@@ -133,9 +125,3 @@ def _targets(
         return {k: (None if skip[k] else v) for k, v in named.items()}
     base = out_dir if out_dir is not None else Path()
     return {k: None if skip[k] else (v or base / f"{config.stem}.{k}") for k, v in named.items()}
-
-
-def _json_number(v: float | str) -> float | str | None:
-    if isinstance(v, float) and not math.isfinite(v):
-        return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
-    return v

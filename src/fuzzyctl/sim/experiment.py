@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from fuzzyctl.sim.config import SimConfig, build_loop
 from fuzzyctl.sim.loop import Trace
@@ -23,6 +25,41 @@ class Result:
     trace: Trace
     quality: Quality | None
     files: dict[str, Path] = field(default_factory=dict)
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``fuzzyctl simulate --json`` prints: the run, its quality figures (NaN as None,
+        infinities as ``"inf"``: JSON has no such numbers) and the files written."""
+        q = self.quality
+        return {
+            "title": self.config.title,
+            "runtime": self.runtime,
+            "cycle": self.cycle,
+            "duration": float(self.trace["t"][-1]),
+            "quality": None if q is None else {k: _json_number(v) for k, v in q.as_dict().items()},
+            "files": {k: str(v) for k, v in self.files.items()},
+        }
+
+    def figures(self) -> dict[str, str]:
+        """The quality figures as ``fuzzyctl simulate`` shows them (empty without a
+        ``[quality]`` table)."""
+        q = self.quality
+        if q is None:
+            return {}
+        return {
+            "ISE": f"{q.ise:.4g}",
+            "IAE": f"{q.iae:.4g}",
+            "ITAE": f"{q.itae:.4g}",
+            "overshoot": f"{q.overshoot:.3g}",
+            "overshoot %": f"{q.overshoot_percent:.2f}",
+            "settling time": "never" if math.isinf(q.settling_time) else f"{q.settling_time:.2f} s",
+            "final error": f"{q.final_error:.3g}",
+        }
+
+
+def _json_number(v: float | str) -> float | str | None:
+    if isinstance(v, float) and not math.isfinite(v):
+        return None if math.isnan(v) else ("inf" if v > 0 else "-inf")
+    return v
 
 
 def simulate(
