@@ -7,7 +7,7 @@ from typing import Annotated
 
 import typer
 
-from fuzzyctl.cli.app import app, err_console
+from fuzzyctl.cli.app import app, err_console, usage_errors
 
 
 @app.command()
@@ -52,70 +52,24 @@ def studio(
 ) -> None:
     """Start the studio: edit, analyse, simulate and download fuzzy knowledge bases in a
     web browser.  Prints its URL (with the token the browser needs); Ctrl-C stops it."""
-    import secrets
-    import socket
-    import urllib.parse
+    from fuzzyctl.studio.launch import prepare, run
 
-    import uvicorn
-
-    from fuzzyctl.diagnostics import FuzzyctlError
-    from fuzzyctl.studio import create_app
-
-    project_root = root or (file.parent if file is not None else Path.cwd())
-    project_root = project_root.resolve()
-    relative = None
-    if file is not None:
-        full = file.resolve()
-        if not full.is_file():
-            raise FuzzyctlError(f"{file}: no such file")
-        if not full.is_relative_to(project_root):
-            raise FuzzyctlError(f"{file} is not inside the project directory {project_root}")
-        relative = full.relative_to(project_root).as_posix()
-    loopback = host in ("127.0.0.1", "localhost", "::1")
-    if no_token and token is not None:
-        raise typer.BadParameter("give either --token or --no-token", param_hint="--no-token")
-    if no_token:
-        token = None
-    elif token is None or token == "auto":  # 'auto': what the default was called before
-        token = secrets.token_urlsafe(24)
-    elif len(token) < 16:
-        raise typer.BadParameter("a token has at least 16 characters", param_hint="--token")
-    application = create_app(project_root, file=relative, host=host, token=token, api_docs=api_docs)
-    sock = socket.socket(socket.AF_INET6 if ":" in host else socket.AF_INET, socket.SOCK_STREAM)
-    sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-    try:
-        sock.bind((host, port))
-        sock.listen(128)  # the URL printed below accepts connections at once (queued until uvicorn runs)
-    except OSError as exc:
-        raise FuzzyctlError(f"cannot listen on {host}:{port}: {exc.strerror or exc}") from None
-    bound = sock.getsockname()[1]
-    shown = "127.0.0.1" if host in ("127.0.0.1", "0.0.0.0") else host
-    query = ([("view", view)] if view else []) + ([("token", token)] if token else [])
-    url = f"http://{shown}:{bound}/" + (f"?{urllib.parse.urlencode(query)}" if query else "")
-    if token is None:
-        where = "on this machine" if loopback else f"that reaches {host}"
-        err_console.print(
-            f"warning: --no-token: any program or user {where} can read and write {project_root} "
-            "through the studio",
-            markup=False,
+    with usage_errors():
+        launch = prepare(
+            file,
+            root=root,
+            host=host,
+            port=port,
+            token=token,
+            no_token=no_token,
+            view=view,
+            api_docs=api_docs,
         )
-    elif not loopback:
-        err_console.print(
-            f"warning: listening on {host}: whoever has the URL (its token) can read and write "
-            f"{project_root}",
-            markup=False,
-        )
-    if api_docs:
-        err_console.print(
-            "warning: --api-docs: the page at /api/docs loads Swagger UI from a CDN (third-party "
-            "code in a page of the studio)",
-            markup=False,
-        )
-    typer.echo(f"fuzzyctl studio on {url}  (project directory {project_root}; Ctrl-C stops)", err=False)
+    for warning in launch.warnings:
+        err_console.print(f"warning: {warning}", markup=False)
+    typer.echo(f"fuzzyctl studio on {launch.url}  (project directory {launch.root}; Ctrl-C stops)", err=False)
     if open_browser:
         import webbrowser
 
-        webbrowser.open(url)
-    config = uvicorn.Config(application, log_level="warning", lifespan="off")
-    server = uvicorn.Server(config)
-    server.run(sockets=[sock])
+        webbrowser.open(launch.url)
+    run(launch)
