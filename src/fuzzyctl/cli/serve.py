@@ -7,6 +7,8 @@ import signal
 import sys
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import Annotated, Any
 
@@ -38,30 +40,47 @@ def serve(
     from rich.console import Console
 
     from fuzzyctl.runtime import Runtime, load_config
-    from fuzzyctl.runtime.config import ConfigError
+    from fuzzyctl.runtime.display import api_banner
 
     if check:
-        from fuzzyctl.runtime.core import check_config
+        from fuzzyctl.runtime.capacity import check as check_file
 
-        checked, problems = check_config(config)
-        if problems:
-            raise ConfigError(problems)
-        assert checked is not None
-        from fuzzyctl.runtime import capacity
-
-        runtime = Runtime(checked, api=False, event_log=None)
-        est = capacity.estimate(runtime)  # times the cycles: a runtime that is then dropped
-        runtime.stop()
-        typer.echo(
-            f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s); "
-            f"the cycles need about {est.load:.1%} of one core (capacity {capacity.CAPACITY:.0%})"
-        )
-        for text in capacity.warnings(runtime, est):
+        summary, warnings = check_file(config)
+        typer.echo(summary)
+        for text in warnings:
             err_console.print(f"warning: {text}", markup=False)
         return
     cfg = load_config(config)
     runtime = Runtime(cfg, api=api and cfg.api.enabled, token=not no_token)
     stop = threading.Event()
+    console = Console(highlight=False)
+    last: int | None = None
+    with _signals_set(stop):
+        try:
+            runtime.start()
+            _realtime(cfg.runtime.realtime_priority)
+            if runtime.api_address is not None:
+                line, warnings = api_banner(runtime, cfg.api.docs)
+                err_console.print(line, markup=False)
+                for text in warnings:
+                    err_console.print(f"warning: {text}", markup=False)
+            deadline = None if duration is None else time.monotonic() + duration
+            last = _run(runtime, console, stop, deadline, table and console.is_terminal)
+        except KeyboardInterrupt:
+            last = None
+        finally:
+            stop.set()  # from here a signal means "exit at once"
+            _stop(runtime)
+    if last is not None:
+        _print_events(runtime, last)
+    if runtime.scheduler.error is not None:
+        raise RuntimeError(f"the cycle thread failed: {runtime.scheduler.error}")
+
+
+@contextmanager
+def _signals_set(stop: threading.Event) -> Iterator[None]:
+    """SIGTERM and SIGINT set ``stop``; a second one while stopping exits at once.  The
+    previous handlers come back on leaving."""
 
     def on_signal(signum: int, _frame: Any) -> None:
         if stop.is_set():
@@ -71,60 +90,31 @@ def serve(
             os._exit(128 + signum)
         stop.set()
 
-    console = Console(highlight=False)
     previous = {s: signal.signal(s, on_signal) for s in (signal.SIGTERM, signal.SIGINT)}
-    last: int | None = None
     try:
-        runtime.start()
-        prio = cfg.runtime.realtime_priority
-        if prio > 1:
-            # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
-            # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
-            from fuzzyctl.runtime.scheduler import set_fifo
-
-            set_fifo(prio - 1)
-        if runtime.api_address is not None:
-            host, port = runtime.api_address
-            docs = " (docs: /api/v1/docs)" if cfg.api.docs else ""
-            tokens = (
-                f"token in {runtime.token_path}, read-only token in {runtime.read_token_path}"
-                if runtime.token_required
-                else "no token"
-            )
-            err_console.print(f"API on http://{host}:{port}/api/v1{docs}; {tokens}", markup=False)
-            if not runtime.token_required:
-                where = "on this machine" if host in ("127.0.0.1", "::1") else f"that reaches {host}"
-                err_console.print(
-                    f"warning: --no-token: any program or user {where} can read and command "
-                    "the instances through the API",
-                    markup=False,
-                )
-            if cfg.api.docs:
-                err_console.print(
-                    "warning: [api] docs = true: /api/v1/docs loads Swagger UI from a CDN "
-                    "(third-party code in the page where the token is typed)",
-                    markup=False,
-                )
-        deadline = None if duration is None else time.monotonic() + duration
-        live_table = table and console.is_terminal
-        last = _run(runtime, console, stop, deadline, live_table)
-    except KeyboardInterrupt:
-        last = None
+        yield
     finally:
-        stop.set()  # from here a signal means "exit at once"
-        if runtime.started and runtime.links:
-            err_console.print(
-                f"stopping: safe values to the field (at most {runtime.stop_bound():.3g} s; "
-                "Ctrl-C again to exit at once)",
-                markup=False,
-            )
-        runtime.stop()
         for signum, handler in previous.items():
             signal.signal(signum, handler)
-    if last is not None:
-        _print_events(runtime, last)
-    if runtime.scheduler.error is not None:
-        raise RuntimeError(f"the cycle thread failed: {runtime.scheduler.error}")
+
+
+def _realtime(prio: int) -> None:
+    if prio > 1:
+        # This thread draws the table and holds the interpreter lock meanwhile: an ordinary
+        # process must not preempt it then, the cycle thread would wait (docs/runtime.md).
+        from fuzzyctl.runtime.scheduler import set_fifo
+
+        set_fifo(prio - 1)
+
+
+def _stop(runtime: Any) -> None:
+    if runtime.started and runtime.links:
+        err_console.print(
+            f"stopping: safe values to the field (at most {runtime.stop_bound():.3g} s; "
+            "Ctrl-C again to exit at once)",
+            markup=False,
+        )
+    runtime.stop()
 
 
 def _print_events(runtime: Any, after: int) -> int:

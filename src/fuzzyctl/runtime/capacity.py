@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from fuzzyctl.runtime.events import EventLog
@@ -25,7 +26,7 @@ from fuzzyctl.runtime.events import EventLog
 if TYPE_CHECKING:
     from fuzzyctl.runtime.core import Runtime
 
-__all__ = ["CAPACITY", "CapacityEstimate", "estimate", "warnings"]
+__all__ = ["CAPACITY", "CapacityEstimate", "check", "estimate", "warnings"]
 
 CAPACITY = 0.30
 """The estimated load (fraction of one core, as :func:`estimate` computes it) up to which
@@ -85,3 +86,23 @@ def warnings(runtime: Runtime, est: CapacityEstimate) -> list[str]:
             "and on a loaded machine its jitter reaches tens of milliseconds (docs/runtime.md, Timing)"
         )
     return out
+
+
+def check(config: str | Path) -> tuple[str, list[str]]:
+    """``fuzzyctl serve --check``: read and check ``config`` (a :class:`ConfigError` lists
+    every problem), time its cycles, and say what it needs - one line, and the warnings."""
+    from fuzzyctl.runtime.config import ConfigError
+    from fuzzyctl.runtime.core import Runtime, check_config
+
+    checked, problems = check_config(config)
+    if problems:
+        raise ConfigError(problems)
+    assert checked is not None
+    runtime = Runtime(checked, api=False, event_log=None)
+    est = estimate(runtime)  # times the cycles: a runtime that is then dropped
+    runtime.stop()
+    summary = (
+        f"{config}: OK: {len(checked.instances)} instance(s), {len(checked.connections)} connection(s); "
+        f"the cycles need about {est.load:.1%} of one core (capacity {CAPACITY:.0%})"
+    )
+    return summary, warnings(runtime, est)

@@ -90,3 +90,28 @@ def render(runtime: Runtime, *, events: int = 8, max_instances: int = 40) -> Gro
         log.append(f"{e.seq:>6} {e.time[11:23]} {e.kind:<16} ", style="dim")
         log.append(e.message + "\n", style=_LEVEL_STYLE.get(e.level, ""))
     return Group(inst_table, link_table, Text("events", style="bold"), log)
+
+
+def api_banner(runtime: Runtime, docs: bool) -> tuple[str, list[str]]:
+    """What ``fuzzyctl serve`` says about its API once it listens: where, where the tokens
+    are, and the warnings (no token; Swagger UI loaded from a CDN)."""
+    assert runtime.api_address is not None
+    host, port = runtime.api_address
+    where_docs = " (docs: /api/v1/docs)" if docs else ""
+    tokens = (
+        f"token in {runtime.token_path}, read-only token in {runtime.read_token_path}"
+        if runtime.token_required
+        else "no token"
+    )
+    warnings = []
+    if not runtime.token_required:
+        where = "on this machine" if host in ("127.0.0.1", "::1") else f"that reaches {host}"
+        warnings.append(
+            f"--no-token: any program or user {where} can read and command the instances through the API"
+        )
+    if docs:
+        warnings.append(
+            "[api] docs = true: /api/v1/docs loads Swagger UI from a CDN "
+            "(third-party code in the page where the token is typed)"
+        )
+    return f"API on http://{host}:{port}/api/v1{where_docs}; {tokens}", warnings
