@@ -14,6 +14,7 @@ from typing import Annotated, Any
 
 import typer
 
+from fuzzyctl.blocks.samples import integer, number, read_samples
 from fuzzyctl.cli.app import FromOpt, app, err_console
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, InputError
 
@@ -59,50 +60,6 @@ def _load(path: Path, fmt: str | None = None) -> Any:
         if d.severity.value == "warning":
             err_console.print(d.render(), markup=False)
     return loaded.document
-
-
-def _read_samples(path: Path) -> tuple[list[str], list[tuple[int, dict[str, str]]]]:
-    from fuzzyctl.api import require_file
-
-    require_file(path)
-    text = path.read_text(encoding="utf-8-sig")
-    reader = csv.reader(io.StringIO(text))
-    rows = [(n, r) for n, r in enumerate(reader, start=1) if r and any(c.strip() for c in r)]
-    if not rows:
-        raise InputError(f"{path}: no header row")
-    header = [c.strip() for c in rows[0][1]]
-    if len(set(header)) != len(header):
-        raise InputError(f"{path}:{rows[0][0]}: a column name appears twice")
-    samples = []
-    for lineno, row in rows[1:]:
-        if len(row) > len(header):
-            raise InputError(f"{path}:{lineno}: {len(row)} cells for {len(header)} columns")
-        samples.append((lineno, {h: c.strip() for h, c in zip(header, row, strict=False) if c.strip()}))
-    return header, samples
-
-
-def _number(text: str, where: str) -> float:
-    try:
-        return float(text)
-    except ValueError:
-        raise InputError(f"{where}: {text!r} is not a number") from None
-
-
-def _integer(text: str, where: str) -> int:
-    t = text.strip().upper()
-    for prefix in ("W#16#", "B#16#", "16#", "0X"):
-        if t.startswith(prefix):
-            try:
-                return int(t[len(prefix) :], 16)
-            except ValueError:
-                break
-    try:
-        value = float(t)
-    except ValueError:
-        raise InputError(f"{where}: {text!r} is not an integer") from None
-    if not value.is_integer():
-        raise InputError(f"{where}: {text!r} is not an integer")
-    return int(value)
 
 
 def _emit(rows: list[dict[str, Any]], columns: list[str], output: Path | None, as_json: bool) -> None:
@@ -159,7 +116,7 @@ def siemens(
         raise _located(exc.diagnostics, application) from None
     for d in _located(fb.diagnostics, application).diagnostics:
         err_console.print(d.render(_source(application)), markup=False)
-    header, rows = _read_samples(samples)
+    header, rows = read_samples(samples)
     allowed = set(fb.input_names) | {f"INPUT{i}" for i in range(1, 9)} | {"START_STOP"}
     unknown = [h for h in header if h not in allowed]
     if unknown:
@@ -171,8 +128,8 @@ def siemens(
     for cycle, (lineno, values) in enumerate(rows):
         where = f"{samples}:{lineno}"
         if "START_STOP" in values:
-            fb.START_STOP = _integer(values.pop("START_STOP"), f"{where} START_STOP") & 0xFFFF
-        fb.set_inputs({k: _number(v, f"{where} {k}") for k, v in values.items()})
+            fb.START_STOP = integer(values.pop("START_STOP"), f"{where} START_STOP") & 0xFFFF
+        fb.set_inputs({k: number(v, f"{where} {k}") for k, v in values.items()})
         info = fb.execute()
         row: dict[str, Any] = {"cycle": cycle}
         row.update(fb.output_values())
@@ -223,89 +180,21 @@ def xfuz(
     O1_MAN..O6_MAN, O1_DEF..O6_DEF.  The block starts from a cold restart: MANUAL mode,
     START = 0, on-demand mode unless CONTASK$ = 0.  Output columns: cycle, time, OUT1..OUT6,
     O1_CALC..O6_CALC, STATUS, STATUS_BITS, ERROR, INFERRED (1 when the rules ran)."""
-    from fuzzyctl.blocks.schneider import XfuzFB
-    from fuzzyctl.blocks.task import CyclicTask
-    from fuzzyctl.formats.xfuz.reader import read_tables
-    from fuzzyctl.formats.xfuz.writer import constants_from_model, slot_labels
+    from fuzzyctl.blocks.samples import run_xfuz
 
-    names: dict[str, str] = {}
-    text = knowledge_base.read_text(encoding="utf-8-sig")
-    if knowledge_base.suffix.lower() == ".xfuz":
-        constants = read_tables(text, path=str(knowledge_base))
-    else:
-        document = _load(knowledge_base, from_format)
-        constants, diags = constants_from_model(document)
-        for d in diags:
-            err_console.print(d.render(), markup=False)
-        if any(d.is_error for d in diags):
-            raise DiagnosticError([d for d in diags if d.is_error])
-        names = slot_labels(document)
-    fb = XfuzFB(constants, task_period=period, span_rule=not relaxed_span)
-    for issue in fb.kb_issues:
+    run = run_xfuz(
+        knowledge_base,
+        samples,
+        period=period,
+        span_rule=not relaxed_span,
+        degre=degre,
+        format=from_format,
+        warn=lambda text: err_console.print(text, markup=False),
+    )
+    _emit(run.rows, run.columns, output, as_json)
+    if run.failure is not None:
         err_console.print(
-            f"{knowledge_base}: STATUS bit {issue.bit}: {issue.location} {issue.message}".replace(
-                ":  ", ": "
-            ),
-            markup=False,
-        )
-    header, rows = _read_samples(samples)
-    for h in header:
-        try:
-            fb[names.get(h, h)]
-        except KeyError:
-            raise InputError(
-                f"{samples}: unknown column {h!r} (INP1..INP8, "
-                f"{', '.join(names) + ', ' if names else ''}INIT, MAN_AUTO, CONT_ASK, START, "
-                "REFRESH, INHIB, COMMAND, T_OFB, Ii_SIM, Oi_MAN, Oi_DEF)"
-            ) from None
-    out_rows: list[dict[str, Any]] = []
-    task = CyclicTask(period)
-    pending: list[tuple[int, dict[str, str]]] = list(rows)
-
-    def cycle(ctx: Any) -> None:
-        lineno, values = pending[ctx.index]
-        for key, raw in values.items():
-            try:
-                fb[names.get(key, key)] = _integer(raw, f"{samples}:{lineno} {key}")
-            except KeyError as exc:
-                raise InputError(f"{samples}:{lineno}: {exc.args[0]}") from None
-        snap = fb.execute(ctx.period)
-        row: dict[str, Any] = {"cycle": ctx.index, "time": round(ctx.index * ctx.period, 9)}
-        row.update({f"OUT{i + 1}": v for i, v in enumerate(snap.out)})
-        row.update({f"O{i + 1}_CALC": v for i, v in enumerate(snap.o_calc)})
-        row.update(
-            {
-                "STATUS": snap.status,
-                "STATUS_BITS": " ".join(map(str, fb.status_bits)),
-                "ERROR": int(snap.error),
-                "INFERRED": int(snap.inferred),
-            }
-        )
-        if degre:
-            row.update({f"DEGRE{k}": v for k, v in enumerate(snap.degre[: max(1, len(fb.kb.rules))])})
-        out_rows.append(row)
-
-    task.add(cycle)
-    if pending:
-        task.run(len(pending))
-    columns = [
-        "cycle",
-        "time",
-        *(f"OUT{i}" for i in range(1, 7)),
-        *(f"O{i}_CALC" for i in range(1, 7)),
-        "STATUS",
-        "STATUS_BITS",
-        "ERROR",
-        "INFERRED",
-    ]
-    if degre:
-        columns += [f"DEGRE{k}" for k in range(max(1, len(fb.kb.rules)))]
-    _emit(out_rows, columns, output, as_json)
-    if out_rows and out_rows[-1]["ERROR"]:
-        bits = out_rows[-1]["STATUS_BITS"] or "none"
-        err_console.print(
-            f"error: the block ended in its error state (ERROR = 1, STATUS bits {bits}); "
-            "see docs/blocks.md, STATUS",
+            f"error: the block ended in its error state ({run.failure}); see docs/blocks.md, STATUS",
             markup=False,
         )
         raise typer.Exit(1)
