@@ -9,13 +9,17 @@ from typing import Annotated
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import app
 
 
 @app.command()
 def analyze(
     file: Annotated[
-        Path, typer.Argument(help="The fuzzy system (FCL, FIS, FLL, ...).", exists=True, dir_okay=False)
+        Path,
+        typer.Argument(
+            help=f"The fuzzy system ({formats.names_text(' or ', upper=True)}).", exists=True, dir_okay=False
+        ),
     ],
     epsilon: Annotated[
         float,

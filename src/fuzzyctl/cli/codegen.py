@@ -10,6 +10,7 @@ from typing import Annotated
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console, usage_errors
 
 
@@ -31,7 +32,9 @@ class Dialect(StrEnum):
 def codegen(
     source: Annotated[
         Path,
-        typer.Argument(help="Fuzzy system to translate (FCL, FIS, FLL, ...).", show_default=False),
+        typer.Argument(
+            help=f"Fuzzy system to translate ({formats.names_text(' or ', upper=True)}).", show_default=False
+        ),
     ],
     lang: Annotated[
         Lang,

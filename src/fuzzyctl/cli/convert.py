@@ -17,9 +17,7 @@ def convert(
     target: Annotated[Path, typer.Argument(help="File to write (replaced atomically).", dir_okay=False)],
     from_format: Annotated[
         str | None,
-        typer.Option(
-            "--from", help=f"Format of SOURCE ({formats.names_text()}); default: its extension."
-        ),
+        typer.Option("--from", help=f"Format of SOURCE ({formats.names_text()}); default: its extension."),
     ] = None,
     to_format: Annotated[
         str | None, typer.Option("--to", help="Format of TARGET; default: its extension.")

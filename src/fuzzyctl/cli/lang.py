@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import EXIT_ERRORS, EXIT_OK, EXIT_USAGE, FORCE_HINT, FromOpt, app, err_console
 
 if TYPE_CHECKING:
@@ -28,7 +29,7 @@ def check(
     file: Annotated[
         Path | None,
         typer.Argument(
-            help="Model to check: FCL, FIS, FLL, JSON, FPL or XFUZ (with --conformance: an FCL "
+            help=f"Model to check: {formats.names_text(' or ', upper=True)} (with --conformance: an FCL "
             "program to measure).",
             show_default=False,
         ),
@@ -184,7 +185,10 @@ def _print_statement(file: Path | None) -> None:
 @app.command()
 def fmt(
     file: Annotated[
-        Path, typer.Argument(help="Model to print as FCL (FCL, FIS, FLL, JSON, ...).", show_default=False)
+        Path,
+        typer.Argument(
+            help=f"Model to print as FCL ({formats.names_text(' or ', upper=True)}).", show_default=False
+        ),
     ],
     output: Annotated[
         Path | None, typer.Option("-o", "--output", help="Write to this file instead of standard output.")

@@ -10,6 +10,7 @@ from typing import Annotated, Any
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import FromOpt, app
 from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
@@ -28,7 +29,7 @@ CompatOpt = Annotated[
     str, typer.Option("--compat", help="Semantics: iec (default), fuzzylite, pyfuzzylite, jfuzzylogic.")
 ]
 ModelArg = Annotated[
-    Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+    Path, typer.Argument(help=f"Fuzzy system ({formats.names_text(' or ', upper=True)}).", show_default=False)
 ]
 OutOfRangeOpt = Annotated[
     str,
@@ -103,7 +104,8 @@ def _fmt(v: float) -> str:
 @app.command("eval")
 def eval_(
     file: Annotated[
-        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+        Path,
+        typer.Argument(help=f"Fuzzy system ({formats.names_text(' or ', upper=True)}).", show_default=False),
     ],
     set_: SetOpt = None,
     data: Annotated[
@@ -275,7 +277,8 @@ def _print_outputs(title: str, result: Mapping[str, float]) -> None:
 @app.command()
 def explain(
     file: Annotated[
-        Path, typer.Argument(help="Fuzzy system (FCL, FIS, FLL, JSON, FPL or XFUZ).", show_default=False)
+        Path,
+        typer.Argument(help=f"Fuzzy system ({formats.names_text(' or ', upper=True)}).", show_default=False),
     ],
     set_: SetOpt = None,
     png: Annotated[

@@ -12,6 +12,7 @@ from typing import Annotated, Any
 
 import typer
 
+from fuzzyctl import formats
 from fuzzyctl.cli.app import FromOpt, app
 
 WorkersOpt = Annotated[
@@ -170,7 +171,10 @@ def learn(
 @app.command("tune")
 def tune(
     file: Annotated[
-        Path, typer.Argument(help="The fuzzy system to tune (FCL, FIS, FLL or JSON).", show_default=False)
+        Path,
+        typer.Argument(
+            help=f"The fuzzy system to tune ({formats.names_text(' or ', upper=True)}).", show_default=False
+        ),
     ],
     output: Annotated[
         Path | None,

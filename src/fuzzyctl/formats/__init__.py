@@ -176,10 +176,11 @@ def extensions() -> tuple[str, ...]:
     return tuple(ext for f in available() for ext in f.extensions)
 
 
-def names_text(last: str = ", ") -> str:
+def names_text(last: str = ", ", *, upper: bool = False) -> str:
     """The built-in formats' names for a help text: ``fcl, fis, ..., xfuz`` (``last`` joins
-    the last two)."""
-    return ", ".join(KNOWN_NAMES[:-1]) + last + KNOWN_NAMES[-1]
+    the last two; ``upper``: ``FCL, FIS, ...``)."""
+    names = [n.upper() if upper else n for n in KNOWN_NAMES]
+    return ", ".join(names[:-1]) + last + names[-1]
 
 
 def decode(data: bytes) -> str:

@@ -327,7 +327,9 @@ async function start() {
   const [info, shapes] = await Promise.all([get("/api/info"), get("/api/shapes")]);
   state.info = info;
   // The import dialog offers what the server's format registry reads (no list of our own).
-  $("#import-file").accept = info.formats.filter((f) => f.read).flatMap((f) => f.extensions).join(",");
+  const readable = info.formats.filter((f) => f.read);
+  $("#import-file").accept = readable.flatMap((f) => f.extensions).join(",");
+  $("#btn-import").title = `Import ${readable.map((f) => f.name.toUpperCase()).join(", ")}`;
   setShapes(shapes);
   if (state.info.file) await openPath(state.info.file);
   else status("New (Alt+N) creates a project, Open (Ctrl+O) opens one from the project directory.");
