@@ -2,7 +2,7 @@
 FCL -> FIS -> FCL over every file of the corpus (extra suite) and of the vendored conformance data
 (identical files counted once per set), evaluated with the engine on random inputs.
 
-For each file: read it (A), convert it (``Format.lower`` + ``write``) and read the result
+For each file: read it (A), convert it (``Format.adapt`` + ``write``) and read the result
 back (B; for FCL -> FIS -> FCL, B is the FIS and C the FCL written from it), then evaluate A
 and B (and C) on the same random input sequence with ``evaluate_batch`` and require every
 output to agree within 1e-9 (absolute).  Inputs are
