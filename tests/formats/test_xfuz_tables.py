@@ -10,6 +10,7 @@ import pytest
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats.xfuz.reader import model_from_constants, read_tables, read_xfuz
+from fuzzyctl.formats.xfuz.tablefile import write_tables
 from fuzzyctl.formats.xfuz.tables import (
     StatusBit,
     XfuzConstants,
@@ -17,7 +18,7 @@ from fuzzyctl.formats.xfuz.tables import (
     decode_name,
     encode_name,
 )
-from fuzzyctl.formats.xfuz.writer import constants_from_model, write_tables, write_xfuz
+from fuzzyctl.formats.xfuz.writer import constants_from_model, write_xfuz
 from fuzzyctl.model import (
     And,
     Conclusion,
