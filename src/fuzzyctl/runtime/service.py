@@ -11,7 +11,6 @@ parsing, no JSON of a whole request, no waiting on a client.  Snapshots are shar
 
 from __future__ import annotations
 
-import math
 import threading
 import time
 from collections.abc import Callable
@@ -19,12 +18,13 @@ from typing import TYPE_CHECKING, Any
 
 from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
+from fuzzyctl.jsonsafe import clean
 
 if TYPE_CHECKING:
     from fuzzyctl.runtime.core import Runtime
     from fuzzyctl.runtime.instance import Instance
 
-__all__ = ["MAX_DIAGNOSTICS", "SNAPSHOT_TTL", "Service", "ServiceError", "clean", "short"]
+__all__ = ["MAX_DIAGNOSTICS", "SNAPSHOT_TTL", "Service", "ServiceError", "short"]
 
 SNAPSHOT_TTL = 0.04  # s: live clients at 20 Hz share one snapshot per instance and tick
 MAX_DIAGNOSTICS = 50  # diagnostics returned for a refused download
@@ -47,17 +47,6 @@ class ServiceError(FuzzyctlError):
         if self.diagnostics is not None:
             out["diagnostics"] = self.diagnostics
         return out
-
-
-def clean(obj: Any) -> Any:
-    """JSON-safe: NaN and infinities become null (JSON has no NaN)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [clean(v) for v in obj]
-    return obj
 
 
 def short(text: str, limit: int = MAX_TEXT) -> str:

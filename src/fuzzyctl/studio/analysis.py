@@ -514,16 +514,5 @@ def record(
     }
 
 
-def clean(obj: Any) -> Any:
-    """JSON-ready: NaN and infinities become None (JSON has no such numbers)."""
-    if isinstance(obj, float):
-        return obj if math.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: clean(v) for k, v in obj.items()}
-    if isinstance(obj, list | tuple):
-        return [clean(v) for v in obj]
-    return obj
-
-
 def dumps(data: Any) -> str:
     return json.dumps(data, allow_nan=False)

@@ -9,6 +9,7 @@ from typing import Any
 from fastapi import APIRouter
 
 from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.jsonsafe import clean
 from fuzzyctl.model import SHAPES, FunctionBlock
 from fuzzyctl.studio import analysis, editing, ruleview
 from fuzzyctl.studio.project import split_settings
@@ -36,7 +37,7 @@ def check(body: ModelBody) -> Any:
     text = analysis.fcl_text(document)
     report = analysis.check_text(text)
     ranges = analysis.display_ranges(fb, settings_of(body))
-    return analysis.clean(
+    return clean(
         {
             "text": text,
             "ranges": ranges,
@@ -59,7 +60,7 @@ def parse(body: TextBody) -> Any:
         out["ranges"] = analysis.display_ranges(document.main, settings)
     else:
         out["document"] = None
-    return analysis.clean(out)
+    return clean(out)
 
 
 @router.get("/api/shapes")
@@ -75,13 +76,13 @@ def shapes() -> dict[str, Any]:
 def rules_parse(body: RulesTextBody) -> Any:
     """The rule text editor: one rule per line, read by the FCL parser and checked;
     the rules when the lines have no errors, diagnostics with the typed lines' numbers."""
-    return analysis.clean(editing.parse_rules(edited_block(body), body.rule_block, body.text))
+    return clean(editing.parse_rules(edited_block(body), body.rule_block, body.text))
 
 
 @router.post("/api/term/parse")
 def term_parse(body: TermTextBody) -> Any:
     """A term written as FCL (any spelling the parser reads): its model form."""
-    return analysis.clean(editing.parse_term(edited_block(body), body.variable, body.text))
+    return clean(editing.parse_term(edited_block(body), body.variable, body.text))
 
 
 @router.post("/api/ruleview")
@@ -90,4 +91,4 @@ def rule_view(body: RuleViewBody, studio: StudioDep) -> Any:
     conclusion's activated set, the accumulated sets and the outputs."""
     fb = edited_block(body)
     ranges = analysis.display_ranges(fb, body.settings.model_dump(exclude_none=True))
-    return analysis.clean(ruleview.rule_view(studio.cache.get(fb, "ruleview"), fb, body.inputs, ranges))
+    return clean(ruleview.rule_view(studio.cache.get(fb, "ruleview"), fb, body.inputs, ranges))

@@ -9,8 +9,8 @@ from fastapi.responses import JSONResponse
 
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from fuzzyctl.files import ReadOnlyError
+from fuzzyctl.jsonsafe import clean
 from fuzzyctl.studio import online
-from fuzzyctl.studio.analysis import clean
 from fuzzyctl.studio.project import FileProblem, PathError, os_problem
 
 

@@ -14,8 +14,8 @@ from fastapi.responses import JSONResponse
 from fuzzyctl import __version__, formats
 from fuzzyctl.diagnostics import FuzzyctlError, InputError
 from fuzzyctl.files import check_writable
+from fuzzyctl.jsonsafe import clean
 from fuzzyctl.studio import analysis, viewsettings
-from fuzzyctl.studio.analysis import clean
 from fuzzyctl.studio.project import (
     MAX_FILE,
     FileProblem,

@@ -8,7 +8,7 @@ from typing import Any
 from fastapi import APIRouter
 from fastapi.responses import JSONResponse
 
-from fuzzyctl.studio.analysis import clean
+from fuzzyctl.jsonsafe import clean
 from fuzzyctl.studio.routes.state import StudioDep, model_of
 from fuzzyctl.studio.schemas import SimStartBody, SimStepBody
 from fuzzyctl.studio.simulate import describe_configs
