@@ -160,7 +160,7 @@ def learn(
     )
     result.write_fcl(out)
     if as_json:
-        typer.echo(json.dumps({"file": str(out), "rules": result.rules, **result.scores}))
+        typer.echo(json.dumps(result.to_dict(out)))
         return
     rows = [(k, v) for k, v in result.scores.items() if not k.endswith("rows")]
     _print_table(f"{out}: {result.kind} by {result.method}, {result.rules} rules", rows)

@@ -106,6 +106,11 @@ class LearnResult:
         path.write_text(write(self.document), encoding="utf-8")
         return path
 
+    def to_dict(self, file: str | Path | None = None) -> dict[str, Any]:
+        """What ``fuzzyctl learn --json`` prints: the file written, the rule count and the
+        errors on the training and validation rows."""
+        return {"file": None if file is None else str(file), "rules": self.rules, **self.scores}
+
 
 def default_terms(method: str, inputs: int) -> int:
     """Grid: 5 terms per input for one or two inputs, 3 for three or four, then 2 (the
