@@ -59,8 +59,8 @@ def test_valid_and_equal_to_the_engine(name: str, fmi: int, tmp_path: Path) -> N
     sig = signal(ctl, out.path)
     ins, outs = list(ctl.inputs), list(ctl.outputs)
     res = fmpy.simulate_fmu(
-        str(out.path), input=sig, output=[*ins, *outs, "INFO"], step_size=0.01, stop_time=float(sig["time"][-1]),
-        output_interval=0.01,
+        str(out.path), input=sig, output=[*ins, *outs, "INFO"], step_size=0.01,
+        stop_time=float(sig["time"][-1]), output_interval=0.01,
     )  # fmt: skip
     assert len(res) == len(sig)
     # the inputs the FMU computed with, row by row (FMPy interpolates the signal)
@@ -100,7 +100,9 @@ def test_a_tuned_parameter_is_the_changed_model(fmi: int, tmp_path: Path) -> Non
         str(out.path), input=sig, output=["temp", "pressure", "valve"], step_size=0.01,
         stop_time=float(sig["time"][-1]), start_values={"FZ_valve_S[2]": 50.0},
     )  # fmt: skip
-    expected = [ctl.evaluate({"temp": float(r["temp"]), "pressure": float(r["pressure"])})["valve"] for r in res]
+    expected = [
+        ctl.evaluate({"temp": float(r["temp"]), "pressure": float(r["pressure"])})["valve"] for r in res
+    ]
     assert np.max(np.abs(np.array(expected) - res["valve"])) < 1e-9 * 200
 
 
@@ -131,7 +133,9 @@ def test_block_named_like_the_framework_is_refused() -> None:
 
 def test_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     fmu = tmp_path / "f7.fmu"
-    assert main(["codegen", str(EXAMPLES / "figure7.fcl"), "--lang", "fmu", "--fmi", "2", "-o", str(fmu)]) == 0
+    assert (
+        main(["codegen", str(EXAMPLES / "figure7.fcl"), "--lang", "fmu", "--fmi", "2", "-o", str(fmu)]) == 0
+    )
     assert "FMI 2 co-simulation, binary binaries/linux64/Fuzzy_FB.so" in capsys.readouterr().err
     assert fmpy.read_model_description(str(fmu)).fmiVersion == "2.0"
     for args, message in [

@@ -31,7 +31,18 @@ def build(model: str = "StateSpace") -> Path:
         with tarfile.open(TARBALL) as tf:
             tf.extractall(where / "src", filter="data")
         src = where / "src" / "Reference-FMUs"
-        _run(["cmake", "-S", str(src), "-B", str(where / "b"), "-DFMI_VERSION=3", "-DCMAKE_BUILD_TYPE=Release"], where)
+        _run(
+            [
+                "cmake",
+                "-S",
+                str(src),
+                "-B",
+                str(where / "b"),
+                "-DFMI_VERSION=3",
+                "-DCMAKE_BUILD_TYPE=Release",
+            ],
+            where,
+        )
         _run(["cmake", "--build", str(where / "b"), "--target", model], where)
         shutil.copy(where / "b" / "fmus" / f"{model}.fmu", where / f"{model}.fmu")
         shutil.rmtree(where / "src")

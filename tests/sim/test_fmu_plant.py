@@ -73,7 +73,13 @@ def reference(dt: float, n: int, method: str) -> tuple[np.ndarray, np.ndarray]:
     err = ct.summing_junction(inputs=["w", "-y"], output="e", dt=dt, name="sum")
     loop = ct.interconnect(
         [K, D, G, err],
-        connections=[["K.error", "sum.e"], ["D.e", "sum.e"], ["K.derror", "D.de"], ["G.u", "K.du"], ["sum.y", "G.y"]],
+        connections=[
+            ["K.error", "sum.e"],
+            ["D.e", "sum.e"],
+            ["K.derror", "D.de"],
+            ["G.u", "K.du"],
+            ["sum.y", "G.y"],
+        ],
         inplist=["sum.w"],
         outlist=["G.y", "K.du"],
         inputs="w",
@@ -106,7 +112,9 @@ def test_reset_starts_a_new_instance(loop_dir: Path) -> None:
 
 
 def test_tune_improves_the_cost(loop_dir: Path) -> None:
-    r = fuzzyctl.tune(loop_dir / "pi.fcl", plant_config=loop_dir / "statespace.toml", budget=12, workers=0, seed=0)
+    r = fuzzyctl.tune(
+        loop_dir / "pi.fcl", plant_config=loop_dir / "statespace.toml", budget=12, workers=0, seed=0
+    )
     assert r.kind == "plant"
     assert r.after < r.before
 
@@ -140,11 +148,20 @@ def _model_exchange_only(src: Path, dst: Path) -> None:
     ("edit", "message"),
     [
         (('fmu = "StateSpace.fmu"', 'fmu = "nope.fmu"'), "[plant] fmu 'nope.fmu': no such file"),
-        (('inputs = { u = "u[1]" }', 'inputs = { u = "v" }'), "[plant] inputs.u: 'v' is not an input of StateSpace.fmu"),
+        (
+            ('inputs = { u = "u[1]" }', 'inputs = { u = "v" }'),
+            "[plant] inputs.u: 'v' is not an input of StateSpace.fmu",
+        ),
         (('inputs = { u = "u[1]" }', 'inputs = { u = "u" }'), "inputs.u: 'u' of StateSpace.fmu has 3 values"),
-        (('outputs = { y = "y[1]" }', 'outputs = { y = "y[4]" }'), "outputs.y: 'y' of StateSpace.fmu has 3 values"),
+        (
+            ('outputs = { y = "y[1]" }', 'outputs = { y = "y[4]" }'),
+            "outputs.y: 'y' of StateSpace.fmu has 3 values",
+        ),
         (("D = [[0,", "DD = [[0,"), "StateSpace.fmu has no parameter 'DD'"),
-        (("D = [[0, 0, 0], [0, 0, 0], [0, 0, 0]]", "D = [[0, 0], [0, 0]]"), "parameter 'D' has 9 value(s), got 4"),
+        (
+            ("D = [[0, 0, 0], [0, 0, 0], [0, 0, 0]]", "D = [[0, 0], [0, 0]]"),
+            "parameter 'D' has 9 value(s), got 4",
+        ),
         (('fmu = "StateSpace.fmu"', 'fmu = "StateSpace.fmu"\nmodel = "fopdt"'), "give either model or fmu"),
         (('fmu = "StateSpace.fmu"', 'fmu = "me.fmu"'), "me.fmu: the FMU is model exchange only"),
         (('fmu = "StateSpace.fmu"', 'fmu = "pi.fcl"'), "pi.fcl: not an FMU"),

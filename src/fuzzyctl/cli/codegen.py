@@ -105,7 +105,8 @@ def codegen(
         bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
     ] = False,
     fmi: Annotated[
-        int | None, typer.Option("--fmi", help="fmu only: FMI version 2 or 3 (default: 3).", show_default=False)
+        int | None,
+        typer.Option("--fmi", help="fmu only: FMI version 2 or 3 (default: 3).", show_default=False),
     ] = None,
     no_binary: Annotated[
         bool, typer.Option("--no-binary", help="fmu only: sources only, no binary (no C compiler needed).")

@@ -124,7 +124,8 @@ def model_description(
     lines = ['<?xml version="1.0" encoding="UTF-8"?>', f"<fmiModelDescription{head}>"]
     cs = _attrs(modelIdentifier=ident, canHandleVariableCommunicationStepSize="true")
     if fmi == 2:
-        cs += ' canNotUseMemoryManagementFunctions="true" canGetAndSetFMUstate="true" canSerializeFMUstate="true"'
+        cs += ' canNotUseMemoryManagementFunctions="true"'
+        cs += ' canGetAndSetFMUstate="true" canSerializeFMUstate="true"'
         lines.append(f"  <CoSimulation{cs}>")
         lines.append("    <SourceFiles>")
         lines += [f"      <File{_attrs(name=s)}/>" for s in sources]
@@ -149,7 +150,11 @@ def model_description(
 def _variables(iface: Interface, fmi: int) -> list[str]:
     time = _attrs(name="time", valueReference="0", causality="independent", variability="continuous")
     time_desc = _attrs(description="Simulation time")
-    out = [f"    <ScalarVariable{time}{time_desc}><Real/></ScalarVariable>" if fmi == 2 else f"    <Float64{time}{time_desc}/>"]
+    out = [
+        f"    <ScalarVariable{time}{time_desc}><Real/></ScalarVariable>"
+        if fmi == 2
+        else f"    <Float64{time}{time_desc}/>"
+    ]
     for v in iface.variables:
         causality, variability, start, initial = {
             "input": ("input", "continuous", _num(v.start or 0.0), None),

@@ -21,8 +21,9 @@ FMPy is imported only here, when a loop uses an FMU (``pip install 'fuzzyctl[fmi
 from __future__ import annotations
 
 import atexit
-import re
+import contextlib
 import math
+import re
 import shutil
 import weakref
 from collections.abc import Mapping
@@ -50,7 +51,9 @@ def _fmpy() -> Any:
     try:
         import fmpy
     except ModuleNotFoundError:
-        raise InputError("an FMU plant needs FMPy: pip install 'fuzzyctl[fmi]' (or pip install fmpy)") from None
+        raise InputError(
+            "an FMU plant needs FMPy: pip install 'fuzzyctl[fmi]' (or pip install fmpy)"
+        ) from None
     return fmpy
 
 
@@ -124,7 +127,9 @@ def _platforms(path: Path) -> list[str]:
     import zipfile
 
     with zipfile.ZipFile(path) as zf:
-        return sorted({n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/") and n.count("/") >= 2})
+        return sorted(
+            {n.split("/")[1] for n in zf.namelist() if n.startswith("binaries/") and n.count("/") >= 2}
+        )
 
 
 def _size(var: Any, structural: Mapping[str, float], variables: Mapping[str, Any]) -> int:
@@ -155,10 +160,8 @@ class FmuState:
 
 
 def _free(slave: Any) -> None:
-    try:
+    with contextlib.suppress(Exception):  # an instance that failed to start cannot terminate
         slave.terminate()
-    except Exception:  # an instance that failed to start cannot terminate; it is still freed
-        pass
     slave.freeInstance()
 
 
@@ -218,7 +221,10 @@ class FmuPlant(Plant[FmuState]):
             return {k: f"{v}[{i + 1}]" if self._size_of(v) > 1 else v for k, (v, i) in m.items()}
 
         return FmuPlant(
-            self.file.path, names(self.input_map), names(self.output_map), {**self.parameter_values, **changes}
+            self.file.path,
+            names(self.input_map),
+            names(self.output_map),
+            {**self.parameter_values, **changes},
         )
 
     def _size_of(self, name: str) -> int:
@@ -231,16 +237,18 @@ class FmuPlant(Plant[FmuState]):
         for name, value in self.parameter_values.items():
             var = variables.get(name)
             if var is None or var.causality not in ("parameter", "structuralParameter"):
-                known = [v.name for v in variables.values() if v.causality in ("parameter", "structuralParameter")]
+                known = [
+                    v.name for v in variables.values() if v.causality in ("parameter", "structuralParameter")
+                ]
                 raise InputError(
                     f"{where} has no parameter {name!r} (parameters: {', '.join(known) or 'none'})"
                 )
             if var.variability == "constant" or var.type not in _NUMERIC:
                 raise InputError(f"{where}: parameter {name!r} ({var.type}, {var.variability}) cannot be set")
             for x in _flatten(value):
-                if isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x):
-                    if not (isinstance(x, bool) and var.type == "Boolean"):
-                        raise InputError(f"{where}: parameter {name!r} must be numbers, got {value!r}")
+                bad = isinstance(x, bool) or not isinstance(x, int | float) or not math.isfinite(x)
+                if bad and not (isinstance(x, bool) and var.type == "Boolean"):
+                    raise InputError(f"{where}: parameter {name!r} must be numbers, got {value!r}")
             if var.causality == "structuralParameter":
                 structural[name] = float(_flatten(value)[0])
         for name, value in self.parameter_values.items():
@@ -251,7 +259,12 @@ class FmuPlant(Plant[FmuState]):
         return structural
 
     def _mapping(
-        self, given: Mapping[str, str] | None, causality: str, key: str, variables: Mapping[str, Any], where: str
+        self,
+        given: Mapping[str, str] | None,
+        causality: str,
+        key: str,
+        variables: Mapping[str, Any],
+        where: str,
     ) -> dict[str, tuple[str, int]]:
         """loop name -> (FMU variable, 0-based element); ``"y[2]"`` is element 2 of array ``y``
         (1-based, as FMI's structured names count)."""
@@ -284,7 +297,11 @@ class FmuPlant(Plant[FmuState]):
 
     def _start_values(self, var: Any) -> list[float]:
         n = _size(var, self.structural, self.file.variables)
-        raw = var.start.split() if isinstance(var.start, str) else _flatten(var.start if var.start is not None else 0)
+        raw = (
+            var.start.split()
+            if isinstance(var.start, str)
+            else _flatten(var.start if var.start is not None else 0)
+        )
         values = [float(x) for x in raw] or [0.0]
         return (values * n)[:n] if len(values) < n else values[:n]
 
@@ -339,7 +356,9 @@ class FmuPlant(Plant[FmuState]):
             values = [int(v) for v in values]
         getattr(slave, f"set{kind}")([var.valueReference], values)
 
-    def advance(self, state: FmuState, u: Mapping[str, float], t: float, dt: float, integrator: Integrator) -> FmuState:
+    def advance(
+        self, state: FmuState, u: Mapping[str, float], t: float, dt: float, integrator: Integrator
+    ) -> FmuState:
         variables = self.file.variables
         try:
             arrays = {k: list(v) for k, v in self.held.items()}
@@ -351,7 +370,9 @@ class FmuPlant(Plant[FmuState]):
         except Exception as exc:
             raise InputError(f"{self.file.path.name}: doStep at t = {t:g} s failed: {exc}") from None
         if state.fmi == 3 and result[1]:
-            raise InputError(f"{self.file.path.name}: the FMU asked to end the simulation at t = {t + dt:g} s")
+            raise InputError(
+                f"{self.file.path.name}: the FMU asked to end the simulation at t = {t + dt:g} s"
+            )
         return state
 
     def measure(self, state: FmuState) -> dict[str, float]:
@@ -360,8 +381,10 @@ class FmuPlant(Plant[FmuState]):
         for name, (fmu_name, element) in self.output_map.items():
             var = variables[fmu_name]
             n = _size(var, self.structural, variables)
-            values = getattr(state.slave, f"get{var.type}")([var.valueReference], n) if n > 1 else (
-                getattr(state.slave, f"get{var.type}")([var.valueReference])
+            values = (
+                getattr(state.slave, f"get{var.type}")([var.valueReference], n)
+                if n > 1
+                else (getattr(state.slave, f"get{var.type}")([var.valueReference]))
             )
             out[name] = float(values[element])
         return out
