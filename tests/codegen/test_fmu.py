@@ -150,3 +150,14 @@ def test_cli(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["codegen", str(tmp_path / "s.fcl"), "--lang", "fmu", "-o", str(tmp_path / "s.fmu")]) == 1
     err = capsys.readouterr().err
     assert "the FMU framework uses this name" in err and "Traceback" not in err
+
+
+def test_docstring_example(monkeypatch: pytest.MonkeyPatch) -> None:
+    import doctest
+
+    import fuzzyctl.codegen.fmu as module
+    from tests.conftest import ROOT
+
+    monkeypatch.chdir(ROOT)
+    result = doctest.testmod(module, optionflags=doctest.ELLIPSIS)
+    assert result.attempted > 0 and result.failed == 0
