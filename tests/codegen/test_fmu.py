@@ -203,3 +203,13 @@ def test_fmpy_builds_the_source_fmu(fmi: int, tmp_path: Path, monkeypatch: pytes
     assert res["valve"][-1] == pytest.approx(
         ctl.evaluate({"temp": 10.0, "pressure": 60.0})["valve"], abs=1e-12
     )
+
+
+def test_no_compiler_is_a_message(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("CC", "no-such-cc")
+    args = ["codegen", str(EXAMPLES / "figure7.fcl"), "--lang", "fmu", "-o", str(tmp_path / "f.fmu")]
+    assert main(args) == 1
+    assert "no C compiler found" in capsys.readouterr().err and not (tmp_path / "f.fmu").exists()
+    assert main([*args, "--no-binary"]) == 0  # a source FMU needs none

@@ -177,3 +177,12 @@ def test_errors_name_the_file_and_the_key(
     err = capsys.readouterr().err
     assert message in " ".join(err.split()) and "statespace.toml" in err
     assert "Traceback" not in err
+
+
+def test_simulate_cli_with_an_fmu_plant(loop_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
+    toml = loop_dir / "statespace.toml"
+    assert main(["simulate", str(toml), "--json", "--csv", str(loop_dir / "run.csv")]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["quality"]["settling_time"] < 15 and abs(out["quality"]["final_error"]) < 0.01
+    header = (loop_dir / "run.csv").read_text().splitlines()[0].split(",")
+    assert header[:4] == ["t", "w", "y", "u"]
