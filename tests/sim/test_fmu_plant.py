@@ -9,6 +9,9 @@ for the controller, the plant as a ``control.ss``): with the plant sampled exact
 hold) the loops agree to 1e-3 (measured 1.1e-4 over a response spanning 1.02: StateSpace
 integrates with forward Euler at its fixed 1 ms step); with the plant discretised as the FMU
 does (100 Euler steps per 0.1 s cycle) to 1e-9 (measured 3e-14).
+
+Without ../shared, an FMU exported by ``codegen --lang fmu`` (FMI 2 and 3) serves as the plant
+of a PI loop, checked sample by sample against the engine.
 """
 
 from __future__ import annotations
@@ -30,7 +33,8 @@ from fuzzyctl.cli import main  # noqa: E402
 from fuzzyctl.sim.config import build_loop, load_config  # noqa: E402
 from tests.conftest import data_path  # noqa: E402
 
-pytestmark = pytest.mark.extra("reference_fmus")
+#: the tests on StateSpace need the Reference FMUs' source (deselected without ../shared)
+needs_reference_fmus = pytest.mark.extra("reference_fmus")
 
 A = np.array([[0.0, 1.0], [-2.0, -3.0]])
 B = np.array([[0.0], [1.0]])
@@ -91,6 +95,7 @@ def reference(dt: float, n: int, method: str) -> tuple[np.ndarray, np.ndarray]:
     return y, u
 
 
+@needs_reference_fmus
 def test_closed_loop_equals_python_control(loop_dir: Path) -> None:
     config = load_config(loop_dir / "statespace.toml")
     trace = build_loop(config).run(config.duration)
@@ -103,6 +108,7 @@ def test_closed_loop_equals_python_control(loop_dir: Path) -> None:
     assert np.max(np.abs(u[:-1] - ref_u[:-1])) < 1e-9
 
 
+@needs_reference_fmus
 def test_reset_starts_a_new_instance(loop_dir: Path) -> None:
     loop = build_loop(load_config(loop_dir / "statespace.toml"))
     first = [loop.step()["y"] for _ in range(20)]
@@ -111,6 +117,7 @@ def test_reset_starts_a_new_instance(loop_dir: Path) -> None:
     assert first == again and max(first) > 0.05
 
 
+@needs_reference_fmus
 def test_tune_improves_the_cost(loop_dir: Path) -> None:
     r = fuzzyctl.tune(
         loop_dir / "pi.fcl", plant_config=loop_dir / "statespace.toml", budget=12, workers=0, seed=0
@@ -119,6 +126,7 @@ def test_tune_improves_the_cost(loop_dir: Path) -> None:
     assert r.after < r.before
 
 
+@needs_reference_fmus
 def test_tune_cli(loop_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     args = ["tune", str(loop_dir / "pi.fcl"), "--plant", str(loop_dir / "statespace.toml")]
     assert main([*args, "--budget", "8", "--workers", "0", "--json", "-o", str(loop_dir / "tuned.fcl")]) == 0
@@ -144,6 +152,7 @@ def _model_exchange_only(src: Path, dst: Path) -> None:
             zout.writestr(item, data)
 
 
+@needs_reference_fmus
 @pytest.mark.parametrize(
     ("edit", "message"),
     [
@@ -179,6 +188,7 @@ def test_errors_name_the_file_and_the_key(
     assert "Traceback" not in err
 
 
+@needs_reference_fmus
 def test_simulate_cli_with_an_fmu_plant(loop_dir: Path, capsys: pytest.CaptureFixture[str]) -> None:
     toml = loop_dir / "statespace.toml"
     assert main(["simulate", str(toml), "--json", "--csv", str(loop_dir / "run.csv")]) == 0
@@ -186,3 +196,31 @@ def test_simulate_cli_with_an_fmu_plant(loop_dir: Path, capsys: pytest.CaptureFi
     assert out["quality"]["settling_time"] < 15 and abs(out["quality"]["final_error"]) < 0.01
     header = (loop_dir / "run.csv").read_text().splitlines()[0].split(",")
     assert header[:4] == ["t", "w", "y", "u"]
+
+
+@pytest.mark.parametrize("fmi", [2, 3])
+def test_an_exported_fuzzy_block_as_the_plant(fmi: int, tmp_path: Path) -> None:
+    """No ../shared needed: ``codegen --lang fmu`` of a static map (``saturation.fcl``, u = e
+    limited to [-1, 1]) is the plant of a PI loop, FMI 2 and 3.  Each cycle the loop sets the
+    input, steps and measures the next cycle, so u(k) is the engine's map of e(k - 1)."""
+    from fuzzyctl.codegen.fmu import generate_fmu
+    from fuzzyctl.codegen.native import compiler
+
+    if compiler() is None:
+        pytest.skip("no C compiler for the FMU's binary")
+    model = fuzzyctl.load(data_path("control", "saturation.fcl"))
+    generate_fmu(model, tmp_path / "sat.fmu", fmi=fmi)
+    (tmp_path / "loop.toml").write_text(
+        'duration = 8\n[plant]\nfmu = "sat.fmu"\n'
+        '[controller]\nstructure = "pid"\nsetpoint = "w"\nmeasurement = "u"\ndrive = "e"\ncycle = 0.1\n'
+        "[controller.pid]\nkp = 0.5\nti = 0.4\n[setpoints]\nw = { steps = [[0, 1.5], [2, 0.5]] }\n"
+    )
+    config = load_config(tmp_path / "loop.toml")
+    trace = build_loop(config).run(config.duration)
+    e, u = np.asarray(trace["e"]), np.asarray(trace["u"])
+    assert {"ENABLE", "INFO"} <= set(trace.names)  # every FMU input and output, by default
+    ctl = fuzzyctl.compile(model, out_of_range="ignore")
+    expected = [0.0] + [ctl.evaluate({"e": float(x)})["u"] for x in e[:-1]]
+    assert np.max(np.abs(u - expected)) < 1e-12
+    assert np.max(u) == pytest.approx(1.0) and np.max(e) > 1.5  # held at the limit (w = 1.5)
+    assert abs(u[-1] - 0.5) < 0.01  # then settled at w = 0.5

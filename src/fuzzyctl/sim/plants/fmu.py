@@ -145,6 +145,13 @@ def _size(var: Any, structural: Mapping[str, float], variables: Mapping[str, Any
     return n
 
 
+def _number(x: Any) -> float:
+    """A start value as a number (FMI writes Booleans as true/false)."""
+    if isinstance(x, str) and x.lower() in ("true", "false"):
+        return 1.0 if x.lower() == "true" else 0.0
+    return float(x)
+
+
 def _flatten(value: Any) -> list[Any]:
     if isinstance(value, list | tuple):
         return [x for item in value for x in _flatten(item)]
@@ -302,7 +309,7 @@ class FmuPlant(Plant[FmuState]):
             if isinstance(var.start, str)
             else _flatten(var.start if var.start is not None else 0)
         )
-        values = [float(x) for x in raw] or [0.0]
+        values = [_number(x) for x in raw] or [0.0]
         return (values * n)[:n] if len(values) < n else values[:n]
 
     def _port(self, name: str, var: Any, element: int, is_input: bool) -> Port:
