@@ -1,5 +1,6 @@
-"""``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
-function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
+"""``fuzzyctl codegen FILE --lang st|plcopen|c|fmu``: IEC 61131-3 Structured Text, the same
+function blocks as PLCopen TC6 XML, C99, or an FMI 2/3 co-simulation FMU from a fuzzy system
+(see docs/codegen.md)."""
 
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ class Lang(StrEnum):
     st = "st"
     plcopen = "plcopen"
     c = "c"
+    fmu = "fmu"
 
 
 class Dialect(StrEnum):
@@ -34,14 +36,19 @@ def codegen(
     ],
     lang: Annotated[
         Lang,
-        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
+        typer.Option(
+            "--lang",
+            help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99; "
+            "fmu: an FMI co-simulation FMU (sources and this platform's binary).",
+        ),
     ] = Lang.st,
     output: Annotated[
         Path | None,
         typer.Option(
             "-o",
             "--output",
-            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .).",
+            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .); "
+            "fmu: the .fmu file (default: NAME.fmu).",
         ),
     ] = None,
     dialect: Annotated[
@@ -97,6 +104,13 @@ def codegen(
     force: Annotated[
         bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
     ] = False,
+    fmi: Annotated[
+        int | None,
+        typer.Option("--fmi", help="fmu only: FMI version 2 or 3 (default: 3).", show_default=False),
+    ] = None,
+    no_binary: Annotated[
+        bool, typer.Option("--no-binary", help="fmu only: sources only, no binary (no C compiler needed).")
+    ] = False,
     from_format: FromOpt = None,
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
@@ -118,7 +132,14 @@ def codegen(
         parse_default(default)
     except CodegenError as exc:
         raise typer.BadParameter(str(exc), param_hint="--default") from None
+    if lang is not Lang.fmu and (fmi is not None or no_binary):
+        raise typer.BadParameter("--fmi and --no-binary apply to --lang fmu", param_hint="--fmi")
+    if lang is Lang.fmu:
+        _check_fmu_options(fmi, dialect, lreal, single, testbench)
     doc = fuzzyctl.load(source, strict=strict, format=from_format)
+    if lang is Lang.fmu:
+        _fmu(doc, output, fmi or 3, block, strict, default, force, no_binary, as_json)
+        return
     if lang is Lang.plcopen:
         _plcopen(doc, output, dialect, lreal, single, block, strict, default, force)
         return
@@ -215,3 +236,48 @@ def _plcopen(
         return
     write_atomic(output, xml, force=force, hint=FORCE_HINT)
     err_console.print(f"wrote {output}", markup=False)
+
+
+def _check_fmu_options(fmi: int | None, dialect: Any, lreal: bool, single: bool, testbench: int) -> None:
+    from fuzzyctl.codegen.fmu.description import FMI_VERSIONS
+
+    if fmi is not None and fmi not in FMI_VERSIONS:
+        raise typer.BadParameter(f"FMI version {fmi}: give 2 or 3", param_hint="--fmi")
+    if dialect is not None or lreal or single or testbench:
+        raise typer.BadParameter(
+            "--dialect, --lreal, --float and --testbench do not apply to --lang fmu (it computes in double)",
+            param_hint="--lang",
+        )
+
+
+def _fmu(
+    doc: Any,
+    output: Path | None,
+    fmi: int,
+    block: str | None,
+    strict: bool,
+    default: str | None,
+    force: bool,
+    no_binary: bool,
+    as_json: bool,
+) -> None:
+    """``--lang fmu``: one function block (``--block``, default the first) as an FMU."""
+    import json
+
+    from fuzzyctl.codegen.fmu import generate_fmu
+    from fuzzyctl.files import check_writable
+
+    if output is not None and output.is_dir():
+        raise typer.BadParameter(f"{output} is a directory: give the .fmu file to write", param_hint="-o")
+    if output is not None and not force:
+        check_writable(output, hint=FORCE_HINT)
+    result = generate_fmu(
+        doc, output, block=block, fmi=fmi, binary=not no_binary, default=default, strict=strict, force=force
+    )
+    if as_json:
+        typer.echo(json.dumps({"lang": "fmu", **result.to_dict()}, indent=2))
+        return
+    built = f", binary {result.binary}" if result.binary else ", sources only"
+    err_console.print(f"wrote {result.path} (FMI {fmi} co-simulation{built})", markup=False)
+    for r in result.renames:
+        err_console.print(f"renamed {r.comment()}", markup=False)
