@@ -19,7 +19,7 @@ fmpy = pytest.importorskip("fmpy")
 import fuzzyctl  # noqa: E402
 from fuzzyctl.cli import main  # noqa: E402
 from fuzzyctl.codegen.fmu import generate_fmu  # noqa: E402
-from fuzzyctl.codegen.native import compiler  # noqa: E402
+from fuzzyctl.engine.native import compiler  # noqa: E402
 from fuzzyctl.escape import CodegenError  # noqa: E402
 from fuzzyctl.fcl import load_text  # noqa: E402
 from tests.conftest import EXAMPLES  # noqa: E402

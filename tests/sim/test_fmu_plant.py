@@ -204,7 +204,7 @@ def test_an_exported_fuzzy_block_as_the_plant(fmi: int, tmp_path: Path) -> None:
     limited to [-1, 1]) is the plant of a PI loop, FMI 2 and 3.  Each cycle the loop sets the
     input, steps and measures the next cycle, so u(k) is the engine's map of e(k - 1)."""
     from fuzzyctl.codegen.fmu import generate_fmu
-    from fuzzyctl.codegen.native import compiler
+    from fuzzyctl.engine.native import compiler
 
     if compiler() is None:
         pytest.skip("no C compiler for the FMU's binary")

@@ -162,7 +162,7 @@ def render_model(iface: Interface, ident: str, token: str, fmi: int, title: str)
 
 
 def _compile(sources: dict[str, str], compiled: list[str], fmi: int, out: Path) -> None:
-    from fuzzyctl.codegen.native import compiler
+    from fuzzyctl.engine.native import compiler
 
     cc = compiler()
     if cc is None:
@@ -211,7 +211,7 @@ def generate_fmu(
     """
     from fuzzyctl import __version__
     from fuzzyctl.codegen.api import build, plans
-    from fuzzyctl.codegen.render_c import render_c
+    from fuzzyctl.ir.render.c import render_c
 
     if fmi not in FMI_VERSIONS:
         raise CodegenError(f"FMI version {fmi!r}: fuzzyctl writes FMI 2 or 3")

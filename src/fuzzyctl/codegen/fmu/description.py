@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fuzzyctl.codegen.ir import Decl, Program
 from fuzzyctl.escape import xml_attr
+from fuzzyctl.ir.nodes import Decl, Program
 
 #: The FMI versions ``--fmi`` accepts.
 FMI_VERSIONS = (2, 3)
