@@ -276,7 +276,7 @@ def section_handwritten(args: argparse.Namespace, work: Path, results: dict[str,
     if hw is None:
         return
     per_hw, out_hw = hw
-    from fuzzyctl.codegen import native
+    from fuzzyctl.engine import native
 
     ctl = fuzzyctl.compile(fuzzyctl.load(HERE / "grid49.fcl"), backend="native")
     cols = {"e": np.ascontiguousarray(rows[:, 0]), "de": np.ascontiguousarray(rows[:, 1])}

@@ -46,6 +46,11 @@ EXTRA_SUITES: dict[str, ExtraSuite] = {
         ExtraSuite("seeds", "seeds", "text of the IEC 61131-7, Siemens and Schneider manuals"),
         ExtraSuite("jfl_oracle", "tools/jfuzzylogic/jfl", "live jFuzzyLogic 3.3 as an oracle"),
         ExtraSuite("matiec", "tools/matiec-src.tar.gz", "matiec, the IEC 61131-3 compiler of OpenPLC"),
+        ExtraSuite(
+            "reference_fmus",
+            "tools/reference-fmus-src.tar.gz",
+            "the Modelica Association's Reference FMUs (StateSpace as an FMU plant)",
+        ),
         ExtraSuite("plcopen", "tools/plcopen/tc6_xml_v201.xsd", "PLCopen TC6 XML 2.01 schema"),
         ExtraSuite("repro", "repro/README.md", "reproducers of issue 25 (some carry corpus terms)"),
     )

@@ -317,7 +317,7 @@ def _backend(plan: Plan, backend: str | None, key: str | None, model: FunctionBl
         # (an emulated tool's arithmetic - jFuzzyLogic's 1000-point sets - has no C form: the
         # controller's own evaluator serves every path)
         from fuzzyctl import cache
-        from fuzzyctl.codegen.native import compile_native
+        from fuzzyctl.engine.native import compile_native
 
         hint = cache.cache_dir() / "plans" / f"{key}.lib" if key is not None and cache.enabled() else None
         return compile_native(plan, model, explicit=backend == "native", hint=hint, content_key=key)

@@ -1,7 +1,7 @@
 """Limits on what fuzzyctl reads, so that no input can take unbounded time or memory.
 
 * :func:`max_input_bytes` - the largest model file read, per format (each format's
-  ``max_bytes`` in the registry, :mod:`fuzzyctl.formats`): 1.5 MiB of FCL or FLL (the
+  entry in the registry's table, :mod:`fuzzyctl.formatspec`): 1.5 MiB of FCL or FLL (the
   10,000-rule 8-input system is 1.31 / 1.19 MiB), 512 KiB of FIS, 1 MiB of FPL and of
   XFUZ, 96 MiB of JSON (which spells out every span: that 10,000-rule system is 43.5 MB of
   JSON).
@@ -34,6 +34,7 @@ from pathlib import Path
 from typing import Any
 
 from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, Diagnostic, DiagnosticError, error
+from fuzzyctl.formatspec import DEFAULT_MAX_BYTES, SPECS
 from fuzzyctl.model import (
     And,
     Binary,
@@ -52,8 +53,7 @@ from fuzzyctl.model import (
     Unary,
 )
 
-MiB = 1024 * 1024
-DEFAULT_MAX_INPUT_BYTES = 8 * MiB
+DEFAULT_MAX_INPUT_BYTES = DEFAULT_MAX_BYTES
 
 MAX_NESTING = 100
 MAX_JSON_DEPTH = 2 * MAX_NESTING + 40  # a condition's levels are two JSON levels each
@@ -94,12 +94,8 @@ def max_input_bytes(format: str | None = None) -> int:
         limit = 0
     if limit > 0:
         return limit
-    if not format:
-        return DEFAULT_MAX_INPUT_BYTES
-    from fuzzyctl import formats  # the registry holds each format's limit
-
-    fmt = formats.find(format)
-    return DEFAULT_MAX_INPUT_BYTES if fmt is None else fmt.max_bytes
+    spec = SPECS.get((format or "").lower().lstrip("."))
+    return DEFAULT_MAX_INPUT_BYTES if spec is None else spec.max_bytes
 
 
 def _mib(n: int) -> str:

@@ -138,7 +138,7 @@ class ShapeSpec:
 # Canonical parametric shapes.  Each reader maps its own spelling and parameter order onto
 # these (e.g. jFuzzyLogic ``GBELL a b mean`` and fuzzylite ``Bell center width slope`` both
 # become ``bell(center, width, slope)``); writers map back.  Formulas live in
-# ``fuzzyctl.engine.shapes`` and nowhere else.
+# ``fuzzyctl.engine.semantics.shapes`` and nowhere else.
 SHAPES: dict[str, ShapeSpec] = {
     s.kind: s
     for s in (

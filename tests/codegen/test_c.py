@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from fuzzyctl.codegen import CodegenError
-from fuzzyctl.codegen.program import build_program
-from fuzzyctl.codegen.render_c import render_c
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.ir.programs.plc_block import build_program
+from fuzzyctl.ir.render.c import render_c
 from tests.codegen import systems as S
 from tests.diskcache import cached_dir
 

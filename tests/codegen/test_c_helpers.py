@@ -1,4 +1,4 @@
-"""The libm stand-ins of the generated C (``codegen/c_helpers.py``) against Python's math.
+"""The libm stand-ins of the generated C (``ir/render/c_helpers.py``) against Python's math.
 
 All helpers are compiled in one strict cc run with vectorised wrappers and evaluated on many
 values spread over the whole range (tiny, huge, subnormal, near the reduction boundaries);
@@ -17,7 +17,7 @@ from collections.abc import Callable
 import numpy as np
 import pytest
 
-from fuzzyctl.codegen import c_helpers
+from fuzzyctl.ir.render import c_helpers
 
 UNARY = {
     "fz_sqrt": math.sqrt,

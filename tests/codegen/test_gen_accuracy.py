@@ -1,4 +1,4 @@
-"""Generated C of smooth outputs (the IR quadrature of :mod:`fuzzyctl.codegen.quadrature`)
+"""Generated C of smooth outputs (the IR quadrature of :mod:`fuzzyctl.ir.builders.quadrature`)
 under every activation and accumulation (tests/engine/opsweep.py) against the reference
 interpreter: within 1e-9 of the output range, and within the error bound the generated header
 states for that output (its coefficient times range^2 / area, the area from the independent

@@ -26,14 +26,14 @@ import fuzzyctl
 import fuzzyctl.formats.json.writer  # used as fuzzyctl.formats.json.writer (the registry imports it lazily)
 from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError, generate_c, generate_st, lower_block
-from fuzzyctl.codegen.native import NativeController
-from fuzzyctl.codegen.program import build_program
-from fuzzyctl.codegen.render_c import render_c, render_native
-from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.diagnostics import DiagnosticError
-from fuzzyctl.engine.fastprog import build_fast
-from fuzzyctl.engine.render_np import render_np
-from fuzzyctl.engine.render_py import render_py
+from fuzzyctl.engine.native import NativeController
+from fuzzyctl.ir.programs.evaluator import build_fast
+from fuzzyctl.ir.programs.plc_block import build_program
+from fuzzyctl.ir.render.c import render_c, render_native
+from fuzzyctl.ir.render.npsrc import render_np
+from fuzzyctl.ir.render.pysrc import render_py
+from fuzzyctl.ir.render.st import render_st
 from fuzzyctl.model import Document
 from tests.codegen import hostile as H
 

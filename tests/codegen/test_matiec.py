@@ -21,10 +21,10 @@ import pytest
 from hypothesis import HealthCheck, Phase, given, settings
 
 import fuzzyctl
-from fuzzyctl.codegen.program import build_program
-from fuzzyctl.codegen.render_st import render_st
-from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.engine.reference.interp import Interpreter
+from fuzzyctl.ir.programs.plc_block import build_program
+from fuzzyctl.ir.render.st import render_st
 from tests.codegen import matiec as M
 from tests.codegen import systems as S
 from tests.engine import randsys
@@ -282,7 +282,7 @@ def test_iec_dialect_refuses_every_name_of_matiecs_library(matiec: Path, tmp_pat
 
 @pytest.mark.parametrize("real", list(TOL))
 def test_matiec_smooth_sets_under_every_operator(matiec: Path, tmp_path: Path, real: str) -> None:
-    """The adaptive quadrature of smooth sets (codegen/quadrature.py) through matiec: every
+    """The adaptive quadrature of smooth sets (ir/builders/quadrature.py) through matiec: every
     activation and accumulation (tests/engine/opsweep.py, smooth and PWL terms) against the
     reference interpreter, LREAL within 1e-9 of the range, REAL within 1e-4; INFO never says
     the quadrature reached its cap (16#04) on these systems."""

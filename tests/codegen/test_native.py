@@ -24,9 +24,9 @@ from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
 
 import fuzzyctl
-from fuzzyctl.codegen import native
-from fuzzyctl.codegen.native import NativeController
+from fuzzyctl.engine import native
 from fuzzyctl.engine.controller import Controller
+from fuzzyctl.engine.native import NativeController
 from tests.codegen import systems as S
 from tests.engine import randsys
 

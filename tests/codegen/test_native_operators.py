@@ -23,7 +23,7 @@ from hypothesis import strategies as st
 
 import fuzzyctl
 from fuzzyctl import model as m
-from fuzzyctl.codegen.native import NativeController
+from fuzzyctl.engine.native import NativeController
 from tests.engine import bruteforce, opsweep
 from tests.extras import extra_path
 

@@ -21,9 +21,9 @@ from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError, generate_plcopen, generate_st, lower_block
 from fuzzyctl.codegen.api import DIALECTS
 from fuzzyctl.codegen.plcopen import render_plcopen
-from fuzzyctl.codegen.program import build_program
-from fuzzyctl.codegen.render_st import STParts, st_parts
 from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.ir.programs.plc_block import build_program
+from fuzzyctl.ir.render.st import STParts, st_parts
 from fuzzyctl.model import Document
 from tests.codegen import hostile as H
 from tests.conftest import EXAMPLES, shared_path

@@ -14,10 +14,11 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl import model as m
-from fuzzyctl.codegen import CodegenError, generate_c, native
-from fuzzyctl.codegen.native import NativeController
-from fuzzyctl.codegen.program import build_program
+from fuzzyctl.codegen import CodegenError, generate_c
+from fuzzyctl.engine import native
+from fuzzyctl.engine.native import NativeController
 from fuzzyctl.engine.plan import Options, Plan
+from fuzzyctl.ir.programs.plc_block import build_program
 from tests.codegen import systems as S
 from tests.engine.builders import is_, pts, rule, shape, single, terms, then, var_in, var_out
 

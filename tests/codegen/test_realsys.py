@@ -15,11 +15,11 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl.codegen import CodegenError, generate_c, generate_st
-from fuzzyctl.codegen import quadrature as Q
 from fuzzyctl.codegen.api import Generated
 from fuzzyctl.codegen.rename import rename_plan
 from fuzzyctl.engine.plan import Plan
-from fuzzyctl.engine.pwl import gauss_legendre
+from fuzzyctl.engine.reference.pwl import gauss_legendre
+from fuzzyctl.ir.builders import quadrature as Q
 from tests.codegen import systems as S
 from tests.codegen.st_interp import STBlock
 from tests.codegen.test_c import build_library, run

@@ -15,7 +15,7 @@ import pytest
 from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError, generate_c, generate_st
 from fuzzyctl.codegen.testbench import choose
-from fuzzyctl.engine.interp import Interpreter
+from fuzzyctl.engine.reference.interp import Interpreter
 from tests.codegen import systems as S
 
 STRICT = ["-std=c99", "-Wall", "-Wextra", "-Werror", "-pedantic"]

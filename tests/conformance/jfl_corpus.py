@@ -9,8 +9,8 @@ from pathlib import Path
 
 import fuzzyctl
 from fuzzyctl.diagnostics import FuzzyctlError
-from fuzzyctl.engine import universe
 from fuzzyctl.engine.plan import Slot
+from fuzzyctl.engine.semantics import universe
 from tests.conformance import jfl_oracle
 from tests.conformance.jfl_agreement import Stats
 from tests.conformance.jfl_oracle import Job

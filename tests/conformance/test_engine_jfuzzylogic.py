@@ -20,7 +20,7 @@ import pytest
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine.explain import Explanation, OutputTrace
-from fuzzyctl.engine.shapes import membership_np, pwl_value_np, sort_points
+from fuzzyctl.engine.semantics.shapes import membership_np, pwl_value_np, sort_points
 from fuzzyctl.model import FunctionBlock, PointsMF, ShapeMF
 from tests.conftest import data_path
 

@@ -45,8 +45,8 @@ import pytest
 import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
-from fuzzyctl.engine import shapes
 from fuzzyctl.engine.controller import Controller
+from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.formats import decode, get
 from fuzzyctl.model import FunctionBlock
 from tests.conftest import DATA

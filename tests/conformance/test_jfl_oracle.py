@@ -26,8 +26,10 @@ from hypothesis import strategies as st
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine import compile as compile_mod
-from fuzzyctl.engine import jfl, jfl_terms, lower_jfl, universe
-from fuzzyctl.engine import operators as ops
+from fuzzyctl.engine.compat import jfl, jfl_terms
+from fuzzyctl.engine.lowering import jfl_rules as lower_jfl
+from fuzzyctl.engine.semantics import operators as ops
+from fuzzyctl.engine.semantics import universe
 from fuzzyctl.fcl import load_file
 from tests.conformance import jfl_agreement, jfl_corpus, jfl_oracle
 from tests.conformance.jfl_agreement import Stats
@@ -104,7 +106,7 @@ def _profile(**changes: object) -> Callable[[], contextlib.AbstractContextManage
 
 def _iec_pwl(x: object, xs: list[object], ys: list[object]) -> object:
     """Our own points (sorted; the upper value on a vertical edge) instead of jFuzzyLogic's."""
-    from fuzzyctl.engine import shapes
+    from fuzzyctl.engine.semantics import shapes
 
     pts = shapes.sort_points(list(zip(map(float, xs), map(float, ys), strict=True)))  # type: ignore[arg-type]
     return shapes.pwl_value_np(pts, np.asarray(x, dtype=np.float64))

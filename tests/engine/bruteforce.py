@@ -1,7 +1,7 @@
 """A brute-force oracle for Mamdani outputs under every operator the engine reads: the rule
 degrees and the accumulated set written from IEC 61131-7 Tables 3-5 (and the open-level norms
 as docs/engine.md defines them) against the *model*, sharing no code with the engine (operator
-names are only resolved through ``fuzzyctl.engine.operators``' alias tables), and the set
+names are only resolved through ``fuzzyctl.engine.semantics.operators``' alias tables), and the set
 integrated by vectorised adaptive Simpson quadrature with a Richardson step, started from
 2^14 cells of the range plus every term parameter, each cell halved until its two Simpson
 estimates agree to ``tol`` (so narrow plateaus, jumps and kinks are found by refinement, not
@@ -9,7 +9,7 @@ assumed).  Slow and independent, which is the point.
 
 Covered: the shapes of :mod:`tests.engine.reference` plus arc and concave; Is / NOT / AND /
 OR conditions (no hedges); rule weights; every activation, accumulation and AND/OR norm of
-``fuzzyctl.engine.operators``; CoG and CoA.
+``fuzzyctl.engine.semantics.operators``; CoG and CoA.
 """
 
 from __future__ import annotations
@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from fuzzyctl import model as m
-from fuzzyctl.engine.operators import resolve_accu, resolve_act, resolve_pair
+from fuzzyctl.engine.semantics.operators import resolve_accu, resolve_act, resolve_pair
 from tests.engine import reference
 
 Arr = Any

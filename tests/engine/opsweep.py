@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from fuzzyctl import model as m
-from fuzzyctl.engine.operators import ACCU_NAMES, SNORMS, TNORMS
+from fuzzyctl.engine.semantics.operators import ACCU_NAMES, SNORMS, TNORMS
 
 ACTS = sorted(TNORMS)
 ACCUS = sorted(ACCU_NAMES)

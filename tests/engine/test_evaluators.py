@@ -1,4 +1,4 @@
-"""The evaluators ``compile()`` generates from the IR (engine/fastprog.py, printed as Python and
+"""The evaluators ``compile()`` generates from the IR (ir/programs/evaluator.py, printed as Python and
 numpy) on what test_paths.py's small random systems do not reach: table-driven rule sections
 with sparse evaluation, merged smooth contributions with kink-cut integration, the numpy
 renderer's if-conversion, and the caches of load()/compile()."""
@@ -14,12 +14,12 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl import api, cache
-from fuzzyctl.engine import shapes
 from fuzzyctl.engine.controller import Controller
-from fuzzyctl.engine.fastprog import TABLE_THRESHOLD, build_fast
-from fuzzyctl.engine.ir import Assign, Bin, If, Num, Program, Var
-from fuzzyctl.engine.render_np import vectorise
-from fuzzyctl.engine.render_py import specialise
+from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.ir.nodes import Assign, Bin, If, Num, Program, Var
+from fuzzyctl.ir.programs.evaluator import TABLE_THRESHOLD, build_fast
+from fuzzyctl.ir.render.npsrc import vectorise
+from fuzzyctl.ir.render.pysrc import specialise
 from tests.engine import bigsys
 
 RANGE = bigsys.HI - bigsys.LO
@@ -131,8 +131,8 @@ def _without_weights(fb: fuzzyctl.model.FunctionBlock) -> fuzzyctl.model.Functio
 def test_numpy_renderer_if_converts_conditions_on_samples() -> None:
     """IF/ELSIF/ELSE on values that differ between samples become masks; MIN written as
     an IF becomes numpy.minimum; conditions on constants stay Python control flow."""
-    from fuzzyctl.engine.fastprog import FastProgram
-    from fuzzyctl.engine.ir import Decl
+    from fuzzyctl.ir.nodes import Decl
+    from fuzzyctl.ir.programs.evaluator import FastProgram
 
     x, y, t = Var("FZ_IN0"), Var("FZ_OUT0"), Var("FZ_T")
     body = [
@@ -202,7 +202,7 @@ def test_unknown_plan_switch_falls_back_to_the_interpreter() -> None:
     evaluates correctly (through the interpreter) instead of ignoring the switch."""
     import dataclasses
 
-    from fuzzyctl.engine import fastprog
+    from fuzzyctl.ir.programs import evaluator as fastprog
 
     ctl = fuzzyctl.compile(fuzzyctl.load("examples/figure7.fcl"), backend="python")
     known = dict(fastprog.KNOWN_FIELDS)

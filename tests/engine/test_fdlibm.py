@@ -1,4 +1,4 @@
-"""fuzzyctl.engine.fdlibm against Java's own ``StrictMath``, bit for bit, on millions of
+"""fuzzyctl.engine.semantics.fdlibm against Java's own ``StrictMath``, bit for bit, on millions of
 arguments: the shapes' ranges (Gaussian and sigmoid exponents, cosine phases, bell powers),
 random bit patterns over every exponent, and the special values.  Needs ``javac`` (make
 system-deps installs a JDK)."""
@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fuzzyctl.engine import fdlibm
+from fuzzyctl.engine.semantics import fdlibm
 
 JAVA_SOURCE = Path(__file__).resolve().parent / "java" / "StrictMathBatch.java"
 N = 1_000_000

@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import fuzzyctl
 from fuzzyctl import model as m
-from fuzzyctl.engine.operators import AND_TO_OR
+from fuzzyctl.engine.semantics.operators import AND_TO_OR
 from tests.engine.builders import and_, is_, mamdani, or_, rule, shape, single, then
 from tests.engine.randsys import HI, LO, input_values, system
 

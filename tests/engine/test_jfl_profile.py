@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import fuzzyctl
-from fuzzyctl.engine.jfl_terms import hashmap_order
+from fuzzyctl.engine.compat.jfl_terms import hashmap_order
 
 HEAD = """FUNCTION_BLOCK f
 VAR_INPUT a : REAL; b : REAL; c : REAL; END_VAR

@@ -20,7 +20,7 @@ import pytest
 from fuzzyctl import model as m
 from fuzzyctl.api import compile as compile_api
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine.semantics import shapes
 from tests.engine.builders import is_, rule, shape, single, terms, then, var_in, var_out
 
 HUGE = 1e300

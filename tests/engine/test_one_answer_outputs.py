@@ -279,7 +279,8 @@ def test_largest_of_maximum_of_a_function_term_is_proportionate(monkeypatch: pyt
     """LoM of a clipped Function triangle: the right end of the plateau, in closed form, with
     a bounded number of evaluations of the term (a golden-section search from every plateau
     node made it 0.5 s an evaluation)."""
-    from fuzzyctl.engine import expr, interp
+    from fuzzyctl.engine.reference import interp
+    from fuzzyctl.engine.semantics import expr
 
     calls = 0
     real = expr.eval_expr_np
@@ -417,7 +418,7 @@ def test_mom_takes_a_rounded_crossing_next_to_a_vertex_for_that_vertex() -> None
     degree): MoM = 1.5.  A crossing computed 1.3e-15 left of 2 (rounding in the degrees)
     reaches the height too; it is neither a plateau (MoM 2.0) nor a third point (1.67): it
     is the vertex (valeriot90's mamdani.fis: 1.5 on one path, 2.0 on the other)."""
-    from fuzzyctl.engine import pwl
+    from fuzzyctl.engine.reference import pwl
 
     h = 1.1466298317900281e-23
     x_near = 1.9999999999999987

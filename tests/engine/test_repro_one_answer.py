@@ -146,7 +146,8 @@ def test_zero_over_zero_in_a_function_term_bounded_memory(name: str, tmp_path: P
 def test_largest_of_maximum_of_a_function_term_is_proportionate(monkeypatch: pytest.MonkeyPatch) -> None:
     """slow_lom_function.fll: 0.5 s an evaluation (a golden-section search from every node of
     the plateau); now a bounded number of evaluations of the term."""
-    from fuzzyctl.engine import expr, interp
+    from fuzzyctl.engine.reference import interp
+    from fuzzyctl.engine.semantics import expr
 
     calls = 0
     real = expr.eval_expr_np

@@ -1,10 +1,10 @@
-"""Sampled defuzzification (engine/sampled.py): closed-form values."""
+"""Sampled defuzzification (engine/reference/sampled.py): closed-form values."""
 
 from __future__ import annotations
 
 import pytest
 
-from fuzzyctl.engine.sampled import mean_of_maxima, sampled_centroid, weighted_mean
+from fuzzyctl.engine.reference.sampled import mean_of_maxima, sampled_centroid, weighted_mean
 
 
 def test_sampled_centroid() -> None:

@@ -11,7 +11,7 @@ import pytest
 import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, InputError
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.engine.support import unsupported
 from tests.engine.builders import (
     and_,

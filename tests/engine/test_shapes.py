@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from fuzzyctl import model as m
-from fuzzyctl.engine import shapes
+from fuzzyctl.engine.semantics import shapes
 from tests import peers
 
 X = np.linspace(-2.0, 12.0, 2801)

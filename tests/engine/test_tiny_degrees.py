@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import fuzzyctl
-from fuzzyctl.engine import pwl
+from fuzzyctl.engine.reference import pwl
 from tests.fuzz import differential as D
 
 TINY = 5e-324  # the smallest subnormal: DARK fires at 4 ulps of it, DIM at 2

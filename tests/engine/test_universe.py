@@ -9,7 +9,7 @@ import subprocess
 import pytest
 
 import fuzzyctl
-from fuzzyctl.engine import universe
+from fuzzyctl.engine.semantics import universe
 from tests.extras import extra_path
 
 # (FCL term, jFuzzyLogic's universe computed by hand from MembershipFunction*.estimateUniverse)

@@ -1,7 +1,7 @@
 """The shape of the formats (issue 27, A3): every format is a subpackage with a reader, a
 writer and the names both use, the reader and the writer never import each other, and the
-registry (:mod:`fuzzyctl.formats`) is the one list of formats - no other module of fuzzyctl
-spells one out."""
+registry (:mod:`fuzzyctl.formats` and its table :mod:`fuzzyctl.formatspec`) is the one list of
+formats - no other module of fuzzyctl spells one out."""
 
 from __future__ import annotations
 
@@ -143,7 +143,7 @@ def test_no_list_of_formats_outside_the_registry() -> None:
     found = [
         hit
         for path in sorted(SRC.rglob("*.py"))
-        if FORMATS not in path.parents
+        if FORMATS not in path.parents and path.name != "formatspec.py"
         for hit in _format_lists(path)
     ]
     for path in sorted((SRC / "studio" / "static").rglob("*")):

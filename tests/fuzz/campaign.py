@@ -108,7 +108,7 @@ def _decode(path: Path) -> str:
 
 # --------------------------------------------------------------------------- mutation
 
-_NUMBER = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
+NUMBER_RE = re.compile(r"(?<![\w.])[-+]?\d+(?:\.\d*)?(?:[eE][-+]?\d+)?")
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
@@ -138,7 +138,7 @@ def _op_insert(rng: random.Random, text: str) -> tuple[str, str]:
 
 
 def _op_number(rng: random.Random, text: str) -> tuple[str, str]:
-    nums = list(_NUMBER.finditer(text))
+    nums = list(NUMBER_RE.finditer(text))
     if not nums:
         return _op_insert(rng, text)
     m = rng.choice(nums)

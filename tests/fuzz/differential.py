@@ -119,7 +119,7 @@ def agree(a: Value, b: Value, scale: float, tol: float = REL_TOL) -> bool:
 
 def _points(plan: Any, slot: int) -> list[float]:
     """Breakpoints and characteristic points of the terms that read input ``slot``."""
-    from fuzzyctl.engine import shapes
+    from fuzzyctl.engine.semantics import shapes
 
     xs: list[float] = []
     for fi in plan.fuzzy_inputs:
@@ -453,7 +453,7 @@ def check(model: Any, block: str | None, rng: random.Random, extra: ExtraPaths, 
         run("numpy", lambda: _batch(py, names, rows, outs))
     nat = compile_quiet(model, block, "native")
     if nat is not None:
-        from fuzzyctl.codegen.native import NativeController
+        from fuzzyctl.engine.native import NativeController
 
         if not isinstance(nat, NativeController):
             result.notes.add("native-fallback")

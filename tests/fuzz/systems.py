@@ -1,7 +1,7 @@
 """Seeded random fuzzy systems for the differential fuzzer (issue 25, point 2).
 
 The operators, methods and shapes are read from the engine's own tables - the AND/OR norms
-(:data:`fuzzyctl.engine.operators.TNORMS` / ``SNORMS``, every t-norm also being an
+(:data:`fuzzyctl.engine.semantics.operators.TNORMS` / ``SNORMS``, every t-norm also being an
 activation), the accumulations (``ACCU_NAMES``), the defuzzification methods
 (:data:`fuzzyctl.model.DEFUZZ_METHODS`), the shapes (:data:`fuzzyctl.model.SHAPES` with
 their parameter names, plus IEC points and singletons) and the hedges - so that a kind
@@ -22,8 +22,8 @@ import random
 from typing import Any
 
 from fuzzyctl import model as m
-from fuzzyctl.engine import operators as ops
-from fuzzyctl.engine.shapes import TS_KINDS
+from fuzzyctl.engine.semantics import operators as ops
+from fuzzyctl.engine.semantics.shapes import TS_KINDS
 
 LO, HI = 0.0, 10.0
 EXTREMES = (1e300, -1e300, 5e-324, -5e-324, 1e-310, 0.0, 1e-12, 1e12)

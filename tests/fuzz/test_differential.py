@@ -16,7 +16,7 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl import model as m
-from fuzzyctl.engine import operators
+from fuzzyctl.engine.semantics import operators
 from tests.fuzz import differential as D
 from tests.fuzz import systems as S
 
@@ -166,9 +166,9 @@ def test_generated_st_of_random_systems_agrees_on_matiec(tmp_path: Path) -> None
     Text through matiec and gcc, successive cycles of one instance: each output within 1e-9
     of its range of the reference (or the bound the generated text states)."""
     from fuzzyctl.codegen import CodegenError
-    from fuzzyctl.codegen.program import build_program
-    from fuzzyctl.codegen.render_st import render_st
     from fuzzyctl.diagnostics import FuzzyctlError
+    from fuzzyctl.ir.programs.plc_block import build_program
+    from fuzzyctl.ir.render.st import render_st
     from tests.codegen import matiec as M
 
     chosen: list[tuple[int, Any, str]] = []

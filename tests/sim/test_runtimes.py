@@ -88,7 +88,7 @@ def test_unknown_or_missing_runtime():
 
 @pytest.mark.parametrize("example", ["crane", "tank"])
 def test_native_loop_agrees_with_the_engine_loop(example, native_cache, monkeypatch):
-    from fuzzyctl.codegen.native import NativeController
+    from fuzzyctl.engine.native import NativeController
     from fuzzyctl.sim import config as sim_config
 
     made = []

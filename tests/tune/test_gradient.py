@@ -9,7 +9,7 @@ import pytest
 
 import fuzzyctl
 from fuzzyctl.engine.compile import COMPAT_PROFILES
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.fcl import load_text
 from fuzzyctl.tune import gradient
 from fuzzyctl.tune.space import build_space

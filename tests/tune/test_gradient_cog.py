@@ -13,7 +13,7 @@ import pytest
 import fuzzyctl
 from fuzzyctl.engine.batch import BatchEvaluator
 from fuzzyctl.engine.compile import COMPAT_PROFILES
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.fcl import load_text
 from fuzzyctl.model import FunctionBlock
 from fuzzyctl.tune import gradient

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 import fuzzyctl
-from fuzzyctl.engine.shapes import membership_np
+from fuzzyctl.engine.semantics.shapes import membership_np
 from fuzzyctl.fcl import load_text, write
 from fuzzyctl.model import (
     Conclusion,

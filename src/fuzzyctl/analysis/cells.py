@@ -21,9 +21,20 @@ import numpy as np
 
 from fuzzyctl.analysis.context import Context, FloatArray, constant, leaf_axis, leaf_values, term_points
 from fuzzyctl.diagnostics import FuzzyctlError
-from fuzzyctl.engine import shapes
-from fuzzyctl.engine.operators import SNORMS, TNORMS, accumulate_np
-from fuzzyctl.engine.plan import CAnd, CChained, CDegree, CNot, CondPlan, COr, CTerm, CTrue, Plan, Slot
+from fuzzyctl.engine.plan import (
+    CAnd,
+    CChained,
+    CDegree,
+    CNot,
+    CondPlan,
+    COr,
+    CTerm,
+    CTrue,
+    Plan,
+    Slot,
+)
+from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS, accumulate_np
 
 SAMPLES = 2049
 #: refuse a decomposition larger than this many cells (8 bytes each, several arrays)

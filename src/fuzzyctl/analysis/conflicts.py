@@ -20,10 +20,10 @@ import numpy as np
 from fuzzyctl.analysis.cells import Axis
 from fuzzyctl.analysis.context import Context, leaf_values
 from fuzzyctl.analysis.table import AxisLeaves, Row, leaf_matrix
-from fuzzyctl.engine import shapes
 from fuzzyctl.engine.explain import Explanation
-from fuzzyctl.engine.operators import TNORMS
 from fuzzyctl.engine.plan import TermPlan
+from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.engine.semantics.operators import TNORMS
 
 DEFAULT_DELTA = 0.5
 #: conflicts reported at most (each is confirmed by an explanation of the whole block)

@@ -12,8 +12,8 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.diagnostics import FuzzyctlError
-from fuzzyctl.engine import shapes
 from fuzzyctl.engine.plan import CDegree, CondPlan, CTerm, Plan, Slot, TermPlan
+from fuzzyctl.engine.semantics import shapes
 
 if TYPE_CHECKING:
     from fuzzyctl.engine.controller import Controller

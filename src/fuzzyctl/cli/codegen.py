@@ -1,5 +1,6 @@
-"""``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
-function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
+"""``fuzzyctl codegen FILE --lang st|plcopen|c|fmu``: IEC 61131-3 Structured Text, the same
+function blocks as PLCopen TC6 XML, C99, or an FMI 2/3 co-simulation FMU from a fuzzy system
+(see docs/codegen.md)."""
 
 from __future__ import annotations
 
@@ -18,6 +19,7 @@ class Lang(StrEnum):
     st = "st"
     plcopen = "plcopen"
     c = "c"
+    fmu = "fmu"
 
 
 class Dialect(StrEnum):
@@ -38,14 +40,19 @@ def codegen(
     ],
     lang: Annotated[
         Lang,
-        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
+        typer.Option(
+            "--lang",
+            help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99; "
+            "fmu: an FMI co-simulation FMU (sources and this platform's binary).",
+        ),
     ] = Lang.st,
     output: Annotated[
         Path | None,
         typer.Option(
             "-o",
             "--output",
-            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .).",
+            help="st, plcopen: the file (default: print); c: the directory for NAME.h, NAME.c (default: .); "
+            "fmu: the .fmu file (default: NAME.fmu).",
         ),
     ] = None,
     dialect: Annotated[
@@ -101,6 +108,13 @@ def codegen(
     force: Annotated[
         bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
     ] = False,
+    fmi: Annotated[
+        int | None,
+        typer.Option("--fmi", help="fmu only: FMI version 2 or 3 (default: 3).", show_default=False),
+    ] = None,
+    no_binary: Annotated[
+        bool, typer.Option("--no-binary", help="fmu only: sources only, no binary (no C compiler needed).")
+    ] = False,
     from_format: FromOpt = None,
 ) -> None:
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
@@ -122,13 +136,14 @@ def codegen(
             force=force,
             hint=FORCE_HINT,
             format=from_format,
+            fmi=fmi,
+            binary=not no_binary,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))
     elif emitted.text is not None:
         typer.echo(emitted.text, nl=False)
     else:
-        err_console.print(f"wrote {', '.join(str(p) for p in emitted.written)}", markup=False)
-        for gen in emitted.blocks:
-            for r in gen.renames:
-                err_console.print(f"renamed {r.comment()}", markup=False)
+        err_console.print(emitted.wrote(), markup=False)
+        for r in emitted.renames:
+            err_console.print(f"renamed {r.comment()}", markup=False)

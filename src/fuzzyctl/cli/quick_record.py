@@ -136,8 +136,8 @@ def lookup(file: Path, block: str | None, compat: str) -> tuple[QuickRecord | No
 
 def save(key: str, ctl: Any, title: str) -> None:
     """Record ``ctl`` when it evaluates through a native library (else nothing)."""
-    from fuzzyctl.codegen.native import NativeController
     from fuzzyctl.diagnostics import render_all
+    from fuzzyctl.engine.native import NativeController
 
     if not isinstance(ctl, NativeController):
         return

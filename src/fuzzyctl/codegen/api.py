@@ -5,14 +5,14 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
-from fuzzyctl.codegen.context import CodegenError, Target
 from fuzzyctl.codegen.defaults import apply_default, parse_default
-from fuzzyctl.codegen.ir import Program
-from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.rename import Rename, rename_plan
-from fuzzyctl.codegen.render_c import render_c
-from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.ir.nodes import Program
+from fuzzyctl.ir.programs.plc_block import build_program
+from fuzzyctl.ir.render.c import render_c
+from fuzzyctl.ir.render.st import render_st
+from fuzzyctl.ir.state import CodegenError, Target
 from fuzzyctl.model import Document, FunctionBlock
 
 Dialect = Literal["codesys", "twincat", "scl", "iec", "openplc"]

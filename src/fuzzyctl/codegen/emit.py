@@ -1,5 +1,5 @@
-"""What ``fuzzyctl codegen`` produces: the code of one target (``st``, ``plcopen`` or ``c``),
-printed or written where asked, and its JSON report.  The CLI and the Python API both call
+"""What ``fuzzyctl codegen`` produces: the code of one target (``st``, ``plcopen``, ``c`` or
+``fmu``), printed or written where asked, and its JSON report.  The CLI and the Python API both call
 :func:`emit`; the generators themselves are :func:`~fuzzyctl.codegen.generate_st`,
 :func:`~fuzzyctl.codegen.generate_plcopen` and :func:`~fuzzyctl.codegen.generate_c`."""
 
@@ -15,7 +15,7 @@ from fuzzyctl.model import Document
 if TYPE_CHECKING:
     from fuzzyctl.codegen.api import Generated
 
-LANGS = ("st", "plcopen", "c")
+LANGS = ("st", "plcopen", "c", "fmu")
 """The targets, as ``--lang`` names them."""
 DEFAULT_DIALECT = "codesys"
 READ_ONLY_HINT = "make it writable to replace it"
@@ -32,6 +32,23 @@ class Emitted:
     blocks: list[Generated] = field(default_factory=list)
     text: str | None = None
     written: list[Path] = field(default_factory=list)
+    fmu: Any = None
+    """The FMU written (:class:`fuzzyctl.codegen.fmu.FmuResult`, ``fmu`` only)."""
+    fmi: int | None = None
+
+    @property
+    def renames(self) -> list[Any]:
+        """What the generator renamed for the target, block after block."""
+        if self.fmu is not None:
+            return list(self.fmu.renames)
+        return [r for g in self.blocks for r in g.renames]
+
+    def wrote(self) -> str:
+        """The line that says what was written."""
+        if self.fmu is not None:
+            built = f", binary {self.fmu.binary}" if self.fmu.binary else ", sources only"
+            return f"wrote {self.fmu.path} (FMI {self.fmi} co-simulation{built})"
+        return f"wrote {', '.join(str(p) for p in self.written)}"
 
     @property
     def reports(self) -> bool:
@@ -42,6 +59,8 @@ class Emitted:
     def to_dict(self) -> dict[str, Any]:
         """The JSON report: the target, each block's renames and notes, and the text or the
         files written."""
+        if self.fmu is not None:
+            return {"lang": "fmu", **self.fmu.to_dict()}
         out: dict[str, Any] = {"lang": self.lang, "blocks": [g.to_dict() for g in self.blocks]}
         if self.text is not None:
             out["text"] = self.text
@@ -50,7 +69,17 @@ class Emitted:
         return out
 
 
-def check_options(lang: str, *, dialect: str | None, lreal: bool, single: bool, default: str | None) -> None:
+def check_options(
+    lang: str,
+    *,
+    dialect: str | None,
+    lreal: bool,
+    single: bool,
+    default: str | None,
+    testbench: int = 0,
+    fmi: int | None = None,
+    binary: bool = True,
+) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
     (:class:`OptionError` names the option)."""
     from fuzzyctl.codegen.defaults import parse_default
@@ -64,6 +93,19 @@ def check_options(lang: str, *, dialect: str | None, lreal: bool, single: bool, 
         parse_default(default)
     except CodegenError as exc:
         raise OptionError(str(exc), "--default") from None
+    if lang != "fmu" and (fmi is not None or not binary):
+        raise OptionError("--fmi and --no-binary apply to --lang fmu", "--fmi")
+    if lang == "fmu":
+        from fuzzyctl.codegen.fmu.description import FMI_VERSIONS
+
+        if fmi is not None and fmi not in FMI_VERSIONS:
+            raise OptionError(f"FMI version {fmi}: give 2 or 3", "--fmi")
+        if dialect is not None or lreal or single or testbench:
+            raise OptionError(
+                "--dialect, --lreal, --float and --testbench do not apply to --lang fmu "
+                "(it computes in double)",
+                "--lang",
+            )
 
 
 def emit(
@@ -81,16 +123,31 @@ def emit(
     force: bool = False,
     hint: str = READ_ONLY_HINT,
     format: str | None = None,
+    fmi: int | None = None,
+    binary: bool = True,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
-    are checked first) and write it: ``st`` and ``plcopen`` to the file
-    ``output`` (None: the text is returned), ``c`` into the directory ``output`` (default: the
-    current one), every file checked writable before any is replaced."""
+        are checked first) and write it: ``st`` and ``plcopen`` to the file
+        ``output`` (None: the text is returned), ``c`` into the directory ``output`` (default: the
+        current one), every file checked writable before any is replaced; ``fmu`` one block
+    (``block``, default the first) as an FMI ``fmi`` (2 or 3, default 3) co-simulation FMU in the
+    file ``output`` (default ``NAME.fmu``), with this platform's binary unless not ``binary``."""
     import fuzzyctl
     from fuzzyctl.codegen import generate_c, generate_plcopen, generate_st
 
-    check_options(lang, dialect=dialect, lreal=lreal, single=single, default=default)
+    check_options(
+        lang,
+        dialect=dialect,
+        lreal=lreal,
+        single=single,
+        default=default,
+        testbench=testbench,
+        fmi=fmi,
+        binary=binary,
+    )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
+    if lang == "fmu":
+        return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     if lang == "plcopen":
         if single:
             raise OptionError("--float applies to --lang c (use --lreal)", "--lang")
@@ -156,3 +213,27 @@ def _write_files(files: dict[str, str], out_dir: Path, force: bool, hint: str) -
     for name, text in files.items():
         write_atomic(out_dir / name, text, force=force, hint=hint)
     return [out_dir / name for name in files]
+
+
+def _fmu(
+    document: Document,
+    output: Path | None,
+    fmi: int,
+    block: str | None,
+    strict: bool,
+    default: str | None,
+    force: bool,
+    binary: bool,
+    hint: str,
+) -> Emitted:
+    from fuzzyctl.codegen.fmu import generate_fmu
+    from fuzzyctl.files import check_writable
+
+    if output is not None and output.is_dir():
+        raise OptionError(f"{output} is a directory: give the .fmu file to write", "-o")
+    if output is not None and not force:
+        check_writable(output, hint=hint)
+    result = generate_fmu(
+        document, output, block=block, fmi=fmi, binary=binary, default=default, strict=strict, force=force
+    )
+    return Emitted("fmu", fmu=result, fmi=fmi, written=[Path(result.path)])

@@ -1,4 +1,4 @@
-"""PLCopen TC6 XML 2.01: the function blocks of :mod:`~fuzzyctl.codegen.render_st` as the
+"""PLCopen TC6 XML 2.01: the function blocks of :mod:`~fuzzyctl.ir.render.st` as the
 exchange file CODESYS, TwinCAT, Beremiz / OpenPLC Editor and Simulink PLC Coder import.
 
 One ``<project>`` (``fileHeader``, ``contentHeader``, ``types/pous``, an empty
@@ -28,9 +28,9 @@ from datetime import UTC, datetime
 from typing import Any
 
 from fuzzyctl.codegen.api import DIALECT_ALIASES, DIALECTS
-from fuzzyctl.codegen.context import CodegenError
-from fuzzyctl.codegen.render_st import STParts, STSection, STVar, format_st, st_parts
 from fuzzyctl.escape import st_comment, xml_attr, xml_text
+from fuzzyctl.ir.render.st import STParts, STSection, STVar, format_st, st_parts
+from fuzzyctl.ir.state import CodegenError
 from fuzzyctl.model import Document, FunctionBlock
 
 NS_TC6 = "http://www.plcopen.org/xml/tc6_0201"

@@ -19,9 +19,9 @@ import re
 import unicodedata
 from dataclasses import dataclass
 
-from fuzzyctl.engine.irgen import PREFIX, Target
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import MAX_IDENT_C, MAX_IDENT_ST, CodegenError, c_ident, st_ident
+from fuzzyctl.ir.state import PREFIX, Target
 
 #: Names the generated block declares itself.
 _OWN = ("ENABLE", "INFO")

@@ -17,10 +17,10 @@ import math
 import random
 from dataclasses import dataclass
 
-from fuzzyctl.codegen.context import CodegenError
-from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan, Slot
+from fuzzyctl.engine.reference.interp import Interpreter
 from fuzzyctl.escape import c_comment, c_ident, st_comment, st_ident
+from fuzzyctl.ir.state import CodegenError
 
 #: relative tolerance (of each output's range) by arithmetic
 TOLERANCE = {"REAL": 1e-4, "LREAL": 1e-9, "float": 1e-4, "double": 1e-9}
@@ -222,7 +222,7 @@ def _header(bench: Bench, real: str) -> list[str]:
 
 def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = False) -> str:
     """The test bench as an IEC 61131-3 PROGRAM ``TB_<block>`` (after the block's text)."""
-    from fuzzyctl.codegen.render_st import st_real
+    from fuzzyctl.ir.render.st import st_real
 
     if dialect == "scl":
         raise CodegenError("the test bench is written for --dialect codesys, twincat or iec (not scl)")

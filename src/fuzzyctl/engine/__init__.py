@@ -1,17 +1,19 @@
 """The inference engine: IEC 61131-7 semantics, exact defuzzification, scalar and batch
 evaluation, explanations.
 
-Layers (each consumes the one above it):
+Layers, each importing only those before it (tests/test_layout.py keeps it so):
 
-* :mod:`~fuzzyctl.engine.shapes`, :mod:`~fuzzyctl.engine.operators` - the formulas, once.
-* :mod:`~fuzzyctl.engine.lower` - FunctionBlock -> :class:`~fuzzyctl.engine.plan.Plan`.
-* :mod:`~fuzzyctl.engine.interp` - the reference interpreter (the readable statement of the
-  semantics; explanations).
-* :mod:`~fuzzyctl.engine.fastprog` - the plan as one IR program (:mod:`~fuzzyctl.engine.ir`,
-  rule evaluation from :mod:`~fuzzyctl.engine.irrules`), printed as straight-line Python
-  (:mod:`~fuzzyctl.engine.render_py`), as numpy (:mod:`~fuzzyctl.engine.render_np`) and, by
-  :mod:`fuzzyctl.codegen`, as the native backend's C.
-* :mod:`~fuzzyctl.engine.controller` - the public :class:`Controller`.
+* :mod:`~fuzzyctl.engine.plan` - the lowered form, plain data every layer reads.
+* :mod:`fuzzyctl.engine.semantics` - what the words mean: membership formulas, operators,
+  function-term expressions, fuzzylite's rule activation, the C library as Java computes it.
+* :mod:`fuzzyctl.engine.lowering` - FunctionBlock -> :class:`~fuzzyctl.engine.plan.Plan`,
+  every decision the standard leaves open made once.
+* :mod:`fuzzyctl.engine.reference` - the readable interpreter and exact defuzzifiers every
+  other path is tested against (and explanations are read from).
+* :mod:`fuzzyctl.engine.compat` - jFuzzyLogic 3.3 reproduced (``compat="jfuzzylogic"``).
+* :mod:`fuzzyctl.ir` (a package of its own) - the plan as IR programs and their renderers.
+* here, on top: :func:`~fuzzyctl.engine.compile.compile_block`, the public
+  :class:`Controller`, the native backend (:mod:`~fuzzyctl.engine.native`), explanations.
 
 Importing the package is cheap; numpy and the generators are imported when first used.
 """

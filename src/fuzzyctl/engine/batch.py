@@ -1,6 +1,6 @@
 """Columns of samples through a plan without a :class:`~fuzzyctl.engine.controller.Controller`
 (what tuning evaluates each candidate with): the generated numpy evaluator
-(:mod:`fuzzyctl.engine.render_np`), or the interpreter row by row for a plan it does not
+(:mod:`fuzzyctl.ir.render.npsrc`), or the interpreter row by row for a plan it does not
 implement.  No semantics live here."""
 
 from __future__ import annotations

@@ -7,7 +7,7 @@ from typing import Any
 
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from fuzzyctl.engine.controller import Controller
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.engine.plan import Options
 from fuzzyctl.model import Document, FunctionBlock
 
@@ -28,7 +28,7 @@ COMPAT_PROFILES: dict[str, Options] = {
     "pyfuzzylite": Options(
         weight_before_activation=True, ts_default_accu="SUM", singleton_default_accu="SUM"
     ),
-    # jFuzzyLogic 3.3, reproduced by engine/jfl.py (docs/engine.md, "jfuzzylogic profile")
+    # jFuzzyLogic 3.3, reproduced by engine/compat/jfl.py (docs/engine.md, "jfuzzylogic profile")
     "jfuzzylogic": Options(
         weight_before_activation=True,
         weight_whole_rule=True,

@@ -21,7 +21,7 @@ if TYPE_CHECKING:  # numpy, the interpreter and explanations are imported when f
     import numpy.typing as npt
 
     from fuzzyctl.engine import explain as explain_mod
-    from fuzzyctl.engine.interp import Interpreter
+    from fuzzyctl.engine.reference.interp import Interpreter
     from fuzzyctl.model import FunctionBlock
 
 _INF = math.inf
@@ -56,7 +56,7 @@ class Controller:
         self._jfl: Any = None
         if plan.options.emulate == "jfuzzylogic":
             # another tool's arithmetic (1000-point sets, ...): one evaluator serves every path
-            from fuzzyctl.engine.jfl import JflEvaluator
+            from fuzzyctl.engine.compat.jfl import JflEvaluator
 
             self._jfl = JflEvaluator(plan)
             specialise = False
@@ -70,20 +70,20 @@ class Controller:
     @property
     def _interp(self) -> Interpreter:
         if self._interp_obj is None:
-            from fuzzyctl.engine.interp import Interpreter
+            from fuzzyctl.engine.reference.interp import Interpreter
 
             self._interp_obj = Interpreter(self.plan)
         return self._interp_obj
 
     @property
     def _fast(self) -> Callable[[list[float], list[float | None]], list[float]] | None:
-        """The generated scalar evaluator (:mod:`fuzzyctl.engine.render_py`), or None."""
+        """The generated scalar evaluator (:mod:`fuzzyctl.ir.render.pysrc`), or None."""
         if self._fast_fn is None:
             self._fast_fn = False
             if self._specialise:
-                from fuzzyctl.engine.fastprog import build_fast
-                from fuzzyctl.engine.irgen import CodegenError
-                from fuzzyctl.engine.render_py import specialise
+                from fuzzyctl.ir.programs.evaluator import build_fast
+                from fuzzyctl.ir.render.pysrc import specialise
+                from fuzzyctl.ir.state import CodegenError
 
                 with contextlib.suppress(CodegenError):  # the interpreter evaluates it
                     self._fast_fn = specialise(build_fast(self.plan, "py"))
@@ -91,13 +91,13 @@ class Controller:
 
     @property
     def _batch(self) -> Any:
-        """The generated numpy evaluator (:mod:`fuzzyctl.engine.render_np`), or None."""
+        """The generated numpy evaluator (:mod:`fuzzyctl.ir.render.npsrc`), or None."""
         if self._batch_fn is None:
             self._batch_fn = False
             if self._specialise:
-                from fuzzyctl.engine.fastprog import build_fast
-                from fuzzyctl.engine.irgen import CodegenError
-                from fuzzyctl.engine.render_np import vectorise
+                from fuzzyctl.ir.programs.evaluator import build_fast
+                from fuzzyctl.ir.render.npsrc import vectorise
+                from fuzzyctl.ir.state import CodegenError
 
                 with contextlib.suppress(CodegenError):  # the interpreter evaluates it
                     self._batch_fn = vectorise(build_fast(self.plan, "np"))

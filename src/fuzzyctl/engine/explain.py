@@ -10,9 +10,9 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from fuzzyctl.engine import pwl
-from fuzzyctl.engine.interp import OutputRecord, Record
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.engine.reference import pwl
+from fuzzyctl.engine.reference.interp import OutputRecord, Record
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure

@@ -1,6 +1,6 @@
 """The lowered form of a function block: plain, immutable data every evaluator consumes.
 
-:func:`fuzzyctl.engine.lower.lower` turns a :class:`~fuzzyctl.model.FunctionBlock` into a
+:func:`fuzzyctl.engine.lowering.lower.lower` turns a :class:`~fuzzyctl.model.FunctionBlock` into a
 :class:`Plan`.  The scalar evaluator (interpreted and specialised), the numpy batch evaluator
 and the code generators (Structured Text, C) all read this one structure, so they cannot
 disagree about *what* is computed; they only differ in *how*.
@@ -97,7 +97,7 @@ class TermPlan:
     ``"singletons"`` (x0, y0, ...), or ``"function"`` (``expr``).
 
     ``pwl`` is the breakpoint list when the term is piecewise linear with constant
-    parameters (see :mod:`fuzzyctl.engine.shapes`)."""
+    parameters (see :mod:`fuzzyctl.engine.semantics.shapes`)."""
 
     name: str
     kind: str
@@ -228,7 +228,7 @@ class SelectionPlan:
     degree is > 0 and >= ``threshold``), ``HIGHEST``, ``LOWEST`` (the ``count`` rules with the
     highest/lowest degree > 0, earlier rules first on ties), ``PROPORTIONAL`` (every degree
     divided by their sum) or ``THRESHOLD`` (the rules whose degree satisfies ``comparison``
-    ``threshold``).  Formulas: :mod:`fuzzyctl.engine.selection`."""
+    ``threshold``).  Formulas: :mod:`fuzzyctl.engine.semantics.selection`."""
 
     method: str
     rules: tuple[int, ...]
@@ -342,7 +342,7 @@ class Options:
     span_universe: bool = False
     #: jFuzzyLogic: a RANGE on the VAR declaration line is ignored (only DEFUZZIFY's counts)
     ignore_declared_range: bool = False
-    #: ``"jfuzzylogic"``: the plan is evaluated by :mod:`fuzzyctl.engine.jfl`, which reproduces
+    #: ``"jfuzzylogic"``: the plan is evaluated by :mod:`fuzzyctl.engine.compat.jfl`, which reproduces
     #: jFuzzyLogic 3.3 (its 1000-point defuzzification and the rest, docs/engine.md); the
     #: code generators refuse such a plan
     emulate: str | None = None

@@ -9,7 +9,7 @@ from __future__ import annotations
 import dataclasses
 
 from fuzzyctl.diagnostics import Diagnostic
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.model import FunctionBlock
 
 

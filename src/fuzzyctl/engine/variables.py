@@ -39,7 +39,7 @@ class TermInfo:
         """The degree of membership at ``x`` (an array or a number)."""
         import numpy as np
 
-        from fuzzyctl.engine import shapes
+        from fuzzyctl.engine.semantics import shapes
 
         xs = np.asarray(x, dtype=np.float64)
         if self.points is not None:

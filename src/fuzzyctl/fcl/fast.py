@@ -63,15 +63,17 @@ from fuzzyctl.model import (
 )
 
 # lark's NUMBER (fcl.lark), its COMMENT_* terminals and its WS.
-_NUMBER = r"[-+\u2212\u2013]?(?:(?:\d+(?:\.(?!\.)\d*)?|\.\d+)(?:[eE][-+]?\d+)?|(?i:nan|inf(?:inity)?)(?!\w))"
-_COMMENT = r"\(\*.*?\*\)|/\*.*?\*/|//[^\r\n]*"
+NUMBER_RE = (
+    r"[-+\u2212\u2013]?(?:(?:\d+(?:\.(?!\.)\d*)?|\.\d+)(?:[eE][-+]?\d+)?|(?i:nan|inf(?:inity)?)(?!\w))"
+)
+COMMENT_RE = r"\(\*.*?\*\)|/\*.*?\*/|//[^\r\n]*"
 _WS = r"[ \t\f\r\n\ufeff]*"
 # One token with the white space before it: 1 comment, 2 number, 3 word, 4 other \w run,
 # 5 punctuation.
-_TOKEN = re.compile(rf"{_WS}(?:({_COMMENT})|({_NUMBER})|([^\W\d]\w*)|(\w+)|(:=|[:;,()]))", re.S)
+_TOKEN = re.compile(rf"{_WS}(?:({COMMENT_RE})|({NUMBER_RE})|([^\W\d]\w*)|(\w+)|(:=|[:;,()]))", re.S)
 _LABEL = re.compile(r"\w+")
 # Where runs may start: comments and OPTIONS text are skipped as lark skips them.
-_SCAN = re.compile(rf"({_COMMENT})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
+_SCAN = re.compile(rf"({COMMENT_RE})|\b(RULE|TERM|OPTIONS|OPTION)\b", re.S | re.I)
 _OPTIONS_END = re.compile(r"(?s:.+?)(?=\bEND_OPTIONS?\b)", re.I)
 # The most common rule, on one line with spaces only: read with one match (possessive
 # repeats: no backtracking entry kept per AND of a long chain).
@@ -83,15 +85,15 @@ _SIMPLE_RULE = re.compile(
     re.I,
 )
 # The rest of a point ``(x, y)`` after its '(' when both are numbers.
-_POINT_REST = re.compile(rf"[ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
+_POINT_REST = re.compile(rf"[ \t]*({NUMBER_RE})[ \t]*,[ \t]*({NUMBER_RE})[ \t]*\)")
 # The most common TERM, on one line with spaces only: points (short of SUBSTITUTE_MIN) or
 # one number, read with one match.
 _SIMPLE_TERM = re.compile(
-    rf"TERM[ \t]+({_NAME})[ \t]*:=[ \t]*((?:\([ \t]*{_NUMBER}[ \t]*,[ \t]*{_NUMBER}[ \t]*\)[ \t]*)++"
-    rf"|{_NUMBER})[ \t]*;",
+    rf"TERM[ \t]+({_NAME})[ \t]*:=[ \t]*((?:\([ \t]*{NUMBER_RE}[ \t]*,[ \t]*{NUMBER_RE}[ \t]*\)[ \t]*)++"
+    rf"|{NUMBER_RE})[ \t]*;",
     re.I,
 )
-_POINT = re.compile(rf"\([ \t]*({_NUMBER})[ \t]*,[ \t]*({_NUMBER})[ \t]*\)")
+_POINT = re.compile(rf"\([ \t]*({NUMBER_RE})[ \t]*,[ \t]*({NUMBER_RE})[ \t]*\)")
 _PART = re.compile(rf"({_NAME})[ \t]+IS[ \t]+({_NAME})|(AND|OR)", re.I)
 _WORD_CHAR = re.compile(r"\w")
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
@@ -104,9 +106,6 @@ SUBSTITUTE_MIN = 200
 MIN_RUN = 3
 #: Statements in a row not taken after which only the one-match forms are tried.
 MAX_MISSES = 1000
-
-
-_Bail = Bail
 
 
 @dataclass
@@ -198,7 +197,7 @@ def _offset(entry: tuple[int, Any]) -> int:
 _Part = tuple[int, int, "Condition | PointsMF | None", int]
 
 
-class _Reader:
+class Reader:
     """Scanner and parser over ``text`` (positions are string offsets)."""
 
     quick_only = False  # after many statements not taken: only the one-match forms
@@ -222,7 +221,7 @@ class _Reader:
         self.last_end = 0  # where the last point read ends
 
     def statement(self) -> tuple[Rule | Term, str | None]:
-        """One statement and the spelling of its shape (``_Bail`` when not taken)."""
+        """One statement and the spelling of its shape (``Bail`` when not taken)."""
         raise NotImplementedError
 
     # ---------------------------------------------------------------- positions
@@ -273,7 +272,7 @@ class _Reader:
             self.comments.append((m.group(COMMENT), m.start(COMMENT)))
             m = _TOKEN.match(self.text, m.end())
         if m is None:
-            raise _Bail
+            raise Bail
         k = m.lastindex or 0
         self.pos = m.end()
         return k, m.start(k), self.pos, m.group(k).upper()
@@ -299,19 +298,19 @@ class _Reader:
         """A name that is no keyword."""
         k, a, b, u = self.next()
         if k != WORD or u in KEYWORDS:
-            raise _Bail
+            raise Bail
         return self.text[a:b], a, b
 
     def keyword(self, *allowed: str) -> tuple[str, int, int]:
         k, a, b, u = self.next()
         if k != WORD or u not in allowed:
-            raise _Bail
+            raise Bail
         return u, a, b
 
     def punct(self, p: str) -> int:
         k, a, _, u = self.next()
         if k != PUNCT or u != p:
-            raise _Bail
+            raise Bail
         return a
 
     def number(self, a: int, b: int) -> float:
@@ -321,7 +320,7 @@ class _Reader:
         except ValueError:  # a Unicode minus sign
             value = float(tok.translate(_MINUS_SIGNS))
         if (value == math.inf or value == -math.inf) and tok[-1:].isdigit():
-            raise _Bail  # lark's reader reports it
+            raise Bail  # lark's reader reports it
         return value
 
     def param(self) -> tuple[Param, int, int]:
@@ -329,11 +328,11 @@ class _Reader:
         if k == NUMBER:
             return self.number(a, b), a, b
         if k != WORD or u in KEYWORDS:
-            raise _Bail
+            raise Bail
         return Ref(self.text[a:b], self.span(a, b)), a, b
 
 
-class _RuleReader(_Reader):
+class RuleReader(Reader):
     """RULE label : IF condition THEN conclusions [;]"""
 
     def statement(self) -> tuple[Rule, None]:
@@ -346,7 +345,7 @@ class _RuleReader(_Reader):
                     self.cond = (m.start(2), m.end(2), rule.condition, nesting(rule.condition))
                 return rule, None
         if self.quick_only:
-            raise _Bail
+            raise Bail
         return self.general(), None
 
     def simple(self, m: re.Match[str]) -> Rule | None:
@@ -387,10 +386,10 @@ class _RuleReader(_Reader):
         _, r0, _ = self.keyword("RULE")
         k, a, _, _ = self.next()
         if k not in (NUMBER, WORD, LABEL):
-            raise _Bail
+            raise Bail
         m = _LABEL.match(self.text, a)
         if m is None:
-            raise _Bail
+            raise Bail
         label = m.group()
         self.seek(m.end())
         self.punct(":")
@@ -400,7 +399,7 @@ class _RuleReader(_Reader):
         _, _, end = self.keyword("THEN")
         self.cond = (start, stop, condition, depth)
         if condition is None:
-            raise _Bail  # too deep: lark reports it, with this condition in its place
+            raise Bail  # too deep: lark reports it, with this condition in its place
         conclusions = [self.conclusion()]
         while True:
             k, _, _, w = self.peek()
@@ -411,7 +410,7 @@ class _RuleReader(_Reader):
         if k == PUNCT and w == ";":
             _, _, end, _ = self.next()
         elif not (k == WORD and w in ("RULE", "END_RULEBLOCK")):
-            raise _Bail
+            raise Bail
         return Rule(label, condition, tuple(conclusions), self.span(r0, end))
 
     def ids(self) -> tuple[list[str], int]:
@@ -444,13 +443,13 @@ class _RuleReader(_Reader):
         return Conclusion(variable, term, weight, self.span(a, end), hedges)
 
 
-class _TermReader(_Reader):
+class TermReader(Reader):
     """TERM name := points | number | shape numbers ;"""
 
     def statement(self) -> tuple[Term, str | None]:
         self.cond = None
         if self.quick_only:
-            raise _Bail
+            raise Bail
         m = _SIMPLE_TERM.match(self.text, self.pos) if self.la is None else None
         if m is not None and m.group(1).upper() not in KEYWORDS and m.end(2) - m.start(2) < SUBSTITUTE_MIN:
             return self.simple(m), None
@@ -469,7 +468,7 @@ class _TermReader(_Reader):
                     self.next()
                     k, _, _, w = self.peek()
                     if not (k == PUNCT and w == "("):
-                        raise _Bail  # a ',' after the last point: lark reports it
+                        raise Bail  # a ',' after the last point: lark reports it
                 if not (k == PUNCT and w == "("):
                     break
                 _, p, _, _ = self.next()
@@ -482,7 +481,7 @@ class _TermReader(_Reader):
         elif k == WORD and u not in KEYWORDS:
             mf, spelling = self.shape(self.text[a:b])
         else:
-            raise _Bail
+            raise Bail
         end = self.punct(";") + 1
         self.cond = part
         return Term(name, mf, self.span(t0, end)), spelling
@@ -522,17 +521,17 @@ class _TermReader(_Reader):
     def shape(self, name: str) -> tuple[MembershipFunction, str]:
         spelling = shapes.lookup(name)
         if spelling is None or name.upper() == "DISCRETE":
-            raise _Bail
+            raise Bail
         args: list[Param] = []
         while self.peek()[0] == NUMBER:
             _, a, b, _ = self.next()
             args.append(self.number(a, b))
         if not args:
-            raise _Bail
+            raise Bail
         try:
             return shapes.build(spelling, args), spelling.written
         except shapes.ShapeError:
-            raise _Bail from None
+            raise Bail from None
 
 
 def _spaced_condition(cond: str, pos: int, line: int, shift: int) -> Condition | None:
@@ -597,7 +596,7 @@ def read_runs(text: str) -> FastResult | None:
     blanks: list[tuple[int, int, int, str]] = []
     comments: dict[int, str] = {}
     subs: dict[int, tuple[int, int, Condition | PointsMF | None, int, int]] = {}
-    readers: dict[str, _Reader] = {"RULE": _RuleReader(text), "TERM": _TermReader(text)}
+    readers: dict[str, Reader] = {"RULE": RuleReader(text), "TERM": TermReader(text)}
     pos = misses = 0
     while (item := next_item(text, _SCAN, pos)) is not None:
         word, start, _ = item
@@ -621,12 +620,12 @@ def read_runs(text: str) -> FastResult | None:
     for offset in sorted(comments):
         result.add_comment(comments[offset], offset)
     blanks.sort()
-    result.text = _blank(text, blanks)
+    result.text = blank_regions(text, blanks)
     return result
 
 
 def _run(
-    reader: _Reader,
+    reader: Reader,
     word: str,
     start: int,
     result: FastResult,
@@ -648,9 +647,9 @@ def _run(
         try:
             if at in reader.bailed:  # read before: not again
                 reader.cond = reader.bailed[at]
-                raise _Bail
+                raise Bail
             item, spelling = reader.statement()
-        except _Bail:
+        except Bail:
             reader.bailed[at] = reader.cond
             if reader.cond is not None:
                 conds.append((at, reader.cond))
@@ -661,7 +660,7 @@ def _run(
         got.append((at, item, spelling))
         try:
             kind, a, _, u = reader.peek()  # comments before it are recorded here
-        except _Bail:
+        except Bail:
             resume = reader.pos
             break
         if kind != WORD or u != word:
@@ -718,7 +717,7 @@ class _Lines:
         return self.line, p - self.ls + 1
 
 
-def _blank(text: str, regions: list[tuple[int, int, int, str]]) -> str:
+def blank_regions(text: str, regions: list[tuple[int, int, int, str]]) -> str:
     """``text`` with every character of ``regions`` but ``\\n`` replaced by a space, and
     the placeholder mark at the offset of each (when not -1)."""
     out: list[str] = []

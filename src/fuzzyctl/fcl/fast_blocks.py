@@ -24,19 +24,18 @@ from typing import Any
 from fuzzyctl.fcl import keywords
 from fuzzyctl.fcl.errors import CLOSERS
 from fuzzyctl.fcl.fast import (
-    _COMMENT,
-    _NUMBER,
+    COMMENT_RE,
     MIN_RUN,
+    NUMBER_RE,
     FastResult,
-    _Bail,
-    _blank,
-    _Reader,
-    _RuleReader,
-    _TermReader,
+    Reader,
+    RuleReader,
+    TermReader,
+    blank_regions,
     next_item,
     read_runs,
 )
-from fuzzyctl.fcl.fast_conditions import KEYWORDS, PUNCT, WORD
+from fuzzyctl.fcl.fast_conditions import KEYWORDS, PUNCT, WORD, Bail
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -54,12 +53,12 @@ from fuzzyctl.model import (
 _ITEMS = ("VAR_INPUT", "VAR_OUTPUT", "VAR", "FUZZIFY", "DEFUZZIFY", "RULEBLOCK")
 _END = {item: CLOSERS[item] for item in _ITEMS}
 # Where runs of blocks may start: comments and OPTIONS text are skipped as lark skips them.
-_SCAN = re.compile(rf"({_COMMENT})|\b({'|'.join(_ITEMS)}|OPTIONS|OPTION)\b", re.S | re.I)
-_END_SCAN = {end: re.compile(rf"({_COMMENT})|\b{end}\b", re.S | re.I) for end in set(_END.values())}
+_SCAN = re.compile(rf"({COMMENT_RE})|\b({'|'.join(_ITEMS)}|OPTIONS|OPTION)\b", re.S | re.I)
+_END_SCAN = {end: re.compile(rf"({COMMENT_RE})|\b{end}\b", re.S | re.I) for end in set(_END.values())}
 _WS = r"[ \t\f\r\n\ufeff]*"
 # RANGE [:=] (low .. high); with white space only (lark's NUMBER stops before '..').
 _RANGE = re.compile(
-    rf"RANGE{_WS}(?::={_WS})?\({_WS}({_NUMBER}){_WS}(?:\.\.|,){_WS}({_NUMBER}){_WS}\){_WS};", re.I
+    rf"RANGE{_WS}(?::={_WS})?\({_WS}({NUMBER_RE}){_WS}(?:\.\.|,){_WS}({NUMBER_RE}){_WS}\){_WS};", re.I
 )
 # The one-line statements of DEFUZZIFY and RULEBLOCK: (key, what the message calls it, synonyms)
 _KEYWORD_ITEMS = {
@@ -85,13 +84,13 @@ class _Taken:
     comments: dict[int, str] = field(default_factory=dict)
 
 
-class _BlockReader(_Reader):
+class _BlockReader(Reader):
     """Blocks and declarations, with the TERM and RULE readers of fuzzyctl.fcl.fast."""
 
     def __init__(self, text: str) -> None:
         super().__init__(text)
-        self.terms = _TermReader(text)
-        self.rules = _RuleReader(text)
+        self.terms = TermReader(text)
+        self.rules = RuleReader(text)
         self.spellings: set[str] = set()
         self.start = (1, 1)  # line and column of the block being read
         self.ends: dict[str, tuple[int, int]] = {}  # END keyword: (searched from, found)
@@ -113,7 +112,7 @@ class _BlockReader(_Reader):
         """Where the next token starts, or where the last one ended."""
         return self.la[1] if self.la is not None else self.pos
 
-    def sub(self, reader: _Reader, at: int) -> Rule | Term:
+    def sub(self, reader: Reader, at: int) -> Rule | Term:
         """A statement read by ``reader`` from ``at``; this reader goes on after it."""
         reader.comments = []
         reader.seek(at)
@@ -129,10 +128,10 @@ class _BlockReader(_Reader):
     def range(self, at: int) -> tuple[Range, int]:
         m = _RANGE.match(self.text, at)
         if m is None:
-            raise _Bail
+            raise Bail
         low, high = self.number(*m.span(1)), self.number(*m.span(2))
         if low > high or low == high:
-            raise _Bail  # lark's transformer reports it
+            raise Bail  # lark's transformer reports it
         self.seek(m.end())
         return Range(low, high, self.span(at, m.end())), m.end()
 
@@ -147,7 +146,7 @@ class _BlockReader(_Reader):
             return key, None, self.span(at, end)
         value = keywords.canonical(table, spelling)
         if value is None:
-            raise _Bail
+            raise Bail
         return key, value, self.span(at, end)
 
     def default(self, at: int) -> Default:
@@ -161,7 +160,7 @@ class _BlockReader(_Reader):
         elif k == 2:  # a number
             value, no_change = self.number(a, b), False
         else:
-            raise _Bail
+            raise Bail
         end = self.punct(";") + 1
         return Default(value, no_change, self.span(at, end))
 
@@ -187,7 +186,7 @@ class _BlockReader(_Reader):
         while True:
             k, a, b, u = self.peek()
             if k != WORD:
-                raise _Bail
+                raise Bail
             if u == end_word:
                 self.next()
                 break
@@ -200,14 +199,14 @@ class _BlockReader(_Reader):
             elif word == "DEFUZZIFY" and u in _DEFUZZIFY_ITEMS:
                 key, setting, span = self.keyword_item(u, a)
                 if key in items:
-                    raise _Bail
+                    raise Bail
                 items[key] = (setting, span)
             elif word == "DEFUZZIFY" and u == "DEFAULT" and "default" not in items:
                 default = self.default(a)
                 assert default.span is not None
                 items["default"] = (default, default.span)
             else:
-                raise _Bail
+                raise Bail
         span = Span(*self.start, *self.lc(b))
         if word == "FUZZIFY":
             return FuzzifyBlock(name, tuple(terms), ranges[0] if ranges else None, span), b
@@ -238,7 +237,7 @@ class _BlockReader(_Reader):
         while True:
             k, a, b, u = self.peek()
             if k != WORD:
-                raise _Bail
+                raise Bail
             if u == "END_RULEBLOCK":
                 self.next()
                 break
@@ -249,10 +248,10 @@ class _BlockReader(_Reader):
             elif u in _RULEBLOCK_ITEMS:
                 key, setting, span = self.keyword_item(u, a)
                 if key in items:
-                    raise _Bail
+                    raise Bail
                 items[key] = (setting, span)
             else:
-                raise _Bail
+                raise Bail
 
         def value(key: str) -> str | None:
             return items.get(key, (None,))[0]
@@ -285,11 +284,11 @@ class _BlockReader(_Reader):
         while True:
             k, _, _, u = self.next()
             if k != PUNCT:
-                raise _Bail
+                raise Bail
             if u == ":":
                 break
             if u != ",":
-                raise _Bail
+                raise Bail
             names.append(self.word())
         data_type, _, _ = self.word()
         initial: float | bool | str | None = None
@@ -302,10 +301,10 @@ class _BlockReader(_Reader):
                 text = self.text[a:b]
                 initial = u == "TRUE" if u in ("TRUE", "FALSE") else text
             else:
-                raise _Bail
+                raise Bail
             k, a, b, u = self.next()
         if not (k == PUNCT and u == ";"):
-            raise _Bail
+            raise Bail
         end = b
         rng: Range | None = None
         k, a, _, u = self.peek()
@@ -362,7 +361,7 @@ def _next_block(reader: _BlockReader, at: int) -> tuple[str, int, int] | None:
                     return None
                 reader.next()
                 k, a, _, u = reader.peek()
-    except _Bail:
+    except Bail:
         return None
     return (u, a, gap) if k == WORD and u in _END else None
 
@@ -380,7 +379,7 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
             # rule labelled END_RULEBLOCK), and lark must leave it as it leaves a block read
             # here
             _, end = reader.block(word, start)
-        except _Bail:
+        except Bail:
             return start + len(word)
     reader.comments = []
     # (offset, the block or None when lark reads it, spellings, where the text after the
@@ -405,7 +404,7 @@ def _block_run(reader: _BlockReader, word: str, start: int, taken: _Taken) -> in
             break
         try:
             block, end = reader.block(w, at)
-        except _Bail:
+        except Bail:
             got.append((at, None, frozenset(), gap))
             resume = at + len(w)
             break
@@ -452,7 +451,7 @@ def _decl_run(reader: _BlockReader, kind: VarKind, start: int, taken: _Taken) ->
                 break
             reader.at_statement(a)
             got.append((a, reader.decl(kind, a)))
-        except _Bail:
+        except Bail:
             break
         at = reader.after()
     if len(got) < MIN_RUN:
@@ -479,7 +478,7 @@ def read_blocks(text: str) -> FastResult | None:
     if not taken.blanks:
         return read_runs(text)
     taken.blanks.sort()
-    rest = _blank(text, taken.blanks)
+    rest = blank_regions(text, taken.blanks)
     result = read_runs(rest) or FastResult(rest)
     result.blocks = [(at, block) for at, block, _ in taken.blocks]
     result.block_spellings = [(at, s) for at, _, spellings in taken.blocks for s in sorted(spellings)]

@@ -23,7 +23,7 @@ from fuzzyctl.limits import MAX_NESTING
 from fuzzyctl.model import And, Condition, Degree, Is, Not, Or, Span
 
 if TYPE_CHECKING:
-    from fuzzyctl.fcl.fast import _RuleReader
+    from fuzzyctl.fcl.fast import RuleReader
 
 COMMENT, NUMBER, WORD, LABEL, PUNCT = 1, 2, 3, 4, 5
 
@@ -101,7 +101,7 @@ class _Level:
 class ConditionParser:
     """One condition from the reader's position; see :meth:`parse`."""
 
-    def __init__(self, reader: _RuleReader) -> None:
+    def __init__(self, reader: RuleReader) -> None:
         self.r = reader
         self.build = True  # False once the condition is known to be too deep
         self.frames: list[_Level] = []  # the enclosing levels, innermost last

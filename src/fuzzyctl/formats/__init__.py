@@ -16,8 +16,10 @@ Meaning-preserving rewrites (renaming a ``LDL-Level`` to ``LDL_Level`` for FCL, 
 that is a triangle to ``trimf``) are not losses.
 
 This registry is the one list of formats: each format's name, extensions, size limit and
-description live in its ``FORMAT``, and the CLI's help, the studio's file list and dialogs,
-the runtime API and :func:`fuzzyctl.limits.max_input_bytes` are built from it.
+description are its entry in :mod:`fuzzyctl.formatspec` (at the bottom of the stack, so that
+the FCL parser's size limit comes from it too) and its ``FORMAT`` is built from that entry;
+the CLI's help, the studio's file list and dialogs, the runtime API and
+:func:`fuzzyctl.limits.max_input_bytes` are built from them.
 """
 
 from __future__ import annotations
@@ -27,11 +29,12 @@ import importlib.util
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
 from fuzzyctl.files import write_atomic
+from fuzzyctl.formatspec import DEFAULT_MAX_BYTES, SPECS, FormatSpec
 from fuzzyctl.gcpause import gc_paused
-from fuzzyctl.limits import DEFAULT_MAX_INPUT_BYTES
 from fuzzyctl.model import Document
 from fuzzyctl.validation import Placer, at_spans
 
@@ -85,7 +88,7 @@ class Format:
     read: Reader | None = None
     write: Writer | None = None
     adapt: Adapter = field(default=_nothing_lost)
-    max_bytes: int = DEFAULT_MAX_INPUT_BYTES
+    max_bytes: int = DEFAULT_MAX_BYTES
     """The largest file read (:func:`fuzzyctl.limits.max_input_bytes`): every shape of file at
     the limit is read (accepted or refused) well within the 5 s of issue 14
     (benchmarks/large_inputs.py; docs/limits.md has the figures)."""
@@ -99,6 +102,12 @@ class Format:
     validates: bool = False
     """The reader runs :func:`fuzzyctl.validation.validate` itself (FCL, among its checks)."""
 
+    @classmethod
+    def builtin(cls, spec: FormatSpec, **parts: Any) -> Format:
+        """A built-in format: its name, extensions, size limit and description from its
+        entry in :mod:`fuzzyctl.formatspec`, the reader, writer, ... from ``parts``."""
+        return cls(spec.name, spec.extensions, spec.description, max_bytes=spec.max_bytes, **parts)
+
     def losses(self, document: Document) -> list[Loss]:
         """What this format cannot express of ``document`` (empty: a lossless write)."""
         return self.adapt(document)[1]
@@ -108,7 +117,7 @@ REGISTRY: dict[str, Format] = {}
 """Registered formats by name.  Use :func:`get` and :func:`available`, which load the
 built-in ones on first use."""
 
-KNOWN_NAMES: tuple[str, ...] = ("fcl", "fis", "fll", "json", "fpl", "xfuz")
+KNOWN_NAMES: tuple[str, ...] = tuple(SPECS)
 """The built-in formats, each the subpackage ``fuzzyctl.formats.<name>`` (optional ones may be
 absent from an installation).  Their ``__init__`` modules are small: a reader or writer is
 imported when a file of that kind is used."""

@@ -166,8 +166,20 @@ def load_config(path: str | Path) -> SimConfig:
 
     plant = _table(data, "plant", path)
     model = plant.pop("model", None)
+    if "fmu" in plant:
+        # an FMU plant (fuzzyctl.sim.plants.fmu): its file relative to this one
+        if model is not None:
+            raise InputError(f"{path}: [plant] give either model or fmu, not both")
+        if not isinstance(plant["fmu"], str):
+            raise InputError(f'{path}: [plant] fmu must be a file name, fmu = "plant.fmu"')
+        fmu = path.parent / plant["fmu"]
+        if not fmu.is_file():
+            raise InputError(f"{path}: [plant] fmu {plant['fmu']!r}: no such file ({fmu.resolve()})")
+        model, plant["fmu"] = "fmu", str(fmu.resolve())
     if not isinstance(model, str):
-        raise InputError(f'{path}: [plant] needs model = "crane" | "pendulum" | "tank" | "fopdt"')
+        raise InputError(
+            f'{path}: [plant] needs model = "crane" | "pendulum" | "tank" | "fopdt" (or fmu = "plant.fmu")'
+        )
 
     controller = _table(data, "controller", path)
     structure = controller.get("structure", "direct")

@@ -108,6 +108,18 @@ class Plant(ABC, Generic[S]):
     def measure(self, state: S) -> dict[str, float]:
         """The measured outputs (the sensors) in the state."""
 
+    @classmethod
+    def configure(cls, parameters: Mapping[str, Any] | None) -> Plant[Any]:
+        """The plant with some parameters changed (a ``[plant]`` table without ``model``);
+        unknown names are errors that list the valid ones."""
+        names = {p.name for p in cls.parameters()}
+        for key in parameters or {}:
+            if key not in names:
+                raise InputError(
+                    f"plant {cls.kind!r} has no parameter {key!r}; parameters: {', '.join(sorted(names))}"
+                )
+        return cls(**dict(parameters or {}))
+
     def replace(self, **changes: float) -> Plant[S]:
         """A copy with some parameters changed (validated)."""
         return dataclasses.replace(self, **changes)  # type: ignore[type-var]
@@ -152,11 +164,4 @@ def make_plant(kind: str, parameters: Mapping[str, Any] | None = None) -> Plant[
 
     if kind not in PLANTS:
         raise InputError(f"unknown plant model {kind!r}; models: {', '.join(sorted(PLANTS))}")
-    cls = PLANTS[kind]
-    names = {p.name for p in cls.parameters()}
-    for key in parameters or {}:
-        if key not in names:
-            raise InputError(
-                f"plant {kind!r} has no parameter {key!r}; parameters: {', '.join(sorted(names))}"
-            )
-    return cls(**dict(parameters or {}))
+    return PLANTS[kind].configure(parameters)

@@ -60,7 +60,7 @@ class NativeRuntime(EngineRuntime):
     def __init__(self, model: Document | FunctionBlock, *, block: str | None = None) -> None:
         import fuzzyctl
         from fuzzyctl.codegen import CodegenError
-        from fuzzyctl.codegen.native import NativeController, NativeError, build
+        from fuzzyctl.engine.native import NativeController, NativeError, build
 
         plan = fuzzyctl.compile(model, block=block, backend="interpreted").plan
         try:

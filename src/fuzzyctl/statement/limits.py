@@ -157,7 +157,7 @@ def limit_rows() -> list[LimitRow]:
     """Table 11 for the system as a whole: fuzzyctl, the Siemens FUZZY block, XFUZ."""
     from fuzzyctl.blocks.schneider.fb import DEGRE_FULL
     from fuzzyctl.blocks.siemens.profile import LIMITS
-    from fuzzyctl.formats import xfuz_tables as xt
+    from fuzzyctl.formats.xfuz import tables as xt
     from fuzzyctl.io.s7 import FUZZY_DB
 
     s_in, s_terms, s_out, s_oterms = (

@@ -65,7 +65,7 @@ def _c_sizes(doc: Document) -> tuple[int | None, int | None]:
     import tempfile
 
     from fuzzyctl.codegen import generate_c, lower_block
-    from fuzzyctl.codegen.native import build, compiler
+    from fuzzyctl.engine.native import build, compiler
 
     cc = compiler()
     if cc is None:
@@ -162,7 +162,7 @@ def machine() -> str:
         pass
     cc = "no C compiler"
     try:
-        from fuzzyctl.codegen.native import compiler
+        from fuzzyctl.engine.native import compiler
 
         found = compiler()
         if found:

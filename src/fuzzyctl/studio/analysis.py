@@ -280,7 +280,7 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
     extended flat to the range ends), ``{"singleton": x}``, ``{"spikes": [[x, mu], ...]}``,
     or ``{"text": ...}`` for terms given by variables or expressions; each also has
     ``"fcl"``, the term as the FCL text writes it (after ``:=``)."""
-    from fuzzyctl.engine.shapes import membership_np, pwl_points
+    from fuzzyctl.engine.semantics.shapes import membership_np, pwl_points
     from fuzzyctl.fcl.writer import mf_text
 
     out: dict[str, dict[str, Any]] = {}

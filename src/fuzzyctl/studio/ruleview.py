@@ -4,7 +4,7 @@ each conclusion activates - with the accumulated sets and the outputs at the bot
 
 Everything comes from the engine: the degrees from ``explain``, the activation operator
 and the weight convention from the compiled plan, the term shapes from
-``fuzzyctl.engine.shapes``; the activated set of a conclusion is ``w * act(d, mu)`` (IEC
+``fuzzyctl.engine.semantics.shapes``; the activated set of a conclusion is ``w * act(d, mu)`` (IEC
 61131-7; ``act(w * d, mu)`` under the fuzzylite option) sampled over the output's range.
 """
 
@@ -15,8 +15,8 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.engine.operators import TNORMS
-from fuzzyctl.engine.shapes import FloatArray, membership_np, pwl_points
+from fuzzyctl.engine.semantics.operators import TNORMS
+from fuzzyctl.engine.semantics.shapes import FloatArray, membership_np, pwl_points
 from fuzzyctl.fcl.writer import conclusion_text, condition_text
 from fuzzyctl.model import (
     And,

@@ -37,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
-from fuzzyctl.engine.shapes import pwl_value_np
+from fuzzyctl.engine.semantics.shapes import pwl_value_np
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 from fuzzyctl.tune import gradient_cog
 

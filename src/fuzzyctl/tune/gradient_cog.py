@@ -1,8 +1,8 @@
 """Closed-form derivatives of a Mamdani output defuzzified by centre of gravity (COG) or
 of area (COA).
 
-The engine integrates the accumulated set exactly (:mod:`fuzzyctl.engine.pwl`,
-:mod:`fuzzyctl.engine.kernels_np`): on the output grid (the range cut at every term point) each
+The engine integrates the accumulated set exactly (:mod:`fuzzyctl.engine.reference.pwl`,
+:mod:`fuzzyctl.ir.kernels.columns`): on the output grid (the range cut at every term point) each
 term is linear; MIN activation adds a kink where a term crosses the rule's degree, MAX
 accumulation adds the crossings of activated sets, BSUM the crossings of their sum with 1.
 Between two consecutive cuts the accumulated set ``f`` is linear, and
@@ -56,8 +56,8 @@ from dataclasses import dataclass
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.engine.kernels_np import _coa  # the engine's bisector: the same x* to the last bit
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
+from fuzzyctl.ir.kernels.columns import coa_columns  # the engine's bisector: the same x* to the last bit
 
 Arr = npt.NDArray[np.float64]
 Bool = npt.NDArray[np.bool_]
@@ -219,7 +219,7 @@ def _cuts(
     lines: Sequence[Line], accu: str, n: int, levels: Sequence[tuple[float, float, Arr]] = ()
 ) -> tuple[Arr, Arr]:
     """The cuts of one grid interval (``t`` in [0, 1], sorted per row) and the accumulated
-    degree there - the engine's candidates (:func:`fuzzyctl.engine.kernels_np._interval`) and
+    degree there - the engine's candidates (:func:`fuzzyctl.ir.kernels.columns._interval`) and
     where a term ``(L, R, level)`` of ``levels`` crosses a level."""
     zeros, ones = np.zeros(n), np.ones(n)
     cands = [zeros, ones]
@@ -407,7 +407,7 @@ def _bisector(pieces: list[tuple[Arr, Arr]]) -> tuple[Arr, Arr]:
     x1 = np.concatenate([X[:, 1:] for X, _V in pieces], axis=1)
     v0 = np.concatenate([V[:, :-1] for _X, V in pieces], axis=1)
     v1 = np.concatenate([V[:, 1:] for _X, V in pieces], axis=1)
-    xc, _fired = _coa(x0, x1, v0, v1)
+    xc, _fired = coa_columns(x0, x1, v0, v1)
     inside = (x0 <= xc[:, None]) & (xc[:, None] <= x1) & (x1 > x0)
     with np.errstate(all="ignore"):
         at = v0 + (v1 - v0) * (xc[:, None] - x0) / (x1 - x0)

@@ -41,7 +41,7 @@ import numpy.typing as npt
 
 from fuzzyctl.diagnostics import InputError
 from fuzzyctl.engine.compile import COMPAT_PROFILES
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.model import (
     And,
     Conclusion,

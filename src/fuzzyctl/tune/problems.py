@@ -17,7 +17,7 @@ import numpy.typing as npt
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.batch import BatchEvaluator
 from fuzzyctl.engine.compile import COMPAT_PROFILES
-from fuzzyctl.engine.lower import lower
+from fuzzyctl.engine.lowering.lower import lower
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.model import Document, FunctionBlock
 from fuzzyctl.tune import gradient, plant

@@ -228,8 +228,8 @@ def _moved_variables(r: TuneResult) -> list[str]:
 def _curves(fb: FunctionBlock, var: str) -> tuple[np.ndarray, list[tuple[str, np.ndarray, bool]]]:
     """Sampled membership functions of one variable (singletons as stems)."""
     from fuzzyctl.engine.compile import COMPAT_PROFILES
-    from fuzzyctl.engine.lower import lower
-    from fuzzyctl.engine.shapes import membership_np
+    from fuzzyctl.engine.lowering.lower import lower
+    from fuzzyctl.engine.semantics.shapes import membership_np
 
     plan, _ = lower(fb, COMPAT_PROFILES["iec"])
     assert plan is not None

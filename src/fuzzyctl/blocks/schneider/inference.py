@@ -15,8 +15,8 @@ output and intermediate fuzzy sets sampled on ``Discr`` points, two inference le
    the mean of those points weighted by their aggregated degrees.
 
 The terms, t-norms, aggregation and the sampled defuzzifiers come from the engine
-(:mod:`fuzzyctl.engine.shapes`, :mod:`~fuzzyctl.engine.operators`,
-:mod:`~fuzzyctl.engine.sampled`); what is particular to XFUZ is the choice of the Discr
+(:mod:`fuzzyctl.engine.semantics.shapes`, :mod:`~fuzzyctl.engine.semantics.operators`,
+:mod:`~fuzzyctl.engine.reference.sampled`); what is particular to XFUZ is the choice of the Discr
 points and the two levels.
 """
 
@@ -29,9 +29,9 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from fuzzyctl.engine.operators import TNORMS, accumulate, accumulate_np
-from fuzzyctl.engine.sampled import mean_of_maxima, sampled_centroid, weighted_mean
-from fuzzyctl.engine.shapes import Points, pwl_points, pwl_value, pwl_value_np
+from fuzzyctl.engine.reference.sampled import mean_of_maxima, sampled_centroid, weighted_mean
+from fuzzyctl.engine.semantics.operators import TNORMS, accumulate, accumulate_np
+from fuzzyctl.engine.semantics.shapes import Points, pwl_points, pwl_value, pwl_value_np
 from fuzzyctl.formats.xfuz.tables import (
     INT16_MAX,
     INT16_MIN,

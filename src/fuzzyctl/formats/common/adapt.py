@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
-from fuzzyctl.engine import operators as ops
+from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.basics import identifier, is_identifier
 from fuzzyctl.model import (

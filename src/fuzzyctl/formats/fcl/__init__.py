@@ -5,8 +5,8 @@ and writer load on first use."""
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats.fcl.names import EXTENSIONS, NAME, fcl_api
-from fuzzyctl.limits import MiB
+from fuzzyctl.formats.fcl.names import fcl_api
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 
 
@@ -35,15 +35,11 @@ def _notes(document: Document) -> list[Loss]:
 
 
 _available = fcl_api() is not None
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "IEC 61131-7 Fuzzy Control Language",
+FORMAT = Format.builtin(
+    SPECS["fcl"],
     read=_read if _available else None,
     write=_write if _available else None,
     adapt=_adapt,
     notes=_notes,
     validates=True,
-    # the 10,000-rule 8-input system is 1.31 MiB; the largest real FCL file we know 290 KB
-    max_bytes=MiB * 3 // 2,
 )

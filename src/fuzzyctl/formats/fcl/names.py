@@ -7,9 +7,6 @@ import importlib
 import importlib.util
 from typing import Any
 
-NAME = "fcl"
-EXTENSIONS = (".fcl",)
-
 
 def fcl_api() -> Any | None:
     """:mod:`fuzzyctl.fcl`, or None when this installation has no FCL reader and writer."""

@@ -5,7 +5,7 @@ reader and writer load on first use."""
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.limits import MiB
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 
 
@@ -27,14 +27,9 @@ def _adapt(document: Document) -> tuple[Document, list[Loss]]:
     return adapt(document)
 
 
-FORMAT = Format(
-    name="fis",
-    extensions=(".fis",),
-    description="MATLAB / Octave Fuzzy Logic Toolbox FIS (and fuzzylite's FIS export)",
+FORMAT = Format.builtin(
+    SPECS["fis"],
     read=_read,
     write=_write,
     adapt=_adapt,
-    # FIS rules are dense (8 bytes each): 512 KiB is 65,000 rules (a 10,000-rule 4-input
-    # FIS file is 191 KB, the largest real one 179 KB)
-    max_bytes=MiB // 2,
 )

@@ -5,7 +5,7 @@ first use."""
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.limits import MiB
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 
 
@@ -27,15 +27,9 @@ def _adapt(document: Document) -> tuple[Document, list[Loss]]:
     return adapt(document)
 
 
-FORMAT = Format(
-    name="fll",
-    extensions=(".fll",),
-    description="fuzzylite language (fuzzylite 5/6, pyfuzzylite 8)",
+FORMAT = Format.builtin(
+    SPECS["fll"],
     read=_read,
     write=_write,
     adapt=_adapt,
-    # FLL's terse lines make the most model per byte (a Function term or a nested rule costs
-    # three times what an FCL rule of that length does); the 10,000-rule system is 1.19 MiB,
-    # the largest real FLL file 14 KB
-    max_bytes=MiB * 3 // 2,
 )

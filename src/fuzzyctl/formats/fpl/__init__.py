@@ -5,8 +5,7 @@ both use in :mod:`.names`.  The reader and writer load on first use."""
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats.fpl.names import EXTENSIONS, NAME
-from fuzzyctl.limits import MiB
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 
 
@@ -29,14 +28,9 @@ def _adapt(document: Document) -> tuple[Document, list[Loss]]:
     return adapted, [Loss(element, reason) for element, reason in losses]
 
 
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "FPL of Siemens S7 Fuzzy Control (Togai InfraLogic subset, Siemens manual 1.3)",
+FORMAT = Format.builtin(
+    SPECS["fpl"],
     read=_read,
     write=_write,
     adapt=_adapt,
-    # the largest project S7 Fuzzy Control allows (8 inputs of 7 terms, 4 outputs of 9, 200
-    # rules; Siemens manual 1.3) is a 77 KB FPL file, 346 KB with 56 conditions a rule
-    max_bytes=MiB,
 )

@@ -1,5 +1,5 @@
-"""Names the FPL reader and writer share: the format's name and extensions, the words FPL
-reserves and how long a name may be, and how Fuzzy Control accumulates (manual 1.3, 1.4)."""
+"""Names the FPL reader and writer share: the words FPL reserves, how long a name may be, and
+how Fuzzy Control accumulates (manual 1.3, 1.4)."""
 
 from __future__ import annotations
 
@@ -7,9 +7,6 @@ import re
 from collections.abc import Iterator
 
 from fuzzyctl.model import And, Condition, FunctionBlock, Is, Rule
-
-NAME = "fpl"
-EXTENSIONS = (".fpl",)
 
 #: The longest name FPL reads (Siemens 1.3).
 MAX_NAME = 255

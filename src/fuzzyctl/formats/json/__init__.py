@@ -5,8 +5,7 @@ use."""
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded
-from fuzzyctl.formats.json.names import EXTENSIONS, NAME
-from fuzzyctl.limits import DEFAULT_MAX_INPUT_BYTES
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 from fuzzyctl.validation import at_json_paths
 
@@ -23,13 +22,9 @@ def _write(document: Document) -> str:
     return dumps(document)
 
 
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "fuzzyctl model as JSON (lossless; schema in fuzzyctl/formats/json/fuzzyctl-model.schema.json)",
+FORMAT = Format.builtin(
+    SPECS["json"],
     read=_read,
     write=_write,
     place=at_json_paths,
-    # JSON spells out every span (that 10,000-rule system is 43.5 MB) and is read by C
-    max_bytes=12 * DEFAULT_MAX_INPUT_BYTES,
 )

@@ -9,8 +9,6 @@ from typing import Any
 
 from fuzzyctl import model as m
 
-NAME = "json"
-EXTENSIONS = (".json",)
 FORMAT_NAME = "fuzzyctl-model"
 VERSION = 1
 SCHEMA_FILE = "fuzzyctl-model.schema.json"

@@ -5,8 +5,7 @@ layout the XFUZ block shares in :mod:`.tables`.  The reader and writer load on f
 from __future__ import annotations
 
 from fuzzyctl.formats import Format, Loaded, Loss
-from fuzzyctl.formats.xfuz.names import EXTENSIONS, NAME
-from fuzzyctl.limits import MiB
+from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
 
 
@@ -35,15 +34,10 @@ def _notes(document: Document) -> list[Loss]:
     return [Loss(element, reason) for element, reason in notes(document)]
 
 
-FORMAT = Format(
-    NAME,
-    EXTENSIONS,
-    "Schneider XFUZ knowledge-base tables ESV/FA/RG and constants (JSON or CSV layout)",
+FORMAT = Format.builtin(
+    SPECS["xfuz"],
     read=_read,
     write=_write,
     adapt=_adapt,
     notes=_notes,
-    # an XFUZ block's tables are fixed in size (ESV 62, FA 576, RG 384 words): the examples
-    # are 4 KB
-    max_bytes=MiB,
 )

@@ -1,12 +1,10 @@
-"""Names the XFUZ table reader and writer share: the format's name and extensions, the tag
-of a JSON table file, and the block constants besides the tables (manual 3.2)."""
+"""Names the XFUZ table reader and writer share: the tag of a JSON table file, and the block
+constants besides the tables (manual 3.2)."""
 
 from __future__ import annotations
 
 from fuzzyctl.formats.xfuz.tables import XfuzConstants
 
-NAME = "xfuz"
-EXTENSIONS = (".xfuz",)
 FORMAT_TAG = "xfuz-tables"
 
 CONSTANT_KEYS = (

@@ -1,0 +1,1 @@
+"""jFuzzyLogic 3.3 reproduced (the ``compat="jfuzzylogic"`` profile)."""

@@ -1,0 +1,1 @@
+"""IR builders: rules, term formulas, piecewise-linear and smooth defuzzification, written once."""

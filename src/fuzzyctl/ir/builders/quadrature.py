@@ -1,0 +1,402 @@
+"""Centre of gravity of a smooth output (Gaussian, bell, sigmoid, ... terms, or operators that
+bend straight lines) in the generated block, to the tolerance its header states.
+
+An accumulated set of smooth terms has no closed-form integral.  The generated code does what
+the native evaluator does (:data:`fuzzyctl.ir.kernels.c.SMOOTH_DRIVER`), written in the
+IR so that Structured Text (``EXP`` is an IEC 61131-3 standard function) and C share it:
+
+1. the output range is cut at constant breakpoints: every term's characteristic points
+   (peaks, joins, support ends: :func:`fuzzyctl.engine.semantics.shapes.characteristic_points`), its
+   corners when piecewise linear, and the panels the calibration below adds;
+2. each interval is sampled at :data:`SAMPLES` points; where the branch the set takes changes
+   between two samples the kink is located by :data:`BISECTIONS` halvings (several kinks
+   between two samples: up to :data:`ROUNDS`).  The branch code has one bit per comparison
+   that decides a branch: each term against the degrees where its activation jumps or bends
+   (:data:`fuzzyctl.engine.semantics.operators.ACT_LEVELS`, the table the engine's integrators cut at:
+   MIN bends at the rule degree a, NIPMIN jumps at 1 - a and bends at a, BDIF bends at
+   1 - a), which set is largest (MAX, NIPMAX), where NIPMAX's sum reaches 1, where DMAX meets
+   two nonzero sets, where a bounded sum reaches 1.  Terms are monotonic between the
+   breakpoints, so each crosses a level at most once per interval;
+3. every piece between breakpoints and kinks is smooth and is integrated by adaptive
+   Gauss-Kronrod 7/15 (area and first moment): a panel is accepted when the Kronrod and
+   Gauss values agree to :data:`QTOL` per unit of width (:data:`QTOL_REAL` in REAL builds),
+   else halved, with at most :data:`QCAP` panels per evaluation and :data:`STACK` pending -
+   the bounded work a PLC cycle needs.  A panel accepted short of the tolerance (cap
+   reached) sets INFO 16#04.
+
+Calibration (generation time) halves each interval until the :data:`NODES`-point and
+``2*NODES``-point Gauss-Legendre rules agree on every term to :data:`PANEL_TOL`: it makes the
+sampling of step 2 dense where terms are narrow.  The error aimed at (:func:`cog_bound`, in
+the header) is ``2 QTOL (high - low)^2 / area`` on the CoG; tests compare it with the
+observed difference to the reference interpreter.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fuzzyctl.engine.lowering.grid import left_limit, right_limit
+from fuzzyctl.engine.plan import OutputPlan, Slot, TermPlan
+from fuzzyctl.engine.reference.pwl import gauss_legendre
+from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.engine.semantics.operators import ACT_LEVELS
+from fuzzyctl.ir.builders import terms as T
+from fuzzyctl.ir.nodes import Ex, Num, Var, not_
+from fuzzyctl.ir.state import Gen
+
+SAMPLES = 8  # points per interval where the branch taken is compared
+BISECTIONS = 46  # halvings locating a kink (to 2^-46 ~ 1.4e-14 of the sample spacing)
+ROUNDS = 8  # kinks located between two samples at most
+NODES = 8  # Gauss-Legendre nodes of the generation-time calibration
+QTOL = 1e-12  # Gauss-Kronrod acceptance per unit of width (area; moment: times the range)
+QTOL_REAL = 1e-5  # the same in REAL (32-bit float) builds, where rounding is ~1e-7
+STACK = 48  # pending panels at most (depth first: STACK - 2 nested halvings of one piece)
+QCAP = 4000  # panels per evaluation at most (15 evaluations of the set each)
+PIECE_MIN = 1e-13  # pieces narrower than this share of the range are not integrated
+CODE_BITS = 50  # branch comparisons coded exactly (LREAL mantissa)
+PANEL_TOL = 1e-10  # calibration tolerance per unit of width
+MAX_DEPTH = 8  # halvings of one interval at most
+
+
+@dataclass(frozen=True)
+class SmoothSet:
+    """One activated set: ``w * act(a, term)``."""
+
+    term: int
+    a: Ex
+    w: Ex
+    act: str
+
+
+@dataclass(frozen=True)
+class Calibration:
+    cuts: tuple[float, ...]
+    worst: float  # largest disagreement found per unit of width (<= PANEL_TOL when met)
+
+
+def constant_term(t: TermPlan) -> bool:
+    return not isinstance(t.height, Slot) and not any(isinstance(p, Slot) for p in t.params)
+
+
+def _degree_np(t: TermPlan, x: np.ndarray) -> np.ndarray:
+    if t.pwl is not None:
+        return shapes.pwl_value_np(t.pwl, x)
+    return shapes.membership_np(t.kind, [float(p) for p in t.params], float(t.height), x)  # type: ignore[arg-type]
+
+
+def _breakpoints(op: OutputPlan) -> list[float]:
+    assert op.low is not None and op.high is not None
+    lo, hi = op.low, op.high
+    pts = {lo, hi}
+    for t in op.terms:
+        if t.pwl is not None:
+            cand = [x for x, _y in t.pwl]
+        else:
+            cand = list(shapes.characteristic_points(t.kind, [float(p) for p in t.params]))  # type: ignore[arg-type]
+        pts.update(c for c in cand if lo < c < hi and math.isfinite(c))
+    return sorted(pts)
+
+
+def calibrate(op: OutputPlan) -> Calibration:
+    """The breakpoints of ``op`` refined until every term is integrated to :data:`PANEL_TOL`."""
+    assert op.low is not None and op.high is not None
+    width, low = op.high - op.low, op.low
+    x8, w8 = (np.array(v) for v in gauss_legendre(NODES))
+    x16, w16 = (np.array(v) for v in gauss_legendre(2 * NODES))
+    worst = 0.0
+
+    def err(a: float, b: float) -> float:
+        d = b - a
+        out = 0.0
+        for t in op.terms:
+            xa, xb = a + x8 * d, a + x16 * d
+            fa, fb = _degree_np(t, xa), _degree_np(t, xb)
+            e_area = abs(float(fa @ w8 - fb @ w16)) * d
+            e_mom = abs(float((fa * (xa - low)) @ w8 - (fb * (xb - low)) @ w16)) * d / width
+            out = max(out, e_area, e_mom)
+        return out / d
+
+    cuts: list[float] = []
+    bps = _breakpoints(op)
+    for a, b in itertools.pairwise(bps):
+        stack = [(a, b, 0)]
+        pieces: list[float] = []
+        while stack:
+            u, v, depth = stack.pop()
+            e = err(u, v)
+            if e > PANEL_TOL and depth < MAX_DEPTH:
+                m = 0.5 * (u + v)
+                stack += [(m, v, depth + 1), (u, m, depth + 1)]
+                continue
+            worst = max(worst, e)
+            pieces.append(u)
+        cuts += pieces
+    cuts.append(bps[-1])
+    return Calibration(tuple(cuts), worst)
+
+
+def cog_bound() -> str:
+    """The error the generated CoG aims at, as text for the header (checked against the
+    reference interpreter by tests/codegen/test_gen_accuracy.py and test_realsys.py)."""
+    return (
+        f"each panel accepted when Kronrod and Gauss agree to {QTOL:.0e} x width (area) and "
+        f"{QTOL:.0e} x width x (high - low) (moment), so |CoG error| <= {2 * QTOL:.0e} x "
+        f"(high - low)^2 / area (in a REAL (float) build {QTOL_REAL:.0e} and {2 * QTOL_REAL:.0e}), "
+        f"kinks located to 2^-{BISECTIONS} of the sample spacing; unless INFO = 16#04: more "
+        f"than {QCAP} panels of 15 points per evaluation (or {STACK - 2} nested halvings of "
+        f"one piece) were needed"
+    )
+
+
+# --------------------------------------------------------------------------- the set at x
+
+
+def _const_pwl(g: Gen, pts: tuple[tuple[float, float], ...], x: Ex) -> Var:
+    """``shapes.pwl_value`` of constant breakpoints as an IF chain."""
+    out = g.temp(hint="MU")
+    xs = sorted({q[0] for q in pts})
+    b = g.b
+    branches: list[tuple[Ex, float | Ex]] = [(x.lt(xs[0]), pts[0][1])]
+    for k, u in enumerate(xs):
+        pv = shapes.pwl_value(pts, u)
+        branches.append((x.eq(u), pv))
+        if k + 1 < len(xs):
+            u1 = xs[k + 1]
+            r0, l1 = right_limit(pts, u), left_limit(pts, u1)
+            val: float | Ex = r0 if r0 == l1 else r0 + (x - u) * ((l1 - r0) / (u1 - u))
+            branches.append((x.lt(u1), val))
+    for k, (cond, val) in enumerate(branches):
+        with b.if_(cond) if k == 0 else b.elif_(cond):
+            b.set(out, val)
+    with b.else_():
+        b.set(out, pts[-1][1])
+    return out
+
+
+def _set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> tuple[Var, Var]:
+    """The accumulated set at ``x`` and a code of the branch it took: a sum of distinct powers
+    of two, one per comparison that decides a branch - each term against the levels where its
+    activation jumps or bends (:data:`fuzzyctl.engine.semantics.operators.ACT_LEVELS`), which set is the
+    largest (MAX, NIPMAX), whether NIPMAX's sum reached 1, whether DMAX meets two nonzero sets,
+    whether a bounded sum reached 1.  Between two points of equal code the set is smooth."""
+    b = g.b
+    acc = g.let(0.0, "ACC")
+    code = g.let(0.0, "CODE")
+    bit = itertools.count()
+
+    def flag(cond: Ex) -> None:
+        # 2^(k mod CODE_BITS): exact in LREAL; beyond CODE_BITS comparisons two flips could
+        # cancel (a kink then integrated by the adaptive rule, not located)
+        with b.if_(cond):
+            b.set(code, code + float(2 ** (next(bit) % CODE_BITS)))
+
+    for s in sets:
+        term = op.terms[s.term]
+        where = f"term {op.name}.{term.name}"
+        mu: Ex
+        if term.pwl is not None:
+            mu = _const_pwl(g, term.pwl, x)
+        else:
+            ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
+            mu = T.smooth(g, term.kind, ps, x, where)
+            if float(term.height) != 1.0:  # type: ignore[arg-type]
+                mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
+        mu = mu if isinstance(mu, Var) else g.let(mu, "MU")
+        for offset, slope in ACT_LEVELS.get(s.act, ()):
+            flag(mu.gt(Num(offset) + Num(slope) * s.a))
+        c = g.let(T.mul(s.w, T.tnorm(g, s.act, s.a, mu)), "C")
+        if accu in ("MAX", "NIPMAX"):
+            flag(c.gt(acc))
+        if accu == "NIPMAX":
+            flag((acc + c).lt(1.0))
+        if accu == "DMAX":
+            flag(c.gt(0.0).and_(acc.gt(0.0)))
+        T.accumulate_into(g, accu, acc, c)
+    if accu == "BSUM":
+        flag(acc.ge(1.0))
+    return acc, code
+
+
+# --------------------------------------------------------------------------- the driver
+
+
+def smooth_cog(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) -> tuple[Var, Var, Var]:
+    """Emit the CoG of ``op`` from its activated ``sets``; returns (value, fired, capped):
+    ``capped`` is TRUE when a panel was accepted short of :data:`QTOL` (iteration cap)."""
+    b = g.b
+    accu = op.accu or "MAX"
+    cuts = cal.cuts
+    nc = len(cuts)
+    cap = (nc - 1) * (SAMPLES * ROUNDS + 1) + 2
+    ctab = g.declare(g.fresh("QCUT", "QCUT"), "REAL", "const", nc, cuts, f"{op.name}: breakpoints")
+    pts = g.array("QPT", "REAL", cap)
+    n = g.let(0, "NQ", "INT")
+    area, mom = g.let(0.0, "QA"), g.let(0.0, "QM")
+    value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
+    i = g.counter("QI")
+    with b.for_(i, 0, nc - 2) as iv:
+        a_, b_ = g.let(ctab[iv], "QL"), g.let(ctab[iv + 1], "QR")
+        b.set(pts[n], a_)
+        b.set(n, n + 1)
+        x = g.temp(hint="X")
+        xprev, c0 = g.let(a_, "XP"), g.let(0.0, "C0")
+        j = g.counter("QJ")
+        with b.for_(j, 0, SAMPLES - 1) as jv:
+            with b.if_(jv.eq(SAMPLES - 1)):
+                b.set(x, b_)
+            with b.else_():
+                b.set(x, a_ + (b_ - a_) * (g.call("TO_REAL", jv) / float(SAMPLES - 1)))
+            _val, cx = _set_at(g, op, sets, x, accu)
+            with b.if_(jv.gt(0).and_(cx.ne(c0))):
+                _locate(g, op, sets, accu, xprev, x, c0, cx, pts, n, cap)
+            b.set(xprev, x)
+            b.set(c0, cx)
+    b.set(pts[n], cuts[-1])
+    b.set(n, n + 1)
+    capped = g.let(False, "QCAPPED", "BOOL")
+    _integrate(g, op, sets, accu, pts, n, area, mom, capped)
+    b.set(fired, area.gt(0.0))
+    with b.if_(fired):
+        b.set(value, float(op.low or 0.0) + mom / area)
+    with b.else_():
+        b.set(value, 0.0)
+    return value, fired, capped
+
+
+def _integrate(
+    g: Gen,
+    op: OutputPlan,
+    sets: list[SmoothSet],
+    accu: str,
+    pts: Var,
+    n: Var,
+    area: Var,
+    mom: Var,
+    capped: Var,
+) -> None:
+    """Area and moment of the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod
+    7/15: a panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width
+    (area; times the range for the moment), else halved - at most :data:`QCAP` panels per
+    evaluation and :data:`STACK` pending ones (depth first: STACK - 2 nested halvings); a
+    panel accepted short of the tolerance sets ``capped``."""
+    from fuzzyctl.engine.reference.quadrature import NODES as GKX
+    from fuzzyctl.engine.reference.quadrature import WG as GKG
+    from fuzzyctl.engine.reference.quadrature import WK as GKK
+
+    b = g.b
+    low = float(op.low or 0.0)
+    width = float((op.high or 0.0) - low) or 1.0
+    xs = g.declare(
+        g.fresh("GKX", "GKX"),
+        "REAL",
+        "const",
+        15,
+        tuple(0.5 * (float(v) + 1.0) for v in GKX),
+        "Gauss-Kronrod nodes on 0..1",
+    )
+    wk = g.declare(
+        g.fresh("GKK", "GKK"), "REAL", "const", 15, tuple(0.5 * float(v) for v in GKK), "Kronrod weights"
+    )
+    wg = g.declare(
+        g.fresh("GKG", "GKG"),
+        "REAL",
+        "const",
+        15,
+        tuple(0.5 * float(v) for v in GKG),
+        "Gauss weights (0 off the 7 Gauss nodes)",
+    )
+    # the program is precision-neutral; in REAL (float) 1e-10 vanishes beside 1 and the
+    # tolerance must be one REAL can reach, else every panel would run to the cap
+    tol = g.let(QTOL, "QTOL")
+    probe = g.let(Num(1.0) + Num(1e-10), "QE")  # stored: rounded to the variable's type
+    with b.if_(probe.eq(1.0)):
+        b.set(tol, QTOL_REAL)
+    sl, sr = g.array("QSL", "REAL", STACK), g.array("QSR", "REAL", STACK)
+    sp = g.let(0, "QSP", "INT")
+    used = g.let(0, "QUSED", "DINT")
+    p = g.counter("QP")
+    # pieces narrower than PIECE_MIN of the range are left out: bisection brackets a point to
+    # a few ulps, and a node there would give an isolated point (DMIN's peak) a positive area
+    with b.for_(p, 0, n - 2) as pv, b.if_((pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)):
+        b.set(sl[0], pts[pv])
+        b.set(sr[0], pts[pv + 1])
+        b.set(sp, 1)
+        with b.while_(sp.gt(0)):
+            b.set(sp, sp - 1)
+            u, d = g.let(sl[sp], "QU"), g.let(sr[sp] - sl[sp], "QD")
+            ka, km, ga, gm = (g.let(0.0, h) for h in ("KA", "KM", "GA", "GM"))
+            k = g.counter("QK")
+            with b.for_(k, 0, 14) as kv:
+                xq = g.let(u + xs[kv] * d, "XQ")
+                y, _code = _set_at(g, op, sets, xq, accu)
+                ym = g.let(y * (xq - low), "YM")
+                b.set(ka, ka + wk[kv] * y)
+                b.set(km, km + wk[kv] * ym)
+                b.set(ga, ga + wg[kv] * y)
+                b.set(gm, gm + wg[kv] * ym)
+            b.set(used, used + 1)
+            ok = g.call("ABS", ka - ga).le(tol).and_(g.call("ABS", km - gm).le(tol * width))
+            mid = g.let(u + 0.5 * d, "QMID")
+            # a panel a few ulps wide holds a jump the bisection placed to the last bit: its
+            # share is rounding, not a missed tolerance (no halving, no INFO)
+            split = g.let(mid.gt(u).and_(mid.lt(u + d)), "QSPLIT", "BOOL")
+            room = sp.lt(STACK - 2).and_(used.lt(QCAP))
+            with b.if_(not_(ok).and_(split).and_(room)):
+                b.set(sl[sp], mid)
+                b.set(sr[sp], u + d)
+                b.set(sl[sp + 1], u)
+                b.set(sr[sp + 1], mid)
+                b.set(sp, sp + 2)
+            with b.else_():
+                b.set(area, area + ka * d)
+                b.set(mom, mom + km * d)
+                with b.if_(not_(ok).and_(split)):
+                    b.set(capped, True)
+
+
+def _locate(
+    g: Gen,
+    op: OutputPlan,
+    sets: list[SmoothSet],
+    accu: str,
+    lo0: Var,
+    x: Var,
+    c0: Var,
+    cx: Var,
+    pts: Var,
+    n: Var,
+    cap: int,
+) -> None:
+    """Kinks between two samples (``lo0`` with code ``c0``, ``x`` with code ``cx``) appended to
+    ``pts`` by bisection on the branch code."""
+    b = g.b
+    lo, hi = g.let(lo0, "LO"), g.let(x, "HI")
+    code, chi = g.let(c0, "CL"), g.let(cx, "CH")
+    q = g.let(0, "QR", "INT")
+    go = g.let(True, "GO", "BOOL")
+    with b.while_(go):
+        k = g.counter("QB")
+        with b.for_(k, 1, BISECTIONS):
+            mid = g.let(0.5 * (lo + hi), "MID")
+            _v, cm = _set_at(g, op, sets, mid, accu)
+            with b.if_(cm.eq(code)):
+                b.set(lo, mid)
+            with b.else_():
+                b.set(hi, mid)
+                b.set(chi, cm)
+        with b.if_(n.lt(cap - 1)):
+            b.set(pts[n], 0.5 * (lo + hi))
+            b.set(n, n + 1)
+        b.set(q, q + 1)
+        stop = chi.eq(cx).or_(not_(hi.lt(x))).or_(q.ge(ROUNDS)).or_(n.ge(cap - 1))
+        with b.if_(stop):
+            b.set(go, False)
+        with b.else_():
+            b.set(lo, hi)
+            b.set(hi, x)
+            b.set(code, chi)
+            b.set(chi, cx)

@@ -1,0 +1,545 @@
+"""Formulas in the IR: fuzzy operators (translated from the engine's own expression templates),
+hedges, smooth membership functions, function terms, and the run-time routines on
+breakpoint lists (stable sort, degree, one-sided limits) the exact integration needs.
+
+Operators are not rewritten by hand: :data:`fuzzyctl.engine.semantics.operators.TNORMS` and ``SNORMS``
+carry each norm as a Python expression template, and :func:`norm` translates that template
+(conditional expressions, comparisons, ``min``/``max``) into IR statements, so a norm changed
+in the engine changes here too.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections.abc import Callable
+
+from fuzzyctl.engine.plan import EX, EBinary, ECall, EInput, ENum, EOutput, EUnary, ExprPlan
+from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
+from fuzzyctl.engine.semantics.shapes import power_of
+from fuzzyctl.ir.nodes import Bin, Ex, ExLike, Index, Neg, Num, Var, ex, not_
+from fuzzyctl.ir.state import Gen
+
+# The two helpers the Hamacher templates call, as templates themselves (operators._ham_t/_s).
+_HELPERS = {
+    "_ham_t": "(({a} * {b}) / ({a} + {b} - {a} * {b}) if {a} + {b} - {a} * {b} != 0.0 else 0.0)",
+    # 1 - T(1-a, 1-b), the stable form of (a+b-2ab)/(1-ab) (see operators._ham_s)
+    "_ham_s": "(1.0 - ((1.0 - {a}) * (1.0 - {b})) / ((1.0 - {a}) + (1.0 - {b}) - (1.0 - {a}) * (1.0 - {b}))"
+    " if (1.0 - {a}) + (1.0 - {b}) - (1.0 - {a}) * (1.0 - {b}) != 0.0 else 1.0)",
+}
+_BINOPS = {ast.Add: "+", ast.Sub: "-", ast.Mult: "*", ast.Div: "/"}
+_CMPOPS = {ast.Lt: "<", ast.Gt: ">", ast.LtE: "<=", ast.GtE: ">=", ast.Eq: "=", ast.NotEq: "<>"}
+
+
+def _simple(g: Gen, v: ExLike) -> Ex:
+    """Operands used several times by a template are bound to a temporary first."""
+    e = ex(v)
+    return e if isinstance(e, Var | Num | Index) else g.let(e)
+
+
+def template(g: Gen, src: str, a: ExLike, b: ExLike) -> Ex:
+    """Translate an operator template over ``{a}`` and ``{b}`` into IR (statements go to
+    ``g.b``; the value is returned)."""
+    env = {"a": _simple(g, a), "b": _simple(g, b)}
+    return _tr(g, ast.parse(src.format(a="a", b="b"), mode="eval").body, env)
+
+
+def _tr(g: Gen, node: ast.expr, env: dict[str, Ex]) -> Ex:
+    if isinstance(node, ast.Name):
+        return env[node.id]
+    if isinstance(node, ast.Constant) and isinstance(node.value, int | float):
+        return Num(float(node.value))
+    if isinstance(node, ast.BinOp) and type(node.op) in _BINOPS:
+        return Bin(_BINOPS[type(node.op)], _tr(g, node.left, env), _tr(g, node.right, env))
+    if isinstance(node, ast.UnaryOp) and isinstance(node.op, ast.USub):
+        return Neg(_tr(g, node.operand, env))
+    if isinstance(node, ast.Compare) and len(node.ops) == 1 and type(node.ops[0]) in _CMPOPS:
+        return Bin(_CMPOPS[type(node.ops[0])], _tr(g, node.left, env), _tr(g, node.comparators[0], env))
+    if isinstance(node, ast.IfExp):
+        t = g.temp()
+        if isinstance(node.orelse, ast.Name | ast.Constant):
+            # a plain alternative can be assigned first (shorter code, same value)
+            g.b.set(t, _tr(g, node.orelse, env))
+            with g.b.if_(_tr(g, node.test, env)):
+                g.b.set(t, _tr(g, node.body, env))
+            return t
+        with g.b.if_(_tr(g, node.test, env)):
+            g.b.set(t, _tr(g, node.body, env))
+        with g.b.else_():
+            g.b.set(t, _tr(g, node.orelse, env))
+        return t
+    if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
+        fn = node.func.id
+        args = [_tr(g, a, env) for a in node.args]
+        if fn in ("min", "max") and len(args) == 2:
+            # Python's min/max keep the first argument unless the second is strictly better
+            t = g.let(args[0])
+            with g.b.if_(args[1].lt(t) if fn == "min" else args[1].gt(t)):
+                g.b.set(t, args[1])
+            return t
+        if fn in _HELPERS and len(args) == 2:
+            return template(g, _HELPERS[fn], args[0], args[1])
+    raise AssertionError(f"operator template construct not translated: {ast.dump(node)}")
+
+
+def tnorm(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
+    return template(g, TNORMS[name].source, a, b)
+
+
+def snorm(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
+    return template(g, SNORMS[name].source, a, b)
+
+
+def accumulate(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
+    """:func:`fuzzyctl.engine.semantics.operators.accumulate` (MAX, SUM/NSUM, BSUM, PROBOR, the
+    other OR norms)."""
+    if name in ("SUM", "NSUM"):
+        return ex(a) + ex(b)
+    if name == "PROBOR":
+        return template(g, SNORMS["ASUM"].source, a, b)
+    return snorm(g, name, a, b)
+
+
+def accumulate_into(g: Gen, name: str, target: Var | Index, value: ExLike) -> None:
+    """``target := accumulate(name, target, value)``; MAX as one IF (``a if a > b else b``
+    keeps ``a`` unless ``b`` is larger)."""
+    if name == "MAX":
+        v = _simple(g, value)
+        with g.b.if_(v.gt(target)):
+            g.b.set(target, v)
+        return
+    g.b.set(target, accumulate(g, name, target, value))
+
+
+def mul(w: Ex, x: ExLike) -> Ex:
+    """``w * x``, with a literal weight 1.0 left out (1.0 * x == x exactly)."""
+    if isinstance(w, Num) and w.value == 1.0:
+        return ex(x)
+    return w * ex(x)
+
+
+# --------------------------------------------------------------------------- hedges
+
+
+def hedge(g: Gen, name: str, d: Ex) -> Ex:
+    """One hedge of :data:`fuzzyctl.engine.semantics.shapes.HEDGES` (or ``pow:p``) applied to ``d``."""
+    x = _simple(g, d)
+    t = g.temp(hint="H")
+    p = power_of(name)
+    if p is not None:  # max(x, 0) ** p
+        with g.b.if_(x.gt(0.0)):
+            if p == int(p) and 1 <= p <= 4:
+                prod: Ex = x
+                for _ in range(int(p) - 1):
+                    prod = prod * x
+                g.b.set(t, prod)
+            elif g.target != "st":
+                g.b.set(t, g.call("POW", x, p))
+            else:
+                g.b.set(t, g.call("EXP", Num(p) * g.call("LN", x)))
+        with g.b.else_():
+            g.b.set(t, 1.0 if p == 0.0 else 0.0)
+        return t
+    if name == "not":
+        g.b.set(t, 1.0 - x)
+    elif name == "very":
+        g.b.set(t, x * x)
+    elif name == "somewhat":
+        with g.b.if_(x.gt(0.0)):
+            g.b.set(t, g.call("SQRT", x))
+        with g.b.else_():
+            g.b.set(t, 0.0)
+    elif name == "extremely":
+        with g.b.if_(x.le(0.5)):
+            g.b.set(t, 2.0 * x * x)
+        with g.b.else_():
+            g.b.set(t, 1.0 - 2.0 * (1.0 - x) * (1.0 - x))
+    elif name == "seldom":
+        with g.b.if_(x.le(0.5)):
+            g.b.set(t, g.call("SQRT", 0.5 * x))
+        with g.b.else_():
+            g.b.set(t, 1.0 - g.call("SQRT", 0.5 * (1.0 - x)))
+    elif name == "any":
+        g.b.set(t, 1.0)
+    else:  # pragma: no cover - lowering rejects unknown hedges
+        raise AssertionError(name)
+    return t
+
+
+def hedged(g: Gen, d: Ex, hedges: tuple[str, ...], negated: bool) -> Ex:
+    """Hedges nearest the term first, then NOT (``interp._hedged``)."""
+    for h in reversed(hedges):
+        d = hedge(g, h, d)
+    if negated:
+        d = g.let(1.0 - d, "N")
+    return d
+
+
+# --------------------------------------------------------------------------- smooth shapes
+
+P = list[Ex]
+
+
+def _sig(g: Gen, x: Ex, c: Ex, s: Ex) -> Var:
+    """shapes._sig: 1 / (1 + exp(-s (x - c))), 0 when the exponent would overflow."""
+    z = g.let(-s * (x - c), "Z")
+    t = g.temp(hint="S")
+    with g.b.if_(z.gt(700.0)):
+        g.b.set(t, 0.0)
+    with g.b.else_():
+        g.b.set(t, 1.0 / (1.0 + g.call("EXP", z)))
+    return t
+
+
+def _sshape(g: Gen, x: Ex, s: Ex, e: Ex, z: bool) -> Var:
+    lo, hi = (1.0, 0.0) if z else (0.0, 1.0)
+    t = g.temp(hint="S")
+    u = g.temp(hint="U")
+    with g.b.if_(x.le(s)):
+        g.b.set(t, lo)
+    with g.b.elif_(x.le(0.5 * (s + e))):
+        g.b.set(u, (x - s) / (e - s))
+        g.b.set(t, 1.0 - 2.0 * u * u if z else 2.0 * u * u)
+    with g.b.elif_(x.lt(e)):
+        g.b.set(u, (x - e) / (e - s))
+        g.b.set(t, 2.0 * u * u if z else 1.0 - 2.0 * u * u)
+    with g.b.else_():
+        g.b.set(t, hi)
+    return t
+
+
+def _gauss(g: Gen, x: Ex, m: Ex, sd: Ex) -> Ex:
+    d = g.let(x - m, "D")
+    return g.call("EXP", -(d * d) / (2.0 * sd * sd))
+
+
+def _absv(g: Gen, v: Ex) -> Var:
+    t = g.let(v, "A")
+    with g.b.if_(t.lt(0.0)):
+        g.b.set(t, -t)
+    return t
+
+
+def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
+    """``shapes._smooth`` for one kind (the formulas written the same way)."""
+    out = g.temp(hint="M")
+    if kind == "gaussian":
+        g.b.set(out, _gauss(g, x, p[0], p[1]))
+    elif kind == "gaussian2":
+        left = g.temp(hint="G")
+        with g.b.if_(x.lt(p[0])):
+            g.b.set(left, _gauss(g, x, p[0], p[1]))
+        with g.b.else_():
+            g.b.set(left, 1.0)
+        right = g.temp(hint="G")
+        with g.b.if_(x.gt(p[2])):
+            g.b.set(right, _gauss(g, x, p[2], p[3]))
+        with g.b.else_():
+            g.b.set(right, 1.0)
+        g.b.set(out, left * right)
+    elif kind == "bell":
+        # IEEE pow at the centre (u = 0), as fuzzylite and numpy: 0^e is 0 for e > 0, 1 for
+        # e = 0 and +inf for e < 0 (a negative slope is 0 at its centre); ST has no pow(0, e)
+        u = _absv(g, (x - p[0]) / p[1])
+        expo = g.let(2.0 * p[2], "E")
+        with g.b.if_(u.gt(0.0)):
+            pw = g.call("POW", u, expo) if g.target != "st" else g.call("EXP", expo * g.call("LN", u))
+            g.b.set(out, 1.0 / (1.0 + pw))
+        with g.b.elif_(u.eq(0.0).and_(expo.gt(0.0))):
+            g.b.set(out, 1.0)
+        with g.b.elif_(u.eq(0.0).and_(expo.eq(0.0))):
+            g.b.set(out, 0.5)
+        with g.b.elif_(u.eq(0.0).and_(expo.lt(0.0))):
+            g.b.set(out, 0.0)
+        with g.b.else_():  # NaN in, NaN out
+            g.b.set(out, u + expo)
+    elif kind == "sigmoid":
+        g.b.set(out, _sig(g, x, p[0], p[1]))
+    elif kind in ("dsigmoid", "dsigmoid_pos", "psigmoid"):
+        s1 = _sig(g, x, p[0], p[1])
+        s2 = _sig(g, x, p[2], p[3])
+        if kind == "psigmoid":
+            g.b.set(out, s1 * s2)
+        elif kind == "dsigmoid":
+            g.b.set(out, _absv(g, s1 - s2))
+        else:
+            g.b.set(out, s1 - s2)
+            with g.b.if_(out.lt(0.0)):
+                g.b.set(out, 0.0)
+    elif kind == "cosine":
+        with g.b.if_(x.lt(p[0] - 0.5 * p[1]).or_(x.gt(p[0] + 0.5 * p[1]))):
+            g.b.set(out, 0.0)
+        with g.b.else_():
+            g.b.set(out, 0.5 * (1.0 + g.call("COS", 2.0 / p[1] * Num(_PI) * (x - p[0]))))
+    elif kind in ("sshape", "zshape"):
+        g.b.set(out, _sshape(g, x, p[0], p[1], kind == "zshape"))
+    elif kind == "pishape":
+        g.b.set(out, _sshape(g, x, p[0], p[1], False) * _sshape(g, x, p[2], p[3], True))
+    elif kind == "spike":
+        g.b.set(out, g.call("EXP", -_absv(g, 10.0 / p[1] * (x - p[0]))))
+    elif kind == "concave":
+        i, e = p
+        with g.b.if_(i.le(e).and_(x.lt(e))):
+            g.b.set(out, (e - i) / (2.0 * e - i - x))
+        with g.b.elif_(i.ge(e).and_(x.gt(e))):
+            g.b.set(out, (i - e) / (i - 2.0 * e + x))
+        with g.b.else_():
+            g.b.set(out, 1.0)
+    elif kind == "cosine_half":
+        c, hw = p
+        ahw = _absv(g, hw)
+        with g.b.if_(x.lt(c - ahw).or_(x.gt(c + ahw))):
+            g.b.set(out, 0.0)
+        with g.b.else_():
+            g.b.set(out, 0.5 * (1.0 + g.call("COS", Num(_PI) * (x - c) / hw)))
+    elif kind == "arc":
+        s, e = p
+        r = g.let(e - s, "R")
+        with g.b.if_((s.lt(e).and_(s.le(x)).and_(x.le(e))).or_(s.gt(e).and_(e.le(x)).and_(x.le(s)))):
+            t = g.let((x - e) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
+            with g.b.if_(q.lt(0.0)):
+                g.b.set(q, 0.0)
+            g.b.set(out, g.call("SQRT", q))
+        with g.b.elif_((s.lt(e).and_(x.gt(e))).or_(s.gt(e).and_(x.lt(e)))):
+            g.b.set(out, 1.0)
+        with g.b.else_():
+            g.b.set(out, 0.0)
+    elif kind == "semiellipse":
+        s = g.min_(p[1], p[0])  # min(p) / max(p) of two values
+        e = g.max_(p[1], p[0])
+        r = g.let(0.5 * (e - s), "R")
+        c = g.let(s + r, "C")
+        with g.b.if_(s.le(x).and_(x.le(e))):
+            t = g.let((x - c) / r, "T")  # shapes._smooth: r^2 would overflow
+            q = g.let(1.0 - t * t, "Q")
+            with g.b.if_(q.lt(0.0)):
+                g.b.set(q, 0.0)
+            g.b.set(out, g.call("SQRT", q))
+        with g.b.else_():
+            g.b.set(out, 0.0)
+    else:
+        raise g.refuse(what, f"{kind} membership functions are not supported by the code generator")
+    return out
+
+
+_PI = 3.141592653589793
+
+
+# --------------------------------------------------------------------------- function terms
+
+_C_FUNCS = {
+    "sin": "SIN",
+    "cos": "COS",
+    "tan": "TAN",
+    "asin": "ASIN",
+    "acos": "ACOS",
+    "atan": "ATAN",
+    "sinh": "SINH",
+    "cosh": "COSH",
+    "tanh": "TANH",
+    "exp": "EXP",
+    "log": "LN",
+    "ln": "LN",
+    "log10": "LOG",
+    "sqrt": "SQRT",
+    "abs": "ABS",
+    "fabs": "ABS",
+    "floor": "FLOOR",
+    "ceil": "CEIL",
+    "round": "RINT",  # Python's round(): halves to even, like rint()
+    "pow": "POW",
+    "atan2": "ATAN2",
+    "fmod": "FMOD",
+}
+#: The IEC 61131-3 standard functions portable Structured Text may call.
+_ST_FUNCS = frozenset({"EXP", "LN", "LOG", "SQRT", "ABS", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN"})
+_COMPARE = {"eq": "=", "neq": "<>", "lt": "<", "le": "<=", "gt": ">", "ge": ">="}
+
+
+def expression(
+    g: Gen, e: ExprPlan, inputs: list[Ex], outputs: Callable[[int], Ex], x: Ex | None, what: str
+) -> Ex:
+    """A function term (``engine.expr.eval_expr``).  C: IEEE arithmetic gives the same
+    inf/nan as the engine's C-like evaluation.  Structured Text: + - * /, comparisons,
+    min/max/sign and the IEC 61131-3 standard functions (EXP, LN, LOG, SQRT, ABS and the
+    trigonometric ones); a PLC faults where the engine would give inf or nan."""
+    if g.target not in ("c", "st"):
+        raise g.refuse(what, "function terms are an Open-level feature")
+
+    def rec(n: ExprPlan) -> Ex:
+        if isinstance(n, ENum):
+            return Num(n.value)
+        if isinstance(n, EInput):
+            return inputs[n.slot]
+        if isinstance(n, EOutput):
+            return outputs(n.output)
+        if isinstance(n, EX):
+            assert x is not None
+            return x
+        if isinstance(n, EUnary):
+            v = rec(n.operand)
+            return Neg(v) if n.op == "-" else v
+        if isinstance(n, EBinary):
+            a, b = rec(n.left), rec(n.right)
+            if n.op in "+-*/":
+                return Bin(n.op, a, b)
+            if g.target == "st":
+                raise g.refuse(
+                    what,
+                    f"the operator {n.op} has no portable Structured Text form; write the "
+                    "function with + - * / and EXP/LN",
+                )
+            return g.call("FMOD" if n.op == "%" else "POW", a, b)
+        assert isinstance(n, ECall)
+        args = [rec(a) for a in n.args]
+        fn = n.function
+        if fn in _COMPARE:
+            t = g.temp(hint="F")
+            with g.b.if_(Bin(_COMPARE[fn], args[0], args[1])):
+                g.b.set(t, 1.0)
+            with g.b.else_():
+                g.b.set(t, 0.0)
+            return t
+        if fn in ("min", "max"):
+            acc: Ex = args[0]
+            for a in args[1:]:
+                acc = g.min_(acc, a) if fn == "min" else g.max_(acc, a)
+            return acc
+        if fn == "sign":
+            v = g.let(args[0], "F")
+            t = g.temp(hint="F")
+            with g.b.if_(v.gt(0.0)):
+                g.b.set(t, 1.0)
+            with g.b.elif_(v.lt(0.0)):
+                g.b.set(t, -1.0)
+            with g.b.else_():
+                g.b.set(t, 0.0)
+            return t
+        if fn not in _C_FUNCS:
+            raise g.refuse(what, f"function {fn}() is not supported")
+        if g.target == "st" and _C_FUNCS[fn] not in _ST_FUNCS:
+            raise g.refuse(
+                what,
+                f"function {fn}() is no IEC 61131-3 standard function; write the function with "
+                "+ - * / and EXP, LN, LOG, SQRT, ABS, SIN, COS, TAN, ASIN, ACOS or ATAN",
+            )
+        return g.call(_C_FUNCS[fn], *args)
+
+    return rec(e)
+
+
+# --------------------------------------------------------------------------- breakpoint lists
+
+
+def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, last: ExLike) -> None:
+    """Stable insertion sort of ``xs[off .. last]`` (and ``ys`` alongside) by x: the engine
+    sorts points given by variables stably at each evaluation (5.2.2)."""
+    i = g.counter("I")
+    j = g.counter("J")
+    kx = g.temp(hint="KX")
+    ky = g.temp(hint="KY") if ys is not None else None
+    moving = g.temp("BOOL", "MV")
+    with g.b.for_(i, ex(off) + 1, last) as iv:
+        g.b.set(kx, xs[iv])
+        if ys is not None and ky is not None:
+            g.b.set(ky, ys[iv])
+        g.b.set(Var(j), iv - 1)
+        g.b.set(moving, True)
+        # no short-circuit AND in ST: the bound check and the comparison are separate IFs
+        with g.b.while_(moving):
+            with g.b.if_(xs[Var(j)].gt(kx)):
+                g.b.set(xs[Var(j) + 1], xs[Var(j)])
+                if ys is not None:
+                    g.b.set(ys[Var(j) + 1], ys[Var(j)])
+                g.b.set(Var(j), Var(j) - 1)
+                with g.b.if_(Var(j).lt(off)):
+                    g.b.set(moving, False)
+            with g.b.else_():
+                g.b.set(moving, False)
+        g.b.set(xs[Var(j) + 1], kx)
+        if ys is not None and ky is not None:
+            g.b.set(ys[Var(j) + 1], ky)
+
+
+def _interp(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, out: Var) -> None:
+    """grid._interp: linear between the first point right of x and its predecessor."""
+    k = g.counter("K")
+    done = g.temp("BOOL", "DN")
+    g.b.set(done, False)
+    with g.b.for_(k, ex(off) + 1, last) as kv, g.b.if_(not_(done).and_(xs[kv].gt(x))):
+        g.b.set(
+            out,
+            ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
+        )
+        g.b.set(done, True)
+    with g.b.if_(not_(done)):
+        g.b.set(out, ys[last])
+
+
+def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
+    """shapes.pwl_value on the sorted segment: constant beyond the ends, the upper value on
+    a vertical edge, linear between points."""
+    out = g.temp(hint="MU")
+    with g.b.if_(x.lt(xs[off])):
+        g.b.set(out, ys[off])
+    with g.b.elif_(x.gt(xs[last])):
+        g.b.set(out, ys[last])
+    with g.b.else_():
+        found = g.temp("BOOL", "FD")
+        done = g.temp("BOOL", "DN")
+        g.b.set(found, False)
+        g.b.set(done, False)
+        k = g.counter("K")
+        with g.b.for_(k, off, last) as kv, g.b.if_(not_(done)):
+            with g.b.if_(xs[kv].eq(x)):
+                with g.b.if_(not_(found)):
+                    g.b.set(out, ys[kv])
+                    g.b.set(found, True)
+                with g.b.elif_(ys[kv].gt(out)):
+                    g.b.set(out, ys[kv])
+            with g.b.elif_(xs[kv].gt(x)):
+                with g.b.if_(not_(found)):
+                    g.b.set(
+                        out,
+                        ys[kv - 1] + (ys[kv] - ys[kv - 1]) * ((x - xs[kv - 1]) / (xs[kv] - xs[kv - 1])),
+                    )
+                g.b.set(done, True)
+    return out
+
+
+def right_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
+    """grid.right_limit: lim u -> x+ (the last point at x on a vertical edge)."""
+    out = g.temp(hint="RL")
+    with g.b.if_(x.lt(xs[off])):
+        g.b.set(out, ys[off])
+    with g.b.elif_(x.ge(xs[last])):
+        g.b.set(out, ys[last])
+    with g.b.else_():
+        found = g.temp("BOOL", "FD")
+        g.b.set(found, False)
+        k = g.counter("K")
+        with g.b.for_(k, last, off, step=-1) as kv, g.b.if_(not_(found).and_(xs[kv].eq(x))):
+            g.b.set(out, ys[kv])
+            g.b.set(found, True)
+        with g.b.if_(not_(found)):
+            _interp(g, xs, ys, off, last, x, out)
+    return out
+
+
+def left_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
+    """grid.left_limit: lim u -> x- (the first point at x on a vertical edge)."""
+    out = g.temp(hint="LL")
+    with g.b.if_(x.le(xs[off])):
+        g.b.set(out, ys[off])
+    with g.b.elif_(x.gt(xs[last])):
+        g.b.set(out, ys[last])
+    with g.b.else_():
+        found = g.temp("BOOL", "FD")
+        g.b.set(found, False)
+        k = g.counter("K")
+        with g.b.for_(k, off, last) as kv, g.b.if_(not_(found).and_(xs[kv].eq(x))):
+            g.b.set(out, ys[kv])
+            g.b.set(found, True)
+        with g.b.if_(not_(found)):
+            _interp(g, xs, ys, off, last, x, out)
+    return out

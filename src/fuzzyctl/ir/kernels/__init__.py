@@ -1,0 +1,2 @@
+"""Hand-written kernels the rendered evaluators call (each names its IR twin and has a
+benchmark row)."""

@@ -1,0 +1,734 @@
+"""Print a :class:`~fuzzyctl.ir.nodes.Program` as C99: a header with the instance struct and
+``NAME_init`` / ``NAME_step`` / ``NAME_batch``, and a source file.
+
+No allocation, no globals besides constant tables; libm only for ``exp`` (smooth shapes):
+``sqrt`` (exact CoA, some shapes and hedges), ``pow``, ``cos`` and the functions of function
+terms are static helpers of :mod:`fuzzyctl.ir.render.c_helpers`, emitted only when used.
+"""
+
+from __future__ import annotations
+
+import array
+import math
+from collections.abc import Sequence
+from typing import TYPE_CHECKING
+
+from fuzzyctl.engine.plan import OutputPlan
+from fuzzyctl.escape import CodegenError, c_comment, c_ident
+from fuzzyctl.ir.kernels import c as c_kernels
+from fuzzyctl.ir.kernels.c import ACCU_CODES
+from fuzzyctl.ir.nodes import (
+    Assign,
+    Bin,
+    Bool,
+    Call,
+    Comment,
+    Decl,
+    Ex,
+    For,
+    If,
+    Index,
+    Int,
+    Kernel,
+    Neg,
+    Not,
+    Num,
+    Program,
+    Pwl,
+    Region,
+    Stmt,
+    Var,
+    While,
+    identifiers,
+    subexprs,
+)
+from fuzzyctl.ir.programs.evaluator import FastProgram
+from fuzzyctl.ir.render import c_helpers
+
+if TYPE_CHECKING:
+    from fuzzyctl.ir.state import Gen
+
+_PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
+_COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
+# libm itself is used for ``exp`` only; every other intrinsic is one of the static helpers
+# of :mod:`fuzzyctl.ir.render.c_helpers` (written with + - * / and exp), emitted on demand.
+_LIBM = {"EXP": "exp"}
+_HELPER_OF = {
+    "LN": "fz_log",
+    "LOG": "fz_log10",
+    "SQRT": "fz_sqrt",
+    "ABS": "fz_fabs",
+    "SIN": "fz_sin",
+    "COS": "fz_cos",
+    "TAN": "fz_tan",
+    "ASIN": "fz_asin",
+    "ACOS": "fz_acos",
+    "ATAN": "fz_atan",
+    "SINH": "fz_sinh",
+    "COSH": "fz_cosh",
+    "TANH": "fz_tanh",
+    "FLOOR": "fz_floor",
+    "CEIL": "fz_ceil",
+    "RINT": "fz_rint",
+    "POW": "fz_pow",
+    "ATAN2": "fz_atan2",
+    "FMOD": "fz_fmod",
+}
+
+
+def helper_functions(prog: Program) -> list[str]:
+    """The static helpers the generated C defines (callees included, callees first)."""
+    return c_helpers.closure({_HELPER_OF[f] for f in prog.uses if f in _HELPER_OF})
+
+
+def libm_functions(prog: Program) -> list[str]:
+    """The libm functions the generated C calls (documented in its header): ``exp`` or none."""
+    direct = any(f in _LIBM for f in prog.uses)
+    via_helpers = any(c_helpers.HELPERS[h].uses_exp for h in helper_functions(prog))
+    return ["exp"] if direct or via_helpers else []
+
+
+class _C:
+    def __init__(self, prog: Program, single: bool) -> None:
+        self.prog = prog
+        self.single = single
+        self.real = f"{prog.name}_real"
+        self.fields = {d.name for d in prog.decls if d.storage in ("input", "output", "param", "state")}
+        self.consts = {d.name for d in prog.decls if d.storage == "const"}
+        self.lines: list[str] = []
+
+    # ------------------------------------------------------------------ expressions
+
+    def num(self, v: float) -> str:
+        if math.isnan(v):
+            return "NAN"
+        if math.isinf(v):
+            return "INFINITY" if v > 0 else "(-INFINITY)"
+        s = repr(float(v))
+        if "e" not in s and "." not in s:
+            s += ".0"
+        s = s + ("f" if self.single else "")
+        return f"({s})" if v < 0 else s
+
+    def name(self, n: str) -> str:
+        if n in self.consts:  # file-scope tables: unique per block (several blocks may share a unit)
+            return f"{self.prog.name}_{n}"
+        return f"fb->{n}" if n in self.fields else n
+
+    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
+        if isinstance(e, Num):
+            return self.num(e.value)
+        if isinstance(e, Int):
+            return str(e.value) if e.value >= 0 else f"({e.value})"
+        if isinstance(e, Bool):
+            return "1" if e.value else "0"
+        if isinstance(e, Var):
+            return self.name(e.name)
+        if isinstance(e, Index):
+            return f"{self.name(e.name)}[{self.ex(e.index)}]"
+        if isinstance(e, Neg):
+            return f"-{self.ex(e.operand, 6)}"
+        if isinstance(e, Not):
+            return f"!{self.ex(e.operand, 6)}"
+        if isinstance(e, Call):
+            if e.function == "NAN":
+                return "NAN"
+            if e.function == "TO_REAL":
+                return f"(({self.real}){self.ex(e.args[0])})"
+            args = ", ".join(self.ex(a) for a in e.args)
+            if e.function in _LIBM:
+                return f"{_LIBM[e.function]}{'f' if self.single else ''}({args})"
+            # the helpers compute in double; the float build rounds their result once
+            call = f"{_HELPER_OF[e.function]}({args})"
+            return f"(({self.real}){call})" if self.single else call
+        assert isinstance(e, Bin)
+        p = _PREC[e.op]
+        s = f"{self.ex(e.left, p)} {_COP.get(e.op, e.op)} {self.ex(e.right, p, True)}"
+        # operands keep the IR's tree exactly (floating point is not associative)
+        return f"({s})" if p < parent or (right and p == parent) else s
+
+    # ------------------------------------------------------------------ statements
+
+    def emit(self, s: str, ind: int) -> None:
+        self.lines.append("    " * ind + s)
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        for s in body:
+            if isinstance(s, Assign):
+                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)};", ind)
+            elif isinstance(s, Comment):
+                self.emit(_comment(s.text), ind)
+            elif isinstance(s, Region):
+                self.emit(_comment(s.name), ind)
+                self.stmts(s.body, ind)
+            elif isinstance(s, If):
+                for k, (cond, body) in enumerate(s.branches):
+                    kw = "if" if k == 0 else "} else if"
+                    self.emit(f"{kw} ({self.ex(cond)}) {{", ind)
+                    self.stmts(body, ind + 1)
+                if s.orelse:
+                    self.emit("} else {", ind)
+                    self.stmts(s.orelse, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, For):
+                v = s.var
+                cmp, inc = ("<=", "++") if s.step > 0 else (">=", "--")
+                self.emit(f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, While):
+                self.emit(f"while ({self.ex(s.cond)}) {{", ind)
+                self.stmts(s.body, ind + 1)
+                self.emit("}", ind)
+
+
+def _comment(text: str) -> str:
+    """A C comment: every comment of the generated files is made here, from model text
+    escaped by :func:`fuzzyctl.escape.c_comment`."""
+    return f"/* {c_comment(text)} */"
+
+
+_CTYPES = {"INT": "int", "DINT": "long", "BOOL": "unsigned char", "BYTE": "unsigned char"}
+
+
+def _ctype(d: Decl, real: str) -> str:
+    return {"REAL": real, **_CTYPES}[d.type]
+
+
+def _read_names(body: Sequence[Stmt]) -> set[str]:
+    """Names whose value is read somewhere (an assignment target itself is not a read)."""
+    out: set[str] = set()
+
+    def visit(e: Ex, top_target: bool) -> None:
+        for sub in subexprs(e):
+            if sub is e and top_target:
+                if isinstance(e, Index):
+                    visit(e.index, False)
+                continue
+            if isinstance(sub, Var | Index):
+                out.add(sub.name)
+
+    def rec(stmts: Sequence[Stmt]) -> None:
+        for s in stmts:
+            if isinstance(s, Assign):
+                visit(s.target, True)
+                visit(s.value, False)
+            elif isinstance(s, If):
+                for c, b in s.branches:
+                    visit(c, False)
+                    rec(b)
+                rec(s.orelse)
+            elif isinstance(s, For):
+                out.add(s.var)
+                visit(s.start, False)
+                visit(s.stop, False)
+                rec(s.body)
+            elif isinstance(s, While):
+                visit(s.cond, False)
+                rec(s.body)
+            elif isinstance(s, Region):
+                rec(s.body)
+
+    rec(body)
+    return out
+
+
+def _render_header(prog: Program, name: str, r: _C, single: bool) -> list[str]:
+    """The header: the instance struct and the prototypes."""
+    real = r.real
+    guard = f"FUZZYCTL_{name.upper()}_H"
+    h: list[str] = []
+    h.append(_comment(f"{name}.h - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
+    for line in prog.header:
+        h.append(_comment(line))
+    h += [f"#ifndef {guard}", f"#define {guard}", "", "#include <stddef.h>", ""]
+    h.append(f"typedef {'float' if single else 'double'} {real};")
+    h.append("")
+    h.append(
+        _comment(f"One instance of the function block: set the inputs, call {name}_step(), read the outputs.")
+    )
+    h.append("typedef struct {")
+    for storage, title in (
+        ("input", "inputs"),
+        ("output", "outputs"),
+        ("param", "tunable parameters (initialised by init; may be changed between steps)"),
+        ("state", "internal state"),
+    ):
+        ds = prog.of(storage)  # type: ignore[arg-type]
+        if not ds:
+            continue
+        h.append(f"    {_comment(title)}")
+        for d in ds:
+            dim = f"[{d.size}]" if d.size is not None else ""
+            note = d.comment.split("\n")[0]
+            h.append(f"    {_ctype(d, real)} {d.name}{dim};" + (f" {_comment(note)}" if note else ""))
+    h.append(f"}} {name};")
+    h.append("")
+    n_in = len(prog.of("input")) - 1  # without ENABLE
+    outs = [d for d in prog.of("output") if d.name != "INFO"]
+    h.append(f"#define {name.upper()}_N_INPUTS {n_in}")
+    h.append(f"#define {name.upper()}_N_OUTPUTS {len(outs)}")
+    h.append("")
+    h.append(_comment("Set the parameters to the FCL's values, clear the state, ENABLE = 1."))
+    h.append(f"void {name}_init({name} *fb);")
+    h.append(_comment(f"One evaluation (a PLC cycle); returns INFO: {prog.decl('INFO').comment}."))
+    h.append(f"unsigned char {name}_step({name} *fb);")
+    in_names = ", ".join(d.name for d in prog.of("input") if d.name != "ENABLE")
+    out_names = ", ".join(d.name for d in outs)
+    h.append(_comment(f"n evaluations in a row: in[i*{n_in} + k] is input k ({in_names}) of row i,"))
+    h.append(_comment(f"out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row."))
+    h.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out);")
+    h.append("")
+    h.append(f"#endif /* {guard} */")
+    return h
+
+
+def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
+    """``(header, source)`` for ``prog``; ``single`` selects float instead of double."""
+    name = c_ident(prog.name, "function block name")
+    for d in prog.decls:  # model names become struct members: each one must be inert
+        c_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
+    r = _C(prog, single)
+    real = r.real
+    h = _render_header(prog, name, r, single)
+    outs = [d for d in prog.of("output") if d.name != "INFO"]
+
+    c: list[str] = []
+    c.append(_comment(f"{name}.c - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
+    libs = libm_functions(prog)
+    c.append(_comment(f"libm functions used: {', '.join(libs) if libs else 'none'}"))
+    helpers = helper_functions(prog)
+    if helpers:
+        c.append(_comment(f"static helpers instead of libm (only + - * / and exp): {', '.join(helpers)}"))
+    c += [f'#include "{name}.h"', "#include <math.h>", ""]
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
+        c.append(f"static const {_ctype(d, real)} {r.name(d.name)}[{d.size}] = {{{vals}}};")
+    c.append("")
+    c += c_helpers.render(set(helpers))
+    c.append(f"void {name}_init({name} *fb)")
+    c.append("{")
+    for d in prog.decls:
+        if d.storage not in ("input", "output", "param", "state"):
+            continue
+        if d.size is None:
+            one = d.init if isinstance(d.init, float | int | bool) else 0.0
+            if isinstance(one, bool) or d.type != "REAL":
+                c.append(f"    fb->{d.name} = {int(one)};")
+            else:
+                c.append(f"    fb->{d.name} = {r.num(float(one))};")
+        else:
+            values = d.init if isinstance(d.init, tuple) else (0.0,) * d.size
+            for i, val in enumerate(values):
+                c.append(f"    fb->{d.name}[{i}] = {r.num(val)};")
+    c.append("}")
+    c.append("")
+    c.append(f"unsigned char {name}_step({name} *fb)")
+    c.append("{")
+    read = _read_names(prog.body)
+    temps = prog.of("temp")
+    for d in temps:  # zero-initialised: keeps -Wmaybe-uninitialized quiet at any -O
+        if d.size is not None:
+            c.append(f"    {_ctype(d, real)} {d.name}[{d.size}] = {{0}};")
+        else:
+            c.append(f"    {_ctype(d, real)} {d.name} = 0;")
+    r.stmts(prog.body, 1)
+    c += r.lines
+    unread = [d.name for d in temps if d.name not in read]
+    for n in unread:  # assigned but never read: keeps -Wall -Wextra -Werror quiet
+        c.append(f"    (void){n};")
+    c.append("    return fb->INFO;")
+    c.append("}")
+    c.append("")
+    ins = [d.name for d in prog.of("input") if d.name != "ENABLE"]
+    c.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out)")
+    c.append("{")
+    c.append("    size_t i;")
+    c.append("    (void)in;")
+    c.append("    (void)out;")
+    c.append("    for (i = 0; i < n; i++) {")
+    for k, nm in enumerate(ins):
+        c.append(f"        fb->{nm} = ({real})in[i * {len(ins)} + {k}];")
+    c.append(f"        {name}_step(fb);")
+    for k, d in enumerate(outs):
+        c.append(f"        out[i * {len(outs)} + {k}] = (double)fb->{d.name};")
+    c.append("    }")
+    c.append("    return fb->INFO;")
+    c.append("}")
+    return "\n".join(h) + "\n", "\n".join(c) + "\n"
+
+
+# --------------------------------------------------------------------------- the native evaluator
+
+
+class _Native(_C):
+    """The evaluator program of ``compile()`` (:mod:`fuzzyctl.ir.programs.evaluator`) as C: one
+    ``fz_row`` per evaluation, called by a loop over columns.  No name of the model appears
+    (every variable is an ``FZ_`` identifier; comments are not printed)."""
+
+    def __init__(self, fp: FastProgram) -> None:
+        super().__init__(fp.program, False)
+        self.fp = fp
+        self.real = "double"
+        self.fields = set()
+        self.state = fp.state
+        self.pwl_funcs: dict[tuple[tuple[float, float], ...], str] = {}
+        self.max_lines = 1
+        self.uses_lines = False
+        self.uses_max2 = False
+        self.extra: list[str] = []  # functions the kernels need (smooth sets)
+        self.uses: set[str] = set()  # intrinsics they call
+
+    def name(self, n: str) -> str:
+        if n in self.consts:
+            return f"fz_c_{n}"
+        if n == self.state:
+            return "prev"
+        return n
+
+    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
+        if isinstance(e, Pwl):
+            return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
+        if isinstance(e, Call) and e.function == "IMOD":
+            return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
+        return super().ex(e, parent, right)
+
+    def pwl_func(self, points: tuple[tuple[float, float], ...]) -> str:
+        if points not in self.pwl_funcs:
+            self.pwl_funcs[points] = f"fz_pwl{len(self.pwl_funcs)}"
+        return self.pwl_funcs[points]
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        for s in body:
+            if isinstance(s, Kernel):
+                self.kernel(s, ind)
+            elif isinstance(s, Comment):
+                continue
+            elif isinstance(s, Region):
+                self.stmts(s.body, ind)
+            elif isinstance(s, If):
+                for k, (cond, b) in enumerate(s.branches):
+                    self.emit(f"{'if' if k == 0 else '} else if'} ({self.ex(cond)}) {{", ind)
+                    self.stmts(b, ind + 1)
+                if s.orelse:
+                    self.emit("} else {", ind)
+                    self.stmts(s.orelse, ind + 1)
+                self.emit("}", ind)
+            elif isinstance(s, For | While):
+                super().stmts([s], ind)  # loop bodies come back here
+            else:
+                super().stmts([s], ind)
+
+    def kernel(self, k: Kernel, ind: int) -> None:
+        if k.name == "HOLD":
+            self.hold(k, ind)
+        elif k.name == "AM_LINES" and k.data[2] == "MAX" and len(k.data[3]) == 2:
+            x0, x1, _accu, geom = k.data
+            self.uses_max2 = True
+            area, mom = (self.ex(o) for o in k.outs)
+            lines = []
+            for i, (left, right, mn) in enumerate(geom):
+                a_, w_ = self.ex(k.args[2 * i]), self.ex(k.args[2 * i + 1])
+                lines.append(f"{self.num(left)}, {self.num(right)}, {a_}, {w_}, {1 if mn else 0}")
+            self.emit(f"fz_am_max2({self.num(x0)}, {self.num(x1)}, {lines[0]},", ind)
+            self.emit(f"           {lines[1]}, &{area}, &{mom});", ind)
+        elif k.name == "AM_LINES":
+            x0, x1, accu, geom = k.data
+            n = len(geom)
+            self.max_lines = max(self.max_lines, n)
+            self.uses_lines = True
+            ls = ", ".join(self.num(g[0]) for g in geom)
+            rs = ", ".join(self.num(g[1]) for g in geom)
+            mns = ", ".join("1" if g[2] else "0" for g in geom)
+            a_s = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
+            w_s = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
+            self.emit("{", ind)
+            self.emit(f"static const double L[{n}] = {{{ls}}}, R[{n}] = {{{rs}}};", ind + 1)
+            self.emit(f"static const unsigned char mn[{n}] = {{{mns}}};", ind + 1)
+            self.emit(f"const double a[{n}] = {{{a_s}}}, w[{n}] = {{{w_s}}};", ind + 1)
+            area, mom = (self.ex(o) for o in k.outs)
+            self.emit(
+                f"fz_am_lines({self.num(x0)}, {self.num(x1)}, {ACCU_CODES[accu]}, {n}, L, R, a, w, mn, "
+                f"&{area}, &{mom});",
+                ind + 1,
+            )
+            self.emit("}", ind)
+        elif k.name == "SMOOTH":
+            n = len(k.args) // 2
+            name = self.smooth_functions(k)
+            hs = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
+            ws = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
+            value, fired = (self.ex(o) for o in k.outs)
+            self.emit("{", ind)
+            size = max(1, n)
+            self.emit(f"const double h[{size}] = {{{hs or '0.0'}}}, w[{size}] = {{{ws or '0.0'}}};", ind + 1)
+            self.emit(f"{name}(h, w, &{value}, &{fired});", ind + 1)
+            self.emit("}", ind)
+        else:
+            raise CodegenError(f"the native evaluator has no kernel {k.name}")
+
+    def smooth_functions(self, k: Kernel) -> str:
+        """The set function and the quadrature driver of one smooth output."""
+        from fuzzyctl.engine.semantics import shapes
+
+        oi, sets = k.data
+        op = self.fp.plan.outputs[oi]
+        assert op.low is not None and op.high is not None
+        idx = len(self.extra)
+        set_fn, mu_fn, driver = f"fz_set{idx}", f"fz_mu{idx}", f"fz_smooth{idx}"
+        cuts = sorted(
+            {
+                op.low,
+                op.high,
+                *(
+                    c
+                    for t in op.terms
+                    for c in shapes.characteristic_points(t.kind, [float(p) for p in t.params])  # type: ignore[arg-type, unused-ignore]
+                    if op.low < c < op.high
+                ),
+            }
+        )
+        self.extra.append(self.set_function(set_fn, op, sets))
+        self.extra.append(self.mu_function(mu_fn, op, sets))
+        levels = [lv for k, (_t, act) in enumerate(sets) for lv in c_kernels.activation_levels(act, k)]
+        self.extra.append(c_kernels.smooth_driver(driver, set_fn, mu_fn, levels, cuts, self.num))
+        return driver
+
+    def set_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
+        """``double name(double x, const double *h, const double *w, double *code)``: the
+        accumulated set at x (``interp.accumulated_function``) and a code of the branch it
+        took - under MAX 2k (+1 when clipped) for the largest set k, otherwise a sum of
+        2^k over the clipped sets (+0.5 where BSUM, NIPMAX or DMAX reach 1, plus the largest
+        set's index / 1024 under NIPMAX and DMAX)."""
+        from fuzzyctl.ir.builders import terms as T
+        from fuzzyctl.ir.nodes import Index
+        from fuzzyctl.ir.state import Gen
+
+        g = Gen("c")
+        x = Var("x")
+        accu = op.accu or "MAX"
+        acc = g.let(0.0, "ACC")
+        best = g.let(-1.0, "BEST")
+        code = g.let(0.0, "CODE")
+        arg = g.let(0.0, "ARG")
+        for k, (t, act) in enumerate(sets):
+            mu = self._term_degree(g, op, t, x)
+            h, w = Index("h", Int(k)), Index("w", Int(k))
+            c = g.let(w * T.tnorm(g, act, h, mu), "C")
+            if accu == "MAX":
+                with g.b.if_(c.gt(best)):
+                    g.b.set(best, c)
+                    g.b.set(code, float(2 * k))
+                    if act == "MIN":
+                        with g.b.if_(h.lt(mu)):
+                            g.b.set(code, float(2 * k + 1))
+                T.accumulate_into(g, accu, acc, c)
+            else:
+                g.b.set(acc, T.accumulate(g, accu, acc, c))
+                if act == "MIN" and k < 52:
+                    with g.b.if_(h.lt(mu)):
+                        g.b.set(code, code + float(2**k))
+            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
+                with g.b.if_(c.gt(best)):
+                    g.b.set(best, c)
+                    g.b.set(arg, float(k + 1) / 1024.0)
+        if accu in ("NIPMAX", "DMAX"):
+            g.b.set(code, code + arg)
+        if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
+            with g.b.if_(acc.ge(1.0)):
+                g.b.set(code, code + 0.5)
+        return self._set_c(g, name, "double x, const double *h, const double *w, double *code", code, acc)
+
+    def mu_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
+        """``double name(int k, double x)``: the degree of the term of activated set k at x."""
+        from fuzzyctl.ir.state import Gen
+
+        g = Gen("c")
+        x, kv = Var("x"), Var("k")
+        res = g.let(0.0, "RES")
+        for k, (t, _act) in enumerate(sets):
+            with g.b.if_(kv.eq(Int(k))):
+                g.b.set(res, self._term_degree(g, op, t, x))
+        return self._set_c(g, name, "int k, double x", None, res)
+
+    def _term_degree(self, g: Gen, op: OutputPlan, t: int, x: Var) -> Ex:
+        from fuzzyctl.ir.builders import terms as T
+        from fuzzyctl.ir.nodes import Pwl
+
+        term = op.terms[t]
+        if term.pwl is not None:
+            return g.let(Pwl(x, term.pwl), "MU")
+        ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
+        mu = T.smooth(g, term.kind, ps, x, f"term {op.name}.{term.name}")
+        if float(term.height) != 1.0:  # type: ignore[arg-type]
+            mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
+        return mu
+
+    def _set_c(self, g: Gen, name: str, params: str, code: Var | None, result: Var) -> str:
+        r = _Native(self.fp)
+        r.pwl_funcs = self.pwl_funcs  # one set of breakpoint functions per file
+        r.lines = []
+        r.stmts(g.b.root, 1)
+        out = [f"static double {name}({params})", "{"]
+        for d in g.decls:
+            out.append(f"    {_ctype(d, 'double')} {d.name} = 0;")
+        out += r.lines
+        if code is not None:
+            out.append(f"    *code = {code.name};")
+        out += [f"    return {result.name};", "}", ""]
+        self.uses.update(g.uses)
+        return "\n".join(out)
+
+    def hold(self, k: Kernel, ind: int) -> None:
+        oi, default, no_change, clamp = k.data
+        out = self.ex(k.outs[0])
+        value, fired = k.args
+        if isinstance(fired, Bool) and fired.value:
+            if self.ex(value) != out:
+                self.emit(f"{out} = {self.ex(value)};", ind)
+        else:
+            alt = f"prev[{oi}]" if no_change else self.num(default)
+            self.emit(f"{out} = ({self.ex(fired)}) ? {self.ex(value)} : {alt};", ind)
+        if clamp is not None:
+            lo, hi = clamp
+            self.emit(f"if ({out} < {self.num(lo)}) {out} = {self.num(lo)};", ind)
+            self.emit(f"else if ({out} > {self.num(hi)}) {out} = {self.num(hi)};", ind)
+        self.emit(f"prev[{oi}] = {out};", ind)
+
+    def pwl_code(self) -> list[str]:
+        """One static function per breakpoint list (``shapes.pwl_value`` as an if-chain)."""
+        from fuzzyctl.engine.lowering.grid import left_limit, right_limit
+        from fuzzyctl.engine.semantics.shapes import pwl_value
+
+        out: list[str] = []
+        for pts, fname in self.pwl_funcs.items():
+            n = self.num
+            xs = sorted({q[0] for q in pts})
+            out.append(f"static inline double {fname}(double x)\n{{")
+            out.append(f"    if (x < {n(xs[0])}) return {n(pts[0][1])};")
+            for k, u in enumerate(xs):
+                pv = pwl_value(pts, u)
+                jump = left_limit(pts, u) != right_limit(pts, u) or pv != left_limit(pts, u)
+                if jump or k == 0:
+                    out.append(f"    if (x == {n(u)}) return {n(pv)};")
+                if k + 1 < len(xs):
+                    u1 = xs[k + 1]
+                    r0, l1 = right_limit(pts, u), left_limit(pts, u1)
+                    if r0 == l1:
+                        expr = n(r0)
+                    else:
+                        base = f"(x - {n(u)}) * {n((l1 - r0) / (u1 - u))}"
+                        expr = base if r0 == 0.0 else f"{n(r0)} + {base}"
+                    out.append(f"    if (x < {n(u1)}) return {expr};")
+            out.append(f"    if (x == {n(xs[-1])}) return {n(pwl_value(pts, xs[-1]))};")
+            out.append(f"    return {n(pts[-1][1])};\n}}\n")
+        return out
+
+
+#: Tables at least this long go to the native library as binary data (see render_native).
+BINARY_TABLE_MIN = 64
+_ARRAY_CODES = {"double": "d", "long": "l", "int": "i", "unsigned char": "B"}
+
+
+def _binary_table(
+    name: str, ctype: str, size: int, values: tuple[float, ...], tables: dict[str, bytes]
+) -> str:
+    """The declaration of a constant table whose bytes the assembler includes (``.incbin``)
+    instead of the C compiler parsing a long initialiser: a 10,000-rule system's tables are
+    960 KB of C text, 0.5 s of gcc at -O0 and 1.5 s at -O3, against nothing as data.  The
+    file name is the table's (generated) name, in the build directory the compiler runs in."""
+    code = _ARRAY_CODES[ctype]
+    data = array.array(code, [int(v) for v in values] if code != "d" else [float(v) for v in values])
+    fname = f"{name}.bin"
+    tables[fname] = data.tobytes()
+    return (
+        f'extern const {ctype} {name}[{size}] __attribute__((visibility("hidden")));\n'
+        f'__asm__(".pushsection .rodata\\n.balign 8\\n.globl {name}\\n.hidden {name}\\n'
+        f'{name}:\\n.incbin \\"{fname}\\"\\n.popsection");'
+    )
+
+
+def render_native(fp: FastProgram, tables: dict[str, bytes] | None = None) -> str:
+    """One C file: ``fz_row`` (one evaluation), ``fz_eval``, ``fz_batch`` (a loop over
+    columns of rows) and ``fz_init`` (the NC state), exported for the native backend.
+
+    With ``tables`` (a dict to fill; ELF targets with the GNU assembler), constant tables of
+    :data:`BINARY_TABLE_MIN` entries or more are written there as ``{name}.bin`` files of the
+    native byte order, which the C includes as data: the compiler must run in the directory
+    holding them."""
+    prog = fp.program
+    # every name printed passes c_ident (they are the program's FZ_ names: a model name
+    # reaching here is refused, never printed)
+    for n in sorted(identifiers(prog) | {*fp.inputs, *fp.outputs, fp.state}):
+        c_ident(n, "generated name")
+    r = _Native(fp)
+    r.stmts(prog.body, 1)
+    body = r.lines
+    c: list[str] = ["/* generated by fuzzyctl: the native evaluator; do not edit */"]
+    c += ["#include <math.h>", "#include <stddef.h>"]
+    c += ['#define FZ_API __attribute__((visibility("default")))', ""]
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        ctype = {"REAL": "double", **_CTYPES}[d.type]
+        if tables is not None and d.size is not None and d.size >= BINARY_TABLE_MIN:
+            c.append(_binary_table(f"fz_c_{d.name}", ctype, d.size, d.init, tables))
+            continue
+        vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
+        c.append(f"static const {ctype} fz_c_{d.name}[{d.size}] = {{{vals}}};")
+    helpers = helper_functions(prog)
+    helpers = c_helpers.closure(set(helpers) | {_HELPER_OF[f] for f in r.uses if f in _HELPER_OF})
+    c += c_helpers.render(set(helpers))
+    if r.uses_lines:
+        c.append(c_kernels.am_lines_code(r.max_lines))
+    if r.uses_max2:
+        c.append(c_kernels.AM_MAX2)
+    c += r.pwl_code()
+    c += r.extra
+    n_out = len(fp.outputs)
+    c.append(
+        "static inline void fz_row(double *restrict prev, const double *restrict in, double *restrict out)"
+    )
+    c.append("{")
+    for k, name in enumerate(fp.inputs):
+        c.append(f"    double {name} = in[{k}];")
+    for d in prog.of("output"):
+        c.append(f"    double {d.name} = 0;")
+    for d in prog.of("temp"):
+        ctype = _ctype(d, "double")
+        if d.size is not None:
+            c.append(f"    {ctype} {d.name}[{d.size}] = {{0}};")
+        else:
+            c.append(f"    {ctype} {d.name} = 0;")
+    c += body
+    for k, name in enumerate(fp.outputs):
+        c.append(f"    out[{k}] = {name};")
+    c.append("    (void)prev;")
+    c.append("}")
+    c.append("")
+    init = prog.decl(fp.state).init
+    assert isinstance(init, tuple)
+    c.append(f"FZ_API size_t fz_n_state(void) {{ return {len(init)}; }}")
+    c.append("FZ_API void fz_init(double *prev)\n{")
+    for i, v in enumerate(init):
+        c.append(f"    prev[{i}] = {r.num(v)};")
+    c.append("}")
+    c.append("FZ_API void fz_eval(double *prev, const double *in, double *out)")
+    c.append("{ fz_row(prev, in, out); }")
+    n_in = max(1, len(fp.inputs))
+    c.append("/* n rows: input k of row i is cols[k][i], output k of row i goes to outs[k][i] */")
+    c.append("FZ_API void fz_batch(double *prev, size_t n, const double *const *cols, double *const *outs)")
+    c.append("{")
+    c.append(f"    double in[{n_in}] = {{0}}, out[{max(1, n_out)}];")
+    c.append("    size_t i;")
+    c.append("    for (i = 0; i < n; i++) {")
+    for k in range(len(fp.inputs)):
+        c.append(f"        in[{k}] = cols[{k}][i];")
+    c.append("        fz_row(prev, in, out);")
+    for k in range(n_out):
+        c.append(f"        outs[{k}][i] = out[{k}];")
+    c.append("    }")
+    c.append("    (void)cols;")
+    c.append("    (void)outs;")
+    c.append("}")
+    return "\n".join(c) + "\n"

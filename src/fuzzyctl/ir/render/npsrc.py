@@ -1,0 +1,344 @@
+"""Print the evaluator program (:mod:`fuzzyctl.ir.programs.evaluator`) as one numpy function,
+``_batch(v, state, n) -> outputs``, evaluating whole columns of samples at once.
+
+The program is written for one sample; printed for columns it is *if-converted*: a value that
+differs between samples (anything computed from an input) is an array, a condition on such
+values a mask, and an assignment under a mask ``x = where(mask, new, x)``.  Values that are the
+same for every sample (constants, loop counters) stay Python numbers and their IFs and loops
+stay Python control flow.  Two patterns the IR writes for MIN and MAX (``t := b; IF a < t THEN
+t := a``) become ``numpy.minimum``/``numpy.maximum``.  Kernels are the vectorised routines of
+:mod:`fuzzyctl.ir.kernels.columns`; DEFAULT := NC is a running fill along the batch (rows are
+successive evaluations of one instance).
+
+A program that loops a number of times depending on the sample cannot be if-converted: that is
+refused (:class:`~fuzzyctl.ir.state.CodegenError`); the evaluator program never does it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+import numpy as np
+
+from fuzzyctl.engine.semantics import libm_np
+from fuzzyctl.escape import py_str
+from fuzzyctl.ir.kernels import columns as kernels_np
+from fuzzyctl.ir.nodes import (
+    Assign,
+    Bin,
+    Bool,
+    Call,
+    Comment,
+    Ex,
+    For,
+    If,
+    Index,
+    Int,
+    Kernel,
+    Neg,
+    Not,
+    Num,
+    Program,
+    Pwl,
+    Region,
+    Stmt,
+    Var,
+    While,
+    subexprs,
+)
+from fuzzyctl.ir.programs.evaluator import FastProgram
+from fuzzyctl.ir.render.pysrc import check_names, lit
+from fuzzyctl.ir.state import CodegenError
+
+Batch = Callable[[list[Any], list[float | None], int], list[Any]]
+
+_OPS = {"=": "==", "<>": "!="}
+# transcendental functions as libm computes them: the scalar paths call it (libm_np says why)
+_FUNCS = {
+    "EXP": "_libm.exp",
+    "SQRT": "_np.sqrt",
+    "LN": "_libm.log",
+    "LOG": "_libm.log10",
+    "ABS": "_np.abs",
+    "SIN": "_libm.sin",
+    "COS": "_libm.cos",
+    "TAN": "_libm.tan",
+    "ASIN": "_libm.asin",
+    "ACOS": "_libm.acos",
+    "ATAN": "_libm.atan",
+    "POW": "_libm.pow_",
+    "TO_REAL": "_real",
+}
+
+
+def varying_names(prog: Program, inputs: Sequence[str]) -> set[str]:
+    """Names whose value can differ between samples (fixpoint over the program)."""
+    vary = set(inputs)
+
+    def ex_varies(e: Ex) -> bool:
+        return any(isinstance(s, Var | Index) and s.name in vary for s in subexprs(e))
+
+    def run(stmts: Sequence[Stmt], masked: bool) -> bool:
+        changed = False
+        for s in stmts:
+            if isinstance(s, Assign):
+                index_varies = isinstance(s.target, Index) and ex_varies(s.target.index)
+                if (masked or ex_varies(s.value) or index_varies) and s.target.name not in vary:
+                    vary.add(s.target.name)
+                    changed = True
+            elif isinstance(s, If):
+                m = masked
+                for cond, body in s.branches:
+                    m = m or ex_varies(cond)
+                    changed |= run(body, m)
+                changed |= run(s.orelse, m)
+            elif isinstance(s, For):
+                changed |= run(s.body, masked or ex_varies(s.start) or ex_varies(s.stop))
+            elif isinstance(s, While):
+                changed |= run(s.body, masked or ex_varies(s.cond))
+            elif isinstance(s, Region):
+                changed |= run(s.body, masked)
+            elif isinstance(s, Kernel):
+                for o in s.outs:
+                    if o.name not in vary:
+                        vary.add(o.name)
+                        changed = True
+        return changed
+
+    while run(prog.body, False):
+        pass
+    return vary
+
+
+class _Np:
+    def __init__(self, fp: FastProgram) -> None:
+        self.fp = fp
+        self.vary = varying_names(fp.program, fp.inputs)
+        self.lines: list[str] = []
+        self.env: dict[str, Any] = {
+            "_np": np,
+            "_libm": libm_np,
+            "_w": np.where,
+            "_and": np.logical_and,
+            "_or": np.logical_or,
+            "_not": np.logical_not,
+            "_real": lambda x: x * 1.0,
+            "_NAN": math.nan,
+            "_INF": math.inf,
+        }
+        self.n_bound = 0
+        self.n_masks = 0
+
+    def bind(self, value: Any, prefix: str = "_k") -> str:
+        name = f"{prefix}{self.n_bound}"
+        self.n_bound += 1
+        self.env[name] = value
+        return name
+
+    def emit(self, line: str, ind: int) -> None:
+        self.lines.append("    " * ind + line)
+
+    def varies(self, e: Ex) -> bool:
+        return any(isinstance(s, Var | Index) and s.name in self.vary for s in subexprs(e))
+
+    # ------------------------------------------------------------------ expressions
+
+    def ex(self, e: Ex) -> str:
+        if isinstance(e, Num):
+            return lit(e.value)
+        if isinstance(e, Int):
+            return str(e.value)
+        if isinstance(e, Bool):
+            return "True" if e.value else "False"
+        if isinstance(e, Var):
+            return e.name
+        if isinstance(e, Index):
+            if self.varies(e.index):
+                raise CodegenError("an array index that differs between samples cannot be if-converted")
+            return f"{e.name}[{self.ex(e.index)}]"
+        if isinstance(e, Neg):
+            return f"(-{self.ex(e.operand)})"
+        if isinstance(e, Not):
+            return f"_not({self.ex(e.operand)})"
+        if isinstance(e, Call):
+            if e.function == "NAN":
+                return "_NAN"
+            return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
+        if isinstance(e, Pwl):
+            return f"{self.bind(e.points, '_p')}_v({self.ex(e.x)})"
+        assert isinstance(e, Bin), e
+        if e.op in ("AND", "OR"):
+            return f"_{e.op.lower()}({self.ex(e.left)}, {self.ex(e.right)})"
+        return f"({self.ex(e.left)} {_OPS.get(e.op, e.op)} {self.ex(e.right)})"
+
+    # ------------------------------------------------------------------ statements
+
+    def stmts(self, body: Sequence[Stmt], ind: int, mask: str | None) -> None:
+        start = len(self.lines)
+        i = 0
+        while i < len(body):
+            self.stmt(body[i], ind, mask)
+            i += 1
+        if len(self.lines) == start:
+            self.emit("pass", ind)
+
+    def assign(self, target: Ex, value: str, ind: int, mask: str | None) -> None:
+        t = self.ex(target)
+        self.emit(f"{t} = {value}" if mask is None else f"{t} = _w({mask}, {value}, {t})", ind)
+
+    def stmt(self, s: Stmt, ind: int, mask: str | None) -> None:
+        if isinstance(s, Assign):
+            self.assign(s.target, self.ex(s.value), ind, mask)
+        elif isinstance(s, If):
+            self.if_(s, ind, mask)
+        elif isinstance(s, For):
+            if self.varies(s.start) or self.varies(s.stop):
+                raise CodegenError("a loop whose bounds differ between samples cannot be if-converted")
+            stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
+            self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
+            self.stmts(s.body, ind + 1, mask)
+        elif isinstance(s, While):
+            if self.varies(s.cond):
+                raise CodegenError("a loop whose end differs between samples cannot be if-converted")
+            self.emit(f"while {self.ex(s.cond)}:", ind)
+            self.stmts(s.body, ind + 1, mask)
+        elif isinstance(s, Region):
+            self.stmts(s.body, ind, mask)
+        elif isinstance(s, Kernel):
+            self.kernel(s, ind, mask)
+        else:
+            assert isinstance(s, Comment)
+
+    def if_(self, s: If, ind: int, mask: str | None) -> None:
+        if not any(self.varies(c) for c, _b in s.branches):
+            for k, (cond, body) in enumerate(s.branches):
+                self.emit(f"{'if' if k == 0 else 'elif'} {self.ex(cond)}:", ind)
+                self.stmts(body, ind + 1, mask)
+            if s.orelse:
+                self.emit("else:", ind)
+                self.stmts(s.orelse, ind + 1, mask)
+            return
+        minmax = _minmax(s)
+        if minmax is not None:
+            fn, target, value = minmax
+            self.assign(target, f"_np.{fn}({self.ex(target)}, {self.ex(value)})", ind, mask)
+            return
+        rest = mask
+        for cond, body in s.branches:
+            m = self.mask_name()
+            c = self.ex(cond)
+            self.emit(f"{m} = {c}" if rest is None else f"{m} = _and({rest}, {c})", ind)
+            self.stmts(body, ind, m)
+            if rest is None:
+                r = self.mask_name()
+                self.emit(f"{r} = _not({m})", ind)
+            else:
+                r = self.mask_name()
+                self.emit(f"{r} = _and({rest}, _not({m}))", ind)
+            rest = r
+        if s.orelse:
+            self.stmts(s.orelse, ind, rest)
+
+    def mask_name(self) -> str:
+        self.n_masks += 1
+        return f"_m{self.n_masks}"
+
+    def kernel(self, k: Kernel, ind: int, mask: str | None) -> None:
+        if k.name == "HOLD":
+            if mask is not None:
+                raise CodegenError("DEFAULT / NC under a condition")
+            oi, default, no_change, clamp = k.data
+            value, fired = (self.ex(a) for a in k.args)
+            fn = self.bind(kernels_np.hold(oi, default, no_change, clamp))
+            self.emit(f"{self.ex(k.outs[0])} = {fn}(n, state, {value}, {fired})", ind)
+            return
+        fn = self.bind(kernels_np.make(k.name, k.data, self.fp.plan))
+        args = ", ".join(self.ex(a) for a in k.args)
+        if mask is None:
+            outs = ", ".join(self.ex(o) for o in k.outs)
+            self.emit(f"{outs}{',' if _tuple1(k) else ''} = {fn}(n, {args})", ind)
+            return
+        tmp = [f"_r{i}" for i in range(len(k.outs))]
+        self.emit(f"{', '.join(tmp)}{',' if _tuple1(k) else ''} = {fn}(n, {args})", ind)
+        for o, t in zip(k.outs, tmp, strict=True):
+            self.assign(o, t, ind, mask)
+
+
+def _tuple1(k: Kernel) -> bool:
+    """A kernel returning a tuple of one value (SELECT of a one-rule block)."""
+    return len(k.outs) == 1 and k.name == "SELECT"
+
+
+def _minmax(s: If) -> tuple[str, Var | Index, Ex] | None:
+    """``IF a < t THEN t := a`` (``>``): the MIN (MAX) the IR spells with an IF."""
+    if len(s.branches) != 1 or s.orelse:
+        return None
+    cond, body = s.branches[0]
+    if len(body) != 1 or not isinstance(body[0], Assign) or not isinstance(cond, Bin):
+        return None
+    if cond.op not in ("<", ">"):
+        return None
+    target, value = body[0].target, body[0].value
+    if not _same(cond.right, target):
+        return None
+    if not _same(cond.left, value):
+        return None
+    return ("minimum" if cond.op == "<" else "maximum"), target, value
+
+
+def _same(a: Ex, b: Ex) -> bool:
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, Num | Int | Bool):
+        return a.value == b.value  # type: ignore[attr-defined, no-any-return]
+    if isinstance(a, Var):
+        return a.name == b.name  # type: ignore[attr-defined, no-any-return]
+    if isinstance(a, Index):
+        return a.name == b.name and _same(a.index, b.index)  # type: ignore[attr-defined]
+    if isinstance(a, Bin):
+        return a.op == b.op and _same(a.left, b.left) and _same(a.right, b.right)  # type: ignore[attr-defined]
+    if isinstance(a, Neg | Not):
+        return _same(a.operand, b.operand)  # type: ignore[attr-defined]
+    return a is b
+
+
+def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
+    """The source of ``_batch`` and the globals it needs."""
+    r = _Np(fp)
+    prog = fp.program
+    check_names(fp)
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
+    r.stmts(prog.body, 2, None)
+    body = r.lines
+    head = [f"    {name} = v[{k}]" for k, name in enumerate(fp.inputs)]
+    for d in prog.of("temp") + prog.of("output"):
+        if d.size is not None:
+            head.append(f"    {d.name} = [0.0] * {d.size}")
+        else:
+            head.append(f"    {d.name} = 0.0")
+    for name, value in list(r.env.items()):
+        if name.startswith("_p") and isinstance(value, tuple):
+            r.env[name + "_v"] = lambda x, pts=value: kernels_np.pwl_membership(pts, x)
+    outs = ", ".join(f"_full(n, {o})" for o in fp.outputs)
+    r.env["_full"] = kernels_np.full
+    src = (
+        "def _batch(v, state, n):\n"
+        + "\n".join(head)
+        + "\n    with _np.errstate(all='ignore'):\n"
+        + "\n".join(body)
+        + f"\n    return [{outs}]\n"
+    )
+    return src, r.env
+
+
+def vectorise(fp: FastProgram) -> Batch:
+    """Compile the rendered source into the function."""
+    src, env = render_np(fp)
+    exec(compile(src, f"<fuzzyctl batch evaluator {py_str(fp.plan.name or '')}>", "exec"), env)
+    fn: Batch = env["_batch"]
+    fn.__source__ = src  # type: ignore[attr-defined]
+    return fn

@@ -1,0 +1,317 @@
+"""Print the evaluator program (:mod:`fuzzyctl.ir.programs.evaluator`) as one straight-line Python
+function, ``_fast(v, state) -> outputs``: inputs unpacked into locals, constants inlined as
+exact float literals, IFs as Python ``if``, piecewise-linear memberships as if-chains over
+their breakpoints, kernels as calls of :mod:`fuzzyctl.ir.kernels.scalar`.
+
+The generated source is kept on the function (``__source__``) for inspection.  No name of the
+model reaches the source: every variable is an ``FZ_`` identifier of the program (each one
+checked by :func:`fuzzyctl.escape.py_ident`), and comments (which hold rule labels) are not
+printed.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from typing import Any
+
+from fuzzyctl.escape import py_ident, py_str
+from fuzzyctl.ir.kernels import scalar as kernels
+from fuzzyctl.ir.nodes import (
+    Assign,
+    Bin,
+    Bool,
+    Call,
+    Comment,
+    Ex,
+    For,
+    If,
+    Index,
+    Int,
+    Kernel,
+    Neg,
+    Not,
+    Num,
+    Pwl,
+    Region,
+    Stmt,
+    Var,
+    While,
+    identifiers,
+)
+from fuzzyctl.ir.programs.evaluator import FastProgram
+
+Fast = Callable[[list[float], list[float | None]], list[float]]
+
+_OPS = {"=": "==", "<>": "!=", "AND": "and", "OR": "or"}
+_FUNCS = {
+    "EXP": "_m.exp",
+    "SQRT": "_m.sqrt",
+    "LN": "_m.log",
+    "LOG": "_m.log10",
+    "ABS": "abs",
+    "SIN": "_m.sin",
+    "COS": "_m.cos",
+    "TAN": "_m.tan",
+    "ASIN": "_m.asin",
+    "ACOS": "_m.acos",
+    "ATAN": "_m.atan",
+    "POW": "_m.pow",
+    "TO_REAL": "float",
+}
+
+
+def lit(x: float) -> str:
+    """An exact float literal (``repr`` round-trips), NaN and infinities by name."""
+    if math.isnan(x):
+        return "_NAN"
+    if math.isinf(x):
+        return "_INF" if x > 0 else "(-_INF)"
+    return repr(float(x))
+
+
+class _Py:
+    def __init__(self, fp: FastProgram) -> None:
+        self.fp = fp
+        self.lines: list[str] = []
+        self.env: dict[str, Any] = {"_NAN": math.nan, "_INF": math.inf, "_m": math}
+        self.n_kernels = 0
+
+    def bind(self, value: Any, prefix: str = "_k") -> str:
+        name = f"{prefix}{self.n_kernels}"
+        self.n_kernels += 1
+        self.env[name] = value
+        return name
+
+    def emit(self, line: str, ind: int) -> None:
+        self.lines.append("    " * ind + line)
+
+    # ------------------------------------------------------------------ expressions
+
+    def ex(self, e: Ex) -> str:
+        if isinstance(e, Num):
+            return lit(e.value)
+        if isinstance(e, Int):
+            return str(e.value)
+        if isinstance(e, Bool):
+            return "True" if e.value else "False"
+        if isinstance(e, Var):
+            return e.name
+        if isinstance(e, Index):
+            return f"{e.name}[{self.ex(e.index)}]"
+        if isinstance(e, Neg):
+            return f"(-{self.ex(e.operand)})"
+        if isinstance(e, Not):
+            return f"(not {self.ex(e.operand)})"
+        if isinstance(e, Call):
+            if e.function == "NAN":
+                return "_NAN"
+            if e.function == "IMOD":
+                return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
+            return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
+        if isinstance(e, Pwl):  # not at the top of an assignment: shapes.pwl_value
+            from fuzzyctl.engine.semantics.shapes import pwl_value
+
+            return f"{self.bind(lambda x, pts=e.points: pwl_value(pts, x), '_p')}({self.ex(e.x)})"
+        assert isinstance(e, Bin), e
+        return f"({self.ex(e.left)} {_OPS.get(e.op, e.op)} {self.ex(e.right)})"
+
+    # ------------------------------------------------------------------ statements
+
+    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
+        start = len(self.lines)
+        for s in body:
+            self.stmt(s, ind)
+        if len(self.lines) == start:
+            self.emit("pass", ind)
+
+    def stmt(self, s: Stmt, ind: int) -> None:
+        if isinstance(s, Assign):
+            if isinstance(s.value, Pwl):
+                self.pwl_chain(s.value, self.ex(s.target), ind)
+            else:
+                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)}", ind)
+        elif isinstance(s, If):
+            for k, (cond, body) in enumerate(s.branches):
+                self.emit(f"{'if' if k == 0 else 'elif'} {self.ex(cond)}:", ind)
+                self.stmts(body, ind + 1)
+            if s.orelse:
+                self.emit("else:", ind)
+                self.stmts(s.orelse, ind + 1)
+        elif isinstance(s, For):
+            stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
+            self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
+            self.stmts(s.body, ind + 1)
+        elif isinstance(s, While):
+            self.emit(f"while {self.ex(s.cond)}:", ind)
+            self.stmts(s.body, ind + 1)
+        elif isinstance(s, Region):
+            self.stmts(s.body, ind)
+        elif isinstance(s, Kernel):
+            self.kernel(s, ind)
+        else:
+            assert isinstance(s, Comment)
+
+    def pwl_chain(self, p: Pwl, out: str, ind: int) -> None:
+        """``shapes.pwl_value`` as an if-chain over the breakpoints."""
+        from fuzzyctl.engine.lowering.grid import left_limit, right_limit
+        from fuzzyctl.engine.semantics.shapes import pwl_value
+
+        x = self.ex(p.x)
+        if not isinstance(p.x, Var):
+            self.emit(f"_x = {x}", ind)
+            x = "_x"
+        pts = p.points
+        xs = sorted({q[0] for q in pts})
+        self.emit(f"if {x} < {lit(xs[0])}: {out} = {lit(pts[0][1])}", ind)
+        for k, u in enumerate(xs):
+            pv = pwl_value(pts, u)
+            jump = left_limit(pts, u) != right_limit(pts, u) or pv != left_limit(pts, u)
+            if jump or k == 0:
+                self.emit(f"elif {x} == {lit(u)}: {out} = {lit(pv)}", ind)
+            if k + 1 < len(xs):
+                u1 = xs[k + 1]
+                r0, l1 = right_limit(pts, u), left_limit(pts, u1)
+                if r0 == l1:
+                    expr = lit(r0)
+                else:
+                    base = f"({x} - {lit(u)}) * {lit((l1 - r0) / (u1 - u))}"
+                    expr = base if r0 == 0.0 else f"{lit(r0)} + {base}"
+                self.emit(f"elif {x} < {lit(u1)}: {out} = {expr}", ind)
+        self.emit(f"elif {x} == {lit(xs[-1])}: {out} = {lit(pwl_value(pts, xs[-1]))}", ind)
+        self.emit(f"else: {out} = {lit(pts[-1][1])}", ind)
+
+    # ------------------------------------------------------------------ kernels
+
+    def kernel(self, k: Kernel, ind: int) -> None:
+        outs = ", ".join(self.ex(o) for o in k.outs)
+        args = ", ".join(self.ex(a) for a in k.args)
+        if k.name == "HOLD":
+            self.hold(k, ind)
+            return
+        fn = self.bind(kernels.make(k.name, k.data, self.fp.plan))
+        self.emit(f"{outs}{',' if len(k.outs) == 1 and k.name == 'SELECT' else ''} = {fn}({args})", ind)
+
+    def hold(self, k: Kernel, ind: int) -> None:
+        """DEFAULT / NC / lock-range (``interp.run``)."""
+        oi, default, no_change, clamp = k.data
+        out = self.ex(k.outs[0])
+        value, fired = k.args
+        if not (isinstance(fired, Bool) and fired.value):
+            self.emit(f"if {self.ex(fired)}:", ind)
+            self.emit(f"{out} = {self.ex(value)}", ind + 1)
+            self.emit("else:", ind)
+            if no_change:
+                self.emit(f"{out} = state[{oi}]", ind + 1)
+                self.emit(f"if {out} is None: {out} = {lit(default)}", ind + 1)
+            else:
+                self.emit(f"{out} = {lit(default)}", ind + 1)
+        elif self.ex(value) != out:
+            self.emit(f"{out} = {self.ex(value)}", ind)
+        if clamp is not None:
+            lo, hi = clamp
+            self.emit(f"if {out} < {lit(lo)}: {out} = {lit(lo)}", ind)
+            self.emit(f"elif {out} > {lit(hi)}: {out} = {lit(hi)}", ind)
+        self.emit(f"state[{oi}] = {out}", ind)
+
+
+def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
+    """The source of ``_fast`` and the globals it needs."""
+    r = _Py(fp)
+    prog = fp.program
+    check_names(fp)
+    for d in prog.of("const"):
+        assert isinstance(d.init, tuple)
+        r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
+    body_start = len(r.lines)
+    r.stmts(prog.body, 1)
+    body = r.lines[body_start:]
+    head: list[str] = []
+    for k, name in enumerate(fp.inputs):
+        head.append(f"    {name} = v[{k}]")
+    for d in prog.of("temp"):
+        if d.size is not None:
+            zero = "0.0" if d.type == "REAL" else ("0" if d.type == "INT" else "False")
+            head.append(f"    {d.name} = [{zero}] * {d.size}")
+    scalars = {d.name for d in prog.of("temp") + prog.of("output") if d.size is None}
+    for name in needs_init(prog.body, scalars) + [
+        o for o in fp.outputs if o in scalars and not _assigned(prog.body, o)
+    ]:
+        head.append(f"    {name} = 0.0")
+    src = "def _fast(v, state):\n" + "\n".join(head + body) + f"\n    return [{', '.join(fp.outputs)}]\n"
+    return src, r.env
+
+
+def specialise(fp: FastProgram) -> Fast:
+    """Compile the rendered source into the function."""
+    src, env = render_py(fp)
+    # no model text reaches the source (FZ_ names checked by py_ident, float literals;
+    # kernels are bound objects)
+    exec(compile(src, f"<fuzzyctl evaluator {py_str(fp.plan.name or '')}>", "exec"), env)
+    fn: Fast = env["_fast"]
+    fn.__source__ = src  # type: ignore[attr-defined]
+    return fn
+
+
+def check_names(fp: FastProgram) -> None:
+    """Every name printed into the source passes :func:`fuzzyctl.escape.py_ident` (they are
+    the program's ``FZ_`` names: a model name reaching here is refused, never printed)."""
+    for name in sorted(identifiers(fp.program) | {*fp.inputs, *fp.outputs, fp.state}):
+        py_ident(name, "generated name")
+
+
+def _assigned(body: Sequence[Stmt], name: str) -> bool:
+    return name not in needs_init([*body, Assign(Var("_probe"), Var(name))], {name})
+
+
+def needs_init(body: Sequence[Stmt], scalars: set[str]) -> list[str]:
+    """Scalar temporaries some path may read before assigning (they start at 0, as in C)."""
+    out: set[str] = set()
+
+    # The names defined on every path so far are a stack of sets, one per nesting level, so
+    # that a branch does not copy all of them (linear, not quadratic, in long rule sections).
+    def reads(e: Ex, defined: list[set[str]]) -> None:
+        from fuzzyctl.ir.nodes import subexprs
+
+        for sub in subexprs(e):
+            if isinstance(sub, Var) and sub.name in scalars and not any(sub.name in d for d in defined):
+                out.add(sub.name)
+
+    def run(stmts: Sequence[Stmt], outer: list[set[str]]) -> set[str]:
+        """The names ``stmts`` define on every path (beyond ``outer``)."""
+        added: set[str] = set()
+        defined = [*outer, added]
+        for s in stmts:
+            if isinstance(s, Assign):
+                reads(s.value, defined)
+                if isinstance(s.target, Index):
+                    reads(s.target.index, defined)
+                else:
+                    added.add(s.target.name)
+            elif isinstance(s, If):
+                branch_sets = []
+                for cond, b in s.branches:
+                    reads(cond, defined)
+                    branch_sets.append(run(b, defined))
+                if s.orelse:  # without an else some path adds nothing
+                    branch_sets.append(run(s.orelse, defined))
+                    added |= set.intersection(*branch_sets)
+            elif isinstance(s, For):
+                reads(s.start, defined)
+                reads(s.stop, defined)
+                run(s.body, [*defined, {s.var}])
+            elif isinstance(s, While):
+                reads(s.cond, defined)
+                run(s.body, defined)
+            elif isinstance(s, Region):
+                added |= run(s.body, defined)
+            elif isinstance(s, Kernel):
+                for a in s.args:
+                    reads(a, defined)
+                for o in s.outs:
+                    if isinstance(o, Var):
+                        added.add(o.name)
+        return added
+
+    run(body, [])
+    return sorted(out)

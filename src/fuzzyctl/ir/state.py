@@ -1,0 +1,111 @@
+"""The state of one program being built: declarations, temporaries, names and refusals."""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from typing import Literal
+
+from fuzzyctl.escape import MAX_IDENT_ST as MAX_IDENT
+from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.nodes import Builder, Decl, Ex, ExLike, Storage, Type, Var, ex
+
+#: "c" and "st": the PLC function block; "py", "np" and "c" also the evaluator of ``compile()``
+Target = Literal["c", "st", "py", "np"]
+
+#: Every generated identifier starts with this prefix (user names never do: checked).
+PREFIX = "FZ_"
+
+
+__all__ = ["MAX_IDENT", "PREFIX", "CodegenError", "Gen", "Target", "flat"]
+
+
+@dataclass
+class Gen:
+    """Declarations and statements of one function block under construction."""
+
+    target: Target
+    b: Builder = field(default_factory=Builder)
+    decls: list[Decl] = field(default_factory=list)
+    names: set[str] = field(default_factory=set)  # upper-cased: ST is case-insensitive
+    uses: set[str] = field(default_factory=set)
+    _counter: int = 0
+    _free: dict[Type, list[str]] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ names
+
+    def fresh(self, preferred: str, fallback: str) -> str:
+        """An unused internal identifier: ``PREFIX + preferred`` when it is short enough and
+        free, else ``PREFIX + fallback + n``."""
+        cand = PREFIX + re.sub(r"[^A-Za-z0-9_]", "_", preferred)
+        cand = re.sub(r"_+", "_", cand)
+        if len(cand) <= MAX_IDENT and cand.upper() not in self.names:
+            return cand
+        while True:
+            self._counter += 1
+            cand = f"{PREFIX}{fallback}{self._counter}"
+            if cand.upper() not in self.names:
+                return cand
+
+    def declare(
+        self,
+        name: str,
+        type_: Type,
+        storage: Storage,
+        size: int | None = None,
+        init: tuple[float, ...] | float | bool | None = None,
+        comment: str = "",
+    ) -> Var:
+        if name.upper() in self.names:
+            raise CodegenError(f"identifier {name!r} is declared twice (names are case-insensitive in ST)")
+        self.names.add(name.upper())
+        self.decls.append(Decl(name, type_, storage, size, init, comment))
+        return Var(name)
+
+    def temp(self, type_: Type = "REAL", hint: str = "T") -> Var:
+        """A new temporary scalar (never reused: keeps generated code easy to read)."""
+        return self.declare(self.fresh(hint, hint), type_, "temp")
+
+    def array(self, hint: str, type_: Type, size: int, storage: Storage = "temp") -> Var:
+        return self.declare(self.fresh(hint, hint), type_, storage, max(size, 1))
+
+    def counter(self, hint: str = "K", type_: Type = "INT") -> str:
+        """An INT (or DINT) loop counter."""
+        return self.declare(self.fresh(hint, hint), type_, "temp").name
+
+    # ------------------------------------------------------------------ helpers
+
+    def let(self, value: ExLike, hint: str = "T", type_: Type = "REAL") -> Var:
+        """Assign ``value`` to a new temporary and return it."""
+        v = self.temp(type_, hint)
+        self.b.set(v, value)
+        return v
+
+    def min_(self, a: ExLike, b: ExLike, hint: str = "T") -> Var:
+        """``a if a < b else b`` as an IF (the engine's MIN, no MIN() call in ST)."""
+        t = self.let(b, hint)
+        with self.b.if_(ex(a).lt(t)):
+            self.b.set(t, a)
+        return t
+
+    def max_(self, a: ExLike, b: ExLike, hint: str = "T") -> Var:
+        """``a if a > b else b`` as an IF."""
+        t = self.let(b, hint)
+        with self.b.if_(ex(a).gt(t)):
+            self.b.set(t, a)
+        return t
+
+    def call(self, fn: str, *args: ExLike) -> Ex:
+        from fuzzyctl.ir.nodes import call
+
+        self.uses.add(fn)
+        return call(fn, *args)
+
+    def refuse(self, what: str, why: str) -> CodegenError:
+        lang = {"st": "Structured Text", "c": "C", "py": "Python", "np": "numpy"}[self.target]
+        return CodegenError(f"{what}: {why} (cannot be expressed in generated {lang})")
+
+
+def flat(values: Sequence[float]) -> tuple[float, ...]:
+    return tuple(float(v) for v in values)
