@@ -126,7 +126,8 @@ def test_no_private_name_is_imported_from_another_file() -> None:
     crossing = []
     for path, _name, tree in _modules():
         for line, module, names in _imports(tree):
-            private = [n for n in names if n.startswith("_") and not n.startswith("__")]
+            dotted = [*module.split("."), *names]
+            private = [n for n in dotted if n.startswith("_") and not n.startswith("__")]
             if private:
                 crossing.append(
                     f"{path.relative_to(SRC.parent)}:{line}: from {module} import {', '.join(private)}"
