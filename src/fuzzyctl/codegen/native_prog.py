@@ -1,0 +1,153 @@
+"""The evaluator program of ``compile()`` for the native backend: every output in the IR.
+
+:class:`~fuzzyctl.engine.fastprog.FastBuilder` writes rule evaluation, the closed-form CoG
+and DEFAULT / NC once for Python, numpy and C; what Python and numpy leave to hand-written
+kernels (:mod:`fuzzyctl.engine.kernels`, :mod:`fuzzyctl.engine.kernels_np`) is built here
+from the IR builders the PLC block uses, so the C compiled by :mod:`fuzzyctl.codegen.native`
+is the whole evaluation - no kernel is called back:
+
+=======================  =============================================================
+exact Mamdani outputs    :func:`fuzzyctl.codegen.mamdani.exact_outputs` on the constant
+                         grid (every method the methods registry marks exact)
+closed-form CoG          the shared intervals' pieces: :func:`fuzzyctl.codegen.pieces.interval`
+smooth CoG               :func:`fuzzyctl.codegen.quadrature.smooth_cog`
+terms given by inputs    their breakpoints sorted at run time (as in the PLC block)
+=======================  =============================================================
+
+A plan the IR builders cannot express (fuzzylite's rule activation methods, Tsukamoto
+outputs, a method other than CoG on smooth sets) raises :class:`CodegenError` saying why;
+:func:`fuzzyctl.codegen.native.compile_native` reports it once.
+"""
+
+from __future__ import annotations
+
+from fuzzyctl.codegen import mamdani as M
+from fuzzyctl.codegen import quadrature as Q
+from fuzzyctl.codegen.pieces import ACCUS, Ctx, interval
+from fuzzyctl.engine import irterms as T
+from fuzzyctl.engine import shapes
+from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, Group, merge
+from fuzzyctl.engine.ir import Ex, Int, Var, ex
+from fuzzyctl.engine.irgen import CodegenError, Gen
+from fuzzyctl.engine.irrules import Contrib, Literals
+from fuzzyctl.engine.plan import OutputPlan, Plan
+
+
+class NativeBuilder(FastBuilder):
+    """The evaluator program with every output written in the IR (target ``"c"``)."""
+
+    def __init__(self, plan: Plan) -> None:
+        super().__init__(plan, "c")
+
+    def member(self, var: int, ti: int, x: Ex, where: str) -> Ex:
+        """A term whose points are inputs: its breakpoints sorted at run time, as the PLC
+        block does; other shapes read their parameters from the inputs directly."""
+        g = self.g
+        t = self.plan.fuzzy_inputs[var].terms[ti]
+        if t.kind not in shapes.PWL_KINDS:
+            return self.fuzzify_term(var, ti, Literals(g, "", ""))
+        lit = Literals(g, "", "")
+        pts = M.term_points(self, t, lit, lit, where)
+        n = len(pts)
+        wx, wy = g.array("MX", "REAL", n), g.array("MY", "REAL", n)
+        for k, (px, py) in enumerate(pts):
+            g.b.set(wx[k], px)
+            g.b.set(wy[k], py)
+        T.sort_points(g, wx, wy, 0, n - 1)
+        return g.let(T.pwl_value(g, wx, wy, 0, n - 1, x), "MU")
+
+    def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
+        groups = merge(self.g, contribs, op.accu or "MAX")
+        if op.exact:
+            return self._exact(op, groups)
+        if op.method != "COG":
+            raise self.g.refuse(
+                f"output {op.name}: METHOD : {op.method} of a smooth set",
+                "only the centre of gravity of smooth sets is integrated by the generated code",
+            )
+        for t in op.terms:
+            if not Q.constant_term(t) or t.kind == "function":
+                raise self.g.refuse(f"term {op.name}.{t.name}", "a smooth output term given by variables")
+        sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
+        value, fired, _capped = Q.smooth_cog(self.g, op, sets, Q.calibrate(op))
+        return value, fired
+
+    def _exact(self, op: OutputPlan, groups: list[Group]) -> tuple[Ex, Ex]:
+        """A piecewise-linear output by any exact method: the PLC block's defuzzification
+        on this output's constant grid (or its run-time one when points are inputs)."""
+        assert op.low is not None and op.high is not None
+        lit = Literals(self.g, "", "")
+        points = [M.term_points(self, t, lit, lit, f"term {op.name}.{t.name}") for t in op.terms]
+        spec = M.ExactOutput(
+            op.name,
+            op.method,
+            op.accu or "MAX",
+            op.low,
+            op.high,
+            points,
+            [M.Group(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups],
+        )
+        value, fired = M.exact_outputs(self.g, [spec], None if op.grid is None else [op.grid])
+        return value[0], fired[0]
+
+    def am_lines(
+        self, x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...], args: list[Ex]
+    ) -> tuple[Ex, Ex]:
+        """Area and moment of the accumulated sets on one grid interval: the lines with a
+        positive degree gathered, then :func:`fuzzyctl.codegen.pieces.interval`."""
+        g = self.g
+        b = g.b
+        n = len(geom)
+        c = _lines_ctx(g, n, accu)
+        nl = c.v["NL"]
+        b.set(nl, 0)
+        for i, (left, right, mn) in enumerate(geom):
+            a, w = args[2 * i], args[2 * i + 1]
+            with b.if_((a * w).gt(0.0)):
+                b.set(c.a["LL"][nl], left)
+                b.set(c.a["LR"][nl], right)
+                b.set(c.a["LA"][nl], a)
+                b.set(c.a["LW"][nl], w)
+                b.set(c.a["LMIN"][nl], ex(mn))
+                b.set(nl, nl + 1)
+        b.set(c.v["AREA"], 0.0)
+        b.set(c.v["MOM"], 0.0)
+        with b.if_(nl.gt(0)):
+            interval(c, g.let(x0, "X0"), g.let(x1, "X1"))
+        return c.v["AREA"], c.v["MOM"]
+
+
+def _lines_ctx(g: Gen, n: int, accu: str) -> Ctx:
+    """The scratch variables of :func:`fuzzyctl.codegen.pieces.interval` for at most ``n``
+    lines and one accumulation, the method CoG."""
+    code = ACCUS[accu]
+    v: dict[str, Var] = {}
+    for name, typ in (("AC", "INT"), ("MC", "INT"), ("NL", "INT"), ("NT", "INT"), ("NC", "INT")):
+        v[name] = g.temp(typ, name)  # type: ignore[arg-type]
+    for name in ("V0", "V1", "AREA", "MOM"):
+        v[name] = g.temp(hint=name)
+    g.b.set(v["AC"], Int(code))
+    g.b.set(v["MC"], Int(1))
+    if code == 4:
+        v["PR"] = g.temp("BOOL", "PR")
+    pairs = max(1, n * (n - 1) // 2)
+    arrays = {
+        **{k: g.array(k, "REAL", n) for k in ("LL", "LR", "LA", "LW", "KINK", "P0", "P1")},
+        "LMIN": g.array("LMIN", "BOOL", n),
+        "TS": g.array("TS", "REAL", n + 2),
+        "CUT": g.array("CUT", "REAL", pairs),
+        "CV": g.array("CV", "REAL", pairs),
+    }
+    gl = M.gl_tables(g, n) if code == 4 else None
+    one = g.let(1, "PASS", "INT")
+    dummy = arrays["LL"]
+    # the term tables are read only by the PLC block's run-time geometry, never here
+    return Ctx(g, v, arrays, {}, gl, {"COG"}, {code}, *([dummy] * 8), one, ex(True))
+
+
+def build_native(plan: Plan) -> FastProgram:
+    """The native evaluator program of ``plan``; raises :class:`CodegenError` naming what
+    the IR cannot express."""
+    if plan.options.emulate is not None:
+        raise CodegenError(f"the {plan.options.emulate} profile is evaluated by its own evaluator")
+    return NativeBuilder(plan).build()
