@@ -9,7 +9,8 @@ is the whole evaluation - no kernel is called back:
 =======================  =============================================================
 exact Mamdani outputs    :func:`fuzzyctl.codegen.mamdani.exact_outputs` on the constant
                          grid (every method the methods registry marks exact)
-closed-form CoG          the shared intervals' pieces: :func:`fuzzyctl.codegen.pieces.interval`
+closed-form CoG          the shared intervals: :func:`fuzzyctl.codegen.pieces.max_of_two`
+                         (two sets under MAX), else :func:`~fuzzyctl.codegen.pieces.interval`
 smooth CoG               :func:`fuzzyctl.codegen.quadrature.smooth_cog`
 terms given by inputs    their breakpoints sorted at run time (as in the PLC block)
 =======================  =============================================================
@@ -23,7 +24,7 @@ from __future__ import annotations
 
 from fuzzyctl.codegen import mamdani as M
 from fuzzyctl.codegen import quadrature as Q
-from fuzzyctl.codegen.pieces import ACCUS, Ctx, interval
+from fuzzyctl.codegen.pieces import ACCUS, Ctx, clipped_am, interval, max_of_two
 from fuzzyctl.engine import irterms as T
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, Group, merge
@@ -98,6 +99,16 @@ class NativeBuilder(FastBuilder):
         g = self.g
         b = g.b
         n = len(geom)
+        lines = [(left, right, args[2 * i], args[2 * i + 1], mn) for i, (left, right, mn) in enumerate(geom)]
+        if n == 2 and accu == "MAX":
+            return max_of_two(g, x0, x1, lines[0], lines[1])
+        if n == 1:
+            area, mom = g.let(0.0, "IA"), g.let(0.0, "IM")
+            with b.if_((lines[0][2] * lines[0][3]).gt(0.0)):
+                a, m = clipped_am(g, x0, x1 - x0, lines[0])
+                b.set(area, a)
+                b.set(mom, m)
+            return area, mom
         c = _lines_ctx(g, n, accu)
         nl = c.v["NL"]
         b.set(nl, 0)

@@ -436,3 +436,116 @@ def finish(c: Ctx, value: Index, fired: Index) -> None:
                 b.set(value, st["PMOM"] / st["PLEN"])
             with b.elif_(st["ICNT"].gt(0)):
                 b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))
+
+
+# --------------------------------------------------------------------------- constant geometry
+
+#: One activated set on one grid interval of a constant grid: the term goes linearly from
+#: ``L`` to ``R`` (numbers), the set is ``w * min(a, term)`` (``is_min``) or ``w * a * term``.
+StaticLine = tuple[float, float, Ex, Ex, bool]
+
+
+def polyline_am(g: Gen, x0: float, dx: float, ts: list[Ex], vs: list[Ex]) -> tuple[Var, Var]:
+    """Area and moment of the polyline through ``(x0 + t dx, v)`` for ordered ``ts``, the
+    sums kept in t-space (numpy twin: :func:`fuzzyctl.engine.kernels_np._polyline_am`)."""
+    area: Ex = ex(0.0)
+    tmom: Ex = ex(0.0)
+    for k in range(len(ts) - 1):
+        d = g.let(ts[k + 1] - ts[k], "D")
+        s = g.let(vs[k] + vs[k + 1], "S")
+        area = area + d * s
+        tmom = tmom + d * (ts[k] * (s + vs[k]) + ts[k + 1] * (s + vs[k + 1]))
+    a = g.let(area * (0.5 * dx), "PA")
+    return a, g.let(x0 * a + (dx * dx / 6.0) * tmom, "PM")
+
+
+def clipped_am(g: Gen, x0: float, dx: float, line: StaticLine) -> tuple[Var, Var]:
+    """One activated set alone on an interval: ``w * min(a, line)`` or ``w * a * line``
+    (numpy twin: ``kernels_np._clipped_line_am``).  At the kink the set is exactly ``w*a``."""
+    left, right, a, w, mn = line
+    if not mn:
+        return polyline_am(g, x0, dx, [ex(0.0), ex(1.0)], [w * a * left, w * a * right])
+    tk = g.let(0.0, "TK")
+    if right != left:
+        b = g.b
+        b.set(tk, (a - left) / (right - left))
+        with b.if_(tk.lt(0.0)):
+            b.set(tk, 0.0)
+        with b.elif_(tk.gt(1.0)):
+            b.set(tk, 1.0)
+    mid = g.min_(a, left + (right - left) * tk, "VK")
+    with g.b.if_(((a - left) * (a - right)).lt(0.0)):
+        g.b.set(mid, a)
+    vs: list[Ex] = [w * g.min_(a, left, "VL"), w * mid, w * g.min_(a, right, "VR")]
+    return polyline_am(g, x0, dx, [ex(0.0), tk, ex(1.0)], vs)
+
+
+def max_of_two(g: Gen, x0: float, x1: float, l1: StaticLine, l2: StaticLine) -> tuple[Var, Var]:
+    """Area and moment of ``max(c1, c2)`` on one interval without sorting candidates:
+    ``max = c1 + c2 - min(c1, c2)``, and ``min(c1, c2) = min(H, p1, p2)`` is concave (two
+    lines clipped at the constant H), whose breakpoints come out ordered by construction
+    (numpy twin: ``kernels_np._max_of_two``; the scalar reference is
+    :func:`fuzzyctl.engine.pwl.interval_pieces`)."""
+    b = g.b
+    dx = x1 - x0
+    area, mom = g.temp(hint="IA"), g.temp(hint="IM")
+    (_l1, _r1, h1, w1, _m1), (_l2, _r2, h2, w2, _m2) = l1, l2
+    for k, (cond, line) in enumerate((((h2 * w2).gt(0.0), l1), ((h1 * w1).gt(0.0), l2))):
+        with b.if_(not_(cond)) if k == 0 else b.elif_(not_(cond)):
+            a, m = clipped_am(g, x0, dx, line)
+            b.set(area, a)
+            b.set(mom, m)
+    with b.else_():
+        a1, m1 = clipped_am(g, x0, dx, l1)
+        a2, m2 = clipped_am(g, x0, dx, l2)
+        a3, m3 = _min_of_two(g, x0, dx, l1, l2)
+        b.set(area, a1 + a2 - a3)
+        b.set(mom, m1 + m2 - m3)
+    return area, mom
+
+
+def _min_of_two(g: Gen, x0: float, dx: float, l1: StaticLine, l2: StaticLine) -> tuple[Var, Var]:
+    """Area and moment of ``min(H, p1, p2)``: ``p_i = P_i + S_i t`` the line parts of the two
+    sets, ``H`` the smaller clip level of a MIN-activated one (none: no clip)."""
+    b = g.b
+    ps: list[tuple[Var, Var]] = []
+    for left, right, h, w, mn in (l1, l2):
+        scale = w if mn else w * h
+        ps.append((g.let(scale * left, "P"), g.let(scale * (right - left), "SL")))
+    (p1, s1), (p2, s2) = ps
+    clips = [w * h for _l, _r, h, w, mn in (l1, l2) if mn]
+    t = g.let(0.0, "TC")
+    with b.if_(s1.ne(s2)):
+        b.set(t, (p2 - p1) / (s1 - s2))
+    with b.if_(t.ne(t)):  # NaN
+        b.set(t, 0.0)
+    with b.elif_(t.lt(0.0)):
+        b.set(t, 0.0)
+    with b.elif_(t.gt(1.0)):
+        b.set(t, 1.0)
+
+    def low(u: Ex) -> Var:
+        return g.min_(p2 + s2 * u, p1 + s1 * u, "ML")
+
+    if not clips:
+        ts: list[Ex] = [ex(0.0), t, ex(1.0)]
+        return polyline_am(g, x0, dx, ts, [low(u) for u in ts])
+    hh = g.let(clips[0], "HC") if len(clips) == 1 else g.min_(clips[0], clips[1], "HC")
+    pts: list[Ex] = [ex(0.0)]
+    hits: list[Var] = []
+    for ta, tb in ((ex(0.0), t), (t, ex(1.0))):
+        ma, mb = low(ta), low(tb)
+        hit = g.let(((ma - hh) * (mb - hh)).lt(0.0), "HIT", "BOOL")
+        c = g.let(ta, "TX")
+        with b.if_(hit):
+            b.set(c, ta + (hh - ma) / (mb - ma) * (tb - ta))
+        hits.append(hit)
+        pts += [c, tb]
+    vals: list[Ex] = []
+    for k, u in enumerate(pts):
+        v = g.min_(hh, low(u), "MV")
+        if k in (1, 3):  # exactly H where min(p1, p2) crosses it
+            with b.if_(hits[k // 2]):
+                b.set(v, hh)
+        vals.append(v)
+    return polyline_am(g, x0, dx, pts, vals)
