@@ -13,10 +13,13 @@ closed-form CoG          the shared intervals: :func:`fuzzyctl.codegen.pieces.ma
                          (two sets under MAX), else :func:`~fuzzyctl.codegen.pieces.interval`
 smooth CoG               :func:`fuzzyctl.codegen.quadrature.smooth_cog`
 terms given by inputs    their breakpoints sorted at run time (as in the PLC block)
+Tsukamoto terms          :func:`fuzzyctl.engine.irterms.tsukamoto`
+rule activation          :meth:`NativeBuilder.select` (``selection.select`` in the IR)
 =======================  =============================================================
 
-A plan the IR builders cannot express (fuzzylite's rule activation methods, Tsukamoto
-outputs, a method other than CoG on smooth sets) raises :class:`CodegenError` saying why;
+Takagi-Sugeno outputs (Tsukamoto terms included) and fuzzylite's rule activation methods
+are written here too.  A plan the IR builders cannot express (a method other than CoG on
+smooth sets, a Tsukamoto term whose points are inputs) raises :class:`CodegenError` saying why;
 :func:`fuzzyctl.codegen.native.compile_native` reports it once.
 """
 
@@ -31,7 +34,7 @@ from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, Group, merge
 from fuzzyctl.engine.ir import Ex, Int, Var, ex
 from fuzzyctl.engine.irgen import CodegenError, Gen
 from fuzzyctl.engine.irrules import Contrib, Literals
-from fuzzyctl.engine.plan import OutputPlan, Plan
+from fuzzyctl.engine.plan import OutputPlan, Plan, SelectionPlan
 
 
 class NativeBuilder(FastBuilder):
@@ -56,6 +59,56 @@ class NativeBuilder(FastBuilder):
             g.b.set(wy[k], py)
         T.sort_points(g, wx, wy, 0, n - 1)
         return g.let(T.pwl_value(g, wx, wy, 0, n - 1, x), "MU")
+
+    def _ts_output(
+        self, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
+    ) -> tuple[Ex, Ex]:
+        """Takagi-Sugeno, Tsukamoto terms included (their inverse: ``irterms.tsukamoto``)."""
+        return self.ts(op, contribs, values)
+
+    def select(self, sel: SelectionPlan, degrees: list[Ex]) -> list[Ex]:
+        """fuzzylite's rule activation methods (the IR twin of
+        :func:`fuzzyctl.engine.selection.select`): which of the block's rules keep their
+        degree."""
+        g = self.g
+        b = g.b
+        k = len(degrees)
+        ds = [g.let(d, "SD") for d in degrees]
+        outs = [g.let(0.0, "SEL") for _ in ds]
+        if sel.method in ("FIRST", "LAST"):
+            taken = g.let(0, "TAKEN", "INT")
+            for j in range(k) if sel.method == "FIRST" else range(k - 1, -1, -1):
+                a = ds[j]
+                with b.if_(taken.lt(sel.count).and_(a.gt(0.0)).and_(a.ge(sel.threshold))):
+                    b.set(outs[j], a)
+                    b.set(taken, taken + 1)
+        elif sel.method in ("HIGHEST", "LOWEST"):
+            for j in range(k):  # rank: the positive degrees before it (earlier rules first on ties)
+                rank = g.let(0, "RANK", "INT")
+                for i in range(k):
+                    if i == j:
+                        continue
+                    before = ds[i].gt(ds[j]) if sel.method == "HIGHEST" else ds[i].lt(ds[j])
+                    if i < j:
+                        before = before.or_(ds[i].eq(ds[j]))
+                    with b.if_(ds[i].gt(0.0).and_(before)):
+                        b.set(rank, rank + 1)
+                with b.if_(ds[j].gt(0.0).and_(rank.lt(sel.count))):
+                    b.set(outs[j], ds[j])
+        elif sel.method == "PROPORTIONAL":
+            total = g.let(0.0, "TOTAL")
+            for a in ds:
+                with b.if_(a.gt(0.0)):
+                    b.set(total, total + a)
+            for a, out in zip(ds, outs, strict=True):
+                with b.if_(total.gt(0.0).and_(a.gt(0.0))):
+                    b.set(out, a / total)
+        else:
+            compare = {"<": "lt", "<=": "le", "==": "eq", "!=": "ne", ">=": "ge", ">": "gt"}[sel.comparison]
+            for a, out in zip(ds, outs, strict=True):
+                with b.if_(getattr(a, compare)(sel.threshold)):
+                    b.set(out, a)
+        return list(outs)
 
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         groups = merge(self.g, contribs, op.accu or "MAX")
