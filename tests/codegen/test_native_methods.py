@@ -137,9 +137,8 @@ def _compile(src: str) -> tuple[Controller, Controller]:
     if "(* activation: " in src:
         start = src.index("(* activation: ") + len("(* activation: ")
         activation = src[start : src.index(" *)", start)]
-        fb = dataclasses.replace(
-            fb, rule_blocks=tuple(dataclasses.replace(rb, rule_activation=activation) for rb in fb.rule_blocks)
-        )
+        blocks = tuple(dataclasses.replace(rb, rule_activation=activation) for rb in fb.rule_blocks)
+        fb = dataclasses.replace(fb, rule_blocks=blocks)
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # never a fallback, silent or not
         nat = fuzzyctl.compile(fb, backend="native")

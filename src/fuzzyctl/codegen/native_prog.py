@@ -158,9 +158,9 @@ class NativeBuilder(FastBuilder):
         if n == 1:
             area, mom = g.let(0.0, "IA"), g.let(0.0, "IM")
             with b.if_((lines[0][2] * lines[0][3]).gt(0.0)):
-                a, m = clipped_am(g, x0, x1 - x0, lines[0])
-                b.set(area, a)
-                b.set(mom, m)
+                ca, cm = clipped_am(g, x0, x1 - x0, lines[0])
+                b.set(area, ca)
+                b.set(mom, cm)
             return area, mom
         c = _lines_ctx(g, n, accu)
         nl = c.v["NL"]
@@ -206,7 +206,8 @@ def _lines_ctx(g: Gen, n: int, accu: str) -> Ctx:
     one = g.let(1, "PASS", "INT")
     dummy = arrays["LL"]
     # the term tables are read only by the PLC block's run-time geometry, never here
-    return Ctx(g, v, arrays, {}, gl, {"COG"}, {code}, *([dummy] * 8), one, ex(True))
+    d = dummy
+    return Ctx(g, v, arrays, {}, gl, {"COG"}, {code}, d, d, d, d, d, d, d, d, one, ex(True))
 
 
 def build_native(plan: Plan) -> FastProgram:
