@@ -25,6 +25,7 @@ smooth sets, a Tsukamoto term whose points are inputs) raises :class:`CodegenErr
 
 from __future__ import annotations
 
+from fuzzyctl.codegen import grid_pieces as GP
 from fuzzyctl.codegen import mamdani as M
 from fuzzyctl.codegen import quadrature as Q
 from fuzzyctl.codegen.pieces import ACCUS, Ctx, clipped_am, interval, max_of_two
@@ -34,7 +35,7 @@ from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, Group, merge
 from fuzzyctl.engine.ir import Ex, Int, Var, ex
 from fuzzyctl.engine.irgen import CodegenError, Gen
 from fuzzyctl.engine.irrules import Contrib, Literals
-from fuzzyctl.engine.plan import OutputPlan, Plan, SelectionPlan
+from fuzzyctl.engine.plan import GridPlan, OutputPlan, Plan, SelectionPlan
 
 
 class NativeBuilder(FastBuilder):
@@ -130,6 +131,9 @@ class NativeBuilder(FastBuilder):
         """A piecewise-linear output by any exact method: the PLC block's defuzzification
         on this output's constant grid (or its run-time one when points are inputs)."""
         assert op.low is not None and op.high is not None
+        accu = op.accu or "MAX"
+        if op.grid is not None and GP.applies(accu):
+            return self._unrolled(op, op.grid, groups, accu)
         lit = Literals(self.g, "", "")
         points = [M.term_points(self, t, lit, lit, f"term {op.name}.{t.name}") for t in op.terms]
         spec = M.ExactOutput(
@@ -143,6 +147,27 @@ class NativeBuilder(FastBuilder):
         )
         value, fired = M.exact_outputs(self.g, [spec], None if op.grid is None else [op.grid])
         return value[0], fired[0]
+
+    def _unrolled(self, op: OutputPlan, grid: GridPlan, groups: list[Group], accu: str) -> tuple[Ex, Ex]:
+        """CoA, LM, RM, MoM on the constant grid as straight-line code (:mod:`grid_pieces`)."""
+        g = self.g
+        sets = [GP.Set(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups]
+        maxima = op.method in ("LM", "RM", "MOM")
+        p = GP.pieces(g, grid, sets, accu, maxima)
+        fired = g.let(ex(False), "FIRED", "BOOL")
+        value = g.let(0.0, "Y")
+        if not p.x0:
+            return value, fired
+        areas, total = GP.area(g, p)
+        g.b.set(fired, total.gt(0.0))
+        with g.b.if_(fired):
+            if maxima:
+                assert op.low is not None and op.high is not None
+                res = GP.maxima(g, GP.maxima_state(g, op.low, op.high), p, op.method, grid)
+            else:
+                res = GP.bisector(g, p, areas, total)
+            g.b.set(value, res)
+        return value, fired
 
     def am_lines(
         self, x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...], args: list[Ex]

@@ -370,34 +370,42 @@ def _solve(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var, pdx: Var, r: Var) -> Var:
     else:
         ctx = b.if_(ex(True))
     with ctx:
-        a0 = g.let(v0, "SV0")
-        a1 = g.let(v1, "SV1")
-        rr = g.let(r, "SR")
-        m0 = g.let(a0, "SC")
-        with b.if_(m0.lt(0.0)):
-            b.set(m0, -m0)
-        m1 = g.let(a1, "SC")
-        with b.if_(m1.lt(0.0)):
-            b.set(m1, -m1)
-        sc = g.max_(m0, m1, "SC")
-        with b.if_(sc.gt(0.0)):
-            b.set(a0, a0 / sc)
-            b.set(a1, a1 / sc)
-            b.set(rr, rr / sc)
-        kk = g.let(0.0, "SK")
-        with b.if_(pdx.gt(0.0)):
-            b.set(kk, (a1 - a0) / pdx)
-        disc = g.let(a0 * a0 + 2.0 * kk * rr, "DISC")
-        with b.if_(disc.lt(0.0)):
-            b.set(disc, 0.0)
-        den = g.let(a0 + g.call("SQRT", disc), "DEN")
-        with b.if_(den.le(0.0)):
-            b.set(out, xa)
-        with b.else_():
-            b.set(out, xa + 2.0 * rr / den)
-            with b.if_(xb.lt(out)):
-                b.set(out, xb)
+        solve_linear(g, out, xa, xb, v0, v1, pdx, r)
     return out
+
+
+
+def solve_linear(g: Gen, out: Var, xa: Ex, xb: Ex, v0: Ex, v1: Ex, pdx: Ex, r: Ex) -> None:
+    """``out`` := where the area of the linear piece from ``xa`` (degree ``v0``) to ``xb``
+    (``v1``) reaches ``r`` from its start (pwl._solve_in_piece: scaled, the stable root)."""
+    b = g.b
+    a0 = g.let(v0, "SV0")
+    a1 = g.let(v1, "SV1")
+    rr = g.let(r, "SR")
+    m0 = g.let(a0, "SC")
+    with b.if_(m0.lt(0.0)):
+        b.set(m0, -m0)
+    m1 = g.let(a1, "SC")
+    with b.if_(m1.lt(0.0)):
+        b.set(m1, -m1)
+    sc = g.max_(m0, m1, "SC")
+    with b.if_(sc.gt(0.0)):
+        b.set(a0, a0 / sc)
+        b.set(a1, a1 / sc)
+        b.set(rr, rr / sc)
+    kk = g.let(0.0, "SK")
+    with b.if_(pdx.gt(0.0)):
+        b.set(kk, (a1 - a0) / pdx)
+    disc = g.let(a0 * a0 + 2.0 * kk * rr, "DISC")
+    with b.if_(disc.lt(0.0)):
+        b.set(disc, 0.0)
+    den = g.let(a0 + g.call("SQRT", disc), "DEN")
+    with b.if_(den.le(0.0)):
+        b.set(out, xa)
+    with b.else_():
+        b.set(out, xa + 2.0 * rr / den)
+        with b.if_(xb.lt(out)):
+            b.set(out, xb)
 
 
 def finish(c: Ctx, value: Index, fired: Index) -> None:

@@ -1,0 +1,260 @@
+"""Exact defuzzification of a piecewise-linear output on a constant grid, unrolled (the
+native evaluator, :mod:`fuzzyctl.codegen.native_prog`).
+
+The PLC block builds its grid at run time and loops over tables
+(:mod:`fuzzyctl.codegen.mamdani`); here the grid is the plan's
+(:class:`~fuzzyctl.engine.plan.GridPlan`) and every interval becomes straight-line code: a
+fixed list of candidate cut points (the interval's ends, each MIN-clipped set's kink, where
+two linear parts of two sets cross under MAX) that only their order leaves to run time (a
+sorting network), the accumulated degree at each, and the pieces between consecutive ones,
+on which the set is linear.  The methods then read the pieces in increasing x:
+
+* CoA: the total area, then from the left and from the right the piece where half of it is
+  reached (:func:`fuzzyctl.engine.pwl.bisector`);
+* LM, RM, MoM: the height over the pieces' ends and the grid points, then the points reaching
+  it (:func:`fuzzyctl.engine.pwl.maxima`).
+
+The reference is :mod:`fuzzyctl.engine.pwl`; the numpy twin of the candidate points is
+``kernels_np._interval``.  Accumulations whose pieces are not linear between those points
+(BSUM's cut where the sum reaches 1, PROBOR's products) use the general loops.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from fuzzyctl.codegen.pieces import Ctx, candidate, solve_linear
+from fuzzyctl.engine import irterms as T
+from fuzzyctl.engine.ir import Ex, Var, ex, not_
+from fuzzyctl.engine.irgen import Gen
+from fuzzyctl.engine.plan import GridPlan
+from fuzzyctl.engine.pwl import COA_TOL, MAX_TOL
+
+#: Accumulations whose accumulated set is linear between the candidate points.
+LINEAR_ACCUS = frozenset({"MAX", "SUM", "NSUM"})
+
+
+@dataclass(frozen=True)
+class Set:
+    """One activated set: ``w * min(a, term)`` (``is_min``) or ``w * a * term``."""
+
+    term: int
+    a: Ex
+    w: Ex
+    is_min: bool
+
+
+@dataclass
+class Pieces:
+    """The linear pieces of the accumulated set in increasing x; ``points[j]`` the degree
+    exactly at grid point ``j`` (filled for the maxima only)."""
+
+    x0: list[Ex] = field(default_factory=list)
+    x1: list[Ex] = field(default_factory=list)
+    v0: list[Ex] = field(default_factory=list)
+    v1: list[Ex] = field(default_factory=list)
+    first: dict[int, int] = field(default_factory=dict)  # grid interval -> its first piece
+    points: list[Ex] = field(default_factory=list)
+
+
+def applies(accu: str) -> bool:
+    return accu in LINEAR_ACCUS
+
+
+def pieces(g: Gen, grid: GridPlan, sets: list[Set], accu: str, with_points: bool) -> Pieces:
+    """Every interval's pieces (see the module docstring)."""
+    out = Pieces()
+    for j in range(len(grid.xs) - 1):
+        act = grid.active[j]
+        lines = [(grid.left[s.term][j], grid.right[s.term][j], s) for s in sets if s.term in act]
+        if lines:
+            out.first[j] = len(out.x0)
+            _interval(g, grid.xs[j], grid.xs[j + 1], lines, accu, out)
+    if with_points:  # pwl.point_values
+        for j in range(len(grid.xs)):
+            v = g.let(0.0, "GP")
+            for s in sets:
+                y = grid.point[s.term][j]
+                if y != 0.0:
+                    c = s.w * (g.min_(s.a, y, "PY") if s.is_min else s.a * y)
+                    g.b.set(v, T.accumulate(g, accu, v, c))
+            out.points.append(v)
+    return out
+
+
+Line = tuple[float, float, Set]
+
+
+def _interval(g: Gen, x0: float, x1: float, lines: list[Line], accu: str, out: Pieces) -> None:
+    b = g.b
+    dx = x1 - x0
+    cands: list[Var] = []
+    kinks: list[Var | None] = []
+    for left, right, s in lines:
+        if s.is_min and left != right:  # where the term strictly crosses the degree
+            kt = g.let(-1.0, "KT")
+            with b.if_(((left - s.a) * (right - s.a)).lt(0.0)):
+                b.set(kt, (s.a - left) / (right - left))
+            kinks.append(kt)
+            cands.append(g.max_(kt, 0.0, "CT"))
+        else:
+            kinks.append(None)
+    if accu == "MAX" and len(lines) > 1:
+        parts = [_parts(left, right, s) for left, right, s in lines]
+        for i in range(len(lines)):
+            for k in range(i + 1, len(lines)):
+                for ai, bi in parts[i]:
+                    for ak, bk in parts[k]:
+                        t = g.let(0.0, "CT")
+                        num, den = ak - ai, bi - bk
+                        with b.if_(den.ne(0.0)):
+                            b.set(t, num / den)
+                        with b.if_(not_(t.gt(0.0).and_(t.lt(1.0)))):
+                            b.set(t, 0.0)
+                        cands.append(t)
+    _sort(g, cands)
+    ts: list[Ex] = [ex(0.0), *cands, ex(1.0)]
+    vals = [_value_at(g, lines, kinks, t, accu) for t in ts]
+    xs: list[Ex] = [ex(x0)] + [g.let(x0 + t * dx, "CX") for t in cands] + [ex(x1)]
+    for k in range(len(ts) - 1):
+        out.x0.append(xs[k])
+        out.x1.append(xs[k + 1])
+        out.v0.append(vals[k])
+        out.v1.append(vals[k + 1])
+
+
+def _parts(left: float, right: float, s: Set) -> list[tuple[Ex, Ex]]:
+    """The linear parts ``A + B t`` of one set on the interval."""
+    if s.is_min:
+        return [(s.w * left, s.w * (right - left)), (s.w * s.a, ex(0.0))]
+    return [(s.w * s.a * left, s.w * s.a * (right - left))]
+
+
+def _sort(g: Gen, vs: list[Var]) -> None:
+    """Sort the variables in place by compare-exchange (an insertion network: few values)."""
+    b = g.b
+    for i in range(1, len(vs)):
+        for k in range(i, 0, -1):
+            lo, hi = vs[k - 1], vs[k]
+            with b.if_(hi.lt(lo)):
+                tmp = g.let(lo, "SW")
+                b.set(lo, hi)
+                b.set(hi, tmp)
+
+
+def _value_at(g: Gen, lines: list[Line], kinks: list[Var | None], t: Ex, accu: str) -> Var:
+    """The accumulated degree at ``t`` (exactly ``w*a`` at a set's own kink)."""
+    b = g.b
+    acc: Var | None = None
+    for (left, right, s), kink in zip(lines, kinks, strict=True):
+        y = left + (right - left) * t
+        if s.is_min:
+            c = g.let(s.w * g.min_(s.a, y, "Y"), "CV")
+            if kink is not None:
+                with b.if_(kink.eq(t)):
+                    b.set(c, s.w * s.a)
+        else:
+            c = g.let(s.w * s.a * y, "CV")
+        acc = c if acc is None else g.let(T.accumulate(g, accu, acc, c), "AV")
+    assert acc is not None
+    return acc
+
+
+# --------------------------------------------------------------------------- methods
+
+
+def area(g: Gen, p: Pieces) -> tuple[list[Var], Var]:
+    """Each piece's area and their sum."""
+    ends = zip(p.x0, p.x1, p.v0, p.v1, strict=True)
+    areas = [g.let(0.5 * (x1 - x0) * (v0 + v1), "PA") for x0, x1, v0, v1 in ends]
+    total = g.let(0.0, "AREA")
+    for a in areas:
+        g.b.set(total, total + a)
+    return areas, total
+
+
+def bisector(g: Gen, p: Pieces, areas: list[Var], total: Var) -> Var:
+    """pwl.bisector: from the left and from the right, the piece where half the area is
+    reached (within COA_TOL of half before a zero gap: the gap's middle)."""
+    b = g.b
+    half = g.let(0.5 * total, "HALF")
+    tol = g.let(COA_TOL * total, "CTOL")
+    ends = []
+    for side in ("left", "right"):
+        order = range(len(areas)) if side == "left" else range(len(areas) - 1, -1, -1)
+        found = g.let(False, "FOUND", "BOOL")
+        cum = g.let(0.0, "CUM")
+        res = g.let(p.x1[-1] if side == "left" else p.x0[0], "END")
+        for k in order:
+            a = areas[k]
+            with b.if_(not_(found)):
+                with b.if_(a.gt(0.0).and_((cum + a).ge(half - tol))):
+                    b.set(found, True)
+                    with b.if_((half - cum).ge(a - tol)):  # the whole piece: its end
+                        b.set(res, p.x1[k] if side == "left" else p.x0[k])
+                    with b.else_():
+                        r = (half - cum) if side == "left" else a - (half - cum)
+                        solve_linear(g, res, p.x0[k], p.x1[k], p.v0[k], p.v1[k], p.x1[k] - p.x0[k], r)
+                with b.else_():
+                    b.set(cum, cum + a)
+        ends.append(res)
+    return g.let(0.5 * (ends[0] + ends[1]), "COA")
+
+
+def maxima(g: Gen, c: Ctx, p: Pieces, method: str, grid: GridPlan) -> Var:
+    """pwl.maxima: the height over the pieces' ends and the grid points, then LM, RM or
+    MoM from the points reaching it, visited in increasing x (grid point j, then the
+    pieces of interval j) so that :func:`~fuzzyctl.codegen.pieces.candidate` sees repeated
+    points next to each other."""
+    b, st = g.b, c.st
+    sup = st["SUP"]
+    for v in [*p.v0, *p.v1, *p.points]:
+        with b.if_(v.gt(sup)):
+            b.set(sup, v)
+    thr = g.let(sup * (1.0 - MAX_TOL), "THR")
+    st["THR"] = thr
+    n_pieces = len(p.x0)
+    for j in range(len(grid.xs)):
+        with b.if_(p.points[j].ge(thr)):
+            candidate(c, ex(grid.xs[j]))
+        start = p.first.get(j)
+        if start is None:
+            continue
+        stop = min([s for s in p.first.values() if s > start], default=n_pieces)
+        for k in range(start, stop):
+            x0, x1, v0, v1 = p.x0[k], p.x1[k], p.v0[k], p.v1[k]
+            with b.if_(v0.ge(thr)):
+                candidate(c, x0)
+            with b.if_(v1.ge(thr)):
+                candidate(c, x1)
+            if method == "MOM":
+                with b.if_(v0.ge(thr).and_(v1.ge(thr)).and_(x1.gt(x0))):
+                    b.set(st["PLEN"], st["PLEN"] + (x1 - x0))
+                    b.set(st["PMOM"], st["PMOM"] + (x1 - x0) * 0.5 * (x0 + x1))
+    value = g.temp(hint="MX")
+    if method == "LM":
+        b.set(value, st["LMX"])
+    elif method == "RM":
+        b.set(value, st["RMX"])
+    else:
+        near = MAX_TOL * (grid.xs[-1] - grid.xs[0])
+        with b.if_(st["PLEN"].gt(near)):
+            b.set(value, st["PMOM"] / st["PLEN"])
+        with b.elif_(st["ICNT"].gt(0)):
+            b.set(value, st["ISUM"] / g.call("TO_REAL", st["ICNT"]))
+        with b.else_():
+            b.set(value, 0.0)
+    return value
+
+
+def maxima_state(g: Gen, low: float, high: float) -> Ctx:
+    """The running state :func:`~fuzzyctl.codegen.pieces.candidate` updates."""
+    st: dict[str, Var] = {}
+    for name in ("SUP", "LMX", "RMX", "PLEN", "PMOM", "ISUM", "LASTX"):
+        st[name] = g.let(0.0, name)
+    st["ICNT"] = g.let(0, "ICNT", "INT")
+    v = {"LOW": g.let(low, "LOW"), "HIGH": g.let(high, "HIGH")}
+    none = st["SUP"]  # the table fields of the context are not read here
+    return Ctx(g, v, {}, st, None, set(), set(), none, none, none, none, none, none, none, none)
+
+
