@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 from fuzzyctl.codegen.pieces import Ctx, candidate, solve_linear
 from fuzzyctl.engine import irterms as T
-from fuzzyctl.engine.ir import Ex, Var, ex, not_
+from fuzzyctl.engine.ir import Ex, Num, Var, ex, not_
 from fuzzyctl.engine.irgen import Gen
 from fuzzyctl.engine.plan import GridPlan
 from fuzzyctl.engine.pwl import COA_TOL, MAX_TOL
@@ -105,6 +105,8 @@ def _interval(g: Gen, x0: float, x1: float, lines: list[Line], accu: str, out: P
             for k in range(i + 1, len(lines)):
                 for ai, bi in parts[i]:
                     for ak, bk in parts[k]:
+                        if _zero(bi) and _zero(bk):  # two flat parts never cross
+                            continue
                         t = g.let(0.0, "CT")
                         num, den = ak - ai, bi - bk
                         with b.if_(den.ne(0.0)):
@@ -128,6 +130,10 @@ def _parts(left: float, right: float, s: Set) -> list[tuple[Ex, Ex]]:
     if s.is_min:
         return [(s.w * left, s.w * (right - left)), (s.w * s.a, ex(0.0))]
     return [(s.w * s.a * left, s.w * s.a * (right - left))]
+
+
+def _zero(e: Ex) -> bool:
+    return isinstance(e, Num) and e.value == 0.0
 
 
 def _sort(g: Gen, vs: list[Var]) -> None:
@@ -213,6 +219,8 @@ def maxima(g: Gen, c: Ctx, p: Pieces, method: str, grid: GridPlan) -> Var:
             b.set(sup, v)
     thr = g.let(sup * (1.0 - MAX_TOL), "THR")
     st["THR"] = thr
+    if method in ("LM", "RM"):
+        return _extreme(g, p, grid, thr, method == "LM")
     n_pieces = len(p.x0)
     for j in range(len(grid.xs)):
         with b.if_(p.points[j].ge(thr)):
@@ -244,6 +252,27 @@ def maxima(g: Gen, c: Ctx, p: Pieces, method: str, grid: GridPlan) -> Var:
             b.set(value, st["ISUM"] / g.call("TO_REAL", st["ICNT"]))
         with b.else_():
             b.set(value, 0.0)
+    return value
+
+
+def _extreme(g: Gen, p: Pieces, grid: GridPlan, thr: Var, leftmost: bool) -> Var:
+    """LM (``leftmost``) or RM: the first point reaching ``thr`` from that side."""
+    b = g.b
+    points: list[tuple[Ex, Ex]] = []  # (x, degree) in increasing x
+    starts = sorted(p.first.items())
+    for j in range(len(grid.xs)):
+        points.append((ex(grid.xs[j]), p.points[j]))
+        for jj, start in starts:
+            if jj == j:
+                stop = min([s for s in p.first.values() if s > start], default=len(p.x0))
+                for k in range(start, stop):
+                    points += [(p.x0[k], p.v0[k]), (p.x1[k], p.v1[k])]
+    if not leftmost:
+        points.reverse()
+    value = g.let(0.0, "MX")
+    for k, (x, v) in enumerate(points):  # an if / else-if chain: the first hit ends it
+        with b.if_(v.ge(thr)) if k == 0 else b.elif_(v.ge(thr)):
+            b.set(value, x)
     return value
 
 
