@@ -9,10 +9,14 @@ two linear parts of two sets cross under MAX) that only their order leaves to ru
 sorting network), the accumulated degree at each, and the pieces between consecutive ones,
 on which the set is linear.  The methods then read the pieces in increasing x:
 
-* CoA: the total area, then from the left and from the right the piece where half of it is
-  reached (:func:`fuzzyctl.engine.pwl.bisector`);
-* LM, RM, MoM: the height over the pieces' ends and the grid points, then the points reaching
-  it (:func:`fuzzyctl.engine.pwl.maxima`).
+* CoA (:func:`bisector_value`): the total area, then from the left and from the right the
+  piece where half of it is reached (:func:`fuzzyctl.engine.pwl.bisector`);
+* LM, RM, MoM (:func:`leftmost`, :func:`rightmost`, :func:`mean_of_maximum`): the height
+  over the pieces' ends and the grid points, then the points reaching it
+  (:func:`fuzzyctl.engine.pwl.maxima`).
+
+Each method's builder is named by its entry in :mod:`fuzzyctl.kinds.methods` (``ir``) and
+takes ``(g, pieces, grid, areas, total)``.
 
 The reference is :mod:`fuzzyctl.engine.pwl`; the numpy twin of the candidate points is
 ``kernels_np._interval``.  Accumulations whose pieces are not linear between those points
@@ -179,7 +183,7 @@ def area(g: Gen, p: Pieces) -> tuple[list[Var], Var]:
     return areas, total
 
 
-def bisector(g: Gen, p: Pieces, areas: list[Var], total: Var) -> Var:
+def bisector_value(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: Var) -> Var:
     """pwl.bisector: from the left and from the right, the piece where half the area is
     reached (within COA_TOL of half before a zero gap: the gap's middle)."""
     b = g.b
@@ -207,20 +211,35 @@ def bisector(g: Gen, p: Pieces, areas: list[Var], total: Var) -> Var:
     return g.let(0.5 * (ends[0] + ends[1]), "COA")
 
 
-def maxima(g: Gen, c: Ctx, p: Pieces, method: str, grid: GridPlan) -> Var:
-    """pwl.maxima: the height over the pieces' ends and the grid points, then LM, RM or
-    MoM from the points reaching it, visited in increasing x (grid point j, then the
-    pieces of interval j) so that :func:`~fuzzyctl.codegen.pieces.candidate` sees repeated
-    points next to each other."""
-    b, st = g.b, c.st
-    sup = st["SUP"]
+def _height(g: Gen, p: Pieces) -> Var:
+    """The level the maximum is reached at: the height over the pieces' ends and the grid
+    points, less MAX_TOL of it (computed crossings: pwl.maxima)."""
+    sup = g.let(0.0, "SUP")
     for v in [*p.v0, *p.v1, *p.points]:
-        with b.if_(v.gt(sup)):
-            b.set(sup, v)
-    thr = g.let(sup * (1.0 - MAX_TOL), "THR")
-    st["THR"] = thr
-    if method in ("LM", "RM"):
-        return _extreme(g, p, grid, thr, method == "LM")
+        with g.b.if_(v.gt(sup)):
+            g.b.set(sup, v)
+    return g.let(sup * (1.0 - MAX_TOL), "THR")
+
+
+def leftmost(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: Var) -> Var:
+    """LM: the first point reaching the height."""
+    return _extreme(g, p, grid, _height(g, p), True)
+
+
+def rightmost(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: Var) -> Var:
+    """RM: the last point reaching the height."""
+    return _extreme(g, p, grid, _height(g, p), False)
+
+
+def mean_of_maximum(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: Var) -> Var:
+    """MoM (pwl.maxima): the centroid of the plateaus at the height, or the mean of the
+    distinct points reaching it, visited in increasing x (grid point j, then the pieces of
+    interval j) so that :func:`~fuzzyctl.codegen.pieces.candidate` sees repeated points
+    next to each other."""
+    b = g.b
+    c = _maxima_state(g, grid.xs[0], grid.xs[-1])
+    st = c.st
+    thr = st["THR"] = _height(g, p)
     n_pieces = len(p.x0)
     for j in range(len(grid.xs)):
         with b.if_(p.points[j].ge(thr)):
@@ -235,23 +254,15 @@ def maxima(g: Gen, c: Ctx, p: Pieces, method: str, grid: GridPlan) -> Var:
                 candidate(c, x0)
             with b.if_(v1.ge(thr)):
                 candidate(c, x1)
-            if method == "MOM":
-                with b.if_(v0.ge(thr).and_(v1.ge(thr)).and_(x1.gt(x0))):
-                    b.set(st["PLEN"], st["PLEN"] + (x1 - x0))
-                    b.set(st["PMOM"], st["PMOM"] + (x1 - x0) * 0.5 * (x0 + x1))
-    value = g.temp(hint="MX")
-    if method == "LM":
-        b.set(value, st["LMX"])
-    elif method == "RM":
-        b.set(value, st["RMX"])
-    else:
-        near = MAX_TOL * (grid.xs[-1] - grid.xs[0])
-        with b.if_(st["PLEN"].gt(near)):
-            b.set(value, st["PMOM"] / st["PLEN"])
-        with b.elif_(st["ICNT"].gt(0)):
-            b.set(value, st["ISUM"] / g.call("TO_REAL", st["ICNT"]))
-        with b.else_():
-            b.set(value, 0.0)
+            with b.if_(v0.ge(thr).and_(v1.ge(thr)).and_(x1.gt(x0))):
+                b.set(st["PLEN"], st["PLEN"] + (x1 - x0))
+                b.set(st["PMOM"], st["PMOM"] + (x1 - x0) * 0.5 * (x0 + x1))
+    value = g.let(0.0, "MX")
+    near = MAX_TOL * (grid.xs[-1] - grid.xs[0])
+    with b.if_(st["PLEN"].gt(near)):
+        b.set(value, st["PMOM"] / st["PLEN"])
+    with b.elif_(st["ICNT"].gt(0)):
+        b.set(value, st["ISUM"] / g.call("TO_REAL", st["ICNT"]))
     return value
 
 
@@ -276,14 +287,12 @@ def _extreme(g: Gen, p: Pieces, grid: GridPlan, thr: Var, leftmost: bool) -> Var
     return value
 
 
-def maxima_state(g: Gen, low: float, high: float) -> Ctx:
+def _maxima_state(g: Gen, low: float, high: float) -> Ctx:
     """The running state :func:`~fuzzyctl.codegen.pieces.candidate` updates."""
     st: dict[str, Var] = {}
-    for name in ("SUP", "LMX", "RMX", "PLEN", "PMOM", "ISUM", "LASTX"):
+    for name in ("LMX", "RMX", "PLEN", "PMOM", "ISUM", "LASTX"):
         st[name] = g.let(0.0, name)
     st["ICNT"] = g.let(0, "ICNT", "INT")
     v = {"LOW": g.let(low, "LOW"), "HIGH": g.let(high, "HIGH")}
-    none = st["SUP"]  # the table fields of the context are not read here
+    none = st["LMX"]  # the table fields of the context are not read here
     return Ctx(g, v, {}, st, None, set(), set(), none, none, none, none, none, none, none, none)
-
-

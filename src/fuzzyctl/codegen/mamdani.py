@@ -31,8 +31,10 @@ from fuzzyctl.codegen.pieces import (
     Ctx,
     accumulate_dynamic,
     candidate,
+    code_test,
     dedupe,
     finish,
+    having,
     interval,
 )
 from fuzzyctl.engine import pwl
@@ -267,7 +269,7 @@ def _each_output(
     from the left and from the right)."""
     g, b, v, st = ctx.g, ctx.g.b, ctx.v, ctx.st
     methods = ctx.methods
-    maxima = bool(methods & {"LM", "RM", "MOM"})
+    maxima = bool(having(methods, lambda m: m.maximum is not None))
     o_ = v["O"]
     ov = Var(g.counter("OO"))
     with b.for_(ov.name, 0, n_out - 1):
@@ -284,16 +286,16 @@ def _each_output(
                 b.set(st[name], ex(init) if typ != "REAL" else float(init))
         n_pass = g.temp("INT", "NPASS")
         b.set(n_pass, 1)
-        with b.if_(v["MC"].eq(METHODS["COA"])):
+        with b.if_(code_test(v["MC"], lambda m: m.bisects)):
             b.set(n_pass, 3)
-        with b.elif_(v["MC"].ge(METHODS["LM"])):
+        with b.elif_(code_test(v["MC"], lambda m: m.maximum is not None)):
             b.set(n_pass, 2)
         ps = Var(g.counter("PASS"))
         with b.for_(ps.name, 1, n_pass):
             ctx.pass_ = ps
             forward = ps.ne(3)
             ctx.forward = forward
-            if "COA" in methods:
+            if having(methods, lambda m: m.bisects):
                 with b.if_(ps.eq(2)):
                     b.set(st["HALF"], 0.5 * v["AREA"])
             if maxima:
@@ -309,7 +311,7 @@ def _each_output(
                 gx = cache["SGX"]
                 gbase = cache["GOFF"][o_]
                 if maxima:
-                    with b.if_(v["MC"].ge(METHODS["LM"])):
+                    with b.if_(code_test(v["MC"], lambda m: m.maximum is not None)):
                         _grid_point(ctx, gx[gbase + j], j, cache, tab["G0"][o_], tab["G1"][o_])
                 with b.if_(j.ge(0).and_(j.le(ng - 2))):
                     _interval_lines(ctx, gx[gbase + j], gx[gbase + j + 1], j, cache, tab)
@@ -406,9 +408,10 @@ _COA_STATE = ("HALF", "CUM", "CUMR", "LEFT", "RIGHT", "FX0", "LX1", "HAVE", "FOU
 
 def _method_state(g: Gen, methods: set[str]) -> dict[str, Var]:
     st: dict[str, Var] = {}
+    coa = bool(having(methods, lambda m: m.bisects))
+    maxima = bool(having(methods, lambda m: m.maximum is not None))
     for name, (typ, _init) in _STATE.items():
-        coa = name in _COA_STATE
-        if (coa and "COA" in methods) or (not coa and methods & {"LM", "RM", "MOM"}):
+        if coa if name in _COA_STATE else maxima:
             st[name] = g.temp(typ, name)
     return st
 

@@ -36,6 +36,7 @@ from fuzzyctl.engine.ir import Ex, Int, Var, ex
 from fuzzyctl.engine.irgen import CodegenError, Gen
 from fuzzyctl.engine.irrules import Contrib, Literals
 from fuzzyctl.engine.plan import GridPlan, OutputPlan, Plan, SelectionPlan
+from fuzzyctl.kinds.methods import METHODS, implementation
 
 
 class NativeBuilder(FastBuilder):
@@ -115,7 +116,7 @@ class NativeBuilder(FastBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         if op.exact:
             return self._exact(op, groups)
-        if op.method != "COG":
+        if not METHODS[op.method].centroid:
             raise self.g.refuse(
                 f"output {op.name}: METHOD : {op.method} of a smooth set",
                 "only the centre of gravity of smooth sets is integrated by the generated code",
@@ -149,10 +150,12 @@ class NativeBuilder(FastBuilder):
         return value[0], fired[0]
 
     def _unrolled(self, op: OutputPlan, grid: GridPlan, groups: list[Group], accu: str) -> tuple[Ex, Ex]:
-        """CoA, LM, RM, MoM on the constant grid as straight-line code (:mod:`grid_pieces`)."""
+        """CoA, LM, RM, MoM on the constant grid as straight-line code: the pieces
+        (:mod:`~fuzzyctl.codegen.grid_pieces`), then the method's IR builder (its registry
+        entry's ``ir``)."""
         g = self.g
         sets = [GP.Set(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups]
-        maxima = op.method in ("LM", "RM", "MOM")
+        maxima = METHODS[op.method].maximum is not None
         p = GP.pieces(g, grid, sets, accu, maxima)
         fired = g.let(ex(False), "FIRED", "BOOL")
         value = g.let(0.0, "Y")
@@ -161,12 +164,7 @@ class NativeBuilder(FastBuilder):
         areas, total = GP.area(g, p)
         g.b.set(fired, total.gt(0.0))
         with g.b.if_(fired):
-            if maxima:
-                assert op.low is not None and op.high is not None
-                res = GP.maxima(g, GP.maxima_state(g, op.low, op.high), p, op.method, grid)
-            else:
-                res = GP.bisector(g, p, areas, total)
-            g.b.set(value, res)
+            g.b.set(value, implementation(METHODS[op.method].ir)(g, p, grid, areas, total))
         return value, fired
 
     def am_lines(

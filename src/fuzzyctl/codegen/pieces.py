@@ -4,14 +4,47 @@ pwl.piece_area_moment, pwl.bisector/_solve_in_piece and pwl.maxima as run-time l
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from fuzzyctl.codegen import terms as T
 from fuzzyctl.codegen.context import Gen
 from fuzzyctl.codegen.ir import Ex, Index, Var, ex, not_
 from fuzzyctl.engine.pwl import COA_TOL, MAX_TOL
+from fuzzyctl.kinds import methods as kinds
 
-METHODS = {"COG": 1, "COA": 2, "LM": 3, "RM": 4, "MOM": 5}
+#: The run-time code of each method on sets, in registry order (1 CoG, 2 CoA, 3 LM, 4 RM,
+#: 5 MoM): the PLC block reads an output's method from a table of these.
+METHODS = {code: k + 1 for k, code in enumerate(c for c, m in kinds.METHODS.items() if m.on_sets)}
+
+
+def having(methods: set[str], predicate: Callable[[kinds.Method], bool]) -> list[str]:
+    """The methods of ``methods`` whose registry entry satisfies ``predicate``, by code."""
+    return sorted((m for m in methods if predicate(kinds.METHODS[m])), key=METHODS.__getitem__)
+
+
+def code_test(mc: Ex, predicate: Callable[[kinds.Method], bool]) -> Ex:
+    """``mc`` (a run-time method code) is one of the methods satisfying ``predicate``: a
+    single comparison when their codes are the last ones, else one per code."""
+    codes = sorted(METHODS[m] for m in METHODS if predicate(kinds.METHODS[m]))
+    if len(codes) > 1 and codes == list(range(codes[0], max(METHODS.values()) + 1)):
+        return mc.ge(codes[0])
+    test = mc.eq(codes[0])
+    for k in codes[1:]:
+        test = test.or_(mc.eq(k))
+    return test
+
+
+def _centroid(m: kinds.Method) -> bool:
+    return m.centroid
+
+
+def _bisects(m: kinds.Method) -> bool:
+    return m.bisects
+
+
+def _maximum(m: kinds.Method) -> bool:
+    return m.maximum is not None
 ACCUS = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
 
 
@@ -269,12 +302,12 @@ def _piece(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
         first = False
         return mgr
 
-    if "COG" in c.methods:
-        with branch(mc.eq(METHODS["COG"])):
+    if having(c.methods, _centroid):
+        with branch(code_test(mc, _centroid)):
             b.set(area, area + pa)
             b.set(mom, mom + pm)
-    if "COA" in c.methods:
-        with branch(mc.eq(METHODS["COA"])):
+    if having(c.methods, _bisects):
+        with branch(code_test(mc, _bisects)):
             with b.if_(ps.eq(1)):
                 b.set(area, area + pa)
                 with b.if_(xb.gt(xa)):
@@ -318,8 +351,8 @@ def _piece(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
                         b.set(st["CUM"], cum + pa)
                     with b.else_():
                         b.set(st["CUMR"], cum + pa)
-    if c.methods & {"LM", "RM", "MOM"}:
-        with branch(mc.ge(METHODS["LM"])):
+    if having(c.methods, _maximum):
+        with branch(code_test(mc, _maximum)):
             with b.if_(ps.eq(1)):
                 b.set(area, area + pa)
                 with b.if_(v0.gt(st["SUP"])):
@@ -422,28 +455,28 @@ def finish(c: Ctx, value: Index, fired: Index) -> None:
         return mgr
 
     mc = v["MC"]
-    if "COG" in c.methods:
-        with branch(mc.eq(METHODS["COG"]).and_(v["AREA"].gt(0.0))):
+    if having(c.methods, _centroid):
+        with branch(code_test(mc, _centroid).and_(v["AREA"].gt(0.0))):
             b.set(value, v["MOM"] / v["AREA"])
-    if "COA" in c.methods:
-        with branch(mc.eq(METHODS["COA"])):
+    if having(c.methods, _bisects):
+        with branch(code_test(mc, _bisects)):
             with b.if_(not_(st["FOUNDL"])):
                 b.set(st["LEFT"], st["LX1"])
             with b.if_(not_(st["FOUNDR"])):
                 b.set(st["RIGHT"], st["FX0"])
             b.set(value, 0.5 * (st["LEFT"] + st["RIGHT"]))
-    if "LM" in c.methods:
-        with branch(mc.eq(METHODS["LM"])):
-            b.set(value, st["LMX"])
-    if "RM" in c.methods:
-        with branch(mc.eq(METHODS["RM"])):
-            b.set(value, st["RMX"])
-    if "MOM" in c.methods:
-        with branch(mc.eq(METHODS["MOM"])):
-            with b.if_(st["PLEN"].gt(MAX_TOL * (v["HIGH"] - v["LOW"]))):  # pwl.maxima
-                b.set(value, st["PMOM"] / st["PLEN"])
-            with b.elif_(st["ICNT"].gt(0)):
-                b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))
+    for code in having(c.methods, _maximum):
+        with branch(mc.eq(METHODS[code])):
+            side = kinds.METHODS[code].maximum
+            if side == "left":
+                b.set(value, st["LMX"])
+            elif side == "right":
+                b.set(value, st["RMX"])
+            else:
+                with b.if_(st["PLEN"].gt(MAX_TOL * (v["HIGH"] - v["LOW"]))):  # pwl.maxima
+                    b.set(value, st["PMOM"] / st["PLEN"])
+                with b.elif_(st["ICNT"].gt(0)):
+                    b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))
 
 
 # --------------------------------------------------------------------------- constant geometry

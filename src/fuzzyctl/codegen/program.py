@@ -30,6 +30,7 @@ from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs, term_poi
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.irrules import Contrib, Params, RuleBuilder, literal
 from fuzzyctl.engine.plan import OutputPlan, Plan, TermPlan
+from fuzzyctl.kinds.methods import METHODS
 
 #: INFO codes (modelled on the Siemens FUZZY block's INFO byte).
 INFO_OK = 0x00
@@ -162,7 +163,7 @@ class _Builder(RuleBuilder):
         check_known_fields(g, self.plan)
         for op in self.plan.outputs:
             if op.kind == "mamdani" and not op.exact:
-                if op.method != "COG":
+                if not METHODS[op.method].centroid:
                     raise g.refuse(
                         f"output {op.name}: METHOD : {op.method} of a smooth set",
                         "only the centre of gravity of smooth sets is integrated by the generated "

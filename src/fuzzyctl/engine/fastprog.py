@@ -64,6 +64,7 @@ from fuzzyctl.engine.plan import (
     Plan,
     SelectionPlan,
 )
+from fuzzyctl.kinds.methods import METHODS
 
 FastTarget = Literal["py", "np", "c"]
 
@@ -204,8 +205,8 @@ class FastBuilder(RuleBuilder):
             value, fired = self.singleton(op, contribs)
         elif op.kind == "ts":
             value, fired = self._ts_output(oi, op, contribs, values)
-        elif op.exact and op.grid is not None and op.method == "COG":
-            value, fired = self._cog(op, op.grid, merge(g, contribs, op.accu or "MAX"))
+        elif op.exact and op.grid is not None and METHODS[op.method].centroid:
+            value, fired = self.closed_cog(op, op.grid, merge(g, contribs, op.accu or "MAX"))
         else:
             value, fired = self._mamdani_kernel(oi, op, contribs)
         default = op.default if op.default is not None else 0.0
@@ -256,7 +257,7 @@ class FastBuilder(RuleBuilder):
         g.b.add(Kernel(kind, (value, fired), tuple(args), layout))
         return value, fired
 
-    def _cog(self, op: OutputPlan, grid: GridPlan, groups: list[Group]) -> tuple[Ex, Ex]:
+    def closed_cog(self, op: OutputPlan, grid: GridPlan, groups: list[Group]) -> tuple[Ex, Ex]:
         """CoG on a constant grid: band polynomials where a term is alone, exact integrals
         of the overlapping sets elsewhere (``batch``/``specialise`` before, one code now)."""
         g = self.g

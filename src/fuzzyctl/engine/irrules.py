@@ -43,6 +43,7 @@ from fuzzyctl.engine.plan import (
     Slot,
     TermPlan,
 )
+from fuzzyctl.kinds.methods import METHODS
 
 #: (term, degree, weight, ACT) of one activated set
 Contrib = tuple[int | None, Ex, Ex, str]
@@ -362,7 +363,7 @@ class RuleBuilder:
         for key in keys:
             b.set(total, total + acc[key])
         b.set(fired, total.gt(0.0))
-        if op.method == "COGS":
+        if METHODS[op.method].weighted is not None:
             num = g.let(0.0, "NUM")
             for key in keys:
                 b.set(num, num + entries[key[0]][key[1]][0] * acc[key])
@@ -442,7 +443,7 @@ class RuleBuilder:
         fired = g.let(den.gt(0.0), "FIRED", "BOOL")
         value = g.temp(hint="Y")
         with b.if_(fired):
-            b.set(value, num / den if op.method == "WTAVER" else num)
+            b.set(value, num / den if METHODS[op.method].weighted == "average" else num)
         with b.else_():
             b.set(value, 0.0)
         return value, fired

@@ -31,6 +31,7 @@ from fuzzyctl.engine import quadrature, shapes
 from fuzzyctl.engine.expr import eval_expr_np
 from fuzzyctl.engine.operators import ACT_LEVELS, TNORMS, accumulate_np
 from fuzzyctl.engine.plan import OutputPlan, Plan
+from fuzzyctl.kinds.methods import METHODS
 
 Arr = Any
 
@@ -44,7 +45,7 @@ def smooth_output(
     n: int,
 ) -> tuple[Arr, Arr]:
     """(value, fired) of output ``op`` for ``n`` rows from its activated sets."""
-    if op.method != "COG" or not all(t.constant for t in op.terms) or n == 0:
+    if not METHODS[op.method].centroid or not all(t.constant for t in op.terms) or n == 0:
         return _rows(plan, op, contribs, vals, outs, n)
     assert op.low is not None and op.high is not None
     cs = [(t, np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)), w, act) for t, a, w, act in contribs]

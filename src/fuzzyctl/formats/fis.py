@@ -30,6 +30,7 @@ from fuzzyctl.formats._common import Reporter, parse_count, parse_number
 from fuzzyctl.formats._expr import ExprError, names_in, parse_expr
 from fuzzyctl.formats._terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.formats.fis_rules import TS_KINDS, is_ts_term, numbers, rules
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -76,18 +77,9 @@ AGG_METHODS = {
     "hamacher_sum": "HAMACHER",
     "nilpotent_maximum": "NIPMAX",
 }
-DEFUZZ_METHODS = {
-    "centroid": "COG",
-    "bisector": "COA",
-    "mom": "MOM",
-    "som": "LM",
-    "lom": "RM",
-    "wtaver": "WTAVER",
-    "wtsum": "WTSUM",
-    # A user-defined function of the Octave toolkit's demos: the centroid by integration,
-    # which is what our COG computes exactly.
-    "centroid_integral": "COG",
-}
+#: MATLAB's defuzzMethod names (kinds/methods.py; ``centroid_integral``, a user-defined
+#: function of the Octave toolkit's demos, is the centroid by integration: our exact COG)
+DEFUZZ_METHODS = methods.spelled("fis")
 
 
 @dataclass

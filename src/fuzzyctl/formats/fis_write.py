@@ -30,8 +30,9 @@ from fuzzyctl.formats._lower import (
     with_range,
 )
 from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
-from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
+from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, OR_METHODS
 from fuzzyctl.formats.fis_rules import FUZZYLITE_HEDGE_CODES
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
@@ -59,7 +60,7 @@ _AND = {v: k for k, v in AND_METHODS.items()}
 _OR = {v: k for k, v in OR_METHODS.items()}
 _AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
 _AGG["ASUM"] = "probor"
-_DEFUZZ = {v: k for k, v in DEFUZZ_METHODS.items() if k != "centroid_integral"}
+_DEFUZZ = methods.written("fis")
 _DEFUZZ["COGS"] = "wtaver"
 DIALECT_COMMENT = (
     "% FIS written by fuzzyctl in the fuzzylite dialect "

@@ -32,6 +32,7 @@ from fuzzyctl.formats._expr import ExprError, parse_function
 from fuzzyctl.formats._fll_rules import HEDGE_WORDS as HEDGE_WORDS  # the writer avoids them as names
 from fuzzyctl.formats._fll_rules import Lookup, RuleError, parse_rule
 from fuzzyctl.formats._terms import FLL_TYPES
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -82,15 +83,7 @@ SNORMS_ACCU = {
     "NilpotentMaximum": "NIPMAX",
     "UnboundedSum": "SUM",
 }
-DEFUZZIFIERS = {
-    "Centroid": "COG",
-    "Bisector": "COA",
-    "SmallestOfMaximum": "LM",
-    "LargestOfMaximum": "RM",
-    "MeanOfMaximum": "MOM",
-    "WeightedAverage": "WTAVER",
-    "WeightedSum": "WTSUM",
-}
+DEFUZZIFIERS = methods.spelled("fll")  # kinds/methods.py
 KEYWORDS = frozenset({"if", "then", "and", "or", "is", "with"})
 
 _LINE = re.compile(r"^(?P<indent>\s*)(?P<key>[A-Za-z][A-Za-z-]*)\s*:\s?(?P<value>.*)$")

@@ -20,6 +20,7 @@ from fuzzyctl.formats._lower import (
 )
 from fuzzyctl.formats._terms import FLL_OF_KIND, FLL_TYPES
 from fuzzyctl.formats.fll import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -43,7 +44,7 @@ _ACCU_NAMES = {v: k for k, v in SNORMS_ACCU.items()}
 _DEFUZZ_NAMES = {v: k for k, v in DEFUZZIFIERS.items()}
 _DEFUZZ_NAMES["COGS"] = "WeightedAverage"
 FLL_HEDGES = frozenset(HEDGES)
-INTEGRAL_METHODS = frozenset({"COG", "COA", "LM", "RM", "MOM"})
+INTEGRAL_METHODS = methods.ON_SETS  # fuzzylite integral defuzzifiers (take a resolution)
 RESOLUTION = 1000
 """Integration steps written for fuzzylite's integral defuzzifiers (fuzzyctl itself is
 exact; fuzzylite approximates with this many midpoint samples)."""
