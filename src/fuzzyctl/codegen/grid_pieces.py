@@ -146,10 +146,10 @@ def _sort(g: Gen, vs: list[Var]) -> None:
     for i in range(1, len(vs)):
         for k in range(i, 0, -1):
             lo, hi = vs[k - 1], vs[k]
-            with b.if_(hi.lt(lo)):
-                tmp = g.let(lo, "SW")
-                b.set(lo, hi)
-                b.set(hi, tmp)
+            # min and max as separate selects: the C compiler makes them branch-free
+            small = g.min_(hi, lo, "SL")
+            b.set(hi, g.max_(lo, hi, "SH"))
+            b.set(lo, small)
 
 
 def _value_at(g: Gen, lines: list[Line], kinks: list[Var | None], t: Ex, accu: str) -> Var:
@@ -285,6 +285,70 @@ def _extreme(g: Gen, p: Pieces, grid: GridPlan, thr: Var, leftmost: bool) -> Var
         with b.if_(v.ge(thr)) if k == 0 else b.elif_(v.ge(thr)):
             b.set(value, x)
     return value
+
+
+def first_reaching(g: Gen, grid: GridPlan, sets: list[Set], leftmost: bool) -> Var:
+    """LM (``leftmost``) or RM under MAX accumulation, without building every piece: the
+    height is the largest set's (``w * min(a, peak)`` or ``w * a * peak``, ``peak`` the
+    largest value the term's pieces end at: what :func:`pieces` would find), then the grid
+    points and intervals are visited from that side, each interval's pieces built only
+    while nothing reached the height yet."""
+    b = g.b
+    sup = g.let(0.0, "SUP")
+    for s in sets:
+        peak = _peak(grid, s.term)
+        top = s.w * (g.min_(s.a, peak, "PK") if s.is_min else s.a * peak)
+        with b.if_(top.gt(sup)):
+            b.set(sup, top)
+    thr = g.let(sup * (1.0 - MAX_TOL), "THR")
+    value = g.let(0.0, "MX")
+    found = g.let(False, "FOUND", "BOOL")
+    n = len(grid.xs)
+    steps = [("point", j) if k % 2 == 0 else ("interval", j) for j in range(n) for k in range(2)][:-1]
+    if not leftmost:
+        steps.reverse()
+    for kind, j in steps:
+        with b.if_(not_(found)):
+            if kind == "point":
+                ends: list[tuple[Ex, Ex]] = [(ex(grid.xs[j]), _point(g, grid, sets, j))]
+            else:
+                lines = [
+                    (grid.left[s.term][j], grid.right[s.term][j], s) for s in sets if s.term in grid.active[j]
+                ]
+                if not lines:
+                    continue
+                p = Pieces()
+                _interval(g, grid.xs[j], grid.xs[j + 1], lines, "MAX", p)
+                ends = [e for k in range(len(p.x0)) for e in ((p.x0[k], p.v0[k]), (p.x1[k], p.v1[k]))]
+                if not leftmost:
+                    ends.reverse()
+            for x, v in ends:
+                with b.if_(not_(found).and_(v.ge(thr))):
+                    b.set(value, x)
+                    b.set(found, True)
+    return value
+
+
+def _peak(grid: GridPlan, t: int) -> float:
+    """The largest degree term ``t`` takes at a piece end or grid point, computed as the
+    pieces compute it (``L + (R - L) * 1.0`` at an interval's right end)."""
+    vals = [*grid.point[t], 0.0]
+    for j in range(len(grid.xs) - 1):
+        if t in grid.active[j]:
+            left, right = grid.left[t][j], grid.right[t][j]
+            vals += [left, left + (right - left) * 1.0]
+    return max(vals)
+
+
+def _point(g: Gen, grid: GridPlan, sets: list[Set], j: int) -> Var:
+    """The accumulated degree (MAX) exactly at grid point ``j`` (pwl.point_values)."""
+    v = g.let(0.0, "GP")
+    for s in sets:
+        y = grid.point[s.term][j]
+        if y != 0.0:
+            c = s.w * (g.min_(s.a, y, "PY") if s.is_min else s.a * y)
+            g.b.set(v, T.accumulate(g, "MAX", v, c))
+    return v
 
 
 def _maxima_state(g: Gen, low: float, high: float) -> Ctx:

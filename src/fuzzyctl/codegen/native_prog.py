@@ -155,7 +155,16 @@ class NativeBuilder(FastBuilder):
         entry's ``ir``)."""
         g = self.g
         sets = [GP.Set(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups]
-        maxima = METHODS[op.method].maximum is not None
+        entry = METHODS[op.method]
+        if accu == "MAX" and entry.maximum in ("left", "right"):
+            # fired is the closed form's (area > 0); the first point reaching the height
+            # from that side ends the scan (grid_pieces.first_reaching)
+            _cog, fired = self.closed_cog(op, grid, groups)
+            value = g.let(0.0, "Y")
+            with g.b.if_(fired):
+                g.b.set(value, GP.first_reaching(g, grid, sets, entry.maximum == "left"))
+            return value, fired
+        maxima = entry.maximum is not None
         p = GP.pieces(g, grid, sets, accu, maxima)
         fired = g.let(ex(False), "FIRED", "BOOL")
         value = g.let(0.0, "Y")
