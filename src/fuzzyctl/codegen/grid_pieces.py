@@ -249,14 +249,25 @@ def mean_of_maximum(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: 
             continue
         stop = min([s for s in p.first.values() if s > start], default=n_pieces)
         for k in range(start, stop):
-            x0, x1, v0, v1 = p.x0[k], p.x1[k], p.v0[k], p.v1[k]
-            with b.if_(v0.ge(thr)):
-                candidate(c, x0)
-            with b.if_(v1.ge(thr)):
-                candidate(c, x1)
-            with b.if_(v0.ge(thr).and_(v1.ge(thr)).and_(x1.gt(x0))):
-                b.set(st["PLEN"], st["PLEN"] + (x1 - x0))
-                b.set(st["PMOM"], st["PMOM"] + (x1 - x0) * 0.5 * (x0 + x1))
+            _visit(c, thr, p.x0[k], p.x1[k], p.v0[k], p.v1[k])
+    return _mean(g, c, grid)
+
+
+def _visit(c: Ctx, thr: Var, x0: Ex, x1: Ex, v0: Ex, v1: Ex) -> None:
+    """One piece for MoM: its ends reaching the height, its length when it is a plateau."""
+    b, st = c.g.b, c.st
+    with b.if_(v0.ge(thr)):
+        candidate(c, x0)
+    with b.if_(v1.ge(thr)):
+        candidate(c, x1)
+    with b.if_(v0.ge(thr).and_(v1.ge(thr)).and_(x1.gt(x0))):
+        b.set(st["PLEN"], st["PLEN"] + (x1 - x0))
+        b.set(st["PMOM"], st["PMOM"] + (x1 - x0) * 0.5 * (x0 + x1))
+
+
+def _mean(g: Gen, c: Ctx, grid: GridPlan) -> Var:
+    """MoM from what :func:`_visit` gathered (pwl.maxima)."""
+    b, st = g.b, c.st
     value = g.let(0.0, "MX")
     near = MAX_TOL * (grid.xs[-1] - grid.xs[0])
     with b.if_(st["PLEN"].gt(near)):
@@ -294,13 +305,7 @@ def first_reaching(g: Gen, grid: GridPlan, sets: list[Set], leftmost: bool) -> V
     points and intervals are visited from that side, each interval's pieces built only
     while nothing reached the height yet."""
     b = g.b
-    sup = g.let(0.0, "SUP")
-    for s in sets:
-        peak = _peak(grid, s.term)
-        top = s.w * (g.min_(s.a, peak, "PK") if s.is_min else s.a * peak)
-        with b.if_(top.gt(sup)):
-            b.set(sup, top)
-    thr = g.let(sup * (1.0 - MAX_TOL), "THR")
+    thr = _max_height(g, grid, sets)
     value = g.let(0.0, "MX")
     found = g.let(False, "FOUND", "BOOL")
     n = len(grid.xs)
@@ -327,6 +332,49 @@ def first_reaching(g: Gen, grid: GridPlan, sets: list[Set], leftmost: bool) -> V
                     b.set(value, x)
                     b.set(found, True)
     return value
+
+
+def mean_reaching(g: Gen, grid: GridPlan, sets: list[Set]) -> Var:
+    """MoM under MAX accumulation: the height from each set's peak (as
+    :func:`first_reaching`), then only the intervals where some set can reach it are cut
+    into pieces (a set stays below ``w * min(a, max(L, R))`` on an interval)."""
+    b = g.b
+    thr = _max_height(g, grid, sets)
+    c = _maxima_state(g, grid.xs[0], grid.xs[-1])
+    c.st["THR"] = thr
+    for j in range(len(grid.xs)):
+        with b.if_(_point(g, grid, sets, j).ge(thr)):
+            candidate(c, ex(grid.xs[j]))
+        if j == len(grid.xs) - 1:
+            break
+        lines = [(grid.left[s.term][j], grid.right[s.term][j], s) for s in sets if s.term in grid.active[j]]
+        if not lines:
+            continue
+        reach: Ex | None = None
+        for left, right, s in lines:
+            top = max(left, left + (right - left) * 1.0)
+            r = (s.w * (g.min_(s.a, top, "PK") if s.is_min else s.a * top)).ge(thr)
+            reach = r if reach is None else reach.or_(r)
+        assert reach is not None
+        with b.if_(reach):
+            p = Pieces()
+            _interval(g, grid.xs[j], grid.xs[j + 1], lines, "MAX", p)
+            for k in range(len(p.x0)):
+                _visit(c, thr, p.x0[k], p.x1[k], p.v0[k], p.v1[k])
+    return _mean(g, c, grid)
+
+
+def _max_height(g: Gen, grid: GridPlan, sets: list[Set]) -> Var:
+    """The level of the maximum under MAX accumulation: the largest set's height (its term's
+    peak, clipped or scaled), less MAX_TOL of it."""
+    b = g.b
+    sup = g.let(0.0, "SUP")
+    for s in sets:
+        peak = _peak(grid, s.term)
+        top = s.w * (g.min_(s.a, peak, "PK") if s.is_min else s.a * peak)
+        with b.if_(top.gt(sup)):
+            b.set(sup, top)
+    return g.let(sup * (1.0 - MAX_TOL), "THR")
 
 
 def _peak(grid: GridPlan, t: int) -> float:

@@ -156,13 +156,16 @@ class NativeBuilder(FastBuilder):
         g = self.g
         sets = [GP.Set(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups]
         entry = METHODS[op.method]
-        if accu == "MAX" and entry.maximum in ("left", "right"):
-            # fired is the closed form's (area > 0); the first point reaching the height
-            # from that side ends the scan (grid_pieces.first_reaching)
+        if accu == "MAX" and entry.maximum is not None:
+            # the height from each set's peak and fired from the closed-form area: LM and RM
+            # stop at the first point reaching it, MoM cuts only the intervals that can
             _cog, fired = self.closed_cog(op, grid, groups)
             value = g.let(0.0, "Y")
             with g.b.if_(fired):
-                g.b.set(value, GP.first_reaching(g, grid, sets, entry.maximum == "left"))
+                if entry.maximum == "mean":
+                    g.b.set(value, GP.mean_reaching(g, grid, sets))
+                else:
+                    g.b.set(value, GP.first_reaching(g, grid, sets, entry.maximum == "left"))
             return value, fired
         maxima = entry.maximum is not None
         p = GP.pieces(g, grid, sets, accu, maxima)
