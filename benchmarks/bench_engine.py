@@ -25,8 +25,10 @@ independently by benchmarks/systems.py (tipper and grid49 are ../shared/bench/pe
    ``fuzzyctl --help`` and fuzzylite's C++ command line.
 5. Peak resident memory of a 10,000,000-row batch (grid49), native and numpy.
 6. Per defuzzification method (CoG, CoA, LM, RM, MoM, CoGS, COGF, Takagi-Sugeno) on one
-   2-input, 4-rule base: the batch cost per row on one core, native and numpy, the native
-   batch as a multiple of CoG's, and the native single evaluation (``--only methods``).
+   2-input, 4-rule base: the batch cost per row on one core, native and numpy, the numpy
+   path with its hand-written kernels replaced by the native builder's IR printed as numpy
+   ("np IR": the row that keeps engine/kernels_np.py where it is faster), the native batch
+   as a multiple of CoG's, and the native single evaluation (``--only methods``).
 
 The machine's load average is printed at the start and the end: speed ratios measured in the
 same run are what counts on a shared machine.
@@ -497,6 +499,23 @@ def _cpu_batch(ctl: Any, cols: dict[str, np.ndarray], repeats: int) -> float:
     return best / n
 
 
+def _numpy_ir(ctl: Any, cols: dict[str, np.ndarray], repeats: int) -> float:
+    """CPU time per row of the native builder's output IR printed as numpy (what replacing
+    the hand-written kernels of engine/kernels_np.py with rendered IR would cost)."""
+    from fuzzyctl.codegen.native_prog import NativeBuilder
+    from fuzzyctl.engine.render_np import vectorise
+
+    fn = vectorise(NativeBuilder(ctl.plan, "np").build())
+    columns = [cols[name] for name in ctl.inputs]
+    n = len(columns[0])
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.process_time()
+        fn(columns, [0.0] * len(ctl.plan.outputs), n)
+        best = min(best, time.process_time() - t0)
+    return best / n
+
+
 def section_methods(args: argparse.Namespace, work: Path, results: dict[str, Any]) -> None:
     """6. Per method on one 2-input, 4-rule base: batch cost (ns/row, one core) native and
     numpy, and single evaluation (us) native; the native batch as a multiple of CoG's."""
@@ -506,7 +525,7 @@ def section_methods(args: argparse.Namespace, work: Path, results: dict[str, Any
     cols = {"a": rng.uniform(0, 10, n), "b": rng.uniform(0, 10, n)}
     rows = np.column_stack([cols["a"], cols["b"]])
     print("\n6. methods: one 2-input, 4-rule base per method; batch ns/row (one core), single us")
-    print(f"{'method':8s} {'native':>8s} {'numpy':>8s} {'x CoG':>6s} {'single':>8s}")
+    print(f"{'method':8s} {'native':>8s} {'numpy':>8s} {'np IR':>8s} {'x CoG':>6s} {'single':>8s}")
     out: dict[str, Any] = {}
     for label, method, terms, act in METHOD_ROWS:
         doc = fuzzyctl.load(METHODS_FCL.format(terms=terms, method=method, act=act))
@@ -514,12 +533,14 @@ def section_methods(args: argparse.Namespace, work: Path, results: dict[str, Any
         npy = fuzzyctl.compile(doc, backend="python")
         native_ns = _cpu_batch(nat, cols, repeats) * 1e9
         numpy_ns = _cpu_batch(npy, cols, repeats) * 1e9
+        ir_ns = _numpy_ir(npy, cols, repeats) * 1e9
 
         def single(r: np.ndarray, ctl: Any = nat) -> float:
             return float(ctl.evaluate({"a": float(r[0]), "b": float(r[1])})["y"])
 
         single_us = latency(single, rows, 0.3 if args.quick else 1.0) * 1e6
         out[label] = {
+            "numpy_ir_ns": ir_ns,
             "native_ns": native_ns,
             "numpy_ns": numpy_ns,
             "single_us": single_us,
@@ -527,7 +548,7 @@ def section_methods(args: argparse.Namespace, work: Path, results: dict[str, Any
         }
         ratio = native_ns / out["COG"]["native_ns"]
         print(
-            f"{label:8s} {native_ns:8.0f} {numpy_ns:8.0f} {ratio:6.2f} {single_us:8.2f}"
+            f"{label:8s} {native_ns:8.0f} {numpy_ns:8.0f} {ir_ns:8.0f} {ratio:6.2f} {single_us:8.2f}"
             + ("" if type(nat).__name__ == "NativeController" else "  (not native)")
         )
     results["methods"] = out

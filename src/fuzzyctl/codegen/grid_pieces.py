@@ -9,14 +9,17 @@ two linear parts of two sets cross under MAX) that only their order leaves to ru
 sorting network), the accumulated degree at each, and the pieces between consecutive ones,
 on which the set is linear.  The methods then read the pieces in increasing x:
 
-* CoA (:func:`bisector_value`): the total area, then from the left and from the right the
-  piece where half of it is reached (:func:`fuzzyctl.engine.pwl.bisector`);
+* CoA (:func:`bisector_by_intervals`): each interval's area in closed form, then from the
+  left and from the right the piece where half of it is reached, only the interval holding
+  it cut into pieces (:func:`fuzzyctl.engine.pwl.bisector`);
 * LM, RM, MoM (:func:`leftmost`, :func:`rightmost`, :func:`mean_of_maximum`): the height
   over the pieces' ends and the grid points, then the points reaching it
   (:func:`fuzzyctl.engine.pwl.maxima`).
 
-Each method's builder is named by its entry in :mod:`fuzzyctl.kinds.methods` (``ir``) and
-takes ``(g, pieces, grid, areas, total)``.
+Each method's builder is named by its entry in :mod:`fuzzyctl.kinds.methods` (``ir``).
+Under MAX accumulation the maxima need not cut every interval: the height is the largest
+set's (:func:`first_reaching` for LM and RM, :func:`mean_reaching` for MoM); under a sum
+:func:`leftmost`, :func:`rightmost` and :func:`mean_of_maximum` read every piece.
 
 The reference is :mod:`fuzzyctl.engine.pwl`; the numpy twin of the candidate points is
 ``kernels_np._interval``.  Accumulations whose pieces are not linear between those points
@@ -27,7 +30,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from fuzzyctl.codegen.pieces import Ctx, candidate, solve_linear
+from fuzzyctl.codegen.pieces import Ctx, candidate, clipped_am, max_of_two, solve_linear
 from fuzzyctl.engine import irterms as T
 from fuzzyctl.engine.ir import Ex, Num, Var, ex, not_
 from fuzzyctl.engine.irgen import Gen
@@ -183,32 +186,90 @@ def area(g: Gen, p: Pieces) -> tuple[list[Var], Var]:
     return areas, total
 
 
-def bisector_value(g: Gen, p: Pieces, grid: GridPlan, areas: list[Var], total: Var) -> Var:
-    """pwl.bisector: from the left and from the right, the piece where half the area is
-    reached (within COA_TOL of half before a zero gap: the gap's middle)."""
+def bisector_by_intervals(g: Gen, grid: GridPlan, sets: list[Set], accu: str) -> tuple[Var, Var]:
+    """CoA without cutting every interval: each interval's area in closed form (one set:
+    :func:`~fuzzyctl.codegen.pieces.clipped_am`; two under MAX:
+    :func:`~fuzzyctl.codegen.pieces.max_of_two`; under a sum, the sets' areas added), then
+    from each side the intervals are passed by their areas and only the one where half the
+    area is reached is cut into pieces (pwl.bisector on its pieces, the areas before it as
+    the running sum; when rounding put the half just past its pieces, the next interval is
+    tried).  Returns (value, fired)."""
     b = g.b
-    half = g.let(0.5 * total, "HALF")
-    tol = g.let(COA_TOL * total, "CTOL")
-    ends = []
-    for side in ("left", "right"):
-        order = range(len(areas)) if side == "left" else range(len(areas) - 1, -1, -1)
-        found = g.let(False, "FOUND", "BOOL")
-        cum = g.let(0.0, "CUM")
-        res = g.let(p.x1[-1] if side == "left" else p.x0[0], "END")
-        for k in order:
-            a = areas[k]
-            with b.if_(not_(found)):
-                with b.if_(a.gt(0.0).and_((cum + a).ge(half - tol))):
-                    b.set(found, True)
-                    with b.if_((half - cum).ge(a - tol)):  # the whole piece: its end
-                        b.set(res, p.x1[k] if side == "left" else p.x0[k])
-                    with b.else_():
-                        r = (half - cum) if side == "left" else a - (half - cum)
-                        solve_linear(g, res, p.x0[k], p.x1[k], p.v0[k], p.v1[k], p.x1[k] - p.x0[k], r)
-                with b.else_():
+    spans: list[tuple[int, list[Line], Var]] = []
+    for j in range(len(grid.xs) - 1):
+        lines = [(grid.left[s.term][j], grid.right[s.term][j], s) for s in sets if s.term in grid.active[j]]
+        if lines:
+            spans.append((j, lines, _interval_area(g, grid.xs[j], grid.xs[j + 1], lines, accu)))
+    total = g.let(0.0, "AREA")
+    for _j, _lines, a in spans:
+        b.set(total, total + a)
+    fired = g.let(total.gt(0.0), "FIRED", "BOOL")
+    value = g.let(0.0, "COA")
+    if not spans:
+        return value, fired
+    with b.if_(fired):
+        half = g.let(0.5 * total, "HALF")
+        tol = g.let(COA_TOL * total, "CTOL")
+        ends = []
+        for left_side in (True, False):
+            found = g.let(False, "FOUND", "BOOL")
+            cum = g.let(0.0, "CUM")
+            last = spans[-1] if left_side else spans[0]
+            res = g.let(grid.xs[last[0] + 1] if left_side else grid.xs[last[0]], "END")
+            for j, lines, a in spans if left_side else spans[::-1]:
+                with b.if_(not_(found).and_(a.gt(0.0)).and_((cum + a).ge(half - tol))):
+                    p = Pieces()
+                    _interval(g, grid.xs[j], grid.xs[j + 1], lines, accu, p)
+                    areas = [g.let(0.5 * (x1 - x0) * (v0 + v1), "PA") for x0, x1, v0, v1 in _ends(p)]
+                    order = range(len(areas)) if left_side else range(len(areas) - 1, -1, -1)
+                    for k in order:
+                        _bisect_piece(g, p, k, areas[k], left_side, half, tol, cum, found, res)
+                with b.if_(not_(found)):
                     b.set(cum, cum + a)
-        ends.append(res)
-    return g.let(0.5 * (ends[0] + ends[1]), "COA")
+            ends.append(res)
+        b.set(value, 0.5 * (ends[0] + ends[1]))
+    return value, fired
+
+
+def _ends(p: Pieces) -> list[tuple[Ex, Ex, Ex, Ex]]:
+    return list(zip(p.x0, p.x1, p.v0, p.v1, strict=True))
+
+
+def _bisect_piece(
+    g: Gen, p: Pieces, k: int, a: Var, left_side: bool, half: Var, tol: Var, cum: Var, found: Var, res: Var
+) -> None:
+    """One piece of pwl.bisector's scan (``cum``: the area before it from that side)."""
+    b = g.b
+    with b.if_(not_(found)):
+        with b.if_(a.gt(0.0).and_((cum + a).ge(half - tol))):
+            b.set(found, True)
+            with b.if_((half - cum).ge(a - tol)):  # the whole piece: its end
+                b.set(res, p.x1[k] if left_side else p.x0[k])
+            with b.else_():
+                r = (half - cum) if left_side else a - (half - cum)
+                solve_linear(g, res, p.x0[k], p.x1[k], p.v0[k], p.v1[k], p.x1[k] - p.x0[k], r)
+        with b.else_():
+            b.set(cum, cum + a)
+
+
+def _interval_area(g: Gen, x0: float, x1: float, lines: list[Line], accu: str) -> Var:
+    """The area of the accumulated sets on one interval, in closed form where it has one."""
+    as_static = [(left, right, s.a, s.w, s.is_min) for left, right, s in lines]
+    if len(lines) == 1 or accu in ("SUM", "NSUM"):
+        total = g.let(0.0, "IA")
+        for line in as_static:
+            with g.b.if_((line[2] * line[3]).gt(0.0)):
+                a, _m = clipped_am(g, x0, x1 - x0, line)
+                g.b.set(total, total + a)
+        return total
+    if len(lines) == 2 and accu == "MAX":
+        return max_of_two(g, x0, x1, as_static[0], as_static[1])[0]
+    p = Pieces()
+    _interval(g, x0, x1, lines, accu, p)
+    total = g.let(0.0, "IA")
+    for x0_, x1_, v0, v1 in _ends(p):
+        g.b.set(total, total + 0.5 * (x1_ - x0_) * (v0 + v1))
+    return total
 
 
 def _height(g: Gen, p: Pieces) -> Var:

@@ -31,7 +31,7 @@ from fuzzyctl.codegen import quadrature as Q
 from fuzzyctl.codegen.pieces import ACCUS, Ctx, clipped_am, interval, max_of_two
 from fuzzyctl.engine import irterms as T
 from fuzzyctl.engine import shapes
-from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, Group, merge
+from fuzzyctl.engine.fastprog import FastBuilder, FastProgram, FastTarget, Group, merge
 from fuzzyctl.engine.ir import Ex, Int, Var, ex
 from fuzzyctl.engine.irgen import CodegenError, Gen
 from fuzzyctl.engine.irrules import Contrib, Literals
@@ -42,8 +42,10 @@ from fuzzyctl.kinds.methods import METHODS, implementation
 class NativeBuilder(FastBuilder):
     """The evaluator program with every output written in the IR (target ``"c"``)."""
 
-    def __init__(self, plan: Plan) -> None:
-        super().__init__(plan, "c")
+    def __init__(self, plan: Plan, target: FastTarget = "c") -> None:
+        # target "np": the same output IR printed as numpy (benchmarks/bench_engine.py
+        # compares it with the hand-written kernels of engine/kernels_np.py)
+        super().__init__(plan, target)
 
     def member(self, var: int, ti: int, x: Ex, where: str) -> Ex:
         """A term whose points are inputs: its breakpoints sorted at run time, as the PLC
@@ -167,6 +169,8 @@ class NativeBuilder(FastBuilder):
                 else:
                     g.b.set(value, GP.first_reaching(g, grid, sets, entry.maximum == "left"))
             return value, fired
+        if entry.bisects:
+            return GP.bisector_by_intervals(g, grid, sets, accu)
         maxima = entry.maximum is not None
         p = GP.pieces(g, grid, sets, accu, maxima)
         fired = g.let(ex(False), "FIRED", "BOOL")

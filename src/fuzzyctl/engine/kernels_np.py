@@ -11,6 +11,13 @@ by row by the interpreter.
 
 Every kernel takes the number of rows first; its other arguments are arrays of that length or
 numbers (the same for every row).
+
+These are hand-written because printing their IR twins as numpy was measured slower
+(benchmarks/bench_engine.py, section 6, column "np IR": 2-4x on CoG, CoA, LM, RM, MoM): the
+twins are :meth:`fuzzyctl.engine.fastprog.FastBuilder.closed_cog` with
+:func:`fuzzyctl.codegen.pieces.max_of_two` (:func:`centroid`, :func:`_max_of_two`) and
+:mod:`fuzzyctl.codegen.grid_pieces` (:func:`bisector_value`, :func:`maximum_point`), which the
+native backend compiles; each method's entry in :mod:`fuzzyctl.kinds.methods` names both.
 """
 
 from __future__ import annotations
@@ -334,7 +341,7 @@ def _all_pieces(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> 
 
 
 def bisector_value(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
-    """CoA from every piece (IR twin: :func:`fuzzyctl.codegen.grid_pieces.bisector_value`)."""
+    """CoA from every piece (IR twin: :func:`fuzzyctl.codegen.grid_pieces.bisector_by_intervals`)."""
     p = _all_pieces(op, grid, groups, n)
     if p is None:
         return np.full(n, np.nan), np.zeros(n, dtype=bool)
@@ -342,7 +349,8 @@ def bisector_value(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) 
 
 
 def maximum_point(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
-    """LM, RM or MoM from every piece and the grid points (IR twins: ``grid_pieces.leftmost``,
+    """LM, RM or MoM from every piece and the grid points (IR twins:
+    ``grid_pieces.first_reaching`` and ``mean_reaching`` under MAX, else ``leftmost``,
     ``rightmost``, ``mean_of_maximum``)."""
     p = _all_pieces(op, grid, groups, n)
     if p is None:

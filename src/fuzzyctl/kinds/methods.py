@@ -142,7 +142,7 @@ METHODS: dict[str, Method] = {
             integrating=True,
             bisects=True,
             reference=_PWL + ":bisector_value",
-            ir=_GRID + ":bisector_value",
+            ir=_GRID + ":bisector_by_intervals",
             numpy=_NP + ":bisector_value",
         ),
         _entry(
