@@ -524,10 +524,10 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
     # own (MATLAB, and fuzzylite's "aggregation: none").  With both kinds in one file
     # (fuzzylite's hybrid) it is said on the Mamdani outputs alone.
     block_accu: str | None = None
-    if any_mamdani_output and all(d.method not in {"WTAVER", "WTSUM"} for d in defuzzify):
+    if any_mamdani_output and all(d.method not in methods.SUGENO for d in defuzzify):
         block_accu = accu
     elif any_mamdani_output:
-        defuzzify = [d if d.method in {"WTAVER", "WTSUM"} else replace(d, accu=accu) for d in defuzzify]
+        defuzzify = [d if d.method in methods.SUGENO else replace(d, accu=accu) for d in defuzzify]
     declared_rules = count("NumRules")
     rule_list = rules(rules_s.rules, inputs, outputs, rep, dialect) if rules_s is not None else []
     if declared_rules is not None and rules_s is not None and declared_rules != len(rules_s.rules):

@@ -32,7 +32,7 @@ from fuzzyctl.formats._lower import (
 from fuzzyctl.formats._terms import FIS_OF_KIND, FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.formats.fis import AGG_METHODS, AND_METHODS, OR_METHODS
 from fuzzyctl.formats.fis_rules import FUZZYLITE_HEDGE_CODES
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
@@ -60,7 +60,7 @@ _AND = {v: k for k, v in AND_METHODS.items()}
 _OR = {v: k for k, v in OR_METHODS.items()}
 _AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
 _AGG["ASUM"] = "probor"
-_DEFUZZ = methods.written("fis")
+_DEFUZZ = method_kinds.written("fis")
 _DEFUZZ["COGS"] = "wtaver"
 DIALECT_COMMENT = (
     "% FIS written by fuzzyctl in the fuzzylite dialect "
@@ -360,7 +360,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
         losses.append(
             Loss("defuzzification", f"FIS has one DefuzzMethod; the outputs use {', '.join(sorted(methods))}")
         )
-    ts_methods = {("WTSUM" if d.method == "WTSUM" else "WTAVER") for d in fb.defuzzify if is_point_output(d)}
+    ts_methods = {method_kinds.ts_method(d.method) for d in fb.defuzzify if is_point_output(d)}
     if methods and ts_methods - {"WTAVER"}:
         losses.append(
             Loss("defuzzification", "a FIS mixing Mamdani and Sugeno outputs has weighted averages only")

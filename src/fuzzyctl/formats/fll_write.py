@@ -82,7 +82,7 @@ def lower(document: Document) -> tuple[Document, list[Loss]]:
             rules.append(rule)
         blocks.append(replace(block, rules=tuple(rules)))
     for d in fb.defuzzify:
-        if d.method in {"COGS", "WTAVER", "WTSUM"}:
+        if d.method in methods.POINT_OUTPUTS:
             continue  # NSUM adds the degrees of a weighted average, written UnboundedSum
         if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
             losses.append(
@@ -106,7 +106,7 @@ def _replace_block(fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock) -> Fun
 
 def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], blk: object) -> bool:
     if isinstance(term.mf, SingletonMF) and not (
-        isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"}
+        isinstance(blk, DefuzzifyBlock) and blk.method in methods.POINT_OUTPUTS
     ):
         losses.append(
             Loss(
@@ -118,7 +118,7 @@ def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], bl
     if (
         isinstance(term.mf, ShapeMF)
         and term.mf.kind in {"constant", "linear"}
-        and not (isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"})
+        and not (isinstance(blk, DefuzzifyBlock) and blk.method in methods.POINT_OUTPUTS)
     ):
         losses.append(
             Loss(
@@ -226,7 +226,7 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         rng = d.range or var.range
         out.append(f"  range: {fmt_number(rng.low)} {fmt_number(rng.high)}" if rng else "  range: -inf inf")
         out.append(f"  lock-range: {'true' if d.clamp else 'false'}")
-        point = (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
+        point = (d.method or "") in methods.POINT_OUTPUTS
         if point:
             # pyfuzzylite 8 aggregates a weighted average's terms as our engine does (fuzzylite 6
             # ignores the aggregation there and lets every rule count)
@@ -280,7 +280,7 @@ def _has(condition: Condition | None, kind: type) -> bool:
 
 def _is_point(fb: FunctionBlock, variable: str) -> bool:
     d = fb.defuzzify_block(variable)
-    return d is not None and (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
+    return d is not None and (d.method or "") in methods.POINT_OUTPUTS
 
 
 def rule_text(fb: FunctionBlock, rule: object) -> str:

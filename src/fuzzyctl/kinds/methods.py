@@ -282,3 +282,8 @@ ON_SETS = codes(lambda m: m.on_sets)
 WEIGHTED = codes(lambda m: m.weighted is not None)
 #: Takagi-Sugeno methods.
 TAKAGI_SUGENO = codes(lambda m: m.takagi_sugeno)
+#: The methods of point outputs as models hold them (COGS, WTAVER, WTSUM; COGF is read as
+#: jFuzzyLogic's and lowered to WTAVER).
+POINT_OUTPUTS = codes(lambda m: m.weighted is not None and m.lowers_to is None)
+#: The Takagi-Sugeno methods as models hold them (WTAVER, WTSUM).
+SUGENO = codes(lambda m: m.takagi_sugeno and m.lowers_to is None)
