@@ -1,7 +1,7 @@
 """fuzzyctl's speed, measured in ONE run against pyfuzzylite, scikit-fuzzy, simpful, Debian's
 fuzzylite 6 C++ (its ``benchmark`` mode) and a hand-written C loop.
 
-usage: python benchmarks/bench_engine.py [--quick] [--json out.json] [--peers PYTHON]
+usage: python benchmarks/bench_engine.py [--quick] [--json out.json] [--peers PYTHON] [--only SECTIONS]
 
 Peers run in their own virtual environment (``.venv-peers``: they pin numpy<2, the project
 keeps numpy 2) through benchmarks/peer_driver.py; the systems are written for each tool
@@ -24,6 +24,11 @@ independently by benchmarks/systems.py (tipper and grid49 are ../shared/bench/pe
 4. Cold start: median of 10 runs of ``fuzzyctl eval FILE --set ...`` (caches warm), against
    ``fuzzyctl --help`` and fuzzylite's C++ command line.
 5. Peak resident memory of a 10,000,000-row batch (grid49), native and numpy.
+6. Per defuzzification method (CoG, CoA, LM, RM, MoM, CoGS, COGF, Takagi-Sugeno) on one
+   2-input, 4-rule base: the batch cost per row on one core, native and numpy, the numpy
+   path with its hand-written kernels replaced by the native builder's IR printed as numpy
+   ("np IR": the row that keeps ir/kernels/columns.py where it is faster), the native batch
+   as a multiple of CoG's, and the native single evaluation (``--only methods``).
 
 The machine's load average is printed at the start and the end: speed ratios measured in the
 same run are what counts on a shared machine.
@@ -449,6 +454,106 @@ def section_memory(args: argparse.Namespace, work: Path, results: dict[str, Any]
         print(f"  {k}: peak {v['peak_mb']:,.0f} MB (with the inputs in memory: {v['inputs_mb']:,.0f} MB)")
 
 
+# --------------------------------------------------------------------------- methods
+
+METHODS_FCL = """
+FUNCTION_BLOCK methods
+VAR_INPUT a : REAL; b : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY a RANGE := (0 .. 10); TERM lo := (0, 1) (10, 0); TERM hi := (0, 0) (10, 1); END_FUZZIFY
+FUZZIFY b RANGE := (0 .. 10); TERM lo := (0, 1) (10, 0); TERM hi := (0, 0) (10, 1); END_FUZZIFY
+DEFUZZIFY y RANGE := (0 .. 10); {terms} METHOD : {method}; DEFAULT := 0; END_DEFUZZIFY
+RULEBLOCK r AND : MIN; ACT : {act}; ACCU : MAX;
+RULE 1 : IF a IS lo AND b IS lo THEN y IS s;
+RULE 2 : IF a IS hi AND b IS lo THEN y IS m;
+RULE 3 : IF a IS lo AND b IS hi THEN y IS m;
+RULE 4 : IF a IS hi AND b IS hi THEN y IS l;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+_SETS = "TERM s := (0,0) (2,1) (4,0); TERM m := (3,0) (5,1) (7,0); TERM l := (6,0) (8,1) (10,0);"
+_POINTS = "TERM s := 2; TERM m := 5; TERM l := 8;"
+_LINEAR = "TERM s := 2; TERM m := LINEAR 0.25 0.25 2; TERM l := LINEAR 0.5 0.25 1;"
+#: (row label, METHOD, terms, ACT): one rule base, every method (section 6)
+METHOD_ROWS = (
+    ("COG", "COG", _SETS, "MIN"),
+    ("COA", "COA", _SETS, "MIN"),
+    ("LM", "LM", _SETS, "MIN"),
+    ("RM", "RM", _SETS, "MIN"),
+    ("MoM", "MOM", _SETS, "MIN"),
+    ("COGS", "COGS", _POINTS, "MIN"),
+    ("COGF", "COGF", _POINTS, "MIN"),
+    ("TS", "WTAVER", _LINEAR, "PROD"),
+)
+
+
+def _cpu_batch(ctl: Any, cols: dict[str, np.ndarray], repeats: int) -> float:
+    """Best CPU time per row of one batch (below the threading threshold: one core)."""
+    n = len(next(iter(cols.values())))
+    ctl.evaluate_batch({k: v[:10] for k, v in cols.items()})
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.process_time()
+        ctl.evaluate_batch(cols)
+        best = min(best, time.process_time() - t0)
+    return best / n
+
+
+def _numpy_ir(ctl: Any, cols: dict[str, np.ndarray], repeats: int) -> float:
+    """CPU time per row of the native builder's output IR printed as numpy (what replacing
+    the hand-written kernels of ir/kernels/columns.py with rendered IR would cost)."""
+    from fuzzyctl.ir.programs.native import NativeBuilder
+    from fuzzyctl.ir.render.npsrc import vectorise
+
+    fn = vectorise(NativeBuilder(ctl.plan, "np").build())
+    columns = [cols[name] for name in ctl.inputs]
+    n = len(columns[0])
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.process_time()
+        fn(columns, [0.0] * len(ctl.plan.outputs), n)
+        best = min(best, time.process_time() - t0)
+    return best / n
+
+
+def section_methods(args: argparse.Namespace, work: Path, results: dict[str, Any]) -> None:
+    """6. Per method on one 2-input, 4-rule base: batch cost (ns/row, one core) native and
+    numpy, and single evaluation (us) native; the native batch as a multiple of CoG's."""
+    n = 50_000 if args.quick else 100_000
+    repeats = 3 if args.quick else 7
+    rng = np.random.default_rng(5)
+    cols = {"a": rng.uniform(0, 10, n), "b": rng.uniform(0, 10, n)}
+    rows = np.column_stack([cols["a"], cols["b"]])
+    print("\n6. methods: one 2-input, 4-rule base per method; batch ns/row (one core), single us")
+    print(f"{'method':8s} {'native':>8s} {'numpy':>8s} {'np IR':>8s} {'x CoG':>6s} {'single':>8s}")
+    out: dict[str, Any] = {}
+    for label, method, terms, act in METHOD_ROWS:
+        doc = fuzzyctl.load(METHODS_FCL.format(terms=terms, method=method, act=act))
+        nat = fuzzyctl.compile(doc, backend="native")
+        npy = fuzzyctl.compile(doc, backend="python")
+        native_ns = _cpu_batch(nat, cols, repeats) * 1e9
+        numpy_ns = _cpu_batch(npy, cols, repeats) * 1e9
+        ir_ns = _numpy_ir(npy, cols, repeats) * 1e9
+
+        def single(r: np.ndarray, ctl: Any = nat) -> float:
+            return float(ctl.evaluate({"a": float(r[0]), "b": float(r[1])})["y"])
+
+        single_us = latency(single, rows, 0.3 if args.quick else 1.0) * 1e6
+        out[label] = {
+            "numpy_ir_ns": ir_ns,
+            "native_ns": native_ns,
+            "numpy_ns": numpy_ns,
+            "single_us": single_us,
+            "type": type(nat).__name__,
+        }
+        ratio = native_ns / out["COG"]["native_ns"]
+        print(
+            f"{label:8s} {native_ns:8.0f} {numpy_ns:8.0f} {ir_ns:8.0f} {ratio:6.2f} {single_us:8.2f}"
+            + ("" if type(nat).__name__ == "NativeController" else "  (not native)")
+        )
+    results["methods"] = out
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="smaller budgets (rougher numbers)")
@@ -459,7 +564,7 @@ def main() -> None:
         default=str(default_peers) if default_peers.exists() else None,
         help="python of the peers' virtual environment (default: .venv-peers)",
     )
-    ap.add_argument("--only", help="comma-separated sections: peers,handwritten,scaling,cold,memory")
+    ap.add_argument("--only", help="comma-separated sections: peers,handwritten,scaling,cold,memory,methods")
     args = ap.parse_args()
     if args.peers is None:
         print("no .venv-peers: peers skipped (make .venv-peers)", file=sys.stderr)
@@ -476,6 +581,7 @@ def main() -> None:
         "scaling": section_scaling,
         "cold": section_cold_start,
         "memory": section_memory,
+        "methods": section_methods,
     }
     wanted = args.only.split(",") if args.only else list(sections)
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-bench-") as tmp:

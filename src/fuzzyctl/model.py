@@ -26,6 +26,8 @@ from enum import StrEnum
 from functools import cached_property
 from typing import TypeAlias
 
+from fuzzyctl.kinds import methods as method_kinds
+
 # --------------------------------------------------------------------------- comments
 
 PlacedComments: TypeAlias = tuple[tuple[str, str], ...]
@@ -684,7 +686,7 @@ ACT_METHODS = frozenset({"MIN", "PROD", "BDIF", "DMIN", "NIPMIN", "HAMACHER", "E
 # also written ASUM by fuzzylite), and the s-norms fuzzylite exports (ESUM -> EINSTEIN,
 # HSUM -> HAMACHER, DSUM -> DMAX, NMAX -> NIPMAX).  The synonym table is fuzzyctl.fcl.keywords.
 ACCU_METHODS = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR", "DMAX", "NIPMAX", "HAMACHER", "EINSTEIN"})
-DEFUZZ_METHODS = frozenset({"COG", "COGS", "COA", "LM", "RM", "MOM", "COGF", "WTAVER", "WTSUM"})
+DEFUZZ_METHODS = method_kinds.CODES  # one entry per method: fuzzyctl/kinds/methods.py
 
 # Hedges (``x IS very t``, ``then y is very t``): name -> what it does to a degree d.
 # fuzzylite's ``any`` (degree 1 whatever the term) is resolved by the readers, never stored.

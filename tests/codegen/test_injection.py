@@ -29,6 +29,7 @@ from fuzzyctl.codegen import CodegenError, generate_c, generate_st, lower_block
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine.native import NativeController
 from fuzzyctl.ir.programs.evaluator import build_fast
+from fuzzyctl.ir.programs.native import build_native
 from fuzzyctl.ir.programs.plc_block import build_program
 from fuzzyctl.ir.render.c import render_c, render_native
 from fuzzyctl.ir.render.npsrc import render_np
@@ -125,7 +126,7 @@ def _code(doc: Document) -> dict[str, list[str] | None]:
     # the evaluators of compile(): Python (single), numpy (batch), C (native backend)
     out["python"] = render_py(build_fast(plan, "py"))[0].split()
     out["numpy"] = render_np(build_fast(plan, "np"))[0].split()
-    out["native"] = list(H.c_tokens(render_native(build_fast(plan, "c"))))
+    out["native"] = list(H.c_tokens(render_native(build_native(plan))))
     return out
 
 
@@ -191,7 +192,8 @@ def private_cache(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
 def test_evaluator_renderers_refuse_a_name_that_is_not_an_identifier(target: str) -> None:
     """The evaluators of compile() print only the program's own names, each through the
     target's identifier check: a name that got into the program some other way is refused."""
-    fp = build_fast(lower_block(_benign_fcl()), target)  # type: ignore[arg-type]
+    plan = lower_block(_benign_fcl())
+    fp = build_native(plan) if target == "c" else build_fast(plan, target)  # type: ignore[arg-type]
     fp.inputs[0] = H.HOSTILE["c-close"]
     render = {"py": render_py, "np": render_np, "c": render_native}[target]
     with pytest.raises(CodegenError, match="generated name"):

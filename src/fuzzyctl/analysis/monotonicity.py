@@ -27,6 +27,7 @@ from fuzzyctl.analysis.context import Context, FloatArray, term_values
 from fuzzyctl.analysis.table import Row
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.plan import CTerm, TermPlan
+from fuzzyctl.kinds.methods import METHODS
 
 
 @dataclass(frozen=True)
@@ -137,10 +138,11 @@ def proven(ctx: Context, used: list[tuple[Row, int]], d: Declaration) -> bool:
     """The sufficient condition of the module docstring."""
     plan = ctx.plan
     op = next(op for op in plan.outputs if op.name == d.output)
-    if op.kind == "singleton" and op.method != "COGS":
+    if op.kind == "singleton" and METHODS[op.method].weighted is None:
         return False
     if op.kind == "ts" and (
-        op.method != "WTAVER" or any(t.kind not in ("constant", "singleton") for t in op.terms)
+        METHODS[op.method].weighted != "average"
+        or any(t.kind not in ("constant", "singleton") for t in op.terms)
     ):
         return False
     if op.kind not in ("singleton", "ts") or not used:

@@ -2,11 +2,12 @@
 system C compiler into a shared library kept in a cache directory, called through
 :mod:`ctypes`.
 
-* What is compiled: the evaluator program (:mod:`fuzzyctl.ir.programs.evaluator`, printed by
+* What is compiled: the evaluator program (:mod:`fuzzyctl.ir.programs.evaluator`, every output
+  written in the IR by :mod:`fuzzyctl.ir.programs.native`, printed by
   :func:`fuzzyctl.ir.render.c.render_native`: constants inlined, closed forms on the
-  output grid); for a system it does not cover (an output method other than CoG, terms
-  given by inputs) the PLC function block (:mod:`fuzzyctl.ir.programs.plc_block`) behind the same
-  entry points.  Both are tested against the Python core.
+  output grid): the whole evaluation runs in C, nothing is called back.  A system the IR
+  builders cannot express is refused with the reason (a warning when native was asked for).
+  Tested against the reference interpreter.
 * The library exports ``fz_state_size``, ``fz_init``, ``fz_eval`` (one row), ``fz_batch``
   (a loop over columns: one call per batch, no Python per row) and ``fz_get_prev`` /
   ``fz_set_prev`` (the DEFAULT := NC state, shared with ``explain``).
@@ -49,32 +50,6 @@ if TYPE_CHECKING:
 CFLAGS = ("-std=c99", "-O3", "-fPIC", "-shared", "-fvisibility=hidden", "-ffp-contract=off")
 #: Rows per thread below which a batch is not split.
 THREAD_ROWS = 1 << 16
-
-_PLC_WRAPPER = """
-#include "{name}.c"
-#define FZ_API __attribute__((visibility("default")))
-FZ_API size_t fz_state_size(void) {{ return sizeof({name}); }}
-FZ_API void fz_init(void *fb) {{ {name}_init(({name} *)fb); }}
-FZ_API void fz_eval(void *fb, const double *in, double *out)
-{{ {name}_batch(({name} *)fb, 1, in, out); }}
-FZ_API void fz_batch(void *fb, size_t n, const double *const *cols, double *const *outs)
-{{
-    double in[{n_in}] = {{0}}, out[{n_out}];
-    size_t i;
-    int k;
-    for (i = 0; i < n; i++) {{
-        for (k = 0; k < {k_in}; k++) in[k] = cols[k][i];
-        {name}_batch(({name} *)fb, 1, in, out);
-        for (k = 0; k < {k_out}; k++) outs[k][i] = out[k];
-    }}
-    (void)cols;
-    (void)outs;
-}}
-FZ_API void fz_get_prev(const void *fb, double *out)
-{{ size_t i; for (i = 0; i < {n_prev}; i++) out[i] = (double)(({name} *)fb)->{prev}[i]; }}
-FZ_API void fz_set_prev(void *fb, const double *in)
-{{ size_t i; for (i = 0; i < {n_prev}; i++) (({name} *)fb)->{prev}[i] = ({name}_real)in[i]; }}
-"""
 
 _FAST_STATE = """
 FZ_API int fz_is_fast(void) {{ return 1; }}
@@ -119,44 +94,17 @@ def binary_tables() -> bool:
 
 
 def sources(plan: Plan) -> tuple[str, dict[str, str | bytes]]:
-    """(kind, {file name: text or bytes}) of the native library of ``plan``: kind ``"fast"``
-    (the evaluator program, with its large tables as ``.bin`` files where
-    :func:`binary_tables`) or ``"plc"`` (the PLC function block behind the same entry
-    points).  Raises :class:`CodegenError` when neither can express the plan."""
-    from fuzzyctl.ir.programs.evaluator import build_fast
+    """(kind, {file name: text or bytes}) of the native library of ``plan``: kind ``"fast"``,
+    the evaluator program written wholly in the IR (:mod:`fuzzyctl.ir.programs.native`),
+    with its large tables as ``.bin`` files where :func:`binary_tables`.  Raises
+    :class:`CodegenError` saying what the IR builders cannot express."""
+    from fuzzyctl.ir.programs.native import build_native
     from fuzzyctl.ir.render.c import render_native
 
-    try:
-        fp = build_fast(plan, "c")
-        tables: dict[str, bytes] | None = {} if binary_tables() else None
-        text = render_native(fp, tables) + _FAST_STATE.format(n_prev=max(1, len(plan.outputs)))
-        return "fast", {"fz_native.c": text, **(tables or {})}
-    except CodegenError as fast_error:
-        try:
-            return "plc", _plc_sources(plan)
-        except CodegenError:
-            raise fast_error from None
-
-
-def _plc_sources(plan: Plan) -> dict[str, str | bytes]:
-    from fuzzyctl.ir.programs.plc_block import build_program
-    from fuzzyctl.ir.render.c import render_c
-
-    prog = build_program(plan, "c")
-    header, source = render_c(prog)
-    prev = next(d for d in prog.of("state") if d.name.startswith("FZ_PREV"))
-    n_in = len(plan.inputs)
-    n_out = len([o for o in plan.outputs if o.is_output])
-    wrapper = _PLC_WRAPPER.format(
-        name=prog.name,
-        prev=prev.name,
-        n_prev=len(plan.outputs),
-        n_in=max(1, n_in),
-        n_out=max(1, n_out),
-        k_in=n_in,
-        k_out=n_out,
-    )
-    return {f"{prog.name}.h": header, f"{prog.name}.c": source, "fz_native.c": wrapper}
+    fp = build_native(plan)
+    tables: dict[str, bytes] | None = {} if binary_tables() else None
+    text = render_native(fp, tables) + _FAST_STATE.format(n_prev=max(1, len(plan.outputs)))
+    return "fast", {"fz_native.c": text, **(tables or {})}
 
 
 def library_key(plan: Plan, cc: str) -> str:
@@ -255,18 +203,15 @@ class NativeController(Controller):
         self._names = [(plan.outputs[i].name, i) for i in self._out_index]
         self._eval_fn = lib.fz_eval
         self._nc = [oi for oi, op in enumerate(plan.outputs) if op.no_change and op.kind != "degree"]
-        # the PLC block's wrapper returns only the declared outputs, the evaluator all
-        self._plc = not hasattr(lib, "fz_is_fast")
         # slices of a batch can run in parallel when the state is only the previous outputs
         # (the evaluator's) and no output reads another (a NC value is then only copied)
-        self._parallel = not self._plc and not _outputs_read(plan)
+        self._parallel = not _outputs_read(plan)
 
     def result_layout(self) -> tuple[list[tuple[str, int]], int]:
         """Where ``fz_eval`` writes each declared output (its name and index in the result
         array), and how many results it writes: what a caller of the library without this
-        class needs (the CLI's quick path).  The PLC block's wrapper writes only the declared
-        outputs, in order; the evaluator writes every result."""
-        slots = [(n, k if self._plc else i) for k, (n, i) in enumerate(self._names)]
+        class needs (the CLI's quick path).  The evaluator writes every result."""
+        slots = list(self._names)
         return slots, self._n_res
 
     def evaluate(
@@ -283,8 +228,6 @@ class NativeController(Controller):
             buf[i] = v
         self._eval_fn(self._inst_p, buf, self._out1)
         out = self._out1
-        if self._plc:
-            return {n: out[k] for k, (n, _i) in enumerate(self._names)}
         return {n: out[i] for n, i in self._names}
 
     def evaluate_reference(
@@ -307,7 +250,7 @@ class NativeController(Controller):
 
         columns = full
         columns = [np.ascontiguousarray(c, dtype=np.float64) for c in columns]
-        n_cols = len(self._out_index) if self._plc else self._n_res
+        n_cols = self._n_res
         outs = [np.empty(n) for _ in range(n_cols)]
         parts = 1
         if self._parallel and n >= 2 * THREAD_ROWS:
@@ -316,8 +259,6 @@ class NativeController(Controller):
             self._call_batch(self._inst_p, 0, n, columns, outs)
         else:
             self._threaded(n, parts, columns, outs)
-        if self._plc:  # the PLC block's wrapper writes the declared outputs only
-            return {self.plan.outputs[oi].name: outs[k] for k, oi in enumerate(self._out_index)}
         return {o.name: arr for o, arr in zip(self.plan.outputs, outs, strict=True) if o.is_output}
 
     def _call_batch(self, inst: Any, start: int, stop: int, columns: list[Any], outs: list[Any]) -> None:

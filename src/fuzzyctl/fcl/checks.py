@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl.jfl import check_jfuzzylogic
 from fuzzyctl.fcl.reserved import check_reserved_words
+from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     Condition,
@@ -238,7 +239,7 @@ def _check_terms(terms: tuple[Term, ...], variable: str, r: _Reporter) -> None:
 
 def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None:
     method_span = d.item_span("method")
-    if d.method == "COA" and any(is_singleton(t.mf) for t in d.terms):
+    if d.method is not None and METHODS[d.method].bisects and any(is_singleton(t.mf) for t in d.terms):
         r.error(
             f"DEFUZZIFY {d.variable}: CoA cannot be used with singleton terms (Table 1, note 3)",
             method_span,

@@ -12,6 +12,8 @@ from __future__ import annotations
 
 from typing import Final
 
+from fuzzyctl.kinds.methods import METHODS
+
 Synonyms = dict[str, tuple[str, str]]
 
 IEC = "IEC 61131-7"
@@ -69,21 +71,9 @@ ACCU_SYNONYMS: Final[Synonyms] = {
     "HSUM": ("HAMACHER", FL + ": HamacherSum"),
 }
 
+#: the spellings each method's entry lists for FCL, with their notes (kinds/methods.py)
 METHOD_SYNONYMS: Final[Synonyms] = {
-    "COG": ("COG", IEC + " Table 1: centre of gravity"),
-    "COGS": ("COGS", IEC + " Table 1: centre of gravity for singletons (fuzzylite: WeightedAverage)"),
-    "COA": ("COA", IEC + " Table 1: centre of area (bisector)"),
-    "BIS": ("COA", "fuzzylite 4: Bisector"),
-    "LM": ("LM", IEC + " Table 1: left-most maximum (fuzzylite: SmallestOfMaximum)"),
-    "SOM": ("LM", "fuzzylite 4: SmallestOfMaximum"),
-    "RM": ("RM", IEC + " Table 1: right-most maximum (fuzzylite: LargestOfMaximum)"),
-    "LOM": ("RM", "fuzzylite 4: LargestOfMaximum"),
-    "MM": ("MOM", JFL + " / " + FL + ": mean of maximum"),
-    "MOM": ("MOM", "mean of maximum"),
-    "COGF": ("COGF", JFL + ": centre of gravity of FUNCTION terms"),
-    "COGSS": ("WTSUM", FL + ": WeightedSum (Takagi-Sugeno)"),
-    "WTSUM": ("WTSUM", "weighted sum (Takagi-Sugeno)"),
-    "WTAVER": ("WTAVER", "weighted average (MATLAB wtaver)"),
+    spelling: (m.code, note) for m in METHODS.values() for spelling, note in m.notes.items()
 }
 
 # fuzzylite writes NONE for a missing norm; it means "not given".

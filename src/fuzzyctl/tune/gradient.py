@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.shapes import pwl_value_np
+from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 from fuzzyctl.tune import gradient_cog
 
@@ -105,12 +106,12 @@ def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
         if op is None:
             return f"no output {name}"
         if op.kind == "singleton":
-            if op.method != "COGS" or (op.accu or "MAX") not in ("MAX", "SUM", "BSUM"):
+            if METHODS[op.method].weighted is None or (op.accu or "MAX") not in ("MAX", "SUM", "BSUM"):
                 return f"{name}: {op.method} with ACCU {op.accu}"
             if any(t.kind != "singleton" or not t.constant for t in op.terms):
                 return f"{name}: SINGLETONS terms"
         elif op.kind == "ts":
-            if op.method not in ("WTAVER", "WTSUM") or (op.accu or "MAX") not in ("MAX", "SUM"):
+            if not METHODS[op.method].takagi_sugeno or (op.accu or "MAX") not in ("MAX", "SUM"):
                 return f"{name}: {op.method} with ACCU {op.accu}"
             if any(t.kind not in ("constant", "linear", "singleton") or not t.constant for t in op.terms):
                 return f"{name}: function or Tsukamoto terms"
@@ -293,7 +294,7 @@ def _output(
         num = num + v * zs[t][0]
     fired_rows = total > 0.0
     safe = np.where(fired_rows, total, 1.0)
-    average = op.method != "WTSUM"
+    average = METHODS[op.method].weighted == "average"
     y = num / safe if average else num
     grad: Grad = {}
     for t, v, g in items:

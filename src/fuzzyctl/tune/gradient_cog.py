@@ -58,6 +58,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
 from fuzzyctl.ir.kernels.columns import coa_columns  # the engine's bisector: the same x* to the last bit
+from fuzzyctl.kinds.methods import METHODS
 
 Arr = npt.NDArray[np.float64]
 Bool = npt.NDArray[np.bool_]
@@ -84,7 +85,7 @@ def _term_unsupported(t: TermPlan, low: float, high: float) -> str | None:
 
 def unsupported(op: OutputPlan) -> str | None:
     """Why the closed form does not apply to the Mamdani output ``op`` (``None``: it does)."""
-    if op.method not in ("COG", "COA"):
+    if not METHODS[op.method].integrating:
         return f"{op.name}: {op.method} of a Mamdani output (closed form for COG and COA only)"
     accu = op.accu or "MAX"
     if accu not in ACCUS:
@@ -429,7 +430,7 @@ def cog_partials(
     sums, pieces = _accumulate(op, groups, accu, n)
     fired = sums.m0 > 0.0
     safe = np.where(fired, sums.m0, 1.0)
-    if op.method == "COA" and pieces:
+    if METHODS[op.method].bisects and pieces:
         y, height = _bisector(pieces)
         part, _p = _accumulate(op, groups, accu, n, upto=y)
         ok = fired & (height > 0.0)

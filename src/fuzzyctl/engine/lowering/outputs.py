@@ -11,16 +11,10 @@ from fuzzyctl.engine.lowering.terms import LowerContext, first_terms, lower_term
 from fuzzyctl.engine.plan import Contribution, GridPlan, OutputPlan, PParam, RulePlan, Slot, TermPlan
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.engine.semantics import shapes, universe
+from fuzzyctl.kinds import methods
 
-METHOD_ALIASES = {
-    "MM": "MOM",
-    "COGF": "WTAVER",
-    "CENTROID": "COG",
-    "BISECTOR": "COA",
-    "SOM": "LM",
-    "LOM": "RM",
-    "WTAV": "WTAVER",
-}
+#: other names of methods -> the code evaluated (kinds/methods.py)
+METHOD_ALIASES = methods.lowering_aliases()
 
 
 # --------------------------------------------------------------------------- outputs
@@ -104,7 +98,7 @@ def lower_output(
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
     if (
-        method in ("COGS", "WTAVER", "WTSUM")
+        method in methods.WEIGHTED
         and kinds <= shapes.TSUKAMOTO_KINDS
         and all(t.kind != "points" or (t.pwl is not None and shapes.monotone(t.pwl)) for t in tps)
         and ctx.options.emulate is None
@@ -121,24 +115,24 @@ def lower_output(
         return OutputPlan(
             var.name,
             "ts",
-            "WTSUM" if method == "WTSUM" else "WTAVER",
+            methods.ts_method(method),
             ts_accu,
             tps,
             tuple(contributions),
             default,
             no_change,
         )
-    if ts_terms or (singletonish and method in ("WTAVER", "WTSUM")):
+    if ts_terms or (singletonish and method in methods.TAKAGI_SUGENO):
         return _ts_output(ctx, var, db, tps, kinds, method, accu, contributions, default, no_change)
     if singletonish:
-        if method == "COA":
+        if method is not None and methods.METHODS[method].bisects:
             ctx.err(
                 f"DEFUZZIFY {var.name}: CoA is not applicable to singletons (IEC 61131-7 Table 1, note 3)",
                 db.span,
                 "coa-singletons",
             )
             return None
-        meth = "COGS" if method in (None, "COG", "COGS") else method
+        meth = methods.singleton_method(method)
         s_accu = accu or ctx.options.singleton_default_accu or "MAX"
         return OutputPlan(var.name, "singleton", meth, s_accu, tps, tuple(contributions), default, no_change)
     if kinds & {"singleton", "singletons"}:
@@ -173,7 +167,7 @@ def _ts_output(
             "mixed-terms",
         )
         return None
-    if method not in (None, "WTAVER", "WTSUM", "COGS", "COG"):
+    if method is not None and not (method in methods.WEIGHTED or methods.METHODS[method].centroid):
         ctx.err(
             f"DEFUZZIFY {var.name}: {method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
             db.span,
@@ -193,7 +187,7 @@ def _ts_output(
     return OutputPlan(
         var.name,
         "ts",
-        "WTSUM" if method == "WTSUM" else "WTAVER",
+        methods.ts_method(method),
         ts_accu,
         tps,
         tuple(contributions),
@@ -216,7 +210,7 @@ def _mamdani_output(
 ) -> OutputPlan | None:
     """A Mamdani output: its method, universe, and the grid of a constant piecewise-linear one."""
     meth = method or "COG"
-    if meth in ("COGS", "WTAVER", "WTSUM"):
+    if meth in methods.WEIGHTED:
         ctx.err(
             f"DEFUZZIFY {var.name}: {meth} needs singleton or Takagi-Sugeno terms", db.span, "method-terms"
         )

@@ -45,6 +45,7 @@ from fuzzyctl.engine.semantics.operators import (
     clamp,
     fsum,
 )
+from fuzzyctl.kinds.methods import METHODS
 
 # --------------------------------------------------------------------------- records
 
@@ -296,7 +297,7 @@ class Interpreter:
         if not total > 0.0:
             return rec
         rec.fired = True
-        rec.value = fsum(num) / total if op.method == "WTAVER" else fsum(num)
+        rec.value = weighted_value(op.method, fsum(num), total)
         return rec
 
     def _singleton(
@@ -323,12 +324,13 @@ class Interpreter:
         if not total > 0.0:
             return rec
         rec.fired = True
-        if op.method == "COGS":
-            rec.value = fsum(x * v for x, v in rec.points) / total
+        entry = METHODS[op.method]
+        if entry.maximum is None:
+            rec.value = weighted_value(op.method, fsum(x * v for x, v in rec.points), total)
         else:
             sup = max(v for _x, v in rec.points)
             xs = sorted({x for x, v in rec.points if v == sup})
-            rec.value = {"LM": xs[0], "RM": xs[-1], "MOM": fsum(xs) / len(xs)}[op.method]
+            rec.value = {"left": xs[0], "right": xs[-1], "mean": fsum(xs) / len(xs)}[entry.maximum]
         return rec
 
     def _exact(
@@ -383,14 +385,15 @@ class Interpreter:
             # output is NaN, not the DEFAULT of "no rule fired"
             rec.fired = True
             return rec
-        if op.method in ("COG", "COA"):
+        entry = METHODS[op.method]
+        if entry.integrating:
             if not area > 0.0:
                 return rec
             rec.fired = True
             rec.value = (
-                float(np.sum(KM)) / area
-                if op.method == "COG"
-                else quadrature.bisector(f, A, B, K, self.plan.options.quad_rtol)
+                quadrature.bisector(f, A, B, K, self.plan.options.quad_rtol)
+                if entry.bisects
+                else float(np.sum(KM)) / area
             )
             return rec
         if not area > 0.0:
@@ -398,7 +401,8 @@ class Interpreter:
         sup, lm, rm, mom = quadrature.maxima(f, A, B)
         if sup > 0.0:
             rec.fired = True
-            rec.value = {"LM": lm, "RM": rm, "MOM": mom}[op.method]
+            assert entry.maximum is not None
+            rec.value = {"left": lm, "right": rm, "mean": mom}[entry.maximum]
         return rec
 
 
@@ -413,6 +417,12 @@ def _hedged(d: float, hedges: tuple[str, ...], negated: bool) -> float:
     for h in reversed(hedges):  # the hedge nearest the term applies first
         d = shapes.hedge_function(h)(d)
     return 1.0 - d if negated else d
+
+
+def weighted_value(method: str, num: float, total: float) -> float:
+    """A weighted output's value from its weighted sum ``num`` and the sum of its weights:
+    their ratio for a weighted average (COGS, WTAVER), ``num`` for a weighted sum (WTSUM)."""
+    return num / total if METHODS[method].weighted == "average" else num
 
 
 def ts_value(

@@ -22,6 +22,7 @@ import numpy as np
 
 from fuzzyctl.engine.plan import GridPlan
 from fuzzyctl.engine.semantics.operators import fsum
+from fuzzyctl.kinds.methods import METHODS, implementation
 
 #: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
 MAX_TOL = 1e-12
@@ -340,9 +341,34 @@ def defuzzify_pieces(
     area, moment = area_moment(pieces)
     if not area > 0.0:
         return None
-    if method == "COG":
-        return moment / area
-    if method == "COA":
-        return bisector([p for p in pieces if p[1] > p[0]], area)
-    _sup, lm, rm, mom = maxima(pieces, points)
-    return {"LM": lm, "RM": rm, "MOM": mom}[method]
+    defuzzify = implementation(METHODS[method].reference)
+    return float(defuzzify(pieces, points, area, moment))
+
+
+# the methods on the pieces (kinds/methods.py names them as each entry's ``reference``)
+Points = Sequence[tuple[float, float]]
+
+
+def centroid(pieces: Sequence[Piece], points: Points, area: float, moment: float) -> float:
+    """CoG: the first moment over the area."""
+    return moment / area
+
+
+def bisector_value(pieces: Sequence[Piece], points: Points, area: float, moment: float) -> float:
+    """CoA: :func:`bisector` over the pieces with a width."""
+    return bisector([p for p in pieces if p[1] > p[0]], area)
+
+
+def leftmost(pieces: Sequence[Piece], points: Points, area: float, moment: float) -> float:
+    """LM: the smallest point reaching the height (:func:`maxima`)."""
+    return maxima(pieces, points)[1]
+
+
+def rightmost(pieces: Sequence[Piece], points: Points, area: float, moment: float) -> float:
+    """RM: the largest point reaching the height (:func:`maxima`)."""
+    return maxima(pieces, points)[2]
+
+
+def mean_of_maximum(pieces: Sequence[Piece], points: Points, area: float, moment: float) -> float:
+    """MoM: the mean of the maximising set (:func:`maxima`)."""
+    return maxima(pieces, points)[3]

@@ -3,6 +3,8 @@ and fuzzylite's hedge codes."""
 
 from __future__ import annotations
 
+from fuzzyctl.kinds import methods
+
 AND_METHODS = {
     "min": "MIN",
     "prod": "PROD",
@@ -31,18 +33,9 @@ AGG_METHODS = {
     "hamacher_sum": "HAMACHER",
     "nilpotent_maximum": "NIPMAX",
 }
-DEFUZZ_METHODS = {
-    "centroid": "COG",
-    "bisector": "COA",
-    "mom": "MOM",
-    "som": "LM",
-    "lom": "RM",
-    "wtaver": "WTAVER",
-    "wtsum": "WTSUM",
-    # A user-defined function of the Octave toolkit's demos: the centroid by integration,
-    # which is what our COG computes exactly.
-    "centroid_integral": "COG",
-}
+#: MATLAB's defuzzMethod names (kinds/methods.py; ``centroid_integral``, a user-defined
+#: function of the Octave toolkit's demos, is the centroid by integration: our exact COG)
+DEFUZZ_METHODS = methods.spelled("fis")
 
 # fuzzylite's hedge codes (FisImporter::translateProposition); "any" is resolved apart.
 FUZZYLITE_HEDGE_CODES: dict[int, tuple[str, ...]] = {

@@ -31,6 +31,7 @@ from fuzzyctl.formats.common.expr import ExprError, names_in, parse_expr
 from fuzzyctl.formats.common.terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
 from fuzzyctl.formats.fis.names import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
 from fuzzyctl.formats.fis.rules import TS_KINDS, is_ts_term, numbers, rules
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -492,10 +493,10 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
     # own (MATLAB, and fuzzylite's "aggregation: none").  With both kinds in one file
     # (fuzzylite's hybrid) it is said on the Mamdani outputs alone.
     block_accu: str | None = None
-    if any_mamdani_output and all(d.method not in {"WTAVER", "WTSUM"} for d in defuzzify):
+    if any_mamdani_output and all(d.method not in methods.SUGENO for d in defuzzify):
         block_accu = accu
     elif any_mamdani_output:
-        defuzzify = [d if d.method in {"WTAVER", "WTSUM"} else replace(d, accu=accu) for d in defuzzify]
+        defuzzify = [d if d.method in methods.SUGENO else replace(d, accu=accu) for d in defuzzify]
     declared_rules = count("NumRules")
     rule_list = rules(rules_s.rules, inputs, outputs, rep, dialect) if rules_s is not None else []
     if declared_rules is not None and rules_s is not None and declared_rules != len(rules_s.rules):

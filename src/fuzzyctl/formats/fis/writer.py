@@ -39,10 +39,10 @@ from fuzzyctl.formats.common.terms import (
 from fuzzyctl.formats.fis.names import (
     AGG_METHODS,
     AND_METHODS,
-    DEFUZZ_METHODS,
     FUZZYLITE_HEDGE_CODES,
     OR_METHODS,
 )
+from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
@@ -70,7 +70,7 @@ _AND = {v: k for k, v in AND_METHODS.items()}
 _OR = {v: k for k, v in OR_METHODS.items()}
 _AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
 _AGG["ASUM"] = "probor"
-_DEFUZZ = {v: k for k, v in DEFUZZ_METHODS.items() if k != "centroid_integral"}
+_DEFUZZ = method_kinds.written("fis")
 _DEFUZZ["COGS"] = "wtaver"
 DIALECT_COMMENT = (
     "% FIS written by fuzzyctl in the fuzzylite dialect "
@@ -370,7 +370,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
         losses.append(
             Loss("defuzzification", f"FIS has one DefuzzMethod; the outputs use {', '.join(sorted(methods))}")
         )
-    ts_methods = {("WTSUM" if d.method == "WTSUM" else "WTAVER") for d in fb.defuzzify if is_point_output(d)}
+    ts_methods = {method_kinds.ts_method(d.method) for d in fb.defuzzify if is_point_output(d)}
     if methods and ts_methods - {"WTAVER"}:
         losses.append(
             Loss("defuzzification", "a FIS mixing Mamdani and Sugeno outputs has weighted averages only")

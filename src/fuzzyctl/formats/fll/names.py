@@ -3,6 +3,8 @@ model spells them, and the words a rule reserves (the writer avoids them as name
 
 from __future__ import annotations
 
+from fuzzyctl.kinds import methods
+
 TNORMS = {
     "Minimum": "MIN",
     "AlgebraicProduct": "PROD",
@@ -31,14 +33,6 @@ SNORMS_ACCU = {
     "NilpotentMaximum": "NIPMAX",
     "UnboundedSum": "SUM",
 }
-DEFUZZIFIERS = {
-    "Centroid": "COG",
-    "Bisector": "COA",
-    "SmallestOfMaximum": "LM",
-    "LargestOfMaximum": "RM",
-    "MeanOfMaximum": "MOM",
-    "WeightedAverage": "WTAVER",
-    "WeightedSum": "WTSUM",
-}
+DEFUZZIFIERS = methods.spelled("fll")  # kinds/methods.py
 KEYWORDS = frozenset({"if", "then", "and", "or", "is", "with"})
 HEDGE_WORDS = frozenset({"not", "very", "somewhat", "extremely", "seldom", "any"})

@@ -20,6 +20,7 @@ from fuzzyctl.formats.common.basics import fmt_number
 from fuzzyctl.formats.common.expr import format_expr
 from fuzzyctl.formats.common.terms import FLL_OF_KIND, FLL_TYPES
 from fuzzyctl.formats.fll.names import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
+from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -43,7 +44,7 @@ _ACCU_NAMES = {v: k for k, v in SNORMS_ACCU.items()}
 _DEFUZZ_NAMES = {v: k for k, v in DEFUZZIFIERS.items()}
 _DEFUZZ_NAMES["COGS"] = "WeightedAverage"
 FLL_HEDGES = frozenset(HEDGES)
-INTEGRAL_METHODS = frozenset({"COG", "COA", "LM", "RM", "MOM"})
+INTEGRAL_METHODS = methods.ON_SETS  # fuzzylite integral defuzzifiers (take a resolution)
 RESOLUTION = 1000
 """Integration steps written for fuzzylite's integral defuzzifiers (fuzzyctl itself is
 exact; fuzzylite approximates with this many midpoint samples)."""
@@ -81,7 +82,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
             rules.append(rule)
         blocks.append(replace(block, rules=tuple(rules)))
     for d in fb.defuzzify:
-        if d.method in {"COGS", "WTAVER", "WTSUM"}:
+        if d.method in methods.POINT_OUTPUTS:
             continue  # NSUM adds the degrees of a weighted average, written UnboundedSum
         if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
             losses.append(
@@ -105,7 +106,7 @@ def _replace_block(fb: FunctionBlock, blk: FuzzifyBlock | DefuzzifyBlock) -> Fun
 
 def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], blk: object) -> bool:
     if isinstance(term.mf, SingletonMF) and not (
-        isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"}
+        isinstance(blk, DefuzzifyBlock) and blk.method in methods.POINT_OUTPUTS
     ):
         losses.append(
             Loss(
@@ -117,7 +118,7 @@ def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], bl
     if (
         isinstance(term.mf, ShapeMF)
         and term.mf.kind in {"constant", "linear"}
-        and not (isinstance(blk, DefuzzifyBlock) and blk.method in {"COGS", "WTAVER", "WTSUM"})
+        and not (isinstance(blk, DefuzzifyBlock) and blk.method in methods.POINT_OUTPUTS)
     ):
         losses.append(
             Loss(
@@ -225,7 +226,7 @@ def write(document: Document, *, resolution: int = RESOLUTION) -> str:
         rng = d.range or var.range
         out.append(f"  range: {fmt_number(rng.low)} {fmt_number(rng.high)}" if rng else "  range: -inf inf")
         out.append(f"  lock-range: {'true' if d.clamp else 'false'}")
-        point = (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
+        point = (d.method or "") in methods.POINT_OUTPUTS
         if point:
             # pyfuzzylite 8 aggregates a weighted average's terms as our engine does (fuzzylite 6
             # ignores the aggregation there and lets every rule count)
@@ -279,7 +280,7 @@ def _has(condition: Condition | None, kind: type) -> bool:
 
 def _is_point(fb: FunctionBlock, variable: str) -> bool:
     d = fb.defuzzify_block(variable)
-    return d is not None and (d.method or "") in {"COGS", "WTAVER", "WTSUM"}
+    return d is not None and (d.method or "") in methods.POINT_OUTPUTS
 
 
 def rule_text(fb: FunctionBlock, rule: object) -> str:

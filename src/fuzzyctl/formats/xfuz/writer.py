@@ -28,6 +28,7 @@ from fuzzyctl.formats.xfuz.tables import (
     slot_kind,
     slot_label,
 )
+from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.model import (
     And,
     Condition,
@@ -318,13 +319,13 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
             "xfuz-expr-method",
         )
     method = methods.pop() if len(methods) == 1 else "COG"
-    if method not in ("COG", "COGS", "MOM"):
+    if method not in _XFUZ_METHODS:
         err(
             f"METHOD : {method}: XFUZ offers COG, MOM (mean of maxima) or singletons (COGS)",
             None,
             "xfuz-expr-method",
         )
-    out_pt = method == "COGS"
+    out_pt = _weighted(method)
 
     variables: list[XVariable] = []
     mf_list: list[tuple[int, Term, str]] = []  # (slot, term, variable name)
@@ -467,7 +468,7 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
     if any(d.is_error for d in diags):
         return XfuzConstants(), diags
     kb = KnowledgeBase(tuple(variables), tuple(memberships), tuple(rules))
-    op_defuz = 1 if method == "MOM" else 0
+    op_defuz = 1 if _mean_of_maximum(method) else 0
     for issue in check_kb(kb, out_pt=out_pt, op_defuz=op_defuz):
         diags.append(
             warning(
@@ -615,16 +616,16 @@ def adapt_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     local_names = {v.name for v in fb.locals}
     methods = {d.method or "COG" for d in fb.defuzzify if d.terms and d.variable not in local_names}
     method = methods.pop() if len(methods) == 1 else "COG"
-    if method not in ("COG", "COGS", "MOM") or methods:
+    if method not in _XFUZ_METHODS or methods:
         losses.append(
             (
                 "defuzzification",
                 f"XFUZ has one method for all outputs, COG, MOM or singletons; "
-                f"{method if method in ('COG', 'COGS', 'MOM') else 'COG'} is used",
+                f"{method if method in _XFUZ_METHODS else 'COG'} is used",
             )
         )
-        method = method if method in ("COG", "COGS", "MOM") else "COG"
-    singletons = method == "COGS"
+        method = method if method in _XFUZ_METHODS else "COG"
+    singletons = _weighted(method)
 
     keep: set[tuple[str, str]] = set()
 
@@ -741,3 +742,19 @@ def adapt_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     _, diags = constants_from_model(adapted)
     losses += [(f"line {d.span.line}" if d.span else "program", d.message) for d in diags if d.is_error]
     return Document((adapted,), path=document.path), losses
+
+
+#: The methods XFUZ expresses (kinds/methods.py: COG, MOM, and singletons as COGS).
+_XFUZ_METHODS = frozenset(method_kinds.written("xfuz"))
+
+
+def _weighted(method: str) -> bool:
+    """Singleton mode (OUT_PT = 1): the method weights points."""
+    entry = method_kinds.METHODS.get(method)
+    return entry is not None and entry.weighted is not None
+
+
+def _mean_of_maximum(method: str) -> bool:
+    """OP_DEFUZ = 1: the mean of maxima."""
+    entry = method_kinds.METHODS.get(method)
+    return entry is not None and entry.maximum == "mean"

@@ -22,6 +22,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from fuzzyctl.engine.plan import GridPlan, Slot, TermPlan
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.reference.pwl import MAX_TOL, gauss_legendre
 from fuzzyctl.ir.builders import terms as T
@@ -31,11 +32,14 @@ from fuzzyctl.ir.builders.pieces import (
     Ctx,
     accumulate_dynamic,
     candidate,
+    code_test,
     dedupe,
     finish,
+    having,
     interval,
 )
-from fuzzyctl.ir.nodes import Ex, Type, Var, ex, not_
+from fuzzyctl.ir.builders.rules import Params, RuleBuilder
+from fuzzyctl.ir.nodes import Ex, Num, Type, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 
 
@@ -60,14 +64,52 @@ class ExactOutput:
     groups: list[Group]
 
 
+def term_points(rb: RuleBuilder, t: TermPlan, xs: Params, ys: Params, where: str) -> list[tuple[Ex, Ex]]:
+    """A piecewise-linear term as breakpoints (x, y) in the engine's order
+    (shapes.pwl_points): constant ones as ``xs``/``ys`` entries (tunable in the PLC block,
+    literals in the evaluator), points given by inputs as those inputs."""
+    if t.pwl is not None:
+        return [(xs.add(x, f"{where} x{k}"), ys.add(y, f"{where} y{k}")) for k, (x, y) in enumerate(t.pwl)]
+    h = t.height
+    if isinstance(h, Slot):
+        raise rb.g.refuse(where, "a height given by a variable")
+    if t.kind == "points":
+        out = []
+        for k in range(0, len(t.params), 2):
+            px, py = t.params[k], t.params[k + 1]
+            x = rb.pv(px, xs, f"{where} x{k // 2}")
+            y: Ex
+            if isinstance(py, Slot):
+                y = rb.inputs[py.index] if h == 1.0 else rb.inputs[py.index] * Num(h)
+            else:
+                y = ys.add(py * h, f"{where} y{k // 2}")
+            out.append((x, y))
+        return out
+    if t.kind in ("triangle", "trapezoid"):
+        ylist = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
+        return [
+            (rb.pv(p, xs, f"{where} x{k}"), ys.add(y, f"{where} y{k}"))
+            for k, (p, y) in enumerate(zip(t.params, ylist, strict=True))
+        ]
+    raise rb.g.refuse(
+        where,
+        f"{t.kind} with parameters given by variables (its breakpoints change form with the "
+        "order of its parameters; write it as points)",
+    )
+
+
 def _const(g: Gen, hint: str, type_: Type, values: Sequence[float], comment: str = "") -> Var:
     init = tuple(float(v) for v in values)
     return g.declare(g.fresh(hint, hint), type_, "const", len(values), init, comment)
 
 
-def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
+def exact_outputs(
+    g: Gen, outs: list[ExactOutput], grids: Sequence[GridPlan] | None = None
+) -> tuple[Var, Var]:
     """Emit the defuzzification of every exact output; returns the arrays (value, fired),
-    indexed like ``outs``."""
+    indexed like ``outs``.  With ``grids`` (one per output: its constant points cut at
+    generation, the evaluator of ``compile()``) the geometry is constant tables; without,
+    it is rebuilt at run time when a point changed (the PLC block: points tunable online)."""
     b = g.b
     n_out = len(outs)
     methods = {o.method for o in outs}
@@ -103,12 +145,13 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     # ---- the output geometry (sorted points, grids, one-sided limits, degrees at grid
     # points) depends only on the term points: it is kept in the instance and rebuilt only
     # when a point changed (retuned online, or given by an input that moved)
-    rx = g.array("RX", "REAL", n_pts)
-    ry = g.array("RY", "REAL", n_pts)
-    for t, pts in enumerate(term_pts):
-        for k, (x, y) in enumerate(pts):
-            b.set(rx[offs[t] + k], x)
-            b.set(ry[offs[t] + k], y)
+    if grids is None:
+        rx = g.array("RX", "REAL", n_pts)
+        ry = g.array("RY", "REAL", n_pts)
+        for t, pts in enumerate(term_pts):
+            for k, (x, y) in enumerate(pts):
+                b.set(rx[offs[t] + k], x)
+                b.set(ry[offs[t] + k], y)
     toff = _const(g, "TOFF", "INT", offs, "first point of each output term")
     tlast = _const(g, "TLAST", "INT", [o + c - 1 for o, c in zip(offs, counts, strict=True)])
     term_out = [oi for oi, o in enumerate(outs) for _t in o.points]
@@ -116,8 +159,12 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     goff = [sum(grid_size[:oi]) for oi in range(n_out)]
     loff = [sum(grid_size[term_out[t]] for t in range(u)) for u in range(n_terms)]
     n_lim = sum(grid_size[term_out[t]] for t in range(n_terms))
-    cache = _cache(g, n_pts, grid_size, n_out, n_lim, goff, loff)
-    wx, wy = cache["SX"], cache["SY"]
+    if grids is not None:
+        cache = _static_cache(g, grids, term_out)
+    else:
+        cache = _cache(g, n_pts, grid_size, n_out, n_lim, goff, loff)
+    # the sorted points are read only where the geometry is rebuilt (never when constant)
+    wx, wy = (cache["SX"], cache["SY"]) if grids is None else (cache["SGX"], cache["SGX"])
     gt = _const(g, "GT", "INT", [gr.term for gr in groups], "term of each activated set")
     gmin = _const(g, "GMIN", "BOOL", [gr.is_min for gr in groups], "MIN activation (else PROD)")
     ga = g.array("GA", "REAL", n_groups)
@@ -143,7 +190,8 @@ def exact_outputs(g: Gen, outs: list[ExactOutput]) -> tuple[Var, Var]:
     v, arrays, st, gl = _work_variables(g, methods, accus, max_pts, max_groups)
     ctx = Ctx(g, v, arrays, st, gl, methods, accus, wx, wy, toff, tlast, gt, gmin, ga, gw)
 
-    _rebuild_cache(ctx, cache, rx, ry, n_pts, n_terms, n_out, tab)
+    if grids is None:
+        _rebuild_cache(ctx, cache, rx, ry, n_pts, n_terms, n_out, tab)
     _each_output(ctx, cache, tab, value, fired, n_out)
     return value, fired
 
@@ -189,7 +237,7 @@ def _work_variables(
         "CUT": g.array("CUT", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
         "CV": g.array("CV", "REAL", max(1, max_groups * (max_groups - 1) // 2)),
     }
-    gl = _gl_tables(g, max_groups) if probor else None
+    gl = gl_tables(g, max_groups) if probor else None
     return v, arrays, st, gl
 
 
@@ -219,7 +267,7 @@ def _each_output(
     from the left and from the right)."""
     g, b, v, st = ctx.g, ctx.g.b, ctx.v, ctx.st
     methods = ctx.methods
-    maxima = bool(methods & {"LM", "RM", "MOM"})
+    maxima = bool(having(methods, lambda m: m.maximum is not None))
     o_ = v["O"]
     ov = Var(g.counter("OO"))
     with b.for_(ov.name, 0, n_out - 1):
@@ -236,16 +284,16 @@ def _each_output(
                 b.set(st[name], ex(init) if typ != "REAL" else float(init))
         n_pass = g.temp("INT", "NPASS")
         b.set(n_pass, 1)
-        with b.if_(v["MC"].eq(METHODS["COA"])):
+        with b.if_(code_test(v["MC"], lambda m: m.bisects)):
             b.set(n_pass, 3)
-        with b.elif_(v["MC"].ge(METHODS["LM"])):
+        with b.elif_(code_test(v["MC"], lambda m: m.maximum is not None)):
             b.set(n_pass, 2)
         ps = Var(g.counter("PASS"))
         with b.for_(ps.name, 1, n_pass):
             ctx.pass_ = ps
             forward = ps.ne(3)
             ctx.forward = forward
-            if "COA" in methods:
+            if having(methods, lambda m: m.bisects):
                 with b.if_(ps.eq(2)):
                     b.set(st["HALF"], 0.5 * v["AREA"])
             if maxima:
@@ -261,7 +309,7 @@ def _each_output(
                 gx = cache["SGX"]
                 gbase = cache["GOFF"][o_]
                 if maxima:
-                    with b.if_(v["MC"].ge(METHODS["LM"])):
+                    with b.if_(code_test(v["MC"], lambda m: m.maximum is not None)):
                         _grid_point(ctx, gx[gbase + j], j, cache, tab["G0"][o_], tab["G1"][o_])
                 with b.if_(j.ge(0).and_(j.le(ng - 2))):
                     _interval_lines(ctx, gx[gbase + j], gx[gbase + j + 1], j, cache, tab)
@@ -297,6 +345,39 @@ def _cache(
     return cache
 
 
+def _static_cache(g: Gen, grids: Sequence[GridPlan], term_out: list[int]) -> dict[str, Var]:
+    """The output geometry as constant tables (the same entries :func:`_rebuild_cache`
+    computes at run time, read off each output's :class:`GridPlan`)."""
+    gx: list[float] = []
+    goff: list[int] = []
+    for grid in grids:
+        goff.append(len(gx))
+        gx.extend(grid.xs)
+    loff: list[int] = []
+    lt: list[float] = []
+    rt: list[float] = []
+    mu: list[float] = []
+    local = 0
+    for t, oi in enumerate(term_out):
+        local = 0 if t == 0 or term_out[t - 1] != oi else local + 1
+        grid = grids[oi]
+        n = len(grid.xs)
+        loff.append(len(mu))
+        mu.extend(grid.point[local])
+        lt.extend([*grid.left[local], 0.0])
+        rt.extend([*grid.right[local], 0.0])
+        assert len(mu) == len(lt) == len(rt) and n == len(grid.point[local])
+    return {
+        "SGX": _const(g, "SGX", "REAL", gx or [0.0], "grids"),
+        "SNG": _const(g, "SNG", "INT", [len(gr.xs) for gr in grids], "grid sizes"),
+        "SLT": _const(g, "SLT", "REAL", lt or [0.0], "term limits from the right"),
+        "SRT": _const(g, "SRT", "REAL", rt or [0.0], "term limits from the left"),
+        "SMU": _const(g, "SMU", "REAL", mu or [0.0], "term degrees at grid points"),
+        "GOFF": _const(g, "GOFF", "INT", goff, "first grid point of each output"),
+        "LOFF": _const(g, "LOFF", "INT", loff or [0], "first table entry of each term"),
+    }
+
+
 _STATE: dict[str, tuple[Type, float]] = {
     # CoA
     "HALF": ("REAL", 0.0),
@@ -325,9 +406,10 @@ _COA_STATE = ("HALF", "CUM", "CUMR", "LEFT", "RIGHT", "FX0", "LX1", "HAVE", "FOU
 
 def _method_state(g: Gen, methods: set[str]) -> dict[str, Var]:
     st: dict[str, Var] = {}
+    coa = bool(having(methods, lambda m: m.bisects))
+    maxima = bool(having(methods, lambda m: m.maximum is not None))
     for name, (typ, _init) in _STATE.items():
-        coa = name in _COA_STATE
-        if (coa and "COA" in methods) or (not coa and methods & {"LM", "RM", "MOM"}):
+        if coa if name in _COA_STATE else maxima:
             st[name] = g.temp(typ, name)
     return st
 
@@ -347,7 +429,7 @@ def _grid(c: Ctx, p0: Ex, p1: Ex) -> None:
     dedupe(g, gx, ng)
 
 
-def _gl_tables(g: Gen, n_groups: int) -> tuple[Var, Var, Var, Var]:
+def gl_tables(g: Gen, n_groups: int) -> tuple[Var, Var, Var, Var]:
     """Gauss-Legendre nodes/weights on [0, 1] for every factor count 2..n_groups, with the
     engine's node count (pwl.piece_area_moment: (n + 3) // 2 + 1)."""
     counts = [0] * (n_groups + 1)

@@ -4,14 +4,49 @@ pwl.piece_area_moment, pwl.bisector/_solve_in_piece and pwl.maxima as run-time l
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from fuzzyctl.engine.reference.pwl import COA_TOL, MAX_TOL
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Index, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import methods as kinds
 
-METHODS = {"COG": 1, "COA": 2, "LM": 3, "RM": 4, "MOM": 5}
+#: The run-time code of each method on sets, in registry order (1 CoG, 2 CoA, 3 LM, 4 RM,
+#: 5 MoM): the PLC block reads an output's method from a table of these.
+METHODS = {code: k + 1 for k, code in enumerate(c for c, m in kinds.METHODS.items() if m.on_sets)}
+
+
+def having(methods: set[str], predicate: Callable[[kinds.Method], bool]) -> list[str]:
+    """The methods of ``methods`` whose registry entry satisfies ``predicate``, by code."""
+    return sorted((m for m in methods if predicate(kinds.METHODS[m])), key=METHODS.__getitem__)
+
+
+def code_test(mc: Ex, predicate: Callable[[kinds.Method], bool]) -> Ex:
+    """``mc`` (a run-time method code) is one of the methods satisfying ``predicate``: a
+    single comparison when their codes are the last ones, else one per code."""
+    codes = sorted(METHODS[m] for m in METHODS if predicate(kinds.METHODS[m]))
+    if len(codes) > 1 and codes == list(range(codes[0], max(METHODS.values()) + 1)):
+        return mc.ge(codes[0])
+    test = mc.eq(codes[0])
+    for k in codes[1:]:
+        test = test.or_(mc.eq(k))
+    return test
+
+
+def _centroid(m: kinds.Method) -> bool:
+    return m.centroid
+
+
+def _bisects(m: kinds.Method) -> bool:
+    return m.bisects
+
+
+def _maximum(m: kinds.Method) -> bool:
+    return m.maximum is not None
+
+
 ACCUS = {"MAX": 1, "SUM": 2, "NSUM": 2, "BSUM": 3, "PROBOR": 4}
 
 
@@ -269,12 +304,12 @@ def _piece(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
         first = False
         return mgr
 
-    if "COG" in c.methods:
-        with branch(mc.eq(METHODS["COG"])):
+    if having(c.methods, _centroid):
+        with branch(code_test(mc, _centroid)):
             b.set(area, area + pa)
             b.set(mom, mom + pm)
-    if "COA" in c.methods:
-        with branch(mc.eq(METHODS["COA"])):
+    if having(c.methods, _bisects):
+        with branch(code_test(mc, _bisects)):
             with b.if_(ps.eq(1)):
                 b.set(area, area + pa)
                 with b.if_(xb.gt(xa)):
@@ -318,8 +353,8 @@ def _piece(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var) -> None:
                         b.set(st["CUM"], cum + pa)
                     with b.else_():
                         b.set(st["CUMR"], cum + pa)
-    if c.methods & {"LM", "RM", "MOM"}:
-        with branch(mc.ge(METHODS["LM"])):
+    if having(c.methods, _maximum):
+        with branch(code_test(mc, _maximum)):
             with b.if_(ps.eq(1)):
                 b.set(area, area + pa)
                 with b.if_(v0.gt(st["SUP"])):
@@ -370,34 +405,41 @@ def _solve(c: Ctx, xa: Var, xb: Var, v0: Var, v1: Var, pdx: Var, r: Var) -> Var:
     else:
         ctx = b.if_(ex(True))
     with ctx:
-        a0 = g.let(v0, "SV0")
-        a1 = g.let(v1, "SV1")
-        rr = g.let(r, "SR")
-        m0 = g.let(a0, "SC")
-        with b.if_(m0.lt(0.0)):
-            b.set(m0, -m0)
-        m1 = g.let(a1, "SC")
-        with b.if_(m1.lt(0.0)):
-            b.set(m1, -m1)
-        sc = g.max_(m0, m1, "SC")
-        with b.if_(sc.gt(0.0)):
-            b.set(a0, a0 / sc)
-            b.set(a1, a1 / sc)
-            b.set(rr, rr / sc)
-        kk = g.let(0.0, "SK")
-        with b.if_(pdx.gt(0.0)):
-            b.set(kk, (a1 - a0) / pdx)
-        disc = g.let(a0 * a0 + 2.0 * kk * rr, "DISC")
-        with b.if_(disc.lt(0.0)):
-            b.set(disc, 0.0)
-        den = g.let(a0 + g.call("SQRT", disc), "DEN")
-        with b.if_(den.le(0.0)):
-            b.set(out, xa)
-        with b.else_():
-            b.set(out, xa + 2.0 * rr / den)
-            with b.if_(xb.lt(out)):
-                b.set(out, xb)
+        solve_linear(g, out, xa, xb, v0, v1, pdx, r)
     return out
+
+
+def solve_linear(g: Gen, out: Var, xa: Ex, xb: Ex, v0: Ex, v1: Ex, pdx: Ex, r: Ex) -> None:
+    """``out`` := where the area of the linear piece from ``xa`` (degree ``v0``) to ``xb``
+    (``v1``) reaches ``r`` from its start (pwl._solve_in_piece: scaled, the stable root)."""
+    b = g.b
+    a0 = g.let(v0, "SV0")
+    a1 = g.let(v1, "SV1")
+    rr = g.let(r, "SR")
+    m0 = g.let(a0, "SC")
+    with b.if_(m0.lt(0.0)):
+        b.set(m0, -m0)
+    m1 = g.let(a1, "SC")
+    with b.if_(m1.lt(0.0)):
+        b.set(m1, -m1)
+    sc = g.max_(m0, m1, "SC")
+    with b.if_(sc.gt(0.0)):
+        b.set(a0, a0 / sc)
+        b.set(a1, a1 / sc)
+        b.set(rr, rr / sc)
+    kk = g.let(0.0, "SK")
+    with b.if_(pdx.gt(0.0)):
+        b.set(kk, (a1 - a0) / pdx)
+    disc = g.let(a0 * a0 + 2.0 * kk * rr, "DISC")
+    with b.if_(disc.lt(0.0)):
+        b.set(disc, 0.0)
+    den = g.let(a0 + g.call("SQRT", disc), "DEN")
+    with b.if_(den.le(0.0)):
+        b.set(out, xa)
+    with b.else_():
+        b.set(out, xa + 2.0 * rr / den)
+        with b.if_(xb.lt(out)):
+            b.set(out, xb)
 
 
 def finish(c: Ctx, value: Index, fired: Index) -> None:
@@ -414,25 +456,138 @@ def finish(c: Ctx, value: Index, fired: Index) -> None:
         return mgr
 
     mc = v["MC"]
-    if "COG" in c.methods:
-        with branch(mc.eq(METHODS["COG"]).and_(v["AREA"].gt(0.0))):
+    if having(c.methods, _centroid):
+        with branch(code_test(mc, _centroid).and_(v["AREA"].gt(0.0))):
             b.set(value, v["MOM"] / v["AREA"])
-    if "COA" in c.methods:
-        with branch(mc.eq(METHODS["COA"])):
+    if having(c.methods, _bisects):
+        with branch(code_test(mc, _bisects)):
             with b.if_(not_(st["FOUNDL"])):
                 b.set(st["LEFT"], st["LX1"])
             with b.if_(not_(st["FOUNDR"])):
                 b.set(st["RIGHT"], st["FX0"])
             b.set(value, 0.5 * (st["LEFT"] + st["RIGHT"]))
-    if "LM" in c.methods:
-        with branch(mc.eq(METHODS["LM"])):
-            b.set(value, st["LMX"])
-    if "RM" in c.methods:
-        with branch(mc.eq(METHODS["RM"])):
-            b.set(value, st["RMX"])
-    if "MOM" in c.methods:
-        with branch(mc.eq(METHODS["MOM"])):
-            with b.if_(st["PLEN"].gt(MAX_TOL * (v["HIGH"] - v["LOW"]))):  # pwl.maxima
-                b.set(value, st["PMOM"] / st["PLEN"])
-            with b.elif_(st["ICNT"].gt(0)):
-                b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))
+    for code in having(c.methods, _maximum):
+        with branch(mc.eq(METHODS[code])):
+            side = kinds.METHODS[code].maximum
+            if side == "left":
+                b.set(value, st["LMX"])
+            elif side == "right":
+                b.set(value, st["RMX"])
+            else:
+                with b.if_(st["PLEN"].gt(MAX_TOL * (v["HIGH"] - v["LOW"]))):  # pwl.maxima
+                    b.set(value, st["PMOM"] / st["PLEN"])
+                with b.elif_(st["ICNT"].gt(0)):
+                    b.set(value, st["ISUM"] / c.g.call("TO_REAL", st["ICNT"]))
+
+
+# --------------------------------------------------------------------------- constant geometry
+
+#: One activated set on one grid interval of a constant grid: the term goes linearly from
+#: ``L`` to ``R`` (numbers), the set is ``w * min(a, term)`` (``is_min``) or ``w * a * term``.
+StaticLine = tuple[float, float, Ex, Ex, bool]
+
+
+def polyline_am(g: Gen, x0: float, dx: float, ts: list[Ex], vs: list[Ex]) -> tuple[Var, Var]:
+    """Area and moment of the polyline through ``(x0 + t dx, v)`` for ordered ``ts``, the
+    sums kept in t-space (numpy twin: :func:`fuzzyctl.ir.kernels.columns._polyline_am`)."""
+    area: Ex = ex(0.0)
+    tmom: Ex = ex(0.0)
+    for k in range(len(ts) - 1):
+        d = g.let(ts[k + 1] - ts[k], "D")
+        s = g.let(vs[k] + vs[k + 1], "S")
+        area = area + d * s
+        tmom = tmom + d * (ts[k] * (s + vs[k]) + ts[k + 1] * (s + vs[k + 1]))
+    a = g.let(area * (0.5 * dx), "PA")
+    return a, g.let(x0 * a + (dx * dx / 6.0) * tmom, "PM")
+
+
+def clipped_am(g: Gen, x0: float, dx: float, line: StaticLine) -> tuple[Var, Var]:
+    """One activated set alone on an interval: ``w * min(a, line)`` or ``w * a * line``
+    (numpy twin: ``kernels_np._clipped_line_am``).  At the kink the set is exactly ``w*a``."""
+    left, right, a, w, mn = line
+    if not mn:
+        return polyline_am(g, x0, dx, [ex(0.0), ex(1.0)], [w * a * left, w * a * right])
+    tk = g.let(0.0, "TK")
+    if right != left:
+        b = g.b
+        b.set(tk, (a - left) / (right - left))
+        with b.if_(tk.lt(0.0)):
+            b.set(tk, 0.0)
+        with b.elif_(tk.gt(1.0)):
+            b.set(tk, 1.0)
+    mid = g.min_(a, left + (right - left) * tk, "VK")
+    with g.b.if_(((a - left) * (a - right)).lt(0.0)):
+        g.b.set(mid, a)
+    vs: list[Ex] = [w * g.min_(a, left, "VL"), w * mid, w * g.min_(a, right, "VR")]
+    return polyline_am(g, x0, dx, [ex(0.0), tk, ex(1.0)], vs)
+
+
+def max_of_two(g: Gen, x0: float, x1: float, l1: StaticLine, l2: StaticLine) -> tuple[Var, Var]:
+    """Area and moment of ``max(c1, c2)`` on one interval without sorting candidates:
+    ``max = c1 + c2 - min(c1, c2)``, and ``min(c1, c2) = min(H, p1, p2)`` is concave (two
+    lines clipped at the constant H), whose breakpoints come out ordered by construction
+    (numpy twin: ``kernels_np._max_of_two``; the scalar reference is
+    :func:`fuzzyctl.engine.reference.pwl.interval_pieces`)."""
+    b = g.b
+    dx = x1 - x0
+    area, mom = g.temp(hint="IA"), g.temp(hint="IM")
+    (_l1, _r1, h1, w1, _m1), (_l2, _r2, h2, w2, _m2) = l1, l2
+    for k, (cond, line) in enumerate((((h2 * w2).gt(0.0), l1), ((h1 * w1).gt(0.0), l2))):
+        with b.if_(not_(cond)) if k == 0 else b.elif_(not_(cond)):
+            a, m = clipped_am(g, x0, dx, line)
+            b.set(area, a)
+            b.set(mom, m)
+    with b.else_():
+        a1, m1 = clipped_am(g, x0, dx, l1)
+        a2, m2 = clipped_am(g, x0, dx, l2)
+        a3, m3 = _min_of_two(g, x0, dx, l1, l2)
+        b.set(area, a1 + a2 - a3)
+        b.set(mom, m1 + m2 - m3)
+    return area, mom
+
+
+def _min_of_two(g: Gen, x0: float, dx: float, l1: StaticLine, l2: StaticLine) -> tuple[Var, Var]:
+    """Area and moment of ``min(H, p1, p2)``: ``p_i = P_i + S_i t`` the line parts of the two
+    sets, ``H`` the smaller clip level of a MIN-activated one (none: no clip)."""
+    b = g.b
+    ps: list[tuple[Var, Var]] = []
+    for left, right, h, w, mn in (l1, l2):
+        scale = w if mn else w * h
+        ps.append((g.let(scale * left, "P"), g.let(scale * (right - left), "SL")))
+    (p1, s1), (p2, s2) = ps
+    clips = [w * h for _l, _r, h, w, mn in (l1, l2) if mn]
+    t = g.let(0.0, "TC")
+    with b.if_(s1.ne(s2)):
+        b.set(t, (p2 - p1) / (s1 - s2))
+    with b.if_(t.ne(t)):  # NaN
+        b.set(t, 0.0)
+    with b.elif_(t.lt(0.0)):
+        b.set(t, 0.0)
+    with b.elif_(t.gt(1.0)):
+        b.set(t, 1.0)
+
+    def low(u: Ex) -> Var:
+        return g.min_(p2 + s2 * u, p1 + s1 * u, "ML")
+
+    if not clips:
+        ts: list[Ex] = [ex(0.0), t, ex(1.0)]
+        return polyline_am(g, x0, dx, ts, [low(u) for u in ts])
+    hh = g.let(clips[0], "HC") if len(clips) == 1 else g.min_(clips[0], clips[1], "HC")
+    pts: list[Ex] = [ex(0.0)]
+    hits: list[Var] = []
+    for ta, tb in ((ex(0.0), t), (t, ex(1.0))):
+        ma, mb = low(ta), low(tb)
+        hit = g.let(((ma - hh) * (mb - hh)).lt(0.0), "HIT", "BOOL")
+        c = g.let(ta, "TX")
+        with b.if_(hit):
+            b.set(c, ta + (hh - ma) / (mb - ma) * (tb - ta))
+        hits.append(hit)
+        pts += [c, tb]
+    vals: list[Ex] = []
+    for k, u in enumerate(pts):
+        v = g.min_(hh, low(u), "MV")
+        if k in (1, 3):  # exactly H where min(p1, p2) crosses it
+            with b.if_(hits[k // 2]):
+                b.set(v, hh)
+        vals.append(v)
+    return polyline_am(g, x0, dx, pts, vals)

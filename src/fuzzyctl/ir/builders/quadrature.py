@@ -1,9 +1,10 @@
 """Centre of gravity of a smooth output (Gaussian, bell, sigmoid, ... terms, or operators that
 bend straight lines) in the generated block, to the tolerance its header states.
 
-An accumulated set of smooth terms has no closed-form integral.  The generated code does what
-the native evaluator does (:data:`fuzzyctl.ir.kernels.c.SMOOTH_DRIVER`), written in the
-IR so that Structured Text (``EXP`` is an IEC 61131-3 standard function) and C share it:
+An accumulated set of smooth terms has no closed-form integral.  The generated code (the PLC
+block, and the native evaluator through :mod:`fuzzyctl.ir.programs.native`) does this,
+written in the IR so that Structured Text (``EXP`` is an IEC 61131-3 standard function) and C
+share it (the reference is :mod:`fuzzyctl.engine.reference.quadrature`):
 
 1. the output range is cut at constant breakpoints: every term's characteristic points
    (peaks, joins, support ends: :func:`fuzzyctl.engine.semantics.shapes.characteristic_points`), its

@@ -44,6 +44,7 @@ from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds.methods import METHODS
 
 #: (term, degree, weight, ACT) of one activated set
 Contrib = tuple[int | None, Ex, Ex, str]
@@ -363,7 +364,7 @@ class RuleBuilder:
         for key in keys:
             b.set(total, total + acc[key])
         b.set(fired, total.gt(0.0))
-        if op.method == "COGS":
+        if METHODS[op.method].weighted is not None:
             num = g.let(0.0, "NUM")
             for key in keys:
                 b.set(num, num + entries[key[0]][key[1]][0] * acc[key])
@@ -423,7 +424,7 @@ class RuleBuilder:
             for t, a, w, _act in contribs:
                 assert t is not None
                 wt = g.let(T.mul(w, a), "WT")
-                zt = self._ts_value(op, t, values, zs, coef)
+                zt = self._ts_value(op, t, values, zs, coef, wt)
                 with b.if_(wt.gt(0.0)):
                     b.set(num, num + wt * zt)
                     b.set(den, den + wt)
@@ -436,25 +437,34 @@ class RuleBuilder:
                 with b.if_(T.mul(w, a).gt(0.0)):
                     T.accumulate_into(g, op.accu, per[t], T.mul(w, a))
             for t in sorted(per):
-                zt = self._ts_value(op, t, values, zs, coef)
+                zt = self._ts_value(op, t, values, zs, coef, per[t])
                 with b.if_(per[t].gt(0.0)):
                     b.set(num, num + per[t] * zt)
                     b.set(den, den + per[t])
         fired = g.let(den.gt(0.0), "FIRED", "BOOL")
         value = g.temp(hint="Y")
         with b.if_(fired):
-            b.set(value, num / den if op.method == "WTAVER" else num)
+            b.set(value, num / den if METHODS[op.method].weighted == "average" else num)
         with b.else_():
             b.set(value, 0.0)
         return value, fired
 
-    def _ts_value(self, op: OutputPlan, t: int, values: dict[int, Ex], zs: dict[int, Ex], coef: Params) -> Ex:
-        """z of a Takagi-Sugeno term (computed once per evaluation)."""
-        if t in zs:
-            return zs[t]
+    def _ts_value(
+        self, op: OutputPlan, t: int, values: dict[int, Ex], zs: dict[int, Ex], coef: Params, wt: Ex
+    ) -> Ex:
+        """z of a Takagi-Sugeno term (computed once per evaluation); of a Tsukamoto term,
+        where it reaches the weight ``wt`` (computed for each weight)."""
         g = self.g
         term = op.terms[t]
         where = f"term {op.name}.{term.name}"
+        if term.kind in shapes.TSUKAMOTO_KINDS:
+            ps = [self.pv(p, coef, f"{term.name} {k}") for k, p in enumerate(term.params)]
+            pts = None
+            if term.kind == "points" and not any(isinstance(p, Slot) for p in (*term.params, term.height)):
+                pts = shapes.pwl_points("points", [float(p) for p in term.params], float(term.height))  # type: ignore[arg-type]
+            return T.tsukamoto(g, term.kind, ps, self.pv(term.height, None, ""), wt, pts)
+        if t in zs:
+            return zs[t]
         n_in = len(self.plan.inputs)
         if term.kind in ("singleton", "constant"):
             zs[t] = self.pv(term.params[0], coef, term.name)

@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 from fuzzyctl.engine.plan import EX, EBinary, ECall, EInput, ENum, EOutput, EUnary, ExprPlan
 from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
-from fuzzyctl.engine.semantics.shapes import power_of
+from fuzzyctl.engine.semantics.shapes import Points, power_of
 from fuzzyctl.ir.nodes import Bin, Ex, ExLike, Index, Neg, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 
@@ -543,3 +543,54 @@ def left_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Va
         with g.b.if_(not_(found)):
             _interp(g, xs, ys, off, last, x, out)
     return out
+
+
+def tsukamoto(g: Gen, kind: str, ps: list[Ex], h: Ex, y: Ex, points: Points | None = None) -> Ex:
+    """The x at which a monotonic term reaches degree ``y`` (Tsukamoto inference; the IR
+    twin of :func:`fuzzyctl.engine.semantics.shapes.tsukamoto`).  ``points``: the breakpoints of a
+    constant ``points`` term (their inverse is an if-chain, as ``numpy.interp`` reads it)."""
+    b = g.b
+    if kind == "points":
+        if points is None:
+            raise g.refuse("a Tsukamoto points term", "points given by variables")
+        xs, ys = [x for x, _v in points], [v for _x, v in points]
+        if ys[0] > ys[-1]:
+            xs, ys = xs[::-1], ys[::-1]
+        out = g.let(xs[-1], "TZ")
+        with b.if_(y.lt(ys[0])):
+            b.set(out, xs[0])
+        for j in range(len(xs) - 2, -1, -1):
+            if ys[j + 1] > ys[j]:
+                slope = (xs[j + 1] - xs[j]) / (ys[j + 1] - ys[j])
+                with b.elif_(y.ge(ys[j]).and_(y.lt(ys[-1]))):
+                    b.set(out, slope * (y - ys[j]) + xs[j])
+        return out
+    if kind == "ramp":
+        s, e = ps
+        return g.let(s + (e - s) * y / h, "TZ")
+    if kind == "sigmoid":
+        i, s = ps
+        return g.let(i + g.call("LN", h / y - 1.0) / -s, "TZ")
+    if kind == "concave":
+        i, e = ps
+        return g.let(h * (i - e) / y + 2.0 * e - i, "TZ")
+    if kind == "arc":
+        s, e = ps
+        r = g.let(e - s, "TR")
+        q = g.max_(r * r - (y * r / h) * (y * r / h), 0.0, "TQ")
+        sign = g.let(1.0, "TS")
+        with b.if_(s.lt(e)):
+            b.set(sign, -1.0)
+        return g.let(e + sign * g.call("SQRT", q), "TZ")
+    if kind in ("sshape", "zshape"):
+        s, e = ps
+        out = g.temp(hint="TZ")
+        low = g.call("SQRT", y / (2.0 * h))
+        high = g.call("SQRT", (h - y) / (2.0 * h))
+        first = y.le(0.5 * h) if kind == "sshape" else y.ge(0.5 * h)
+        with b.if_(first):
+            b.set(out, s + (e - s) * (low if kind == "sshape" else high))
+        with b.else_():
+            b.set(out, e - (e - s) * (high if kind == "sshape" else low))
+        return out
+    raise g.refuse(f"a {kind} term", "not monotonic (no Tsukamoto inverse)")

@@ -11,6 +11,13 @@ by row by the interpreter.
 
 Every kernel takes the number of rows first; its other arguments are arrays of that length or
 numbers (the same for every row).
+
+These are hand-written because printing their IR twins as numpy was measured slower
+(benchmarks/bench_engine.py, section 6, column "np IR": 2-4x on CoG, CoA, LM, RM, MoM): the
+twins are :meth:`fuzzyctl.ir.programs.evaluator.FastBuilder.closed_cog` with
+:func:`fuzzyctl.ir.builders.pieces.max_of_two` (:func:`centroid`, :func:`_max_of_two`) and
+:mod:`fuzzyctl.ir.builders.grid_pieces` (:func:`bisector_value`, :func:`maximum_point`), which the
+native backend compiles; each method's entry in :mod:`fuzzyctl.kinds.methods` names both.
 """
 
 from __future__ import annotations
@@ -27,6 +34,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import accumulate_np, clamp_np
+from fuzzyctl.kinds.methods import METHODS, implementation
 
 Arr = npt.NDArray[np.float64]
 W = Any  # a weight: float or array
@@ -170,7 +178,7 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         if op.kind == "ts":
             return _ts(op, contribs, vals, outs, n)
         contribs = _scale_tiny(contribs, n)
-        if op.exact and op.grid is not None and not (op.accu == "PROBOR" and op.method == "COA"):
+        if op.exact and op.grid is not None and not (op.accu == "PROBOR" and METHODS[op.method].bisects):
             groups = [(t or 0, a, w, act == "MIN") for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
         from fuzzyctl.ir.kernels.smooth_columns import smooth_output
@@ -247,7 +255,7 @@ def _ts(
         den = den + wt
     fired = den > 0.0
     with np.errstate(all="ignore"):
-        value = num / den if op.method == "WTAVER" else num
+        value = num / den if METHODS[op.method].weighted == "average" else num
     return np.where(fired, value, np.nan), fired
 
 
@@ -255,51 +263,65 @@ def _pv(p: Any, vals: Sequence[Arr]) -> W:
     return vals[p.index] if isinstance(p, Slot) else p
 
 
-def _mamdani(op: OutputPlan, grid: GridPlan, groups: list[tuple[int, Arr, W, bool]], n: int) -> Result:
-    """An exact output on a constant grid from its (merged) activated sets."""
+Group = tuple[int, Arr, W, bool]
+
+
+def _mamdani(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
+    """An exact output on a constant grid from its (merged) activated sets: the method's
+    kernel (its registry entry's ``numpy``)."""
+    kernel = implementation(METHODS[op.method].numpy)
+    return kernel(op, grid, groups, n)  # type: ignore[no-any-return]
+
+
+def centroid(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
+    """CoG: band polynomials where a term is alone, exact integrals where sets overlap
+    (IR twin: :meth:`fuzzyctl.ir.programs.evaluator.FastBuilder.closed_cog`)."""
     accu = op.accu or "MAX"
     per_term: dict[int, int] = {}
     for t, _a, _w, _mn in groups:
         per_term[t] = per_term.get(t, 0) + 1
-    if op.method == "COG":
-        area = np.zeros(n)
-        moment = np.zeros(n)
-        closed = {t for t, k in per_term.items() if k == 1 or accu in ("SUM", "NSUM")}
-        for t, a, w, is_min in groups:
-            if t not in closed or not grid.solo[t]:
-                continue
-            if is_min:
-                ar, mo = _band_eval(grid.min_bands[t], a)
-            else:
-                fa, fm = grid.full[t]
-                ar, mo = a * fa, a * fm
-            area += w * ar
-            moment += w * mo
-        general = sorted(set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]})
-        for j in general:
-            lines = [
-                (grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]
-            ]
-            if not lines:
-                continue
-            if accu == "MAX" and len(lines) == 2:
-                ar2, mo2 = _max_of_two(grid.xs[j], grid.xs[j + 1], lines[0], lines[1])
-                area += ar2
-                moment += mo2
-                continue
-            X, V, extra = _interval(grid.xs[j], grid.xs[j + 1], lines, accu, n)
-            if extra is not None:
-                area += extra[0]
-                moment += extra[1]
-            else:
-                x0, x1, v0, v1 = X[:, :-1], X[:, 1:], V[:, :-1], V[:, 1:]
-                dx = x1 - x0
-                area += (0.5 * dx * (v0 + v1)).sum(axis=1)
-                moment += (dx * (x0 * (2.0 * v0 + v1) + x1 * (v0 + 2.0 * v1))).sum(axis=1) / 6.0
-        fired = area > 0.0
-        with np.errstate(all="ignore"):
-            return np.where(fired, moment / area, np.nan), fired
-    # CoA, LM, RM, MoM: every interval as pieces
+    area = np.zeros(n)
+    moment = np.zeros(n)
+    closed = {t for t, k in per_term.items() if k == 1 or accu in ("SUM", "NSUM")}
+    for t, a, w, is_min in groups:
+        if t not in closed or not grid.solo[t]:
+            continue
+        if is_min:
+            ar, mo = _band_eval(grid.min_bands[t], a)
+        else:
+            fa, fm = grid.full[t]
+            ar, mo = a * fa, a * fm
+        area += w * ar
+        moment += w * mo
+    general = sorted(set(grid.shared) | {j for t in per_term if t not in closed for j in grid.solo[t]})
+    for j in general:
+        lines = [
+            (grid.left[t][j], grid.right[t][j], a, w, mn) for t, a, w, mn in groups if t in grid.active[j]
+        ]
+        if not lines:
+            continue
+        if accu == "MAX" and len(lines) == 2:
+            ar2, mo2 = _max_of_two(grid.xs[j], grid.xs[j + 1], lines[0], lines[1])
+            area += ar2
+            moment += mo2
+            continue
+        X, V, extra = _interval(grid.xs[j], grid.xs[j + 1], lines, accu, n)
+        if extra is not None:
+            area += extra[0]
+            moment += extra[1]
+        else:
+            x0, x1, v0, v1 = X[:, :-1], X[:, 1:], V[:, :-1], V[:, 1:]
+            dx = x1 - x0
+            area += (0.5 * dx * (v0 + v1)).sum(axis=1)
+            moment += (dx * (x0 * (2.0 * v0 + v1) + x1 * (v0 + 2.0 * v1))).sum(axis=1) / 6.0
+    fired = area > 0.0
+    with np.errstate(all="ignore"):
+        return np.where(fired, moment / area, np.nan), fired
+
+
+def _all_pieces(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> tuple[Arr, ...] | None:
+    """Every interval as pieces: (x0, x1, v0, v1), one row per sample."""
+    accu = op.accu or "MAX"
     xs_all, vs_all = [], []
     for j in range(len(grid.xs) - 1):
         lines = [
@@ -311,14 +333,31 @@ def _mamdani(op: OutputPlan, grid: GridPlan, groups: list[tuple[int, Arr, W, boo
         xs_all.append(X)
         vs_all.append(V)
     if not xs_all:
-        return np.full(n, np.nan), np.zeros(n, dtype=bool)
+        return None
     x0 = np.concatenate([X[:, :-1] for X in xs_all], axis=1)
     x1 = np.concatenate([X[:, 1:] for X in xs_all], axis=1)
     v0 = np.concatenate([V[:, :-1] for V in vs_all], axis=1)
     v1 = np.concatenate([V[:, 1:] for V in vs_all], axis=1)
-    if op.method == "COA":
-        return coa_columns(x0, x1, v0, v1)
-    pts = _point_values(grid, groups, accu, n)
+    return x0, x1, v0, v1
+
+
+def bisector_value(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
+    """CoA from every piece (IR twin: :func:`fuzzyctl.ir.builders.grid_pieces.bisector_by_intervals`)."""
+    p = _all_pieces(op, grid, groups, n)
+    if p is None:
+        return np.full(n, np.nan), np.zeros(n, dtype=bool)
+    return coa_columns(*p)
+
+
+def maximum_point(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Result:
+    """LM, RM or MoM from every piece and the grid points (IR twins:
+    ``grid_pieces.first_reaching`` and ``mean_reaching`` under MAX, else ``leftmost``,
+    ``rightmost``, ``mean_of_maximum``)."""
+    p = _all_pieces(op, grid, groups, n)
+    if p is None:
+        return np.full(n, np.nan), np.zeros(n, dtype=bool)
+    x0, x1, v0, v1 = p
+    pts = _point_values(grid, groups, op.accu or "MAX", n)
     value, _fired = _maxima(op.method, x0, x1, v0, v1, np.asarray(grid.xs), pts)
     fired = (0.5 * (x1 - x0) * (v0 + v1)).sum(axis=1) > 0.0
     return np.where(fired, value, np.nan), fired
@@ -540,12 +579,13 @@ def _maxima(method: str, x0: Arr, x1: Arr, v0: Arr, v1: Arr, gx: Arr, gv: Arr) -
     s = sup[:, None] * (1.0 - pwl.MAX_TOL)
     gxb = np.broadcast_to(gx, gv.shape)
     hit0, hit1, hitg = v0 >= s, v1 >= s, gv >= s
-    if method == "LM":
+    side = METHODS[method].maximum
+    if side == "left":
         value = np.minimum(
             np.minimum(np.where(hit0, x0, np.inf).min(axis=1), np.where(hit1, x1, np.inf).min(axis=1)),
             np.where(hitg, gxb, np.inf).min(axis=1),
         )
-    elif method == "RM":
+    elif side == "right":
         value = np.maximum(
             np.maximum(np.where(hit0, x0, -np.inf).max(axis=1), np.where(hit1, x1, -np.inf).max(axis=1)),
             np.where(hitg, gxb, -np.inf).max(axis=1),

@@ -15,6 +15,7 @@ from typing import Any
 from fuzzyctl.engine.plan import Plan, Slot, TermPlan
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
+from fuzzyctl.kinds.methods import METHODS
 
 Kernel = Callable[..., Any]
 
@@ -110,7 +111,10 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
     n_in = len(plan.inputs)
     n_out = len(plan.outputs)
     smooth_cog = (
-        op.kind == "mamdani" and not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
+        op.kind == "mamdani"
+        and not op.exact
+        and METHODS[op.method].centroid
+        and all(t.constant for t in op.terms)
     )
 
     def f(*args: float) -> tuple[float, bool]:

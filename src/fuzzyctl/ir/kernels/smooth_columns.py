@@ -32,6 +32,7 @@ from fuzzyctl.engine.reference import quadrature
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import ACT_LEVELS, TNORMS, accumulate_np
+from fuzzyctl.kinds.methods import METHODS
 
 Arr = Any
 
@@ -45,7 +46,7 @@ def smooth_output(
     n: int,
 ) -> tuple[Arr, Arr]:
     """(value, fired) of output ``op`` for ``n`` rows from its activated sets."""
-    if op.method != "COG" or not all(t.constant for t in op.terms) or n == 0:
+    if not METHODS[op.method].centroid or not all(t.constant for t in op.terms) or n == 0:
         return _rows(plan, op, contribs, vals, outs, n)
     assert op.low is not None and op.high is not None
     cs = [(t, np.broadcast_to(np.asarray(a, dtype=np.float64), (n,)), w, act) for t, a, w, act in contribs]

@@ -9,12 +9,14 @@ geometry is known here, so a Mamdani CoG on a constant grid is the closed form o
 itself, and an exact integral (the ``AM_LINES`` kernel) where sets overlap.  Large rule bases
 become tables and loops (:mod:`fuzzyctl.ir.programs.rule_table`).
 
-What each target writes in its own language is a :class:`~fuzzyctl.ir.nodes.Kernel`:
+What Python and numpy write by hand is a :class:`~fuzzyctl.ir.nodes.Kernel`; the native
+backend's builder (:mod:`fuzzyctl.ir.programs.native`) writes every one of them in the IR
+(HOLD aside, which each renderer prints as two lines):
 
 ==============  ==================================================================
 ``AM_LINES``    area and moment of the accumulated lines on one grid interval
 ``MAMDANI``     a whole Mamdani output the closed form above does not cover (other
-                methods, terms given by inputs, smooth sets: quadrature)
+                methods, terms given by inputs, smooth sets: quadrature; Python and numpy)
 ``HOLD``        DEFAULT / NC / lock-range of an output (a running fill on a batch)
 ``SELECT``      fuzzylite's rule activation methods (Python and numpy only)
 ``MEMBER``      a membership function whose points are inputs (Python and numpy only)
@@ -62,6 +64,7 @@ from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders.rules import Contrib, Literals, Params, RuleBuilder
 from fuzzyctl.ir.nodes import Ex, Kernel, Num, Program, Pwl, Var, ex
 from fuzzyctl.ir.state import CodegenError, Gen
+from fuzzyctl.kinds.methods import METHODS
 
 FastTarget = Literal["py", "np", "c"]
 
@@ -168,15 +171,17 @@ class FastBuilder(RuleBuilder):
             if t.pwl is not None:
                 degrees[(var, ti)] = g.let(Pwl(x, t.pwl), "MU")
             elif t.kind in shapes.PWL_KINDS or (not t.constant and t.kind != "function"):
-                degrees[(var, ti)] = self._member(t, x, f"term {fi.name}.{t.name}")
+                degrees[(var, ti)] = self.member(var, ti, x, f"term {fi.name}.{t.name}")
             else:
                 degrees[(var, ti)] = self.fuzzify_term(var, ti, pp)
         return degrees
 
-    def _member(self, t: object, x: Ex, where: str) -> Ex:
-        """A term whose points are inputs: ``shapes.membership`` at run time."""
+    def member(self, var: int, ti: int, x: Ex, where: str) -> Ex:
+        """A term whose points are inputs: ``shapes.membership`` at run time (Python and
+        numpy; the native builder writes it in the IR)."""
         if self.target == "c":
             raise self.g.refuse(where, "membership points given by variables")
+        t = self.plan.fuzzy_inputs[var].terms[ti]
         out = self.g.temp(hint="MU")
         self.g.b.add(Kernel("MEMBER", (out,), (x, *self.inputs), t))
         return out
@@ -200,8 +205,8 @@ class FastBuilder(RuleBuilder):
             value, fired = self.singleton(op, contribs)
         elif op.kind == "ts":
             value, fired = self._ts_output(oi, op, contribs, values)
-        elif op.exact and op.grid is not None and op.method == "COG":
-            value, fired = self._cog(op, op.grid, merge(g, contribs, op.accu or "MAX"))
+        elif op.exact and op.grid is not None and METHODS[op.method].centroid:
+            value, fired = self.closed_cog(op, op.grid, merge(g, contribs, op.accu or "MAX"))
         else:
             value, fired = self._mamdani_kernel(oi, op, contribs)
         default = op.default if op.default is not None else 0.0
@@ -218,26 +223,24 @@ class FastBuilder(RuleBuilder):
         return self._whole_output("TS", oi, op, contribs, values)
 
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
+        """A Mamdani output the closed form does not cover, as one kernel (Python and numpy;
+        the native builder, :mod:`fuzzyctl.ir.programs.native`, writes it in the IR)."""
+        if self.target == "c":
+            raise self.g.refuse(f"output {op.name}", f"{op.method} needs the native builder")
         groups = merge(self.g, contribs, op.accu or "MAX")
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
-        if self.target == "c":
-            smooth_cog = not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
-            if not smooth_cog or any(t.kind == "function" for t in op.terms):
-                raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
-            return self._smooth_kernel(oi, merged)
         return self._whole_output("MAMDANI", oi, op, merged, {})
 
-    def _smooth_kernel(self, oi: int, contribs: list[Contrib]) -> tuple[Ex, Ex]:
-        """A smooth CoG in C: the set's kinks located, then a fixed Gauss-Legendre rule per
-        piece (:func:`fuzzyctl.ir.render.c.smooth_code`)."""
-        g = self.g
-        value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
-        args: list[Ex] = []
-        for _t, a, w, _act in contribs:
-            args += [a, w]
-        sets = tuple((t, act) for t, _a, _w, act in contribs)
-        g.b.add(Kernel("SMOOTH", (value, fired), tuple(args), (oi, sets)))
-        return value, fired
+    def am_lines(
+        self, x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...], args: list[Ex]
+    ) -> tuple[Ex, Ex]:
+        """Area and moment of the accumulated sets on one shared grid interval: the
+        ``AM_LINES`` kernel (Python and numpy; the native builder writes it in the IR)."""
+        if self.target == "c":
+            raise self.g.refuse("a shared output interval", "the AM_LINES kernel needs the native builder")
+        ta, tm = self.g.temp(hint="IA"), self.g.temp(hint="IM")
+        self.g.b.add(Kernel("AM_LINES", (ta, tm), tuple(args), (x0, x1, accu, geom)))
+        return ta, tm
 
     def _whole_output(
         self, kind: str, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
@@ -254,7 +257,7 @@ class FastBuilder(RuleBuilder):
         g.b.add(Kernel(kind, (value, fired), tuple(args), layout))
         return value, fired
 
-    def _cog(self, op: OutputPlan, grid: GridPlan, groups: list[Group]) -> tuple[Ex, Ex]:
+    def closed_cog(self, op: OutputPlan, grid: GridPlan, groups: list[Group]) -> tuple[Ex, Ex]:
         """CoG on a constant grid: band polynomials where a term is alone, exact integrals
         of the overlapping sets elsewhere (``batch``/``specialise`` before, one code now)."""
         g = self.g
@@ -278,14 +281,13 @@ class FastBuilder(RuleBuilder):
             for gr in members[1:]:
                 cond = cond.or_(_positive(gr))
             with b.if_(cond):
-                ta, tm = g.temp(hint="IA"), g.temp(hint="IM")
                 geom = tuple(
                     (grid.left[gr.term][j], grid.right[gr.term][j], gr.act == "MIN") for gr in members
                 )
                 args: list[Ex] = []
                 for gr in members:
                     args += [gr.a, gr.w]
-                b.add(Kernel("AM_LINES", (ta, tm), tuple(args), (grid.xs[j], grid.xs[j + 1], accu, geom)))
+                ta, tm = self.am_lines(grid.xs[j], grid.xs[j + 1], accu, geom, args)
                 b.set(area, area + ta)
                 b.set(moment, moment + tm)
         fired = g.let(area.gt(0.0), "FIRED", "BOOL")

@@ -21,15 +21,16 @@ from __future__ import annotations
 
 import math
 
-from fuzzyctl.engine.plan import OutputPlan, Plan, Slot, TermPlan
+from fuzzyctl.engine.plan import OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import quadrature as Q
 from fuzzyctl.ir.builders import terms as T
-from fuzzyctl.ir.builders.mamdani import ExactOutput, Group, exact_outputs
+from fuzzyctl.ir.builders.mamdani import ExactOutput, Group, exact_outputs, term_points
 from fuzzyctl.ir.builders.rules import Contrib, Params, RuleBuilder, literal
 from fuzzyctl.ir.nodes import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.ir.programs.guard import check_known_fields
 from fuzzyctl.ir.state import CodegenError, Gen, Target
+from fuzzyctl.kinds.methods import METHODS
 
 #: INFO codes (modelled on the Siemens FUZZY block's INFO byte).
 INFO_OK = 0x00
@@ -49,38 +50,8 @@ class _Builder(RuleBuilder):
         self.capped: dict[str, Var] = {}  # smooth output -> TRUE when its quadrature hit the cap
 
     def pwl_points(self, t: TermPlan, xs: Params, ys: Params, where: str) -> list[tuple[Ex, Ex]]:
-        """A piecewise-linear term as breakpoints (x, y) in the engine's order
-        (shapes.pwl_points); constant ones are tunable entries."""
-        if t.pwl is not None:
-            return [
-                (xs.add(x, f"{where} x{k}"), ys.add(y, f"{where} y{k}")) for k, (x, y) in enumerate(t.pwl)
-            ]
-        h = t.height
-        if isinstance(h, Slot):
-            raise self.g.refuse(where, "a height given by a variable")
-        if t.kind == "points":
-            out = []
-            for k in range(0, len(t.params), 2):
-                px, py = t.params[k], t.params[k + 1]
-                x = self.pv(px, xs, f"{where} x{k // 2}")
-                y: Ex
-                if isinstance(py, Slot):
-                    y = self.inputs[py.index] if h == 1.0 else self.inputs[py.index] * Num(h)
-                else:
-                    y = ys.add(py * h, f"{where} y{k // 2}")
-                out.append((x, y))
-            return out
-        if t.kind in ("triangle", "trapezoid"):
-            ylist = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
-            return [
-                (self.pv(p, xs, f"{where} x{k}"), ys.add(y, f"{where} y{k}"))
-                for k, (p, y) in enumerate(zip(t.params, ylist, strict=True))
-            ]
-        raise self.g.refuse(
-            where,
-            f"{t.kind} with parameters given by variables (its breakpoints change form with the "
-            "order of its parameters; write it as points)",
-        )
+        """A piecewise-linear term as breakpoints, constant ones as tunable entries."""
+        return term_points(self, t, xs, ys, where)
 
     # ------------------------------------------------------------------ the block
 
@@ -192,7 +163,7 @@ class _Builder(RuleBuilder):
         check_known_fields(g, self.plan)
         for op in self.plan.outputs:
             if op.kind == "mamdani" and not op.exact:
-                if op.method != "COG":
+                if not METHODS[op.method].centroid:
                     raise g.refuse(
                         f"output {op.name}: METHOD : {op.method} of a smooth set",
                         "only the centre of gravity of smooth sets is integrated by the generated "

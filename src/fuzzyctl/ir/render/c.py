@@ -11,12 +11,8 @@ from __future__ import annotations
 import array
 import math
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
-from fuzzyctl.engine.plan import OutputPlan
 from fuzzyctl.escape import CodegenError, c_comment, c_ident
-from fuzzyctl.ir.kernels import c as c_kernels
-from fuzzyctl.ir.kernels.c import ACCU_CODES
 from fuzzyctl.ir.nodes import (
     Assign,
     Bin,
@@ -44,9 +40,6 @@ from fuzzyctl.ir.nodes import (
 )
 from fuzzyctl.ir.programs.evaluator import FastProgram
 from fuzzyctl.ir.render import c_helpers
-
-if TYPE_CHECKING:
-    from fuzzyctl.ir.state import Gen
 
 _PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
 _COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
@@ -374,11 +367,7 @@ class _Native(_C):
         self.fields = set()
         self.state = fp.state
         self.pwl_funcs: dict[tuple[tuple[float, float], ...], str] = {}
-        self.max_lines = 1
-        self.uses_lines = False
-        self.uses_max2 = False
-        self.extra: list[str] = []  # functions the kernels need (smooth sets)
-        self.uses: set[str] = set()  # intrinsics they call
+        self.uses: set[str] = set()  # intrinsics the kernels call
 
     def name(self, n: str) -> str:
         if n in self.consts:
@@ -423,162 +412,8 @@ class _Native(_C):
     def kernel(self, k: Kernel, ind: int) -> None:
         if k.name == "HOLD":
             self.hold(k, ind)
-        elif k.name == "AM_LINES" and k.data[2] == "MAX" and len(k.data[3]) == 2:
-            x0, x1, _accu, geom = k.data
-            self.uses_max2 = True
-            area, mom = (self.ex(o) for o in k.outs)
-            lines = []
-            for i, (left, right, mn) in enumerate(geom):
-                a_, w_ = self.ex(k.args[2 * i]), self.ex(k.args[2 * i + 1])
-                lines.append(f"{self.num(left)}, {self.num(right)}, {a_}, {w_}, {1 if mn else 0}")
-            self.emit(f"fz_am_max2({self.num(x0)}, {self.num(x1)}, {lines[0]},", ind)
-            self.emit(f"           {lines[1]}, &{area}, &{mom});", ind)
-        elif k.name == "AM_LINES":
-            x0, x1, accu, geom = k.data
-            n = len(geom)
-            self.max_lines = max(self.max_lines, n)
-            self.uses_lines = True
-            ls = ", ".join(self.num(g[0]) for g in geom)
-            rs = ", ".join(self.num(g[1]) for g in geom)
-            mns = ", ".join("1" if g[2] else "0" for g in geom)
-            a_s = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
-            w_s = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
-            self.emit("{", ind)
-            self.emit(f"static const double L[{n}] = {{{ls}}}, R[{n}] = {{{rs}}};", ind + 1)
-            self.emit(f"static const unsigned char mn[{n}] = {{{mns}}};", ind + 1)
-            self.emit(f"const double a[{n}] = {{{a_s}}}, w[{n}] = {{{w_s}}};", ind + 1)
-            area, mom = (self.ex(o) for o in k.outs)
-            self.emit(
-                f"fz_am_lines({self.num(x0)}, {self.num(x1)}, {ACCU_CODES[accu]}, {n}, L, R, a, w, mn, "
-                f"&{area}, &{mom});",
-                ind + 1,
-            )
-            self.emit("}", ind)
-        elif k.name == "SMOOTH":
-            n = len(k.args) // 2
-            name = self.smooth_functions(k)
-            hs = ", ".join(self.ex(k.args[2 * i]) for i in range(n))
-            ws = ", ".join(self.ex(k.args[2 * i + 1]) for i in range(n))
-            value, fired = (self.ex(o) for o in k.outs)
-            self.emit("{", ind)
-            size = max(1, n)
-            self.emit(f"const double h[{size}] = {{{hs or '0.0'}}}, w[{size}] = {{{ws or '0.0'}}};", ind + 1)
-            self.emit(f"{name}(h, w, &{value}, &{fired});", ind + 1)
-            self.emit("}", ind)
         else:
             raise CodegenError(f"the native evaluator has no kernel {k.name}")
-
-    def smooth_functions(self, k: Kernel) -> str:
-        """The set function and the quadrature driver of one smooth output."""
-        from fuzzyctl.engine.semantics import shapes
-
-        oi, sets = k.data
-        op = self.fp.plan.outputs[oi]
-        assert op.low is not None and op.high is not None
-        idx = len(self.extra)
-        set_fn, mu_fn, driver = f"fz_set{idx}", f"fz_mu{idx}", f"fz_smooth{idx}"
-        cuts = sorted(
-            {
-                op.low,
-                op.high,
-                *(
-                    c
-                    for t in op.terms
-                    for c in shapes.characteristic_points(t.kind, [float(p) for p in t.params])  # type: ignore[arg-type, unused-ignore]
-                    if op.low < c < op.high
-                ),
-            }
-        )
-        self.extra.append(self.set_function(set_fn, op, sets))
-        self.extra.append(self.mu_function(mu_fn, op, sets))
-        levels = [lv for k, (_t, act) in enumerate(sets) for lv in c_kernels.activation_levels(act, k)]
-        self.extra.append(c_kernels.smooth_driver(driver, set_fn, mu_fn, levels, cuts, self.num))
-        return driver
-
-    def set_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
-        """``double name(double x, const double *h, const double *w, double *code)``: the
-        accumulated set at x (``interp.accumulated_function``) and a code of the branch it
-        took - under MAX 2k (+1 when clipped) for the largest set k, otherwise a sum of
-        2^k over the clipped sets (+0.5 where BSUM, NIPMAX or DMAX reach 1, plus the largest
-        set's index / 1024 under NIPMAX and DMAX)."""
-        from fuzzyctl.ir.builders import terms as T
-        from fuzzyctl.ir.nodes import Index
-        from fuzzyctl.ir.state import Gen
-
-        g = Gen("c")
-        x = Var("x")
-        accu = op.accu or "MAX"
-        acc = g.let(0.0, "ACC")
-        best = g.let(-1.0, "BEST")
-        code = g.let(0.0, "CODE")
-        arg = g.let(0.0, "ARG")
-        for k, (t, act) in enumerate(sets):
-            mu = self._term_degree(g, op, t, x)
-            h, w = Index("h", Int(k)), Index("w", Int(k))
-            c = g.let(w * T.tnorm(g, act, h, mu), "C")
-            if accu == "MAX":
-                with g.b.if_(c.gt(best)):
-                    g.b.set(best, c)
-                    g.b.set(code, float(2 * k))
-                    if act == "MIN":
-                        with g.b.if_(h.lt(mu)):
-                            g.b.set(code, float(2 * k + 1))
-                T.accumulate_into(g, accu, acc, c)
-            else:
-                g.b.set(acc, T.accumulate(g, accu, acc, c))
-                if act == "MIN" and k < 52:
-                    with g.b.if_(h.lt(mu)):
-                        g.b.set(code, code + float(2**k))
-            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
-                with g.b.if_(c.gt(best)):
-                    g.b.set(best, c)
-                    g.b.set(arg, float(k + 1) / 1024.0)
-        if accu in ("NIPMAX", "DMAX"):
-            g.b.set(code, code + arg)
-        if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
-            with g.b.if_(acc.ge(1.0)):
-                g.b.set(code, code + 0.5)
-        return self._set_c(g, name, "double x, const double *h, const double *w, double *code", code, acc)
-
-    def mu_function(self, name: str, op: OutputPlan, sets: tuple[tuple[int, str], ...]) -> str:
-        """``double name(int k, double x)``: the degree of the term of activated set k at x."""
-        from fuzzyctl.ir.state import Gen
-
-        g = Gen("c")
-        x, kv = Var("x"), Var("k")
-        res = g.let(0.0, "RES")
-        for k, (t, _act) in enumerate(sets):
-            with g.b.if_(kv.eq(Int(k))):
-                g.b.set(res, self._term_degree(g, op, t, x))
-        return self._set_c(g, name, "int k, double x", None, res)
-
-    def _term_degree(self, g: Gen, op: OutputPlan, t: int, x: Var) -> Ex:
-        from fuzzyctl.ir.builders import terms as T
-        from fuzzyctl.ir.nodes import Pwl
-
-        term = op.terms[t]
-        if term.pwl is not None:
-            return g.let(Pwl(x, term.pwl), "MU")
-        ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
-        mu = T.smooth(g, term.kind, ps, x, f"term {op.name}.{term.name}")
-        if float(term.height) != 1.0:  # type: ignore[arg-type]
-            mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
-        return mu
-
-    def _set_c(self, g: Gen, name: str, params: str, code: Var | None, result: Var) -> str:
-        r = _Native(self.fp)
-        r.pwl_funcs = self.pwl_funcs  # one set of breakpoint functions per file
-        r.lines = []
-        r.stmts(g.b.root, 1)
-        out = [f"static double {name}({params})", "{"]
-        for d in g.decls:
-            out.append(f"    {_ctype(d, 'double')} {d.name} = 0;")
-        out += r.lines
-        if code is not None:
-            out.append(f"    *code = {code.name};")
-        out += [f"    return {result.name};", "}", ""]
-        self.uses.update(g.uses)
-        return "\n".join(out)
 
     def hold(self, k: Kernel, ind: int) -> None:
         oi, default, no_change, clamp = k.data
@@ -679,12 +514,7 @@ def render_native(fp: FastProgram, tables: dict[str, bytes] | None = None) -> st
     helpers = helper_functions(prog)
     helpers = c_helpers.closure(set(helpers) | {_HELPER_OF[f] for f in r.uses if f in _HELPER_OF})
     c += c_helpers.render(set(helpers))
-    if r.uses_lines:
-        c.append(c_kernels.am_lines_code(r.max_lines))
-    if r.uses_max2:
-        c.append(c_kernels.AM_MAX2)
     c += r.pwl_code()
-    c += r.extra
     n_out = len(fp.outputs)
     c.append(
         "static inline void fz_row(double *restrict prev, const double *restrict in, double *restrict out)"
