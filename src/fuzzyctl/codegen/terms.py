@@ -25,19 +25,10 @@ from fuzzyctl.engine.irterms import (
     _absv as _absv,
 )
 from fuzzyctl.engine.irterms import (
-    _gauss as _gauss,
-)
-from fuzzyctl.engine.irterms import (
     _interp as _interp,
 )
 from fuzzyctl.engine.irterms import (
-    _sig as _sig,
-)
-from fuzzyctl.engine.irterms import (
     _simple as _simple,
-)
-from fuzzyctl.engine.irterms import (
-    _sshape as _sshape,
 )
 from fuzzyctl.engine.irterms import (
     _tr as _tr,

@@ -20,217 +20,46 @@ singletons, jFuzzyLogic SINGLETONS, function terms - are model types of their ow
 
 from __future__ import annotations
 
+import ast
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 from fuzzyctl.kinds import formula as fm
+from fuzzyctl.kinds.shape_types import (
+    FL,
+    HELPERS,
+    JFL,
+    NA,
+    SB,
+    Degenerate,
+    Points,
+    Role,
+    Shape,
+    Span,
+    Spellings,
+    Studio,
+    Written,
+    java_div,
+    java_pow,
+    shoulders,
+)
 
-Points = tuple[tuple[float, float], ...]
-Family = Literal["pwl", "smooth", "ts"]
-Role = Literal["x", "width", "slope", "number", "coef"]
-
-
-@dataclass(frozen=True)
-class NA:
-    """A field that does not apply to a shape, and why."""
-
-    reason: str
-
-
-@dataclass(frozen=True)
-class Written:
-    """How a tool writes a shape: its name and, for canonical parameter ``i``, the position
-    ``order[i]`` in the written list.
-
-    ``dialect`` (FCL): jFuzzyLogic, fuzzylite or scalablurry; ``height``: an optional trailing
-    height; ``scale[i]`` multiplies the written value (jFuzzyLogic's COSINE gives a half
-    width), and a scaled parameter given by a variable makes the term ``ref_kind``;
-    ``matlab`` (FIS): one of MATLAB's own types, not a fuzzylite extension;
-    ``pyfuzzylite_only`` (FLL): fuzzylite 6 cannot read it."""
-
-    name: str
-    order: tuple[int, ...]
-    dialect: str = ""
-    height: bool = False
-    scale: tuple[float, ...] | None = None
-    ref_kind: str | None = None
-    variadic: bool = False
-    matlab: bool = False
-    pyfuzzylite_only: bool = False
-    write_only: bool = False  # FCL: how the writer spells the kind; the reader never gives it
-
-
-JFL, FL, SB = "jFuzzyLogic", "fuzzylite", "scalablurry"
-
-
-@dataclass(frozen=True)
-class Spellings:
-    """A shape in every format.  FPL and XFUZ have no parametric shapes: ``fpl`` gives the
-    points FPL writes, ``xfuz`` which parameters are XFUZ's trapezoid abscissae a, b, c, d."""
-
-    fcl: tuple[Written, ...] | NA
-    fis: Written | NA
-    fll: Written | NA
-    fpl: Callable[[Sequence[float]], list[tuple[float, float]]] | NA
-    xfuz: tuple[int, int, int, int] | NA
-    json: str  # the model's own kind name
-
-
-@dataclass(frozen=True)
-class Degenerate:
-    """Parameters that define no shape: ``bad(params)`` says so, ``text`` says what is needed."""
-
-    text: str
-    bad: Callable[[Sequence[float]], bool]
-
-
-@dataclass(frozen=True)
-class Span:
-    """The universe of a term without RANGE (jFuzzyLogic ``estimateUniverse``)."""
-
-    rule: str
-    of: Callable[[Sequence[float]], tuple[float, float]]
-
-
-@dataclass(frozen=True)
-class Studio:
-    """The studio's view: ``placement`` gives each parameter from where the term is placed,
-    an expression over a, b (the support), c (the peak) and w (b - a) (a variadic shape gets
-    zeros, one per input and a constant); ``handles`` the draggable points (``at``: the parameter; ``y``: the height
-    there; with ``centre`` and ``factor``: at ``centre + factor * |p|``; ``line``: a
-    vertical line); ``polygon``: the handles are the curve's corners (drawn live);
-    ``pickable``: offered in the Shape picker."""
-
-    placement: tuple[str, ...]
-    handles: tuple[dict[str, Any], ...]
-    polygon: bool = False
-    pickable: bool = True
-
-
-@dataclass(frozen=True)
-class Shape:
-    """One parametric shape; see the module docstring for each field's consumers."""
-
-    kind: str
-    params: tuple[str, ...]
-    roles: tuple[Role, ...]
-    summary: str
-    family: Family
-    formula: str | NA  # over x and the parameters (smooth shapes)
-    breakpoints: Callable[[Sequence[float], float], Points] | NA  # piecewise-linear shapes
-    support: Callable[[Sequence[float]], tuple[float, float]] | NA  # smooth shapes
-    characteristic: Callable[[Sequence[float]], tuple[float, ...]] | NA
-    tsukamoto: str | NA  # x where the shape reaches y (over y, h and the parameters)
-    spellings: Spellings
-    probe: tuple[float, ...] | NA  # conformance statement, universe 0..10
-    studio: Studio
-    degenerate: Degenerate | NA
-    span: Span
-    jfl: str | NA  # jFuzzyLogic's formula (numpy over x and the parameters, fdlibm calls)
-    infinite: tuple[int, ...] = ()  # parameters that may be infinite (shoulders, directions)
-    probe_output: tuple[float, ...] | None = None  # default: the probe doubled
-    variadic: bool = False
-    tune_note: str = ""
-    compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
-
-    # ---- family flags
-    @property
-    def piecewise_linear(self) -> bool:
-        return self.family == "pwl"
-
-    @property
-    def smooth(self) -> bool:
-        return self.family == "smooth"
-
-    @property
-    def takagi_sugeno(self) -> bool:
-        return self.family == "ts"
-
-    @property
-    def tsukamoto_invertible(self) -> bool:
-        return not isinstance(self.tsukamoto, NA)
-
-    # ---- derived views
-    @property
-    def tuning(self) -> tuple[str, ...]:
-        """Per parameter how a tuner moves it: ``abscissa`` (a breakpoint of the variable),
-        ``scale``/``slope`` (log scale, sign kept), ``coef`` (a box around its value)."""
-        if self.takagi_sugeno:
-            return tuple("coef" for _ in self.params)
-        names = {"x": "abscissa", "width": "scale", "number": "scale", "slope": "slope", "coef": "coef"}
-        return tuple(names[r] for r in self.roles)
-
-    def parsed(self) -> fm.Formula:
-        """The formula, parsed (once)."""
-        if "formula" not in self.compiled:
-            assert isinstance(self.formula, str), self.kind
-            self.compiled["formula"] = fm.parse(self.formula, ("x", *self.params), HELPERS)
-        f: fm.Formula = self.compiled["formula"]
-        return f
-
-    def parsed_tsukamoto(self) -> fm.Formula:
-        if "tsukamoto" not in self.compiled:
-            assert isinstance(self.tsukamoto, str), self.kind
-            self.compiled["tsukamoto"] = fm.parse(self.tsukamoto, ("y", "h", *self.params), HELPERS)
-        f: fm.Formula = self.compiled["tsukamoto"]
-        return f
-
-    def parsed_jfl(self) -> fm.Formula:
-        if "jfl" not in self.compiled:
-            assert isinstance(self.jfl, str), self.kind
-            self.compiled["jfl"] = fm.parse(self.jfl, ("x", *self.params), HELPERS)
-        f: fm.Formula = self.compiled["jfl"]
-        return f
-
-    def output_probe(self) -> tuple[float, ...] | NA:
-        if isinstance(self.probe, NA):
-            return self.probe
-        return self.probe_output if self.probe_output is not None else tuple(2 * p for p in self.probe)
-
-
-# --------------------------------------------------------------------------- helper formulas
-
-#: Formulas the shape formulas call (inlined in the IR, functions in float and numpy).
-HELPERS: dict[str, fm.Formula] = {}
-for _name, _args, _src in (
-    # 1 / (1 + exp(-s (x - c))), 0 where the exponent would overflow
-    ("sig", ("x", "c", "s"), "0.0 if (z := -s * (x - c)) > 700.0 else 1.0 / (1.0 + exp(z))"),
-    ("gauss", ("x", "m", "sd"), "exp(-((d := x - m) * d) / (2.0 * sd * sd))"),
-    (
-        "smf",
-        ("x", "s", "e"),
-        "0.0 if x <= s else (2.0 * (t := (x - s) / (e - s)) * t if x <= 0.5 * (s + e) else "
-        "(1.0 - 2.0 * (u := (x - e) / (e - s)) * u if x < e else 1.0))",
-    ),
-    (
-        "zmf",
-        ("x", "s", "e"),
-        "1.0 if x <= s else (1.0 - 2.0 * (t := (x - s) / (e - s)) * t if x <= 0.5 * (s + e) else "
-        "(2.0 * (u := (x - e) / (e - s)) * u if x < e else 0.0))",
-    ),
-):
-    HELPERS[_name] = fm.parse(_src, _args, HELPERS)
-
-
-# --------------------------------------------------------------------------- Java arithmetic
-
-
-def java_div(a: float, b: float) -> float:
-    """``a / b`` as Java computes it: a zero divisor gives an infinity (NaN for 0 / 0)."""
-    try:
-        return a / b
-    except ZeroDivisionError:
-        return math.nan if a == 0.0 or math.isnan(a) else math.copysign(math.inf, a) * math.copysign(1.0, b)
-
-
-def java_pow(base: float, exponent: float) -> float:
-    """``base ** exponent``, infinite where it overflows (Java's Math.pow)."""
-    try:
-        return math.pow(base, exponent)
-    except OverflowError:
-        return math.inf
+__all__ = [
+    "ENTRIES",
+    "HELPERS",
+    "NA",
+    "SHAPES",
+    "Degenerate",
+    "Shape",
+    "Span",
+    "Spellings",
+    "Studio",
+    "Written",
+    "get",
+    "kinds_where",
+    "placement_tree",
+]
 
 
 def _sig_span(c: float, s: float) -> tuple[float, float]:
@@ -251,19 +80,6 @@ def _bell_span(p: Sequence[float]) -> tuple[float, float]:
 
 HULL = Span("the hull of its parameters", lambda p: (min(p), max(p)))
 WHOLE_LINE = Span("the whole line (no parameter spans it)", lambda p: (-math.inf, math.inf))
-
-
-# --------------------------------------------------------------------------- breakpoints
-
-
-def shoulders(points: Points, h: float) -> Points:
-    """A triangle or trapezoid with vertices at -inf / +inf is a shoulder (MATLAB
-    ``trapmf [-Inf -Inf 2 4]``; fuzzylite gives the height beyond a finite vertex whose
-    neighbour is infinite): the infinite vertices are dropped and the ends continue flat."""
-    if all(math.isfinite(x) for x, _y in points):
-        return points
-    finite = tuple((x, y) for x, y in points if math.isfinite(x))
-    return finite or ((0.0, h),)
 
 
 def _ramp(p: Sequence[float], h: float) -> Points:
@@ -319,7 +135,9 @@ def _sd_bad(sds: Sequence[float]) -> bool:
     return not all(_WIDTH_MIN <= abs(sd) <= _WIDTH_MAX for sd in sds)
 
 
-_SD = Degenerate(f"needs a standard deviation between {_WIDTH_MIN:g} and {_WIDTH_MAX:g} in size", lambda p: _sd_bad(p[1:2]))
+_SD = Degenerate(
+    f"needs a standard deviation between {_WIDTH_MIN:g} and {_WIDTH_MAX:g} in size", lambda p: _sd_bad(p[1:2])
+)
 _SD2 = Degenerate(_SD.text, lambda p: _sd_bad(p[1::2]))
 
 NO_FPL = NA("FPL writes points only: the term is written as IEC points or refused")
@@ -366,8 +184,23 @@ def _smooth(
     probe_output: tuple[float, ...] | None = None,
 ) -> Shape:
     return Shape(
-        kind, params, roles, summary, "smooth", formula, _PWL_NA, support, characteristic, tsukamoto,
-        spellings, probe, studio, degenerate, span, jfl, probe_output=probe_output,
+        kind,
+        params,
+        roles,
+        summary,
+        "smooth",
+        formula,
+        _PWL_NA,
+        support,
+        characteristic,
+        tsukamoto,
+        spellings,
+        probe,
+        studio,
+        degenerate,
+        span,
+        jfl,
+        probe_output=probe_output,
     )
 
 
@@ -399,32 +232,55 @@ _NO_FIS = NA("no FIS type: the FIS writer refuses it (or writes points)")
 
 ENTRIES: tuple[Shape, ...] = (
     Shape(
-        "triangle", ("a", "b", "c"), ("x", "x", "x"), "0 at a, 1 at b, 0 at c, linear between", "pwl",
-        _NOT_PWL, lambda p, h: shoulders(((p[0], 0.0), (p[1], h), (p[2], 0.0)), h), _BP_SUPPORT, _BP_POINTS,
+        "triangle",
+        ("a", "b", "c"),
+        ("x", "x", "x"),
+        "0 at a, 1 at b, 0 at c, linear between",
+        "pwl",
+        _NOT_PWL,
+        lambda p, h: shoulders(((p[0], 0.0), (p[1], h), (p[2], 0.0)), h),
+        _BP_SUPPORT,
+        _BP_POINTS,
         NOT_MONOTONIC,
         _sp(
             _fcl(Written("TRIAN", _I3, JFL), _fl("Triangle", 3), Written("triangular", _I3, SB)),
-            Written("trimf", _I3, matlab=True), Written("Triangle", _I3), "triangle",
-            _triangle_fpl, (0, 1, 1, 2),
+            Written("trimf", _I3, matlab=True),
+            Written("Triangle", _I3),
+            "triangle",
+            _triangle_fpl,
+            (0, 1, 1, 2),
         ),
         (0, 5, 10),
         Studio(("a", "c", "b"), (_h(0, 0), _h(1, 1), _h(2, 0)), polygon=True),
         Degenerate("needs a <= b <= c", lambda p: not p[0] <= p[1] <= p[2]),
         Span("a..c", lambda p: (p[0], p[2])),
-        "0.0 if x < a or x > c else (1.0 if x == b else ((x - a) / (b - a) if x < b else 1 - (x - b) / (c - b)))",
+        "0.0 if x < a or x > c else "
+        "(1.0 if x == b else ((x - a) / (b - a) if x < b else 1 - (x - b) / (c - b)))",
         infinite=(0, 1, 2),
     ),
     Shape(
-        "trapezoid", ("a", "b", "c", "d"), ("x", "x", "x", "x"), "0 at a, 1 on [b, c], 0 at d", "pwl",
-        _NOT_PWL, lambda p, h: shoulders(((p[0], 0.0), (p[1], h), (p[2], h), (p[3], 0.0)), h), _BP_SUPPORT,
-        _BP_POINTS, NOT_MONOTONIC,
+        "trapezoid",
+        ("a", "b", "c", "d"),
+        ("x", "x", "x", "x"),
+        "0 at a, 1 on [b, c], 0 at d",
+        "pwl",
+        _NOT_PWL,
+        lambda p, h: shoulders(((p[0], 0.0), (p[1], h), (p[2], h), (p[3], 0.0)), h),
+        _BP_SUPPORT,
+        _BP_POINTS,
+        NOT_MONOTONIC,
         _sp(
             _fcl(Written("TRAPE", _I4, JFL), _fl("Trapezoid", 4), Written("trapetzoidal", _I4, SB)),
-            Written("trapmf", _I4, matlab=True), Written("Trapezoid", _I4), "trapezoid",
-            _trapezoid_fpl, (0, 1, 2, 3),
+            Written("trapmf", _I4, matlab=True),
+            Written("Trapezoid", _I4),
+            "trapezoid",
+            _trapezoid_fpl,
+            (0, 1, 2, 3),
         ),
         (0, 2, 6, 10),
-        Studio(("a", "(a + c) / 2", "(c + b) / 2", "b"), (_h(0, 0), _h(1, 1), _h(2, 1), _h(3, 0)), polygon=True),
+        Studio(
+            ("a", "(a + c) / 2", "(c + b) / 2", "b"), (_h(0, 0), _h(1, 1), _h(2, 1), _h(3, 0)), polygon=True
+        ),
         Degenerate("needs a <= b <= c <= d", lambda p: not p[0] <= p[1] <= p[2] <= p[3]),
         Span("a..d", lambda p: (p[0], p[3])),
         "0.0 if x < a or x > d else (1.0 if x >= b and x <= c else "
@@ -432,23 +288,43 @@ ENTRIES: tuple[Shape, ...] = (
         infinite=(0, 1, 2, 3),
     ),
     Shape(
-        "rectangle", ("start", "end"), ("x", "x"), "1 on [start, end], 0 elsewhere", "pwl", _NOT_PWL,
-        lambda p, h: ((min(p), 0.0), (min(p), h), (max(p), h), (max(p), 0.0)), _BP_SUPPORT, _BP_POINTS,
+        "rectangle",
+        ("start", "end"),
+        ("x", "x"),
+        "1 on [start, end], 0 elsewhere",
+        "pwl",
+        _NOT_PWL,
+        lambda p, h: ((min(p), 0.0), (min(p), h), (max(p), h), (max(p), 0.0)),
+        _BP_SUPPORT,
+        _BP_POINTS,
         NOT_MONOTONIC,
         _sp(
-            _fcl(_fl("Rectangle", 2)), Written("rectmf", _I2), Written("Rectangle", _I2), "rectangle",
-            _rectangle_fpl, (0, 0, 1, 1),
+            _fcl(_fl("Rectangle", 2)),
+            Written("rectmf", _I2),
+            Written("Rectangle", _I2),
+            "rectangle",
+            _rectangle_fpl,
+            (0, 0, 1, 1),
         ),
-        (2, 6), Studio(("a", "b"), (_h(0, 0.5), _h(1, 0.5))), ANY, HULL, NO_JFL,
+        (2, 6),
+        Studio(("a", "b"), (_h(0, 0.5), _h(1, 0.5))),
+        ANY,
+        HULL,
+        NO_JFL,
     ),
     _smooth(
-        "gaussian", ("mean", "sigma"), ("x", "width"), "exp(-(x-mean)^2 / (2 sigma^2))",
+        "gaussian",
+        ("mean", "sigma"),
+        ("x", "width"),
+        "exp(-(x-mean)^2 / (2 sigma^2))",
         "gauss(x, mean, sigma)",
         support=lambda p: (-math.inf, math.inf),
         characteristic=lambda p: _sym(p[0], abs(p[1]), (-8, -4, -2, -1, 0, 1, 2, 4, 8)),
         spellings=_sp(
-            _fcl(Written("GAUSS", _I2, JFL), _fl("Gaussian", 2)), Written("gaussmf", (1, 0), matlab=True),
-            Written("Gaussian", _I2), "gaussian",
+            _fcl(Written("GAUSS", _I2, JFL), _fl("Gaussian", 2)),
+            Written("gaussmf", (1, 0), matlab=True),
+            Written("Gaussian", _I2),
+            "gaussian",
         ),
         probe=(5, 2),
         studio=Studio(("c", "w / 6"), (_h(0, 1), _h(1, _E, 0, 1))),
@@ -457,16 +333,22 @@ ENTRIES: tuple[Shape, ...] = (
         jfl="exp(-(x - mean) * (x - mean) / (2 * sigma * sigma))",
     ),
     _smooth(
-        "gaussian2", ("mean1", "sigma1", "mean2", "sigma2"), ("x", "width", "x", "width"),
+        "gaussian2",
+        ("mean1", "sigma1", "mean2", "sigma2"),
+        ("x", "width", "x", "width"),
         "g1(x) * g2(x) where g1 = exp(-(x-mean1)^2 / (2 sigma1^2)) for x < mean1 else 1 and "
         "g2 = exp(-(x-mean2)^2 / (2 sigma2^2)) for x > mean2 else 1; so 1 between the means "
         "when mean1 <= mean2 (MATLAB gauss2mf, fuzzylite GaussianProduct, jFuzzyLogic GAUSS2)",
         "(gauss(x, mean1, sigma1) if x < mean1 else 1.0) * (gauss(x, mean2, sigma2) if x > mean2 else 1.0)",
         support=lambda p: (-math.inf, math.inf),
-        characteristic=lambda p: _sym(p[0], abs(p[1]), (-8, -4, -2, -1, 0)) + _sym(p[2], abs(p[3]), (0, 1, 2, 4, 8)),
+        characteristic=lambda p: (
+            _sym(p[0], abs(p[1]), (-8, -4, -2, -1, 0)) + _sym(p[2], abs(p[3]), (0, 1, 2, 4, 8))
+        ),
         spellings=_sp(
             _fcl(Written("GAUSS2", _I4, JFL), _fl("GaussianProduct", 4)),
-            Written("gauss2mf", (1, 0, 3, 2), matlab=True), Written("GaussianProduct", _I4), "gaussian2",
+            Written("gauss2mf", (1, 0, 3, 2), matlab=True),
+            Written("GaussianProduct", _I4),
+            "gaussian2",
         ),
         probe=(3, 1, 6, 1),
         studio=Studio(
@@ -479,7 +361,9 @@ ENTRIES: tuple[Shape, ...] = (
         "(exp(-(x - mean2) * (x - mean2) / (2 * sigma2 * sigma2)) if x > mean2 else 1.0)",
     ),
     _smooth(
-        "bell", ("center", "width", "slope"), ("x", "width", "number"),
+        "bell",
+        ("center", "width", "slope"),
+        ("x", "width", "number"),
         "1 / (1 + |(x-center)/width|^(2 slope))",
         # IEEE pow at the centre (u = 0), as fuzzylite and numpy: 0^e is 0 for e > 0, 1 for e = 0
         # and +inf for e < 0 (a negative slope is 0 at its centre); written out because
@@ -491,7 +375,9 @@ ENTRIES: tuple[Shape, ...] = (
         characteristic=lambda p: _sym(p[0], abs(p[1]), (-16, -4, -2, -1, 0, 1, 2, 4, 16)),
         spellings=_sp(
             _fcl(Written("GBELL", (2, 0, 1), JFL), _fl("Bell", 3), Written("generalizedBell", (2, 0, 1), SB)),
-            Written("gbellmf", (2, 0, 1), matlab=True), Written("Bell", _I3), "bell",
+            Written("gbellmf", (2, 0, 1), matlab=True),
+            Written("Bell", _I3),
+            "bell",
         ),
         probe=(5, 2, 2),
         studio=Studio(("c", "w / 4", "2"), (_h(0, 1), _h(1, 0.5, 0, 1))),
@@ -500,13 +386,18 @@ ENTRIES: tuple[Shape, ...] = (
         jfl="1.0 / (1.0 + pow(abs((x - center) / width), 2.0 * slope))",
     ),
     _smooth(
-        "sigmoid", ("center", "slope"), ("x", "slope"), "1 / (1 + exp(-slope (x-center)))",
+        "sigmoid",
+        ("center", "slope"),
+        ("x", "slope"),
+        "1 / (1 + exp(-slope (x-center)))",
         "sig(x, center, slope)",
         support=lambda p: (-math.inf, math.inf),
         characteristic=_sig_points,
         spellings=_sp(
             _fcl(Written("SIGM", (1, 0), JFL), _fl("Sigmoid", 2), Written("sigmoidal", (1, 0), SB)),
-            Written("sigmf", (1, 0), matlab=True), Written("Sigmoid", _I2), "sigmoid",
+            Written("sigmf", (1, 0), matlab=True),
+            Written("Sigmoid", _I2),
+            "sigmoid",
         ),
         probe=(5, 1),
         probe_output=(5, 1),
@@ -516,28 +407,36 @@ ENTRIES: tuple[Shape, ...] = (
         jfl="1.0 / (1.0 + exp(-slope * (x - center)))",
     ),
     _smooth(
-        "dsigmoid", ("center1", "slope1", "center2", "slope2"), ("x", "slope", "x", "slope"),
+        "dsigmoid",
+        ("center1", "slope1", "center2", "slope2"),
+        ("x", "slope", "x", "slope"),
         "|s1 - s2| of two sigmoids (fuzzylite SigmoidDifference)",
         "abs(sig(x, center1, slope1) - sig(x, center2, slope2))",
         support=lambda p: (-math.inf, math.inf),
         characteristic=_sig_points,
         spellings=_sp(
-            _fcl(_fl("SigmoidDifference", 4, (0, 1, 3, 2))), Written("dsigmf", (1, 0, 3, 2), matlab=True),
-            Written("SigmoidDifference", (0, 1, 3, 2)), "dsigmoid",
+            _fcl(_fl("SigmoidDifference", 4, (0, 1, 3, 2))),
+            Written("dsigmf", (1, 0, 3, 2), matlab=True),
+            Written("SigmoidDifference", (0, 1, 3, 2)),
+            "dsigmoid",
         ),
         probe=(2, 2, 8, 2),
         studio=Studio((*_SIG2, "20 / w"), (_h(0, 0.5), _h(2, 0.5))),
         span=Span("centers +- 9/|slope|", _two_sig_span),
     ),
     _smooth(
-        "dsigmoid_pos", ("center1", "slope1", "center2", "slope2"), ("x", "slope", "x", "slope"),
+        "dsigmoid_pos",
+        ("center1", "slope1", "center2", "slope2"),
+        ("x", "slope", "x", "slope"),
         "max(s1 - s2, 0) of two sigmoids (jFuzzyLogic DSIGM)",
         "max(sig(x, center1, slope1) - sig(x, center2, slope2), 0.0)",
         support=lambda p: (-math.inf, math.inf),
         characteristic=_sig_points,
         spellings=_sp(
-            _fcl(Written("DSIGM", (1, 0, 3, 2), JFL)), NA("MATLAB's dsigmf is |s1 - s2|: no FIS type"),
-            NA("fuzzylite's SigmoidDifference is |s1 - s2|: no FLL class"), "dsigmoid_pos",
+            _fcl(Written("DSIGM", (1, 0, 3, 2), JFL)),
+            NA("MATLAB's dsigmf is |s1 - s2|: no FIS type"),
+            NA("fuzzylite's SigmoidDifference is |s1 - s2|: no FLL class"),
+            "dsigmoid_pos",
         ),
         probe=(2, 2, 8, 2),
         studio=Studio((*_SIG2, "20 / w"), (_h(0, 0.5), _h(2, 0.5))),
@@ -546,31 +445,37 @@ ENTRIES: tuple[Shape, ...] = (
         "nan if isnan(d) else max(d, 0.0)",
     ),
     _smooth(
-        "psigmoid", ("center1", "slope1", "center2", "slope2"), ("x", "slope", "x", "slope"),
+        "psigmoid",
+        ("center1", "slope1", "center2", "slope2"),
+        ("x", "slope", "x", "slope"),
         "product of two sigmoids (psigmf / SigmoidProduct)",
         "sig(x, center1, slope1) * sig(x, center2, slope2)",
         support=lambda p: (-math.inf, math.inf),
         characteristic=_sig_points,
         spellings=_sp(
-            _fcl(_fl("SigmoidProduct", 4, (0, 1, 3, 2))), Written("psigmf", (1, 0, 3, 2), matlab=True),
-            Written("SigmoidProduct", (0, 1, 3, 2)), "psigmoid",
+            _fcl(_fl("SigmoidProduct", 4, (0, 1, 3, 2))),
+            Written("psigmf", (1, 0, 3, 2), matlab=True),
+            Written("SigmoidProduct", (0, 1, 3, 2)),
+            "psigmoid",
         ),
         probe=(2, 2, 8, -2),
         studio=Studio((*_SIG2, "-20 / w"), (_h(0, 0.5), _h(2, 0.5))),
         span=Span("centers +- 9/|slope|", _two_sig_span),
     ),
     _smooth(
-        "cosine", ("center", "width"), ("x", "width"),
+        "cosine",
+        ("center", "width"),
+        ("x", "width"),
         "(1 + cos(2 pi (x-center)/width)) / 2 on [center-width/2, center+width/2], 0 outside",
         "0.0 if x < center - 0.5 * width or x > center + 0.5 * width else "
         "0.5 * (1.0 + cos(2.0 / width * pi * (x - center)))",
         support=lambda p: (p[0] - 0.5 * abs(p[1]), p[0] + 0.5 * abs(p[1])),
         characteristic=lambda p: _sym(p[0], abs(p[1]), (-0.5, -0.25, 0, 0.25, 0.5)),
         spellings=_sp(
-            _fcl(
-                Written("COSINE", (1, 0), JFL, scale=(1.0, 2.0), ref_kind="cosine_half"), _fl("Cosine", 2)
-            ),
-            Written("cosinemf", _I2), Written("Cosine", _I2), "cosine",
+            _fcl(Written("COSINE", (1, 0), JFL, scale=(1.0, 2.0), ref_kind="cosine_half"), _fl("Cosine", 2)),
+            Written("cosinemf", _I2),
+            Written("Cosine", _I2),
+            "cosine",
         ),
         probe=(5, 6),
         studio=Studio(("c", "w"), (_h(0, 1), _h(1, 0, 0, 0.5))),
@@ -579,7 +484,9 @@ ENTRIES: tuple[Shape, ...] = (
         jfl="t = 0.5 * width; u = x - center\n(cos(u * (pi / t)) + 1) / 2 if -t <= u and u <= t else 0.0",
     ),
     _smooth(
-        "cosine_half", ("center", "half_width"), ("x", "width"),
+        "cosine_half",
+        ("center", "half_width"),
+        ("x", "width"),
         "(1 + cos(pi (x-center)/half_width)) / 2 on [center-half_width, center+half_width], "
         "0 outside: jFuzzyLogic COSINE net_max offset when net_max is a variable (with a "
         "literal net_max the reader gives cosine(offset, 2 net_max))",
@@ -590,7 +497,8 @@ ENTRIES: tuple[Shape, ...] = (
         spellings=_sp(
             _fcl(Written("COSINE", (1, 0), JFL, write_only=True)),
             NA("a cosine whose half width is a variable: FIS has no variables"),
-            NA("a cosine whose half width is a variable: FLL has no variables"), "cosine_half",
+            NA("a cosine whose half width is a variable: FLL has no variables"),
+            "cosine_half",
         ),
         probe=NA("jFuzzyLogic COSINE with a variable half-width: probed with a variable (COSINE hw 5)"),
         studio=Studio(("c", "w / 2"), (_h(0, 1), _h(1, 0, 0, 1)), pickable=False),
@@ -599,7 +507,9 @@ ENTRIES: tuple[Shape, ...] = (
         jfl="t = half_width; u = x - center\n(cos(u * (pi / t)) + 1) / 2 if -t <= u and u <= t else 0.0",
     ),
     _smooth(
-        "sshape", ("start", "end"), ("x", "x"),
+        "sshape",
+        ("start", "end"),
+        ("x", "x"),
         "0 for x <= start; 2 ((x-start)/(end-start))^2 up to (start+end)/2; "
         "1 - 2 ((x-end)/(end-start))^2 up to end; 1 for x >= end (smf, fuzzylite SShape)",
         "smf(x, start, end)",
@@ -615,7 +525,9 @@ ENTRIES: tuple[Shape, ...] = (
         "end - (end - start) * sqrt((h - y) / (2.0 * h))",
     ),
     _smooth(
-        "zshape", ("start", "end"), ("x", "x"),
+        "zshape",
+        ("start", "end"),
+        ("x", "x"),
         "1 - sshape(start, end): 1 for x <= start, 0 for x >= end (zmf, fuzzylite ZShape)",
         "zmf(x, start, end)",
         support=lambda p: (-math.inf, p[1]),
@@ -630,7 +542,10 @@ ENTRIES: tuple[Shape, ...] = (
         "end - (end - start) * sqrt(y / (2.0 * h))",
     ),
     _smooth(
-        "pishape", ("a", "b", "c", "d"), ("x", "x", "x", "x"), "S-shape a..b times Z-shape c..d",
+        "pishape",
+        ("a", "b", "c", "d"),
+        ("x", "x", "x", "x"),
+        "S-shape a..b times Z-shape c..d",
         "smf(x, a, b) * zmf(x, c, d)",
         support=lambda p: (p[0], p[3]),
         characteristic=lambda p: (p[0], 0.5 * (p[0] + p[1]), p[1], p[2], 0.5 * (p[2] + p[3]), p[3]),
@@ -643,16 +558,29 @@ ENTRIES: tuple[Shape, ...] = (
         degenerate=Degenerate("needs a < b and c < d", lambda p: not (p[0] < p[1] and p[2] < p[3])),
     ),
     Shape(
-        "ramp", ("start", "end"), ("x", "x"),
+        "ramp",
+        ("start", "end"),
+        ("x", "x"),
         "linear from 0 at start to 1 at end, clamped to [0, 1] outside (rising when "
         "start < end, falling when start > end; 0 everywhere when start == end)",
-        "pwl", _NOT_PWL, _ramp, _BP_SUPPORT, _BP_POINTS, "start + (end - start) * y / h",
+        "pwl",
+        _NOT_PWL,
+        _ramp,
+        _BP_SUPPORT,
+        _BP_POINTS,
+        "start + (end - start) * y / h",
         _sp(_fcl(_fl("Ramp", 2)), Written("rampmf", _I2), Written("Ramp", _I2), "ramp"),
-        (2, 8), Studio(("a", "b"), (_h(0, 0), _h(1, 1))),
-        NA("start == end is defined: 0 everywhere (fuzzylite)"), HULL, NO_JFL,
+        (2, 8),
+        Studio(("a", "b"), (_h(0, 0), _h(1, 1))),
+        NA("start == end is defined: 0 everywhere (fuzzylite)"),
+        HULL,
+        NO_JFL,
     ),
     _smooth(
-        "spike", ("center", "width"), ("x", "width"), "exp(-|10 (x-center) / width|)",
+        "spike",
+        ("center", "width"),
+        ("x", "width"),
+        "exp(-|10 (x-center) / width|)",
         "exp(-abs(10.0 / width * (x - center)))",
         support=lambda p: (-math.inf, math.inf),
         characteristic=lambda p: _sym(p[0], abs(p[1]) / 10.0, (-40, -8, -2, 0, 2, 8, 40)),
@@ -663,7 +591,9 @@ ENTRIES: tuple[Shape, ...] = (
         degenerate=_nonzero(1),
     ),
     _smooth(
-        "concave", ("inflection", "end"), ("x", "x"),
+        "concave",
+        ("inflection", "end"),
+        ("x", "x"),
         "inflection <= end: (end-inflection) / (2 end - inflection - x) for x < end, else 1; "
         "inflection > end: (inflection-end) / (inflection - 2 end + x) for x > end, else 1 "
         "(fuzzylite Concave)",
@@ -678,16 +608,29 @@ ENTRIES: tuple[Shape, ...] = (
         tsukamoto="h * (inflection - end) / y + 2.0 * end - inflection",
     ),
     Shape(
-        "binary", ("start", "direction"), ("x", "x"),
+        "binary",
+        ("start", "direction"),
+        ("x", "x"),
         "1 for x >= start when direction > start, 1 for x <= start when direction < start, "
         "0 elsewhere (fuzzylite Binary)",
-        "pwl", _NOT_PWL, _binary, _BP_SUPPORT, _BP_POINTS, NOT_MONOTONIC,
+        "pwl",
+        _NOT_PWL,
+        _binary,
+        _BP_SUPPORT,
+        _BP_POINTS,
+        NOT_MONOTONIC,
         _sp(_fcl(_fl("Binary", 2)), Written("binarymf", _I2), Written("Binary", _I2), "binary"),
-        (5, 10), Studio(("c", "b"), (_h(0, 0.5),)),
-        NA("direction == start is defined: 0 everywhere (fuzzylite)"), HULL, NO_JFL, infinite=(1,),
+        (5, 10),
+        Studio(("c", "b"), (_h(0, 0.5),)),
+        NA("direction == start is defined: 0 everywhere (fuzzylite)"),
+        HULL,
+        NO_JFL,
+        infinite=(1,),
     ),
     _smooth(
-        "arc", ("start", "end"), ("x", "x"),
+        "arc",
+        ("start", "end"),
+        ("x", "x"),
         "quarter ellipse: 0 before start, sqrt(r^2 - (x-end)^2) / |r| with r = end - start "
         "between start and end, 1 beyond end (pyfuzzylite Arc; falls when end < start)",
         # (x - end) / r, squared: sqrt(r^2 - (x-end)^2) / |r| without squaring r (1e300 overflows)
@@ -697,8 +640,10 @@ ENTRIES: tuple[Shape, ...] = (
         support=lambda p: (p[0], math.inf) if p[0] < p[1] else (-math.inf, p[0]),
         characteristic=lambda p: (p[0], 0.5 * (p[0] + p[1]), p[1]),
         spellings=_sp(
-            _fcl(_fl("Arc", 2)), NA("pyfuzzylite 8 only: no FIS type"),
-            Written("Arc", _I2, pyfuzzylite_only=True), "arc",
+            _fcl(_fl("Arc", 2)),
+            NA("pyfuzzylite 8 only: no FIS type"),
+            Written("Arc", _I2, pyfuzzylite_only=True),
+            "arc",
         ),
         probe=(2, 8),
         studio=Studio(("a", "b"), (_h(0, 0), _h(1, 1))),
@@ -707,7 +652,9 @@ ENTRIES: tuple[Shape, ...] = (
         "sqrt(max((r := end - start) * r - (q := y * r / h) * q, 0.0))",
     ),
     _smooth(
-        "semiellipse", ("start", "end"), ("x", "x"),
+        "semiellipse",
+        ("start", "end"),
+        ("x", "x"),
         "sqrt(r^2 - (x-c)^2) / r on [start, end] with c, r its centre and half-width, "
         "0 outside (pyfuzzylite SemiEllipse)",
         "s = min(start, end); e = max(start, end); r = 0.5 * (e - s); c = s + r\n"
@@ -715,30 +662,63 @@ ENTRIES: tuple[Shape, ...] = (
         support=lambda p: (min(p), max(p)),
         characteristic=lambda p: (p[0], 0.5 * (p[0] + p[1]), p[1]),
         spellings=_sp(
-            _fcl(_fl("SemiEllipse", 2)), NA("pyfuzzylite 8 only: no FIS type"),
-            Written("SemiEllipse", _I2, pyfuzzylite_only=True), "semiellipse",
+            _fcl(_fl("SemiEllipse", 2)),
+            NA("pyfuzzylite 8 only: no FIS type"),
+            Written("SemiEllipse", _I2, pyfuzzylite_only=True),
+            "semiellipse",
         ),
         probe=(2, 8),
         studio=Studio(("a", "b"), (_h(0, 0), _h(1, 0))),
         degenerate=Degenerate("needs start != end", lambda p: p[0] == p[1]),
     ),
     Shape(
-        "constant", ("value",), ("x",), "Takagi-Sugeno constant output", "ts", _TS_NA, _TS_NA, _TS_NA,
-        _TS_NA, NA("a Takagi-Sugeno output is averaged as it is"),
-        _sp(_fcl(Written("Constant", (0,), FL)), Written("constant", (0,)), Written("Constant", (0,)), "constant"),
-        (5.0,), Studio(("c",), ({"at": 0, "y": 1, "line": True},)), ANY, WHOLE_LINE,
-        NA("jFuzzyLogic reads it as a singleton at its value"), probe_output=(5.0,),
+        "constant",
+        ("value",),
+        ("x",),
+        "Takagi-Sugeno constant output",
+        "ts",
+        _TS_NA,
+        _TS_NA,
+        _TS_NA,
+        _TS_NA,
+        NA("a Takagi-Sugeno output is averaged as it is"),
+        _sp(
+            _fcl(Written("Constant", (0,), FL)),
+            Written("constant", (0,)),
+            Written("Constant", (0,)),
+            "constant",
+        ),
+        (5.0,),
+        Studio(("c",), ({"at": 0, "y": 1, "line": True},)),
+        ANY,
+        WHOLE_LINE,
+        NA("jFuzzyLogic reads it as a singleton at its value"),
+        probe_output=(5.0,),
     ),
     Shape(
-        "linear", ("coefficients",), ("coef",),
+        "linear",
+        ("coefficients",),
+        ("coef",),
         "Takagi-Sugeno linear output: sum(c_i * input_i) + constant, inputs in declaration order",
-        "ts", _TS_NA, _TS_NA, _TS_NA, _TS_NA, NA("a Takagi-Sugeno output is averaged as it is"),
+        "ts",
+        _TS_NA,
+        _TS_NA,
+        _TS_NA,
+        _TS_NA,
+        NA("a Takagi-Sugeno output is averaged as it is"),
         _sp(
-            _fcl(Written("Linear", (), FL, variadic=True)), Written("linear", (), variadic=True),
-            Written("Linear", (), variadic=True), "linear",
+            _fcl(Written("Linear", (), FL, variadic=True)),
+            Written("linear", (), variadic=True),
+            Written("Linear", (), variadic=True),
+            "linear",
         ),
-        (0.5, 0.25, 1.0), Studio((), ()), ANY, WHOLE_LINE,
-        NA("jFuzzyLogic has no linear output"), probe_output=(0.5, 0.25, 1.0), variadic=True,
+        (0.5, 0.25, 1.0),
+        Studio((), ()),
+        ANY,
+        WHOLE_LINE,
+        NA("jFuzzyLogic has no linear output"),
+        probe_output=(0.5, 0.25, 1.0),
+        variadic=True,
     ),
 )
 
@@ -763,7 +743,7 @@ def placement_tree(text: str) -> Any:
     import ast
 
     def tree(n: ast.expr) -> Any:
-        if isinstance(n, ast.Constant):
+        if isinstance(n, ast.Constant) and isinstance(n.value, int | float):
             return float(n.value)
         if isinstance(n, ast.Name):
             return n.id
