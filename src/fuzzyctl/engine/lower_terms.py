@@ -235,8 +235,6 @@ def _term(ctx: _Ctx, t: m.Term, var: str, outputs: dict[str, int], is_output: bo
     return tp
 
 
-
-
 def _unordered_vertices(ctx: _Ctx, tp: TermPlan, span: m.Span | None, where: str) -> TermPlan:
     """A triangle or trapezoid whose vertices are not in ascending order (node-fuzzylite's
     ``Trapezoid 1 0 2 3``) is read as fuzzylite reads it - its formula compares x with each

@@ -29,6 +29,7 @@ from fuzzyctl.kinds import shapes as registry
 
 __all__ = ["span", "span_rule"]
 
+
 def span_rule(kind: str) -> str:
     """How :func:`span` computes the universe of a term of ``kind`` (for messages)."""
     if kind in ("points", "singletons"):

@@ -117,7 +117,9 @@ class Shape:
     infinite: tuple[int, ...] = ()  # parameters that may be infinite (shoulders, directions)
     probe_output: tuple[float, ...] | None = None  # default: the probe doubled
     variadic: bool = False
-    tune_note: str = ""
+    jfl_refuses: Callable[[Sequence[float]], bool] | NA = field(
+        default_factory=lambda: NA("jFuzzyLogic reads every value its spelling can write")
+    )
     compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     # ---- family flags

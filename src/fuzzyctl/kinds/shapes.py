@@ -47,8 +47,11 @@ from fuzzyctl.kinds.shape_types import (
 
 __all__ = [
     "ENTRIES",
+    "FL",
     "HELPERS",
+    "JFL",
     "NA",
+    "SB",
     "SHAPES",
     "Degenerate",
     "Shape",
@@ -182,6 +185,7 @@ def _smooth(
     tsukamoto: str | NA = NOT_MONOTONIC,
     jfl: str | NA = NO_JFL,
     probe_output: tuple[float, ...] | None = None,
+    **extra: Any,
 ) -> Shape:
     return Shape(
         kind,
@@ -201,6 +205,7 @@ def _smooth(
         span,
         jfl,
         probe_output=probe_output,
+        **extra,
     )
 
 
@@ -357,6 +362,8 @@ ENTRIES: tuple[Shape, ...] = (
         ),
         span=Span("mean1 - 4 sigma1 .. mean2 + 4 sigma2", lambda p: (p[0] - 4.0 * p[1], p[2] + 4.0 * p[3])),
         degenerate=_SD2,
+        # jFuzzyLogic rejects GAUSS2 with mean1 > mean2 (fuzzylite's product form reads it)
+        jfl_refuses=lambda p: p[0] > p[2],
         jfl="exp(-(x - mean1) * (x - mean1) / (2 * sigma1 * sigma1)) if x < mean1 else "
         "(exp(-(x - mean2) * (x - mean2) / (2 * sigma2 * sigma2)) if x > mean2 else 1.0)",
     ),
