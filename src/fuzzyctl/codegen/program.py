@@ -30,6 +30,7 @@ from fuzzyctl.codegen.mamdani import ExactOutput, Group, exact_outputs
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.irrules import Contrib, Params, RuleBuilder, literal
 from fuzzyctl.engine.plan import OutputPlan, Plan, Slot, TermPlan
+from fuzzyctl.kinds import shapes as registry
 
 #: INFO codes (modelled on the Siemens FUZZY block's INFO byte).
 INFO_OK = 0x00
@@ -70,8 +71,9 @@ class _Builder(RuleBuilder):
                     y = ys.add(py * h, f"{where} y{k // 2}")
                 out.append((x, y))
             return out
-        if t.kind in ("triangle", "trapezoid"):
-            ylist = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
+        vertices = registry.vertices(t.kind)
+        if vertices is not None:  # the parameters are the x of the breakpoints
+            ylist = [v * h for v in vertices]
             return [
                 (self.pv(p, xs, f"{where} x{k}"), ys.add(y, f"{where} y{k}"))
                 for k, (p, y) in enumerate(zip(t.params, ylist, strict=True))

@@ -43,6 +43,7 @@ from fuzzyctl.engine.plan import (
     Slot,
     TermPlan,
 )
+from fuzzyctl.kinds import shapes as registry
 
 #: (term, degree, weight, ACT) of one activated set
 Contrib = tuple[int | None, Ex, Ex, str]
@@ -455,9 +456,9 @@ class RuleBuilder:
         term = op.terms[t]
         where = f"term {op.name}.{term.name}"
         n_in = len(self.plan.inputs)
-        if term.kind in ("singleton", "constant"):
+        if term.kind == "singleton" or registry.flag(term.kind, "ts_constant"):
             zs[t] = self.pv(term.params[0], coef, term.name)
-        elif term.kind == "linear":
+        elif registry.flag(term.kind, "ts_linear"):
             acc: Ex = Num(0.0)
             for i, c in enumerate(term.params[:n_in]):
                 acc = acc + self.pv(c, coef, f"{term.name} * {self.plan.inputs[i].name}") * self.inputs[i]

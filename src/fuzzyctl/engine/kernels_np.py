@@ -26,6 +26,7 @@ from fuzzyctl.engine import pwl, selection, shapes
 from fuzzyctl.engine.expr import eval_expr_np
 from fuzzyctl.engine.operators import accumulate_np, clamp_np
 from fuzzyctl.engine.plan import GridPlan, OutputPlan, Plan, Slot, TermPlan
+from fuzzyctl.kinds import shapes as registry
 
 Arr = npt.NDArray[np.float64]
 W = Any  # a weight: float or array
@@ -213,9 +214,9 @@ def _ts(
                 dtype=np.float64,
             )
         if t not in zs:
-            if term.kind in ("singleton", "constant"):
+            if term.kind == "singleton" or registry.flag(term.kind, "ts_constant"):
                 z = np.full(n, 1.0) * _pv(term.params[0], vals)
-            elif term.kind == "linear":
+            elif registry.flag(term.kind, "ts_linear"):
                 cs = [_pv(p, vals) for p in term.params]
                 m = len(vals)
                 z = np.zeros(n)

@@ -10,6 +10,7 @@ from fuzzyctl.engine import shapes, universe
 from fuzzyctl.engine.grid import build_grid
 from fuzzyctl.engine.lower_terms import _Ctx, _first_terms, _term, uses_x
 from fuzzyctl.engine.plan import Contribution, GridPlan, OutputPlan, PParam, RulePlan, Slot, TermPlan
+from fuzzyctl.kinds import shapes as registry
 
 METHOD_ALIASES = {
     "MM": "MOM",
@@ -180,7 +181,7 @@ def _ts_output(
         )
         return None
     for t in tps:
-        if t.kind == "linear" and len(t.params) > len(fb.inputs) + 1:
+        if registry.flag(t.kind, "ts_linear") and len(t.params) > len(fb.inputs) + 1:
             ctx.err(
                 f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
                 f"{len(fb.inputs)} inputs",

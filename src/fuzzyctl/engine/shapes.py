@@ -238,12 +238,9 @@ def _pwl_dynamic(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -
     if kind == "points":
         xs = np.stack(flat[0::2], axis=1)
         ys = np.stack(flat[1::2], axis=1) * hh[:, None]
-    elif kind == "triangle":
+    elif (vertices := registry.vertices(kind)) is not None:  # the parameters are the x
         xs = np.stack(flat, axis=1)
-        ys = np.stack([zero, hh, zero], axis=1)
-    elif kind == "trapezoid":
-        xs = np.stack(flat, axis=1)
-        ys = np.stack([zero, hh, hh, zero], axis=1)
+        ys = np.stack([zero if v == 0.0 else hh if v == 1.0 else v * hh for v in vertices], axis=1)
     else:
         # rectangle, ramp and binary change form with the order of their parameters: evaluate
         # each sample through the scalar definition (rare: variable points on such shapes).

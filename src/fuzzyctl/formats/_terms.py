@@ -74,6 +74,27 @@ FLL_ONLY_PYFUZZYLITE = frozenset(
 MONOTONIC_KINDS = registry.kinds_where(lambda s: s.tsukamoto_invertible)
 #: Takagi-Sugeno output kinds (no fixed arity in FIS and FLL).
 TS_KINDS = registry.kinds_where(lambda s: s.takagi_sugeno)
+#: FIS and FLL names of the Takagi-Sugeno kinds -> the kind.
+FIS_TS_TYPES: dict[str, str] = {
+    w.name: s.kind
+    for s in registry.ENTRIES
+    if s.takagi_sugeno and isinstance(w := s.spellings.fis, registry.Written)
+}
+FLL_TS_TYPES: dict[str, str] = {
+    w.name: s.kind
+    for s in registry.ENTRIES
+    if s.takagi_sugeno and isinstance(w := s.spellings.fll, registry.Written)
+}
+
+
+def fis_ts_name(kind: str) -> str:
+    """The FIS type of a Takagi-Sugeno kind (``constant``, ``linear``)."""
+    return next(name for name, k in FIS_TS_TYPES.items() if k == kind)
+
+
+def fll_ts_name(kind: str) -> str:
+    """The FLL class of a Takagi-Sugeno kind (``Constant``, ``Linear``)."""
+    return next(name for name, k in FLL_TS_TYPES.items() if k == kind)
 
 
 def shape(kind: str, params: tuple[float, ...], height: float = 1.0) -> ShapeMF:

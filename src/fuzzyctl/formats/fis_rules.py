@@ -18,6 +18,7 @@ from typing import Protocol
 from fuzzyctl.diagnostics import warning
 from fuzzyctl.formats._common import Reporter, parse_number, power_hedge
 from fuzzyctl.formats._expr import eval_constant, parse_expr
+from fuzzyctl.formats._terms import TS_KINDS as TS_SHAPE_KINDS
 from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
     And,
@@ -42,7 +43,7 @@ FUZZYLITE_HEDGE_CODES: dict[int, tuple[str, ...]] = {
     40: ("very", "very"),
 }
 ANY_CODE = 99
-TS_KINDS = frozenset({"constant", "linear"})
+TS_KINDS = TS_SHAPE_KINDS
 
 
 def is_ts_term(mf: MembershipFunction) -> bool:

@@ -31,7 +31,7 @@ from fuzzyctl.formats._common import Reporter, parse_number
 from fuzzyctl.formats._expr import ExprError, parse_function
 from fuzzyctl.formats._fll_rules import HEDGE_WORDS as HEDGE_WORDS  # the writer avoids them as names
 from fuzzyctl.formats._fll_rules import Lookup, RuleError, parse_rule
-from fuzzyctl.formats._terms import FLL_TYPES
+from fuzzyctl.formats._terms import FLL_TS_TYPES, FLL_TYPES
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -187,7 +187,7 @@ def _term(
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) != 1:
             raise rep.fail(f"Constant {name!r} takes one value, found {len(params)}", line, code="fll-term")
-        mf = ShapeMF("constant", (params[0],))
+        mf = ShapeMF(FLL_TS_TYPES[cls], (params[0],))
     elif cls == "Linear":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) == n_inputs:
@@ -199,7 +199,7 @@ def _term(
                 line,
                 code="fll-term",
             )
-        mf = ShapeMF("linear", tuple(params))
+        mf = ShapeMF(FLL_TS_TYPES[cls], tuple(params))
     elif cls == "Discrete":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         height = params.pop() if len(params) % 2 == 1 else 1.0

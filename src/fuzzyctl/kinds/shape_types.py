@@ -117,6 +117,9 @@ class Shape:
     infinite: tuple[int, ...] = ()  # parameters that may be infinite (shoulders, directions)
     probe_output: tuple[float, ...] | None = None  # default: the probe doubled
     variadic: bool = False
+    vertices: tuple[float, ...] | NA = field(
+        default_factory=lambda: NA("its parameters are not the x of its breakpoints")
+    )  # the degrees at the parameters, when the parameters are the breakpoints' x in order
     jfl_refuses: Callable[[Sequence[float]], bool] | NA = field(
         default_factory=lambda: NA("jFuzzyLogic reads every value its spelling can write")
     )
@@ -138,6 +141,22 @@ class Shape:
     @property
     def tsukamoto_invertible(self) -> bool:
         return not isinstance(self.tsukamoto, NA)
+
+    @property
+    def ts_constant(self) -> bool:
+        """A Takagi-Sugeno output whose value is its one parameter."""
+        return self.takagi_sugeno and not self.variadic
+
+    @property
+    def ts_linear(self) -> bool:
+        """A Takagi-Sugeno output linear in the inputs (coefficients, then the constant)."""
+        return self.takagi_sugeno and self.variadic
+
+    @property
+    def centre_spread(self) -> bool:
+        """Its first two parameters are a centre and a spread around it (a bump: gaussian,
+        bell, cosine, spike...): it matters within a few spreads of the centre."""
+        return self.roles[:2] == ("x", "width")
 
     # ---- derived views
     @property

@@ -59,9 +59,11 @@ __all__ = [
     "Spellings",
     "Studio",
     "Written",
+    "flag",
     "get",
     "kinds_where",
     "placement_tree",
+    "vertices",
 ]
 
 
@@ -262,6 +264,7 @@ ENTRIES: tuple[Shape, ...] = (
         "0.0 if x < a or x > c else "
         "(1.0 if x == b else ((x - a) / (b - a) if x < b else 1 - (x - b) / (c - b)))",
         infinite=(0, 1, 2),
+        vertices=(0.0, 1.0, 0.0),
     ),
     Shape(
         "trapezoid",
@@ -291,6 +294,7 @@ ENTRIES: tuple[Shape, ...] = (
         "0.0 if x < a or x > d else (1.0 if x >= b and x <= c else "
         "((x - a) / (b - a) if x < b else 1 - (x - c) / (d - c)))",
         infinite=(0, 1, 2, 3),
+        vertices=(0.0, 1.0, 1.0, 0.0),
     ),
     Shape(
         "rectangle",
@@ -737,6 +741,22 @@ def get(kind: str) -> Shape | None:
     """The entry of ``kind``, or ``None`` for a kind that is not a parametric shape (IEC
     points, singletons, function terms)."""
     return SHAPES.get(kind)
+
+
+def flag(kind: str, name: str) -> bool:
+    """A flag of ``kind``'s entry (``"ts_constant"``, ``"takagi_sugeno"``, ...); False for a
+    kind that is not a parametric shape (points, singletons, function terms)."""
+    shape = SHAPES.get(kind)
+    return bool(getattr(shape, name)) if shape is not None else False
+
+
+def vertices(kind: str) -> tuple[float, ...] | None:
+    """The degrees at the parameters of a shape whose parameters are its breakpoints' x in
+    order (triangle, trapezoid), else None."""
+    shape = SHAPES.get(kind)
+    if shape is None or isinstance(shape.vertices, NA):
+        return None
+    return shape.vertices
 
 
 def kinds_where(flag: Callable[[Shape], bool]) -> frozenset[str]:
