@@ -42,6 +42,7 @@ from fuzzyctl.model import (
     FuzzifyBlock,
     PointsMF,
     Range,
+    Ref,
     Rule,
     RuleBlock,
     ShapeMF,
@@ -278,24 +279,26 @@ def _term_slots(
         if _const(mf.value):
             yield ("term", var, ti, 0), _num(mf.value), "x", base
     elif isinstance(mf, ShapeMF):
-        if not all(_const(p) for p in mf.params):
-            return
         shape = SHAPES.get(mf.kind)
-        if shape is None:
-            return
-        roles = shape.tuning
+        if shape is None or not all(_const(p) or isinstance(p, Ref) for p in mf.params):
+            return  # an infinite parameter (a shoulder): kept as written
+        roles = [shape.tuning[min(k, len(shape.tuning) - 1)] for k in range(len(mf.params))]  # variadic: last
+        variable = [isinstance(p, Ref) for p in mf.params]
+        # a parameter given by a variable stays; the term's other abscissae too when one of
+        # them is a variable (their order against it is unknown), its scales move
+        fixed_x = any(v and r == "abscissa" for v, r in zip(variable, roles, strict=True))
         for k, c in enumerate(mf.params):
-            role = roles[min(k, len(roles) - 1)]  # a variadic shape repeats its last role
+            if variable[k]:
+                continue
             v = _num(c)
-            if role == "coef":
+            if roles[k] == "coef":
                 what = f"coefficient of {inputs[k]}" if shape.variadic and k < len(inputs) else "constant"
                 yield ("term", var, ti, k), v, "coef", f"{base} {what}"
-            elif role == "abscissa" and math.isfinite(v):
+            elif roles[k] == "abscissa" and math.isfinite(v) and not fixed_x:
                 yield ("term", var, ti, k), v, "x", f"{base} {shape.params[k]}"
         for k, c in enumerate(mf.params):
-            v = _num(c)
-            if roles[min(k, len(roles) - 1)] in ("scale", "slope") and v != 0.0 and math.isfinite(v):
-                yield ("term", var, ti, k), v, "scale", f"{base} {shape.params[k]}"
+            if not variable[k] and roles[k] in ("scale", "slope") and _num(c) != 0.0:
+                yield ("term", var, ti, k), _num(c), "scale", f"{base} {shape.params[k]}"
 
 
 def _universe(fb: FunctionBlock, var: str, xs: Sequence[float]) -> tuple[float, float]:
