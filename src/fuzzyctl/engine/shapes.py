@@ -1,8 +1,10 @@
-"""Membership functions: the one place where shape formulas live.
+"""Membership functions: evaluation of the shape registry's formulas.
 
-Every shape kind of :data:`fuzzyctl.model.SHAPES` is defined here twice, once for a Python
-float (``math``) and once for numpy arrays, with the same formula written the same way, so
-the scalar and the batch evaluators agree to the last few ulps.
+Every shape kind of :data:`fuzzyctl.model.SHAPES` is an entry of :mod:`fuzzyctl.kinds.shapes`
+whose formula is written once; here it is compiled for a Python float (``math``) and for
+numpy arrays (:data:`NUMPY`: the C library's functions element by element) from the same
+syntax tree, so the scalar and the batch evaluators agree to the last bit (and
+:mod:`fuzzyctl.engine.irterms` translates the same tree to the IR of the generated code).
 
 Piecewise-linear shapes (IEC points, triangle, trapezoid, rectangle, ramp, binary) are also
 expressed as *breakpoint lists* (:func:`pwl_points`): ``((x0, y0), (x1, y1), ...)`` with
