@@ -161,9 +161,16 @@ def pwl_value_dynamic_np(xs: FloatArray, ys: FloatArray, x: FloatArray) -> Float
 # --------------------------------------------------------------------------- smooth shapes
 
 
+#: kind -> the float form of its formula (filled on first use: the hot path of membership)
+_FLOAT: dict[str, Callable[..., float]] = {}
+
+
 def smooth(kind: str, p: Sequence[float], x: float) -> float:
     """A smooth shape's formula (the registry's, compiled for floats) at ``x``, height 1."""
-    return float(_compiled(kind, "float")(x, *p))
+    fn = _FLOAT.get(kind)
+    if fn is None:
+        fn = _FLOAT[kind] = _compiled(kind, "float")
+    return fn(x, *p)
 
 
 def smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:

@@ -163,10 +163,47 @@ class _Vectorise(ast.NodeTransformer):
         return acc
 
 
-def _source(f: Formula, name: str, vector: bool) -> str:
+class _Inline(ast.NodeTransformer):
+    """Calls of helper formulas written in place (a Python call costs more than the helper's
+    arithmetic): the helper's arguments replaced by the caller's names or numbers, its own
+    names renamed apart.  A call with a computed argument, or of a helper with ``lets``,
+    stays a call."""
+
+    def __init__(self, helpers: Mapping[str, Formula]) -> None:
+        self.helpers = helpers
+        self.count = 0
+
+    def visit_Call(self, node: ast.Call) -> ast.AST:
+        self.generic_visit(node)
+        helper = self.helpers.get(node.func.id) if isinstance(node.func, ast.Name) else None
+        simple = all(isinstance(a, ast.Name | ast.Constant) for a in node.args)
+        if helper is None or helper.lets or not simple:
+            return node
+        self.count += 1
+        args = dict(zip(helper.args, node.args, strict=True))
+        suffix = f"_{node.func.id}{self.count}"  # type: ignore[attr-defined]
+
+        class Rename(ast.NodeTransformer):
+            def visit_Call(self, n: ast.Call) -> ast.AST:
+                n.args = [self.visit(a) for a in n.args]  # the function's name stays
+                return n
+
+            def visit_Name(self, n: ast.Name) -> ast.AST:
+                if n.id in args:
+                    return args[n.id]
+                return ast.Name(n.id + suffix if n.id not in CONSTANTS else n.id, n.ctx)
+
+        body = ast.parse(ast.unparse(helper.body), mode="eval").body
+        return self.visit(Rename().visit(body))  # type: ignore[no-any-return]
+
+
+def _source(f: Formula, name: str, vector: bool, helpers: Mapping[str, Formula]) -> str:
+    inline = _Inline(helpers)
+
     def text(e: ast.expr) -> str:
+        e = inline.visit(ast.parse(ast.unparse(e), mode="eval")).body
         if vector:
-            e = _Vectorise().visit(ast.parse(ast.unparse(e), mode="eval")).body
+            e = _Vectorise().visit(e)
         return ast.unparse(ast.fix_missing_locations(e))
 
     lines = [f"def {name}({', '.join(f.args)}):"]
@@ -181,7 +218,7 @@ def _compile(
     ns: dict[str, Any] = dict(namespace)
     for h in sorted(f.helpers()):
         ns[h] = _compile(helpers[h], namespace, helpers, vector)
-    code = _source(f, "formula", vector)
+    code = _source(f, "formula", vector, helpers)
     exec(compile(code, f"<formula {f.source!r}>", "exec"), ns)
     fn: Callable[..., Any] = ns["formula"]
     return fn

@@ -381,7 +381,7 @@ ENTRIES: tuple[Shape, ...] = (
         # Structured Text has no pow(0, e)
         "u = abs((x - center) / width); e = 2.0 * slope\n"
         "1.0 / (1.0 + pow(u, e)) if u > 0.0 else "
-        "((1.0 if e > 0.0 else (0.5 if e == 0.0 else (0.0 if e < 0.0 else u + e))) if u == 0.0 else u + e)",
+        "((1.0 if e > 0.0 else (0.5 if e == 0.0 else (0.0 if e < 0.0 else e))) if u == 0.0 else u)",
         support=lambda p: (-math.inf, math.inf),
         characteristic=lambda p: _sym(p[0], abs(p[1]), (-16, -4, -2, -1, 0, 1, 2, 4, 16)),
         spellings=_sp(
