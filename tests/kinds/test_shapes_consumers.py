@@ -229,12 +229,9 @@ def test_studio_places_a_shape_the_engine_reads(shape: Shape, catalogue: dict[st
     )
     fuzzyctl.compile(placed, backend="interpreted")  # no diagnostic: a valid shape
     if not shape.takagi_sugeno:
-        # placed on the support [a, b]: where it is highest touches it
-        xs = sorted({*np.linspace(a - 10, b + 10, 401).tolist(), a, b, c})
-        mu = [membership(shape.kind, params, 1.0, x) for x in xs]
-        top = max(mu)
-        xs_top = [x for x, m in zip(xs, mu, strict=True) if m >= top - 1e-9]
-        assert top > 0.0 and min(xs_top) <= b and max(xs_top) >= a, (params, xs_top[:3], xs_top[-3:])
+        # placed on the support [a, b]: it reaches half its height there
+        mu = [membership(shape.kind, params, 1.0, x) for x in np.linspace(a, b, 241)]
+        assert max(mu) >= 0.5, (params, max(mu))
 
 
 @pytest.mark.parametrize("shape", ENTRIES, ids=IDS)
