@@ -27,6 +27,8 @@ from functools import cached_property
 from typing import TypeAlias
 
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds.shapes import SHAPES as SHAPE_REGISTRY
+from fuzzyctl.kinds.shapes import Shape
 
 # --------------------------------------------------------------------------- comments
 
@@ -127,116 +129,14 @@ class SingletonsMF:
     points: tuple[Point, ...]
 
 
-@dataclass(frozen=True)
-class ShapeSpec:
-    """Description of a parametric shape kind: parameter names and their meaning."""
+#: A parametric shape kind's entry (parameters, their meaning, the formula, ...).
+ShapeSpec = Shape
 
-    kind: str
-    params: tuple[str, ...]
-    summary: str
-    variadic: bool = False
-
-
-# Canonical parametric shapes.  Each reader maps its own spelling and parameter order onto
-# these (e.g. jFuzzyLogic ``GBELL a b mean`` and fuzzylite ``Bell center width slope`` both
-# become ``bell(center, width, slope)``); writers map back.  Formulas live in
-# ``fuzzyctl.engine.semantics.shapes`` and nowhere else.
-SHAPES: dict[str, ShapeSpec] = {
-    s.kind: s
-    for s in (
-        ShapeSpec("triangle", ("a", "b", "c"), "0 at a, 1 at b, 0 at c, linear between"),
-        ShapeSpec("trapezoid", ("a", "b", "c", "d"), "0 at a, 1 on [b, c], 0 at d"),
-        ShapeSpec("rectangle", ("start", "end"), "1 on [start, end], 0 elsewhere"),
-        ShapeSpec("gaussian", ("mean", "sigma"), "exp(-(x-mean)^2 / (2 sigma^2))"),
-        ShapeSpec(
-            "gaussian2",
-            ("mean1", "sigma1", "mean2", "sigma2"),
-            "g1(x) * g2(x) where g1 = exp(-(x-mean1)^2 / (2 sigma1^2)) for x < mean1 else 1 and "
-            "g2 = exp(-(x-mean2)^2 / (2 sigma2^2)) for x > mean2 else 1; so 1 between the means "
-            "when mean1 <= mean2 (MATLAB gauss2mf, fuzzylite GaussianProduct, jFuzzyLogic GAUSS2)",
-        ),
-        ShapeSpec("bell", ("center", "width", "slope"), "1 / (1 + |(x-center)/width|^(2 slope))"),
-        ShapeSpec("sigmoid", ("center", "slope"), "1 / (1 + exp(-slope (x-center)))"),
-        ShapeSpec(
-            "dsigmoid",
-            ("center1", "slope1", "center2", "slope2"),
-            "|s1 - s2| of two sigmoids (fuzzylite SigmoidDifference)",
-        ),
-        ShapeSpec(
-            "dsigmoid_pos",
-            ("center1", "slope1", "center2", "slope2"),
-            "max(s1 - s2, 0) of two sigmoids (jFuzzyLogic DSIGM)",
-        ),
-        ShapeSpec(
-            "psigmoid",
-            ("center1", "slope1", "center2", "slope2"),
-            "product of two sigmoids (psigmf / SigmoidProduct)",
-        ),
-        ShapeSpec(
-            "cosine",
-            ("center", "width"),
-            "(1 + cos(2 pi (x-center)/width)) / 2 on [center-width/2, center+width/2], 0 outside",
-        ),
-        ShapeSpec(
-            "cosine_half",
-            ("center", "half_width"),
-            "(1 + cos(pi (x-center)/half_width)) / 2 on [center-half_width, center+half_width], "
-            "0 outside: jFuzzyLogic COSINE net_max offset when net_max is a variable (with a "
-            "literal net_max the reader gives cosine(offset, 2 net_max))",
-        ),
-        ShapeSpec(
-            "sshape",
-            ("start", "end"),
-            "0 for x <= start; 2 ((x-start)/(end-start))^2 up to (start+end)/2; "
-            "1 - 2 ((x-end)/(end-start))^2 up to end; 1 for x >= end (smf, fuzzylite SShape)",
-        ),
-        ShapeSpec(
-            "zshape",
-            ("start", "end"),
-            "1 - sshape(start, end): 1 for x <= start, 0 for x >= end (zmf, fuzzylite ZShape)",
-        ),
-        ShapeSpec("pishape", ("a", "b", "c", "d"), "S-shape a..b times Z-shape c..d"),
-        ShapeSpec(
-            "ramp",
-            ("start", "end"),
-            "linear from 0 at start to 1 at end, clamped to [0, 1] outside (rising when "
-            "start < end, falling when start > end; 0 everywhere when start == end)",
-        ),
-        ShapeSpec("spike", ("center", "width"), "exp(-|10 (x-center) / width|)"),
-        ShapeSpec(
-            "concave",
-            ("inflection", "end"),
-            "inflection <= end: (end-inflection) / (2 end - inflection - x) for x < end, else 1; "
-            "inflection > end: (inflection-end) / (inflection - 2 end + x) for x > end, else 1 "
-            "(fuzzylite Concave)",
-        ),
-        ShapeSpec(
-            "binary",
-            ("start", "direction"),
-            "1 for x >= start when direction > start, 1 for x <= start when direction < start, "
-            "0 elsewhere (fuzzylite Binary)",
-        ),
-        ShapeSpec(
-            "arc",
-            ("start", "end"),
-            "quarter ellipse: 0 before start, sqrt(r^2 - (x-end)^2) / |r| with r = end - start "
-            "between start and end, 1 beyond end (pyfuzzylite Arc; falls when end < start)",
-        ),
-        ShapeSpec(
-            "semiellipse",
-            ("start", "end"),
-            "sqrt(r^2 - (x-c)^2) / r on [start, end] with c, r its centre and half-width, "
-            "0 outside (pyfuzzylite SemiEllipse)",
-        ),
-        ShapeSpec("constant", ("value",), "Takagi-Sugeno constant output"),
-        ShapeSpec(
-            "linear",
-            ("coefficients",),
-            "Takagi-Sugeno linear output: sum(c_i * input_i) + constant, inputs in declaration order",
-            variadic=True,
-        ),
-    )
-}
+# Canonical parametric shapes: the registry :mod:`fuzzyctl.kinds.shapes`, one entry per
+# kind.  Each reader maps its own spelling and parameter order onto these (e.g. jFuzzyLogic
+# ``GBELL a b mean`` and fuzzylite ``Bell center width slope`` both become
+# ``bell(center, width, slope)``) through the entry's spellings; writers map back.
+SHAPES: dict[str, Shape] = SHAPE_REGISTRY
 
 
 @dataclass(frozen=True)

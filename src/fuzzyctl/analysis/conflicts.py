@@ -24,6 +24,7 @@ from fuzzyctl.engine.explain import Explanation
 from fuzzyctl.engine.plan import TermPlan
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.engine.semantics.operators import TNORMS
+from fuzzyctl.kinds import shapes as registry
 
 DEFAULT_DELTA = 0.5
 #: conflicts reported at most (each is confirmed by an explanation of the whole block)
@@ -45,10 +46,10 @@ def term_support(t: TermPlan) -> tuple[float, float] | None:
     """The closed support of an output term (a point for singletons), None when unknown."""
     if not t.constant:
         return None
-    if t.kind in ("singleton", "constant"):
+    if t.kind == "singleton" or registry.flag(t.kind, "ts_constant"):
         v = float(t.params[0])  # type: ignore[arg-type]
         return (v, v)
-    if t.kind in ("function", "linear"):
+    if t.kind == "function" or registry.flag(t.kind, "ts_linear"):
         return None
     try:
         return shapes.support(t.kind, [float(p) for p in t.params], float(t.height))  # type: ignore[arg-type]

@@ -79,7 +79,7 @@ def term_points(t: TermPlan) -> list[float]:
     """The breakpoints of a piecewise-linear term, else its characteristic points."""
     if t.pwl is not None:
         return [x for x, _y in t.pwl]
-    if not t.constant or t.kind in ("function", "constant", "linear"):
+    if not t.constant or t.kind in shapes.TS_KINDS:
         return []
     return list(shapes.characteristic_points(t.kind, [float(p) for p in t.params]))  # type: ignore[arg-type]
 
@@ -105,7 +105,7 @@ def term_values(t: TermPlan, x: FloatArray) -> FloatArray:
     """The engine's membership of ``t`` at ``x`` (constant parameters only)."""
     if t.pwl is not None:
         return shapes.pwl_value_np(t.pwl, x)
-    if not t.constant or t.kind in ("function", "constant", "linear"):
+    if not t.constant or t.kind in shapes.TS_KINDS:
         raise FuzzyctlError(
             f"analyze: term {t.name!r} ({t.kind}) has parameters given by variables or no "
             "membership function of its input alone; the analysis needs constant terms"

@@ -27,6 +27,7 @@ from fuzzyctl.analysis.context import Context, FloatArray, term_values
 from fuzzyctl.analysis.table import Row
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.plan import CTerm, TermPlan
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
 
@@ -70,7 +71,7 @@ def parse_declarations(specs: list[str], inputs: tuple[str, ...], outputs: list[
 
 def centre(t: TermPlan, low: float, high: float) -> float:
     """The middle of where a term is highest on [low, high] (a singleton: its position)."""
-    if t.kind in ("singleton", "constant"):
+    if t.kind == "singleton" or registry.flag(t.kind, "ts_constant"):
         return float(t.params[0])  # type: ignore[arg-type]
     xs = np.linspace(low, high, 4097)
     if t.pwl is not None:
@@ -88,7 +89,10 @@ def rule_table(
     op = plan.outputs[o]
     lo, hi = (op.low, op.high) if op.low is not None and op.high is not None else (-1e300, 1e300)
     out_c = [
-        centre(t, lo, hi) if t.constant and t.kind not in ("linear", "function") else np.nan for t in op.terms
+        centre(t, lo, hi)
+        if t.constant and not (t.kind == "function" or registry.flag(t.kind, "ts_linear"))
+        else np.nan
+        for t in op.terms
     ]
     slot = ctx.inputs.index(d.input)
     groups: dict[tuple[object, ...], list[tuple[float, float, Row]]] = {}
@@ -142,7 +146,7 @@ def proven(ctx: Context, used: list[tuple[Row, int]], d: Declaration) -> bool:
         return False
     if op.kind == "ts" and (
         METHODS[op.method].weighted != "average"
-        or any(t.kind not in ("constant", "singleton") for t in op.terms)
+        or any(not (t.kind == "singleton" or registry.flag(t.kind, "ts_constant")) for t in op.terms)
     ):
         return False
     if op.kind not in ("singleton", "ts") or not used:

@@ -21,6 +21,7 @@ from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.engine.reference.interp import Interpreter
 from fuzzyctl.escape import c_comment, c_ident, st_comment, st_ident
 from fuzzyctl.ir.state import CodegenError
+from fuzzyctl.kinds import shapes as registry
 
 #: relative tolerance (of each output's range) by arithmetic
 TOLERANCE = {"REAL": 1e-4, "LREAL": 1e-9, "float": 1e-4, "double": 1e-9}
@@ -62,7 +63,7 @@ def _bounds(plan: Plan, i: int) -> tuple[float, float]:
                 xs += [x for x, _y in t.pwl]
                 continue
             nums = [float(p) for p in t.params if not isinstance(p, Slot)]
-            if t.kind in ("gaussian", "bell", "spike", "cosine") and len(nums) >= 2:
+            if registry.flag(t.kind, "centre_spread") and len(nums) >= 2:  # a bump: around it
                 xs += [nums[0] - 3 * abs(nums[1]), nums[0] + 3 * abs(nums[1])]
             else:
                 xs += nums

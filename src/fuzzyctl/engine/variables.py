@@ -44,7 +44,7 @@ class TermInfo:
         xs = np.asarray(x, dtype=np.float64)
         if self.points is not None:
             return shapes.pwl_value_np(self.points, xs.reshape(-1)).reshape(xs.shape)
-        if self.kind in ("function", "constant", "linear") or any(isinstance(p, str) for p in self.params):
+        if self.kind in shapes.TS_KINDS or any(isinstance(p, str) for p in self.params):
             raise ValueError(f"term {self.name!r} ({self.kind}) has no membership function of x alone")
         if isinstance(self.height, str):
             raise ValueError(f"term {self.name!r}: its height is given by variable {self.height!r}")

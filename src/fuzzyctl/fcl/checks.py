@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl.jfl import check_jfuzzylogic
 from fuzzyctl.fcl.reserved import check_reserved_words
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
@@ -117,7 +118,9 @@ def mf_params(mf: object) -> list[Param]:
 
 
 def is_singleton(mf: object) -> bool:
-    return isinstance(mf, SingletonMF | SingletonsMF) or (isinstance(mf, ShapeMF) and mf.kind == "constant")
+    return isinstance(mf, SingletonMF | SingletonsMF) or (
+        isinstance(mf, ShapeMF) and registry.flag(mf.kind, "ts_constant")
+    )
 
 
 # --------------------------------------------------------------------------- built-in checks

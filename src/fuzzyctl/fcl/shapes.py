@@ -17,9 +17,12 @@ to write them back.  Every mapping was checked against the tool's source:
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import SHAPES, Param, Ref, ShapeMF
 
 
@@ -55,47 +58,39 @@ class Spelling:
         return f"{self.written} {' '.join(written)}{extra}".strip()
 
 
-JFL, FL, SB = "jFuzzyLogic", "fuzzylite", "scalablurry"
+JFL, FL, SB = registry.JFL, registry.FL, registry.SB
+_DIALECTS = (JFL, FL, SB)
 
-SPELLINGS: tuple[Spelling, ...] = (
-    # jFuzzyLogic
-    Spelling("TRIAN", "triangle", (0, 1, 2), JFL),
-    Spelling("TRAPE", "trapezoid", (0, 1, 2, 3), JFL),
-    Spelling("GAUSS", "gaussian", (0, 1), JFL),
-    Spelling("GAUSS2", "gaussian2", (0, 1, 2, 3), JFL),
-    Spelling("GBELL", "bell", (2, 0, 1), JFL),
-    Spelling("SIGM", "sigmoid", (1, 0), JFL),
-    Spelling("DSIGM", "dsigmoid_pos", (1, 0, 3, 2), JFL),
-    Spelling("COSINE", "cosine", (1, 0), JFL, scale=(1.0, 2.0), ref_kind="cosine_half"),
-    # fuzzylite (optional trailing height)
-    Spelling("Triangle", "triangle", (0, 1, 2), FL, height=True),
-    Spelling("Trapezoid", "trapezoid", (0, 1, 2, 3), FL, height=True),
-    Spelling("Rectangle", "rectangle", (0, 1), FL, height=True),
-    Spelling("Gaussian", "gaussian", (0, 1), FL, height=True),
-    Spelling("GaussianProduct", "gaussian2", (0, 1, 2, 3), FL, height=True),
-    Spelling("Bell", "bell", (0, 1, 2), FL, height=True),
-    Spelling("Sigmoid", "sigmoid", (0, 1), FL, height=True),
-    Spelling("SigmoidDifference", "dsigmoid", (0, 1, 3, 2), FL, height=True),
-    Spelling("SigmoidProduct", "psigmoid", (0, 1, 3, 2), FL, height=True),
-    Spelling("Cosine", "cosine", (0, 1), FL, height=True),
-    Spelling("SShape", "sshape", (0, 1), FL, height=True),
-    Spelling("ZShape", "zshape", (0, 1), FL, height=True),
-    Spelling("PiShape", "pishape", (0, 1, 2, 3), FL, height=True),
-    Spelling("Ramp", "ramp", (0, 1), FL, height=True),
-    Spelling("Spike", "spike", (0, 1), FL, height=True),
-    Spelling("Concave", "concave", (0, 1), FL, height=True),
-    Spelling("Binary", "binary", (0, 1), FL, height=True),
-    # pyfuzzylite 8 terms (its FCL export writes the class name like the others)
-    Spelling("Arc", "arc", (0, 1), FL, height=True),
-    Spelling("SemiEllipse", "semiellipse", (0, 1), FL, height=True),
-    Spelling("Constant", "constant", (0,), FL),
-    Spelling("Linear", "linear", (), FL, variadic=True),
-    # scalablurry
-    Spelling("triangular", "triangle", (0, 1, 2), SB),
-    Spelling("trapetzoidal", "trapezoid", (0, 1, 2, 3), SB),
-    Spelling("generalizedBell", "bell", (2, 0, 1), SB),
-    Spelling("sigmoidal", "sigmoid", (1, 0), SB),
-)
+
+def _spellings() -> tuple[Spelling, ...]:
+    """Every FCL spelling of the registry's entries, jFuzzyLogic's first, then fuzzylite's,
+    then scalablurry's (the first of a name wins when names clash without case)."""
+    out: list[Spelling] = []
+    for shape in registry.ENTRIES:
+        fcl = shape.spellings.fcl
+        if isinstance(fcl, registry.NA):
+            continue
+        for w in fcl:
+            if not w.write_only:
+                spelling = Spelling(w.name, shape.kind, w.order, w.dialect, w.height, w.scale, w.ref_kind)
+                out.append(dataclasses.replace(spelling, variadic=w.variadic))
+    return tuple(sorted(out, key=lambda s: _DIALECTS.index(s.dialect)))
+
+
+def _written_only() -> dict[str, Spelling]:
+    """Kinds the reader never gives (a cosine whose half width is a variable) and how the
+    writer spells them."""
+    out: dict[str, Spelling] = {}
+    for shape in registry.ENTRIES:
+        fcl = shape.spellings.fcl
+        for w in () if isinstance(fcl, registry.NA) else fcl:
+            if w.write_only:
+                out[shape.kind] = Spelling(w.name, shape.kind, w.order, w.dialect)
+    return out
+
+
+SPELLINGS: tuple[Spelling, ...] = _spellings()
+WRITE_ONLY: dict[str, Spelling] = _written_only()
 
 # Names are case-insensitive, as FCL keywords are, with one clash: jFuzzyLogic ``COSINE
 # net_max offset`` and fuzzylite ``Cosine center width``.  fuzzylite always writes exactly
@@ -115,7 +110,6 @@ for _s in SPELLINGS:
 for _s in SPELLINGS:
     if _s.dialect == FL:
         _PREFERRED.setdefault(_s.kind, _s)
-_COSINE_HALF = Spelling("COSINE", "cosine_half", (1, 0), JFL)
 
 
 class ShapeError(ValueError):
@@ -161,21 +155,31 @@ def build(spelling: Spelling, args: Sequence[Param]) -> ShapeMF:
 def spelling_for(mf: ShapeMF) -> Spelling:
     """How the writer spells ``mf``: jFuzzyLogic's name where it can express the term
     exactly, else fuzzylite's."""
-    if mf.kind == "cosine_half":
-        return _COSINE_HALF
+    if mf.kind in WRITE_ONLY:
+        return WRITE_ONLY[mf.kind]
     preferred = _PREFERRED.get(mf.kind)
     if preferred is None:
         raise KeyError(f"no spelling for shape kind {mf.kind!r}")
     needs_fuzzylite = mf.height != 1.0 or (
         preferred.scale is not None and any(isinstance(p, Ref) for p in mf.params)
     )
-    if mf.kind == "gaussian2":
-        # jFuzzyLogic rejects GAUSS2 with mean1 > mean2; fuzzylite's product form reads it.
-        m1, m2 = mf.params[0], mf.params[2]
-        needs_fuzzylite = needs_fuzzylite or (not isinstance(m1, Ref) and not isinstance(m2, Ref) and m1 > m2)
+    if preferred.dialect == JFL and not needs_fuzzylite:
+        # a jFuzzyLogic spelling only for what jFuzzyLogic accepts (it rejects GAUSS2 with
+        # mean1 > mean2, which fuzzylite's product form reads): the entry's degenerate rule
+        # for jFuzzyLogic
+        needs_fuzzylite = _jfl_refuses(mf)
     if needs_fuzzylite and preferred.dialect != FL:
         return next(s for s in SPELLINGS if s.kind == mf.kind and s.dialect == FL)
     return preferred
+
+
+def _jfl_refuses(mf: ShapeMF) -> bool:
+    shape = registry.SHAPES[mf.kind]
+    rule = shape.jfl_refuses
+    if isinstance(rule, registry.NA):
+        return False
+    # a parameter given by a variable is unknown here: NaN compares false
+    return rule([math.nan if isinstance(p, Ref) else float(p) for p in mf.params])
 
 
 def written_args(spelling: Spelling, mf: ShapeMF) -> list[Param]:
@@ -198,7 +202,7 @@ def _self_check() -> None:
         assert s.kind in SHAPES, s
         if not s.variadic:
             assert sorted(s.order) == list(range(len(SHAPES[s.kind].params))), s
-    missing = set(SHAPES) - {s.kind for s in SPELLINGS} - {"cosine_half"}
+    missing = set(SHAPES) - {s.kind for s in SPELLINGS} - set(WRITE_ONLY)
     assert not missing, missing
 
 

@@ -149,7 +149,9 @@ def available() -> list[Format]:
     """Every format that can be used here, built-in ones first."""
     for name in KNOWN_NAMES:
         find(name)
-    return list(REGISTRY.values())
+    # the built-in order, whichever was looked up first; plug-ins after them
+    builtin = [REGISTRY[n] for n in KNOWN_NAMES if n in REGISTRY]
+    return builtin + [f for n, f in REGISTRY.items() if n not in KNOWN_NAMES]
 
 
 def get(name: str) -> Format:

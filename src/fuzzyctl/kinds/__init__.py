@@ -1,1 +1,14 @@
-"""Registries: one entry per kind (shape, method, norm, target); nothing outside them compares kind names."""
+"""Registries: one entry per kind, the one place that says what a kind is.
+
+A new kind is one entry here; every consumer (the readers and writers of each format, the
+engine's evaluators and lowering, the code generators, the tuner, the conformance statement,
+the studio) reads the entry instead of keeping its own table or comparing kind names.
+
+* :mod:`fuzzyctl.kinds.shapes` - parametric membership-function shapes;
+* ``methods`` - defuzzification, activation and accumulation methods;
+* ``norms`` - AND/OR operators;
+* ``targets`` - code-generation targets (a capabilities record each).
+
+This package sits at the bottom of the stack, next to :mod:`fuzzyctl.model`: it imports
+the standard library and numpy, nothing else of fuzzyctl.
+"""

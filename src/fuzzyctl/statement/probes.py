@@ -18,6 +18,7 @@ from string import Template
 
 from fuzzyctl.fcl import conformance, load_text
 from fuzzyctl.fcl.conformance import Level
+from fuzzyctl.kinds.shapes import ENTRIES
 from fuzzyctl.model import ACCU_METHODS, ACT_METHODS, AND_OPERATORS, OR_OPERATORS, SHAPES, Document, ShapeMF
 
 __all__ = ["BASE", "SHAPE_PARAMS", "SLOTS", "Probe", "ProbeResult", "element_rows", "probes", "run_probe"]
@@ -299,33 +300,15 @@ def _extension() -> list[Probe]:
     return out
 
 
-# Parameters of a term of each parametric shape on the universe 0..10 (doubled for an output
-# on -20..20).  A shape added to fuzzyctl.model.SHAPES without an entry here stops the
-# generation of the statement: the statement lists every shape.
+# Parameters of a term of each parametric shape on the universe 0..10 (the registry's
+# ``probe``; ``probe_output`` for an output on -20..20).  An entry without a probe says why
+# (NA): the statement lists every shape.
 SHAPE_PARAMS: dict[str, tuple[float, ...]] = {
-    "triangle": (0, 5, 10),
-    "trapezoid": (0, 2, 6, 10),
-    "rectangle": (2, 6),
-    "gaussian": (5, 2),
-    "gaussian2": (3, 1, 6, 1),
-    "bell": (5, 2, 2),
-    "sigmoid": (5, 1),
-    "dsigmoid": (2, 2, 8, 2),
-    "dsigmoid_pos": (2, 2, 8, 2),
-    "psigmoid": (2, 2, 8, -2),
-    "cosine": (5, 6),
-    "sshape": (2, 8),
-    "zshape": (2, 8),
-    "pishape": (1, 3, 7, 9),
-    "ramp": (2, 8),
-    "spike": (5, 4),
-    "concave": (4, 8),
-    "binary": (5, 10),
-    "arc": (2, 8),
-    "semiellipse": (2, 8),
+    s.kind: s.probe for s in ENTRIES if isinstance(s.probe, tuple) and not s.takagi_sugeno
 }
-_TS = {"constant": (5.0,), "linear": (0.5, 0.25, 1.0)}  # Takagi-Sugeno outputs
-_BY_VARIABLE = {"cosine_half"}  # jFuzzyLogic COSINE with a variable half-width
+_TS = {s.kind: s.probe for s in ENTRIES if isinstance(s.probe, tuple) and s.takagi_sugeno}
+#: The Takagi-Sugeno constant (the second output term of the Takagi-Sugeno probes).
+_CONSTANT = next(s.kind for s in ENTRIES if s.takagi_sugeno and not s.variadic)
 
 
 def _shape(kind: str, params: tuple[float, ...]) -> str:
@@ -336,14 +319,13 @@ def _shape(kind: str, params: tuple[float, ...]) -> str:
 
 def _open_shapes() -> list[Probe]:
     t, mf, el = "Table 10", "membership function", "free membership functions"
-    missing = set(SHAPES) - set(SHAPE_PARAMS) - set(_TS) - _BY_VARIABLE
-    if missing:
-        raise RuntimeError(f"statement: no probe parameters for shapes {sorted(missing)} (SHAPE_PARAMS)")
     out = []
     for kind, params in SHAPE_PARAMS.items():
         text = _shape(kind, params)
         out.append(_p(t, el, f"input {text.split()[0]} ({kind})", (mf, f"input shape {kind}"), xlo=text))
-        wide = _shape(kind, params if kind == "sigmoid" else tuple(2 * p for p in params))
+        wide_params = SHAPES[kind].output_probe()
+        assert isinstance(wide_params, tuple)
+        wide = _shape(kind, wide_params)
         out.append(
             _p(
                 t,
@@ -372,7 +354,7 @@ def _open_shapes() -> list[Probe]:
                 el,
                 f"output {text.split()[0]} (Takagi-Sugeno {kind})",
                 (mf, f"output shape {kind}"),
-                zterms=f"    TERM a := {text};\n    TERM b := {_shape('constant', (10.0,))};",
+                zterms=f"    TERM a := {text};\n    TERM b := {_shape(_CONSTANT, (10.0,))};",
                 zitems="    METHOD : WTAVER;\n    DEFAULT := 0;",
             )
         )

@@ -21,6 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError, has_errors
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     DefuzzifyBlock,
     Document,
@@ -227,10 +228,10 @@ def _constant_points(t: Term) -> list[float]:
         values = [mf.value]
     elif isinstance(mf, ShapeMF):
         params = [p for p in mf.params if isinstance(p, float | int)]
-        if mf.kind in ("gaussian", "gaussian2", "bell") and len(params) >= 2:
+        if registry.flag(mf.kind, "centre_spread") and len(params) >= 2:  # a bump: around it
             centre, spread = float(params[0]), abs(float(params[1]))
             values = [centre - 3 * spread, centre + 3 * spread]
-        elif mf.kind not in ("constant", "linear"):
+        elif not registry.flag(mf.kind, "takagi_sugeno"):
             values = params
     return [float(v) for v in values if isinstance(v, float | int) and math.isfinite(v)]
 
@@ -304,7 +305,7 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
                 shape = {"spikes": [[_num(p.x), _num(p.y)] for p in mf.points]}
             elif (
                 isinstance(mf, ShapeMF)
-                and mf.kind not in ("constant", "linear")
+                and not registry.flag(mf.kind, "takagi_sugeno")
                 and all(isinstance(p, float | int) for p in (*mf.params, mf.height))
             ):
                 params = [_num(p) for p in mf.params]

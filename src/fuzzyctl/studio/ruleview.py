@@ -18,6 +18,7 @@ import numpy as np
 from fuzzyctl.engine.semantics.operators import TNORMS
 from fuzzyctl.engine.semantics.shapes import FloatArray, membership_np, pwl_points
 from fuzzyctl.fcl.writer import conclusion_text, condition_text
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
     Condition,
@@ -69,7 +70,7 @@ def _grid(term: Term, low: float, high: float) -> tuple[FloatArray, FloatArray] 
         corners = [float(p.x) for p in mf.points]  # type: ignore[arg-type]
         xs = np.unique(np.concatenate([xs, [x for x in corners if low <= x <= high]]))
         return xs, membership_np("points", flat, 1.0, xs)
-    if isinstance(mf, ShapeMF) and mf.kind not in ("constant", "linear"):
+    if isinstance(mf, ShapeMF) and not registry.flag(mf.kind, "takagi_sugeno"):
         if any(isinstance(p, Ref) for p in (*mf.params, mf.height)):
             return None
         params = [float(p) for p in mf.params]  # type: ignore[arg-type]

@@ -38,6 +38,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.shapes import pwl_value_np
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 from fuzzyctl.tune import gradient_cog
@@ -46,7 +47,9 @@ Arr = npt.NDArray[np.float64]
 PSlot = tuple[str, int, int, int] | tuple[str, int, int] | tuple[str, int]
 Grad = dict[PSlot, Arr]
 
-_PIECE_KINDS = {"points": None, "triangle": (0, 1, 2), "trapezoid": (0, 1, 2, 3)}
+# piecewise-linear terms whose breakpoints' x are parameters: IEC points and the shapes whose
+# parameters are their vertices (the registry's ``vertices``)
+_PIECE_KINDS = {"points"} | {k for k in registry.SHAPES if registry.vertices(k) is not None}
 
 
 def _term_unsupported(t: TermPlan) -> str | None:
@@ -113,7 +116,10 @@ def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
         elif op.kind == "ts":
             if not METHODS[op.method].takagi_sugeno or (op.accu or "MAX") not in ("MAX", "SUM"):
                 return f"{name}: {op.method} with ACCU {op.accu}"
-            if any(t.kind not in ("constant", "linear", "singleton") or not t.constant for t in op.terms):
+            if any(
+                not (t.kind == "singleton" or registry.flag(t.kind, "takagi_sugeno")) or not t.constant
+                for t in op.terms
+            ):
                 return f"{name}: function or Tsukamoto terms"
         elif op.kind == "mamdani":
             why = gradient_cog.unsupported(op)
@@ -149,9 +155,11 @@ def _term_degree(var: int, ti: int, t: TermPlan, x: Arr) -> tuple[Arr, Grad]:
     if t.kind == "points":
         xs, ys, idx = p[0::2], [y * h for y in p[1::2]], list(range(0, len(p), 2))
     else:
-        idx = list(_PIECE_KINDS[t.kind] or ())
+        vertices = registry.vertices(t.kind)
+        assert vertices is not None
+        idx = list(range(len(vertices)))
         xs = [p[i] for i in idx]
-        ys = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
+        ys = [v * h for v in vertices]
     for k in range(len(xs) - 1):
         x0, x1 = xs[k], xs[k + 1]
         if not x0 < x1:
@@ -275,7 +283,7 @@ def _output(
         term = op.terms[t]
         params = [float(p) for p in term.params]  # type: ignore[arg-type]
         zg: Grad = {}
-        if term.kind == "linear":
+        if registry.flag(term.kind, "ts_linear"):
             z = np.zeros(n)
             for i, c in enumerate(params[:m]):
                 z = z + c * vals[i]

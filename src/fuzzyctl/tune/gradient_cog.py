@@ -58,17 +58,17 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
 from fuzzyctl.ir.kernels.columns import coa_columns  # the engine's bisector: the same x* to the last bit
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
 Arr = npt.NDArray[np.float64]
 Bool = npt.NDArray[np.bool_]
 #: accumulations the closed form covers
 ACCUS = ("MAX", "SUM", "BSUM")
-_PARAM_INDEX = {"triangle": (0, 1, 2), "trapezoid": (0, 1, 2, 3)}
 
 
 def _term_unsupported(t: TermPlan, low: float, high: float) -> str | None:
-    if t.kind not in ("points", "triangle", "trapezoid"):
+    if t.kind != "points" and registry.vertices(t.kind) is None:
         return f"shape {t.kind}"
     if not t.constant or t.pwl is None:
         return "parameters given by variables"
@@ -108,7 +108,9 @@ def unsupported(op: OutputPlan) -> str | None:
 def _param_index(t: TermPlan) -> tuple[int, ...]:
     if t.kind == "points":
         return tuple(range(0, len(t.params), 2))
-    return _PARAM_INDEX[t.kind]
+    vertices = registry.vertices(t.kind)
+    assert vertices is not None
+    return tuple(range(len(vertices)))
 
 
 @dataclass

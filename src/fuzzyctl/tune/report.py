@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from fuzzyctl.files import write_atomic
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
 
 if TYPE_CHECKING:
@@ -217,7 +218,7 @@ def _moved_variables(r: TuneResult) -> list[str]:
             blk.variable
         ) or r.block.defuzzify_block(blk.variable)
         sets = any(
-            hasattr(t.mf, "points") or getattr(t.mf, "kind", "") not in ("linear", "constant")
+            hasattr(t.mf, "points") or not registry.flag(getattr(t.mf, "kind", ""), "takagi_sugeno")
             for t in blk.terms
         )
         if other is not None and other.terms != blk.terms and sets:
@@ -248,7 +249,7 @@ def _curves(fb: FunctionBlock, var: str) -> tuple[np.ndarray, list[tuple[str, np
     x = np.linspace(lo - pad, hi + pad, 600)
     out = []
     for t in terms:
-        if t.kind in ("linear", "constant", "function"):
+        if t.kind == "function" or registry.flag(t.kind, "takagi_sugeno"):
             continue
         if t.kind == "singleton":
             out.append((t.name, np.array([float(t.params[0])]), True))

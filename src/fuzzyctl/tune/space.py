@@ -3,7 +3,8 @@
 Every optimiser works on ``u`` in ``[0, 1]^n``; :meth:`Space.decode` turns any such ``u``
 into a function block that is valid by construction:
 
-* **Abscissae** (points of IEC terms, triangle/trapezoid/... vertices, Gaussian means,
+* **Abscissae** (points of IEC terms, the parameters the shape registry calls positions:
+  triangle/trapezoid/... vertices, Gaussian means,
   singleton positions) are *breakpoints of their variable*.  Equal abscissae of one
   variable are one breakpoint (a point shared by two neighbouring terms moves in both, so a
   partition stays a partition).  Breakpoints at the ends of the universe (the RANGE, or
@@ -14,7 +15,8 @@ into a function block that is valid by construction:
   the variable, which keeps each term's points ascending, keeps it inside the RANGE and
   keeps the union of the supports covering what it covered (coverage is a statement about
   the order of breakpoints only).
-* **Scales** (Gaussian sigma, bell width and slope, sigmoid slope) move on a log scale in
+* **Scales** (Gaussian sigma, bell width and slope, sigmoid slope: the parameters whose
+  role in the shape registry is not a position) move on a log scale in
   ``[v/4, 4 v]`` and keep their sign.
 * **Takagi-Sugeno coefficients** move in a box around their value (see :func:`_coef_box`).
 * **Weights** (WITH, rule weights) move in ``[0, 1]``.
@@ -40,6 +42,7 @@ from fuzzyctl.model import (
     FuzzifyBlock,
     PointsMF,
     Range,
+    Ref,
     Rule,
     RuleBlock,
     ShapeMF,
@@ -54,37 +57,6 @@ Vector = npt.NDArray[np.float64]
 DELTA = 1e-4
 #: Scales move within [v / SCALE_FACTOR, v * SCALE_FACTOR].
 SCALE_FACTOR = 4.0
-
-# Which shape parameters are abscissae of the variable and which are scales.
-_ABSCISSAE: dict[str, tuple[int, ...]] = {
-    "triangle": (0, 1, 2),
-    "trapezoid": (0, 1, 2, 3),
-    "rectangle": (0, 1),
-    "ramp": (0, 1),
-    "gaussian": (0,),
-    "gaussian2": (0, 2),
-    "bell": (0,),
-    "sigmoid": (0,),
-    "dsigmoid": (0, 2),
-    "dsigmoid_pos": (0, 2),
-    "psigmoid": (0, 2),
-    "cosine": (0,),
-    "sshape": (0, 1),
-    "zshape": (0, 1),
-    "pishape": (0, 1, 2, 3),
-    "spike": (0,),
-}
-_SCALES: dict[str, tuple[int, ...]] = {
-    "gaussian": (1,),
-    "gaussian2": (1, 3),
-    "bell": (1, 2),
-    "sigmoid": (1,),
-    "dsigmoid": (1, 3),
-    "dsigmoid_pos": (1, 3),
-    "psigmoid": (1, 3),
-    "cosine": (1,),
-    "spike": (1,),
-}
 
 
 class SpaceError(FuzzyctlError):
@@ -307,24 +279,26 @@ def _term_slots(
         if _const(mf.value):
             yield ("term", var, ti, 0), _num(mf.value), "x", base
     elif isinstance(mf, ShapeMF):
-        if not all(_const(p) for p in mf.params):
-            return
-        names = SHAPES[mf.kind].params if mf.kind in SHAPES else ()
-        if mf.kind in ("constant", "linear"):
-            for k, c in enumerate(mf.params):
-                if mf.kind == "constant" or k >= len(inputs):
-                    what = "constant"
-                else:
-                    what = f"coefficient of {inputs[k]}"
-                yield ("term", var, ti, k), _num(c), "coef", f"{base} {what}"
-            return
-        for k in _ABSCISSAE.get(mf.kind, ()):
-            if math.isfinite(_num(mf.params[k])):
-                yield ("term", var, ti, k), _num(mf.params[k]), "x", f"{base} {names[k]}"
-        for k in _SCALES.get(mf.kind, ()):
-            v = _num(mf.params[k])
-            if v != 0.0 and math.isfinite(v):
-                yield ("term", var, ti, k), v, "scale", f"{base} {names[k]}"
+        shape = SHAPES.get(mf.kind)
+        if shape is None or not all(_const(p) or isinstance(p, Ref) for p in mf.params):
+            return  # an infinite parameter (a shoulder): kept as written
+        roles = [shape.tuning[min(k, len(shape.tuning) - 1)] for k in range(len(mf.params))]  # variadic: last
+        variable = [isinstance(p, Ref) for p in mf.params]
+        # a parameter given by a variable stays; the term's other abscissae too when one of
+        # them is a variable (their order against it is unknown), its scales move
+        fixed_x = any(v and r == "abscissa" for v, r in zip(variable, roles, strict=True))
+        for k, c in enumerate(mf.params):
+            if variable[k]:
+                continue
+            v = _num(c)
+            if roles[k] == "coef":
+                what = f"coefficient of {inputs[k]}" if shape.variadic and k < len(inputs) else "constant"
+                yield ("term", var, ti, k), v, "coef", f"{base} {what}"
+            elif roles[k] == "abscissa" and math.isfinite(v) and not fixed_x:
+                yield ("term", var, ti, k), v, "x", f"{base} {shape.params[k]}"
+        for k, c in enumerate(mf.params):
+            if not variable[k] and roles[k] in ("scale", "slope") and _num(c) != 0.0:
+                yield ("term", var, ti, k), _num(c), "scale", f"{base} {shape.params[k]}"
 
 
 def _universe(fb: FunctionBlock, var: str, xs: Sequence[float]) -> tuple[float, float]:

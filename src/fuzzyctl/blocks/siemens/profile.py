@@ -29,6 +29,7 @@ from collections.abc import Iterable
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.formats.fpl.names import ADDING_ACCU, shared_conclusions
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
     Condition,
@@ -70,7 +71,8 @@ def input_shape(mf: MembershipFunction) -> str | None:
     are trapezoids whose outer points sit at the limits of the input."""
     if isinstance(mf, ShapeMF):
         if (
-            mf.kind in ("rectangle", "triangle", "trapezoid")
+            registry.SHAPES.get(mf.kind) is not None
+            and not isinstance(registry.SHAPES[mf.kind].spellings.fpl, registry.NA)
             and mf.height == 1.0
             and all(is_constant(p) for p in mf.params)
         ):

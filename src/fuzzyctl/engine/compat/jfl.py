@@ -52,6 +52,7 @@ from fuzzyctl.engine.plan import (
 )
 from fuzzyctl.engine.reference.interp import OutputRecord, Record
 from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.kinds import shapes as registry
 
 __all__ = ["SAMPLES", "JflEvaluator"]
 
@@ -86,7 +87,9 @@ class JflEvaluator:
             if op.kind == "degree" and op.contributions:
                 raise FuzzyctlError(f"output {op.name}: jFuzzyLogic has no conclusions without a term")
             for t in op.terms if op.kind != "mamdani" and op.contributions else ():
-                if t.kind not in ("singleton", "singletons", "function", "constant"):
+                if not (
+                    t.kind in ("singleton", "singletons", "function") or registry.flag(t.kind, "ts_constant")
+                ):
                     raise FuzzyctlError(f"term {op.name}.{t.name}: jFuzzyLogic has no {t.kind} output terms")
         names = [o.name for o in plan.outputs]
         self.chained_output: list[int] = []
@@ -260,7 +263,7 @@ class JflEvaluator:
     def _degree(self, t: TermPlan, vals: list[Arr], x: Arr) -> Arr:
         """A term's membership of value ``x`` (an input, or an output's crisp value)."""
         p = [_value(v, vals) for v in t.params]
-        if t.kind in ("singleton", "singletons", "constant"):
+        if t.kind in ("singleton", "singletons") or registry.flag(t.kind, "ts_constant"):
             return jt.point_membership(t, p, x)
         if t.kind == "function":
             assert t.expr is not None

@@ -18,6 +18,8 @@ import numpy as np
 from fuzzyctl.engine.plan import EBinary, ECall, EUnary, ExprPlan, TermPlan
 from fuzzyctl.engine.semantics import fdlibm, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
+from fuzzyctl.kinds import formula
+from fuzzyctl.kinds import shapes as registry
 
 Arr = Any  # numpy arrays (and floats) broadcasting together
 
@@ -30,39 +32,36 @@ def membership(kind: str, p: Sequence[Arr], x: Arr) -> Arr:
     with np.errstate(all="ignore"):
         if kind == "points":
             return _pwl(x, p[0::2], p[1::2])
-        if kind == "triangle":
-            a, b, c = p
-            inner = np.where(x == b, 1.0, np.where(x < b, (x - a) / (b - a), 1 - (x - b) / (c - b)))
-            return np.where((x < a) | (x > c), 0.0, inner)
-        if kind == "trapezoid":
-            a, b, c, d = p
-            slope = np.where(x < b, (x - a) / (b - a), 1 - (x - c) / (d - c))
-            return np.where((x < a) | (x > d), 0.0, np.where((x >= b) & (x <= c), 1.0, slope))
-        if kind == "gaussian":
-            m, s = p
-            return fdlibm.exp(-(x - m) * (x - m) / (2 * s * s))
-        if kind == "gaussian2":
-            m1, s1, m2, s2 = p
-            left = fdlibm.exp(-(x - m1) * (x - m1) / (2 * s1 * s1))
-            right = fdlibm.exp(-(x - m2) * (x - m2) / (2 * s2 * s2))
-            return np.where(x < m1, left, np.where(x > m2, right, 1.0))  # NaN: 1, as its Java
-        if kind == "bell":
-            c, w, b = p
-            return 1.0 / (1.0 + fdlibm.pow_(np.abs((x - c) / w), 2.0 * b))
-        if kind == "sigmoid":
-            c, s = p
-            return 1.0 / (1.0 + fdlibm.exp(-s * (x - c)))
-        if kind == "dsigmoid_pos":
-            c1, s1, c2, s2 = p
-            d = 1.0 / (1.0 + fdlibm.exp(-s1 * (x - c1))) - 1.0 / (1.0 + fdlibm.exp(-s2 * (x - c2)))
-            return np.where(np.isnan(d), np.nan, np.maximum(d, 0.0))
-        if kind in ("cosine", "cosine_half"):
-            c, w = p
-            t = 0.5 * w if kind == "cosine" else w  # jFuzzyLogic's net_max
-            u = x - c
-            return np.where((-t <= u) & (u <= t), (fdlibm.cos(u * (np.pi / t)) + 1) / 2, 0.0)
+        shape = registry.SHAPES.get(kind)
+        if shape is not None and isinstance(shape.jfl, str):
+            return _jfl_formula(shape)(x, *p)
     # shapes jFuzzyLogic does not have (a file using them does not load there)
     return shapes.membership_np(kind, list(p), 1.0, np.asarray(x, dtype=np.float64))
+
+
+#: What jFuzzyLogic's formulas call: its Java's StrictMath (fdlibm), elementwise.
+_JAVA: dict[str, Any] = {
+    "exp": fdlibm.exp,
+    "cos": fdlibm.cos,
+    "pow": fdlibm.pow_,
+    "sqrt": np.sqrt,
+    "abs": np.abs,
+    "min": np.minimum,
+    "max": np.maximum,
+    "isnan": np.isnan,
+    "where": np.where,
+    "pi": np.pi,
+    "nan": np.nan,
+}
+
+
+def _jfl_formula(shape: registry.Shape) -> Callable[..., Arr]:
+    """The entry's jFuzzyLogic variant (:attr:`~fuzzyctl.kinds.shapes.Shape.jfl`), compiled once."""
+    fn = shape.compiled.get("jfl_np")
+    if fn is None:
+        fn = formula.vectorised(shape.parsed_jfl(), _JAVA, registry.HELPERS)
+        shape.compiled["jfl_np"] = fn
+    return fn
 
 
 def _pwl(x: Arr, xs: Sequence[Arr], ys: Sequence[Arr]) -> Arr:
@@ -92,7 +91,9 @@ def point_membership(term: TermPlan, p: Sequence[Arr], x: Arr, position: Arr | N
             res = np.where(hit, ys[i], res)
             done |= hit
         return np.where(x <= xs[0], ys[0], np.where(x > xs[-1], ys[-1], res))
-    value = p[0] if term.kind in ("singleton", "constant") else position
+    shape = registry.SHAPES.get(term.kind)
+    at_value = term.kind == "singleton" or (shape is not None and shape.takagi_sugeno and not shape.variadic)
+    value = p[0] if at_value else position
     return np.where(x == value, 1.0, 0.0)
 
 

@@ -12,6 +12,7 @@ from fuzzyctl.engine.plan import Contribution, GridPlan, OutputPlan, PParam, Rul
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.engine.semantics import shapes, universe
 from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import shapes as registry
 
 #: other names of methods -> the code evaluated (kinds/methods.py)
 METHOD_ALIASES = methods.lowering_aliases()
@@ -175,7 +176,7 @@ def _ts_output(
         )
         return None
     for t in tps:
-        if t.kind == "linear" and len(t.params) > len(fb.inputs) + 1:
+        if registry.flag(t.kind, "ts_linear") and len(t.params) > len(fb.inputs) + 1:
             ctx.err(
                 f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
                 f"{len(fb.inputs)} inputs",

@@ -25,6 +25,7 @@ from fuzzyctl.engine.plan import (
     TermPlan,
 )
 from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.kinds import shapes as registry
 
 FUNCTIONS = frozenset(
     [
@@ -213,16 +214,12 @@ def lower_term(
             )
             return None
         # infinite vertices are MATLAB/fuzzylite shoulders; fuzzylite's Binary points to +-inf
-        shoulders = mf.kind in ("triangle", "trapezoid")
-        raw = [
-            lower_param(ctx, p, where, shoulders or (mf.kind == "binary" and i == 1))
-            for i, p in enumerate(mf.params)
-        ]
+        raw = [lower_param(ctx, p, where, i in spec.infinite) for i, p in enumerate(mf.params)]
         h = lower_param(ctx, mf.height, where)
         if any(p is None for p in raw) or h is None:
             return None
         params = tuple(p for p in raw if p is not None)
-        if mf.kind in ("constant", "linear") and not is_output:
+        if spec.takagi_sugeno and not is_output:
             ctx.err(
                 f"{where}: {mf.kind} terms are Takagi-Sugeno outputs, not input sets", t.span, "ts-on-input"
             )
@@ -243,9 +240,6 @@ def lower_term(
         )
         tp = TermPlan(tp.name, tp.kind, tp.params, tp.height, tp.expr, pts)
     return tp
-
-
-_WIDTH_MIN, _WIDTH_MAX = 1e-150, 1e150
 
 
 def _unordered_vertices(ctx: LowerContext, tp: TermPlan, span: m.Span | None, where: str) -> TermPlan:
@@ -308,27 +302,9 @@ def _check_shape(ctx: LowerContext, tp: TermPlan, span: m.Span | None, where: st
     if not tp.constant:
         return
     p = [float(v) for v in tp.params if not isinstance(v, Slot)]
-    bad = None
-    if tp.kind == "triangle" and not (p[0] <= p[1] <= p[2]):
-        bad = "needs a <= b <= c"
-    elif tp.kind == "trapezoid" and not (p[0] <= p[1] <= p[2] <= p[3]):
-        bad = "needs a <= b <= c <= d"
-    elif tp.kind in ("gaussian", "gaussian2") and not all(
-        _WIDTH_MIN <= abs(sd) <= _WIDTH_MAX for sd in (p[1::2] if tp.kind == "gaussian2" else p[1:2])
-    ):
-        # 2 sd^2 must be a normal number: 0 or inf there makes exp(-d^2 / 2 sd^2) 0/0 at the
-        # centre (NaN, or a ZeroDivisionError in Python) where the shape means 1
-        bad = f"needs a standard deviation between {_WIDTH_MIN:g} and {_WIDTH_MAX:g} in size"
-    elif (tp.kind == "bell" and p[1] == 0.0) or (tp.kind in ("cosine", "spike") and p[1] == 0.0):
-        bad = "needs a nonzero width"
-    elif tp.kind in ("sshape", "zshape") and not p[0] < p[1]:
-        bad = "needs start < end"
-    elif tp.kind == "pishape" and not (p[0] < p[1] and p[2] < p[3]):
-        bad = "needs a < b and c < d"
-    elif tp.kind in ("arc", "semiellipse") and p[0] == p[1]:
-        bad = "needs start != end"
-    elif tp.kind == "cosine_half" and p[1] == 0.0:
-        bad = "needs a nonzero half width"
+    shape = registry.SHAPES.get(tp.kind)
+    rule = shape.degenerate if shape is not None else None
+    bad = rule.text if isinstance(rule, registry.Degenerate) and rule.bad(p) else None
     if bad:
         ctx.err(f"{where}: {tp.kind} {bad}", span, "shape-params")
 

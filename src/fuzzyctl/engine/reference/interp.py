@@ -45,6 +45,7 @@ from fuzzyctl.engine.semantics.operators import (
     clamp,
     fsum,
 )
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
 # --------------------------------------------------------------------------- records
@@ -433,9 +434,9 @@ def ts_value(
         return shapes.tsukamoto(
             term.kind, [pv(p, values) for p in term.params], pv(term.height, values), weight
         )
-    if term.kind in ("singleton", "constant"):
+    if term.kind == "singleton" or registry.flag(term.kind, "ts_constant"):
         return float(pv(term.params[0], values))
-    if term.kind == "linear":
+    if registry.flag(term.kind, "ts_linear"):
         cs = [pv(p, values) for p in term.params]
         n = len(values)
         v = fsum(c * x for c, x in zip(cs[:n], values, strict=False))

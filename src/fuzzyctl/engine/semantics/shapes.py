@@ -1,8 +1,10 @@
-"""Membership functions: the one place where shape formulas live.
+"""Membership functions: evaluation of the shape registry's formulas.
 
-Every shape kind of :data:`fuzzyctl.model.SHAPES` is defined here twice, once for a Python
-float (``math``) and once for numpy arrays, with the same formula written the same way, so
-the scalar and the batch evaluators agree to the last few ulps.
+Every shape kind of :data:`fuzzyctl.model.SHAPES` is an entry of :mod:`fuzzyctl.kinds.shapes`
+whose formula is written once; here it is compiled for a Python float (``math``) and for
+numpy arrays (:data:`NUMPY`: the C library's functions element by element) from the same
+syntax tree, so the scalar and the batch evaluators agree to the last bit (and
+:mod:`fuzzyctl.ir.builders.terms` translates the same tree to the IR of the generated code).
 
 Piecewise-linear shapes (IEC points, triangle, trapezoid, rectangle, ramp, binary) are also
 expressed as *breakpoint lists* (:func:`pwl_points`): ``((x0, y0), (x1, y1), ...)`` with
@@ -23,38 +25,59 @@ import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.engine.semantics import libm_np
+from fuzzyctl.kinds import formula
+from fuzzyctl.kinds import shapes as registry
 
 FloatArray = npt.NDArray[np.float64]
 Points = tuple[tuple[float, float], ...]
 
-#: Shapes that are piecewise linear and become breakpoint lists.
-PWL_KINDS = frozenset({"points", "triangle", "trapezoid", "rectangle", "ramp", "binary"})
-#: Takagi-Sugeno output terms: a value, not a fuzzy set.
-TS_KINDS = frozenset({"constant", "linear", "function"})
+#: Shapes that are piecewise linear and become breakpoint lists (and IEC points).
+PWL_KINDS = frozenset({"points"}) | registry.kinds_where(lambda s: s.piecewise_linear)
+#: Takagi-Sugeno output terms: a value, not a fuzzy set (and function terms).
+TS_KINDS = frozenset({"function"}) | registry.kinds_where(lambda s: s.takagi_sugeno)
 #: Monotonic shapes a weighted average can invert (Tsukamoto outputs, fuzzylite; monotonic
 #: ``points`` under COGS: jfuzzyqt's Tsukamoto).
-TSUKAMOTO_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "arc", "points"})
+TSUKAMOTO_KINDS = frozenset({"points"}) | registry.kinds_where(lambda s: s.tsukamoto_invertible)
 #: Smooth parametric shapes (integrated by adaptive quadrature on outputs).
-SMOOTH_KINDS = frozenset(
-    {
-        "gaussian",
-        "gaussian2",
-        "bell",
-        "sigmoid",
-        "dsigmoid",
-        "dsigmoid_pos",
-        "psigmoid",
-        "cosine",
-        "sshape",
-        "zshape",
-        "pishape",
-        "spike",
-        "concave",
-        "cosine_half",
-        "arc",
-        "semiellipse",
-    }
-)
+SMOOTH_KINDS = registry.kinds_where(lambda s: s.smooth)
+
+#: What the numpy forms of the registry's formulas call: the C library's transcendental
+#: functions element by element (libm_np), numpy's exact operations.
+NUMPY: dict[str, Any] = {
+    "exp": libm_np.exp,
+    "cos": libm_np.cos,
+    "pow": libm_np.pow_,
+    "log": np.log,
+    "sqrt": np.sqrt,
+    "abs": np.abs,
+    "min": np.minimum,
+    "max": np.maximum,
+    "isnan": np.isnan,
+    "where": np.where,
+    "pi": np.pi,
+    "nan": np.nan,
+}
+
+
+def _compiled(kind: str, which: str) -> Callable[..., Any]:
+    """The registry formula of ``kind`` (``which``: "float", "np", "tsu", "tsu_np"),
+    compiled once."""
+    shape = registry.SHAPES.get(kind)
+    if shape is None:
+        raise ValueError(f"unknown shape kind {kind!r}")
+    fn = shape.compiled.get(which)
+    if fn is None:
+        if which in ("float", "np") and not shape.smooth:
+            raise ValueError(f"{kind} has no formula ({shape.formula})")
+        if which in ("tsu", "tsu_np") and not shape.tsukamoto_invertible:
+            raise ValueError(f"{kind} is not monotonic")
+        f = shape.parsed() if which in ("float", "np") else shape.parsed_tsukamoto()
+        if which in ("float", "tsu"):
+            fn = formula.scalar(f, registry.HELPERS)
+        else:
+            fn = formula.vectorised(f, NUMPY, registry.HELPERS)
+        shape.compiled[which] = fn
+    return fn
 
 
 # --------------------------------------------------------------------------- breakpoint lists
@@ -75,38 +98,10 @@ def pwl_points(kind: str, params: Sequence[float], height: float = 1.0) -> Point
     if kind == "points":
         pts = sort_points(list(zip(p[0::2], p[1::2], strict=True)))
         return tuple((x, y * h) for x, y in pts)
-    if kind == "triangle":
-        a, b, c = p
-        return _shoulders(((a, 0.0), (b, h), (c, 0.0)), h)
-    if kind == "trapezoid":
-        a, b, c, d = p
-        return _shoulders(((a, 0.0), (b, h), (c, h), (d, 0.0)), h)
-    if kind == "rectangle":
-        s, e = min(p), max(p)
-        return ((s, 0.0), (s, h), (e, h), (e, 0.0))
-    if kind == "ramp":
-        s, e = p
-        if s == e:  # fuzzylite: a ramp without extent is 0 everywhere
-            return ((s, 0.0),)
-        return ((s, 0.0), (e, h)) if s < e else ((e, h), (s, 0.0))
-    if kind == "binary":
-        s, direction = p
-        if direction > s:
-            return ((s, 0.0), (s, h))
-        if direction < s:
-            return ((s, h), (s, 0.0))
-        return ((s, 0.0),)
-    return None
-
-
-def _shoulders(points: Points, h: float) -> Points:
-    """A triangle or trapezoid with vertices at -inf / +inf is a shoulder (MATLAB
-    ``trapmf [-Inf -Inf 2 4]``; fuzzylite gives the height beyond a finite vertex whose
-    neighbour is infinite): the infinite vertices are dropped and the ends continue flat."""
-    if all(math.isfinite(x) for x, _y in points):
-        return points
-    finite = tuple((x, y) for x, y in points if math.isfinite(x))
-    return finite or ((0.0, h),)
+    shape = registry.SHAPES.get(kind)
+    if shape is None or isinstance(shape.breakpoints, registry.NA):
+        return None
+    return shape.breakpoints(p, h)
 
 
 def pwl_value(points: Points, x: float) -> float:
@@ -166,189 +161,22 @@ def pwl_value_dynamic_np(xs: FloatArray, ys: FloatArray, x: FloatArray) -> Float
 # --------------------------------------------------------------------------- smooth shapes
 
 
-def _sig(x: float, c: float, s: float) -> float:
-    z = -s * (x - c)
-    if z > 700.0:  # exp overflow: the sigmoid is 0 to double precision
-        return 0.0
-    return 1.0 / (1.0 + math.exp(z))
+#: kind -> the float form of its formula (filled on first use: the hot path of membership)
+_FLOAT: dict[str, Callable[..., float]] = {}
 
 
-def _sshape(x: float, s: float, e: float) -> float:
-    if x <= s:
-        return 0.0
-    if x <= 0.5 * (s + e):
-        t = (x - s) / (e - s)
-        return 2.0 * t * t
-    if x < e:
-        t = (x - e) / (e - s)
-        return 1.0 - 2.0 * t * t
-    return 1.0
+def smooth(kind: str, p: Sequence[float], x: float) -> float:
+    """A smooth shape's formula (the registry's, compiled for floats) at ``x``, height 1."""
+    fn = _FLOAT.get(kind)
+    if fn is None:
+        fn = _FLOAT[kind] = _compiled(kind, "float")
+    return fn(x, *p)
 
 
-def _zshape(x: float, s: float, e: float) -> float:
-    if x <= s:
-        return 1.0
-    if x <= 0.5 * (s + e):
-        t = (x - s) / (e - s)
-        return 1.0 - 2.0 * t * t
-    if x < e:
-        t = (x - e) / (e - s)
-        return 2.0 * t * t
-    return 0.0
-
-
-def _gauss(x: float, m: float, sd: float) -> float:
-    d = x - m
-    return math.exp(-(d * d) / (2.0 * sd * sd))
-
-
-def _smooth(kind: str, p: Sequence[float], x: float) -> float:
-    if kind == "gaussian":
-        return _gauss(x, p[0], p[1])
-    if kind == "gaussian2":
-        a = _gauss(x, p[0], p[1]) if x < p[0] else 1.0
-        b = _gauss(x, p[2], p[3]) if x > p[2] else 1.0
-        return a * b
-    if kind == "bell":
-        c, w, s = p
-        return 1.0 / (1.0 + float(abs((x - c) / w) ** (2.0 * s)))
-    if kind == "sigmoid":
-        return _sig(x, p[0], p[1])
-    if kind == "dsigmoid":
-        return abs(_sig(x, p[0], p[1]) - _sig(x, p[2], p[3]))
-    if kind == "dsigmoid_pos":
-        return max(_sig(x, p[0], p[1]) - _sig(x, p[2], p[3]), 0.0)
-    if kind == "psigmoid":
-        return _sig(x, p[0], p[1]) * _sig(x, p[2], p[3])
-    if kind == "cosine":
-        c, w = p
-        if x < c - 0.5 * w or x > c + 0.5 * w:
-            return 0.0
-        return 0.5 * (1.0 + math.cos(2.0 / w * math.pi * (x - c)))
-    if kind == "sshape":
-        return _sshape(x, p[0], p[1])
-    if kind == "zshape":
-        return _zshape(x, p[0], p[1])
-    if kind == "pishape":
-        return _sshape(x, p[0], p[1]) * _zshape(x, p[2], p[3])
-    if kind == "spike":
-        c, w = p
-        return math.exp(-abs(10.0 / w * (x - c)))
-    if kind == "concave":
-        i, e = p
-        if i <= e and x < e:
-            return (e - i) / (2.0 * e - i - x)
-        if i >= e and x > e:
-            return (i - e) / (i - 2.0 * e + x)
-        return 1.0
-    if kind == "cosine_half":
-        c, hw = p
-        if x < c - abs(hw) or x > c + abs(hw):
-            return 0.0
-        return 0.5 * (1.0 + math.cos(math.pi * (x - c) / hw))
-    if kind == "arc":
-        s, e = p
-        r = e - s
-        if (s < e and s <= x <= e) or (s > e and e <= x <= s):
-            t = (x - e) / r  # sqrt(r^2 - (x-e)^2) / |r| without squaring r (1e300 overflows)
-            return math.sqrt(max(1.0 - t * t, 0.0))
-        return 1.0 if (s < e and x > e) or (s > e and x < e) else 0.0
-    if kind == "semiellipse":
-        s, e = min(p), max(p)
-        r = 0.5 * (e - s)
-        c = s + r
-        if s <= x <= e:
-            t = (x - c) / r  # as arc: r^2 would overflow
-            return math.sqrt(max(1.0 - t * t, 0.0))
-        return 0.0
-    raise ValueError(f"unknown shape kind {kind!r}")
-
-
-def _sig_np(x: Any, c: Any, s: Any) -> Any:
-    with np.errstate(over="ignore"):
-        return 1.0 / (1.0 + libm_np.exp(-s * (x - c)))
-
-
-def _sshape_np(x: Any, s: Any, e: Any) -> Any:
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t1 = (x - s) / (e - s)
-        t2 = (x - e) / (e - s)
-    return np.where(
-        x <= s, 0.0, np.where(x <= 0.5 * (s + e), 2.0 * t1 * t1, np.where(x < e, 1.0 - 2.0 * t2 * t2, 1.0))
-    )
-
-
-def _zshape_np(x: Any, s: Any, e: Any) -> Any:
-    with np.errstate(invalid="ignore", divide="ignore"):
-        t1 = (x - s) / (e - s)
-        t2 = (x - e) / (e - s)
-    return np.where(
-        x <= s, 1.0, np.where(x <= 0.5 * (s + e), 1.0 - 2.0 * t1 * t1, np.where(x < e, 2.0 * t2 * t2, 0.0))
-    )
-
-
-def _gauss_np(x: Any, m: Any, sd: Any) -> Any:
-    d = x - m
-    return libm_np.exp(-(d * d) / (2.0 * sd * sd))
-
-
-def _smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
-    if kind == "gaussian":
-        return _gauss_np(x, p[0], p[1])
-    if kind == "gaussian2":
-        a = np.where(x < p[0], _gauss_np(x, p[0], p[1]), 1.0)
-        b = np.where(x > p[2], _gauss_np(x, p[2], p[3]), 1.0)
-        return a * b
-    if kind == "bell":
-        c, w, s = p
-        return 1.0 / (1.0 + libm_np.pow_(np.abs((x - c) / w), 2.0 * s))
-    if kind == "sigmoid":
-        return _sig_np(x, p[0], p[1])
-    if kind == "dsigmoid":
-        return np.abs(_sig_np(x, p[0], p[1]) - _sig_np(x, p[2], p[3]))
-    if kind == "dsigmoid_pos":
-        return np.maximum(_sig_np(x, p[0], p[1]) - _sig_np(x, p[2], p[3]), 0.0)
-    if kind == "psigmoid":
-        return _sig_np(x, p[0], p[1]) * _sig_np(x, p[2], p[3])
-    if kind == "cosine":
-        c, w = p
-        inside = (x >= c - 0.5 * w) & (x <= c + 0.5 * w)
-        return np.where(inside, 0.5 * (1.0 + libm_np.cos(2.0 / w * np.pi * (x - c))), 0.0)
-    if kind == "sshape":
-        return _sshape_np(x, p[0], p[1])
-    if kind == "zshape":
-        return _zshape_np(x, p[0], p[1])
-    if kind == "pishape":
-        return _sshape_np(x, p[0], p[1]) * _zshape_np(x, p[2], p[3])
-    if kind == "spike":
-        c, w = p
-        return libm_np.exp(-np.abs(10.0 / w * (x - c)))
-    if kind == "concave":
-        i, e = p
-        with np.errstate(invalid="ignore", divide="ignore"):
-            inc = (e - i) / (2.0 * e - i - x)
-            dec = (i - e) / (i - 2.0 * e + x)
-        return np.where((i <= e) & (x < e), inc, np.where((i >= e) & (x > e), dec, 1.0))
-    if kind == "cosine_half":
-        c, hw = p
-        inside = (x >= c - np.abs(hw)) & (x <= c + np.abs(hw))
-        return np.where(inside, 0.5 * (1.0 + libm_np.cos(np.pi * (x - c) / hw)), 0.0)
-    if kind == "arc":
-        s, e = p
-        r = e - s
-        inside = ((s < e) & (s <= x) & (x <= e)) | ((s > e) & (e <= x) & (x <= s))
-        t = (x - e) / r  # as _smooth
-        arc = np.sqrt(np.maximum(1.0 - t * t, 0.0))
-        beyond = ((s < e) & (x > e)) | ((s > e) & (x < e))
-        return np.where(inside, arc, np.where(beyond, 1.0, 0.0))
-    if kind == "semiellipse":
-        s, e = np.minimum(p[0], p[1]), np.maximum(p[0], p[1])
-        r = 0.5 * (e - s)
-        c = s + r
-        inside = (x >= s) & (x <= e)
-        t = (x - c) / r  # as _smooth
-        return np.where(inside, np.sqrt(np.maximum(1.0 - t * t, 0.0)), 0.0)
-    raise ValueError(f"unknown shape kind {kind!r}")
+def smooth_np(kind: str, p: Sequence[Any], x: Any) -> Any:
+    """:func:`smooth` on numpy arrays (the same formula, compiled for numpy)."""
+    with np.errstate(all="ignore"):
+        return _compiled(kind, "np")(x, *p)
 
 
 # --------------------------------------------------------------------------- public evaluation
@@ -369,7 +197,7 @@ def membership(kind: str, params: Sequence[float], height: float, x: float) -> f
                 best = yi
         return best * float(height)
     try:
-        return float(height) * _smooth(kind, params, x)
+        return float(height) * smooth(kind, params, x)
     except (ArithmeticError, ValueError):
         if kind not in SMOOTH_KINDS:
             raise
@@ -403,7 +231,7 @@ def _membership_np(kind: str, params: Sequence[Any], height: Any, x: FloatArray)
         return np.asarray(best * height, dtype=np.float64)
     # numpy scalars: a Python float operand would raise where IEEE gives inf (2 / w, w = 0)
     p64 = [np.float64(p) if np.ndim(p) == 0 else p for p in params]
-    return np.asarray(height * _smooth_np(kind, p64, x), dtype=np.float64)
+    return np.asarray(height * smooth_np(kind, p64, x), dtype=np.float64)
 
 
 def _pwl_dynamic(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -> FloatArray:
@@ -419,12 +247,9 @@ def _pwl_dynamic(kind: str, params: Sequence[Any], height: Any, x: FloatArray) -
     if kind == "points":
         xs = np.stack(flat[0::2], axis=1)
         ys = np.stack(flat[1::2], axis=1) * hh[:, None]
-    elif kind == "triangle":
+    elif (vertices := registry.vertices(kind)) is not None:  # the parameters are the x
         xs = np.stack(flat, axis=1)
-        ys = np.stack([zero, hh, zero], axis=1)
-    elif kind == "trapezoid":
-        xs = np.stack(flat, axis=1)
-        ys = np.stack([zero, hh, hh, zero], axis=1)
+        ys = np.stack([zero if v == 0.0 else hh if v == 1.0 else v * hh for v in vertices], axis=1)
     else:
         # rectangle, ramp and binary change form with the order of their parameters: evaluate
         # each sample through the scalar definition (rare: variable points on such shapes).
@@ -469,73 +294,23 @@ def support(kind: str, params: Sequence[float], height: float = 1.0) -> tuple[fl
     if kind == "singletons":
         xs = [x for x, y in zip(params[0::2], params[1::2], strict=True) if y != 0.0]
         return (min(xs), max(xs)) if xs else (0.0, 0.0)
-    if kind == "cosine":
-        c, w = params
-        return (c - 0.5 * abs(w), c + 0.5 * abs(w))
-    if kind == "sshape":
-        return (params[0], inf)
-    if kind == "zshape":
-        return (-inf, params[1])
-    if kind == "pishape":
-        return (params[0], params[3])
-    if kind == "cosine_half":
-        c, hw = params
-        return (c - abs(hw), c + abs(hw))
-    if kind == "semiellipse":
-        return (min(params), max(params))
-    if kind == "arc":
-        s, e = params
-        return (s, inf) if s < e else (-inf, s)
+    shape = registry.SHAPES.get(kind)
+    if shape is not None and not isinstance(shape.support, registry.NA):
+        return shape.support([float(v) for v in params])
     return (-inf, inf)
 
 
 def characteristic_points(kind: str, params: Sequence[float]) -> tuple[float, ...]:
     """Points where a smooth shape changes character (peaks, joins, support ends): the
     adaptive quadrature splits there first so that it never misses a narrow peak."""
-    p = list(params)
-    if kind == "gaussian":
-        m, s = p
-        return tuple(m + k * abs(s) for k in (-8, -4, -2, -1, 0, 1, 2, 4, 8))
-    if kind == "gaussian2":
-        return tuple(
-            [p[0] + k * abs(p[1]) for k in (-8, -4, -2, -1, 0)]
-            + [p[2] + k * abs(p[3]) for k in (0, 1, 2, 4, 8)]
-        )
-    if kind == "bell":
-        c, w, _s = p
-        return tuple(c + k * abs(w) for k in (-16, -4, -2, -1, 0, 1, 2, 4, 16))
-    if kind in ("sigmoid",):
-        c, s = p
-        d = 1.0 / abs(s) if s else 1.0
-        return tuple(c + k * d for k in (-30, -8, -2, 0, 2, 8, 30))
-    if kind in ("dsigmoid", "dsigmoid_pos", "psigmoid"):
-        out: list[float] = []
-        for c, s in ((p[0], p[1]), (p[2], p[3])):
-            d = 1.0 / abs(s) if s else 1.0
-            out += [c + k * d for k in (-30, -8, -2, 0, 2, 8, 30)]
-        return tuple(out)
-    if kind == "cosine":
-        c, w = p
-        return (c - 0.5 * abs(w), c - 0.25 * abs(w), c, c + 0.25 * abs(w), c + 0.5 * abs(w))
-    if kind in ("sshape", "zshape"):
-        return (p[0], 0.5 * (p[0] + p[1]), p[1])
-    if kind == "pishape":
-        return (p[0], 0.5 * (p[0] + p[1]), p[1], p[2], 0.5 * (p[2] + p[3]), p[3])
-    if kind == "spike":
-        c, w = p
-        return tuple(c + k * abs(w) / 10.0 for k in (-40, -8, -2, 0, 2, 8, 40))
-    if kind == "concave":
-        return (p[0], p[1])
-    if kind == "cosine_half":
-        c, hw = p
-        return (c - abs(hw), c - 0.5 * abs(hw), c, c + 0.5 * abs(hw), c + abs(hw))
-    if kind in ("arc", "semiellipse"):
-        return (p[0], 0.5 * (p[0] + p[1]), p[1])
+    shape = registry.SHAPES.get(kind)
+    if shape is not None and not isinstance(shape.characteristic, registry.NA):
+        return shape.characteristic([float(v) for v in params])
     pts = pwl_points(kind, params)
     if pts is not None:
         return tuple(x for x, _y in pts)
     if kind == "singleton":
-        return (p[0],)
+        return (float(params[0]),)
     return ()
 
 
@@ -608,39 +383,13 @@ def tsukamoto(kind: str, params: Sequence[float], height: float, y: float) -> fl
     p = list(params)
     if kind == "points":
         return float(_monotone_inverse(p, h, y))
+    fn = _compiled(kind, "tsu")
     try:
-        if kind == "ramp":
-            s, e = p
-            return s + (e - s) * y / h
-        if kind == "sigmoid":
-            i, s = p
-            return i + math.log(h / y - 1.0) / -s
-        if kind == "sshape":
-            s, e = p
-            return (
-                s + (e - s) * math.sqrt(y / (2.0 * h))
-                if y <= 0.5 * h
-                else e - (e - s) * math.sqrt((h - y) / (2.0 * h))
-            )
-        if kind == "zshape":
-            s, e = p
-            return (
-                s + (e - s) * math.sqrt((h - y) / (2.0 * h))
-                if y >= 0.5 * h
-                else e - (e - s) * math.sqrt(y / (2.0 * h))
-            )
-        if kind == "concave":
-            i, e = p
-            return h * (i - e) / y + 2.0 * e - i
-        if kind == "arc":
-            s, e = p
-            r = e - s
-            return e + (-1.0 if s < e else 1.0) * math.sqrt(max(r * r - (y * r / h) ** 2, 0.0))
+        return float(fn(y, h, *p))
     except (ArithmeticError, ValueError):
         # log(0), a division by zero: the IEEE value of the numpy path (whose sign follows the
         # slope), so that every backend agrees
         return float(tsukamoto_np(kind, params, height, np.float64(y)))
-    raise ValueError(f"{kind} is not monotonic")
 
 
 def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
@@ -648,31 +397,9 @@ def tsukamoto_np(kind: str, params: Sequence[Any], height: Any, y: Any) -> Any:
     h = height
     if kind == "points":
         return _monotone_inverse([float(v) for v in params], float(h), y)
+    fn = _compiled(kind, "tsu_np")
     with np.errstate(all="ignore"):
-        if kind == "ramp":
-            s, e = params
-            return s + (e - s) * y / h
-        if kind == "sigmoid":
-            i, s = params
-            return i + np.log(h / y - 1.0) / -s
-        if kind == "sshape":
-            s, e = params
-            return np.where(
-                y <= 0.5 * h, s + (e - s) * np.sqrt(y / (2.0 * h)), e - (e - s) * np.sqrt((h - y) / (2.0 * h))
-            )
-        if kind == "zshape":
-            s, e = params
-            return np.where(
-                y >= 0.5 * h, s + (e - s) * np.sqrt((h - y) / (2.0 * h)), e - (e - s) * np.sqrt(y / (2.0 * h))
-            )
-        if kind == "concave":
-            i, e = params
-            return h * (i - e) / y + 2.0 * e - i
-        if kind == "arc":
-            s, e = params
-            r = e - s
-            return e + np.where(s < e, -1.0, 1.0) * np.sqrt(np.maximum(r * r - (y * r / h) ** 2, 0.0))
-    raise ValueError(f"{kind} is not monotonic")
+        return fn(y, h, *params)
 
 
 def monotone(points: Points) -> bool:

@@ -16,6 +16,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.basics import identifier, is_identifier
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     DEFUZZ_METHODS,
     And,
@@ -565,7 +566,7 @@ def _breakpoints(term: Term) -> list[float]:
     mf = term.mf
     if isinstance(mf, PointsMF):
         return [float(p.x) for p in mf.points if not isinstance(p.x, Ref)]
-    if isinstance(mf, ShapeMF) and mf.kind not in {"constant", "linear"}:
+    if isinstance(mf, ShapeMF) and not registry.flag(mf.kind, "takagi_sugeno"):
         return [float(p) for p in mf.params if not isinstance(p, Ref)]
     if isinstance(mf, SingletonMF) and not isinstance(mf.value, Ref):
         return [float(mf.value)]

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import ShapeMF
 
 
@@ -36,62 +37,64 @@ class ShapeMap:
         return out
 
 
+def _maps(fmt: str) -> dict[str, ShapeMap]:
+    """The tool's type name -> its map, from the registry's spellings (``fmt``: fis or fll).
+    Takagi-Sugeno outputs have no fixed arity and are read and written apart."""
+    out: dict[str, ShapeMap] = {}
+    for shape in registry.ENTRIES:
+        w = getattr(shape.spellings, fmt)
+        if isinstance(w, registry.NA) or shape.takagi_sugeno:
+            continue
+        out[w.name] = ShapeMap(shape.kind, w.order)
+    return out
+
+
 # MATLAB FIS types (and fuzzylite's additions to the FIS format).  ``linear``,
 # ``constant``, ``discretemf`` and ``function`` have no fixed arity and are handled apart.
-FIS_TYPES: dict[str, ShapeMap] = {
-    "trimf": ShapeMap("triangle", (0, 1, 2)),
-    "trapmf": ShapeMap("trapezoid", (0, 1, 2, 3)),
-    "gaussmf": ShapeMap("gaussian", (1, 0)),  # [sigma c]
-    "gauss2mf": ShapeMap("gaussian2", (1, 0, 3, 2)),  # [sigma1 c1 sigma2 c2]
-    "gbellmf": ShapeMap("bell", (2, 0, 1)),  # [a b c]: width a, slope b, centre c
-    "sigmf": ShapeMap("sigmoid", (1, 0)),  # [a c]
-    "dsigmf": ShapeMap("dsigmoid", (1, 0, 3, 2)),  # [a1 c1 a2 c2]
-    "psigmf": ShapeMap("psigmoid", (1, 0, 3, 2)),
-    "smf": ShapeMap("sshape", (0, 1)),
-    "zmf": ShapeMap("zshape", (0, 1)),
-    "pimf": ShapeMap("pishape", (0, 1, 2, 3)),
-    # fuzzylite's FIS extensions, parameters in fuzzylite's own order
-    "rampmf": ShapeMap("ramp", (0, 1)),
-    "rectmf": ShapeMap("rectangle", (0, 1)),
-    "cosinemf": ShapeMap("cosine", (0, 1)),
-    "spikemf": ShapeMap("spike", (0, 1)),
-    "concavemf": ShapeMap("concave", (0, 1)),
-    "binarymf": ShapeMap("binary", (0, 1)),
-}
+FIS_TYPES: dict[str, ShapeMap] = _maps("fis")
 MATLAB_TYPES = frozenset(
-    {"trimf", "trapmf", "gaussmf", "gauss2mf", "gbellmf", "sigmf", "dsigmf", "psigmf", "smf", "zmf", "pimf"}
+    w.name
+    for s in registry.ENTRIES
+    if isinstance(w := s.spellings.fis, registry.Written) and w.matlab and not s.takagi_sugeno
 )
 FIS_OF_KIND: dict[str, str] = {m.kind: name for name, m in FIS_TYPES.items()}
 
 # fuzzylite term classes (FLL), parameters as fuzzylite writes them.
-FLL_TYPES: dict[str, ShapeMap] = {
-    "Triangle": ShapeMap("triangle", (0, 1, 2)),
-    "Trapezoid": ShapeMap("trapezoid", (0, 1, 2, 3)),
-    "Rectangle": ShapeMap("rectangle", (0, 1)),
-    "Gaussian": ShapeMap("gaussian", (0, 1)),  # mean standardDeviation
-    "GaussianProduct": ShapeMap("gaussian2", (0, 1, 2, 3)),  # meanA sdA meanB sdB
-    "Bell": ShapeMap("bell", (0, 1, 2)),  # center width slope
-    "Sigmoid": ShapeMap("sigmoid", (0, 1)),  # inflection slope
-    "SigmoidDifference": ShapeMap("dsigmoid", (0, 1, 3, 2)),  # left rising falling right
-    "SigmoidProduct": ShapeMap("psigmoid", (0, 1, 3, 2)),  # left rising falling right
-    "Cosine": ShapeMap("cosine", (0, 1)),
-    "SShape": ShapeMap("sshape", (0, 1)),
-    "ZShape": ShapeMap("zshape", (0, 1)),
-    "PiShape": ShapeMap("pishape", (0, 1, 2, 3)),
-    "Ramp": ShapeMap("ramp", (0, 1)),
-    "Spike": ShapeMap("spike", (0, 1)),
-    "Concave": ShapeMap("concave", (0, 1)),
-    "Binary": ShapeMap("binary", (0, 1)),
-    "Arc": ShapeMap("arc", (0, 1)),
-    "SemiEllipse": ShapeMap("semiellipse", (0, 1)),
-}
+FLL_TYPES: dict[str, ShapeMap] = _maps("fll")
 FLL_OF_KIND: dict[str, str] = {m.kind: name for name, m in FLL_TYPES.items()}
 # Terms fuzzylite 6 (the C++ library and its Debian command) cannot read.
-FLL_ONLY_PYFUZZYLITE = frozenset({"Arc", "SemiEllipse"})
+FLL_ONLY_PYFUZZYLITE = frozenset(
+    w.name
+    for s in registry.ENTRIES
+    if isinstance(w := s.spellings.fll, registry.Written) and w.pyfuzzylite_only
+)
 
 # Shapes whose value rises or falls monotonically: the only ones a Tsukamoto output
 # (fuzzylite WeightedAverage on non-constant terms) can use.
-MONOTONIC_KINDS = frozenset({"ramp", "sigmoid", "sshape", "zshape", "concave", "arc"})
+MONOTONIC_KINDS = registry.kinds_where(lambda s: s.tsukamoto_invertible)
+#: Takagi-Sugeno output kinds (no fixed arity in FIS and FLL).
+TS_KINDS = registry.kinds_where(lambda s: s.takagi_sugeno)
+#: FIS and FLL names of the Takagi-Sugeno kinds -> the kind.
+FIS_TS_TYPES: dict[str, str] = {
+    w.name: s.kind
+    for s in registry.ENTRIES
+    if s.takagi_sugeno and isinstance(w := s.spellings.fis, registry.Written)
+}
+FLL_TS_TYPES: dict[str, str] = {
+    w.name: s.kind
+    for s in registry.ENTRIES
+    if s.takagi_sugeno and isinstance(w := s.spellings.fll, registry.Written)
+}
+
+
+def fis_ts_name(kind: str) -> str:
+    """The FIS type of a Takagi-Sugeno kind (``constant``, ``linear``)."""
+    return next(name for name, k in FIS_TS_TYPES.items() if k == kind)
+
+
+def fll_ts_name(kind: str) -> str:
+    """The FLL class of a Takagi-Sugeno kind (``Constant``, ``Linear``)."""
+    return next(name for name, k in FLL_TS_TYPES.items() if k == kind)
 
 
 def shape(kind: str, params: tuple[float, ...], height: float = 1.0) -> ShapeMF:

@@ -17,6 +17,7 @@ from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.adapt import rename
 from fuzzyctl.formats.common.basics import hedge_power, identifier
 from fuzzyctl.formats.fcl.names import fcl_api
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     POWER_HEDGE_PREFIX,
     And,
@@ -126,14 +127,15 @@ def _as_points(mf: MembershipFunction) -> MembershipFunction:
     written as 5.2.2 asks (two points at least); anything else unchanged."""
     if isinstance(mf, PointsMF) and len(mf.points) == 1:
         return PointsMF(mf.points * 2)
-    if not isinstance(mf, ShapeMF) or mf.kind not in ("triangle", "trapezoid"):
+    vertices = registry.vertices(mf.kind) if isinstance(mf, ShapeMF) else None
+    if not isinstance(mf, ShapeMF) or vertices is None:
         return mf
     values = (*mf.params, mf.height)
     if not all(isinstance(v, int | float) and math.isfinite(v) for v in values):
         return mf
     h = float(mf.height)  # type: ignore[arg-type]
     xs = [float(v) for v in mf.params]  # type: ignore[arg-type]
-    ys = [0.0, h, 0.0] if mf.kind == "triangle" else [0.0, h, h, 0.0]
+    ys = [v * h for v in vertices]
     if any(b < a for a, b in itertools.pairwise(xs)):
         return mf  # not a well-formed shape: keep what the source said
     return PointsMF(tuple(Point(x, y) for x, y in zip(xs, ys, strict=True)))

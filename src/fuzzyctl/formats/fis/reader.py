@@ -28,10 +28,17 @@ from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Loaded
 from fuzzyctl.formats.common.basics import Reporter, parse_count, parse_number
 from fuzzyctl.formats.common.expr import ExprError, names_in, parse_expr
-from fuzzyctl.formats.common.terms import FIS_TYPES, MATLAB_TYPES, MONOTONIC_KINDS, fis_shape_problem
+from fuzzyctl.formats.common.terms import (
+    FIS_TS_TYPES,
+    FIS_TYPES,
+    MATLAB_TYPES,
+    MONOTONIC_KINDS,
+    fis_shape_problem,
+)
 from fuzzyctl.formats.fis.names import AGG_METHODS, AND_METHODS, DEFUZZ_METHODS, OR_METHODS
 from fuzzyctl.formats.fis.rules import TS_KINDS, is_ts_term, numbers, rules
 from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     Default,
     DefuzzifyBlock,
@@ -174,21 +181,22 @@ def _membership(
     params = numbers(params_text, rep, line, f"parameters of {kind!r}")
     if height_text is not None:
         params.append(numbers(height_text, rep, line, "height")[0])
-    if kind_lower == "constant":
+    ts_kind = FIS_TS_TYPES.get(kind_lower)
+    if ts_kind is not None and registry.flag(ts_kind, "ts_constant"):
         if not params:
-            raise rep.fail("'constant' needs a value", line, code="fis-params")
-        return ShapeMF("constant", (params[0],))
-    if kind_lower == "linear":
+            raise rep.fail(f"{kind_lower!r} needs a value", line, code="fis-params")
+        return ShapeMF(ts_kind, (params[0],))
+    if ts_kind is not None:  # linear: a coefficient per input and a constant
         if len(params) == n_inputs:  # fuzzylite allows leaving out the constant term
             params = [*params, 0.0]
         if len(params) != n_inputs + 1:
             raise rep.fail(
-                f"'linear' needs {n_inputs + 1} parameters (one per input and a constant), "
+                f"{kind_lower!r} needs {n_inputs + 1} parameters (one per input and a constant), "
                 f"found {len(params)}",
                 line,
                 code="fis-params",
             )
-        return ShapeMF("linear", tuple(params))
+        return ShapeMF(ts_kind, tuple(params))
     if kind_lower == "discretemf":
         height = params.pop() if len(params) % 2 == 1 else 1.0
         if len(params) < 2:
@@ -201,7 +209,7 @@ def _membership(
     if mapping is None or (
         dialect == "matlab" and kind_lower not in MATLAB_TYPES and kind_lower not in FIS_TYPES
     ):
-        known = ", ".join(sorted([*FIS_TYPES, "constant", "linear", "discretemf", "function"]))
+        known = ", ".join(sorted([*FIS_TYPES, *FIS_TS_TYPES, "discretemf", "function"]))
         raise rep.fail(
             f"unknown membership function type {kind!r} (known: {known})", line, code="fis-mf-type"
         )

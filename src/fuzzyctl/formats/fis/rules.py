@@ -18,6 +18,7 @@ from typing import Protocol
 from fuzzyctl.diagnostics import warning
 from fuzzyctl.formats.common.basics import Reporter, parse_number, power_hedge
 from fuzzyctl.formats.common.expr import eval_constant, parse_expr
+from fuzzyctl.formats.common.terms import TS_KINDS as TS_SHAPE_KINDS
 from fuzzyctl.formats.fis.names import FUZZYLITE_HEDGE_CODES
 from fuzzyctl.limits import shorten
 from fuzzyctl.model import (
@@ -35,7 +36,7 @@ from fuzzyctl.model import (
 )
 
 ANY_CODE = 99
-TS_KINDS = frozenset({"constant", "linear"})
+TS_KINDS = TS_SHAPE_KINDS
 
 
 def is_ts_term(mf: MembershipFunction) -> bool:

@@ -34,7 +34,9 @@ from fuzzyctl.formats.common.terms import (
     FIS_TYPES,
     MATLAB_TYPES,
     MONOTONIC_KINDS,
+    TS_KINDS,
     fis_shape_problem,
+    fis_ts_name,
 )
 from fuzzyctl.formats.fis.names import (
     AGG_METHODS,
@@ -89,7 +91,7 @@ def _term_problem(term: Term, point_output: bool) -> str | None:
     """Why the FIS reader would refuse this (otherwise writable) term; ``None``: it reads it."""
     mf = term.mf
     if point_output:
-        ts_term = (isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}) or (
+        ts_term = (isinstance(mf, ShapeMF) and mf.kind in TS_KINDS) or (
             isinstance(mf, FunctionMF) and mf.argument is None
         )
         if not ts_term and not (isinstance(mf, ShapeMF) and mf.kind in MONOTONIC_KINDS):
@@ -97,7 +99,7 @@ def _term_problem(term: Term, point_output: bool) -> str | None:
                 "a weighted-average output of a FIS has constant, linear or (fuzzylite's Tsukamoto) "
                 "monotonic terms"
             )
-    elif isinstance(mf, ShapeMF) and mf.kind in {"constant", "linear"}:
+    elif isinstance(mf, ShapeMF) and mf.kind in TS_KINDS:
         return "a Mamdani output of a FIS has no constant or linear terms"
     if isinstance(mf, ShapeMF) and mf.kind in FIS_OF_KIND and not _has_refs(mf):
         return fis_shape_problem(FIS_OF_KIND[mf.kind], tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
@@ -144,7 +146,7 @@ def _needs_fuzzylite(fb: FunctionBlock) -> bool:
                 continue  # a loss, reported with the term
             if (
                 isinstance(mf, ShapeMF)
-                and mf.kind not in {"constant", "linear"}
+                and mf.kind not in TS_KINDS
                 and mf.kind in FIS_OF_KIND
                 and (FIS_OF_KIND[mf.kind] not in MATLAB_TYPES or float(mf.height) != 1.0)  # type: ignore[arg-type]
             ):
@@ -231,7 +233,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
                 for b in fb.rule_blocks
             ),
         )
-    supported = set(FIS_OF_KIND) | {"constant", "linear"}
+    supported = set(FIS_OF_KIND) | TS_KINDS
     # Inputs of a FIS cannot be clamped (fuzzylite's FIS importer rejects LockRange there).
     fuzzify: list[FuzzifyBlock] = []
     for f in fb.fuzzify:
@@ -285,7 +287,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
                     t
                     for t in f.terms
                     if not isinstance(t.mf, SingletonMF)
-                    and term_losses(f.variable, t, supported - {"constant", "linear"}, "FIS", losses)
+                    and term_losses(f.variable, t, supported - TS_KINDS, "FIS", losses)
                     and _input_term_readable(f.variable, t, losses)
                 ),
             )
@@ -527,8 +529,8 @@ def _mf_text(term: Term) -> str:
     mf = term.mf
     name = term.name.replace("'", "")
     if isinstance(mf, ShapeMF):
-        if mf.kind in {"constant", "linear"}:
-            kind = mf.kind
+        if mf.kind in TS_KINDS:
+            kind = fis_ts_name(mf.kind)
             values = [float(p) for p in mf.params]  # type: ignore[arg-type]
         else:
             kind = FIS_OF_KIND[mf.kind]

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 from fuzzyctl.formats import Loaded
 from fuzzyctl.formats.common.basics import Reporter, parse_number
 from fuzzyctl.formats.common.expr import ExprError, parse_function
-from fuzzyctl.formats.common.terms import FLL_TYPES
+from fuzzyctl.formats.common.terms import FLL_TS_TYPES, FLL_TYPES
 from fuzzyctl.formats.fll.names import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.formats.fll.rules import Lookup, RuleError, parse_rule
 from fuzzyctl.model import (
@@ -148,7 +148,7 @@ def _term(
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) != 1:
             raise rep.fail(f"Constant {name!r} takes one value, found {len(params)}", line, code="fll-term")
-        mf = ShapeMF("constant", (params[0],))
+        mf = ShapeMF(FLL_TS_TYPES[cls], (params[0],))
     elif cls == "Linear":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) == n_inputs:
@@ -160,7 +160,7 @@ def _term(
                 line,
                 code="fll-term",
             )
-        mf = ShapeMF("linear", tuple(params))
+        mf = ShapeMF(FLL_TS_TYPES[cls], tuple(params))
     elif cls == "Discrete":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         height = params.pop() if len(params) % 2 == 1 else 1.0

@@ -18,7 +18,7 @@ from fuzzyctl.formats.common.adapt import (
 )
 from fuzzyctl.formats.common.basics import fmt_number
 from fuzzyctl.formats.common.expr import format_expr
-from fuzzyctl.formats.common.terms import FLL_OF_KIND, FLL_TYPES
+from fuzzyctl.formats.common.terms import FLL_OF_KIND, FLL_TYPES, TS_KINDS, fll_ts_name
 from fuzzyctl.formats.fll.names import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.kinds import methods
 from fuzzyctl.model import (
@@ -59,7 +59,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
         fuzzify=tuple(with_range(fb, f, losses, "FLL") for f in fb.fuzzify),  # type: ignore[misc]
         defuzzify=tuple(with_range(fb, d, losses, "FLL") for d in fb.defuzzify),  # type: ignore[misc]
     )
-    supported = set(FLL_OF_KIND) | {"constant", "linear"}
+    supported = set(FLL_OF_KIND) | TS_KINDS
     all_blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for blk in all_blocks:
         kept = tuple(t for t in blk.terms if _term_ok(blk.variable, t, supported, losses, blk))
@@ -117,7 +117,7 @@ def _term_ok(owner: str, term: Term, supported: set[str], losses: list[Loss], bl
         return False
     if (
         isinstance(term.mf, ShapeMF)
-        and term.mf.kind in {"constant", "linear"}
+        and term.mf.kind in TS_KINDS
         and not (isinstance(blk, DefuzzifyBlock) and blk.method in methods.POINT_OUTPUTS)
     ):
         losses.append(
@@ -162,10 +162,9 @@ def _params(values: list[float], height: float) -> str:
 def term_text(term: Term) -> str:
     mf = term.mf
     if isinstance(mf, ShapeMF):
-        if mf.kind == "constant":
-            return f"{term.name} Constant {fmt_number(float(mf.params[0]))}"  # type: ignore[arg-type]
-        if mf.kind == "linear":
-            return f"{term.name} Linear {' '.join(fmt_number(float(p)) for p in mf.params)}"  # type: ignore[arg-type]
+        if mf.kind in TS_KINDS:  # Constant value, Linear c1 .. cn constant: no height
+            coefs = " ".join(fmt_number(float(p)) for p in mf.params)  # type: ignore[arg-type]
+            return f"{term.name} {fll_ts_name(mf.kind)} {coefs}"
         cls = FLL_OF_KIND[mf.kind]
         values = FLL_TYPES[cls].from_model(tuple(float(p) for p in mf.params))  # type: ignore[arg-type]
         return f"{term.name} {cls} {_params(values, float(mf.height))}"  # type: ignore[arg-type]

@@ -17,6 +17,7 @@ from fuzzyctl.formats.fpl.names import (
     leaves,
     shared_conclusions,
 )
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
     Condition,
@@ -62,12 +63,9 @@ def _points_of(mf: MembershipFunction) -> list[tuple[float, float]] | None:
         return [(float(p.x), float(p.y)) for p in mf.points]  # type: ignore[arg-type]
     if isinstance(mf, ShapeMF) and all(is_constant(v) for v in mf.params) and mf.height == 1.0:
         v = [float(x) for x in mf.params]  # type: ignore[arg-type]
-        if mf.kind == "triangle":
-            return [(v[0], 0.0), (v[1], 1.0), (v[2], 0.0)]
-        if mf.kind == "trapezoid":
-            return [(v[0], 0.0), (v[1], 1.0), (v[2], 1.0), (v[3], 0.0)]
-        if mf.kind == "rectangle":
-            return [(v[0], 0.0), (v[0], 1.0), (v[1], 1.0), (v[1], 0.0)]
+        shape = registry.SHAPES.get(mf.kind)
+        if shape is not None and not isinstance(shape.spellings.fpl, registry.NA):
+            return shape.spellings.fpl(v)  # the points FPL writes for the shape
     return None
 
 

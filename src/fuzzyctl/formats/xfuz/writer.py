@@ -29,6 +29,7 @@ from fuzzyctl.formats.xfuz.tables import (
     slot_label,
 )
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
     Condition,
@@ -134,14 +135,21 @@ def _abcd(
     return abcd
 
 
+def _xfuz_spelling(mf: MembershipFunction) -> tuple[int, int, int, int] | None:
+    """Which parameters of a shape are XFUZ's trapezoid a, b, c, d (the registry's spelling)."""
+    shape = registry.SHAPES.get(mf.kind) if isinstance(mf, ShapeMF) else None
+    if shape is None or isinstance(shape.spellings.xfuz, registry.NA):
+        return None
+    return shape.spellings.xfuz
+
+
 def _abscissae(
     mf: MembershipFunction, what: str, span: Span | None, diags: list[Diagnostic]
 ) -> tuple[int, int, int, int] | None:
-    if isinstance(mf, ShapeMF) and mf.kind in ("triangle", "trapezoid", "rectangle") and mf.height == 1.0:
+    abcd = _xfuz_spelling(mf)
+    if isinstance(mf, ShapeMF) and abcd is not None and mf.height == 1.0:
         p = [_int_point(x, what, span, diags) for x in mf.params]
-        if mf.kind == "triangle":
-            return (p[0], p[1], p[1], p[2])
-        return (p[0], p[0], p[1], p[1]) if mf.kind == "rectangle" else (p[0], p[1], p[2], p[3])
+        return (p[abcd[0]], p[abcd[1]], p[abcd[2]], p[abcd[3]])
     if isinstance(mf, PointsMF) and mf.points:
         pts = [(p.x, p.y) for p in mf.points]
         if not all(is_constant(y) and float(y) in (0.0, 1.0) for _, y in pts):  # type: ignore[arg-type]

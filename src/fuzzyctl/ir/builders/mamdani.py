@@ -41,6 +41,7 @@ from fuzzyctl.ir.builders.pieces import (
 from fuzzyctl.ir.builders.rules import Params, RuleBuilder
 from fuzzyctl.ir.nodes import Ex, Num, Type, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import shapes as registry
 
 
 @dataclass
@@ -85,8 +86,9 @@ def term_points(rb: RuleBuilder, t: TermPlan, xs: Params, ys: Params, where: str
                 y = ys.add(py * h, f"{where} y{k // 2}")
             out.append((x, y))
         return out
-    if t.kind in ("triangle", "trapezoid"):
-        ylist = [0.0, h, 0.0] if t.kind == "triangle" else [0.0, h, h, 0.0]
+    vertices = registry.vertices(t.kind)
+    if vertices is not None:  # the parameters are the x of the breakpoints
+        ylist = [v * h for v in vertices]
         return [
             (rb.pv(p, xs, f"{where} x{k}"), ys.add(y, f"{where} y{k}"))
             for k, (p, y) in enumerate(zip(t.params, ylist, strict=True))

@@ -44,6 +44,7 @@ from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
 #: (term, degree, weight, ACT) of one activated set
@@ -466,9 +467,9 @@ class RuleBuilder:
         if t in zs:
             return zs[t]
         n_in = len(self.plan.inputs)
-        if term.kind in ("singleton", "constant"):
+        if term.kind == "singleton" or registry.flag(term.kind, "ts_constant"):
             zs[t] = self.pv(term.params[0], coef, term.name)
-        elif term.kind == "linear":
+        elif registry.flag(term.kind, "ts_linear"):
             acc: Ex = Num(0.0)
             for i, c in enumerate(term.params[:n_in]):
                 acc = acc + self.pv(c, coef, f"{term.name} * {self.plan.inputs[i].name}") * self.inputs[i]

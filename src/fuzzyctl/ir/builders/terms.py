@@ -1,6 +1,7 @@
 """Formulas in the IR: fuzzy operators (translated from the engine's own expression templates),
-hedges, smooth membership functions, function terms, and the run-time routines on
-breakpoint lists (stable sort, degree, one-sided limits) the exact integration needs.
+hedges, smooth membership functions (translated from the shape registry's formulas), function
+terms, and the run-time routines on breakpoint lists (stable sort, degree, one-sided limits)
+the exact integration needs.
 
 Operators are not rewritten by hand: :data:`fuzzyctl.engine.semantics.operators.TNORMS` and ``SNORMS``
 carry each norm as a Python expression template, and :func:`norm` translates that template
@@ -18,6 +19,8 @@ from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import Points, power_of
 from fuzzyctl.ir.nodes import Bin, Ex, ExLike, Index, Neg, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import shapes as registry
+from fuzzyctl.kinds.formula import Formula
 
 # The two helpers the Hamacher templates call, as templates themselves (operators._ham_t/_s).
 _HELPERS = {
@@ -67,18 +70,55 @@ def _tr(g: Gen, node: ast.expr, env: dict[str, Ex]) -> Ex:
         with g.b.else_():
             g.b.set(t, _tr(g, node.orelse, env))
         return t
+    if isinstance(node, ast.BoolOp):
+        acc = _tr(g, node.values[0], env)
+        for v in node.values[1:]:
+            acc = acc.and_(_tr(g, v, env)) if isinstance(node.op, ast.And) else acc.or_(_tr(g, v, env))
+        return acc
+    if isinstance(node, ast.NamedExpr):
+        # a name bound where it is written (inside its branch): a division never runs where
+        # the branch is not taken (a PLC faults on a division by zero)
+        env[node.target.id] = g.let(_tr(g, node.value, env), node.target.id.upper())
+        return env[node.target.id]
     if isinstance(node, ast.Call) and isinstance(node.func, ast.Name):
-        fn = node.func.id
-        args = [_tr(g, a, env) for a in node.args]
-        if fn in ("min", "max") and len(args) == 2:
-            # Python's min/max keep the first argument unless the second is strictly better
-            t = g.let(args[0])
-            with g.b.if_(args[1].lt(t) if fn == "min" else args[1].gt(t)):
-                g.b.set(t, args[1])
-            return t
-        if fn in _HELPERS and len(args) == 2:
-            return template(g, _HELPERS[fn], args[0], args[1])
+        return _call(g, node.func.id, [_tr(g, a, env) for a in node.args])
     raise AssertionError(f"operator template construct not translated: {ast.dump(node)}")
+
+
+def _call(g: Gen, fn: str, args: list[Ex]) -> Ex:
+    if fn in ("min", "max") and len(args) == 2:
+        # Python's min/max keep the first argument unless the second is strictly better
+        t = g.let(args[0])
+        with g.b.if_(args[1].lt(t) if fn == "min" else args[1].gt(t)):
+            g.b.set(t, args[1])
+        return t
+    if fn in _HELPERS and len(args) == 2:
+        return template(g, _HELPERS[fn], args[0], args[1])
+    if fn in registry.HELPERS:
+        helper = registry.HELPERS[fn]
+        return formula(g, helper, dict(zip(helper.args, args, strict=True)))
+    if fn == "abs":
+        return _absv(g, args[0])
+    if fn == "pow":  # ST has no power function: exp(e ln u), for u > 0 (the formulas check)
+        if g.target != "st":
+            return g.call("POW", args[0], args[1])
+        return g.call("EXP", args[1] * g.call("LN", args[0]))
+    if fn in _FORMULA_CALLS:
+        return g.call(_FORMULA_CALLS[fn], *args)
+    raise AssertionError(f"formula call not translated: {fn}")
+
+
+_FORMULA_CALLS = {"exp": "EXP", "cos": "COS", "sqrt": "SQRT", "log": "LN"}
+
+
+def formula(g: Gen, f: Formula, env: dict[str, Ex]) -> Ex:
+    """A registry formula (:mod:`fuzzyctl.kinds.formula`) in the IR: ``env`` gives each
+    argument; operands used several times are bound to temporaries first."""
+    local: dict[str, Ex] = {name: _simple(g, v) for name, v in env.items()}
+    local["pi"] = Num(_PI)
+    for name, e in f.lets:
+        local[name] = g.let(_tr(g, e, local), name.upper())
+    return _tr(g, f.body, local)
 
 
 def tnorm(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
@@ -179,39 +219,6 @@ def hedged(g: Gen, d: Ex, hedges: tuple[str, ...], negated: bool) -> Ex:
 P = list[Ex]
 
 
-def _sig(g: Gen, x: Ex, c: Ex, s: Ex) -> Var:
-    """shapes._sig: 1 / (1 + exp(-s (x - c))), 0 when the exponent would overflow."""
-    z = g.let(-s * (x - c), "Z")
-    t = g.temp(hint="S")
-    with g.b.if_(z.gt(700.0)):
-        g.b.set(t, 0.0)
-    with g.b.else_():
-        g.b.set(t, 1.0 / (1.0 + g.call("EXP", z)))
-    return t
-
-
-def _sshape(g: Gen, x: Ex, s: Ex, e: Ex, z: bool) -> Var:
-    lo, hi = (1.0, 0.0) if z else (0.0, 1.0)
-    t = g.temp(hint="S")
-    u = g.temp(hint="U")
-    with g.b.if_(x.le(s)):
-        g.b.set(t, lo)
-    with g.b.elif_(x.le(0.5 * (s + e))):
-        g.b.set(u, (x - s) / (e - s))
-        g.b.set(t, 1.0 - 2.0 * u * u if z else 2.0 * u * u)
-    with g.b.elif_(x.lt(e)):
-        g.b.set(u, (x - e) / (e - s))
-        g.b.set(t, 2.0 * u * u if z else 1.0 - 2.0 * u * u)
-    with g.b.else_():
-        g.b.set(t, hi)
-    return t
-
-
-def _gauss(g: Gen, x: Ex, m: Ex, sd: Ex) -> Ex:
-    d = g.let(x - m, "D")
-    return g.call("EXP", -(d * d) / (2.0 * sd * sd))
-
-
 def _absv(g: Gen, v: Ex) -> Var:
     t = g.let(v, "A")
     with g.b.if_(t.lt(0.0)):
@@ -220,105 +227,14 @@ def _absv(g: Gen, v: Ex) -> Var:
 
 
 def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
-    """``shapes._smooth`` for one kind (the formulas written the same way)."""
-    out = g.temp(hint="M")
-    if kind == "gaussian":
-        g.b.set(out, _gauss(g, x, p[0], p[1]))
-    elif kind == "gaussian2":
-        left = g.temp(hint="G")
-        with g.b.if_(x.lt(p[0])):
-            g.b.set(left, _gauss(g, x, p[0], p[1]))
-        with g.b.else_():
-            g.b.set(left, 1.0)
-        right = g.temp(hint="G")
-        with g.b.if_(x.gt(p[2])):
-            g.b.set(right, _gauss(g, x, p[2], p[3]))
-        with g.b.else_():
-            g.b.set(right, 1.0)
-        g.b.set(out, left * right)
-    elif kind == "bell":
-        # IEEE pow at the centre (u = 0), as fuzzylite and numpy: 0^e is 0 for e > 0, 1 for
-        # e = 0 and +inf for e < 0 (a negative slope is 0 at its centre); ST has no pow(0, e)
-        u = _absv(g, (x - p[0]) / p[1])
-        expo = g.let(2.0 * p[2], "E")
-        with g.b.if_(u.gt(0.0)):
-            pw = g.call("POW", u, expo) if g.target != "st" else g.call("EXP", expo * g.call("LN", u))
-            g.b.set(out, 1.0 / (1.0 + pw))
-        with g.b.elif_(u.eq(0.0).and_(expo.gt(0.0))):
-            g.b.set(out, 1.0)
-        with g.b.elif_(u.eq(0.0).and_(expo.eq(0.0))):
-            g.b.set(out, 0.5)
-        with g.b.elif_(u.eq(0.0).and_(expo.lt(0.0))):
-            g.b.set(out, 0.0)
-        with g.b.else_():  # NaN in, NaN out
-            g.b.set(out, u + expo)
-    elif kind == "sigmoid":
-        g.b.set(out, _sig(g, x, p[0], p[1]))
-    elif kind in ("dsigmoid", "dsigmoid_pos", "psigmoid"):
-        s1 = _sig(g, x, p[0], p[1])
-        s2 = _sig(g, x, p[2], p[3])
-        if kind == "psigmoid":
-            g.b.set(out, s1 * s2)
-        elif kind == "dsigmoid":
-            g.b.set(out, _absv(g, s1 - s2))
-        else:
-            g.b.set(out, s1 - s2)
-            with g.b.if_(out.lt(0.0)):
-                g.b.set(out, 0.0)
-    elif kind == "cosine":
-        with g.b.if_(x.lt(p[0] - 0.5 * p[1]).or_(x.gt(p[0] + 0.5 * p[1]))):
-            g.b.set(out, 0.0)
-        with g.b.else_():
-            g.b.set(out, 0.5 * (1.0 + g.call("COS", 2.0 / p[1] * Num(_PI) * (x - p[0]))))
-    elif kind in ("sshape", "zshape"):
-        g.b.set(out, _sshape(g, x, p[0], p[1], kind == "zshape"))
-    elif kind == "pishape":
-        g.b.set(out, _sshape(g, x, p[0], p[1], False) * _sshape(g, x, p[2], p[3], True))
-    elif kind == "spike":
-        g.b.set(out, g.call("EXP", -_absv(g, 10.0 / p[1] * (x - p[0]))))
-    elif kind == "concave":
-        i, e = p
-        with g.b.if_(i.le(e).and_(x.lt(e))):
-            g.b.set(out, (e - i) / (2.0 * e - i - x))
-        with g.b.elif_(i.ge(e).and_(x.gt(e))):
-            g.b.set(out, (i - e) / (i - 2.0 * e + x))
-        with g.b.else_():
-            g.b.set(out, 1.0)
-    elif kind == "cosine_half":
-        c, hw = p
-        ahw = _absv(g, hw)
-        with g.b.if_(x.lt(c - ahw).or_(x.gt(c + ahw))):
-            g.b.set(out, 0.0)
-        with g.b.else_():
-            g.b.set(out, 0.5 * (1.0 + g.call("COS", Num(_PI) * (x - c) / hw)))
-    elif kind == "arc":
-        s, e = p
-        r = g.let(e - s, "R")
-        with g.b.if_((s.lt(e).and_(s.le(x)).and_(x.le(e))).or_(s.gt(e).and_(e.le(x)).and_(x.le(s)))):
-            t = g.let((x - e) / r, "T")  # shapes._smooth: r^2 would overflow
-            q = g.let(1.0 - t * t, "Q")
-            with g.b.if_(q.lt(0.0)):
-                g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q))
-        with g.b.elif_((s.lt(e).and_(x.gt(e))).or_(s.gt(e).and_(x.lt(e)))):
-            g.b.set(out, 1.0)
-        with g.b.else_():
-            g.b.set(out, 0.0)
-    elif kind == "semiellipse":
-        s = g.min_(p[1], p[0])  # min(p) / max(p) of two values
-        e = g.max_(p[1], p[0])
-        r = g.let(0.5 * (e - s), "R")
-        c = g.let(s + r, "C")
-        with g.b.if_(s.le(x).and_(x.le(e))):
-            t = g.let((x - c) / r, "T")  # shapes._smooth: r^2 would overflow
-            q = g.let(1.0 - t * t, "Q")
-            with g.b.if_(q.lt(0.0)):
-                g.b.set(q, 0.0)
-            g.b.set(out, g.call("SQRT", q))
-        with g.b.else_():
-            g.b.set(out, 0.0)
-    else:
+    """A smooth shape's registry formula (:attr:`fuzzyctl.kinds.shapes.Shape.formula`, the
+    one the float and numpy forms are compiled from), height 1."""
+    shape = registry.SHAPES.get(kind)
+    if shape is None or not shape.smooth:
         raise g.refuse(what, f"{kind} membership functions are not supported by the code generator")
+    env = dict(zip(("x", *shape.params), (x, *p), strict=True))
+    out = g.temp(hint="M")
+    g.b.set(out, formula(g, shape.parsed(), env))
     return out
 
 

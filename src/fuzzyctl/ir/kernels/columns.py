@@ -34,6 +34,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import accumulate_np, clamp_np
+from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS, implementation
 
 Arr = npt.NDArray[np.float64]
@@ -222,9 +223,9 @@ def _ts(
                 dtype=np.float64,
             )
         if t not in zs:
-            if term.kind in ("singleton", "constant"):
+            if term.kind == "singleton" or registry.flag(term.kind, "ts_constant"):
                 z = np.full(n, 1.0) * _pv(term.params[0], vals)
-            elif term.kind == "linear":
+            elif registry.flag(term.kind, "ts_linear"):
                 cs = [_pv(p, vals) for p in term.params]
                 m = len(vals)
                 z = np.zeros(n)

@@ -135,7 +135,7 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
     def f(x: Arr, r: Arr, branch: bool = False) -> Any:
         mu = np.empty((k, len(x)))
         for kind, gs, ps, hs in stacked:
-            mu[gs] = hs * shapes._smooth_np(kind, ps, x[None, :])
+            mu[gs] = hs * shapes.smooth_np(kind, ps, x[None, :])
         for g in single:
             mu[g] = _membership(op.terms[cs[g][0]], vals, rows, x, r)
         a = A[:, r]

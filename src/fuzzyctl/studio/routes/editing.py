@@ -10,6 +10,7 @@ from fastapi import APIRouter
 
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.jsonsafe import clean
+from fuzzyctl.kinds.shapes import Shape, placement_tree
 from fuzzyctl.model import SHAPES, FunctionBlock
 from fuzzyctl.studio import analysis, editing, ruleview
 from fuzzyctl.studio.project import split_settings
@@ -63,13 +64,28 @@ def parse(body: TextBody) -> Any:
     return clean(out)
 
 
+def shape_view(spec: Shape) -> dict[str, Any]:
+    """A registry entry as the studio's front end reads it (``placement``: expression trees
+    over a, b, c and w, see :func:`fuzzyctl.kinds.shapes.placement_tree`)."""
+    return {
+        "params": list(spec.params),
+        "summary": spec.summary,
+        "variadic": spec.variadic,
+        "family": spec.family,
+        "roles": list(spec.roles),
+        "placement": [placement_tree(p) for p in spec.studio.placement],
+        "handles": [dict(h) for h in spec.studio.handles],
+        "polygon": spec.studio.polygon,
+        "pickable": spec.studio.pickable,
+    }
+
+
 @router.get("/api/shapes")
 def shapes() -> dict[str, Any]:
-    """The parametric term kinds the engine reads: parameter names and formulas."""
-    return {
-        kind: {"params": list(spec.params), "summary": spec.summary, "variadic": spec.variadic}
-        for kind, spec in SHAPES.items()
-    }
+    """The parametric term kinds the engine reads: parameter names, roles and formulas,
+    and how the editor places and drags a term of each (the shape registry's entries:
+    the front end keeps no per-kind table)."""
+    return {kind: shape_view(spec) for kind, spec in SHAPES.items()}
 
 
 @router.post("/api/rules/parse")

@@ -1,10 +1,12 @@
-// Terms as the membership-function editor sees them: which parameters each kind has (the
-// server's catalogue, fuzzyctl.model.SHAPES), which of them can be dragged on the chart
-// and where their handle sits, and how to turn a term into another kind keeping its place.
-// No membership formula lives here: curves come from the engine (the check report);
-// handles are positions read from the parameters.
+// Terms as the membership-function editor sees them: which parameters each kind has, which
+// of them can be dragged on the chart and where their handle sits, and how to turn a term
+// into another kind keeping its place.  All of it per kind comes from the server's catalogue
+// (GET /api/shapes: the shape registry, fuzzyctl.kinds.shapes); no per-kind table and no
+// membership formula lives here: curves come from the engine (the check report); handles
+// are positions read from the parameters.
 
-export let SHAPES = {}; // kind -> {params: [...], summary, variadic}
+// kind -> {params, summary, variadic, family, roles, placement, handles, polygon, pickable}
+export let SHAPES = {};
 
 export function setShapes(shapes) {
   SHAPES = shapes;
@@ -26,40 +28,16 @@ export function kindLabel(kind) {
 /** Every kind the picker offers, inputs first the fuzzy sets, outputs also the
  * Takagi-Sugeno ones. */
 export function kinds(isOutput) {
-  // cosine_half is jFuzzyLogic's COSINE with a variable half-width; with numbers it is a
-  // cosine, and FCL writes it as one
-  const shapeKinds = Object.keys(SHAPES).filter((k) => k !== "cosine_half" && (isOutput || (k !== "constant" && k !== "linear")));
+  // not pickable: jFuzzyLogic's COSINE with a variable half-width (with numbers it is a
+  // cosine, and FCL writes it as one); Takagi-Sugeno kinds on outputs only
+  const shapeKinds = Object.keys(SHAPES).filter((k) => SHAPES[k].pickable && (isOutput || SHAPES[k].family !== "ts"));
   return ["points", "singleton", ...(isOutput ? ["singletons"] : []), ...shapeKinds, "function"];
 }
 
-// Handles of a parameter: a position (the parameter is an x), or a spread measured from
-// a centre parameter (x = centre + factor * spread), at the height the shape has there.
-const P = (i, y) => ({ at: i, y });
-const S = (i, centre, factor, y) => ({ at: i, centre, factor, y });
-const HANDLES = {
-  triangle: [P(0, 0), P(1, 1), P(2, 0)],
-  trapezoid: [P(0, 0), P(1, 1), P(2, 1), P(3, 0)],
-  rectangle: [P(0, 0.5), P(1, 0.5)],
-  gaussian: [P(0, 1), S(1, 0, 1, Math.exp(-0.5))],
-  gaussian2: [P(0, 1), S(1, 0, -1, Math.exp(-0.5)), P(2, 1), S(3, 2, 1, Math.exp(-0.5))],
-  bell: [P(0, 1), S(1, 0, 1, 0.5)],
-  sigmoid: [P(0, 0.5)],
-  dsigmoid: [P(0, 0.5), P(2, 0.5)],
-  dsigmoid_pos: [P(0, 0.5), P(2, 0.5)],
-  psigmoid: [P(0, 0.5), P(2, 0.5)],
-  cosine: [P(0, 1), S(1, 0, 0.5, 0)],
-  cosine_half: [P(0, 1), S(1, 0, 1, 0)],
-  sshape: [P(0, 0), P(1, 1)],
-  zshape: [P(0, 1), P(1, 0)],
-  pishape: [P(0, 0), P(1, 1), P(2, 1), P(3, 0)],
-  ramp: [P(0, 0), P(1, 1)],
-  spike: [P(0, 1), S(1, 0, 0.1, Math.exp(-1))],
-  concave: [P(0, 0.5), P(1, 1)],
-  binary: [P(0, 0.5)],
-  arc: [P(0, 0), P(1, 1)],
-  semiellipse: [P(0, 0), P(1, 0)],
-  constant: [{ at: 0, y: 1, line: true }],
-};
+// Handles of a parameter (the catalogue's ``handles``): a position (the parameter is an
+// x), or a spread measured from a centre parameter (x = centre + factor * spread), at the
+// height the shape has there.
+const handleSpecs = (kind) => (SHAPES[kind] && SHAPES[kind].handles) || [];
 
 /** The draggable handles of a term: ``[{x, y, set(x), line}]`` (``line``: a vertical line
  * grabbed anywhere along it, as singletons), or [] when nothing can be dragged (a term
@@ -75,10 +53,10 @@ export function handles(term) {
     if (!mf.points.every((p) => num(p.x) && num(p.y))) return [];
     return mf.points.map((p) => ({ x: p.x, y: p.y, set: (x) => (p.x = x), line: true }));
   }
-  if (mf.type !== "shape" || !HANDLES[mf.kind]) return [];
+  if (mf.type !== "shape" || !handleSpecs(mf.kind).length) return [];
   const h = num(mf.height) ? mf.height : 1;
   const out = [];
-  for (const spec of HANDLES[mf.kind]) {
+  for (const spec of handleSpecs(mf.kind)) {
     const p = mf.params;
     if (!num(p[spec.at]) || (spec.centre !== undefined && !num(p[spec.centre]))) continue;
     if (spec.centre === undefined) {
@@ -137,49 +115,23 @@ export function convert(kind, place, nInputs = 1) {
       return { type: "singletons", points: [{ x: r6(c), y: 1 }] };
     case "function":
       return null; // written in the FCL field
-    case "triangle":
-      return shape([a, c, b]);
-    case "trapezoid":
-      return shape([a, (a + c) / 2, (c + b) / 2, b]);
-    case "rectangle":
-    case "sshape":
-    case "zshape":
-    case "ramp":
-    case "arc":
-    case "semiellipse":
-      return shape([a, b]);
-    case "gaussian":
-      return shape([c, w / 6]);
-    case "gaussian2":
-      return shape([c - w / 10, w / 8, c + w / 10, w / 8]);
-    case "bell":
-      return shape([c, w / 4, 2]);
-    case "sigmoid":
-      return shape([c, 10 / w]);
-    case "dsigmoid":
-    case "dsigmoid_pos":
-      return shape([a + w / 4, 20 / w, b - w / 4, 20 / w]);
-    case "psigmoid":
-      return shape([a + w / 4, 20 / w, b - w / 4, -20 / w]);
-    case "cosine":
-      return shape([c, w]);
-    case "cosine_half":
-      return shape([c, w / 2]);
-    case "pishape":
-      return shape([a, c, c, b]);
-    case "spike":
-      return shape([c, w]);
-    case "concave":
-      return shape([c, b]);
-    case "binary":
-      return shape([c, b]);
-    case "constant":
-      return shape([c]);
-    case "linear":
-      return shape(new Array(nInputs + 1).fill(0));
-    default:
-      return null;
   }
+  const spec = SHAPES[kind];
+  if (!spec) return null;
+  // a variadic shape (Takagi-Sugeno linear): one zero per input and the constant
+  if (spec.variadic) return shape(new Array(nInputs + 1).fill(0));
+  return shape(spec.placement.map((t) => evalPlacement(t, { a, b, c, w })));
+}
+
+/** A placement expression of the catalogue: a number, a name or [op, left, right]. */
+function evalPlacement(t, env) {
+  if (typeof t === "number") return t;
+  if (typeof t === "string") return env[t];
+  const [op, l, r] = t;
+  if (op === "neg") return -evalPlacement(l, env);
+  const x = evalPlacement(l, env);
+  const y = evalPlacement(r, env);
+  return op === "+" ? x + y : op === "-" ? x - y : op === "*" ? x * y : x / y;
 }
 
 /** The name of parameter ``i`` of a shape kind. */
@@ -204,20 +156,15 @@ export function paramText(p) {
   return p && typeof p === "object" ? p.name : String(p);
 }
 
-// What each parameter is, for rescaling a term to a new range: x a position, w a width, s
-// a slope (per unit of x), n a pure number.
-const ROLES = {
-  triangle: "xxx", trapezoid: "xxxx", rectangle: "xx", gaussian: "xw", gaussian2: "xwxw", bell: "xwn",
-  sigmoid: "xs", dsigmoid: "xsxs", dsigmoid_pos: "xsxs", psigmoid: "xsxs", cosine: "xw", cosine_half: "xw",
-  sshape: "xx", zshape: "xx", pishape: "xxxx", ramp: "xx", spike: "xw", concave: "xx", binary: "xx",
-  arc: "xx", semiellipse: "xx", constant: "x",
-};
+// What each parameter is, for rescaling a term to a new range (the catalogue's ``roles``):
+// x a position, width a width, slope a slope (per unit of x), number/coef a pure number.
+const roleOf = (kind, i) => (SHAPES[kind] && SHAPES[kind].roles ? SHAPES[kind].roles[i] : undefined);
 
 /** The positions (x values) of a term with numeric parameters. */
 export function positions(mf) {
   if (mf.type === "points" || mf.type === "singletons") return mf.points.map((p) => p.x).filter(num);
   if (mf.type === "singleton") return num(mf.value) ? [mf.value] : [];
-  if (mf.type === "shape" && ROLES[mf.kind]) return mf.params.filter((p, i) => ROLES[mf.kind][i] === "x" && num(p));
+  if (mf.type === "shape") return mf.params.filter((p, i) => roleOf(mf.kind, i) === "x" && num(p));
   return [];
 }
 
@@ -227,11 +174,11 @@ export function rescale(mf, f, k) {
   const round = (v) => Math.round(v * 1e6) / 1e6;
   if (mf.type === "points" || mf.type === "singletons") for (const p of mf.points) if (num(p.x)) p.x = round(f(p.x));
   if (mf.type === "singleton" && num(mf.value)) mf.value = round(f(mf.value));
-  if (mf.type === "shape" && ROLES[mf.kind]) {
+  if (mf.type === "shape" && SHAPES[mf.kind]) {
     mf.params = mf.params.map((p, i) => {
       if (!num(p)) return p;
-      const role = ROLES[mf.kind][i];
-      return role === "x" ? round(f(p)) : role === "w" ? round(p * k) : role === "s" ? p / k : p;
+      const role = roleOf(mf.kind, i);
+      return role === "x" ? round(f(p)) : role === "width" ? round(p * k) : role === "slope" ? p / k : p;
     });
   }
 }
@@ -248,7 +195,7 @@ export function localCurve(term, lo, hi) {
     const pts = mf.points.map((p) => [p.x, p.y]).sort((a, b) => a[0] - b[0]);
     return { points: [[Math.min(lo, pts[0][0]), pts[0][1]], ...pts, [Math.max(hi, pts[pts.length - 1][0]), pts[pts.length - 1][1]]] };
   }
-  if (mf.type === "shape" && (mf.kind === "triangle" || mf.kind === "trapezoid") && num(mf.height)) {
+  if (mf.type === "shape" && SHAPES[mf.kind] && SHAPES[mf.kind].polygon && num(mf.height)) {
     const pts = h.map((p) => [p.x, p.y]).sort((a, b) => a[0] - b[0]);
     return { points: [[Math.min(lo, pts[0][0]), 0], ...pts, [Math.max(hi, pts[pts.length - 1][0]), 0]] };
   }
