@@ -9,7 +9,6 @@ terms are static helpers of :mod:`fuzzyctl.codegen.c_helpers`, emitted only when
 from __future__ import annotations
 
 import array
-import math
 from collections.abc import Sequence
 from typing import TYPE_CHECKING
 
@@ -18,10 +17,8 @@ from fuzzyctl.codegen.c_kernels import ACCU_CODES
 from fuzzyctl.engine.fastprog import FastProgram
 from fuzzyctl.engine.ir import (
     Assign,
-    Bin,
     Bool,
     Call,
-    Comment,
     Decl,
     Ex,
     For,
@@ -29,8 +26,6 @@ from fuzzyctl.engine.ir import (
     Index,
     Int,
     Kernel,
-    Neg,
-    Not,
     Num,
     Program,
     Pwl,
@@ -42,37 +37,18 @@ from fuzzyctl.engine.ir import (
     subexprs,
 )
 from fuzzyctl.engine.plan import OutputPlan
-from fuzzyctl.escape import CodegenError, c_comment, c_ident
+from fuzzyctl.engine.printer import Printer
+from fuzzyctl.escape import CodegenError, c_ident
+from fuzzyctl.kinds import targets
 
 if TYPE_CHECKING:
     from fuzzyctl.engine.irgen import Gen
 
-_PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
-_COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
+C = targets.C
 # libm itself is used for ``exp`` only; every other intrinsic is one of the static helpers
 # of :mod:`fuzzyctl.codegen.c_helpers` (written with + - * / and exp), emitted on demand.
-_LIBM = {"EXP": "exp"}
-_HELPER_OF = {
-    "LN": "fz_log",
-    "LOG": "fz_log10",
-    "SQRT": "fz_sqrt",
-    "ABS": "fz_fabs",
-    "SIN": "fz_sin",
-    "COS": "fz_cos",
-    "TAN": "fz_tan",
-    "ASIN": "fz_asin",
-    "ACOS": "fz_acos",
-    "ATAN": "fz_atan",
-    "SINH": "fz_sinh",
-    "COSH": "fz_cosh",
-    "TANH": "fz_tanh",
-    "FLOOR": "fz_floor",
-    "CEIL": "fz_ceil",
-    "RINT": "fz_rint",
-    "POW": "fz_pow",
-    "ATAN2": "fz_atan2",
-    "FMOD": "fz_fmod",
-}
+_LIBM = {f: C.functions[f] for f in C.library}
+_HELPER_OF = {f: spelled for f, spelled in C.functions.items() if f not in C.library}
 
 
 def helper_functions(prog: Program) -> list[str]:
@@ -87,104 +63,36 @@ def libm_functions(prog: Program) -> list[str]:
     return ["exp"] if direct or via_helpers else []
 
 
-class _C:
+class _C(Printer):
+    """C99 statements; block fields as ``fb->x``, constant tables as ``NAME_x``."""
+
     def __init__(self, prog: Program, single: bool) -> None:
+        super().__init__(C, real=f"{prog.name}_real", single=single)
         self.prog = prog
-        self.single = single
-        self.real = f"{prog.name}_real"
         self.fields = {d.name for d in prog.decls if d.storage in ("input", "output", "param", "state")}
         self.consts = {d.name for d in prog.decls if d.storage == "const"}
-        self.lines: list[str] = []
-
-    # ------------------------------------------------------------------ expressions
-
-    def num(self, v: float) -> str:
-        if math.isnan(v):
-            return "NAN"
-        if math.isinf(v):
-            return "INFINITY" if v > 0 else "(-INFINITY)"
-        s = repr(float(v))
-        if "e" not in s and "." not in s:
-            s += ".0"
-        s = s + ("f" if self.single else "")
-        return f"({s})" if v < 0 else s
 
     def name(self, n: str) -> str:
         if n in self.consts:  # file-scope tables: unique per block (several blocks may share a unit)
             return f"{self.prog.name}_{n}"
         return f"fb->{n}" if n in self.fields else n
 
-    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
-        if isinstance(e, Num):
-            return self.num(e.value)
-        if isinstance(e, Int):
-            return str(e.value) if e.value >= 0 else f"({e.value})"
-        if isinstance(e, Bool):
-            return "1" if e.value else "0"
-        if isinstance(e, Var):
-            return self.name(e.name)
-        if isinstance(e, Index):
-            return f"{self.name(e.name)}[{self.ex(e.index)}]"
-        if isinstance(e, Neg):
-            return f"-{self.ex(e.operand, 6)}"
-        if isinstance(e, Not):
-            return f"!{self.ex(e.operand, 6)}"
-        if isinstance(e, Call):
-            if e.function == "NAN":
-                return "NAN"
-            if e.function == "TO_REAL":
-                return f"(({self.real}){self.ex(e.args[0])})"
-            args = ", ".join(self.ex(a) for a in e.args)
-            if e.function in _LIBM:
-                return f"{_LIBM[e.function]}{'f' if self.single else ''}({args})"
-            # the helpers compute in double; the float build rounds their result once
-            call = f"{_HELPER_OF[e.function]}({args})"
-            return f"(({self.real}){call})" if self.single else call
-        assert isinstance(e, Bin)
-        p = _PREC[e.op]
-        s = f"{self.ex(e.left, p)} {_COP.get(e.op, e.op)} {self.ex(e.right, p, True)}"
-        # operands keep the IR's tree exactly (floating point is not associative)
-        return f"({s})" if p < parent or (right and p == parent) else s
+    def call(self, e: Call) -> str:
+        if e.function in _LIBM:
+            args = ", ".join(self.args(e))
+            return f"{_LIBM[e.function]}{'f' if self.single else ''}({args})"
+        text = super().call(e)
+        # the helpers compute in double; the float build rounds their result once
+        return f"(({self.real}){text})" if self.single and e.function in _HELPER_OF else text
 
-    # ------------------------------------------------------------------ statements
-
-    def emit(self, s: str, ind: int) -> None:
-        self.lines.append("    " * ind + s)
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        for s in body:
-            if isinstance(s, Assign):
-                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)};", ind)
-            elif isinstance(s, Comment):
-                self.emit(_comment(s.text), ind)
-            elif isinstance(s, Region):
-                self.emit(_comment(s.name), ind)
-                self.stmts(s.body, ind)
-            elif isinstance(s, If):
-                for k, (cond, body) in enumerate(s.branches):
-                    kw = "if" if k == 0 else "} else if"
-                    self.emit(f"{kw} ({self.ex(cond)}) {{", ind)
-                    self.stmts(body, ind + 1)
-                if s.orelse:
-                    self.emit("} else {", ind)
-                    self.stmts(s.orelse, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, For):
-                v = s.var
-                cmp, inc = ("<=", "++") if s.step > 0 else (">=", "--")
-                self.emit(f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind)
-                self.stmts(s.body, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, While):
-                self.emit(f"while ({self.ex(s.cond)}) {{", ind)
-                self.stmts(s.body, ind + 1)
-                self.emit("}", ind)
+    def kernel(self, k: Kernel, ind: int) -> None:
+        """The PLC block has no kernels (the native evaluator's are in :class:`_Native`)."""
 
 
 def _comment(text: str) -> str:
     """A C comment: every comment of the generated files is made here, from model text
-    escaped by :func:`fuzzyctl.escape.c_comment`."""
-    return f"/* {c_comment(text)} */"
+    escaped as the C record says (:func:`fuzzyctl.escape.c_comment`)."""
+    return C.comment(text)
 
 
 _CTYPES = {"INT": "int", "DINT": "long", "BOOL": "unsigned char", "BYTE": "unsigned char"}
@@ -368,6 +276,7 @@ class _Native(_C):
 
     def __init__(self, fp: FastProgram) -> None:
         super().__init__(fp.program, False)
+        self.comments = False  # no model text in the native evaluator
         self.fp = fp
         self.real = "double"
         self.fields = set()
@@ -386,38 +295,13 @@ class _Native(_C):
             return "prev"
         return n
 
-    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
-        if isinstance(e, Pwl):
-            return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
-        if isinstance(e, Call) and e.function == "IMOD":
-            return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
-        return super().ex(e, parent, right)
+    def pwl(self, e: Pwl) -> str:
+        return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
 
     def pwl_func(self, points: tuple[tuple[float, float], ...]) -> str:
         if points not in self.pwl_funcs:
             self.pwl_funcs[points] = f"fz_pwl{len(self.pwl_funcs)}"
         return self.pwl_funcs[points]
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        for s in body:
-            if isinstance(s, Kernel):
-                self.kernel(s, ind)
-            elif isinstance(s, Comment):
-                continue
-            elif isinstance(s, Region):
-                self.stmts(s.body, ind)
-            elif isinstance(s, If):
-                for k, (cond, b) in enumerate(s.branches):
-                    self.emit(f"{'if' if k == 0 else '} else if'} ({self.ex(cond)}) {{", ind)
-                    self.stmts(b, ind + 1)
-                if s.orelse:
-                    self.emit("} else {", ind)
-                    self.stmts(s.orelse, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, For | While):
-                super().stmts([s], ind)  # loop bodies come back here
-            else:
-                super().stmts([s], ind)
 
     def kernel(self, k: Kernel, ind: int) -> None:
         if k.name == "HOLD":

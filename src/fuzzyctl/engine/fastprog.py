@@ -42,7 +42,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal
 
 from fuzzyctl.engine import shapes
 from fuzzyctl.engine.ir import Ex, Kernel, Num, Program, Pwl, Var, ex
@@ -63,7 +62,9 @@ from fuzzyctl.engine.plan import (
     SelectionPlan,
 )
 
-FastTarget = Literal["py", "np", "c"]
+#: A key of :data:`fuzzyctl.kinds.targets.TARGETS` whose renderer prints the evaluator
+#: (py, np, c): its record's ``kernels`` say which routines the program may call.
+FastTarget = str
 
 #: Above this many rules the rule section is tables and loops (:mod:`fuzzyctl.engine.ruletable`).
 TABLE_THRESHOLD = 200
@@ -104,7 +105,7 @@ class FastBuilder(RuleBuilder):
         return Literals(self.g, "", what)
 
     def select(self, sel: SelectionPlan, degrees: list[Ex]) -> list[Ex]:
-        if self.target == "c":
+        if "SELECT" not in self.g.caps.kernels:
             return super().select(sel, degrees)
         outs = tuple(self.g.temp(hint="SEL") for _ in degrees)
         self.g.b.add(Kernel("SELECT", outs, tuple(degrees), sel))
@@ -112,7 +113,7 @@ class FastBuilder(RuleBuilder):
 
     def function_term(self, expr: object, x: Ex | None, outputs: Callable[[int], Ex], where: str) -> Ex:
         assert isinstance(expr, ENum | EInput | EOutput | EX | EUnary | EBinary | ECall)
-        if self.target == "c":
+        if "EXPR" not in self.g.caps.kernels:
             return super().function_term(expr, x, outputs, where)
         refs = sorted(_expr_outputs(expr))
         args = (x if x is not None else Num(0.0), *self.inputs, *(outputs(o) for o in refs))
@@ -146,7 +147,7 @@ class FastBuilder(RuleBuilder):
         if _use_table(plan):
             from fuzzyctl.engine.ruletable import table_rules
 
-            tabled = table_rules(self, degrees, sparse=self.target != "np")
+            tabled = table_rules(self, degrees, sparse=self.g.caps.data_dependent_loops)
         else:
             concl = self.rules(degrees, Literals(g, "", ""))
         values: dict[int, Ex] = {}
@@ -175,7 +176,7 @@ class FastBuilder(RuleBuilder):
 
     def _member(self, t: object, x: Ex, where: str) -> Ex:
         """A term whose points are inputs: ``shapes.membership`` at run time."""
-        if self.target == "c":
+        if "MEMBER" not in self.g.caps.kernels:
             raise self.g.refuse(where, "membership points given by variables")
         out = self.g.temp(hint="MU")
         self.g.b.add(Kernel("MEMBER", (out,), (x, *self.inputs), t))
@@ -213,16 +214,16 @@ class FastBuilder(RuleBuilder):
     ) -> tuple[Ex, Ex]:
         if not any(t.kind in shapes.TSUKAMOTO_KINDS for t in op.terms):
             return self.ts(op, contribs, values)
-        if self.target == "c":
+        if "TS" not in self.g.caps.kernels:
             raise self.g.refuse(f"output {op.name}", "Tsukamoto (monotonic) terms")
         return self._whole_output("TS", oi, op, contribs, values)
 
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         groups = merge(self.g, contribs, op.accu or "MAX")
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
-        if self.target == "c":
+        if "MAMDANI" not in self.g.caps.kernels:
             smooth_cog = not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
-            if not smooth_cog or any(t.kind == "function" for t in op.terms):
+            if not smooth_cog or any(t.kind == "function" for t in op.terms) or "SMOOTH" not in self.g.caps.kernels:
                 raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
             return self._smooth_kernel(oi, merged)
         return self._whole_output("MAMDANI", oi, op, merged, {})

@@ -120,6 +120,14 @@ def mul(w: Ex, x: ExLike) -> Ex:
 # --------------------------------------------------------------------------- hedges
 
 
+def power(g: Gen, x: Ex, y: Ex) -> Ex:
+    """``x ** y`` for ``x > 0``: ``POW`` where the target has it, else ``EXP(y * LN(x))``
+    (portable Structured Text has no power function)."""
+    if g.caps.has("POW"):
+        return g.call("POW", x, y)
+    return g.call("EXP", y * g.call("LN", x))
+
+
 def hedge(g: Gen, name: str, d: Ex) -> Ex:
     """One hedge of :data:`fuzzyctl.engine.shapes.HEDGES` (or ``pow:p``) applied to ``d``."""
     x = _simple(g, d)
@@ -132,10 +140,8 @@ def hedge(g: Gen, name: str, d: Ex) -> Ex:
                 for _ in range(int(p) - 1):
                     prod = prod * x
                 g.b.set(t, prod)
-            elif g.target != "st":
-                g.b.set(t, g.call("POW", x, p))
             else:
-                g.b.set(t, g.call("EXP", Num(p) * g.call("LN", x)))
+                g.b.set(t, power(g, x, Num(p)))
         with g.b.else_():
             g.b.set(t, 1.0 if p == 0.0 else 0.0)
         return t
@@ -242,7 +248,7 @@ def smooth(g: Gen, kind: str, p: P, x: Ex, what: str) -> Ex:
         u = _absv(g, (x - p[0]) / p[1])
         expo = g.let(2.0 * p[2], "E")
         with g.b.if_(u.gt(0.0)):
-            pw = g.call("POW", u, expo) if g.target != "st" else g.call("EXP", expo * g.call("LN", u))
+            pw = power(g, u, expo)
             g.b.set(out, 1.0 / (1.0 + pw))
         with g.b.elif_(u.eq(0.0).and_(expo.gt(0.0))):
             g.b.set(out, 1.0)
@@ -351,8 +357,6 @@ _C_FUNCS = {
     "atan2": "ATAN2",
     "fmod": "FMOD",
 }
-#: The IEC 61131-3 standard functions portable Structured Text may call.
-_ST_FUNCS = frozenset({"EXP", "LN", "LOG", "SQRT", "ABS", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN"})
 _COMPARE = {"eq": "=", "neq": "<>", "lt": "<", "le": "<=", "gt": ">", "ge": ">="}
 
 
@@ -363,7 +367,7 @@ def expression(
     inf/nan as the engine's C-like evaluation.  Structured Text: + - * /, comparisons,
     min/max/sign and the IEC 61131-3 standard functions (EXP, LN, LOG, SQRT, ABS and the
     trigonometric ones); a PLC faults where the engine would give inf or nan."""
-    if g.target not in ("c", "st"):
+    if not g.caps.function_terms:
         raise g.refuse(what, "function terms are an Open-level feature")
 
     def rec(n: ExprPlan) -> Ex:
@@ -383,13 +387,14 @@ def expression(
             a, b = rec(n.left), rec(n.right)
             if n.op in "+-*/":
                 return Bin(n.op, a, b)
-            if g.target == "st":
+            fn = "FMOD" if n.op == "%" else "POW"
+            if not g.caps.has(fn):
                 raise g.refuse(
                     what,
-                    f"the operator {n.op} has no portable Structured Text form; write the "
+                    f"the operator {n.op} has no portable {g.caps.label} form; write the "
                     "function with + - * / and EXP/LN",
                 )
-            return g.call("FMOD" if n.op == "%" else "POW", a, b)
+            return g.call(fn, a, b)
         assert isinstance(n, ECall)
         args = [rec(a) for a in n.args]
         fn = n.function
@@ -417,11 +422,11 @@ def expression(
             return t
         if fn not in _C_FUNCS:
             raise g.refuse(what, f"function {fn}() is not supported")
-        if g.target == "st" and _C_FUNCS[fn] not in _ST_FUNCS:
+        if not g.caps.has(_C_FUNCS[fn]):
             raise g.refuse(
                 what,
-                f"function {fn}() is no IEC 61131-3 standard function; write the function with "
-                "+ - * / and EXP, LN, LOG, SQRT, ABS, SIN, COS, TAN, ASIN, ACOS or ATAN",
+                f"function {fn}() is no {g.caps.function_noun}; write the function with "
+                f"+ - * / and {g.caps.function_list()}",
             )
         return g.call(_C_FUNCS[fn], *args)
 

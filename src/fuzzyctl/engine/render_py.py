@@ -19,19 +19,12 @@ from fuzzyctl.engine import kernels
 from fuzzyctl.engine.fastprog import FastProgram
 from fuzzyctl.engine.ir import (
     Assign,
-    Bin,
     Bool,
-    Call,
-    Comment,
     Ex,
     For,
     If,
     Index,
-    Int,
     Kernel,
-    Neg,
-    Not,
-    Num,
     Pwl,
     Region,
     Stmt,
@@ -39,41 +32,47 @@ from fuzzyctl.engine.ir import (
     While,
     identifiers,
 )
+from fuzzyctl.engine.printer import Printer
 from fuzzyctl.escape import py_ident, py_str
+from fuzzyctl.kinds import targets
 
 Fast = Callable[[list[float], list[float | None]], list[float]]
-
-_OPS = {"=": "==", "<>": "!=", "AND": "and", "OR": "or"}
-_FUNCS = {
-    "EXP": "_m.exp",
-    "SQRT": "_m.sqrt",
-    "LN": "_m.log",
-    "LOG": "_m.log10",
-    "ABS": "abs",
-    "SIN": "_m.sin",
-    "COS": "_m.cos",
-    "TAN": "_m.tan",
-    "ASIN": "_m.asin",
-    "ACOS": "_m.acos",
-    "ATAN": "_m.atan",
-    "POW": "_m.pow",
-    "TO_REAL": "float",
-}
 
 
 def lit(x: float) -> str:
     """An exact float literal (``repr`` round-trips), NaN and infinities by name."""
-    if math.isnan(x):
-        return "_NAN"
-    if math.isinf(x):
-        return "_INF" if x > 0 else "(-_INF)"
-    return repr(float(x))
+    return targets.PY.real(x)
 
 
-class _Py:
+class PythonPrinter(Printer):
+    """Python statement syntax (indentation blocks, ``pass``, ``range`` loops); no comments
+    (they hold model text)."""
+
+    ASSIGN = "{0} = {1}"
+    IF = "if {0}:"
+    ELIF = "elif {0}:"
+    ELSE = "else:"
+    END_IF = None
+    WHILE = "while {0}:"
+    END_WHILE = None
+    EMPTY = "pass"
+
+    def __init__(self, caps: targets.Target) -> None:
+        super().__init__(caps, comments=False)
+
+    def region(self, s: Region, ind: int) -> None:
+        self.block(s.body, ind)  # a region that prints nothing holds a pass
+
+    def for_(self, s: For, ind: int) -> None:
+        stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
+        self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
+        self.block(s.body, ind + 1)
+
+
+class _Py(PythonPrinter):
     def __init__(self, fp: FastProgram) -> None:
+        super().__init__(targets.PY)
         self.fp = fp
-        self.lines: list[str] = []
         self.env: dict[str, Any] = {"_NAN": math.nan, "_INF": math.inf, "_m": math}
         self.n_kernels = 0
 
@@ -83,74 +82,17 @@ class _Py:
         self.env[name] = value
         return name
 
-    def emit(self, line: str, ind: int) -> None:
-        self.lines.append("    " * ind + line)
+    def pwl(self, e: Pwl) -> str:
+        """Not at the top of an assignment: ``shapes.pwl_value`` bound as a function."""
+        from fuzzyctl.engine.shapes import pwl_value
 
-    # ------------------------------------------------------------------ expressions
+        return f"{self.bind(lambda x, pts=e.points: pwl_value(pts, x), '_p')}({self.ex(e.x)})"
 
-    def ex(self, e: Ex) -> str:
-        if isinstance(e, Num):
-            return lit(e.value)
-        if isinstance(e, Int):
-            return str(e.value)
-        if isinstance(e, Bool):
-            return "True" if e.value else "False"
-        if isinstance(e, Var):
-            return e.name
-        if isinstance(e, Index):
-            return f"{e.name}[{self.ex(e.index)}]"
-        if isinstance(e, Neg):
-            return f"(-{self.ex(e.operand)})"
-        if isinstance(e, Not):
-            return f"(not {self.ex(e.operand)})"
-        if isinstance(e, Call):
-            if e.function == "NAN":
-                return "_NAN"
-            if e.function == "IMOD":
-                return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
-            return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
-        if isinstance(e, Pwl):  # not at the top of an assignment: shapes.pwl_value
-            from fuzzyctl.engine.shapes import pwl_value
-
-            return f"{self.bind(lambda x, pts=e.points: pwl_value(pts, x), '_p')}({self.ex(e.x)})"
-        assert isinstance(e, Bin), e
-        return f"({self.ex(e.left)} {_OPS.get(e.op, e.op)} {self.ex(e.right)})"
-
-    # ------------------------------------------------------------------ statements
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        start = len(self.lines)
-        for s in body:
-            self.stmt(s, ind)
-        if len(self.lines) == start:
-            self.emit("pass", ind)
-
-    def stmt(self, s: Stmt, ind: int) -> None:
-        if isinstance(s, Assign):
-            if isinstance(s.value, Pwl):
-                self.pwl_chain(s.value, self.ex(s.target), ind)
-            else:
-                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)}", ind)
-        elif isinstance(s, If):
-            for k, (cond, body) in enumerate(s.branches):
-                self.emit(f"{'if' if k == 0 else 'elif'} {self.ex(cond)}:", ind)
-                self.stmts(body, ind + 1)
-            if s.orelse:
-                self.emit("else:", ind)
-                self.stmts(s.orelse, ind + 1)
-        elif isinstance(s, For):
-            stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
-            self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
-            self.stmts(s.body, ind + 1)
-        elif isinstance(s, While):
-            self.emit(f"while {self.ex(s.cond)}:", ind)
-            self.stmts(s.body, ind + 1)
-        elif isinstance(s, Region):
-            self.stmts(s.body, ind)
-        elif isinstance(s, Kernel):
-            self.kernel(s, ind)
+    def assign(self, s: Assign, ind: int) -> None:
+        if isinstance(s.value, Pwl):
+            self.pwl_chain(s.value, self.ex(s.target), ind)
         else:
-            assert isinstance(s, Comment)
+            super().assign(s, ind)
 
     def pwl_chain(self, p: Pwl, out: str, ind: int) -> None:
         """``shapes.pwl_value`` as an if-chain over the breakpoints."""
@@ -224,7 +166,7 @@ def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
         assert isinstance(d.init, tuple)
         r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
     body_start = len(r.lines)
-    r.stmts(prog.body, 1)
+    r.block(prog.body, 1)
     body = r.lines[body_start:]
     head: list[str] = []
     for k, name in enumerate(fp.inputs):

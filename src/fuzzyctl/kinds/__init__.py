@@ -1,0 +1,1 @@
+"""Registries: one entry per kind (shape, method, norm, code-generation target)."""
