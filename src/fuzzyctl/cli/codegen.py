@@ -1,8 +1,13 @@
 """``fuzzyctl codegen FILE --lang st|plcopen|c``: IEC 61131-3 Structured Text, the same
-function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md)."""
+function blocks as PLCopen TC6 XML, or C99 from a fuzzy system (see docs/codegen.md).
+
+The ``--lang`` and ``--dialect`` choices, which options apply to which, and the function each
+choice calls are the targets' capabilities records (:mod:`fuzzyctl.kinds.targets`)."""
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Callable
 from enum import StrEnum
 from pathlib import Path
 from typing import Annotated, Any
@@ -10,20 +15,34 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console
+from fuzzyctl.kinds import targets
+
+#: ``--lang`` choices: the targets with a CLI choice, in registry order.
+Lang = StrEnum("Lang", [(c, c) for c in targets.cli_choices()])  # type: ignore[misc]
+#: ``--dialect`` choices: the Structured Text dialects and their aliases.
+Dialect = StrEnum("Dialect", [(d, d) for d in targets.dialect_names()])  # type: ignore[misc]
+_DEFAULT_LANG = Lang(targets.cli_choices()[0])
+_DEFAULT_DIALECT = Dialect(next(iter(targets.DIALECTS)))
 
 
-class Lang(StrEnum):
-    st = "st"
-    plcopen = "plcopen"
-    c = "c"
+def _accepting(option: str) -> list[str]:
+    """The --lang choices an option applies to."""
+    return [t.cli for t in targets.TARGETS.values() if t.cli is not None and option in t.cli_options]
 
 
-class Dialect(StrEnum):
-    codesys = "codesys"
-    twincat = "twincat"
-    scl = "scl"
-    iec = "iec"
-    openplc = "openplc"
+def _lang_help() -> str:
+    return "; ".join(f"{t.cli}: {t.cli_help}" for t in targets.TARGETS.values() if t.cli is not None) + "."
+
+
+def _dialect_help() -> str:
+    helps = [d.cli_dialect_help for d in targets.DIALECTS.values()]
+    return (
+        f"{' and '.join(_accepting('dialect'))}: "
+        + ", ".join(helps[:-1])
+        + (" or " if len(helps) > 1 else "")
+        + helps[-1]
+        + "."
+    )
 
 
 @app.command()
@@ -34,8 +53,8 @@ def codegen(
     ],
     lang: Annotated[
         Lang,
-        typer.Option("--lang", help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99."),
-    ] = Lang.st,
+        typer.Option("--lang", help=_lang_help()),
+    ] = _DEFAULT_LANG,
     output: Annotated[
         Path | None,
         typer.Option(
@@ -48,8 +67,7 @@ def codegen(
         Dialect | None,
         typer.Option(
             "--dialect",
-            help="st and plcopen: codesys (default), twincat, scl (TIA Portal, st only) or iec "
-            "(strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc).",
+            help=_dialect_help(),
         ),
     ] = None,
     lreal: Annotated[
@@ -102,14 +120,11 @@ def codegen(
     """Generate a PLC function block (ST) or embedded C that computes exactly what the engine
     computes.  Anything the target cannot express is refused with a message naming it."""
     import fuzzyctl
-    from fuzzyctl.codegen import generate_c, generate_st
     from fuzzyctl.files import check_writable
     from fuzzyctl.formats import write_atomic
 
-    if lang is Lang.c and (dialect is not None or lreal):
-        raise typer.BadParameter("--dialect and --lreal apply to --lang st and plcopen", param_hint="--lang")
-    if lang is Lang.st and single:
-        raise typer.BadParameter("--float applies to --lang c (use --lreal for ST)", param_hint="--lang")
+    caps = targets.cli_target(lang.value)
+    _check_options(caps, dialect, lreal, single)
     from fuzzyctl.codegen.api import Generated
     from fuzzyctl.codegen.defaults import parse_default
     from fuzzyctl.escape import CodegenError
@@ -119,43 +134,63 @@ def codegen(
     except CodegenError as exc:
         raise typer.BadParameter(str(exc), param_hint="--default") from None
     doc = fuzzyctl.load(source, strict=strict, format=from_format)
-    if lang is Lang.plcopen:
-        _plcopen(doc, output, dialect, lreal, single, block, strict, default, force)
-        return
     report: list[Generated] = []
-    if lang is Lang.st:
-        text = generate_st(
-            doc,
-            block=block,
-            dialect=(dialect or Dialect.codesys).value,
-            lreal=lreal,
-            strict=strict,
-            default=default,
-            report=report,
-            testbench=testbench,
-        )
-        if output is None:
-            if as_json:
-                _json_report(lang, report, text=text)
-            else:
-                typer.echo(text, nl=False)
-            return
-        write_atomic(output, text, force=force, hint=FORCE_HINT)
-        _done(as_json, lang, report, [output])
-        return
-    files = generate_c(
-        doc, block=block, single=single, strict=strict, testbench=testbench, default=default, report=report
+    chosen = {"dialect": (dialect or _DEFAULT_DIALECT).value, "lreal": lreal, "single": single}
+    kwargs: dict[str, Any] = {k: chosen[k] for k in ("dialect", "lreal") if k in caps.cli_options} | (
+        {"single": single} if "float" in caps.cli_options else {}
     )
-    out_dir = output or Path(".")
+    if "testbench" in caps.cli_options:
+        kwargs["testbench"] = testbench
+    if caps.report:
+        kwargs["report"] = report
+    result = _generator(caps)(doc, block=block, strict=strict, default=default, **kwargs)
+    json_report = as_json and caps.report
+    if isinstance(result, str):  # one text: printed, or written to -o
+        if output is None:
+            if json_report:
+                _json_report(lang, report, text=result)
+            else:
+                typer.echo(result, nl=False)
+            return
+        write_atomic(output, result, force=force, hint=FORCE_HINT)
+        _done(json_report, lang, report, [output])
+        return
+    out_dir = output or Path(".")  # several files: into the directory -o
     if out_dir.exists() and not out_dir.is_dir():
         raise typer.BadParameter(f"{out_dir} is not a directory", param_hint="-o")
     out_dir.mkdir(parents=True, exist_ok=True)
     if not force:  # every file checked before any is written: no half-replaced set
-        for name in files:
+        for name in result:
             check_writable(out_dir / name, hint=FORCE_HINT)
-    for name, text in files.items():
+    for name, text in result.items():
         write_atomic(out_dir / name, text, force=force, hint=FORCE_HINT)
-    _done(as_json, lang, report, [out_dir / n for n in files])
+    _done(json_report, lang, report, [out_dir / n for n in result])
+
+
+def _check_options(caps: targets.Target, dialect: Any, lreal: bool, single: bool) -> None:
+    """Refuse an option the chosen target does not take (and a dialect it cannot hold)."""
+    if ("dialect" not in caps.cli_options and dialect is not None) or (
+        "lreal" not in caps.cli_options and lreal
+    ):
+        langs = " and ".join(_accepting("dialect"))
+        raise typer.BadParameter(f"--dialect and --lreal apply to --lang {langs}", param_hint="--lang")
+    if "float" not in caps.cli_options and single:
+        hint = " (use --lreal)" if "lreal" in caps.cli_options else ""
+        raise typer.BadParameter(
+            f"--float applies to --lang {' and '.join(_accepting('float'))}{hint}", param_hint="--lang"
+        )
+    refusal = targets.dialect(dialect.value).refused_by.get(caps.name) if dialect is not None else None
+    if refusal is not None:
+        raise typer.BadParameter(
+            f"{refusal}: use --lang st --dialect {dialect.value}", param_hint="--dialect"
+        )
+
+
+def _generator(caps: targets.Target) -> Callable[..., str | dict[str, str]]:
+    """The function the record names (``module:function``), imported on use."""
+    module, _, name = caps.generator.partition(":")
+    fn: Callable[..., str | dict[str, str]] = getattr(importlib.import_module(module), name)
+    return fn
 
 
 def _done(as_json: bool, lang: Lang, report: list[Any], written: list[Path]) -> None:
@@ -179,39 +214,3 @@ def _json_report(
     if written is not None:
         out["written"] = [str(p) for p in written]
     typer.echo(json.dumps(out, indent=2))
-
-
-def _plcopen(
-    doc: Any,
-    output: Path | None,
-    dialect: Dialect | None,
-    lreal: bool,
-    single: bool,
-    block: str | None,
-    strict: bool,
-    default: str | None = None,
-    force: bool = False,
-) -> None:
-    """``--lang plcopen``: the ST blocks as one PLCopen TC6 XML project."""
-    from fuzzyctl.codegen import generate_plcopen
-    from fuzzyctl.formats import write_atomic
-
-    if single:
-        raise typer.BadParameter("--float applies to --lang c (use --lreal)", param_hint="--lang")
-    if dialect is Dialect.scl:
-        raise typer.BadParameter(
-            "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", param_hint="--dialect"
-        )
-    xml = generate_plcopen(
-        doc,
-        block=block,
-        dialect=(dialect or Dialect.codesys).value,
-        lreal=lreal,
-        strict=strict,
-        default=default,
-    )
-    if output is None:
-        typer.echo(xml, nl=False)
-        return
-    write_atomic(output, xml, force=force, hint=FORCE_HINT)
-    err_console.print(f"wrote {output}", markup=False)

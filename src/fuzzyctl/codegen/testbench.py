@@ -21,6 +21,7 @@ from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.engine.interp import Interpreter
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.escape import c_comment, c_ident, st_comment, st_ident
+from fuzzyctl.kinds import targets
 
 #: relative tolerance (of each output's range) by arithmetic
 TOLERANCE = {"REAL": 1e-4, "LREAL": 1e-9, "float": 1e-4, "double": 1e-9}
@@ -224,8 +225,10 @@ def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = Fal
     """The test bench as an IEC 61131-3 PROGRAM ``TB_<block>`` (after the block's text)."""
     from fuzzyctl.codegen.render_st import st_real
 
-    if dialect == "scl":
-        raise CodegenError("the test bench is written for --dialect codesys, twincat or iec (not scl)")
+    if not targets.dialect(dialect).testbench:
+        able = [name for name, d in targets.DIALECTS.items() if d.testbench]
+        listed = ", ".join(able[:-1]) + " or " + able[-1]
+        raise CodegenError(f"the test bench is written for --dialect {listed} (not {dialect})")
     plan, real = bench.plan, "LREAL" if lreal else "REAL"
     fb = st_ident(plan.name or "FUZZY", "function block name")
     prog = st_ident(f"TB_{fb}"[:24].rstrip("_"), "test bench name")

@@ -223,7 +223,11 @@ class FastBuilder(RuleBuilder):
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         if "MAMDANI" not in self.g.caps.kernels:
             smooth_cog = not op.exact and op.method == "COG" and all(t.constant for t in op.terms)
-            if not smooth_cog or any(t.kind == "function" for t in op.terms) or "SMOOTH" not in self.g.caps.kernels:
+            if (
+                not smooth_cog
+                or any(t.kind == "function" for t in op.terms)
+                or "SMOOTH" not in self.g.caps.kernels
+            ):
                 raise self.g.refuse(f"output {op.name}", f"{op.method} in the native evaluator")
             return self._smooth_kernel(oi, merged)
         return self._whole_output("MAMDANI", oi, op, merged, {})

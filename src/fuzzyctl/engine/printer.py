@@ -43,7 +43,20 @@ from fuzzyctl.escape import CodegenError
 from fuzzyctl.kinds.targets import Target
 
 #: Binding strength of the IR's binary operators (unary minus and NOT bind at UNARY).
-PRECEDENCE = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
+PRECEDENCE = {
+    "OR": 0,
+    "AND": 1,
+    "=": 2,
+    "<>": 2,
+    "<": 3,
+    "<=": 3,
+    ">": 3,
+    ">=": 3,
+    "+": 4,
+    "-": 4,
+    "*": 5,
+    "/": 5,
+}
 UNARY = 6
 
 

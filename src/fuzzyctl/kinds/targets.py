@@ -21,7 +21,7 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from types import MappingProxyType
 
 from fuzzyctl.escape import (
@@ -168,7 +168,8 @@ class Target:
     body_indent: int = 0
     temp_arrays: bool = False  # VAR_TEMP may hold arrays without initial value
     testbench: bool = True
-    plcopen_refusal: str | None = None  # why the dialect cannot be PLCopen XML
+    #: targets that cannot hold the dialect's text: target name -> why (a sentence)
+    refused_by: Mapping[str, str] = field(default_factory=lambda: MappingProxyType({}))
     plcopen_p_form: bool = False  # its tools read formatted text from <xhtml:p> only
 
     # ------------------------------------------------------------------ literals
@@ -277,7 +278,7 @@ DIALECTS: Mapping[str, Target] = MappingProxyType(
             body_indent=1,
             temp_arrays=True,
             testbench=False,
-            plcopen_refusal="TIA Portal does not import PLCopen XML",
+            refused_by=MappingProxyType({"plcopen": "TIA Portal does not import PLCopen XML"}),
             cli_dialect_help="scl (TIA Portal, st only)",
         ),
         "iec": dataclasses.replace(
@@ -286,7 +287,9 @@ DIALECTS: Mapping[str, Target] = MappingProxyType(
             identifiers=Identifiers(st_ident_iec, RESERVED, 24, case_sensitive=False),
             for_as_while=True,
             plcopen_p_form=True,
-            cli_dialect_help="iec (strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc)",
+            cli_dialect_help=(
+                "iec (strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc)"
+            ),
         ),
     }
 )
@@ -528,4 +531,3 @@ def incomplete(t: Target) -> list[str]:
     if t.language not in TARGETS:
         out.append(f"language {t.language!r} is no builder target")
     return out
-
