@@ -64,22 +64,16 @@ class _ST(Printer):
         self.emit("END_FOR;", ind)
 
 
-def _comment(text: str) -> str:
-    """An ST comment: every comment of the generated block is made here, from model text
-    escaped as the Structured Text record says (:func:`fuzzyctl.escape.st_comment`)."""
-    return targets.ST.comment(text)
-
-
-def _init_values(d: Decl) -> tuple[str, ...] | None:
-    """The initial value of ``d`` as ST literals (one for a scalar, one per element of an
-    array); None when the declaration has none."""
+def _init_values(d: Decl, record: targets.Target) -> tuple[str, ...] | None:
+    """The initial value of ``d`` as ST literals of the dialect's record (one for a scalar,
+    one per element of an array); None when the declaration has none."""
 
     def one(v: float | bool) -> str:
         if d.type == "BOOL":
-            return "TRUE" if v else "FALSE"
+            return record.boolean(bool(v))
         if d.type in ("INT", "DINT", "BYTE"):
             return str(int(v))
-        return st_real(float(v))
+        return record.real(float(v), parens=False)
 
     if d.init is None:
         return None
@@ -136,9 +130,15 @@ class STParts:
     body: tuple[str, ...]
 
 
-def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> STParts:
-    """The declarations and statements of one FUNCTION_BLOCK, before formatting."""
-    record = targets.dialect(dialect)
+def _record(dialect: str | targets.Target) -> targets.Target:
+    return dialect if isinstance(dialect, targets.Target) else targets.dialect(dialect)
+
+
+def st_parts(prog: Program, *, dialect: str | targets.Target = "codesys", lreal: bool = False) -> STParts:
+    """The declarations and statements of one FUNCTION_BLOCK, before formatting; ``dialect``
+    is a dialect's name or its record (:data:`fuzzyctl.kinds.targets.DIALECTS`)."""
+    record = _record(dialect)
+    name = dialect if isinstance(dialect, str) else record.name
     check = record.identifiers.check
     check(prog.name, "function block name")
     for d in prog.decls:
@@ -148,7 +148,7 @@ def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) ->
 
     def var(d: Decl) -> STVar:
         base = {"REAL": r.real, "INT": "INT", "DINT": "DINT", "BOOL": "BOOL", "BYTE": "BYTE"}[d.type]
-        return STVar(d.name, base, d.size, _init_values(d), d.comment or "")
+        return STVar(d.name, base, d.size, _init_values(d, record), d.comment or "")
 
     # matiec (OpenPLC, Beremiz) turns a VAR_TEMP array without initial value into C that does
     # not compile, and IEC 61131-3 allows no initial value there: outside SCL the scratch
@@ -163,19 +163,22 @@ def st_parts(prog: Program, *, dialect: str = "codesys", lreal: bool = False) ->
         ("VAR_TEMP", [d for d in prog.of("temp") if d not in scratch], ""),
     )
     sections = tuple(STSection(kw, title, tuple(var(d) for d in ds)) for kw, ds, title in groups if ds)
-    header = (*prog.header, f"dialect: {dialect}; arithmetic in {r.real}")
-    return STParts(prog.name, dialect, r.real, header, sections, tuple(r.lines))
+    header = (*prog.header, f"dialect: {name}; arithmetic in {r.real}")
+    return STParts(prog.name, name, r.real, header, sections, tuple(r.lines))
 
 
-def render_st(prog: Program, *, dialect: str = "codesys", lreal: bool = False) -> str:
+def render_st(prog: Program, *, dialect: str | targets.Target = "codesys", lreal: bool = False) -> str:
     """One FUNCTION_BLOCK."""
-    return format_st(st_parts(prog, dialect=dialect, lreal=lreal))
+    return format_st(st_parts(prog, dialect=dialect, lreal=lreal), _record(dialect))
 
 
-def format_st(parts: STParts) -> str:
+def format_st(parts: STParts, record: targets.Target | None = None) -> str:
     """The text of a FUNCTION_BLOCK from its parts: header comments, ``FUNCTION_BLOCK``,
-    the sections, the body lines, ``END_FUNCTION_BLOCK``."""
-    record = targets.dialect(parts.dialect)
+    the sections, the body lines, ``END_FUNCTION_BLOCK``; ``record`` is the dialect's
+    (default: the one ``parts.dialect`` names).  Every comment is made by the record, from
+    model text its escaping function makes inert."""
+    record = record or targets.dialect(parts.dialect)
+    _comment = record.comment
     out = [_comment(line) for line in parts.header]
     quote = record.block_name_quote
     out.append(f"FUNCTION_BLOCK {quote}{parts.name}{quote}")

@@ -39,11 +39,6 @@ from fuzzyctl.kinds import targets
 Fast = Callable[[list[float], list[float | None]], list[float]]
 
 
-def lit(x: float) -> str:
-    """An exact float literal (``repr`` round-trips), NaN and infinities by name."""
-    return targets.PY.real(x)
-
-
 class PythonPrinter(Printer):
     """Python statement syntax (indentation blocks, ``pass``, ``range`` loops); no comments
     (they hold model text)."""
@@ -70,8 +65,8 @@ class PythonPrinter(Printer):
 
 
 class _Py(PythonPrinter):
-    def __init__(self, fp: FastProgram) -> None:
-        super().__init__(targets.PY)
+    def __init__(self, fp: FastProgram, caps: targets.Target = targets.PY) -> None:
+        super().__init__(caps)
         self.fp = fp
         self.env: dict[str, Any] = {"_NAN": math.nan, "_INF": math.inf, "_m": math}
         self.n_kernels = 0
@@ -105,23 +100,23 @@ class _Py(PythonPrinter):
             x = "_x"
         pts = p.points
         xs = sorted({q[0] for q in pts})
-        self.emit(f"if {x} < {lit(xs[0])}: {out} = {lit(pts[0][1])}", ind)
+        self.emit(f"if {x} < {self.num(xs[0])}: {out} = {self.num(pts[0][1])}", ind)
         for k, u in enumerate(xs):
             pv = pwl_value(pts, u)
             jump = left_limit(pts, u) != right_limit(pts, u) or pv != left_limit(pts, u)
             if jump or k == 0:
-                self.emit(f"elif {x} == {lit(u)}: {out} = {lit(pv)}", ind)
+                self.emit(f"elif {x} == {self.num(u)}: {out} = {self.num(pv)}", ind)
             if k + 1 < len(xs):
                 u1 = xs[k + 1]
                 r0, l1 = right_limit(pts, u), left_limit(pts, u1)
                 if r0 == l1:
-                    expr = lit(r0)
+                    expr = self.num(r0)
                 else:
-                    base = f"({x} - {lit(u)}) * {lit((l1 - r0) / (u1 - u))}"
-                    expr = base if r0 == 0.0 else f"{lit(r0)} + {base}"
-                self.emit(f"elif {x} < {lit(u1)}: {out} = {expr}", ind)
-        self.emit(f"elif {x} == {lit(xs[-1])}: {out} = {lit(pwl_value(pts, xs[-1]))}", ind)
-        self.emit(f"else: {out} = {lit(pts[-1][1])}", ind)
+                    base = f"({x} - {self.num(u)}) * {self.num((l1 - r0) / (u1 - u))}"
+                    expr = base if r0 == 0.0 else f"{self.num(r0)} + {base}"
+                self.emit(f"elif {x} < {self.num(u1)}: {out} = {expr}", ind)
+        self.emit(f"elif {x} == {self.num(xs[-1])}: {out} = {self.num(pwl_value(pts, xs[-1]))}", ind)
+        self.emit(f"else: {out} = {self.num(pts[-1][1])}", ind)
 
     # ------------------------------------------------------------------ kernels
 
@@ -145,21 +140,22 @@ class _Py(PythonPrinter):
             self.emit("else:", ind)
             if no_change:
                 self.emit(f"{out} = state[{oi}]", ind + 1)
-                self.emit(f"if {out} is None: {out} = {lit(default)}", ind + 1)
+                self.emit(f"if {out} is None: {out} = {self.num(default)}", ind + 1)
             else:
-                self.emit(f"{out} = {lit(default)}", ind + 1)
+                self.emit(f"{out} = {self.num(default)}", ind + 1)
         elif self.ex(value) != out:
             self.emit(f"{out} = {self.ex(value)}", ind)
         if clamp is not None:
             lo, hi = clamp
-            self.emit(f"if {out} < {lit(lo)}: {out} = {lit(lo)}", ind)
-            self.emit(f"elif {out} > {lit(hi)}: {out} = {lit(hi)}", ind)
+            self.emit(f"if {out} < {self.num(lo)}: {out} = {self.num(lo)}", ind)
+            self.emit(f"elif {out} > {self.num(hi)}: {out} = {self.num(hi)}", ind)
         self.emit(f"state[{oi}] = {out}", ind)
 
 
-def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
-    """The source of ``_fast`` and the globals it needs."""
-    r = _Py(fp)
+def render_py(fp: FastProgram, caps: targets.Target = targets.PY) -> tuple[str, dict[str, Any]]:
+    """The source of ``_fast`` and the globals it needs; ``caps`` is the Python record
+    (literals, functions, operators)."""
+    r = _Py(fp, caps)
     prog = fp.program
     check_names(fp)
     for d in prog.of("const"):
