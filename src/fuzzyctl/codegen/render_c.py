@@ -182,7 +182,7 @@ def _render_header(prog: Program, name: str, r: _C, single: bool) -> list[str]:
     h.append(r.comment(f"out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row."))
     h.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out);")
     h.append("")
-    h.append(f"#endif /* {guard} */")
+    h.append(f"#endif {r.comment(guard)}")
     return h
 
 
