@@ -115,8 +115,9 @@ class Comments:
     close: str
     escape: Callable[[str], str]
 
-    def __call__(self, text: str) -> str:
-        return f"{self.open}{self.escape(text)}{self.close}"
+    def __call__(self, text: str, lead: str = "") -> str:
+        """One comment; ``lead`` is generated text put before the escaped ``text``."""
+        return f"{self.open}{lead}{self.escape(text)}{self.close}"
 
 
 # --------------------------------------------------------------------------- the record
@@ -191,8 +192,8 @@ class Target:
     def boolean(self, v: bool) -> str:
         return self.numbers.true if v else self.numbers.false
 
-    def comment(self, text: str) -> str:
-        return self.comments(text)
+    def comment(self, text: str, lead: str = "") -> str:
+        return self.comments(text, lead)
 
     def has(self, function: str) -> bool:
         """The intrinsic ``function`` exists on the target."""
