@@ -12,19 +12,20 @@ import re
 import shutil
 import subprocess
 from pathlib import Path
-from types import MappingProxyType
+from types import MappingProxyType, SimpleNamespace
 from typing import Any
 
 import numpy as np
 import pytest
 
 import fuzzyctl
-from fuzzyctl.codegen.api import generate_st, lower_block
+from fuzzyctl.codegen.api import build, generate_st, lower_block
+from fuzzyctl.codegen.ir import Program
 from fuzzyctl.codegen.program import build_program
 from fuzzyctl.codegen.render_c import render_c
 from fuzzyctl.codegen.render_st import render_st
 from fuzzyctl.engine.fastprog import build_fast
-from fuzzyctl.engine.render_py import render_py
+from fuzzyctl.engine.render_py import PythonPrinter, render_py
 from fuzzyctl.escape import CodegenError, c_comment, st_comment
 from fuzzyctl.kinds import targets
 from fuzzyctl.kinds.targets import Comments, incomplete, st_real
@@ -251,3 +252,67 @@ def test_no_target_name_is_compared_outside_the_registry() -> None:
                 if _COMPARE.search(line.split("#")[0]):
                     found.append(f"{path.relative_to(SRC)}:{n}: {line.strip()}")
     assert found == []
+
+
+# --------------------------------------------------------------------------- a new target
+
+
+class _BlockPrinter(PythonPrinter):
+    """A toy target's renderer: the PLC function block as a Python function ``step(fb)``
+    whose instance variables are attributes of ``fb`` (the temporaries are locals)."""
+
+    def __init__(self, caps: targets.Target, prog: Program) -> None:
+        super().__init__(caps)
+        self.fields = {d.name for d in prog.decls if d.storage != "temp"}
+
+    def name(self, n: str) -> str:
+        return f"fb.{n}" if n in self.fields else n
+
+
+def _render_block(caps: targets.Target, prog: Program) -> str:
+    r = _BlockPrinter(caps, prog)
+    r.block(prog.body, 1)
+    temps = [f"    {d.name} = {f'[0] * {d.size}' if d.size is not None else '0'}" for d in prog.of("temp")]
+    return "def step(fb):\n" + "\n".join(temps + r.lines) + "\n"
+
+
+def test_a_new_target_is_a_record_and_a_renderer(monkeypatch: pytest.MonkeyPatch) -> None:
+    """A target the registry did not know - the PLC block as Python - needs its record and a
+    renderer (a Printer subclass) and nothing else: the program builder, the renaming and the
+    CLI's choices read the record, and the block computes what the engine computes."""
+    toy = dataclasses.replace(
+        targets.PY,
+        name="pyblock",
+        language="pyblock",
+        kernels=frozenset(),  # the PLC block calls none
+        function_terms=True,
+        data_dependent_loops=True,
+        cli="pyblock",
+        cli_help="the block as Python",
+        generator="tests.codegen.test_targets:_render_block",
+    )
+    monkeypatch.setattr(targets, "TARGETS", MappingProxyType({**targets.TARGETS, "pyblock": toy}))
+    assert incomplete(toy) == [] and targets.cli_target("pyblock") is toy
+    assert "pyblock" in targets.cli_choices()
+    for path in S.example_files():
+        plan = S.plan_of(path)
+        gen = build(plan, "pyblock", default="0")
+        prog = gen.program
+        env: dict[str, Any] = {"_m": math, "_NAN": math.nan, "_INF": math.inf}
+        exec(compile(_render_block(toy, prog), f"<pyblock {path.name}>", "exec"), env)
+        fb = SimpleNamespace()
+        for d in prog.decls:  # as C and ST initialise them: INT as integers
+            kind = {"REAL": float, "BOOL": bool}.get(d.type, int)
+            value = d.init if d.init is not None else (0 if d.size is None else (0,) * d.size)
+            setattr(fb, d.name, [kind(v) for v in value] if isinstance(value, tuple) else kind(value))
+        ins = [d.name for d in prog.of("input") if d.name != "ENABLE"]
+        outs = [d.name for d in prog.of("output") if d.name != "INFO"]
+        data = S.random_inputs(gen.plan, 300, seed=11)
+        got = []
+        for row in data:
+            for name, x in zip(ins, row, strict=True):
+                setattr(fb, name, float(x))
+            env["step"](fb)
+            got.append([getattr(fb, o) for o in outs])
+        want = S.reference(gen.plan, data, "scalar")
+        assert S.max_error(gen.plan, np.array(got, dtype=float).reshape(want.shape), want) < 1e-9, path.name
