@@ -29,7 +29,7 @@ from typing import Any
 
 from fuzzyctl.codegen.context import CodegenError
 from fuzzyctl.codegen.render_st import STParts, STSection, STVar, format_st, st_parts
-from fuzzyctl.escape import st_comment, xml_attr, xml_text
+from fuzzyctl.escape import xml_attr, xml_text
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
@@ -82,7 +82,7 @@ class _Xml:
 
 def _comment_text(text: str) -> str:
     """A model comment as documentation: each line ST-safe (the IDEs show it as a comment)."""
-    return "\n".join(st_comment(line) for line in text.split("\n"))
+    return "\n".join(targets.PLCOPEN.comments.escape(line) for line in text.split("\n"))
 
 
 def _type(v: STVar) -> str:
