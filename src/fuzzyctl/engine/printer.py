@@ -84,6 +84,7 @@ class Printer:
         self.real = real or caps.real_type(single)
         self.single = single
         self.comments = comments
+        self.prefix = caps.var_prefix
         self.lines: list[str] = []
 
     # ------------------------------------------------------------------ expressions
@@ -92,31 +93,32 @@ class Printer:
         return self.caps.real(v, self.single)
 
     def name(self, n: str) -> str:
-        return self.caps.var_prefix + n
+        return self.prefix + n if self.prefix else n
 
     def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
         """``e`` as text, parenthesised for a parent operator of precedence ``parent``
         (``right``: as its right operand)."""
-        if isinstance(e, Num):
-            return self.num(e.value)
-        if isinstance(e, Int):
-            return self.caps.integer(e.value)
-        if isinstance(e, Bool):
-            return self.caps.boolean(e.value)
-        if isinstance(e, Var):
-            return self.name(e.name)
-        if isinstance(e, Index):
-            return self.index(e)
-        if isinstance(e, Neg):
-            return self.caps.neg.format(self.ex(e.operand, UNARY))
-        if isinstance(e, Not):
-            return self.caps.not_.format(self.ex(e.operand, UNARY))
-        if isinstance(e, Call):
-            return self.call(e)
-        if isinstance(e, Pwl):
-            return self.pwl(e)
-        assert isinstance(e, Bin), e
-        return self.bin(e, parent, right)
+        t = type(e)  # the node classes are final: an exact type test, most frequent first
+        if t is Var:
+            return self.name(e.name)  # type: ignore[attr-defined]
+        if t is Num:
+            return self.num(e.value)  # type: ignore[attr-defined]
+        if t is Bin:
+            return self.bin(e, parent, right)  # type: ignore[arg-type]
+        if t is Index:
+            return self.index(e)  # type: ignore[arg-type]
+        if t is Int:
+            return self.caps.integer(e.value)  # type: ignore[attr-defined]
+        if t is Call:
+            return self.call(e)  # type: ignore[arg-type]
+        if t is Neg:
+            return self.caps.neg.format(self.ex(e.operand, UNARY))  # type: ignore[attr-defined]
+        if t is Not:
+            return self.caps.not_.format(self.ex(e.operand, UNARY))  # type: ignore[attr-defined]
+        if t is Bool:
+            return self.caps.boolean(e.value)  # type: ignore[attr-defined]
+        assert t is Pwl, e
+        return self.pwl(e)  # type: ignore[arg-type]
 
     def index(self, e: Index) -> str:
         return f"{self.name(e.name)}[{self.ex(e.index)}]"

@@ -178,12 +178,12 @@ class Target:
     def real(self, v: float, single: bool = False, parens: bool = True) -> str:
         """A REAL literal; a non-finite value the target cannot write is refused."""
         n = self.numbers
-        if math.isnan(v) or math.isinf(v):
+        if not math.isfinite(v):
             spelled = n.nan if math.isnan(v) else n.inf
             if spelled is None:
                 raise CodegenError(f"the value {v} cannot be written in portable {self.label}")
             return spelled if math.isnan(v) or v > 0 else f"(-{spelled})"
-        s = n.real(v) + (n.single_suffix if single else "")
+        s = n.real(v) + n.single_suffix if single else n.real(v)
         return f"({s})" if parens and n.negative_parens and v < 0 else s
 
     def integer(self, v: int) -> str:
