@@ -75,12 +75,12 @@ def test_lookups_refuse_unknown_names() -> None:
 
 def test_the_cli_choices_are_the_registry(capsys: pytest.CaptureFixture[str]) -> None:
     from fuzzyctl.cli.app import main
-    from fuzzyctl.cli.codegen import Dialect, Lang, _generator
+    from fuzzyctl.cli.codegen import Dialect, Lang, generator_of
 
     assert [m.value for m in Lang] == list(targets.cli_choices()) == ["st", "plcopen", "c"]
     assert [m.value for m in Dialect] == list(targets.dialect_names())
     for choice in targets.cli_choices():
-        assert callable(_generator(targets.cli_target(choice)))
+        assert callable(generator_of(targets.cli_target(choice)))
     assert main(["codegen", "--help"]) == 0
     shown = re.sub(r"[\s│]+", " ", capsys.readouterr().out)
     for record in targets.TARGETS.values():

@@ -143,7 +143,7 @@ def codegen(
         kwargs["testbench"] = testbench
     if caps.report:
         kwargs["report"] = report
-    result = _generator(caps)(doc, block=block, strict=strict, default=default, **kwargs)
+    result = generator_of(caps)(doc, block=block, strict=strict, default=default, **kwargs)
     json_report = as_json and caps.report
     if isinstance(result, str):  # one text: printed, or written to -o
         if output is None:
@@ -186,7 +186,7 @@ def _check_options(caps: targets.Target, dialect: Any, lreal: bool, single: bool
         )
 
 
-def _generator(caps: targets.Target) -> Callable[..., str | dict[str, str]]:
+def generator_of(caps: targets.Target) -> Callable[..., str | dict[str, str]]:
     """The function the record names (``module:function``), imported on use."""
     module, _, name = caps.generator.partition(":")
     fn: Callable[..., str | dict[str, str]] = getattr(importlib.import_module(module), name)
