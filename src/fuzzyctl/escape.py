@@ -370,6 +370,9 @@ _PY_KEYWORDS = frozenset(
         "_",
     ]
 )
+#: Python keywords (and ``_``): no generated Python name is one.
+PY_KEYWORDS = _PY_KEYWORDS
+
 # Object-like macros of <math.h> and <stddef.h>: a member of that name would be rewritten by
 # the preprocessor.
 _C_MACRO = re.compile(r"(M_|FP_|HUGE_VAL|MATH_ERR|math_errhandling|INFINITY$|NAN$|NULL$|offsetof$)")

@@ -1,6 +1,9 @@
 """``fuzzyctl codegen FILE --lang st|plcopen|c|fmu``: IEC 61131-3 Structured Text, the same
 function blocks as PLCopen TC6 XML, C99, or an FMI 2/3 co-simulation FMU from a fuzzy system
-(see docs/codegen.md)."""
+(see docs/codegen.md).
+
+The ``--lang`` and ``--dialect`` choices, which options apply to which, and the function each
+choice calls are the targets' capabilities records (:mod:`fuzzyctl.kinds.targets`)."""
 
 from __future__ import annotations
 
@@ -13,21 +16,31 @@ import typer
 
 from fuzzyctl import formats
 from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console, usage_errors
+from fuzzyctl.codegen.emit import accepting, generator_of
+from fuzzyctl.kinds import targets
+
+__all__ = ["Dialect", "Lang", "codegen", "generator_of"]
+
+#: ``--lang`` choices: the targets with a CLI choice, in registry order.
+Lang = StrEnum("Lang", [(c, c) for c in targets.cli_choices()])  # type: ignore[misc]
+#: ``--dialect`` choices: the Structured Text dialects and their aliases.
+Dialect = StrEnum("Dialect", [(d, d) for d in targets.dialect_names()])  # type: ignore[misc]
+_DEFAULT_LANG = Lang(targets.cli_choices()[0])
 
 
-class Lang(StrEnum):
-    st = "st"
-    plcopen = "plcopen"
-    c = "c"
-    fmu = "fmu"
+def _lang_help() -> str:
+    return "; ".join(f"{t.cli}: {t.cli_help}" for t in targets.TARGETS.values() if t.cli is not None) + "."
 
 
-class Dialect(StrEnum):
-    codesys = "codesys"
-    twincat = "twincat"
-    scl = "scl"
-    iec = "iec"
-    openplc = "openplc"
+def _dialect_help() -> str:
+    helps = [d.cli_dialect_help for d in targets.DIALECTS.values()]
+    return (
+        f"{' and '.join(accepting('dialect'))}: "
+        + ", ".join(helps[:-1])
+        + (" or " if len(helps) > 1 else "")
+        + helps[-1]
+        + "."
+    )
 
 
 @app.command()
@@ -40,12 +53,8 @@ def codegen(
     ],
     lang: Annotated[
         Lang,
-        typer.Option(
-            "--lang",
-            help="st: Structured Text; plcopen: the same as PLCopen TC6 XML; c: C99; "
-            "fmu: an FMI co-simulation FMU (sources and this platform's binary).",
-        ),
-    ] = Lang.st,
+        typer.Option("--lang", help=_lang_help()),
+    ] = _DEFAULT_LANG,
     output: Annotated[
         Path | None,
         typer.Option(
@@ -59,8 +68,7 @@ def codegen(
         Dialect | None,
         typer.Option(
             "--dialect",
-            help="st and plcopen: codesys (default), twincat, scl (TIA Portal, st only) or iec "
-            "(strict IEC 61131-3 as OpenPLC's compiler matiec accepts it; alias openplc).",
+            help=_dialect_help(),
         ),
     ] = None,
     lreal: Annotated[

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
@@ -12,13 +12,16 @@ from fuzzyctl.ir.nodes import Program
 from fuzzyctl.ir.programs.plc_block import build_program
 from fuzzyctl.ir.render.c import render_c
 from fuzzyctl.ir.render.st import render_st
-from fuzzyctl.ir.state import CodegenError, Target
+from fuzzyctl.ir.state import Target
+from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
-Dialect = Literal["codesys", "twincat", "scl", "iec", "openplc"]
-DIALECTS: tuple[str, ...] = ("codesys", "twincat", "scl", "iec", "openplc")
+#: A Structured Text dialect's name (:data:`fuzzyctl.kinds.targets.DIALECTS` or an alias).
+Dialect = str
+#: Every dialect name, aliases last (the registry's).
+DIALECTS: tuple[str, ...] = targets.dialect_names()
 #: Other names of a dialect: OpenPLC (and Beremiz) compile strict IEC 61131-3 with matiec.
-DIALECT_ALIASES = {"openplc": "iec"}
+DIALECT_ALIASES = targets.ALIASES
 
 
 def lower_block(model: Document | FunctionBlock, block: str | None = None, **options: Any) -> Plan:
@@ -96,9 +99,7 @@ def generate_st(
     ``default`` (a number or ``"hold"``) replaces ``DEFAULT := nan``.  Names the target cannot
     use are renamed (header comment; ``report`` receives one :class:`Generated` per block).
     Raises :class:`CodegenError` naming what cannot be expressed."""
-    if dialect not in DIALECTS:
-        raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
-    dialect = DIALECT_ALIASES.get(dialect, dialect)
+    dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
     parts = []
     for plan in plans(model, block, **options):
         gen = build(plan, "st", default)
@@ -134,8 +135,9 @@ def generate_c(
             report.append(gen)
         prog = gen.program
         header, source = render_c(prog, single=single)
-        files[f"{prog.name}.h"] = header
-        files[f"{prog.name}.c"] = source
+        h_ext, c_ext = targets.C.extensions
+        files[f"{prog.name}{h_ext}"] = header
+        files[f"{prog.name}{c_ext}"] = source
         if testbench:
             from fuzzyctl.codegen.testbench import choose, render_c_bench
 

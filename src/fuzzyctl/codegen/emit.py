@@ -5,19 +5,20 @@
 
 from __future__ import annotations
 
+import importlib
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.diagnostics import OptionError
+from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document
 
 if TYPE_CHECKING:
     from fuzzyctl.codegen.api import Generated
 
-LANGS = ("st", "plcopen", "c", "fmu")
-"""The targets, as ``--lang`` names them."""
-DEFAULT_DIALECT = "codesys"
+DEFAULT_DIALECT = next(iter(targets.DIALECTS))
 READ_ONLY_HINT = "make it writable to replace it"
 """What a read-only file to replace is told (the CLI says ``--force replaces it``)."""
 
@@ -54,7 +55,7 @@ class Emitted:
     def reports(self) -> bool:
         """Whether this target has a JSON report (PLCopen XML has none: ``--json`` is not
         one of its options)."""
-        return self.lang != "plcopen"
+        return self.fmu is not None or targets.cli_target(self.lang).report
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON report: the target, each block's renames and notes, and the text or the
@@ -69,6 +70,18 @@ class Emitted:
         return out
 
 
+def accepting(option: str) -> list[str]:
+    """The ``--lang`` choices an option applies to (their records' ``cli_options``)."""
+    return [t.cli for t in targets.TARGETS.values() if t.cli is not None and option in t.cli_options]
+
+
+def generator_of(caps: targets.Target) -> Callable[..., Any]:
+    """The function the record names (``module:function``), imported on use."""
+    module, _, name = caps.generator.partition(":")
+    fn: Callable[..., Any] = getattr(importlib.import_module(module), name)
+    return fn
+
+
 def check_options(
     lang: str,
     *,
@@ -81,31 +94,43 @@ def check_options(
     binary: bool = True,
 ) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
-    (:class:`OptionError` names the option)."""
+    (:class:`OptionError` names the option); what applies is the target's record."""
     from fuzzyctl.codegen.defaults import parse_default
     from fuzzyctl.escape import CodegenError
 
-    if lang == "c" and (dialect is not None or lreal):
-        raise OptionError("--dialect and --lreal apply to --lang st and plcopen", "--lang")
-    if lang == "st" and single:
-        raise OptionError("--float applies to --lang c (use --lreal for ST)", "--lang")
+    caps = targets.cli_target(lang)
+    takes = caps.cli_options
+    if "fmi" in takes:
+        _check_fmu_options(lang, fmi, dialect is not None or lreal or single or bool(testbench))
+    elif fmi is not None or not binary:
+        raise OptionError(f"--fmi and --no-binary apply to --lang {' and '.join(accepting('fmi'))}", "--fmi")
+    if ("dialect" not in takes and dialect is not None) or ("lreal" not in takes and lreal):
+        raise OptionError(
+            f"--dialect and --lreal apply to --lang {' and '.join(accepting('dialect'))}", "--lang"
+        )
+    if "float" not in takes and single:
+        hint = " (use --lreal)" if "lreal" in takes else ""
+        raise OptionError(f"--float applies to --lang {' and '.join(accepting('float'))}{hint}", "--lang")
+    refusal = targets.dialect(dialect).refused_by.get(caps.name) if dialect is not None else None
+    if refusal is not None:
+        raise OptionError(f"{refusal}: use --lang st --dialect {dialect}", "--dialect")
     try:
         parse_default(default)
     except CodegenError as exc:
         raise OptionError(str(exc), "--default") from None
-    if lang != "fmu" and (fmi is not None or not binary):
-        raise OptionError("--fmi and --no-binary apply to --lang fmu", "--fmi")
-    if lang == "fmu":
-        from fuzzyctl.codegen.fmu.description import FMI_VERSIONS
 
-        if fmi is not None and fmi not in FMI_VERSIONS:
-            raise OptionError(f"FMI version {fmi}: give 2 or 3", "--fmi")
-        if dialect is not None or lreal or single or testbench:
-            raise OptionError(
-                "--dialect, --lreal, --float and --testbench do not apply to --lang fmu "
-                "(it computes in double)",
-                "--lang",
-            )
+
+def _check_fmu_options(lang: str, fmi: int | None, other: bool) -> None:
+    from fuzzyctl.codegen.fmu.description import FMI_VERSIONS
+
+    if fmi is not None and fmi not in FMI_VERSIONS:
+        raise OptionError(f"FMI version {fmi}: give 2 or 3", "--fmi")
+    if other:
+        raise OptionError(
+            f"--dialect, --lreal, --float and --testbench do not apply to --lang {lang} "
+            "(it computes in double)",
+            "--lang",
+        )
 
 
 def emit(
@@ -133,7 +158,6 @@ def emit(
     (``block``, default the first) as an FMI ``fmi`` (2 or 3, default 3) co-simulation FMU in the
     file ``output`` (default ``NAME.fmu``), with this platform's binary unless not ``binary``."""
     import fuzzyctl
-    from fuzzyctl.codegen import generate_c, generate_plcopen, generate_st
 
     check_options(
         lang,
@@ -146,47 +170,26 @@ def emit(
         binary=binary,
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
-    if lang == "fmu":
+    caps = targets.cli_target(lang)
+    if "fmi" in caps.cli_options:
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
-    if lang == "plcopen":
-        if single:
-            raise OptionError("--float applies to --lang c (use --lreal)", "--lang")
-        if dialect == "scl":
-            raise OptionError(
-                "TIA Portal does not import PLCopen XML: use --lang st --dialect scl", "--dialect"
-            )
-        xml = generate_plcopen(
-            document,
-            block=block,
-            dialect=dialect or DEFAULT_DIALECT,
-            lreal=lreal,
-            strict=strict,
-            default=default,
-        )
-        return _text_or_file(Emitted("plcopen"), xml, output, force, hint)
     emitted = Emitted(lang)
-    if lang == "st":
-        text = generate_st(
-            document,
-            block=block,
-            dialect=dialect or DEFAULT_DIALECT,
-            lreal=lreal,
-            strict=strict,
-            default=default,
-            report=emitted.blocks,
-            testbench=testbench,
-        )
-        return _text_or_file(emitted, text, output, force, hint)
-    files = generate_c(
-        document,
-        block=block,
-        single=single,
-        strict=strict,
-        testbench=testbench,
-        default=default,
-        report=emitted.blocks,
-    )
-    emitted.written = _write_files(files, output or Path("."), force, hint)
+    kwargs: dict[str, Any] = {"block": block, "strict": strict, "default": default}
+    chosen = {"dialect": dialect or DEFAULT_DIALECT, "lreal": lreal, "single": single, "testbench": testbench}
+    for option, keyword in (
+        ("dialect", "dialect"),
+        ("lreal", "lreal"),
+        ("float", "single"),
+        ("testbench", "testbench"),
+    ):
+        if option in caps.cli_options:
+            kwargs[keyword] = chosen[keyword]
+    if caps.report:
+        kwargs["report"] = emitted.blocks
+    result = generator_of(caps)(document, **kwargs)
+    if isinstance(result, str):  # one text: printed, or written to ``output``
+        return _text_or_file(emitted, result, output, force, hint)
+    emitted.written = _write_files(result, output or Path("."), force, hint)
     return emitted
 
 

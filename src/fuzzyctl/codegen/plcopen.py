@@ -27,18 +27,16 @@ from collections.abc import Sequence
 from datetime import UTC, datetime
 from typing import Any
 
-from fuzzyctl.codegen.api import DIALECT_ALIASES, DIALECTS
-from fuzzyctl.escape import st_comment, xml_attr, xml_text
+from fuzzyctl.escape import xml_attr, xml_text
 from fuzzyctl.ir.render.st import STParts, STSection, STVar, format_st, st_parts
 from fuzzyctl.ir.state import CodegenError
+from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
 NS_TC6 = "http://www.plcopen.org/xml/tc6_0201"
 NS_XHTML = "http://www.w3.org/1999/xhtml"
 #: CODESYS's (and TwinCAT's) extension holding the declaration part as plain ST text.
 PLAINTEXT_INTERFACE = "http://www.3s-software.com/plcopenxml/interfaceasplaintext"
-#: Dialects whose tools read formatted text only from ``<xhtml:p>`` (Beremiz, OpenPLC).
-P_DIALECTS = frozenset({"iec", "openplc"})
 #: ST section keyword -> PLCopen variable list.
 VAR_LISTS = {"VAR_INPUT": "inputVars", "VAR_OUTPUT": "outputVars", "VAR": "localVars", "VAR_TEMP": "tempVars"}
 #: Array elements per line of an ``arrayValue`` (large rule tables stay readable and compact).
@@ -84,7 +82,7 @@ class _Xml:
 
 def _comment_text(text: str) -> str:
     """A model comment as documentation: each line ST-safe (the IDEs show it as a comment)."""
-    return "\n".join(st_comment(line) for line in text.split("\n"))
+    return "\n".join(targets.PLCOPEN.comments.escape(line) for line in text.split("\n"))
 
 
 def _type(v: STVar) -> str:
@@ -158,11 +156,14 @@ def _pou(x: _Xml, parts: STParts) -> None:
 
 
 def check_dialect(dialect: str) -> None:
-    """Refuse ``scl``: its text is not IEC 61131-3, and TIA Portal imports SCL source."""
-    if dialect == "scl":
+    """Refuse a dialect whose record says it cannot be PLCopen XML (``scl``: its text is not
+    IEC 61131-3, and TIA Portal imports SCL source)."""
+    record = targets.dialect(dialect)
+    refusal = record.refused_by.get(targets.PLCOPEN.name)
+    if refusal is not None:
         raise CodegenError(
-            "PLCopen XML holds IEC 61131-3 text and TIA Portal does not import it: "
-            "use --lang st --dialect scl for TIA Portal, or another --dialect with --lang plcopen"
+            f"{refusal} (it holds IEC 61131-3 text): use --lang st "
+            f"--dialect {record.name}, or another --dialect with --lang plcopen"
         )
 
 
@@ -181,7 +182,8 @@ def render_plcopen(
     dialects = {b.dialect for b in blocks}
     for d in dialects:
         check_dialect(d)
-    x = _Xml(p_form=bool(dialects & P_DIALECTS))
+    # Beremiz and the OpenPLC Editor read formatted text only from <xhtml:p>
+    x = _Xml(p_form=any(targets.dialect(d).plcopen_p_form for d in dialects))
     stamp = (created or creation_time()).strftime("%Y-%m-%dT%H:%M:%S")
     x.lines.append('<?xml version="1.0" encoding="UTF-8"?>')
     x.open("project", xmlns=NS_TC6, **{"xmlns:xhtml": NS_XHTML})
@@ -222,9 +224,7 @@ def st_blocks(
     """The blocks :func:`fuzzyctl.codegen.api.generate_st` prints, as parts (its
     ``render_st`` is ``format_st(st_parts(...))``): keep the two pipelines in step -
     tests/codegen/test_plcopen.py compares their texts."""
-    if dialect not in DIALECTS:
-        raise CodegenError(f"unknown dialect {dialect!r} (known: {', '.join(DIALECTS)})")
-    dialect = DIALECT_ALIASES.get(dialect, dialect)
+    dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
     from fuzzyctl.codegen.api import build, plans
 
     options = dict(options)

@@ -8,7 +8,8 @@ one: every character that cannot be in an identifier becomes ``_`` (runs collaps
 leading or trailing ``_``), a name that is a reserved word or starts with a digit gets a
 suffix or prefix telling what it is (``time_IN``, ``OUT_1x``), a long name is cut, and a
 number keeps two replacements apart (names are compared case-insensitively: ST ignores case).
-The result still goes through :func:`fuzzyctl.escape.st_ident` / :func:`~fuzzyctl.escape.c_ident`
+The rules are the target's (:attr:`fuzzyctl.kinds.targets.Target.identifiers`); the result
+still goes through its check (:func:`fuzzyctl.escape.st_ident` / :func:`~fuzzyctl.escape.c_ident`)
 when printed, so the table can never let an illegal name through.
 """
 
@@ -20,8 +21,9 @@ import unicodedata
 from dataclasses import dataclass
 
 from fuzzyctl.engine.plan import Plan
-from fuzzyctl.escape import MAX_IDENT_C, MAX_IDENT_ST, CodegenError, c_ident, st_ident
+from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.state import PREFIX, Target
+from fuzzyctl.kinds import targets
 
 #: Names the generated block declares itself.
 _OWN = ("ENABLE", "INFO")
@@ -51,13 +53,11 @@ def _legal(name: str, target: Target) -> str | None:
     """Why ``name`` cannot be used as is, or None."""
     if name.upper().startswith(PREFIX) or name.upper() in _OWN:
         return "the generated code uses this name"
+    ids = targets.get(target).identifiers
     try:
-        if target == "st":
-            st_ident(name, "name")
-        else:
-            c_ident(name, "name")
-            if len(name) > MAX_IDENT_C - 8:  # NAME_step, NAME_real, ...
-                raise CodegenError("too long")
+        ids.check(name, "name")
+        if len(name) > ids.interface_length:  # C: NAME_step, NAME_real, ...
+            raise CodegenError("too long")
     except CodegenError as exc:
         text = str(exc)
         if "reserved word" in text or "keyword" in text or "reserved to the C" in text:
@@ -76,7 +76,7 @@ def _candidate(name: str, kind: str, target: Target) -> str:
         s = tag
     if s[0].isdigit() or s.upper().startswith(PREFIX):
         s = f"{tag}_{s}"
-    limit = MAX_IDENT_ST if target == "st" else MAX_IDENT_C - 8
+    limit = targets.get(target).identifiers.interface_length
     if len(s) > limit:
         s = s[:limit].rstrip("_")
     if _legal(s, target) is not None:
@@ -99,7 +99,7 @@ def rename_plan(plan: Plan, target: Target) -> tuple[Plan, list[Rename]]:
             reason = "another name differs from it only in letter case"
         base = _candidate(name, kind, target)
         new, k = base, 1
-        limit = MAX_IDENT_ST if target == "st" else MAX_IDENT_C - 8
+        limit = targets.get(target).identifiers.interface_length
         while new.upper() in taken or _legal(new, target) is not None:
             k += 1
             new = f"{base[: limit - len(str(k)) - 1].rstrip('_')}_{k}"

@@ -19,9 +19,10 @@ from dataclasses import dataclass
 
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.engine.reference.interp import Interpreter
-from fuzzyctl.escape import c_comment, c_ident, st_comment, st_ident
+from fuzzyctl.escape import c_ident, st_ident
 from fuzzyctl.ir.state import CodegenError
 from fuzzyctl.kinds import shapes as registry
+from fuzzyctl.kinds import targets
 
 #: relative tolerance (of each output's range) by arithmetic
 TOLERANCE = {"REAL": 1e-4, "LREAL": 1e-9, "float": 1e-4, "double": 1e-9}
@@ -223,17 +224,22 @@ def _header(bench: Bench, real: str) -> list[str]:
 
 def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = False) -> str:
     """The test bench as an IEC 61131-3 PROGRAM ``TB_<block>`` (after the block's text)."""
-    from fuzzyctl.ir.render.st import st_real
+    record = targets.dialect(dialect)
+    if not record.testbench:
+        able = [name for name, d in targets.DIALECTS.items() if d.testbench]
+        listed = ", ".join(able[:-1]) + " or " + able[-1]
+        raise CodegenError(f"the test bench is written for --dialect {listed} (not {dialect})")
+    plan, real = bench.plan, record.real_type(not lreal)
 
-    if dialect == "scl":
-        raise CodegenError("the test bench is written for --dialect codesys, twincat or iec (not scl)")
-    plan, real = bench.plan, "LREAL" if lreal else "REAL"
+    def st_real(v: float) -> str:
+        return record.real(v, parens=False)
+
     fb = st_ident(plan.name or "FUZZY", "function block name")
     prog = st_ident(f"TB_{fb}"[:24].rstrip("_"), "test bench name")
     n = len(bench.rows)
     outs = [plan.outputs[k] for k in _outputs(plan)]
-    out: list[str] = [f"(* {st_comment(line)} *)" for line in _header(bench, real)]
-    out += [f"(* vector {r + 1}: {st_comment(why)} *)" for r, why in enumerate(bench.why)]
+    out: list[str] = [record.comment(line) for line in _header(bench, real)]
+    out += [record.comment(why, lead=f"vector {r + 1}: ") for r, why in enumerate(bench.why)]
 
     def array(name: str, typ: str, values: list[str]) -> str:
         return f"    {name} : ARRAY[0..{n - 1}] OF {typ} := [{', '.join(values)}];"
@@ -274,10 +280,7 @@ def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = Fal
 def _c_num(v: float) -> str:
     if not math.isfinite(v):
         raise CodegenError(f"the value {v} cannot be written in the C test bench")
-    s = repr(float(v))
-    if "e" not in s and "." not in s:
-        s += ".0"
-    return s
+    return targets.C.real(v, parens=False)
 
 
 def render_c_bench(bench: Bench, *, single: bool = False) -> str:
@@ -287,9 +290,9 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
     name = c_ident(plan.name or "FUZZY", "function block name")
     n = len(bench.rows)
     outs = [plan.outputs[k] for k in _outputs(plan)]
-    real = "float" if single else "double"
-    lines = [f"/* {c_comment(line)} */" for line in _header(bench, real)]
-    lines += [f"/* vector {r + 1}: {c_comment(why)} */" for r, why in enumerate(bench.why)]
+    real = targets.C.real_type(single)
+    lines = [targets.C.comment(line) for line in _header(bench, real)]
+    lines += [targets.C.comment(why, lead=f"vector {r + 1}: ") for r, why in enumerate(bench.why)]
     lines += ["#include <stdio.h>", f'#include "{name}.h"', ""]
     for i, inp in enumerate(plan.inputs):
         c_ident(inp.name, "variable")

@@ -5,14 +5,17 @@ from __future__ import annotations
 import re
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Literal
 
 from fuzzyctl.escape import MAX_IDENT_ST as MAX_IDENT
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.nodes import Builder, Decl, Ex, ExLike, Storage, Type, Var, ex
+from fuzzyctl.kinds import targets
 
-#: "c" and "st": the PLC function block; "py", "np" and "c" also the evaluator of ``compile()``
-Target = Literal["c", "st", "py", "np"]
+#: A program builder's target, a key of :data:`fuzzyctl.kinds.targets.TARGETS` whose
+#: ``language`` is itself: "c" and "st" the PLC function block; "py", "np" and "c" also the
+#: evaluator of ``compile()``.  What the target can express is its capabilities record
+#: (:attr:`Gen.caps`).
+Target = str
 
 #: Every generated identifier starts with this prefix (user names never do: checked).
 PREFIX = "FZ_"
@@ -32,6 +35,11 @@ class Gen:
     uses: set[str] = field(default_factory=set)
     _counter: int = 0
     _free: dict[Type, list[str]] = field(default_factory=dict)
+
+    @property
+    def caps(self) -> targets.Target:
+        """The capabilities record of the target."""
+        return targets.get(self.target)
 
     # ------------------------------------------------------------------ names
 
@@ -103,8 +111,7 @@ class Gen:
         return call(fn, *args)
 
     def refuse(self, what: str, why: str) -> CodegenError:
-        lang = {"st": "Structured Text", "c": "C", "py": "Python", "np": "numpy"}[self.target]
-        return CodegenError(f"{what}: {why} (cannot be expressed in generated {lang})")
+        return CodegenError(f"{what}: {why} (cannot be expressed in generated {self.caps.label})")
 
 
 def flat(values: Sequence[float]) -> tuple[float, ...]:

@@ -99,8 +99,8 @@ def _call(g: Gen, fn: str, args: list[Ex]) -> Ex:
         return formula(g, helper, dict(zip(helper.args, args, strict=True)))
     if fn == "abs":
         return _absv(g, args[0])
-    if fn == "pow":  # ST has no power function: exp(e ln u), for u > 0 (the formulas check)
-        if g.target != "st":
+    if fn == "pow":  # a target without POW (ST): exp(e ln u), for u > 0 (the formulas check)
+        if g.caps.has("POW"):
             return g.call("POW", args[0], args[1])
         return g.call("EXP", args[1] * g.call("LN", args[0]))
     if fn in _FORMULA_CALLS:
@@ -160,6 +160,14 @@ def mul(w: Ex, x: ExLike) -> Ex:
 # --------------------------------------------------------------------------- hedges
 
 
+def power(g: Gen, x: Ex, y: Ex) -> Ex:
+    """``x ** y`` for ``x > 0``: ``POW`` where the target has it, else ``EXP(y * LN(x))``
+    (portable Structured Text has no power function)."""
+    if g.caps.has("POW"):
+        return g.call("POW", x, y)
+    return g.call("EXP", y * g.call("LN", x))
+
+
 def hedge(g: Gen, name: str, d: Ex) -> Ex:
     """One hedge of :data:`fuzzyctl.engine.semantics.shapes.HEDGES` (or ``pow:p``) applied to ``d``."""
     x = _simple(g, d)
@@ -172,10 +180,8 @@ def hedge(g: Gen, name: str, d: Ex) -> Ex:
                 for _ in range(int(p) - 1):
                     prod = prod * x
                 g.b.set(t, prod)
-            elif g.target != "st":
-                g.b.set(t, g.call("POW", x, p))
             else:
-                g.b.set(t, g.call("EXP", Num(p) * g.call("LN", x)))
+                g.b.set(t, power(g, x, Num(p)))
         with g.b.else_():
             g.b.set(t, 1.0 if p == 0.0 else 0.0)
         return t
@@ -267,8 +273,6 @@ _C_FUNCS = {
     "atan2": "ATAN2",
     "fmod": "FMOD",
 }
-#: The IEC 61131-3 standard functions portable Structured Text may call.
-_ST_FUNCS = frozenset({"EXP", "LN", "LOG", "SQRT", "ABS", "SIN", "COS", "TAN", "ASIN", "ACOS", "ATAN"})
 _COMPARE = {"eq": "=", "neq": "<>", "lt": "<", "le": "<=", "gt": ">", "ge": ">="}
 
 
@@ -279,7 +283,7 @@ def expression(
     inf/nan as the engine's C-like evaluation.  Structured Text: + - * /, comparisons,
     min/max/sign and the IEC 61131-3 standard functions (EXP, LN, LOG, SQRT, ABS and the
     trigonometric ones); a PLC faults where the engine would give inf or nan."""
-    if g.target not in ("c", "st"):
+    if not g.caps.function_terms:
         raise g.refuse(what, "function terms are an Open-level feature")
 
     def rec(n: ExprPlan) -> Ex:
@@ -299,13 +303,14 @@ def expression(
             a, b = rec(n.left), rec(n.right)
             if n.op in "+-*/":
                 return Bin(n.op, a, b)
-            if g.target == "st":
+            fn = "FMOD" if n.op == "%" else "POW"
+            if not g.caps.has(fn):
                 raise g.refuse(
                     what,
-                    f"the operator {n.op} has no portable Structured Text form; write the "
+                    f"the operator {n.op} has no portable {g.caps.label} form; write the "
                     "function with + - * / and EXP/LN",
                 )
-            return g.call("FMOD" if n.op == "%" else "POW", a, b)
+            return g.call(fn, a, b)
         assert isinstance(n, ECall)
         args = [rec(a) for a in n.args]
         fn = n.function
@@ -333,11 +338,11 @@ def expression(
             return t
         if fn not in _C_FUNCS:
             raise g.refuse(what, f"function {fn}() is not supported")
-        if g.target == "st" and _C_FUNCS[fn] not in _ST_FUNCS:
+        if not g.caps.has(_C_FUNCS[fn]):
             raise g.refuse(
                 what,
-                f"function {fn}() is no IEC 61131-3 standard function; write the function with "
-                "+ - * / and EXP, LN, LOG, SQRT, ABS, SIN, COS, TAN, ASIN, ACOS or ATAN",
+                f"function {fn}() is no {g.caps.function_noun}; write the function with "
+                f"+ - * / and {g.caps.function_list()}",
             )
         return g.call(_C_FUNCS[fn], *args)
 

@@ -44,7 +44,6 @@ from __future__ import annotations
 import dataclasses
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Literal
 
 from fuzzyctl.engine.plan import (
     EX,
@@ -66,7 +65,9 @@ from fuzzyctl.ir.nodes import Ex, Kernel, Num, Program, Pwl, Var, ex
 from fuzzyctl.ir.state import CodegenError, Gen
 from fuzzyctl.kinds.methods import METHODS
 
-FastTarget = Literal["py", "np", "c"]
+#: A key of :data:`fuzzyctl.kinds.targets.TARGETS` whose renderer prints the evaluator
+#: (py, np, c): its record's ``kernels`` say which routines the program may call.
+FastTarget = str
 
 #: Above this many rules the rule section is tables and loops (:mod:`fuzzyctl.ir.programs.rule_table`).
 TABLE_THRESHOLD = 200
@@ -107,7 +108,7 @@ class FastBuilder(RuleBuilder):
         return Literals(self.g, "", what)
 
     def select(self, sel: SelectionPlan, degrees: list[Ex]) -> list[Ex]:
-        if self.target == "c":
+        if "SELECT" not in self.g.caps.kernels:
             return super().select(sel, degrees)
         outs = tuple(self.g.temp(hint="SEL") for _ in degrees)
         self.g.b.add(Kernel("SELECT", outs, tuple(degrees), sel))
@@ -115,7 +116,7 @@ class FastBuilder(RuleBuilder):
 
     def function_term(self, expr: object, x: Ex | None, outputs: Callable[[int], Ex], where: str) -> Ex:
         assert isinstance(expr, ENum | EInput | EOutput | EX | EUnary | EBinary | ECall)
-        if self.target == "c":
+        if "EXPR" not in self.g.caps.kernels:
             return super().function_term(expr, x, outputs, where)
         refs = sorted(_expr_outputs(expr))
         args = (x if x is not None else Num(0.0), *self.inputs, *(outputs(o) for o in refs))
@@ -149,7 +150,7 @@ class FastBuilder(RuleBuilder):
         if _use_table(plan):
             from fuzzyctl.ir.programs.rule_table import table_rules
 
-            tabled = table_rules(self, degrees, sparse=self.target != "np")
+            tabled = table_rules(self, degrees, sparse=self.g.caps.data_dependent_loops)
         else:
             concl = self.rules(degrees, Literals(g, "", ""))
         values: dict[int, Ex] = {}
@@ -179,7 +180,7 @@ class FastBuilder(RuleBuilder):
     def member(self, var: int, ti: int, x: Ex, where: str) -> Ex:
         """A term whose points are inputs: ``shapes.membership`` at run time (Python and
         numpy; the native builder writes it in the IR)."""
-        if self.target == "c":
+        if "MEMBER" not in self.g.caps.kernels:
             raise self.g.refuse(where, "membership points given by variables")
         t = self.plan.fuzzy_inputs[var].terms[ti]
         out = self.g.temp(hint="MU")
@@ -218,14 +219,14 @@ class FastBuilder(RuleBuilder):
     ) -> tuple[Ex, Ex]:
         if not any(t.kind in shapes.TSUKAMOTO_KINDS for t in op.terms):
             return self.ts(op, contribs, values)
-        if self.target == "c":
+        if "TS" not in self.g.caps.kernels:
             raise self.g.refuse(f"output {op.name}", "Tsukamoto (monotonic) terms")
         return self._whole_output("TS", oi, op, contribs, values)
 
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         """A Mamdani output the closed form does not cover, as one kernel (Python and numpy;
         the native builder, :mod:`fuzzyctl.ir.programs.native`, writes it in the IR)."""
-        if self.target == "c":
+        if "MAMDANI" not in self.g.caps.kernels:
             raise self.g.refuse(f"output {op.name}", f"{op.method} needs the native builder")
         groups = merge(self.g, contribs, op.accu or "MAX")
         merged: list[Contrib] = [(gr.term, gr.a, gr.w, gr.act) for gr in groups]
@@ -236,7 +237,7 @@ class FastBuilder(RuleBuilder):
     ) -> tuple[Ex, Ex]:
         """Area and moment of the accumulated sets on one shared grid interval: the
         ``AM_LINES`` kernel (Python and numpy; the native builder writes it in the IR)."""
-        if self.target == "c":
+        if "AM_LINES" not in self.g.caps.kernels:
             raise self.g.refuse("a shared output interval", "the AM_LINES kernel needs the native builder")
         ta, tm = self.g.temp(hint="IA"), self.g.temp(hint="IM")
         self.g.b.add(Kernel("AM_LINES", (ta, tm), tuple(args), (x0, x1, accu, geom)))

@@ -81,10 +81,10 @@ class _Builder(RuleBuilder):
             for op in plan.outputs
         )
         for op, v in zip(plan.outputs, init_prev, strict=True):
-            if not math.isfinite(v) and g.target == "st":
+            if not math.isfinite(v) and not g.caps.numbers.nonfinite:
                 raise g.refuse(
                     f"output {op.name}: DEFAULT := nan",
-                    "portable Structured Text has no NaN; choose what the block outputs when no "
+                    f"portable {g.caps.label} has no NaN; choose what the block outputs when no "
                     "rule fires with --default VALUE or --default hold (keep the last value)",
                 )
         prev = g.declare(

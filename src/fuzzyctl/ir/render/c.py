@@ -9,26 +9,19 @@ terms are static helpers of :mod:`fuzzyctl.ir.render.c_helpers`, emitted only wh
 from __future__ import annotations
 
 import array
-import math
 from collections.abc import Sequence
 
-from fuzzyctl.escape import CodegenError, c_comment, c_ident
+from fuzzyctl.escape import CodegenError, c_ident
 from fuzzyctl.ir.nodes import (
     Assign,
-    Bin,
     Bool,
     Call,
-    Comment,
     Decl,
     Ex,
     For,
     If,
     Index,
-    Int,
     Kernel,
-    Neg,
-    Not,
-    Num,
     Program,
     Pwl,
     Region,
@@ -40,33 +33,14 @@ from fuzzyctl.ir.nodes import (
 )
 from fuzzyctl.ir.programs.evaluator import FastProgram
 from fuzzyctl.ir.render import c_helpers
+from fuzzyctl.ir.render.printer import Printer
+from fuzzyctl.kinds import targets
 
-_PREC = {"OR": 0, "AND": 1, "=": 2, "<>": 2, "<": 3, "<=": 3, ">": 3, ">=": 3, "+": 4, "-": 4, "*": 5, "/": 5}
-_COP = {"OR": "||", "AND": "&&", "=": "==", "<>": "!="}
+C = targets.C
 # libm itself is used for ``exp`` only; every other intrinsic is one of the static helpers
 # of :mod:`fuzzyctl.ir.render.c_helpers` (written with + - * / and exp), emitted on demand.
-_LIBM = {"EXP": "exp"}
-_HELPER_OF = {
-    "LN": "fz_log",
-    "LOG": "fz_log10",
-    "SQRT": "fz_sqrt",
-    "ABS": "fz_fabs",
-    "SIN": "fz_sin",
-    "COS": "fz_cos",
-    "TAN": "fz_tan",
-    "ASIN": "fz_asin",
-    "ACOS": "fz_acos",
-    "ATAN": "fz_atan",
-    "SINH": "fz_sinh",
-    "COSH": "fz_cosh",
-    "TANH": "fz_tanh",
-    "FLOOR": "fz_floor",
-    "CEIL": "fz_ceil",
-    "RINT": "fz_rint",
-    "POW": "fz_pow",
-    "ATAN2": "fz_atan2",
-    "FMOD": "fz_fmod",
-}
+_LIBM = {f: C.functions[f] for f in C.library}
+_HELPER_OF = {f: spelled for f, spelled in C.functions.items() if f not in C.library}
 
 
 def helper_functions(prog: Program) -> list[str]:
@@ -81,104 +55,30 @@ def libm_functions(prog: Program) -> list[str]:
     return ["exp"] if direct or via_helpers else []
 
 
-class _C:
-    def __init__(self, prog: Program, single: bool) -> None:
+class _C(Printer):
+    """C99 statements; block fields as ``fb->x``, constant tables as ``NAME_x``."""
+
+    def __init__(self, prog: Program, single: bool, target: targets.Target = C) -> None:
+        super().__init__(target, real=f"{prog.name}_real", single=single)
         self.prog = prog
-        self.single = single
-        self.real = f"{prog.name}_real"
         self.fields = {d.name for d in prog.decls if d.storage in ("input", "output", "param", "state")}
         self.consts = {d.name for d in prog.decls if d.storage == "const"}
-        self.lines: list[str] = []
-
-    # ------------------------------------------------------------------ expressions
-
-    def num(self, v: float) -> str:
-        if math.isnan(v):
-            return "NAN"
-        if math.isinf(v):
-            return "INFINITY" if v > 0 else "(-INFINITY)"
-        s = repr(float(v))
-        if "e" not in s and "." not in s:
-            s += ".0"
-        s = s + ("f" if self.single else "")
-        return f"({s})" if v < 0 else s
 
     def name(self, n: str) -> str:
         if n in self.consts:  # file-scope tables: unique per block (several blocks may share a unit)
             return f"{self.prog.name}_{n}"
         return f"fb->{n}" if n in self.fields else n
 
-    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
-        if isinstance(e, Num):
-            return self.num(e.value)
-        if isinstance(e, Int):
-            return str(e.value) if e.value >= 0 else f"({e.value})"
-        if isinstance(e, Bool):
-            return "1" if e.value else "0"
-        if isinstance(e, Var):
-            return self.name(e.name)
-        if isinstance(e, Index):
-            return f"{self.name(e.name)}[{self.ex(e.index)}]"
-        if isinstance(e, Neg):
-            return f"-{self.ex(e.operand, 6)}"
-        if isinstance(e, Not):
-            return f"!{self.ex(e.operand, 6)}"
-        if isinstance(e, Call):
-            if e.function == "NAN":
-                return "NAN"
-            if e.function == "TO_REAL":
-                return f"(({self.real}){self.ex(e.args[0])})"
-            args = ", ".join(self.ex(a) for a in e.args)
-            if e.function in _LIBM:
-                return f"{_LIBM[e.function]}{'f' if self.single else ''}({args})"
-            # the helpers compute in double; the float build rounds their result once
-            call = f"{_HELPER_OF[e.function]}({args})"
-            return f"(({self.real}){call})" if self.single else call
-        assert isinstance(e, Bin)
-        p = _PREC[e.op]
-        s = f"{self.ex(e.left, p)} {_COP.get(e.op, e.op)} {self.ex(e.right, p, True)}"
-        # operands keep the IR's tree exactly (floating point is not associative)
-        return f"({s})" if p < parent or (right and p == parent) else s
+    def call(self, e: Call) -> str:
+        if e.function in self.caps.library:  # libm: expf in the float build
+            args = ", ".join(self.args(e))
+            return f"{self.caps.functions[e.function]}{'f' if self.single else ''}({args})"
+        text = super().call(e)
+        # the helpers compute in double; the float build rounds their result once
+        return f"(({self.real}){text})" if self.single and e.function in self.caps.functions else text
 
-    # ------------------------------------------------------------------ statements
-
-    def emit(self, s: str, ind: int) -> None:
-        self.lines.append("    " * ind + s)
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        for s in body:
-            if isinstance(s, Assign):
-                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)};", ind)
-            elif isinstance(s, Comment):
-                self.emit(_comment(s.text), ind)
-            elif isinstance(s, Region):
-                self.emit(_comment(s.name), ind)
-                self.stmts(s.body, ind)
-            elif isinstance(s, If):
-                for k, (cond, body) in enumerate(s.branches):
-                    kw = "if" if k == 0 else "} else if"
-                    self.emit(f"{kw} ({self.ex(cond)}) {{", ind)
-                    self.stmts(body, ind + 1)
-                if s.orelse:
-                    self.emit("} else {", ind)
-                    self.stmts(s.orelse, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, For):
-                v = s.var
-                cmp, inc = ("<=", "++") if s.step > 0 else (">=", "--")
-                self.emit(f"for ({v} = {self.ex(s.start)}; {v} {cmp} {self.ex(s.stop)}; {v}{inc}) {{", ind)
-                self.stmts(s.body, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, While):
-                self.emit(f"while ({self.ex(s.cond)}) {{", ind)
-                self.stmts(s.body, ind + 1)
-                self.emit("}", ind)
-
-
-def _comment(text: str) -> str:
-    """A C comment: every comment of the generated files is made here, from model text
-    escaped by :func:`fuzzyctl.escape.c_comment`."""
-    return f"/* {c_comment(text)} */"
+    def kernel(self, k: Kernel, ind: int) -> None:
+        """The PLC block has no kernels (the native evaluator's are in :class:`_Native`)."""
 
 
 _CTYPES = {"INT": "int", "DINT": "long", "BOOL": "unsigned char", "BYTE": "unsigned char"}
@@ -231,14 +131,16 @@ def _render_header(prog: Program, name: str, r: _C, single: bool) -> list[str]:
     real = r.real
     guard = f"FUZZYCTL_{name.upper()}_H"
     h: list[str] = []
-    h.append(_comment(f"{name}.h - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
+    h.append(r.comment(f"{name}.h - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
     for line in prog.header:
-        h.append(_comment(line))
+        h.append(r.comment(line))
     h += [f"#ifndef {guard}", f"#define {guard}", "", "#include <stddef.h>", ""]
     h.append(f"typedef {'float' if single else 'double'} {real};")
     h.append("")
     h.append(
-        _comment(f"One instance of the function block: set the inputs, call {name}_step(), read the outputs.")
+        r.comment(
+            f"One instance of the function block: set the inputs, call {name}_step(), read the outputs."
+        )
     )
     h.append("typedef struct {")
     for storage, title in (
@@ -250,11 +152,11 @@ def _render_header(prog: Program, name: str, r: _C, single: bool) -> list[str]:
         ds = prog.of(storage)  # type: ignore[arg-type]
         if not ds:
             continue
-        h.append(f"    {_comment(title)}")
+        h.append(f"    {r.comment(title)}")
         for d in ds:
             dim = f"[{d.size}]" if d.size is not None else ""
             note = d.comment.split("\n")[0]
-            h.append(f"    {_ctype(d, real)} {d.name}{dim};" + (f" {_comment(note)}" if note else ""))
+            h.append(f"    {_ctype(d, real)} {d.name}{dim};" + (f" {r.comment(note)}" if note else ""))
     h.append(f"}} {name};")
     h.append("")
     n_in = len(prog.of("input")) - 1  # without ENABLE
@@ -262,37 +164,38 @@ def _render_header(prog: Program, name: str, r: _C, single: bool) -> list[str]:
     h.append(f"#define {name.upper()}_N_INPUTS {n_in}")
     h.append(f"#define {name.upper()}_N_OUTPUTS {len(outs)}")
     h.append("")
-    h.append(_comment("Set the parameters to the FCL's values, clear the state, ENABLE = 1."))
+    h.append(r.comment("Set the parameters to the FCL's values, clear the state, ENABLE = 1."))
     h.append(f"void {name}_init({name} *fb);")
-    h.append(_comment(f"One evaluation (a PLC cycle); returns INFO: {prog.decl('INFO').comment}."))
+    h.append(r.comment(f"One evaluation (a PLC cycle); returns INFO: {prog.decl('INFO').comment}."))
     h.append(f"unsigned char {name}_step({name} *fb);")
     in_names = ", ".join(d.name for d in prog.of("input") if d.name != "ENABLE")
     out_names = ", ".join(d.name for d in outs)
-    h.append(_comment(f"n evaluations in a row: in[i*{n_in} + k] is input k ({in_names}) of row i,"))
-    h.append(_comment(f"out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row."))
+    h.append(r.comment(f"n evaluations in a row: in[i*{n_in} + k] is input k ({in_names}) of row i,"))
+    h.append(r.comment(f"out[i*{len(outs)} + k] output k ({out_names}); returns INFO of the last row."))
     h.append(f"unsigned char {name}_batch({name} *fb, size_t n, const double *in, double *out);")
     h.append("")
-    h.append(f"#endif /* {guard} */")
+    h.append(f"#endif {r.comment(guard)}")
     return h
 
 
-def render_c(prog: Program, *, single: bool = False) -> tuple[str, str]:
-    """``(header, source)`` for ``prog``; ``single`` selects float instead of double."""
+def render_c(prog: Program, *, single: bool = False, target: targets.Target = C) -> tuple[str, str]:
+    """``(header, source)`` for ``prog``; ``single`` selects float instead of double;
+    ``target`` is the C record (literals, comments, functions)."""
     name = c_ident(prog.name, "function block name")
     for d in prog.decls:  # model names become struct members: each one must be inert
         c_ident(d.name, "variable" if d.storage in ("input", "output") else "identifier")
-    r = _C(prog, single)
+    r = _C(prog, single, target)
     real = r.real
     h = _render_header(prog, name, r, single)
     outs = [d for d in prog.of("output") if d.name != "INFO"]
 
     c: list[str] = []
-    c.append(_comment(f"{name}.c - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
+    c.append(r.comment(f"{name}.c - generated by fuzzyctl; do not edit (regenerate from the FCL)."))
     libs = libm_functions(prog)
-    c.append(_comment(f"libm functions used: {', '.join(libs) if libs else 'none'}"))
+    c.append(r.comment(f"libm functions used: {', '.join(libs) if libs else 'none'}"))
     helpers = helper_functions(prog)
     if helpers:
-        c.append(_comment(f"static helpers instead of libm (only + - * / and exp): {', '.join(helpers)}"))
+        c.append(r.comment(f"static helpers instead of libm (only + - * / and exp): {', '.join(helpers)}"))
     c += [f'#include "{name}.h"', "#include <math.h>", ""]
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
@@ -362,6 +265,7 @@ class _Native(_C):
 
     def __init__(self, fp: FastProgram) -> None:
         super().__init__(fp.program, False)
+        self.comments = False  # no model text in the native evaluator
         self.fp = fp
         self.real = "double"
         self.fields = set()
@@ -376,38 +280,13 @@ class _Native(_C):
             return "prev"
         return n
 
-    def ex(self, e: Ex, parent: int = -1, right: bool = False) -> str:
-        if isinstance(e, Pwl):
-            return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
-        if isinstance(e, Call) and e.function == "IMOD":
-            return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
-        return super().ex(e, parent, right)
+    def pwl(self, e: Pwl) -> str:
+        return f"{self.pwl_func(e.points)}({self.ex(e.x)})"
 
     def pwl_func(self, points: tuple[tuple[float, float], ...]) -> str:
         if points not in self.pwl_funcs:
             self.pwl_funcs[points] = f"fz_pwl{len(self.pwl_funcs)}"
         return self.pwl_funcs[points]
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        for s in body:
-            if isinstance(s, Kernel):
-                self.kernel(s, ind)
-            elif isinstance(s, Comment):
-                continue
-            elif isinstance(s, Region):
-                self.stmts(s.body, ind)
-            elif isinstance(s, If):
-                for k, (cond, b) in enumerate(s.branches):
-                    self.emit(f"{'if' if k == 0 else '} else if'} ({self.ex(cond)}) {{", ind)
-                    self.stmts(b, ind + 1)
-                if s.orelse:
-                    self.emit("} else {", ind)
-                    self.stmts(s.orelse, ind + 1)
-                self.emit("}", ind)
-            elif isinstance(s, For | While):
-                super().stmts([s], ind)  # loop bodies come back here
-            else:
-                super().stmts([s], ind)
 
     def kernel(self, k: Kernel, ind: int) -> None:
         if k.name == "HOLD":

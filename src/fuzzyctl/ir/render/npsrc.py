@@ -29,8 +29,6 @@ from fuzzyctl.ir.nodes import (
     Assign,
     Bin,
     Bool,
-    Call,
-    Comment,
     Ex,
     For,
     If,
@@ -49,28 +47,11 @@ from fuzzyctl.ir.nodes import (
     subexprs,
 )
 from fuzzyctl.ir.programs.evaluator import FastProgram
-from fuzzyctl.ir.render.pysrc import check_names, lit
+from fuzzyctl.ir.render.pysrc import PythonPrinter, check_names
 from fuzzyctl.ir.state import CodegenError
+from fuzzyctl.kinds import targets
 
 Batch = Callable[[list[Any], list[float | None], int], list[Any]]
-
-_OPS = {"=": "==", "<>": "!="}
-# transcendental functions as libm computes them: the scalar paths call it (libm_np says why)
-_FUNCS = {
-    "EXP": "_libm.exp",
-    "SQRT": "_np.sqrt",
-    "LN": "_libm.log",
-    "LOG": "_libm.log10",
-    "ABS": "_np.abs",
-    "SIN": "_libm.sin",
-    "COS": "_libm.cos",
-    "TAN": "_libm.tan",
-    "ASIN": "_libm.asin",
-    "ACOS": "_libm.acos",
-    "ATAN": "_libm.atan",
-    "POW": "_libm.pow_",
-    "TO_REAL": "_real",
-}
 
 
 def varying_names(prog: Program, inputs: Sequence[str]) -> set[str]:
@@ -112,11 +93,15 @@ def varying_names(prog: Program, inputs: Sequence[str]) -> set[str]:
     return vary
 
 
-class _Np:
+class _Np(PythonPrinter):
+    """The Python printer, if-converted: ``self.mask`` is the mask of the samples the
+    statements being printed apply to (None: all)."""
+
     def __init__(self, fp: FastProgram) -> None:
+        super().__init__(targets.NP)
         self.fp = fp
         self.vary = varying_names(fp.program, fp.inputs)
-        self.lines: list[str] = []
+        self.mask: str | None = None
         self.env: dict[str, Any] = {
             "_np": np,
             "_libm": libm_np,
@@ -137,115 +122,73 @@ class _Np:
         self.env[name] = value
         return name
 
-    def emit(self, line: str, ind: int) -> None:
-        self.lines.append("    " * ind + line)
-
     def varies(self, e: Ex) -> bool:
         return any(isinstance(s, Var | Index) and s.name in self.vary for s in subexprs(e))
 
     # ------------------------------------------------------------------ expressions
 
-    def ex(self, e: Ex) -> str:
-        if isinstance(e, Num):
-            return lit(e.value)
-        if isinstance(e, Int):
-            return str(e.value)
-        if isinstance(e, Bool):
-            return "True" if e.value else "False"
-        if isinstance(e, Var):
-            return e.name
-        if isinstance(e, Index):
-            if self.varies(e.index):
-                raise CodegenError("an array index that differs between samples cannot be if-converted")
-            return f"{e.name}[{self.ex(e.index)}]"
-        if isinstance(e, Neg):
-            return f"(-{self.ex(e.operand)})"
-        if isinstance(e, Not):
-            return f"_not({self.ex(e.operand)})"
-        if isinstance(e, Call):
-            if e.function == "NAN":
-                return "_NAN"
-            return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
-        if isinstance(e, Pwl):
-            return f"{self.bind(e.points, '_p')}_v({self.ex(e.x)})"
-        assert isinstance(e, Bin), e
-        if e.op in ("AND", "OR"):
-            return f"_{e.op.lower()}({self.ex(e.left)}, {self.ex(e.right)})"
-        return f"({self.ex(e.left)} {_OPS.get(e.op, e.op)} {self.ex(e.right)})"
+    def index(self, e: Index) -> str:
+        if self.varies(e.index):
+            raise CodegenError("an array index that differs between samples cannot be if-converted")
+        return super().index(e)
+
+    def pwl(self, e: Pwl) -> str:
+        return f"{self.bind(e.points, '_p')}_v({self.ex(e.x)})"
 
     # ------------------------------------------------------------------ statements
 
-    def stmts(self, body: Sequence[Stmt], ind: int, mask: str | None) -> None:
-        start = len(self.lines)
-        i = 0
-        while i < len(body):
-            self.stmt(body[i], ind, mask)
-            i += 1
-        if len(self.lines) == start:
-            self.emit("pass", ind)
+    def masked(self, body: Sequence[Stmt], ind: int, mask: str | None) -> None:
+        """``body`` under ``mask`` (at the same depth: an if-converted branch)."""
+        outer, self.mask = self.mask, mask
+        try:
+            self.block(body, ind)
+        finally:
+            self.mask = outer
 
-    def assign(self, target: Ex, value: str, ind: int, mask: str | None) -> None:
+    def store(self, target: Ex, value: str, ind: int) -> None:
         t = self.ex(target)
-        self.emit(f"{t} = {value}" if mask is None else f"{t} = _w({mask}, {value}, {t})", ind)
+        self.emit(f"{t} = {value}" if self.mask is None else f"{t} = _w({self.mask}, {value}, {t})", ind)
 
-    def stmt(self, s: Stmt, ind: int, mask: str | None) -> None:
-        if isinstance(s, Assign):
-            self.assign(s.target, self.ex(s.value), ind, mask)
-        elif isinstance(s, If):
-            self.if_(s, ind, mask)
-        elif isinstance(s, For):
-            if self.varies(s.start) or self.varies(s.stop):
-                raise CodegenError("a loop whose bounds differ between samples cannot be if-converted")
-            stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
-            self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
-            self.stmts(s.body, ind + 1, mask)
-        elif isinstance(s, While):
-            if self.varies(s.cond):
-                raise CodegenError("a loop whose end differs between samples cannot be if-converted")
-            self.emit(f"while {self.ex(s.cond)}:", ind)
-            self.stmts(s.body, ind + 1, mask)
-        elif isinstance(s, Region):
-            self.stmts(s.body, ind, mask)
-        elif isinstance(s, Kernel):
-            self.kernel(s, ind, mask)
-        else:
-            assert isinstance(s, Comment)
+    def assign(self, s: Assign, ind: int) -> None:
+        self.store(s.target, self.ex(s.value), ind)
 
-    def if_(self, s: If, ind: int, mask: str | None) -> None:
+    def for_(self, s: For, ind: int) -> None:
+        if self.varies(s.start) or self.varies(s.stop):
+            raise CodegenError("a loop whose bounds differ between samples cannot be if-converted")
+        super().for_(s, ind)
+
+    def while_(self, s: While, ind: int) -> None:
+        if self.varies(s.cond):
+            raise CodegenError("a loop whose end differs between samples cannot be if-converted")
+        super().while_(s, ind)
+
+    def if_(self, s: If, ind: int) -> None:
         if not any(self.varies(c) for c, _b in s.branches):
-            for k, (cond, body) in enumerate(s.branches):
-                self.emit(f"{'if' if k == 0 else 'elif'} {self.ex(cond)}:", ind)
-                self.stmts(body, ind + 1, mask)
-            if s.orelse:
-                self.emit("else:", ind)
-                self.stmts(s.orelse, ind + 1, mask)
+            super().if_(s, ind)
             return
         minmax = _minmax(s)
         if minmax is not None:
             fn, target, value = minmax
-            self.assign(target, f"_np.{fn}({self.ex(target)}, {self.ex(value)})", ind, mask)
+            self.store(target, f"_np.{fn}({self.ex(target)}, {self.ex(value)})", ind)
             return
-        rest = mask
+        rest = self.mask
         for cond, body in s.branches:
             m = self.mask_name()
             c = self.ex(cond)
             self.emit(f"{m} = {c}" if rest is None else f"{m} = _and({rest}, {c})", ind)
-            self.stmts(body, ind, m)
-            if rest is None:
-                r = self.mask_name()
-                self.emit(f"{r} = _not({m})", ind)
-            else:
-                r = self.mask_name()
-                self.emit(f"{r} = _and({rest}, _not({m}))", ind)
+            self.masked(body, ind, m)
+            r = self.mask_name()
+            self.emit(f"{r} = _not({m})" if rest is None else f"{r} = _and({rest}, _not({m}))", ind)
             rest = r
         if s.orelse:
-            self.stmts(s.orelse, ind, rest)
+            self.masked(s.orelse, ind, rest)
 
     def mask_name(self) -> str:
         self.n_masks += 1
         return f"_m{self.n_masks}"
 
-    def kernel(self, k: Kernel, ind: int, mask: str | None) -> None:
+    def kernel(self, k: Kernel, ind: int) -> None:
+        mask = self.mask
         if k.name == "HOLD":
             if mask is not None:
                 raise CodegenError("DEFAULT / NC under a condition")
@@ -263,7 +206,7 @@ class _Np:
         tmp = [f"_r{i}" for i in range(len(k.outs))]
         self.emit(f"{', '.join(tmp)}{',' if _tuple1(k) else ''} = {fn}(n, {args})", ind)
         for o, t in zip(k.outs, tmp, strict=True):
-            self.assign(o, t, ind, mask)
+            self.store(o, t, ind)
 
 
 def _tuple1(k: Kernel) -> bool:
@@ -312,7 +255,7 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
         r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
-    r.stmts(prog.body, 2, None)
+    r.block(prog.body, 2)
     body = r.lines
     head = [f"    {name} = v[{k}]" for k, name in enumerate(fp.inputs)]
     for d in prog.of("temp") + prog.of("output"):

@@ -19,19 +19,12 @@ from fuzzyctl.escape import py_ident, py_str
 from fuzzyctl.ir.kernels import scalar as kernels
 from fuzzyctl.ir.nodes import (
     Assign,
-    Bin,
     Bool,
-    Call,
-    Comment,
     Ex,
     For,
     If,
     Index,
-    Int,
     Kernel,
-    Neg,
-    Not,
-    Num,
     Pwl,
     Region,
     Stmt,
@@ -40,40 +33,41 @@ from fuzzyctl.ir.nodes import (
     identifiers,
 )
 from fuzzyctl.ir.programs.evaluator import FastProgram
+from fuzzyctl.ir.render.printer import Printer
+from fuzzyctl.kinds import targets
 
 Fast = Callable[[list[float], list[float | None]], list[float]]
 
-_OPS = {"=": "==", "<>": "!=", "AND": "and", "OR": "or"}
-_FUNCS = {
-    "EXP": "_m.exp",
-    "SQRT": "_m.sqrt",
-    "LN": "_m.log",
-    "LOG": "_m.log10",
-    "ABS": "abs",
-    "SIN": "_m.sin",
-    "COS": "_m.cos",
-    "TAN": "_m.tan",
-    "ASIN": "_m.asin",
-    "ACOS": "_m.acos",
-    "ATAN": "_m.atan",
-    "POW": "_m.pow",
-    "TO_REAL": "float",
-}
+
+class PythonPrinter(Printer):
+    """Python statement syntax (indentation blocks, ``pass``, ``range`` loops); no comments
+    (they hold model text)."""
+
+    ASSIGN = "{0} = {1}"
+    IF = "if {0}:"
+    ELIF = "elif {0}:"
+    ELSE = "else:"
+    END_IF = None
+    WHILE = "while {0}:"
+    END_WHILE = None
+    EMPTY = "pass"
+
+    def __init__(self, caps: targets.Target) -> None:
+        super().__init__(caps, comments=False)
+
+    def region(self, s: Region, ind: int) -> None:
+        self.block(s.body, ind)  # a region that prints nothing holds a pass
+
+    def for_(self, s: For, ind: int) -> None:
+        stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
+        self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
+        self.block(s.body, ind + 1)
 
 
-def lit(x: float) -> str:
-    """An exact float literal (``repr`` round-trips), NaN and infinities by name."""
-    if math.isnan(x):
-        return "_NAN"
-    if math.isinf(x):
-        return "_INF" if x > 0 else "(-_INF)"
-    return repr(float(x))
-
-
-class _Py:
-    def __init__(self, fp: FastProgram) -> None:
+class _Py(PythonPrinter):
+    def __init__(self, fp: FastProgram, caps: targets.Target = targets.PY) -> None:
+        super().__init__(caps)
         self.fp = fp
-        self.lines: list[str] = []
         self.env: dict[str, Any] = {"_NAN": math.nan, "_INF": math.inf, "_m": math}
         self.n_kernels = 0
 
@@ -83,74 +77,17 @@ class _Py:
         self.env[name] = value
         return name
 
-    def emit(self, line: str, ind: int) -> None:
-        self.lines.append("    " * ind + line)
+    def pwl(self, e: Pwl) -> str:
+        """Not at the top of an assignment: ``shapes.pwl_value`` bound as a function."""
+        from fuzzyctl.engine.semantics.shapes import pwl_value
 
-    # ------------------------------------------------------------------ expressions
+        return f"{self.bind(lambda x, pts=e.points: pwl_value(pts, x), '_p')}({self.ex(e.x)})"
 
-    def ex(self, e: Ex) -> str:
-        if isinstance(e, Num):
-            return lit(e.value)
-        if isinstance(e, Int):
-            return str(e.value)
-        if isinstance(e, Bool):
-            return "True" if e.value else "False"
-        if isinstance(e, Var):
-            return e.name
-        if isinstance(e, Index):
-            return f"{e.name}[{self.ex(e.index)}]"
-        if isinstance(e, Neg):
-            return f"(-{self.ex(e.operand)})"
-        if isinstance(e, Not):
-            return f"(not {self.ex(e.operand)})"
-        if isinstance(e, Call):
-            if e.function == "NAN":
-                return "_NAN"
-            if e.function == "IMOD":
-                return f"({self.ex(e.args[0])} % {self.ex(e.args[1])})"
-            return f"{_FUNCS[e.function]}({', '.join(self.ex(a) for a in e.args)})"
-        if isinstance(e, Pwl):  # not at the top of an assignment: shapes.pwl_value
-            from fuzzyctl.engine.semantics.shapes import pwl_value
-
-            return f"{self.bind(lambda x, pts=e.points: pwl_value(pts, x), '_p')}({self.ex(e.x)})"
-        assert isinstance(e, Bin), e
-        return f"({self.ex(e.left)} {_OPS.get(e.op, e.op)} {self.ex(e.right)})"
-
-    # ------------------------------------------------------------------ statements
-
-    def stmts(self, body: Sequence[Stmt], ind: int) -> None:
-        start = len(self.lines)
-        for s in body:
-            self.stmt(s, ind)
-        if len(self.lines) == start:
-            self.emit("pass", ind)
-
-    def stmt(self, s: Stmt, ind: int) -> None:
-        if isinstance(s, Assign):
-            if isinstance(s.value, Pwl):
-                self.pwl_chain(s.value, self.ex(s.target), ind)
-            else:
-                self.emit(f"{self.ex(s.target)} = {self.ex(s.value)}", ind)
-        elif isinstance(s, If):
-            for k, (cond, body) in enumerate(s.branches):
-                self.emit(f"{'if' if k == 0 else 'elif'} {self.ex(cond)}:", ind)
-                self.stmts(body, ind + 1)
-            if s.orelse:
-                self.emit("else:", ind)
-                self.stmts(s.orelse, ind + 1)
-        elif isinstance(s, For):
-            stop = f"{self.ex(s.stop)} + 1" if s.step > 0 else f"{self.ex(s.stop)} - 1, -1"
-            self.emit(f"for {s.var} in range({self.ex(s.start)}, {stop}):", ind)
-            self.stmts(s.body, ind + 1)
-        elif isinstance(s, While):
-            self.emit(f"while {self.ex(s.cond)}:", ind)
-            self.stmts(s.body, ind + 1)
-        elif isinstance(s, Region):
-            self.stmts(s.body, ind)
-        elif isinstance(s, Kernel):
-            self.kernel(s, ind)
+    def assign(self, s: Assign, ind: int) -> None:
+        if isinstance(s.value, Pwl):
+            self.pwl_chain(s.value, self.ex(s.target), ind)
         else:
-            assert isinstance(s, Comment)
+            super().assign(s, ind)
 
     def pwl_chain(self, p: Pwl, out: str, ind: int) -> None:
         """``shapes.pwl_value`` as an if-chain over the breakpoints."""
@@ -163,23 +100,23 @@ class _Py:
             x = "_x"
         pts = p.points
         xs = sorted({q[0] for q in pts})
-        self.emit(f"if {x} < {lit(xs[0])}: {out} = {lit(pts[0][1])}", ind)
+        self.emit(f"if {x} < {self.num(xs[0])}: {out} = {self.num(pts[0][1])}", ind)
         for k, u in enumerate(xs):
             pv = pwl_value(pts, u)
             jump = left_limit(pts, u) != right_limit(pts, u) or pv != left_limit(pts, u)
             if jump or k == 0:
-                self.emit(f"elif {x} == {lit(u)}: {out} = {lit(pv)}", ind)
+                self.emit(f"elif {x} == {self.num(u)}: {out} = {self.num(pv)}", ind)
             if k + 1 < len(xs):
                 u1 = xs[k + 1]
                 r0, l1 = right_limit(pts, u), left_limit(pts, u1)
                 if r0 == l1:
-                    expr = lit(r0)
+                    expr = self.num(r0)
                 else:
-                    base = f"({x} - {lit(u)}) * {lit((l1 - r0) / (u1 - u))}"
-                    expr = base if r0 == 0.0 else f"{lit(r0)} + {base}"
-                self.emit(f"elif {x} < {lit(u1)}: {out} = {expr}", ind)
-        self.emit(f"elif {x} == {lit(xs[-1])}: {out} = {lit(pwl_value(pts, xs[-1]))}", ind)
-        self.emit(f"else: {out} = {lit(pts[-1][1])}", ind)
+                    base = f"({x} - {self.num(u)}) * {self.num((l1 - r0) / (u1 - u))}"
+                    expr = base if r0 == 0.0 else f"{self.num(r0)} + {base}"
+                self.emit(f"elif {x} < {self.num(u1)}: {out} = {expr}", ind)
+        self.emit(f"elif {x} == {self.num(xs[-1])}: {out} = {self.num(pwl_value(pts, xs[-1]))}", ind)
+        self.emit(f"else: {out} = {self.num(pts[-1][1])}", ind)
 
     # ------------------------------------------------------------------ kernels
 
@@ -203,28 +140,29 @@ class _Py:
             self.emit("else:", ind)
             if no_change:
                 self.emit(f"{out} = state[{oi}]", ind + 1)
-                self.emit(f"if {out} is None: {out} = {lit(default)}", ind + 1)
+                self.emit(f"if {out} is None: {out} = {self.num(default)}", ind + 1)
             else:
-                self.emit(f"{out} = {lit(default)}", ind + 1)
+                self.emit(f"{out} = {self.num(default)}", ind + 1)
         elif self.ex(value) != out:
             self.emit(f"{out} = {self.ex(value)}", ind)
         if clamp is not None:
             lo, hi = clamp
-            self.emit(f"if {out} < {lit(lo)}: {out} = {lit(lo)}", ind)
-            self.emit(f"elif {out} > {lit(hi)}: {out} = {lit(hi)}", ind)
+            self.emit(f"if {out} < {self.num(lo)}: {out} = {self.num(lo)}", ind)
+            self.emit(f"elif {out} > {self.num(hi)}: {out} = {self.num(hi)}", ind)
         self.emit(f"state[{oi}] = {out}", ind)
 
 
-def render_py(fp: FastProgram) -> tuple[str, dict[str, Any]]:
-    """The source of ``_fast`` and the globals it needs."""
-    r = _Py(fp)
+def render_py(fp: FastProgram, caps: targets.Target = targets.PY) -> tuple[str, dict[str, Any]]:
+    """The source of ``_fast`` and the globals it needs; ``caps`` is the Python record
+    (literals, functions, operators)."""
+    r = _Py(fp, caps)
     prog = fp.program
     check_names(fp)
     for d in prog.of("const"):
         assert isinstance(d.init, tuple)
         r.env[d.name] = tuple(float(v) if d.type == "REAL" else int(v) for v in d.init)
     body_start = len(r.lines)
-    r.stmts(prog.body, 1)
+    r.block(prog.body, 1)
     body = r.lines[body_start:]
     head: list[str] = []
     for k, name in enumerate(fp.inputs):
