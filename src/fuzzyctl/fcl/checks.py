@@ -37,6 +37,7 @@ from fuzzyctl.model import (
     Term,
     VarKind,
     walk_condition,
+    walk_expr,
 )
 from fuzzyctl.validation import at_spans, validate
 
@@ -147,48 +148,50 @@ def _line(span: Span | None) -> str:
     return str(span.line) if span else "?"
 
 
+def _check_block(
+    fb: FunctionBlock,
+    block: FuzzifyBlock | DefuzzifyBlock,
+    seen: dict[str, Span | None],
+    r: _Reporter,
+) -> None:
+    """What FUZZIFY and DEFUZZIFY blocks share: a declared variable of the kind the block
+    takes (5.2.2, 5.2.3), one block per variable, no term defined twice."""
+    word, takes, section, code = (
+        ("FUZZIFY", VarKind.INPUT, "5.2.2", "fuzzify-non-input")
+        if isinstance(block, FuzzifyBlock)
+        else ("DEFUZZIFY", VarKind.OUTPUT, "5.2.3", "defuzzify-non-output")
+    )
+    name = block.variable
+    var = fb.variable(name)
+    if var is None:
+        r.error(f"{word} {name}: no variable {name} is declared", block.span, "undeclared-variable")
+    elif var.kind is not takes and var.kind is not VarKind.LOCAL:
+        r.error(
+            f"{word} {name}: {name} is a {var.kind.value}; {word} takes a {takes.value} ({section})",
+            block.span,
+            code,
+        )
+    if name in seen:
+        r.error(f"second {word} block for {name}", block.span, "duplicate-block")
+    seen[name] = block.span
+    _check_terms(block.terms, name, r)
+
+
 def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
     fuzzified: dict[str, Span | None] = {}
     for f in fb.fuzzify:
         var = fb.variable(f.variable)
-        if var is None:
-            r.error(
-                f"FUZZIFY {f.variable}: no variable {f.variable} is declared", f.span, "undeclared-variable"
-            )
-        elif var.kind is VarKind.OUTPUT:
-            r.error(
-                f"FUZZIFY {f.variable}: {f.variable} is a VAR_OUTPUT; FUZZIFY takes a VAR_INPUT (5.2.2)",
-                f.span,
-                "fuzzify-non-input",
-            )
-        elif var.kind is VarKind.LOCAL:
+        if var is not None and var.kind is VarKind.LOCAL:
             r.warning(
                 f"FUZZIFY {f.variable}: {f.variable} is a local VAR; the standard fuzzifies VAR_INPUT "
                 "variables (5.2.2)",
                 f.span,
                 "fuzzify-local",
             )
-        if f.variable in fuzzified:
-            r.error(f"second FUZZIFY block for {f.variable}", f.span, "duplicate-block")
-        fuzzified[f.variable] = f.span
-        _check_terms(f.terms, f.variable, r)
+        _check_block(fb, f, fuzzified, r)
     defuzzified: dict[str, Span | None] = {}
     for d in fb.defuzzify:
-        var = fb.variable(d.variable)
-        if var is None:
-            r.error(
-                f"DEFUZZIFY {d.variable}: no variable {d.variable} is declared", d.span, "undeclared-variable"
-            )
-        elif var.kind is VarKind.INPUT:
-            r.error(
-                f"DEFUZZIFY {d.variable}: {d.variable} is a VAR_INPUT; DEFUZZIFY takes a VAR_OUTPUT (5.2.3)",
-                d.span,
-                "defuzzify-non-output",
-            )
-        if d.variable in defuzzified:
-            r.error(f"second DEFUZZIFY block for {d.variable}", d.span, "duplicate-block")
-        defuzzified[d.variable] = d.span
-        _check_terms(d.terms, d.variable, r)
+        _check_block(fb, d, defuzzified, r)
         _check_defuzzify(fb, d, r)
     for v in fb.variables:
         if v.kind is VarKind.OUTPUT and v.name not in defuzzified and not _assigned_bare(fb, v.name):
@@ -453,7 +456,7 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
         for block in term_blocks(fb):
             for t in block.terms:
                 if isinstance(t.mf, FunctionMF):
-                    for name in sorted(_names(t.mf.expr)):
+                    for name in sorted({n.name for n in walk_expr(t.mf.expr) if isinstance(n, Name)}):
                         if fb.variable(name) is None and name not in ("x", "pi", "e"):
                             r.error(
                                 f"TERM {t.name}: FUNCTION uses undeclared variable {name}",
@@ -461,18 +464,6 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
                                 "undeclared-variable",
                             )
     yield from r.found
-
-
-def _names(e: object) -> set[str]:
-    if isinstance(e, Name):
-        return {e.name}
-    out: set[str] = set()
-    for attr in ("operand", "left", "right"):
-        if hasattr(e, attr):
-            out |= _names(getattr(e, attr))
-    for a in getattr(e, "args", ()):
-        out |= _names(a)
-    return out
 
 
 def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
