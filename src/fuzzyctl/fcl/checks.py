@@ -29,12 +29,14 @@ from fuzzyctl.model import (
     Param,
     PointsMF,
     Ref,
+    Rule,
     RuleBlock,
     ShapeMF,
     SingletonMF,
     SingletonsMF,
     Span,
     Term,
+    Variable,
     VarKind,
     walk_condition,
     walk_expr,
@@ -324,13 +326,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             )
         labels[rule.label] = rule.span
         for sub in walk_condition(rule.condition):
-            var = fb.variable(sub.variable)
-            if var is None:
-                r.error(
-                    f"RULE {rule.label}: undeclared variable {sub.variable}",
-                    sub.span or rule.span,
-                    "undeclared-variable",
-                )
+            if _declared(fb, rule, sub.variable, sub.span, r) is None:
                 continue
             if isinstance(sub, Is):
                 terms = _terms_of(fb, sub.variable)
@@ -348,20 +344,10 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "fuzzylite-any",
                     )
                 elif sub.term not in terms:
-                    r.error(
-                        f"RULE {rule.label}: {sub.variable} has no term {sub.term}",
-                        sub.span or rule.span,
-                        "undeclared-term",
-                        hint="its terms: " + ", ".join(sorted(terms)),
-                    )
+                    _no_term(rule, sub.variable, sub.term, terms, sub.span, r)
         for c in rule.conclusions:
-            var = fb.variable(c.variable)
+            var = _declared(fb, rule, c.variable, c.span, r)
             if var is None:
-                r.error(
-                    f"RULE {rule.label}: undeclared variable {c.variable}",
-                    c.span or rule.span,
-                    "undeclared-variable",
-                )
                 continue
             if var.kind is VarKind.INPUT:
                 r.error(
@@ -379,12 +365,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "undeclared-term",
                     )
                 elif terms is not None and c.term not in terms:
-                    r.error(
-                        f"RULE {rule.label}: {c.variable} has no term {c.term}",
-                        c.span or rule.span,
-                        "undeclared-term",
-                        hint="its terms: " + ", ".join(sorted(terms)),
-                    )
+                    _no_term(rule, c.variable, c.term, terms, c.span, r)
             w = c.weight
             if isinstance(w, Ref):
                 wvar = fb.variable(w.name)
@@ -407,6 +388,25 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "weight-out-of-range",
                     )
             # a numeric weight: fuzzyctl.validation (one validation for every reader)
+
+
+def _declared(fb: FunctionBlock, rule: Rule, name: str, span: Span | None, r: _Reporter) -> Variable | None:
+    """The variable ``name`` a rule uses, or None after reporting it undeclared."""
+    var = fb.variable(name)
+    if var is None:
+        r.error(f"RULE {rule.label}: undeclared variable {name}", span or rule.span, "undeclared-variable")
+    return var
+
+
+def _no_term(
+    rule: Rule, variable: str, term: str, terms: Iterable[str], span: Span | None, r: _Reporter
+) -> None:
+    r.error(
+        f"RULE {rule.label}: {variable} has no term {term}",
+        span or rule.span,
+        "undeclared-term",
+        hint="its terms: " + ", ".join(sorted(terms)),
+    )
 
 
 def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
