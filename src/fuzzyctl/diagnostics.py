@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict, Unpack
 
 if TYPE_CHECKING:  # the model is imported by whoever makes a diagnostic with a span
     from fuzzyctl.model import Span
@@ -140,26 +140,21 @@ def render_all(
     return [d.render(source) for d in shown] + ([more_line(rest)] if rest else [])
 
 
-def error(
-    message: str,
-    span: Span | None = None,
-    *,
-    code: str = "",
-    file: str | None = None,
-    hint: str | None = None,
-) -> Diagnostic:
-    return Diagnostic(Severity.ERROR, message, span, file, code, hint)
+class Where(TypedDict, total=False):
+    """The keywords :func:`error` and :func:`warning` take (the :class:`Diagnostic` fields
+    of the same names; left out: their defaults)."""
+
+    code: str
+    file: str | None
+    hint: str | None
 
 
-def warning(
-    message: str,
-    span: Span | None = None,
-    *,
-    code: str = "",
-    file: str | None = None,
-    hint: str | None = None,
-) -> Diagnostic:
-    return Diagnostic(Severity.WARNING, message, span, file, code, hint)
+def error(message: str, span: Span | None = None, **where: Unpack[Where]) -> Diagnostic:
+    return Diagnostic(Severity.ERROR, message, span, **where)
+
+
+def warning(message: str, span: Span | None = None, **where: Unpack[Where]) -> Diagnostic:
+    return Diagnostic(Severity.WARNING, message, span, **where)
 
 
 def has_errors(diagnostics: Iterable[Diagnostic]) -> bool:

@@ -185,6 +185,21 @@ class Call:
 Expr: TypeAlias = Num | Name | Unary | Binary | Call
 
 
+def walk_expr(e: Expr) -> Iterator[Expr]:
+    """Every node of an expression, the root first (an explicit stack, as
+    :func:`walk_condition`)."""
+    stack: list[Expr] = [e]
+    while stack:
+        node = stack.pop()
+        yield node
+        if isinstance(node, Unary):
+            stack.append(node.operand)
+        elif isinstance(node, Binary):
+            stack += (node.right, node.left)
+        elif isinstance(node, Call):
+            stack.extend(reversed(node.args))
+
+
 @dataclass(frozen=True)
 class FunctionMF:
     """A term whose value is an arithmetic expression of input variables (open level)."""

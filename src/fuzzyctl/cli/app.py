@@ -16,6 +16,7 @@ from fuzzyctl import __version__, formats
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, OptionError
 
 if TYPE_CHECKING:
+    from rich.progress import Progress, ProgressColumn
     from rich.table import Table
 
 
@@ -64,7 +65,31 @@ FromOpt = Annotated[
     ),
 ]
 """The option every command that reads a model takes to name its format."""
+StrictOpt = Annotated[
+    bool,
+    typer.Option(
+        "--strict",
+        help="Refuse what a strict IEC 61131-7 reading refuses: an output without RANGE whose terms "
+        "do not fall to 0, names that are reserved keywords.",
+    ),
+]
+"""The option of the commands that compile a model: refuse what a strict reading refuses."""
 """How the commands that write files for the user override a read-only target."""
+
+
+def stderr_progress(*columns: ProgressColumn | str, hidden: bool) -> Progress:
+    """A progress bar on stderr that disappears when done (none with ``hidden``): the
+    task's description, the bar, then ``columns``."""
+    from rich.progress import BarColumn, Progress, TextColumn
+
+    return Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        *columns,
+        console=Console(stderr=True),
+        transient=True,
+        disable=hidden,
+    )
 
 
 def record_table(title: str, figures: dict[str, str], width: int) -> Table:

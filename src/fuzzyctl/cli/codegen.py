@@ -15,7 +15,7 @@ from typing import Annotated
 import typer
 
 from fuzzyctl import formats
-from fuzzyctl.cli.app import FORCE_HINT, FromOpt, app, err_console, usage_errors
+from fuzzyctl.cli.app import FORCE_HINT, FromOpt, StrictOpt, app, err_console, usage_errors
 from fuzzyctl.codegen.emit import accepting, generator_of
 from fuzzyctl.kinds import targets
 
@@ -105,14 +105,7 @@ def codegen(
             "the --default choice and the quadrature bounds of smooth outputs.",
         ),
     ] = False,
-    strict: Annotated[
-        bool,
-        typer.Option(
-            "--strict",
-            help="Refuse what a strict IEC 61131-7 reading refuses: names that are reserved keywords, "
-            "an output without RANGE whose terms do not fall to 0.",
-        ),
-    ] = False,
+    strict: StrictOpt = False,
     force: Annotated[
         bool, typer.Option("--force", help="Replace the files written even when they are read-only.")
     ] = False,

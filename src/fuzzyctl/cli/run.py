@@ -11,7 +11,7 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl import formats
-from fuzzyctl.cli.app import FromOpt, app
+from fuzzyctl.cli.app import FromOpt, StrictOpt, app
 from fuzzyctl.cli.eval_dask import DaskOpt, SchedulerOpt, WorkersOpt
 
 SetOpt = Annotated[
@@ -37,14 +37,6 @@ OutOfRangeOpt = Annotated[
         "--out-of-range",
         help="An input outside its range (its RANGE, else its terms' span): warn (the result as "
         "computed, and a warning), clamp (limit it first), raise (an error) or ignore.",
-    ),
-]
-StrictOpt = Annotated[
-    bool,
-    typer.Option(
-        "--strict",
-        help="Refuse what a strict IEC 61131-7 reading refuses: an output without RANGE whose terms "
-        "do not fall to 0, names that are reserved keywords.",
     ),
 ]
 
@@ -103,10 +95,7 @@ def _fmt(v: float) -> str:
 
 @app.command("eval")
 def eval_(
-    file: Annotated[
-        Path,
-        typer.Argument(help=f"Fuzzy system ({formats.names_text(' or ', upper=True)}).", show_default=False),
-    ],
+    file: ModelArg,
     set_: SetOpt = None,
     data: Annotated[
         str | None,
@@ -276,10 +265,7 @@ def _print_outputs(title: str, result: Mapping[str, float]) -> None:
 
 @app.command()
 def explain(
-    file: Annotated[
-        Path,
-        typer.Argument(help=f"Fuzzy system ({formats.names_text(' or ', upper=True)}).", show_default=False),
-    ],
+    file: ModelArg,
     set_: SetOpt = None,
     png: Annotated[
         Path | None, typer.Option("--png", help="Also draw the accumulated output sets to a PNG file.")

@@ -11,7 +11,7 @@ from typing import Annotated
 
 import typer
 
-from fuzzyctl.cli.app import app, record_table
+from fuzzyctl.cli.app import app, record_table, stderr_progress
 
 
 @app.command("simulate")
@@ -85,17 +85,10 @@ def simulate(
 @contextmanager
 def _progress(description: str, *, hidden: bool) -> Iterator[Callable[[int, int], None]]:
     """A progress bar on stderr (none with ``hidden``); yields the loop's callback."""
-    from rich.console import Console
-    from rich.progress import BarColumn, Progress, TextColumn, TimeRemainingColumn
+    from rich.progress import TextColumn, TimeRemainingColumn
 
-    with Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        TextColumn("{task.percentage:>3.0f}%"),
-        TimeRemainingColumn(),
-        console=Console(stderr=True),
-        transient=True,
-        disable=hidden,
+    with stderr_progress(
+        TextColumn("{task.percentage:>3.0f}%"), TimeRemainingColumn(), hidden=hidden
     ) as progress:
         task = progress.add_task(description, total=1)
 

@@ -13,7 +13,7 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl import formats
-from fuzzyctl.cli.app import FromOpt, app
+from fuzzyctl.cli.app import FromOpt, app, stderr_progress
 
 WorkersOpt = Annotated[
     int | None,
@@ -296,18 +296,10 @@ def _check_tune(budget: int, workers: int | None, scheduler: str | None, data: A
 @contextmanager
 def _progress(description: str, total: int, *, hidden: bool) -> Iterator[Callable[[int, int, float], None]]:
     """A progress bar on stderr (none with ``hidden``); yields the optimiser's callback."""
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import MofNCompleteColumn, TextColumn, TimeElapsedColumn
 
-    with Progress(
-        TextColumn("[bold]{task.description}"),
-        BarColumn(),
-        MofNCompleteColumn(),
-        TextColumn("best {task.fields[best]}"),
-        TimeElapsedColumn(),
-        console=Console(stderr=True),
-        transient=True,
-        disable=hidden,
+    with stderr_progress(
+        MofNCompleteColumn(), TextColumn("best {task.fields[best]}"), TimeElapsedColumn(), hidden=hidden
     ) as progress:
         task = progress.add_task(description, total=total, best="-")
 

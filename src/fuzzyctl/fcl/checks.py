@@ -31,14 +31,17 @@ from fuzzyctl.model import (
     Param,
     PointsMF,
     Ref,
+    Rule,
     RuleBlock,
     ShapeMF,
     SingletonMF,
     SingletonsMF,
     Span,
     Term,
+    Variable,
     VarKind,
     walk_condition,
+    walk_expr,
 )
 from fuzzyctl.validation import at_spans, validate
 
@@ -151,48 +154,50 @@ def _line(span: Span | None) -> str:
     return str(span.line) if span else "?"
 
 
+def _check_block(
+    fb: FunctionBlock,
+    block: FuzzifyBlock | DefuzzifyBlock,
+    seen: dict[str, Span | None],
+    r: _Reporter,
+) -> None:
+    """What FUZZIFY and DEFUZZIFY blocks share: a declared variable of the kind the block
+    takes (5.2.2, 5.2.3), one block per variable, no term defined twice."""
+    word, takes, section, code = (
+        ("FUZZIFY", VarKind.INPUT, "5.2.2", "fuzzify-non-input")
+        if isinstance(block, FuzzifyBlock)
+        else ("DEFUZZIFY", VarKind.OUTPUT, "5.2.3", "defuzzify-non-output")
+    )
+    name = block.variable
+    var = fb.variable(name)
+    if var is None:
+        r.error(f"{word} {name}: no variable {name} is declared", block.span, "undeclared-variable")
+    elif var.kind is not takes and var.kind is not VarKind.LOCAL:
+        r.error(
+            f"{word} {name}: {name} is a {var.kind.value}; {word} takes a {takes.value} ({section})",
+            block.span,
+            code,
+        )
+    if name in seen:
+        r.error(f"second {word} block for {name}", block.span, "duplicate-block")
+    seen[name] = block.span
+    _check_terms(block.terms, name, r)
+
+
 def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
     fuzzified: dict[str, Span | None] = {}
     for f in fb.fuzzify:
         var = fb.variable(f.variable)
-        if var is None:
-            r.error(
-                f"FUZZIFY {f.variable}: no variable {f.variable} is declared", f.span, "undeclared-variable"
-            )
-        elif var.kind is VarKind.OUTPUT:
-            r.error(
-                f"FUZZIFY {f.variable}: {f.variable} is a VAR_OUTPUT; FUZZIFY takes a VAR_INPUT (5.2.2)",
-                f.span,
-                "fuzzify-non-input",
-            )
-        elif var.kind is VarKind.LOCAL:
+        if var is not None and var.kind is VarKind.LOCAL:
             r.warning(
                 f"FUZZIFY {f.variable}: {f.variable} is a local VAR; the standard fuzzifies VAR_INPUT "
                 "variables (5.2.2)",
                 f.span,
                 "fuzzify-local",
             )
-        if f.variable in fuzzified:
-            r.error(f"second FUZZIFY block for {f.variable}", f.span, "duplicate-block")
-        fuzzified[f.variable] = f.span
-        _check_terms(f.terms, f.variable, r)
+        _check_block(fb, f, fuzzified, r)
     defuzzified: dict[str, Span | None] = {}
     for d in fb.defuzzify:
-        var = fb.variable(d.variable)
-        if var is None:
-            r.error(
-                f"DEFUZZIFY {d.variable}: no variable {d.variable} is declared", d.span, "undeclared-variable"
-            )
-        elif var.kind is VarKind.INPUT:
-            r.error(
-                f"DEFUZZIFY {d.variable}: {d.variable} is a VAR_INPUT; DEFUZZIFY takes a VAR_OUTPUT (5.2.3)",
-                d.span,
-                "defuzzify-non-output",
-            )
-        if d.variable in defuzzified:
-            r.error(f"second DEFUZZIFY block for {d.variable}", d.span, "duplicate-block")
-        defuzzified[d.variable] = d.span
-        _check_terms(d.terms, d.variable, r)
+        _check_block(fb, d, defuzzified, r)
         _check_defuzzify(fb, d, r)
     for v in fb.variables:
         if v.kind is VarKind.OUTPUT and v.name not in defuzzified and not _assigned_bare(fb, v.name):
@@ -325,13 +330,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             )
         labels[rule.label] = rule.span
         for sub in walk_condition(rule.condition):
-            var = fb.variable(sub.variable)
-            if var is None:
-                r.error(
-                    f"RULE {rule.label}: undeclared variable {sub.variable}",
-                    sub.span or rule.span,
-                    "undeclared-variable",
-                )
+            if _declared(fb, rule, sub.variable, sub.span, r) is None:
                 continue
             if isinstance(sub, Is):
                 terms = _terms_of(fb, sub.variable)
@@ -349,20 +348,10 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "fuzzylite-any",
                     )
                 elif sub.term not in terms:
-                    r.error(
-                        f"RULE {rule.label}: {sub.variable} has no term {sub.term}",
-                        sub.span or rule.span,
-                        "undeclared-term",
-                        hint="its terms: " + ", ".join(sorted(terms)),
-                    )
+                    _no_term(rule, sub.variable, sub.term, terms, sub.span, r)
         for c in rule.conclusions:
-            var = fb.variable(c.variable)
+            var = _declared(fb, rule, c.variable, c.span, r)
             if var is None:
-                r.error(
-                    f"RULE {rule.label}: undeclared variable {c.variable}",
-                    c.span or rule.span,
-                    "undeclared-variable",
-                )
                 continue
             if var.kind is VarKind.INPUT:
                 r.error(
@@ -380,12 +369,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "undeclared-term",
                     )
                 elif terms is not None and c.term not in terms:
-                    r.error(
-                        f"RULE {rule.label}: {c.variable} has no term {c.term}",
-                        c.span or rule.span,
-                        "undeclared-term",
-                        hint="its terms: " + ", ".join(sorted(terms)),
-                    )
+                    _no_term(rule, c.variable, c.term, terms, c.span, r)
             w = c.weight
             if isinstance(w, Ref):
                 wvar = fb.variable(w.name)
@@ -408,6 +392,25 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         "weight-out-of-range",
                     )
             # a numeric weight: fuzzyctl.validation (one validation for every reader)
+
+
+def _declared(fb: FunctionBlock, rule: Rule, name: str, span: Span | None, r: _Reporter) -> Variable | None:
+    """The variable ``name`` a rule uses, or None after reporting it undeclared."""
+    var = fb.variable(name)
+    if var is None:
+        r.error(f"RULE {rule.label}: undeclared variable {name}", span or rule.span, "undeclared-variable")
+    return var
+
+
+def _no_term(
+    rule: Rule, variable: str, term: str, terms: Iterable[str], span: Span | None, r: _Reporter
+) -> None:
+    r.error(
+        f"RULE {rule.label}: {variable} has no term {term}",
+        span or rule.span,
+        "undeclared-term",
+        hint="its terms: " + ", ".join(sorted(terms)),
+    )
 
 
 def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
@@ -457,7 +460,7 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
         for block in term_blocks(fb):
             for t in block.terms:
                 if isinstance(t.mf, FunctionMF):
-                    for name in sorted(_names(t.mf.expr)):
+                    for name in sorted({n.name for n in walk_expr(t.mf.expr) if isinstance(n, Name)}):
                         if fb.variable(name) is None and name not in ("x", "pi", "e"):
                             r.error(
                                 f"TERM {t.name}: FUNCTION uses undeclared variable {name}",
@@ -465,18 +468,6 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
                                 "undeclared-variable",
                             )
     yield from r.found
-
-
-def _names(e: object) -> set[str]:
-    if isinstance(e, Name):
-        return {e.name}
-    out: set[str] = set()
-    for attr in ("operand", "left", "right"):
-        if hasattr(e, attr):
-            out |= _names(getattr(e, attr))
-    for a in getattr(e, "args", ()):
-        out |= _names(a)
-    return out
 
 
 def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:

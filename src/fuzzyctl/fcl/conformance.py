@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from enum import IntEnum
 from typing import Any
 
-from fuzzyctl.fcl.checks import is_singleton
+from fuzzyctl.fcl.checks import is_singleton, uses_operator
 from fuzzyctl.model import (
     And,
     Condition,
@@ -122,9 +122,9 @@ def _flat_features(c: Condition | None, leaves: tuple[Is, ...], outputs: set[str
 
 def _nested_features(c: Condition | None, outputs: set[str], add: Any) -> None:
     ext, open_ = Level.EXTENSION, Level.OPEN
-    if _uses(c, Or):
+    if uses_operator(c, Or):
         add(ext, "conditional aggregation", "operator OR in a condition")
-    if _uses(c, Not) or any(s.negated for s in walk_condition(c) if not isinstance(s, Degree)):
+    if uses_operator(c, Not) or any(s.negated for s in walk_condition(c) if not isinstance(s, Degree)):
         add(ext, "conditional aggregation", "operator NOT")
     if depth(c) > 0:
         add(ext, "parentheses", "( ) in conditions")
@@ -135,16 +135,6 @@ def _nested_features(c: Condition | None, outputs: set[str], add: Any) -> None:
             add(open_, "condition", "hedges (fuzzylite)")
         if s.variable in outputs:
             add(open_, "condition", "output variable in a condition (chained rules)")
-
-
-def _uses(c: Condition | None, kind: type) -> bool:
-    if c is None or not isinstance(c, And | Or | Not):
-        return False
-    if isinstance(c, kind):
-        return True
-    if isinstance(c, Not):
-        return _uses(c.operand, kind)
-    return any(_uses(o, kind) for o in c.operands)
 
 
 def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Feature]:

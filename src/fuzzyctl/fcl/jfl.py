@@ -31,6 +31,7 @@ from fuzzyctl.model import (
     FunctionBlock,
     FunctionMF,
     FuzzifyBlock,
+    Name,
     PointsMF,
     Ref,
     ShapeMF,
@@ -38,6 +39,7 @@ from fuzzyctl.model import (
     SingletonsMF,
     Span,
     walk_condition,
+    walk_expr,
 )
 
 __all__ = ["check_jfuzzylogic"]
@@ -196,7 +198,8 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
             if isinstance(t.mf, ShapeMF) and t.mf.height != 1.0:
                 found.add(rejects, f"term {t.name}: its shapes have no height parameter", t.span)
             if isinstance(t.mf, FunctionMF):
-                for call in sorted(_calls(t.mf.expr) - _FUNCTIONS):
+                calls = {n.function.upper() for n in walk_expr(t.mf.expr) if isinstance(n, Call)}
+                for call in sorted(calls - _FUNCTIONS):
                     found.add(rejects, f"term {t.name}: it has no function {call.lower()}", t.span)
         defined.add(block.variable)
     for rb in fb.rule_blocks:
@@ -252,30 +255,5 @@ def _refs(mf: object) -> list[str]:
     if isinstance(mf, ShapeMF):
         return [p.name for p in (*mf.params, mf.height) if isinstance(p, Ref)]
     if isinstance(mf, FunctionMF):
-        return sorted(_expr_names(mf.expr) - {"x", "pi", "e"})
+        return sorted({n.name for n in walk_expr(mf.expr) if isinstance(n, Name)} - {"x", "pi", "e"})
     return []
-
-
-def _expr_names(e: object) -> set[str]:
-    name = getattr(e, "name", None)
-    if isinstance(name, str) and not hasattr(e, "args"):
-        return {name}
-    out: set[str] = set()
-    for attr in ("operand", "left", "right"):
-        if hasattr(e, attr):
-            out |= _expr_names(getattr(e, attr))
-    for a in getattr(e, "args", ()):
-        out |= _expr_names(a)
-    return out
-
-
-def _calls(e: object) -> set[str]:
-    out: set[str] = set()
-    if isinstance(e, Call):
-        out.add(e.function.upper())
-    for attr in ("operand", "left", "right"):
-        if hasattr(e, attr):
-            out |= _calls(getattr(e, attr))
-    for a in getattr(e, "args", ()):
-        out |= _calls(a)
-    return out

@@ -396,30 +396,31 @@ class _Builder(Transformer[Token, Any]):
                 items[c.key] = c
         return items
 
-    def fuzzify_block(self, children: list[Any]) -> FuzzifyBlock:
+    def _terms_and_range(
+        self, children: list[Any], block: str
+    ) -> tuple[str, Span | None, tuple[Term, ...], Range | None]:
+        """The name, span, terms and (one) RANGE of a FUZZIFY or DEFUZZIFY block."""
         name: Token = children[1]
-        span = _outer(children)
         terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Term)]))
         ranges = [c for c in children if isinstance(c, Range)]
         if len(ranges) > 1:
-            self.state.error("RANGE given twice in this FUZZIFY block", ranges[1].span, "duplicate-item")
-        return FuzzifyBlock(str(name), terms, ranges[0] if ranges else None, span)
+            self.state.error(f"RANGE given twice in this {block} block", ranges[1].span, "duplicate-item")
+        return str(name), _outer(children), terms, ranges[0] if ranges else None
+
+    def fuzzify_block(self, children: list[Any]) -> FuzzifyBlock:
+        name, span, terms, rng = self._terms_and_range(children, "FUZZIFY")
+        return FuzzifyBlock(name, terms, rng, span)
 
     def defuzzify_block(self, children: list[Any]) -> DefuzzifyBlock:
-        name: Token = children[1]
-        span = _outer(children)
-        terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Term)]))
-        ranges = [c for c in children if isinstance(c, Range)]
-        if len(ranges) > 1:
-            self.state.error("RANGE given twice in this DEFUZZIFY block", ranges[1].span, "duplicate-item")
+        name, span, terms, rng = self._terms_and_range(children, "DEFUZZIFY")
         items = self._items(children, "DEFUZZIFY block", span)
         method = items.get("method")
         default = items.get("default")
         accu = items.get("accu")
         return DefuzzifyBlock(
-            str(name),
+            name,
             terms,
-            ranges[0] if ranges else None,
+            rng,
             method.value if method else None,
             default.value if default else None,
             accu.value if accu else None,

@@ -35,26 +35,25 @@ def reserved_names(doc: Document) -> Iterator[tuple[str, str, str, Span | None]]
     keyword: function blocks, variables, terms, rule blocks and rule labels (``what`` reads
     ``"term MIN of temp"``)."""
 
-    def hit(name: str | None) -> str | None:
-        return TABLE7.get(name.upper()) if name else None
+    for what, name, span in _identifiers(doc):
+        if name and (kw := TABLE7.get(name.upper())):
+            yield what, name, kw, span
 
+
+def _identifiers(doc: Document) -> Iterator[tuple[str, str | None, Span | None]]:
+    """``(what, name, span)`` for every identifier of ``doc`` (``name`` ``None``: not given)."""
     for fb in doc.blocks:
-        if kw := hit(fb.name):
-            yield f"function block {fb.name}", str(fb.name), kw, fb.span
+        yield f"function block {fb.name}", fb.name, fb.span
         for v in fb.variables:
-            if kw := hit(v.name):
-                yield f"variable {v.name}", v.name, kw, v.span
+            yield f"variable {v.name}", v.name, v.span
         blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
         for block in blocks:
             for t in block.terms:
-                if kw := hit(t.name):
-                    yield f"term {t.name} of {block.variable}", t.name, kw, t.span
+                yield f"term {t.name} of {block.variable}", t.name, t.span
         for rb in fb.rule_blocks:
-            if kw := hit(rb.name):
-                yield f"rule block {rb.name}", str(rb.name), kw, rb.span
+            yield f"rule block {rb.name}", rb.name, rb.span
             for rule in rb.rules:
-                if kw := hit(rule.label):
-                    yield f"rule label {rule.label}", rule.label, kw, rule.span
+                yield f"rule label {rule.label}", rule.label, rule.span
 
 
 def check_reserved_words(doc: Document, file: str | None = None, strict: bool = False) -> list[Diagnostic]:

@@ -113,6 +113,17 @@ def plan_reads(points: Sequence[ModbusPoint], max_gap: int = 8) -> list[tuple[Sp
     return plan
 
 
+def decode_span(
+    out: list[float], points: Sequence[ModbusPoint], members: Sequence[int], span: Span, regs: Sequence[int]
+) -> None:
+    """Decodes the points ``members`` (indices into ``points`` and ``out``) from the
+    registers ``regs`` that one read of ``span`` returned."""
+    for i in members:
+        p = points[i]
+        offset = p.address - span.start
+        out[i] = p.decode(regs[offset : offset + p.width])
+
+
 def plan_writes(points: Sequence[ModbusPoint], values: Sequence[float]) -> list[tuple[str, int, list[int]]]:
     """Registers to write, merged into contiguous runs per table: (table, start, registers)."""
     cells: dict[tuple[str, int], int] = {}
@@ -204,9 +215,7 @@ class ModbusClient(Connector):
             regs = resp.registers
             if len(regs) < span.count:
                 raise LinkError(f"{self.endpoint()}: short answer to a read of {span.count} registers")
-            for i in members:
-                p = pts[i]
-                out[i] = p.decode(regs[p.address - span.start : p.address - span.start + p.width])
+            decode_span(out, pts, members, span, regs)
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
@@ -328,9 +337,7 @@ class ModbusServer(Connector):
         for span, members in plan_reads(pts, 0):
             fc = 3 if span.table == "holding" else 4
             regs = await server.async_getValues(0, fc, span.start, span.count)
-            for i in members:
-                p = pts[i]
-                out[i] = p.decode(regs[p.address - span.start : p.address - span.start + p.width])
+            decode_span(out, pts, members, span, regs)
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:

@@ -34,7 +34,7 @@ from fuzzyctl.blocks.task import CycleContext, CycleRecord, CyclicTask
 from fuzzyctl.diagnostics import FuzzyctlError, InputError
 from fuzzyctl.runtime.adapters import Adapter
 from fuzzyctl.runtime.config import InstanceConfig
-from fuzzyctl.runtime.events import EventLog
+from fuzzyctl.runtime.events import EventLog, Level
 from fuzzyctl.runtime.kb import KnowledgeBaseSource, PreparedKB
 from fuzzyctl.runtime.links import InCell, Link, OutCell
 
@@ -173,6 +173,10 @@ class Instance:
 
     # ------------------------------------------------------------------ bindings
 
+    def _event(self, kind: str, message: str, *, level: Level = "info", **data: Any) -> None:
+        """Logs an event of this instance: its name heads the message and tags the event."""
+        self.events.emit(kind, f"{self.name}: {message}", level=level, instance=self.name, **data)
+
     def bind_input(self, name: str, link: Link, cell: InCell) -> None:
         key = self.adapter.input_key(name)
         if any(b.key == key for b in self.inputs):
@@ -230,10 +234,9 @@ class Instance:
             self._start(now)
         if adapter.before_cycle():
             self._rekey()
-            self.events.emit(
+            self._event(
                 "download-applied",
-                f"{self.name}: knowledge base switched by a rising edge of REFRESH",
-                instance=self.name,
+                "knowledge base switched by a rising edge of REFRESH",
                 sha256=adapter.kb.source.sha256,
             )
         problems = NO_PROBLEMS
@@ -297,11 +300,10 @@ class Instance:
     def _start(self, now: float) -> None:
         self._started = True
         self.state_since = now
-        self.events.emit(
+        self._event(
             "safe-enter",
-            f"{self.name}: outputs at their safe values until every input has been read",
+            "outputs at their safe values until every input has been read",
             level="warning",
-            instance=self.name,
             reason="startup",
         )
 
@@ -317,11 +319,10 @@ class Instance:
 
     def _input_validity(self, b: InputBinding, v: float, valid: bool) -> None:
         b.valid = valid
-        self.events.emit(
+        self._event(
             "input-valid" if valid else "input-invalid",
-            f"{self.name}: input {b.name} = {v!r}" + ("" if valid else ", running on its last good value"),
+            f"input {b.name} = {v!r}" + ("" if valid else ", running on its last good value"),
             level="info" if valid else "warning",
-            instance=self.name,
             input=b.name,
             value=None if math.isnan(v) else v,
         )
@@ -332,15 +333,12 @@ class Instance:
         self.adapter.fault = "block"
         if message != self.error:
             self.error = message
-            self.events.emit(
-                "error", f"{self.name}: {message}; outputs at safe values", level="error", instance=self.name
-            )
+            self._event("error", f"{message}; outputs at safe values", level="error")
         if self.state is not SafetyState.SAFE:
-            self.events.emit(
+            self._event(
                 "safe-enter",
-                f"{self.name}: the block cannot compute; outputs at their safe values",
+                "the block cannot compute; outputs at their safe values",
                 level="error",
-                instance=self.name,
                 reason="block error",
                 error=message,
                 safe_values={o.name: o.safe for o in self.outputs},
@@ -349,13 +347,12 @@ class Instance:
         self._write_outputs()
 
     def _block_cleared(self, now: float) -> None:
-        self.events.emit("error-cleared", f"{self.name}: the block runs again", instance=self.name)
+        self._event("error-cleared", "the block runs again")
         self.error = None
         if self.io_state is not SafetyState.SAFE:
-            self.events.emit(
+            self._event(
                 "safe-exit",
-                f"{self.name}: the block computes again; outputs from the block",
-                instance=self.name,
+                "the block computes again; outputs from the block",
                 after=round(now - self.state_since, 6),
             )
             self.state, self.state_since = self.io_state, now
@@ -385,11 +382,10 @@ class Instance:
         try:
             self._set_param(p.key, v, source=f"field:{p.link.name}")
         except InputError as exc:  # the field wrote a value the block refuses: keep the old one
-            self.events.emit(
+            self._event(
                 "parameter-refused",
-                f"{self.name}: {exc} (field:{p.link.name}); {p.key} stays {current}",
+                f"{exc} (field:{p.link.name}); {p.key} stays {current}",
                 level="warning",
-                instance=self.name,
                 parameter=p.key,
                 value=v,
                 source=f"field:{p.link.name}",
@@ -405,21 +401,19 @@ class Instance:
             if state is not SafetyState.RUN:
                 kind = "safe-exit" if state is SafetyState.SAFE else "hold-end"
                 still = "; the block still cannot compute" if self.error is not None else "; running normally"
-                self.events.emit(
+                self._event(
                     kind,
-                    f"{self.name}: every link up and every input good{still}",
-                    instance=self.name,
+                    f"every link up and every input good{still}",
                     after=round(now - self.io_since, 6),
                 )
                 self._set_io(SafetyState.RUN, now)
             return
         if state is SafetyState.RUN:
             self._set_io(SafetyState.HOLD, now)
-            self.events.emit(
+            self._event(
                 "hold-start",
-                f"{self.name}: {problems.text()}; running on the last good inputs for {hold:g} s",
+                f"{problems.text()}; running on the last good inputs for {hold:g} s",
                 level="warning",
-                instance=self.name,
                 links=problems.links + problems.late,
                 inputs=problems.inputs,
                 hold_time=hold,
@@ -437,11 +431,10 @@ class Instance:
         """Enter the I/O state ``safe`` (``safe-enter`` with the safe values); the cycle
         (or :meth:`stop_safe`) then sets the fault indication and writes the outputs."""
         self._set_io(SafetyState.SAFE, now)
-        self.events.emit(
+        self._event(
             "safe-enter",
-            f"{self.name}: {why}; outputs at their safe values",
+            f"{why}; outputs at their safe values",
             level="error",
-            instance=self.name,
             reason=reason,
             safe_values={o.name: o.safe for o in self.outputs},
             **data,
@@ -489,11 +482,10 @@ class Instance:
             count = self.task.stats.overruns - self._overruns_logged
             self._overruns_logged = self.task.stats.overruns
             self._overrun_logged_at = now
-            self.events.emit(
+            self._event(
                 "overrun",
-                f"{self.name}: {count} cycle(s) overran the {self.config.period:g} s period",
+                f"{count} cycle(s) overran the {self.config.period:g} s period",
                 level="warning",
-                instance=self.name,
                 count=count,
                 total=self.task.stats.overruns,
             )
@@ -503,10 +495,9 @@ class Instance:
     def _set_param(self, key: str, value: float, source: str) -> None:
         old = self.adapter.get_param(key)
         self.adapter.set_param(key, value)
-        self.events.emit(
+        self._event(
             "parameter",
-            f"{self.name}: {key} {old} -> {self.adapter.get_param(key)} ({source})",
-            instance=self.name,
+            f"{key} {old} -> {self.adapter.get_param(key)} ({source})",
             parameter=key,
             old=old,
             new=self.adapter.get_param(key),
@@ -536,12 +527,9 @@ class Instance:
         with self.lock:
             key = self.adapter.input_key(name)
             self.adapter.force(key, value)
-            self.events.emit(
+            self._event(
                 "force",
-                f"{self.name}: {key} "
-                + ("released" if value is None else f"forced to {value:g}")
-                + f" ({source})",
-                instance=self.name,
+                f"{key} " + ("released" if value is None else f"forced to {value:g}") + f" ({source})",
                 input=key,
                 value=value,
                 source=source,
@@ -554,10 +542,9 @@ class Instance:
             if not key.startswith("OUT"):
                 raise InputError(f"{name!r} is not an output with a manual value")
             self.adapter.set_manual(key, value)
-            self.events.emit(
+            self._event(
                 "parameter",
-                f"{self.name}: O{key[3:]}_MAN = {value:g} ({source})",
-                instance=self.name,
+                f"O{key[3:]}_MAN = {value:g} ({source})",
                 parameter=f"O{key[3:]}_MAN",
                 new=value,
                 source=source,
@@ -566,10 +553,9 @@ class Instance:
     def set_mode(self, auto: bool, source: str = "api") -> None:
         with self.lock:
             self.adapter.set_mode(auto)
-            self.events.emit(
+            self._event(
                 "parameter",
-                f"{self.name}: MAN_AUTO = {int(auto)} ({source})",
-                instance=self.name,
+                f"MAN_AUTO = {int(auto)} ({source})",
                 parameter="MAN_AUTO",
                 new=int(auto),
                 source=source,
@@ -613,19 +599,17 @@ class Instance:
                 procedure = "START_STOP = 0, transfer, START_STOP = 16#FFFF between two cycles"
             else:
                 procedure = "new constants, REFRESH raised for the next call"
-            self.events.emit(
+            self._event(
                 "download",
-                f"{self.name}: knowledge base from {kb.source.origin} ({kb.source.format}): {procedure}",
-                instance=self.name,
+                f"knowledge base from {kb.source.origin} ({kb.source.format}): {procedure}",
                 procedure=procedure,
                 warnings=[d.message for d in kb.warnings],
                 details={k: v for k, v in info.items() if k != "time"},
             )
             if style == "siemens":
-                self.events.emit(
+                self._event(
                     "download-applied",
-                    f"{self.name}: knowledge base switched",
-                    instance=self.name,
+                    "knowledge base switched",
                     sha256=kb.source.sha256,
                 )
             return {**info, "procedure": procedure}

@@ -24,10 +24,11 @@ import contextlib
 import math
 import time
 from dataclasses import dataclass, field
+from typing import Any
 
 from fuzzyctl.io.base import Connector, LinkError, LinkState, Point, bounded
 from fuzzyctl.runtime.config import ConnectionConfig
-from fuzzyctl.runtime.events import EventLog
+from fuzzyctl.runtime.events import EventLog, Level
 
 __all__ = ["CLOSE_GRACE", "InCell", "Link", "OutCell"]
 
@@ -98,6 +99,10 @@ class Link:
         """The I/O loop's time by which the stop write must be done; set by the runtime
         before it sets the stop event (None: ``stop_timeout`` from when the loop ends).
         Once set, exchanges no longer write outputs: the stop write is the last one."""
+
+    def _event(self, kind: str, message: str, *, level: Level = "info", **data: Any) -> None:
+        """Logs an event of this link: its name heads the message and tags the event."""
+        self.events.emit(kind, f"{self.name}: {message}", level=level, link=self.name, **data)
 
     # --- bindings (before start)
     def input(self, point: Point) -> InCell:
@@ -216,11 +221,10 @@ class Link:
                     self.counters.failures += 1
                     self.counters.last_error = str(exc)
                     await self.connector.close()
-                    self.events.emit(
+                    self._event(
                         "link-retry",
-                        f"{self.name}: {describe(exc)}; next attempt in {delay:.3g} s",
+                        f"{describe(exc)}; next attempt in {delay:.3g} s",
                         level="warning",
-                        link=self.name,
                         attempt=attempt,
                         delay=delay,
                         error=describe(exc),
@@ -231,10 +235,9 @@ class Link:
                 self.counters.connects += 1
                 self.counters.last_error = None
                 self._set_state(LinkState.UP)
-                self.events.emit(
+                self._event(
                     "link-up",
-                    f"{self.name}: connected to {self.connector.endpoint()}",
-                    link=self.name,
+                    f"connected to {self.connector.endpoint()}",
                     endpoint=self.connector.endpoint(),
                     attempts=attempt,
                 )
@@ -247,11 +250,10 @@ class Link:
                 self.counters.failures += 1
                 self.counters.last_error = describe(exc)
                 self._set_state(LinkState.DOWN)
-                self.events.emit(
+                self._event(
                     "link-lost",
-                    f"{self.name}: {describe(exc)}",
+                    describe(exc),
                     level="error",
-                    link=self.name,
                     error=describe(exc),
                 )
                 await self.connector.close()
@@ -283,11 +285,10 @@ class Link:
             return await self.write_outputs()
 
         if timeout == 0:
-            self.events.emit(
+            self._event(
                 "stop-write",
-                f"{self.name}: at stop nothing written (stop_timeout = 0): the field keeps the last values",
+                "at stop nothing written (stop_timeout = 0): the field keeps the last values",
                 level="warning",
-                link=self.name,
                 written={},
             )
             return
@@ -300,10 +301,9 @@ class Link:
             self.stop_failed(describe(exc))
             return
         shown = ", ".join(f"{k} = {v:g}" for k, v in written.items())
-        self.events.emit(
+        self._event(
             "stop-write",
-            f"{self.name}: at stop wrote {shown or 'nothing (no output has a value yet)'}",
-            link=self.name,
+            f"at stop wrote {shown or 'nothing (no output has a value yet)'}",
             written=written,
             seconds=round(loop.time() - t0, 6),
         )
@@ -327,11 +327,10 @@ class Link:
 
     def stop_failed(self, why: str) -> None:
         """Log that the stop write did not reach the field (``stop-write``, level error)."""
-        self.events.emit(
+        self._event(
             "stop-write",
-            f"{self.name}: at stop the safe values were NOT written: {why}",
+            f"at stop the safe values were NOT written: {why}",
             level="error",
-            link=self.name,
             written={},
             error=why,
         )

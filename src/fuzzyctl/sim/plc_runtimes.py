@@ -18,6 +18,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import replace
+from typing import TypeVar
 
 from fuzzyctl.diagnostics import InputError
 from fuzzyctl.model import (
@@ -32,6 +33,8 @@ from fuzzyctl.model import (
 )
 
 WORD_MAX = 32767
+
+_Block = TypeVar("_Block", FuzzifyBlock, DefuzzifyBlock)
 
 
 def _main(model: Document | FunctionBlock, block: str | None) -> FunctionBlock:
@@ -117,27 +120,15 @@ def scale_model(fb: FunctionBlock, factors: Mapping[str, float]) -> FunctionBloc
     def rng(r: Range | None, f: float) -> Range | None:
         return None if r is None else replace(r, low=r.low * f, high=r.high * f)
 
-    fuzzify = tuple(
-        replace(
-            b,
-            terms=tuple(_scaled_term(t, factors[b.variable]) for t in b.terms),
-            range=rng(b.range, factors[b.variable]),
-        )
-        if b.variable in factors
-        else b
-        for b in fb.fuzzify
+    def scaled(b: _Block) -> _Block:
+        if b.variable not in factors:
+            return b
+        f = factors[b.variable]
+        return replace(b, terms=tuple(_scaled_term(t, f) for t in b.terms), range=rng(b.range, f))
+
+    return replace(
+        fb, fuzzify=tuple(scaled(b) for b in fb.fuzzify), defuzzify=tuple(scaled(b) for b in fb.defuzzify)
     )
-    defuzzify = tuple(
-        replace(
-            b,
-            terms=tuple(_scaled_term(t, factors[b.variable]) for t in b.terms),
-            range=rng(b.range, factors[b.variable]),
-        )
-        if b.variable in factors
-        else b
-        for b in fb.defuzzify
-    )
-    return replace(fb, fuzzify=fuzzify, defuzzify=defuzzify)
 
 
 class XfuzRuntime:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 from fuzzyctl.files import write_atomic
 from fuzzyctl.sim.loop import Trace
@@ -46,8 +47,6 @@ def save_png(
 ) -> Path:
     """Draw the panels one above the other (``dashed``: e.g. the setpoints) and write a PNG
     atomically."""
-    import io
-
     import matplotlib
 
     matplotlib.use("Agg")
@@ -66,6 +65,15 @@ def save_png(
     axes[-1, 0].set_xlabel("time [s]")
     if title:
         fig.suptitle(title, fontsize=11)
+    return write_png(fig, path)
+
+
+def write_png(fig: Any, path: Path) -> Path:
+    """Lay out a matplotlib figure, write it as a PNG (110 dpi) atomically and close it."""
+    import io
+
+    import matplotlib.pyplot as plt
+
     fig.tight_layout()
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=110)

@@ -260,7 +260,41 @@ class PIDLoop(Structure):
         return self.part.names()
 
 
-class PreControl(Structure):
+class _FuzzyPid(Structure):
+    """A PID block with a fuzzy block beside it (Annex B.1 and B.2): the parts, their
+    internals, the reset and the one drive they share."""
+
+    def __init__(
+        self,
+        pid: PID,
+        fuzzy: FuzzyRuntime,
+        inputs: Mapping[str, ExprLike],
+        setpoint: ExprLike,
+        measurement: ExprLike,
+        drive: str,
+    ) -> None:
+        super().__init__()
+        self.pid_part = _PidPart(pid, setpoint, measurement)
+        self.part = _FuzzyPart(fuzzy, inputs, "controller")
+        self.drives = (drive,)
+
+    def _drive(self, values: Mapping[str, float], out: Mapping[str, float], u: float) -> dict[str, float]:
+        """Records this cycle's internals and returns the drive command ``u``."""
+        self.internals = {}
+        self.part.record(self.internals, values, out)
+        self.pid_part.record(self.internals)
+        return {self.drives[0]: u}
+
+    def reset(self) -> None:
+        self.part.reset()
+        self.pid_part.reset()
+        self.internals = {}
+
+    def internal_names(self) -> tuple[str, ...]:
+        return (*self.part.names(), *self.pid_part.names())
+
+
+class PreControl(_FuzzyPid):
     """Annex B.1: ``drive = sat(PID + gain * correction)``; the corrective signal enters the
     PID block as its feedforward, before the limits, so the PID's anti-windup sees the sum."""
 
@@ -278,30 +312,16 @@ class PreControl(Structure):
         correction: str,
         gain: float = 1.0,
     ) -> None:
-        super().__init__()
-        self.pid_part = _PidPart(pid, setpoint, measurement)
-        self.part = _FuzzyPart(fuzzy, inputs, "controller")
+        super().__init__(pid, fuzzy, inputs, setpoint, measurement, drive)
         _check_output(fuzzy, correction, "controller.correction")
-        self.correction, self.gain, self.drives = correction, gain, (drive,)
+        self.correction, self.gain = correction, gain
 
     def step(self, signals: Mapping[str, float], dt: float) -> dict[str, float]:
         values, out = self.part.evaluate(signals, dt)
-        u = self.pid_part.update(signals, dt, self.gain * out[self.correction])
-        self.internals = {}
-        self.part.record(self.internals, values, out)
-        self.pid_part.record(self.internals)
-        return {self.drives[0]: u}
-
-    def reset(self) -> None:
-        self.part.reset()
-        self.pid_part.reset()
-        self.internals = {}
-
-    def internal_names(self) -> tuple[str, ...]:
-        return (*self.part.names(), *self.pid_part.names())
+        return self._drive(values, out, self.pid_part.update(signals, dt, self.gain * out[self.correction]))
 
 
-class GainScheduledPID(Structure):
+class GainScheduledPID(_FuzzyPid):
     """Annex B.2: each cycle the fuzzy block sets some of the PID's parameters (``gains``
     maps ``kp``/``ti``/``td`` to fuzzy outputs), as values (``mode="absolute"``) or as factors
     of the PID's nominal values (``mode="factor"``); changes are bumpless
@@ -321,7 +341,6 @@ class GainScheduledPID(Structure):
         gains: Mapping[str, str],
         mode: str = "factor",
     ) -> None:
-        super().__init__()
         if mode not in ("absolute", "factor"):
             raise InputError(f"controller.mode must be 'absolute' or 'factor', got {mode!r}")
         for param_name, output in gains.items():
@@ -330,9 +349,8 @@ class GainScheduledPID(Structure):
             _check_output(fuzzy, output, f"controller.gains.{param_name}")
         if not gains:
             raise InputError("controller.gains: adapt at least one of kp, ti, td")
-        self.pid_part = _PidPart(pid, setpoint, measurement)
-        self.part = _FuzzyPart(fuzzy, inputs, "controller")
-        self.gains, self.mode, self.drives = dict(gains), mode, (drive,)
+        super().__init__(pid, fuzzy, inputs, setpoint, measurement, drive)
+        self.gains, self.mode = dict(gains), mode
         self.nominal = {"kp": pid.kp, "ti": pid.ti, "td": pid.td}
 
     def step(self, signals: Mapping[str, float], dt: float) -> dict[str, float]:
@@ -347,17 +365,8 @@ class GainScheduledPID(Structure):
             raise InputError(
                 f"controller.gains: the fuzzy block set an invalid PID parameter: {exc}"
             ) from None
-        u = self.pid_part.update(signals, dt)
-        self.internals = {}
-        self.part.record(self.internals, values, out)
-        self.pid_part.record(self.internals)
-        return {self.drives[0]: u}
+        return self._drive(values, out, self.pid_part.update(signals, dt))
 
     def reset(self) -> None:
-        self.part.reset()
         self.pid_part.pid.set_gains(**self.nominal)
-        self.pid_part.reset()
-        self.internals = {}
-
-    def internal_names(self) -> tuple[str, ...]:
-        return (*self.part.names(), *self.pid_part.names())
+        super().reset()

@@ -33,6 +33,7 @@ import math
 import warnings
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any
 
@@ -432,15 +433,11 @@ def _mamdani(
         start = z[idx]
     names = _OUT_NAMES.get(k, tuple(f"o{j + 1}" for j in range(k)))
     terms = [Term(names[j], SingletonMF(_sig(float(start[j])))) for j in range(k)]
-    fb2 = _assemble(
-        fb.name or "learned",
-        variables,
-        fuzz,
-        antecedents,
-        output,
-        out_range,
-        and_op,
-        0,
+    # Both passes build the same rules on the same inputs; only the conclusions differ.
+    assemble = partial(
+        _assemble, fb.name or "learned", variables, fuzz, antecedents, output, out_range, and_op, 0
+    )
+    fb2 = assemble(
         [names[a] for a in assign],
         terms,
         "SUM" if plc else "MAX",  # the sum the PLC blocks compute, as the gradient takes it
@@ -455,15 +452,7 @@ def _mamdani(
     order = np.argsort(pos, kind="stable")
     rename = {names[int(j)]: names[r] for r, j in enumerate(order)}
     terms = [Term(names[r], SingletonMF(_sig(float(pos[int(j)])))) for r, j in enumerate(order)]
-    fb3 = _assemble(
-        fb.name or "learned",
-        variables,
-        fuzz,
-        antecedents,
-        output,
-        out_range,
-        and_op,
-        0,
+    fb3 = assemble(
         [rename[names[a]] for a in assign],
         terms,
         # ACCU NSUM: the IEC sum the Siemens block computes; under CoGS its normalisation

@@ -71,31 +71,30 @@ class Evaluator:
         if self.progress is not None:
             self.progress(self.evaluations, self.budget, self.best_cost)
 
-    def costs(self, cands: Sequence[Arr]) -> list[float]:
+    def _batch(self, method: str, cands: Sequence[Arr]) -> list[list[Any]]:
+        """``method`` of every task of every candidate in one batch, the parts of each
+        candidate together (in the order of ``cands``)."""
         if self.evaluations and len(cands) > self.remaining():
             raise _Stop
         keys = self.problem.task_keys()
         items = [(np.asarray(c, dtype=np.float64), k) for c in cands for k in keys]
-        parts = self.execu.map("task", items)
-        out = []
+        parts = self.execu.map(method, items)
         m = len(keys)
-        for i, c in enumerate(cands):
-            cost = float(self.problem.combine(parts[i * m : (i + 1) * m]))
+        return [parts[i * m : (i + 1) * m] for i in range(len(cands))]
+
+    def costs(self, cands: Sequence[Arr]) -> list[float]:
+        out = []
+        for c, parts in zip(cands, self._batch("task", cands), strict=True):
+            cost = float(self.problem.combine(parts))
             self.record(np.asarray(c), cost)
             out.append(cost)
         return out
 
     def residuals(self, cands: Sequence[Arr]) -> list[Arr]:
         """Residual vectors (data problems), each counted as one evaluation."""
-        if self.evaluations and len(cands) > self.remaining():
-            raise _Stop
-        keys = self.problem.task_keys()
-        items = [(np.asarray(c, dtype=np.float64), k) for c in cands for k in keys]
-        parts = self.execu.map("residuals", items)
         out = []
-        m = len(keys)
-        for i, c in enumerate(cands):
-            r = np.concatenate(parts[i * m : (i + 1) * m])
+        for c, parts in zip(cands, self._batch("residuals", cands), strict=True):
+            r = np.concatenate(parts)
             self.record(np.asarray(c), _loss(self.problem, r))
             out.append(r)
         return out

@@ -7,7 +7,6 @@ interactive, plotly.js embedded once so that the page works offline)."""
 from __future__ import annotations
 
 import html
-import io
 import json
 import math
 from collections.abc import Sequence
@@ -19,6 +18,7 @@ import numpy as np
 from fuzzyctl.files import write_atomic
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
+from fuzzyctl.sim.plot import write_png
 
 if TYPE_CHECKING:
     from fuzzyctl.tune.api import TuneResult
@@ -61,12 +61,7 @@ def _png(path: Path, draw: Any, size: tuple[float, float]) -> Path:
 
     fig = plt.figure(figsize=size)
     draw(fig)
-    fig.tight_layout()
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=110)
-    plt.close(fig)
-    write_atomic(path, buf.getvalue())
-    return path
+    return write_png(fig, path)
 
 
 # --------------------------------------------------------------------------- text

@@ -87,6 +87,19 @@ def _check_db(db: object) -> Info | None:
     return None
 
 
+def _refusal(db: FuzzyDataBlock, number: int, count: int) -> Info | None:
+    """Why a FUZZY_AI/FUZZY_AO call does nothing (in the order the blocks check): the data
+    block, a channel ``number`` outside 1..``count``, or a stopped block (START_STOP = 0)."""
+    bad = _check_db(db)
+    if bad is not None:
+        return bad
+    if not 1 <= number <= count:
+        return Info.BAD_NUMBER
+    if db.START_STOP == 0:
+        return Info.DISABLED
+    return None
+
+
 def _bipolar_warning(what: str, number: int, x_min: float, x_max: float) -> str | None:
     if x_min == -x_max:
         return None
@@ -115,13 +128,9 @@ def fuzzy_ai(
     """FUZZY_AI: normalise the analog input word ``ai_value`` (the value read at AI_ADR)
     and write it to input ``input_nr`` of ``fuzzy_db``.  THERM_EL takes precedence over
     BIPOLAR (the manual lists THERM_EL = TRUE only with BIPOLAR = FALSE)."""
-    bad = _check_db(fuzzy_db)
-    if bad is not None:
-        return AnalogResult(bad)
-    if not 1 <= input_nr <= 8:
-        return AnalogResult(Info.BAD_NUMBER)
-    if fuzzy_db.START_STOP == 0:
-        return AnalogResult(Info.DISABLED)
+    refused = _refusal(fuzzy_db, input_nr, 8)
+    if refused is not None:
+        return AnalogResult(refused)
     xi = _raw_word("AI value", ai_value)
     note = None
     if therm_el:
@@ -150,13 +159,9 @@ def fuzzy_ao(
     """FUZZY_AO: normalise output ``output_nr`` of ``fuzzy_db`` to the analog range; the
     result's ``word`` is what goes to AO_ADR.  An output whose MIN equals its MAX has no
     normalisation line and is reported as INFO 11 (no valid application for it)."""
-    bad = _check_db(fuzzy_db)
-    if bad is not None:
-        return AnalogResult(bad)
-    if not 1 <= output_nr <= 4:
-        return AnalogResult(Info.BAD_NUMBER)
-    if fuzzy_db.START_STOP == 0:
-        return AnalogResult(Info.DISABLED)
+    refused = _refusal(fuzzy_db, output_nr, 4)
+    if refused is not None:
+        return AnalogResult(refused)
     x_min, x_max = fuzzy_db.output_limits(output_nr)
     if x_max == x_min:
         return AnalogResult(Info.NO_APPLICATION)

@@ -33,8 +33,10 @@ from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
     Condition,
+    DefuzzifyBlock,
     Document,
     FunctionBlock,
+    FuzzifyBlock,
     Is,
     MembershipFunction,
     PointsMF,
@@ -217,6 +219,18 @@ def _check_variables(fb: FunctionBlock, r: _Report) -> None:
                 )
 
 
+def _check_term_list(block: FuzzifyBlock | DefuzzifyBlock, side: str, r: _Report) -> None:
+    """How many terms the block takes on this ``side`` (input, output) and their names."""
+    limit = LIMITS[f"{side}_terms"]
+    if len(block.terms) > limit:
+        r.err(
+            f"{side} {block.variable} has {len(block.terms)} terms; the block allows {limit}",
+            block.terms[limit].span or block.span,
+            "too-many-terms",
+        )
+    _check_term_names(block.variable, [t.name for t in block.terms], [t.span for t in block.terms], r)
+
+
 def _check_terms(fb: FunctionBlock, r: _Report) -> None:
     for fz in fb.fuzzify:
         var = fb.variable(fz.variable)
@@ -224,13 +238,7 @@ def _check_terms(fb: FunctionBlock, r: _Report) -> None:
             r.err(
                 f"{fz.variable}: only inputs are fuzzified in the FUZZY block", fz.span, "fuzzify-non-input"
             )
-        if len(fz.terms) > LIMITS["input_terms"]:
-            r.err(
-                f"input {fz.variable} has {len(fz.terms)} terms; the block allows {LIMITS['input_terms']}",
-                fz.terms[LIMITS["input_terms"]].span or fz.span,
-                "too-many-terms",
-            )
-        _check_term_names(fz.variable, [t.name for t in fz.terms], [t.span for t in fz.terms], r)
+        _check_term_list(fz, "input", r)
         for t in fz.terms:
             if input_shape(t.mf) is None:
                 r.err(
@@ -240,13 +248,7 @@ def _check_terms(fb: FunctionBlock, r: _Report) -> None:
                     "input-shape",
                 )
     for dz in fb.defuzzify:
-        if len(dz.terms) > LIMITS["output_terms"]:
-            r.err(
-                f"output {dz.variable} has {len(dz.terms)} terms; the block allows {LIMITS['output_terms']}",
-                dz.terms[LIMITS["output_terms"]].span or dz.span,
-                "too-many-terms",
-            )
-        _check_term_names(dz.variable, [t.name for t in dz.terms], [t.span for t in dz.terms], r)
+        _check_term_list(dz, "output", r)
         for t in dz.terms:
             if not isinstance(t.mf, SingletonMF) or not is_constant(t.mf.value):
                 r.err(

@@ -7,12 +7,9 @@ import math
 from dataclasses import dataclass
 from typing import ClassVar
 
-import numpy as np
-
 from fuzzyctl.sim.integrate import Vector
 from fuzzyctl.sim.plant import OdePlant, Port, param, register
-
-G = 9.81
+from fuzzyctl.sim.plants.cart import G, cart_derivatives, cart_state
 
 
 @register
@@ -59,9 +56,7 @@ class InvertedPendulum(OdePlant):
     speed0: float = param(0.0, "m/s", "initial cart speed")
 
     def initial_state(self) -> Vector:
-        return np.array(
-            [self.position0, self.speed0, math.radians(self.angle0), math.radians(self.angular_speed0)]
-        )
+        return cart_state(self.position0, self.speed0, self.angle0, self.angular_speed0)
 
     def derivatives(self, t: float, x: Vector, u: Vector) -> Vector:
         _, v, th, w = x
@@ -71,10 +66,7 @@ class InvertedPendulum(OdePlant):
         a11, a12, a22 = M + m, m * l * c, 4.0 / 3.0 * m * l * l
         r1 = force - self.cart_friction * v + m * l * s * w * w
         r2 = m * G * l * s - self.hinge_friction * w
-        det = a11 * a22 - a12 * a12
-        acc = (r1 * a22 - a12 * r2) / det
-        alpha = (a11 * r2 - a12 * r1) / det
-        return np.array([v, acc, w, alpha])
+        return cart_derivatives(v, w, a11, a12, a22, r1, r2)
 
     def measure(self, state: Vector) -> dict[str, float]:
         x, v, th, w = (float(s) for s in state)
