@@ -39,7 +39,7 @@ from fuzzyctl import __version__
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError, InputError
 from fuzzyctl.files import ReadOnlyError, check_writable
 from fuzzyctl.model import Document, FunctionBlock
-from fuzzyctl.studio import analysis, api_editing, online, viewsettings
+from fuzzyctl.studio import analysis, api_editing, findings, online, viewsettings
 from fuzzyctl.studio.project import (
     MAX_FILE,
     FileProblem,
@@ -599,6 +599,7 @@ def create_app(
         return FileResponse(STATIC / "index.html", headers={"Cache-Control": "no-cache"})
 
     app.include_router(api_editing.router(cache))
+    app.include_router(findings.router())
     app.mount("/static", StaticFiles(directory=STATIC), name="static")
     return Guard(
         app,
