@@ -167,6 +167,7 @@ export function init() {
   grid.bind($("#rule-table"));
   matrix.bind($("#rules-matrix"));
   on("model", (what) => !$("#view-rules").hidden && what !== "rules" && what !== "rules-text" && render());
+  on("findings", () => !$("#view-rules").hidden && document.querySelector("#rule-matrix") && render());
   on("report", () => {
     if ($("#view-rules").hidden) return;
     if (mode === "text") text.report();
