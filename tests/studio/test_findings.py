@@ -6,7 +6,6 @@ there) and from the FCL text the check returns (the line of each rule), never fr
 
 from __future__ import annotations
 
-import shutil
 from pathlib import Path
 from typing import Any
 
@@ -107,6 +106,10 @@ def test_api_findings_gap_terms_and_rule_lines(tmp_path: Path, reference: Any) -
     assert "rule 4" in dead["message"] and dead["line"] == line_of(text, "RULE 4 :")
     assert dead["element"] == "rule:0:3"
     assert by_code["analyze-gap"]["element"] == "var:z"
+    # with the text the panel shows (the file as opened), the lines are the file's
+    as_opened = client.post("/api/findings", json={"document": doc, "text": opened["text"]}).json()
+    (dead_opened,) = [f for f in as_opened["findings"] if f["code"] == "analyze-dead"]
+    assert dead_opened["line"] == line_of(GAPDEMO, "RULE 4 :") != dead["line"]
     # declared "z falls with x": rules 1 (x lo, y lo -> a = 0) and 3 (x hi, y lo -> b = 1)
     # conclude against it; the entries name the pairs fuzzyctl.analyze finds, at the lines
     mono = client.post("/api/findings", json={"document": doc, "monotone": ["z:-x"]}).json()
@@ -117,3 +120,53 @@ def test_api_findings_gap_terms_and_rule_lines(tmp_path: Path, reference: Any) -
     assert [f["line"] for f in lines] == [line_of(text, f"RULE {b} :") for _a, b in expected]
     bad = client.post("/api/findings", json={"document": doc, "monotone": ["z:-nosuch"]})
     assert bad.status_code in (200, 400, 422) and "nosuch" in bad.text
+
+
+def test_browser_matrix_surface_and_check_panel(page: Any, browser_project: Path, reference: Any) -> None:
+    """In the real browser: the check panel lists the gap and the dead rule 4 at its line
+    (a click goes to the rule), the matrix dashes the cells of the terms reaching into the
+    gap, the 3D display draws the gap's footprint with the box's extent."""
+    from tests.studio.browser import open_file, rule_mode, shot, tab
+
+    pg = page
+    box, terms = reference
+    (browser_project / "gapdemo.fcl").write_text(GAPDEMO)
+    open_file(pg, "gapdemo.fcl")
+    pg.wait_for_selector('#findings-list li[data-code="analyze-dead"]', timeout=60000)
+    tab(pg, "text")
+    text = pg.input_value("#code-input")
+    dead = pg.inner_text('#findings-list li[data-code="analyze-dead"]')
+    assert f" {line_of(text, 'RULE 4 :')}:" in dead and "rule 4 can never fire" in dead
+    gap = pg.inner_text('#findings-list li[data-code="analyze-gap"]')
+    assert "no rule concluding z fires" in gap and f" {line_of(text, 'z : REAL')}:" in gap
+    box_item = pg.inner_text('#findings-list li[data-code="analyze-gap-box"]')
+    assert f"x in [{box['x'][0]:g}" in box_item or "x in [6, 10]" in box_item
+    assert len(pg.query_selector_all("#findings-list li")) == 3  # gap, its box, the dead rule
+    # a click on the dead rule goes to it in the rule editor
+    pg.click('#findings-list li[data-code="analyze-dead"]')
+    pg.wait_for_selector("#view-rules:not([hidden])")
+    # the matrix: x down, y across; dashed where a term of each reaches into the gap
+    rule_mode(pg, "matrix")
+    pg.wait_for_selector("#rule-matrix td.gap")
+    cells = {
+        (td.get_attribute("data-row"), td.get_attribute("data-col"))
+        for td in pg.query_selector_all("#rule-matrix td.gap")
+    }
+    assert cells == {(a, b) for a in terms["x"] for b in terms["y"]} == {("hi", "hi")}
+    assert "gap of z" in pg.inner_text("#matrix-gaps")
+    shot(pg, "34-findings-matrix", doc=True)
+    # the 3D display: the footprint of the gap on the floor, with the box's extent
+    tab(pg, "surface")
+    has_gap = "c && c.data && c.data.some((t) => t.meta === 'gap')"
+    pg.wait_for_function(
+        f"(() => {{ const c = document.querySelector('#sf-chart'); return {has_gap} }})()", timeout=60000
+    )
+    trace = pg.evaluate("document.querySelector('#sf-chart').data.find((t) => t.meta === 'gap')")
+    assert min(trace["x"]) == pytest.approx(box["x"][0], abs=STEP) and max(trace["x"]) == pytest.approx(
+        box["x"][1], abs=STEP
+    )
+    assert min(trace["y"]) == pytest.approx(box["y"][0], abs=STEP) and max(trace["y"]) == pytest.approx(
+        box["y"][1], abs=STEP
+    )
+    assert pg.evaluate("document.querySelector('#sf-chart').data.some((t) => t.meta === 'gap-area')")
+    shot(pg, "35-findings-surface", doc=True)

@@ -27,8 +27,11 @@ SMOOTH_SAMPLES = 257
 
 
 class FindingsBody(ModelBody):
-    """The model, and the declared monotonicity (``"valve:-temp,+flow"``, as ``--monotone``)."""
+    """The model, the declared monotonicity (``"valve:-temp,+flow"``, as ``--monotone``), and
+    the FCL text the check panel's lines refer to (the file as opened, or the check's text
+    after an edit); without it, the model's FCL text."""
 
+    text: Annotated[str, StringConstraints(max_length=5_000_000)] | None = None
     monotone: Annotated[
         list[Annotated[str, StringConstraints(max_length=1000)]], Field(default_factory=list, max_length=50)
     ]
@@ -78,13 +81,16 @@ def element_lines(fb: FunctionBlock) -> dict[int, str]:
     return lines
 
 
-def findings(document: Any, block: int, monotone: list[str]) -> dict[str, Any]:
-    """The findings of block ``block`` of ``document`` (lines: of its FCL text, as the check's)."""
+def findings(document: Any, block: int, monotone: list[str], text: str | None = None) -> dict[str, Any]:
+    """The findings of block ``block`` of ``document`` (lines: of ``text``, the FCL text of
+    the model the check panel shows, else of the model's FCL text)."""
     from fuzzyctl.analysis import analyze
     from fuzzyctl.analysis.findings import block_diagnostics
     from fuzzyctl.fcl import load_text
 
-    parsed = load_text(analysis.fcl_text(document)).document
+    parsed = load_text(text).document if text is not None else None
+    if parsed is None or block >= len(parsed.blocks):
+        parsed = load_text(analysis.fcl_text(document)).document
     if parsed is None or block >= len(parsed.blocks):
         return {"ok": False, "error": "the model has errors: see the check", "findings": [], "gaps": []}
     fb = parsed.blocks[block]
@@ -136,6 +142,6 @@ def router() -> APIRouter:
     def post_findings(body: FindingsBody) -> Any:
         """The analysis of the edited block: check-panel entries and gap boxes."""
         document, _settings = split_settings(analysis.document_from_json(body.document))
-        return analysis.clean(findings(document, body.block, list(body.monotone)))
+        return analysis.clean(findings(document, body.block, list(body.monotone), body.text))
 
     return api

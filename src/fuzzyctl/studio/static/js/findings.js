@@ -30,7 +30,8 @@ async function refresh() {
     const map = ruleIndexMap();
     const monotone = ($("#findings-monotone").value || "").split(/\s+/).filter(Boolean);
     try {
-      const answer = await post("/api/findings", body({ monotone }));
+      // the lines of the text the check panel's diagnostics refer to (the file as opened)
+      const answer = await post("/api/findings", body({ monotone, text: (state.report && state.report.text) || null }));
       if (mine !== seq) return;
       for (const d of answer.findings) {
         const m = /^rule:(\d+):(\d+)$/.exec(d.element || "");
