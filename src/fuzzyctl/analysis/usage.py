@@ -192,21 +192,27 @@ def empty(ctx: Context, cols: dict[str, str]) -> Coverage:
 def exact_sums(values: FloatArray) -> list[int]:
     """Each row's sum of ``values`` (shape (n, m), finite, in [0, 2)) exactly, in units of
     2**-SUM_SHIFT.  A float is M * 2**(e - 53) with an integer 53-bit M: split M into two
-    halves, add the halves per (row, exponent) with ``bincount`` (exact while a sum stays
-    under 2**53: chunks of 2**24 columns), and shift each exponent's sum into place."""
+    halves, add the halves per (row, exponent) with ``bincount`` (exact: a chunk's sums stay
+    under 2**51, the running int64 sums under 2**63 up to 2**36 rows), and shift each
+    exponent's sum into place once at the end."""
     n, m = values.shape
     width = -MIN_EXP + 2  # exponents MIN_EXP .. 1
-    totals = [0] * n
-    for start in range(0, m, 1 << 24):
-        mant, exp = np.frexp(values[:, start : start + (1 << 24)])
+    hi = np.zeros(n * width, dtype=np.int64)
+    lo = np.zeros(n * width, dtype=np.int64)
+    step = max(1, min(1 << 24, (1 << 23) // max(n, 1)))  # about 8M values per chunk
+    for start in range(0, m, step):
+        chunk = values[:, start : start + step]
+        rows, _cols = np.nonzero(chunk)  # most rules are 0 at most rows: only the others count
+        mant, exp = np.frexp(chunk[rows, _cols])
         ints = np.ldexp(mant, 53).astype(np.int64)
-        idx = (np.arange(n)[:, None] * width + (exp - MIN_EXP)).ravel()
-        hi = np.bincount(idx, weights=(ints >> 26).ravel(), minlength=n * width).astype(np.int64)
-        lo = np.bincount(idx, weights=(ints & ((1 << 26) - 1)).ravel(), minlength=n * width).astype(np.int64)
-        for k in np.flatnonzero(hi | lo).tolist():
-            row, b = divmod(k, width)
-            # exponent e = b + MIN_EXP: M * 2**(e - 53) * 2**SUM_SHIFT = M << (b + MIN_EXP - 53 + SUM_SHIFT)
-            totals[row] += ((int(hi[k]) << 26) + int(lo[k])) << (b + MIN_EXP - 53 + SUM_SHIFT)
+        idx = rows * width + (exp - MIN_EXP)
+        hi += np.bincount(idx, weights=ints >> 26, minlength=n * width).astype(np.int64)
+        lo += np.bincount(idx, weights=ints & ((1 << 26) - 1), minlength=n * width).astype(np.int64)
+    totals = [0] * n
+    for k in np.flatnonzero(hi | lo).tolist():
+        row, b = divmod(k, width)
+        # exponent e = b + MIN_EXP: M * 2**(e - 53) * 2**SUM_SHIFT = M << (b + MIN_EXP - 53 + SUM_SHIFT)
+        totals[row] += ((int(hi[k]) << 26) + int(lo[k])) << (b + MIN_EXP - 53 + SUM_SHIFT)
     return totals
 
 
