@@ -6,6 +6,7 @@ there) and from the FCL text the check returns (the line of each rule), never fr
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Any
 
@@ -118,6 +119,11 @@ def test_api_findings_gap_terms_and_rule_lines(tmp_path: Path, reference: Any) -
     assert ("1", "3") in expected
     assert [(f["message"].split()[2], f["message"].split()[4]) for f in lines] == expected
     assert [f["line"] for f in lines] == [line_of(text, f"RULE {b} :") for _a, b in expected]
+    # an invalid model (points out of order) is no request error: the check reports it
+    broken = json.loads(json.dumps(doc))
+    broken["blocks"][0]["fuzzify"][0]["terms"][0]["mf"]["points"].reverse()
+    answer = client.post("/api/findings", json={"document": broken})
+    assert answer.status_code == 200 and answer.json()["ok"] is False
     bad = client.post("/api/findings", json={"document": doc, "monotone": ["z:-nosuch"]})
     assert bad.status_code in (200, 400, 422) and "nosuch" in bad.text
 

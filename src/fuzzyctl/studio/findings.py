@@ -15,7 +15,7 @@ import numpy as np
 from fastapi import APIRouter
 from pydantic import Field, StringConstraints
 
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from fuzzyctl.model import FunctionBlock
 from fuzzyctl.studio import analysis
 from fuzzyctl.studio.project import split_settings
@@ -141,7 +141,10 @@ def router() -> APIRouter:
     @api.post("/api/findings")
     def post_findings(body: FindingsBody) -> Any:
         """The analysis of the edited block: check-panel entries and gap boxes."""
-        document, _settings = split_settings(analysis.document_from_json(body.document))
+        try:
+            document, _settings = split_settings(analysis.document_from_json(body.document))
+        except DiagnosticError:  # an invalid model (points out of order): the check says why
+            return {"ok": False, "error": "the model has errors: see the check", "findings": [], "gaps": []}
         return analysis.clean(findings(document, body.block, list(body.monotone), body.text))
 
     return api

@@ -26,6 +26,8 @@ async function refresh() {
   const mine = ++seq;
   if (!state.doc) {
     found.data = null;
+  } else if (state.report && state.report.ok === false) {
+    found.data = { ok: false, error: "no analysis while the check finds errors", findings: [], gaps: [] };
   } else {
     const map = ruleIndexMap();
     const monotone = ($("#findings-monotone").value || "").split(/\s+/).filter(Boolean);
