@@ -10,9 +10,12 @@ export const found = { data: null };
 let seq = 0;
 let timer = null;
 
+let checking = false;
+
+// after the check has settled: the analysis never holds up the check of the next edit
 function schedule() {
   clearTimeout(timer);
-  timer = setTimeout(refresh, 250);
+  timer = setTimeout(() => (checking ? schedule() : refresh()), 400);
 }
 
 /** The rule indices the server sees: a rule without a THEN part is not sent (state.body). */
@@ -119,6 +122,7 @@ export function gapBoxes(output, x, y, fixed) {
 
 export function init() {
   on("report", schedule);
+  on("checking", (busy) => (checking = busy));
   on("loaded", () => {
     found.data = null;
     render();
