@@ -8,7 +8,9 @@ from typing import TYPE_CHECKING
 from fuzzyctl.analysis.report import Analysis
 
 if TYPE_CHECKING:
+    from collections.abc import Callable
     from pathlib import Path
+    from typing import Any
 
     from fuzzyctl.analysis.usage import Coverage
     from fuzzyctl.model import Document, FunctionBlock
@@ -116,11 +118,18 @@ def coverage(
     *,
     block: str | None = None,
     epsilon: float = 0.0,
+    dask: bool = False,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Coverage:
     """How the rules were used over the rows of a log (CSV/Parquet file, directory or glob):
     per rule how often it fired (degree >= epsilon; 0: > 0) and dominated (the highest degree
     for an output it concludes), its mean and max degree; rows in a gap or outside a RANGE
-    (docs/analyze.md, "Coverage from data")."""
+    (docs/analyze.md, "Coverage from data").  ``dask=True``: the files as a dask dataframe,
+    partitions counted in parallel on ``scheduler`` (a ``distributed.Client`` or a Dask
+    scheduler name; None: Dask's default), the same numbers; ``progress(done, total)``."""
     from fuzzyctl.analysis import usage
 
-    return usage.coverage(model, data, block=block, epsilon=epsilon)
+    return usage.coverage(
+        model, data, block=block, epsilon=epsilon, dask=dask, scheduler=scheduler, progress=progress
+    )

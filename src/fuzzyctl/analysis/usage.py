@@ -5,7 +5,9 @@ leaf evaluation (:func:`fuzzyctl.analysis.cells.row_degrees`), the engine's form
 from __future__ import annotations
 
 import glob as globmod
+from collections.abc import Callable
 from dataclasses import dataclass, field
+from fractions import Fraction
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -24,14 +26,32 @@ PREFIX_SEPARATORS = (".", "_", "/", ":")
 SIMULATE_PREFIX = "fb."
 
 
+#: degrees are summed exactly, as integers in units of 2**-SUM_SHIFT (every float64 in [0, 2)
+#: is one), so the mean does not depend on how rows are split into batches or partitions
+SUM_SHIFT = 1126
+#: a float64's exponent from ``np.frexp`` is at least this (the smallest subnormal)
+MIN_EXP = -1073
+
+
 @dataclass
 class RuleUse:
     rule: str
     where: str | None
     fired: int = 0
     dominated: int = 0
-    total: float = 0.0
+    exact_total: int = 0  # the sum of its degrees, times 2**SUM_SHIFT (exact)
     max_degree: float = 0.0
+
+    @property
+    def total(self) -> float:
+        """The sum of its degrees over the rows, correctly rounded."""
+        return float(Fraction(self.exact_total, 1 << SUM_SHIFT))
+
+    def merge(self, other: RuleUse) -> None:
+        self.fired += other.fired
+        self.dominated += other.dominated
+        self.exact_total += other.exact_total
+        self.max_degree = max(self.max_degree, other.max_degree)
 
     def to_json(self, rows: int) -> dict[str, Any]:
         return {
@@ -54,6 +74,17 @@ class Coverage:
     gap_rows: dict[str, int] = field(default_factory=dict)  # output -> rows no rule fired
     out_of_range: dict[str, int] = field(default_factory=dict)  # input -> rows outside RANGE
     rules: list[RuleUse] = field(default_factory=list)
+
+    def merge(self, other: Coverage) -> None:
+        """Add the counts of ``other`` (the same block, another part of the rows): sums and
+        maxima, so the order of the parts does not matter."""
+        self.rows += other.rows
+        self.invalid_rows += other.invalid_rows
+        for d, o in ((self.gap_rows, other.gap_rows), (self.out_of_range, other.out_of_range)):
+            for k, n in o.items():
+                d[k] = d.get(k, 0) + n
+        for mine, theirs in zip(self.rules, other.rules, strict=True):
+            mine.merge(theirs)
 
     @property
     def never_fired(self) -> list[str]:
@@ -119,19 +150,70 @@ def coverage(
     *,
     block: str | None = None,
     epsilon: float = 0.0,
+    dask: bool = False,
+    scheduler: Any = None,
+    progress: Callable[[int, int], None] | None = None,
 ) -> Coverage:
     """How the rules of ``model`` were used over the rows of ``data`` (CSV/Parquet file,
     directory or glob).  A rule fires at a row when its degree is >= ``epsilon`` (0: > 0),
     as in :func:`fuzzyctl.analyze`; it dominates when it fired and no rule of an output it
-    concludes has a higher degree there (ties: each one dominates)."""
+    concludes has a higher degree there (ties: each one dominates).
+
+    ``dask=True`` reads the files as one ``dask.dataframe`` and counts its partitions in
+    parallel on ``scheduler`` (a ``distributed.Client``, or a Dask scheduler name such as
+    ``"threads"``, ``"processes"``, ``"sync"``; None: Dask's default), then adds the counts
+    up: the same numbers as the serial path.  ``progress(done, total)`` is called as
+    partitions finish."""
     ctx = build_context(model, block)
     files = expand(data)
+    if dask:
+        from fuzzyctl.analysis import usage_dask
+
+        return usage_dask.coverage(ctx, model, files, block, epsilon, scheduler, progress)
     cov: Coverage | None = None
-    for source in files:
+    for i, source in enumerate(files):
         cov = _read_one(ctx, source, cov, epsilon)
+        if progress:
+            progress(i + 1, len(files))
     assert cov is not None
     cov.sources = files
     return cov
+
+
+def empty(ctx: Context, cols: dict[str, str]) -> Coverage:
+    """Zero counts for the block of ``ctx``, inputs read from ``cols``."""
+    cov = Coverage([], cols)
+    cov.rules = [RuleUse(n, w) for n, w in zip(ctx.rule_names, ctx.rule_where, strict=True)]
+    cov.gap_rows = {op.name: 0 for op in ctx.plan.outputs if op.is_output}
+    cov.out_of_range = dict.fromkeys(ctx.inputs, 0)
+    return cov
+
+
+def exact_sums(values: FloatArray) -> list[int]:
+    """Each row's sum of ``values`` (shape (n, m), finite, in [0, 2)) exactly, in units of
+    2**-SUM_SHIFT.  A float is M * 2**(e - 53) with an integer 53-bit M: split M into two
+    halves, add the halves per (row, exponent) with ``bincount`` (exact: a chunk's sums stay
+    under 2**51, the running int64 sums under 2**63 up to 2**36 rows), and shift each
+    exponent's sum into place once at the end."""
+    n, m = values.shape
+    width = -MIN_EXP + 2  # exponents MIN_EXP .. 1
+    hi = np.zeros(n * width, dtype=np.int64)
+    lo = np.zeros(n * width, dtype=np.int64)
+    step = max(1, min(1 << 24, (1 << 23) // max(n, 1)))  # about 8M values per chunk
+    for start in range(0, m, step):
+        chunk = values[:, start : start + step]
+        rows, _cols = np.nonzero(chunk)  # most rules are 0 at most rows: only the others count
+        mant, exp = np.frexp(chunk[rows, _cols])
+        ints = np.ldexp(mant, 53).astype(np.int64)
+        idx = rows * width + (exp - MIN_EXP)
+        hi += np.bincount(idx, weights=ints >> 26, minlength=n * width).astype(np.int64)
+        lo += np.bincount(idx, weights=ints & ((1 << 26) - 1), minlength=n * width).astype(np.int64)
+    totals = [0] * n
+    for k in np.flatnonzero(hi | lo).tolist():
+        row, b = divmod(k, width)
+        # exponent e = b + MIN_EXP: M * 2**(e - 53) * 2**SUM_SHIFT = M << (b + MIN_EXP - 53 + SUM_SHIFT)
+        totals[row] += ((int(hi[k]) << 26) + int(lo[k])) << (b + MIN_EXP - 53 + SUM_SHIFT)
+    return totals
 
 
 def _fired(a: FloatArray, epsilon: float) -> Any:
@@ -141,27 +223,24 @@ def _fired(a: FloatArray, epsilon: float) -> Any:
 def _read_one(ctx: Context, source: str, cov: Coverage | None, epsilon: float) -> Coverage:
     from fuzzyctl.tables import TableReader, numbers
 
-    plan = ctx.plan
     reader = TableReader(source)
     try:
         cols = match_columns(ctx.inputs, reader.header, reader.name)
         if cov is None:
-            cov = Coverage([], cols)
-            cov.rules = [RuleUse(n, w) for n, w in zip(ctx.rule_names, ctx.rule_where, strict=True)]
-            cov.gap_rows = {op.name: 0 for op in plan.outputs if op.is_output}
-            cov.out_of_range = dict.fromkeys(ctx.inputs, 0)
+            cov = empty(ctx, cols)
         for batch in reader.batches():
             values, invalid = numbers(reader, batch, list(dict.fromkeys(cols.values())))
             keep = ~invalid
             cov.invalid_rows += int(invalid.sum())
             columns = [values[cols[n]][keep] for n in ctx.inputs]
-            _count(ctx, cov, columns, epsilon)
+            count(ctx, cov, columns, epsilon)
     finally:
         reader.close()
     return cov
 
 
-def _count(ctx: Context, cov: Coverage, columns: list[FloatArray], epsilon: float) -> None:
+def count(ctx: Context, cov: Coverage, columns: list[FloatArray], epsilon: float) -> None:
+    """Add the rows of ``columns`` (one finite array per input slot) to ``cov``."""
     plan = ctx.plan
     m = len(columns[0]) if columns else 0
     if m == 0:
@@ -177,10 +256,11 @@ def _count(ctx: Context, cov: Coverage, columns: list[FloatArray], epsilon: floa
         for cp in r.conclusions:
             for o in cp.outputs:
                 top[o] = np.maximum(top.get(o, np.zeros(m)), degrees[ri])
+    sums = exact_sums(degrees)
     for ri, r in enumerate(plan.rules):
         use = cov.rules[ri]
         use.fired += int(np.count_nonzero(fired[ri]))
-        use.total += float(degrees[ri].sum())
+        use.exact_total += sums[ri]
         use.max_degree = max(use.max_degree, float(degrees[ri].max()))
         dom = np.zeros(m, dtype=bool)
         for cp in r.conclusions:

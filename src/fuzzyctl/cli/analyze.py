@@ -5,12 +5,13 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Any
 
 import typer
 
 from fuzzyctl import formats
 from fuzzyctl.cli.app import app
+from fuzzyctl.cli.eval_dask import SchedulerOpt, WorkersOpt
 
 
 @app.command()
@@ -47,6 +48,14 @@ def analyze(
             show_default=False,
         ),
     ] = None,
+    dask: Annotated[
+        bool,
+        typer.Option(
+            "--dask", help="With --data: count the files' partitions in parallel on Dask (same numbers)."
+        ),
+    ] = False,
+    workers: WorkersOpt = None,
+    scheduler: SchedulerOpt = None,
     plot: Annotated[
         Path | None,
         typer.Option(
@@ -66,7 +75,14 @@ def analyze(
 
     model = fuzzyctl.load(file)
     result = run(model, block=block, epsilon=epsilon, delta=delta, monotone=monotone or ())
-    cov = cov_mod.coverage(model, list(data), block=block, epsilon=epsilon) if data else None
+    if (dask or workers is not None or scheduler is not None) and not data:
+        raise typer.BadParameter("--dask, --workers and --scheduler go with --data", param_hint="--dask")
+    if not dask and (workers is not None or scheduler is not None):
+        raise typer.BadParameter("--workers and --scheduler go with --dask", param_hint="--workers")
+    if data and dask:
+        cov = _dask_coverage(model, list(data), block, epsilon, workers, scheduler)
+    else:
+        cov = cov_mod.coverage(model, list(data), block=block, epsilon=epsilon) if data else None
     pngs = _plots(model, result, cov, plot, block) if plot is not None else []
     if as_json:
         obj = result.to_json()
@@ -99,3 +115,46 @@ def _plots(model: object, result: object, cov: object, out_dir: Path, block: str
     if cov is not None:
         written.append(cov_mod.plot(cov, out_dir / "coverage.png"))  # type: ignore[arg-type]
     return written
+
+
+def _dask_coverage(
+    model: Any, data: list[str], block: str | None, epsilon: float, workers: int | None, scheduler: str | None
+) -> Any:
+    """Coverage on Dask: a local cluster (``--workers``, default one per CPU; 0: this process)
+    or an existing scheduler, with a progress bar on stderr as ``eval --dask`` shows."""
+    from rich.console import Console
+    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+
+    from fuzzyctl.analysis import usage as cov_mod
+    from fuzzyctl.analysis import usage_dask
+    from fuzzyctl.tune import parallel
+
+    usage_dask.require_dask()
+    if workers is not None and scheduler is not None:
+        raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
+    execu = parallel.executor(workers, scheduler)
+    try:
+        with Progress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            MofNCompleteColumn(),
+            TimeElapsedColumn(),
+            console=Console(stderr=True),
+            transient=True,
+        ) as progress:
+            task = progress.add_task("coverage", total=None)
+
+            def tick(done: int, total: int) -> None:
+                progress.update(task, completed=done, total=total)
+
+            return cov_mod.coverage(
+                model,
+                list(data),
+                block=block,
+                epsilon=epsilon,
+                dask=True,
+                scheduler=getattr(execu, "client", None) or "sync",
+                progress=tick,
+            )
+    finally:
+        execu.close()

@@ -32,6 +32,7 @@ from fastapi import FastAPI
 from fastapi.staticfiles import StaticFiles
 
 from fuzzyctl import __version__
+from fuzzyctl.studio import findings
 from fuzzyctl.studio.project import ProjectDir
 from fuzzyctl.studio.routes import analysis, editing, errors, files, front, online, simulation
 from fuzzyctl.studio.routes.front import STATIC, cookie_name, plotly_bundle
@@ -40,7 +41,7 @@ from fuzzyctl.webguard import LOOPBACK_NAMES, Guard, Refusal, bearer_token, toke
 
 MAX_BODY = 16 * 1024 * 1024
 LOCAL_HOSTS = {"127.0.0.1", "localhost", "[::1]", "::1"}
-ROUTERS = (files, editing, analysis, simulation, online, front)
+ROUTERS = (files, editing, analysis, findings, simulation, online, front)
 """One router per area, in the order they are matched."""
 
 

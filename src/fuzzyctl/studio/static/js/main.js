@@ -14,6 +14,7 @@ import * as onlineView from "./online.js";
 import * as ruleviewer from "./ruleviewer.js";
 import * as panes from "./panes.js";
 import { setShapes } from "./terms.js";
+import * as findings from "./findings.js";
 
 const views = { project: diagram, variable, rules, ruleviewer, text, surface, recorder, explain, online: onlineView };
 let current = "project";
@@ -322,6 +323,7 @@ function bindShell() {
 async function start() {
   bindShell();
   panes.init();
+  findings.init();
   for (const view of Object.values(views)) view.init?.();
   $("#loading-text").textContent = "Reading the project…";
   const [info, shapes] = await Promise.all([get("/api/info"), get("/api/shapes")]);

@@ -6,6 +6,7 @@
 import { fb, inputs, outputs, changed, status } from "./state.js";
 import { $, el } from "./ui.js";
 import { cells, fromCells, termOptions, nextLabel, ruleText } from "./rules-model.js";
+import { gapCells, gapsBetweenTerms } from "./findings.js";
 
 let host = null; // {block(), select(j)}
 const axes = { row: null, col: null, output: null, fixed: {} };
@@ -105,6 +106,7 @@ export function render(container) {
   const table = el("table", { class: "matrix", id: "rule-matrix", role: "grid" });
   table.append(el("thead", {}, el("tr", {}, el("th", { class: "corner" }, `${axes.row} ↓ / ${axes.col || ""} →`), ...colTerms.map((b) => el("th", { scope: "col" }, b || axes.output)))));
   const tbody = el("tbody");
+  const gaps = gapCells(axes.output, axes.row, axes.col, axes.fixed);
   for (const a of rowTerms) {
     const tr = el("tr", {}, el("th", { scope: "row" }, a));
     for (const b of colTerms) {
@@ -115,6 +117,12 @@ export function render(container) {
       const c = terms.length === 1 ? colour(terms[0]) : null;
       if (c) td.style.background = c;
       if (c && ["#2166ac", "#b2182b", "#4393c3", "#d6604d"].includes(c)) td.style.color = "#fff";
+      const gap = gaps.get(`${a}\u0000${b}`);
+      if (gap) {
+        // a gap of the output reaches into this cell: a rule here would cover (part of) it
+        td.classList.add("gap");
+        td.title += `\ngap of ${axes.output} (no rule fires): ${gap.join("; ")}`;
+      }
       tr.append(td);
     }
     tbody.append(tr);
@@ -127,6 +135,11 @@ export function render(container) {
     legend.append(el("span", { style: `background:${c};${["#2166ac", "#b2182b", "#4393c3", "#d6604d"].includes(c) ? "color:#fff" : ""}` }, t));
   }
   container.append(legend);
+  const between = gapsBetweenTerms(axes.output, axes.row, axes.col);
+  if (gaps.size || between.length) {
+    const text = [gaps.size ? `dashed cells: a gap of ${axes.output} (no rule fires) lies where their terms reach` : "", ...between.map((b) => `gap of ${axes.output} between terms (no term above 0): ${b}`)].filter(Boolean);
+    container.append(el("p", { class: "hint matrix-gaps", id: "matrix-gaps" }, text.join(". ")));
+  }
   container.append(el("p", { class: "hint", id: "matrix-note" }, `${block.rules.length - outside} of ${block.rules.length} rule(s) in this matrix${outside ? `; ${outside} other(s) (other inputs, NOT, OR, several terms of one input...) are in the Table and Text views` : ""}. Click a cell (or Enter) to choose the output term; -blank- removes it.`));
 }
 

@@ -167,6 +167,8 @@ export function init() {
   grid.bind($("#rule-table"));
   matrix.bind($("#rules-matrix"));
   on("model", (what) => !$("#view-rules").hidden && what !== "rules" && what !== "rules-text" && render());
+  // new findings redraw the matrix's gap cells; not another mode, nor a cell being picked
+  on("findings", () => !$("#view-rules").hidden && $("#view-rules").dataset.mode === "matrix" && !document.querySelector("#rule-matrix select") && render());
   on("report", () => {
     if ($("#view-rules").hidden) return;
     if (mode === "text") text.report();

@@ -4,6 +4,7 @@
 import { state, on, emit, inputs, outputs, range, body, fmt, num, niceTicks, status } from "./state.js";
 import { post } from "./api.js";
 import { $, el, plot } from "./ui.js";
+import { gapBoxes } from "./findings.js";
 
 let data = null; // {x, y, frames}
 let frame = 0;
@@ -117,6 +118,15 @@ function draw() {
   const [xl, xh] = range(s.x);
   const [yl, yh] = range(s.y);
   const [zl, zh] = range(s.z);
+  // gaps of the output on this plane: their footprint on the floor, outlined (a gap of
+  // width 0 is a line), filled where it has an area
+  gapBoxes(s.z, s.x, s.y, s.fixed).forEach((g, i) => {
+    const [x0, x1] = g.x;
+    const [y0, y1] = g.y;
+    const name = `gap ${i + 1}: ${g.text}`;
+    traces.push({ type: "scatter3d", mode: "lines", x: [x0, x1, x1, x0, x0], y: [y0, y0, y1, y1, y0], z: [zl, zl, zl, zl, zl], line: { color: "#d62728", width: 7 }, name, meta: "gap", hovertemplate: `${name}<extra></extra>` });
+    if (x1 > x0 && y1 > y0) traces.push({ type: "surface", x: [x0, x1], y: [y0, y1], z: [[zl, zl], [zl, zl]], showscale: false, opacity: 0.45, colorscale: [[0, "#d62728"], [1, "#d62728"]], name, meta: "gap-area", hoverinfo: "skip" });
+  });
   const title = f.value === null || f.value === undefined ? "" : `${$("#sf-anim").value} = ${fmt(f.value)}`;
   return plot($("#sf-chart"), traces, {
     scene: {
@@ -197,6 +207,7 @@ export function init() {
   $("#sf-rot-step").addEventListener("change", (e) => (e.target.value = rotationStep()));
   $("#sf-animate").addEventListener("click", toggleAnimation);
   $("#sf-trajectory").addEventListener("change", draw);
+  on("findings", () => data && !$("#view-surface").hidden && draw());
   on("model", () => {
     if ($("#view-surface").hidden) return;
     fillSelects();
