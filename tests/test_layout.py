@@ -145,3 +145,23 @@ def test_the_checks_catch_what_they_look_for(tmp_path: Path) -> None:
     assert _rank("fuzzyctl.engine.lowering.lower") == 3
     assert _rank("fuzzyctl.engine.controller") == 7
     assert _rank("fuzzyctl.engine.plan") == 1
+
+
+#: The packages that keep every function under LONGEST lines (issue 26: the engine, the IR
+#: and the code generators); data tables are assignments, not functions, and do not count.
+SHORT_FUNCTIONS = ("engine", "ir", "codegen", "kinds")
+LONGEST = 100
+
+
+def test_no_function_is_longer_than_a_screenful() -> None:
+    long = []
+    for path, _name, tree in _modules():
+        if path.relative_to(SRC).parts[0] not in SHORT_FUNCTIONS:
+            continue
+        for node in ast.walk(tree):
+            if isinstance(node, ast.FunctionDef | ast.AsyncFunctionDef):
+                assert node.end_lineno is not None
+                lines = node.end_lineno - node.lineno + 1
+                if lines > LONGEST:
+                    long.append(f"{path.relative_to(SRC.parent)}:{node.lineno}: {node.name} ({lines} lines)")
+    assert not long, f"functions over {LONGEST} lines (split them):\n" + "\n".join(long)

@@ -59,11 +59,16 @@ def test_lowering_evaluates_every_name_as_a_method_without_aliases() -> None:
         assert code in M.METHODS and M.METHODS[code].lowers_to is None, name
 
 
-#: Where method names may still be compared: the registry, and the modules this step of the
-#: issue did not reach (formats writers, tuning, analysis, FCL checks, the jFuzzyLogic
-#: emulation, which spells jFuzzyLogic's own names).
-_CHECKED = ("engine", "codegen", "ir")
-_EXEMPT = {"engine/compat/jfl.py", "engine/lowering/outputs.py"}
+#: Files that still compare method names, and why (the list only shrinks: the test fails
+#: when a listed file is clean).  Everything else reads the registry.
+NOT_YET: dict[str, str] = {
+    "engine/compat/jfl.py": "jFuzzyLogic's own defuzzifier switch, reproduced as its Java is written",
+    "engine/lowering/outputs.py": "the methods jFuzzyLogic's profile accepts (its Java's list)",
+    "fcl/checks.py": "COGF without function terms (a fuzzylite-specific warning)",
+    "fcl/conformance.py": "the IEC 61131-7 level of each method (Table 1 vs extensions)",
+    "formats/common/adapt.py": "writers' normal forms (COG of singletons is COGS, COGF as WTAVER)",
+    "formats/fis/writer.py": "MATLAB's default defuzzMethod of a Sugeno system",
+}
 
 
 def _comparisons(path: Path) -> list[int]:
@@ -80,13 +85,15 @@ def _comparisons(path: Path) -> list[int]:
 
 
 def test_no_method_name_is_compared_outside_the_registry() -> None:
-    bad = {}
-    for pkg in _CHECKED:
-        for path in sorted((SRC / pkg).rglob("*.py")):
-            rel = path.relative_to(SRC).as_posix()
-            if rel in _EXEMPT:
-                continue
-            lines = _comparisons(path)
-            if lines:
-                bad[rel] = lines
-    assert not bad, bad
+    found = {}
+    for path in sorted(SRC.rglob("*.py")):
+        rel = path.relative_to(SRC).as_posix()
+        if rel.startswith("kinds/"):
+            continue
+        lines = _comparisons(path)
+        if lines:
+            found[rel] = lines
+    new = {f: lines for f, lines in found.items() if f not in NOT_YET}
+    assert not new, f"method names compared outside fuzzyctl/kinds (read the entry): {new}"
+    cleaned = sorted(set(NOT_YET) - set(found))
+    assert not cleaned, f"clean now, drop from NOT_YET: {cleaned}"

@@ -29,6 +29,7 @@ from collections.abc import Iterable
 
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.formats.fpl.names import ADDING_ACCU, shared_conclusions
+from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
@@ -257,7 +258,7 @@ def _check_terms(fb: FunctionBlock, r: _Report) -> None:
                     "output-shape",
                     hint="in FPL a singleton is a narrow rectangle (1/200 of the range)",
                 )
-        if dz.method not in (None, "COGS", "COG"):
+        if dz.method is not None and dz.method not in method_kinds.written("fpl"):
             r.err(
                 f"{dz.variable}: METHOD : {dz.method}; the block computes the centre of gravity of "
                 "singletons",

@@ -338,17 +338,7 @@ def _outputs(b: _Block) -> tuple[list[OutputPlan], list[int] | None]:
     outputs: list[OutputPlan] = []
     output_deps: list[set[int]] = []
     for oi, var in enumerate(fb.outputs):
-        op = lower_output(
-            ctx,
-            var,
-            oi,
-            b.rules,
-            b.output_names,
-            b.concluded_terms,
-            b.concluded_bare,
-            b.accu_for,
-            b.term_source,
-        )
+        op = lower_output(ctx, var, oi, b)
         if op is None:
             continue
         db = fb.defuzzify_block(var.name)

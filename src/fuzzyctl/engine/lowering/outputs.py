@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from typing import Protocol
 
 from fuzzyctl import model as m
 from fuzzyctl.engine.lowering.grid import build_grid
@@ -21,49 +22,64 @@ METHOD_ALIASES = methods.lowering_aliases()
 # --------------------------------------------------------------------------- outputs
 
 
-def lower_output(
-    ctx: LowerContext,
-    var: m.Variable,
-    oi: int,
-    rules: list[RulePlan],
-    output_names: dict[str, int],
-    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]],
-    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]],
-    accu_for: object,
-    term_source: object,
-) -> OutputPlan | None:
-    assert callable(accu_for)
-    fb = ctx.fb
-    db = fb.defuzzify_block(var.name)
+class BlockSoFar(Protocol):
+    """What lowering an output reads of its function block lowered so far (the block state of
+    :mod:`~fuzzyctl.engine.lowering.lower` is one)."""
+
+    rules: list[RulePlan]
+    output_names: dict[str, int]
+    concluded_terms: dict[str, list[tuple[int, m.Conclusion]]]
+    concluded_bare: dict[str, list[tuple[int, m.Conclusion]]]
+
+    def accu_for(self, name: str, db: m.DefuzzifyBlock | None) -> str | None: ...
+
+
+def lower_output(ctx: LowerContext, var: m.Variable, oi: int, b: BlockSoFar) -> OutputPlan | None:
+    """The plan of output ``var`` (number ``oi``): a degree output without DEFUZZIFY block,
+    else its terms, method and accumulation (None: an error was reported)."""
+    db = ctx.fb.defuzzify_block(var.name)
     contributions = [
         Contribution(ri, ci, c.term, r.act, c.weight)
-        for ri, r in enumerate(rules)
+        for ri, r in enumerate(b.rules)
         for ci, c in enumerate(r.conclusions)
         if oi in c.outputs
     ]
     if db is None:
-        if var.name in concluded_terms:
+        if var.name in b.concluded_terms:
             ctx.err(
                 f"output {var.name} is concluded with terms but has no DEFUZZIFY block",
                 var.span,
                 "no-defuzzify",
             )
             return None
-        if var.name not in concluded_bare:
+        if var.name not in b.concluded_bare:
             ctx.warn(
                 f"output {var.name} is never concluded by a rule and has no DEFUZZIFY block; it stays 0",
                 var.span,
                 "output-unused",
             )
-        accu = accu_for(var.name, None) or "MAX"
+        accu = b.accu_for(var.name, None) or "MAX"
         return OutputPlan(var.name, "degree", "DEGREE", accu, (), tuple(contributions), 0.0, False)
-    if var.name in concluded_bare:
+    if var.name in b.concluded_bare:
         ctx.err(
             f"output {var.name} has a DEFUZZIFY block but a rule concludes it without a term",
-            concluded_bare[var.name][0][1].span,
+            b.concluded_bare[var.name][0][1].span,
             "bare-on-defuzzified",
         )
         return None
+    return _defuzzified(ctx, var, db, b, contributions)
+
+
+def _defuzzified(
+    ctx: LowerContext,
+    var: m.Variable,
+    db: m.DefuzzifyBlock,
+    b: BlockSoFar,
+    contributions: list[Contribution],
+) -> OutputPlan | None:
+    """An output with a DEFUZZIFY block: its kind (singleton, Takagi-Sugeno, Tsukamoto,
+    Mamdani) from its terms and method."""
+    accu_for, output_names = b.accu_for, b.output_names
     terms = [lower_term(ctx, t, var.name, output_names, True) for t in first_terms(ctx, var.name, db.terms)]
     if any(t is None for t in terms):
         return None

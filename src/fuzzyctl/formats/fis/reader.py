@@ -57,6 +57,9 @@ from fuzzyctl.model import (
     VarKind,
 )
 
+#: What a Mamdani output of a file naming a Sugeno-only method computes (MATLAB's centroid).
+_CENTROID = methods.spelled("fis")["centroid"]
+
 
 @dataclass
 class _Section:
@@ -473,11 +476,12 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         weighted = ts or fis_type in {"sugeno", "tsukamoto"}
         out_method: str | None
         if weighted:
-            out_method = defuzz if defuzz in {"WTAVER", "WTSUM"} else "WTAVER"
+            out_method = defuzz if defuzz in methods.SUGENO else methods.ts_method(None)
         else:
             any_mamdani_output = True
-            out_method = defuzz if defuzz not in {"WTAVER", "WTSUM"} else "COG"
-            if defuzz in {"WTAVER", "WTSUM"} and fis_type == "mamdani":
+            sugeno_only = defuzz in methods.SUGENO
+            out_method = defuzz if not sugeno_only else _CENTROID
+            if defuzz is not None and sugeno_only and fis_type == "mamdani":
                 entry = system_value("DefuzzMethod")
                 raise rep.fail(
                     f"DefuzzMethod {defuzz.lower()} needs a Sugeno system",

@@ -17,6 +17,7 @@ from fuzzyctl.formats.fpl.names import (
     leaves,
     shared_conclusions,
 )
+from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
@@ -146,7 +147,7 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
                     hint="equations are not permissible (1.3)",
                 )
     for dz in block.defuzzify:
-        if dz.method not in (None, "COG", "COGS"):
+        if dz.method is not None and dz.method not in method_kinds.written("fpl"):
             err(
                 f"METHOD : {dz.method} cannot be written in FPL (Fuzzy Control computes the centre of "
                 "gravity)",
