@@ -16,7 +16,7 @@ from fuzzyctl.escape import fcl_comment, fcl_options
 from fuzzyctl.fcl import shapes
 from fuzzyctl.fcl.identifiers import fcl_block_name, fcl_name, fcl_term
 from fuzzyctl.fcl.no_if import with_if_parts
-from fuzzyctl.fcl.parser import number_text
+from fuzzyctl.fcl.numbers import number_text
 from fuzzyctl.fcl.words import unwritable_words
 from fuzzyctl.model import (
     And,

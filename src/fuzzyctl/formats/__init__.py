@@ -77,6 +77,18 @@ def _no_notes(document: Document) -> list[Loss]:
     return []
 
 
+def on_use(module: str, function: str) -> Callable[..., Any]:
+    """``module.function``, imported on the first call: a format package names its reader
+    and writer this way, so that importing the registry reads no format's code."""
+
+    def call(*args: Any) -> Any:
+        return getattr(importlib.import_module(module), function)(*args)
+
+    call.__name__ = call.__qualname__ = function
+    call.__doc__ = f"{module}.{function}, imported on first use."
+    return call
+
+
 @dataclass(frozen=True)
 class Format:
     """A file format: name, file extensions, size limit, reader, writer and expressibility

@@ -19,6 +19,8 @@ from typing import Any
 
 import numpy as np
 
+from fuzzyctl.model import OPERATOR_PAIRS
+
 
 def fsum(values: Iterable[float]) -> float:
     """``math.fsum`` (exact), with the IEEE value where it raises: ``inf`` for a sum that
@@ -136,16 +138,8 @@ SNORMS: dict[str, Norm] = {
 #: Helpers referenced by ``Norm.source`` templates.
 SOURCE_HELPERS: dict[str, Any] = {"_ham_t": _ham_t, "_ham_s": _ham_s, "min": min, "max": max}
 
-# Table 3: AND -> OR and back.  The open-level norms pair with their duals.
-AND_TO_OR = {
-    "MIN": "MAX",
-    "PROD": "ASUM",
-    "BDIF": "BSUM",
-    "DMIN": "DMAX",
-    "NIPMIN": "NIPMAX",
-    "HAMACHER": "HAMACHER",
-    "EINSTEIN": "EINSTEIN",
-}
+# Table 3: AND -> OR and back (the model's table; the open-level norms pair with their duals).
+AND_TO_OR = dict(OPERATOR_PAIRS)
 OR_TO_AND = {v: k for k, v in AND_TO_OR.items()}
 
 # Spellings other tools write for the same operators.

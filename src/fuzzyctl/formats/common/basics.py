@@ -7,6 +7,7 @@ import re
 from collections.abc import Iterable
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error, warning
+from fuzzyctl.fcl.numbers import number_text
 from fuzzyctl.model import (
     POWER_HEDGE_PREFIX,
     Conclusion,
@@ -21,14 +22,9 @@ from fuzzyctl.model import (
 
 
 def fmt_number(value: float) -> str:
-    """The shortest text that reads back as exactly ``value`` (``1`` not ``1.0``)."""
-    if math.isnan(value):
-        return "nan"
-    if math.isinf(value):
-        return "inf" if value > 0 else "-inf"
-    if value == int(value) and abs(value) < 1e15:
-        return str(int(value))
-    return repr(float(value))
+    """The shortest text that reads back as exactly ``value`` (``1`` not ``1.0``): FCL's
+    spelling of numbers, which every text format here shares."""
+    return number_text(float(value))
 
 
 def parse_number(text: str) -> float:

@@ -4,35 +4,14 @@ and writer load on first use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats import Format, on_use
 from fuzzyctl.formats.fcl.names import fcl_api
 from fuzzyctl.formatspec import SPECS
-from fuzzyctl.model import Document
 
-
-def _read(text: str, path: str | None) -> Loaded:
-    from fuzzyctl.formats.fcl.reader import read
-
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.fcl.writer import write
-
-    return write(document)
-
-
-def _adapt(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.fcl.writer import adapt
-
-    return adapt(document)
-
-
-def _notes(document: Document) -> list[Loss]:
-    from fuzzyctl.formats.fcl.writer import notes
-
-    return notes(document)
-
+_read = on_use("fuzzyctl.formats.fcl.reader", "read")
+_write = on_use("fuzzyctl.formats.fcl.writer", "write")
+_adapt = on_use("fuzzyctl.formats.fcl.writer", "adapt")
+_notes = on_use("fuzzyctl.formats.fcl.writer", "notes")
 
 _available = fcl_api() is not None
 FORMAT = Format.builtin(

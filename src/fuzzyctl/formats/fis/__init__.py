@@ -4,28 +4,12 @@ reader and writer load on first use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats import Format, on_use
 from fuzzyctl.formatspec import SPECS
-from fuzzyctl.model import Document
 
-
-def _read(text: str, path: str | None) -> Loaded:
-    from fuzzyctl.formats.fis.reader import read
-
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.fis.writer import write
-
-    return write(document)
-
-
-def _adapt(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.fis.writer import adapt
-
-    return adapt(document)
-
+_read = on_use("fuzzyctl.formats.fis.reader", "read")
+_write = on_use("fuzzyctl.formats.fis.writer", "write")
+_adapt = on_use("fuzzyctl.formats.fis.writer", "adapt")
 
 FORMAT = Format.builtin(
     SPECS["fis"],

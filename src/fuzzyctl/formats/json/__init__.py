@@ -4,23 +4,12 @@ use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, Loaded
+from fuzzyctl.formats import Format, on_use
 from fuzzyctl.formatspec import SPECS
-from fuzzyctl.model import Document
 from fuzzyctl.validation import at_json_paths
 
-
-def _read(text: str, path: str | None) -> Loaded:
-    from fuzzyctl.formats.json.reader import read
-
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.json.writer import dumps
-
-    return dumps(document)
-
+_read = on_use("fuzzyctl.formats.json.reader", "read")
+_write = on_use("fuzzyctl.formats.json.writer", "dumps")
 
 FORMAT = Format.builtin(
     SPECS["json"],
