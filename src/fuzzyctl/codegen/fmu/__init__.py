@@ -3,7 +3,7 @@
 The FMU is built from the C that :func:`fuzzyctl.codegen.generate_c` writes (``NAME.h``,
 ``NAME.c``) and a model part rendered from ``templates/`` (``config.h``, ``model.c``) for the
 Modelica Association's Reference FMUs framework, vendored with its BSD-2 licence in
-``fuzzyctl/codegen/fmi/``.  It holds
+``fuzzyctl/codegen/fmu/vendor/``.  It holds
 
 * ``modelDescription.xml``: the inputs (Float64), ``ENABLE`` (Boolean input), the outputs,
   ``INFO`` (UInt8; Integer in FMI 2) and every tunable parameter entry (term points,
@@ -126,7 +126,7 @@ def _check_ident(name: str) -> str:
 
 
 def _vendored(name: str) -> str:
-    return resources.files("fuzzyctl.codegen.fmi").joinpath(name).read_text(encoding="utf-8")
+    return resources.files("fuzzyctl.codegen.fmu").joinpath("vendor", name).read_text(encoding="utf-8")
 
 
 def _template(name: str) -> Template:
