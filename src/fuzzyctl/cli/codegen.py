@@ -17,14 +17,18 @@ import typer
 from fuzzyctl import formats
 from fuzzyctl.cli.app import FORCE_HINT, FromOpt, StrictOpt, app, err_console, usage_errors
 from fuzzyctl.codegen.emit import accepting, generator_of
+from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 
-__all__ = ["Dialect", "Lang", "codegen", "generator_of"]
+__all__ = ["Arith", "Dialect", "Lang", "codegen", "generator_of"]
 
 #: ``--lang`` choices: the targets with a CLI choice, in registry order.
 Lang = StrEnum("Lang", [(c, c) for c in targets.cli_choices()])  # type: ignore[misc]
 #: ``--dialect`` choices: the Structured Text dialects and their aliases.
 Dialect = StrEnum("Dialect", [(d, d) for d in targets.dialect_names()])  # type: ignore[misc]
+#: ``--arith`` choices: the arithmetic records.
+Arith = StrEnum("Arith", [(a, a) for a in arith_kinds.choices()])  # type: ignore[misc]
+_DEFAULT_ARITH = Arith(arith_kinds.DEFAULT)
 _DEFAULT_LANG = Lang(targets.cli_choices()[0])
 
 
@@ -77,6 +81,15 @@ def codegen(
     single: Annotated[
         bool, typer.Option("--float", help="c only: compute in float instead of double.")
     ] = False,
+    arith: Annotated[
+        Arith,
+        typer.Option(
+            "--arith",
+            help=f"{' and '.join(accepting('arith'))}: the arithmetic; "
+            + "; ".join(f"{a.name}: {a.help}" for a in arith_kinds.ARITH.values())
+            + ".",
+        ),
+    ] = _DEFAULT_ARITH,
     testbench: Annotated[
         int,
         typer.Option(
@@ -139,6 +152,7 @@ def codegen(
             format=from_format,
             fmi=fmi,
             binary=not no_binary,
+            arith=arith.value,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))

@@ -8,11 +8,13 @@ from typing import Any
 from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
+from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.nodes import Program
 from fuzzyctl.ir.programs.plc_block import build_program
 from fuzzyctl.ir.render.c import render_c
 from fuzzyctl.ir.render.st import render_st
 from fuzzyctl.ir.state import Target
+from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
@@ -87,6 +89,7 @@ def generate_st(
     testbench: int = 0,
     default: float | str | None = None,
     report: list[Generated] | None = None,
+    arith: str = arith_kinds.DEFAULT,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
@@ -98,8 +101,10 @@ def generate_st(
     checks it on that many input vectors against the engine (:mod:`fuzzyctl.codegen.testbench`);
     ``default`` (a number or ``"hold"``) replaces ``DEFAULT := nan``.  Names the target cannot
     use are renamed (header comment; ``report`` receives one :class:`Generated` per block).
+    ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`).
     Raises :class:`CodegenError` naming what cannot be expressed."""
     dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
+    check_arith(arith)
     parts = []
     for plan in plans(model, block, **options):
         gen = build(plan, "st", default)
@@ -122,12 +127,15 @@ def generate_c(
     testbench: int = 0,
     default: float | str | None = None,
     report: list[Generated] | None = None,
+    arith: str = arith_kinds.DEFAULT,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
     ``block``); ``single`` computes in float instead of double; ``testbench`` > 0 adds
     ``NAME_testbench.c`` checking the block on that many input vectors against the engine;
-    ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does)."""
+    ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does);
+    ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`)."""
+    check_arith(arith)
     files: dict[str, str] = {}
     for plan in plans(model, block, **options):
         gen = build(plan, "c", default)
@@ -144,3 +152,13 @@ def generate_c(
             bench = choose(gen.plan, testbench, single=single)
             files[f"{prog.name}_testbench.c"] = render_c_bench(bench, single=single)
     return files
+
+
+def check_arith(arith: str) -> None:
+    """Refuse an arithmetic this generator does not write (integer forms: not yet)."""
+    try:
+        chosen = arith_kinds.get(arith)
+    except ValueError as exc:
+        raise CodegenError(str(exc)) from None
+    if chosen.integer:
+        raise CodegenError(f"--arith {chosen.name} is not generated yet: use --arith float")

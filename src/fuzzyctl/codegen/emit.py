@@ -12,6 +12,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.diagnostics import OptionError
+from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document
 
@@ -92,6 +93,7 @@ def check_options(
     testbench: int = 0,
     fmi: int | None = None,
     binary: bool = True,
+    arith: str = arith_kinds.DEFAULT,
 ) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
     (:class:`OptionError` names the option); what applies is the target's record."""
@@ -111,6 +113,12 @@ def check_options(
     if "float" not in takes and single:
         hint = " (use --lreal)" if "lreal" in takes else ""
         raise OptionError(f"--float applies to --lang {' and '.join(accepting('float'))}{hint}", "--lang")
+    if arith != arith_kinds.DEFAULT and "arith" not in takes:
+        raise OptionError(f"--arith applies to --lang {' and '.join(accepting('arith'))}", "--arith")
+    try:
+        arith_kinds.get(arith)
+    except ValueError as exc:
+        raise OptionError(str(exc), "--arith") from None
     refusal = targets.dialect(dialect).refused_by.get(caps.name) if dialect is not None else None
     if refusal is not None:
         raise OptionError(f"{refusal}: use --lang st --dialect {dialect}", "--dialect")
@@ -150,6 +158,7 @@ def emit(
     format: str | None = None,
     fmi: int | None = None,
     binary: bool = True,
+    arith: str = arith_kinds.DEFAULT,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
         are checked first) and write it: ``st`` and ``plcopen`` to the file
@@ -168,6 +177,7 @@ def emit(
         testbench=testbench,
         fmi=fmi,
         binary=binary,
+        arith=arith,
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
@@ -175,8 +185,15 @@ def emit(
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     emitted = Emitted(lang)
     kwargs: dict[str, Any] = {"block": block, "strict": strict, "default": default}
-    chosen = {"dialect": dialect or DEFAULT_DIALECT, "lreal": lreal, "single": single, "testbench": testbench}
+    chosen = {
+        "dialect": dialect or DEFAULT_DIALECT,
+        "lreal": lreal,
+        "single": single,
+        "testbench": testbench,
+        "arith": arith,
+    }
     for option, keyword in (
+        ("arith", "arith"),
         ("dialect", "dialect"),
         ("lreal", "lreal"),
         ("float", "single"),

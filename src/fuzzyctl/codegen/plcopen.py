@@ -242,6 +242,7 @@ def generate_plcopen(
     dialect: str = "codesys",
     lreal: bool = False,
     project: str | None = None,
+    arith: str = "float",
     **options: Any,
 ) -> str:
     """PLCopen TC6 XML 2.01 (one project, one ``functionBlock`` POU per function block) whose
@@ -249,7 +250,9 @@ def generate_plcopen(
     ``lreal``; ``project`` names the project (default: the first block's name).  The ``scl``
     dialect is refused (TIA Portal imports SCL source, not PLCopen XML)."""
     from fuzzyctl import __version__
+    from fuzzyctl.codegen.api import check_arith
 
+    check_arith(arith)
     check_dialect(dialect)
     parts = st_blocks(model, block, dialect, lreal, options)
     name = project or (parts[0].name if parts else "fuzzyctl")

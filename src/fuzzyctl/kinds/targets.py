@@ -157,7 +157,7 @@ class Target:
     cli: str | None = None
     cli_help: str = ""
     generator: str = ""  # "module:function" the CLI calls
-    cli_options: frozenset[str] = frozenset()  # of dialect, lreal, float, testbench, fmi
+    cli_options: frozenset[str] = frozenset()  # of CLI_OPTIONS
     report: bool = False  # the generator fills a rename/--default report (--json)
     # --- Structured Text block conventions (dialects)
     cli_dialect_help: str = ""  # the dialect as --dialect's help lists it
@@ -258,7 +258,7 @@ ST = Target(
     cli="st",
     cli_help="Structured Text",
     generator="fuzzyctl.codegen.api:generate_st",
-    cli_options=frozenset({"dialect", "lreal", "testbench"}),
+    cli_options=frozenset({"dialect", "lreal", "testbench", "arith"}),
     report=True,
     cli_dialect_help="codesys (default)",
 )
@@ -306,7 +306,7 @@ PLCOPEN = dataclasses.replace(
     cli="plcopen",
     cli_help="the same as PLCopen TC6 XML",
     generator="fuzzyctl.codegen.plcopen:generate_plcopen",
-    cli_options=frozenset({"dialect", "lreal"}),
+    cli_options=frozenset({"dialect", "lreal", "arith"}),
     report=False,
 )
 
@@ -358,7 +358,7 @@ C = Target(
     cli="c",
     cli_help="C99",
     generator="fuzzyctl.codegen.api:generate_c",
-    cli_options=frozenset({"float", "testbench"}),
+    cli_options=frozenset({"float", "testbench", "arith"}),
     report=True,
 )
 
@@ -494,7 +494,7 @@ def cli_target(choice: str) -> Target:
 #: Intrinsics every builder needs (smooth shapes, CoA, the POW fallback EXP(y * LN(x))).
 CORE_FUNCTIONS = frozenset({"EXP", "LN", "SQRT", "ABS"})
 #: CLI options a target may accept.
-CLI_OPTIONS = frozenset({"dialect", "lreal", "float", "testbench", "fmi"})
+CLI_OPTIONS = frozenset({"dialect", "lreal", "float", "testbench", "fmi", "arith"})
 
 
 def incomplete(t: Target) -> list[str]:
