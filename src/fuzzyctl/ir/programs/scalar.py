@@ -53,7 +53,10 @@ class ScalarBuilder(NativeBuilder):
     def am_lines(
         self, x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...], args: list[Ex]
     ) -> tuple[Ex, Ex]:
-        if len(geom) == 1 or (len(geom) == 2 and accu == "MAX"):
+        """One or two sets on a shared interval: the IR (faster: 3.5 against 12 us a call
+        under MAX, 19 against 24 under PROBOR); three or more: the AM_LINES kernel (the IR's
+        cut-and-sort loop runs as fast or up to 7% slower in Python)."""
+        if len(geom) <= 2:
             return super().am_lines(x0, x1, accu, geom, args)
         return FastBuilder.am_lines(self, x0, x1, accu, geom, args)
 
