@@ -19,6 +19,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import functools
 import math
 import time
 from collections.abc import Callable
@@ -111,7 +112,7 @@ def scalar_us(plan: Plan, rows: list[list[float]], rounds: int) -> dict[str, flo
     best = dict.fromkeys(fns, float("inf"))
     for _ in range(rounds):
         for k, fn in fns.items():
-            best[k] = min(best[k], _best(lambda fn=fn: loop(fn), 1))
+            best[k] = min(best[k], _best(functools.partial(loop, fn), 1))
     return {k: v / len(rows) * 1e6 for k, v in best.items()}
 
 
@@ -127,9 +128,10 @@ def numpy_ns(plan: Plan, cols: list[np.ndarray], rounds: int) -> dict[str, float
     out = {"IR": math.nan}  # NaN: the IR cannot be if-converted (an index that differs per row)
     with contextlib.suppress(CodegenError):
         fns["IR"] = vectorise(NativeBuilder(plan, "np").build())
+    state: list[float | None] = [0.0] * len(plan.outputs)
     for k, fn in fns.items():
-        fn(cols, [0.0] * len(plan.outputs), n)
-        out[k] = _best(lambda fn=fn: fn(cols, [0.0] * len(plan.outputs), n), rounds) / n * 1e9
+        fn(cols, state, n)
+        out[k] = _best(functools.partial(fn, cols, state, n), rounds) / n * 1e9
     return out
 
 
