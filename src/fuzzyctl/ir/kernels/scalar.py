@@ -12,8 +12,8 @@ their IR twin (``benchmarks/bench_engine.py --only kernels``) or that the IR doe
 ============  ==========================================================  ====================
 kernel        IR twin                                                     kept for
 ============  ==========================================================  ====================
-``AM_LINES``  :func:`fuzzyctl.ir.builders.pieces.interval`                three or more sets
-                                                                          on an interval
+``AM_LINES``  :func:`fuzzyctl.ir.builders.pieces.interval`                3+ MIN sets on an
+                                                                          interval under MAX
 ``MAMDANI``   :mod:`fuzzyctl.ir.builders.grid_pieces`,                    BSUM, PROBOR, sums of
               :func:`fuzzyctl.ir.builders.quadrature.smooth_cog`          MIN sets; smooth sets
                                                                           under LM/RM/MoM/CoA

@@ -6,19 +6,23 @@ every output written in the IR, as the native backend's program
 The defuzzification a single evaluation runs is then the one the C and the Structured Text
 run (:mod:`fuzzyctl.ir.builders.mamdani`, :mod:`~fuzzyctl.ir.builders.pieces`,
 :mod:`~fuzzyctl.ir.builders.grid_pieces`, :mod:`~fuzzyctl.ir.builders.quadrature`), not a
-hand-written Python copy of it.  Printed as Python this was measured faster, per call, than
-the kernels of :mod:`fuzzyctl.ir.kernels.scalar` it replaces (``benchmarks/bench_engine.py
---only kernels``, "scalar" rows): on the 2-input, 4-rule base of section 6, CoG about 3x, CoA
-4x, LM, RM and MoM 6-11x, a smooth (Gaussian) CoG output 7x; terms given by inputs, rule
-activation and Tsukamoto outputs about the same or faster.
+hand-written Python copy of it.  Printed as Python it was measured faster per call than
+the kernels of :mod:`fuzzyctl.ir.kernels.scalar` (``benchmarks/bench_engine.py --only
+kernels``, CPU time, one 2-input 4-rule base per row): CoG 12.2 -> 3.6 us, LM 46 -> 23,
+RM 46 -> 32, MoM 48 -> 35, CoA 45 -> 42, CoA of SUM/PROD 31 -> 3.6, a smooth (Gaussian) CoG
+3144 -> 333, terms given by inputs 58 -> 9, rule activation 2.1 -> 1.1, Tsukamoto 7.6 -> 1.0.
 
 What stays a kernel in Python, and why:
 
+* ``AM_LINES`` for three or more MIN-activated sets on one grid interval under MAX (its twin
+  :func:`fuzzyctl.ir.builders.pieces.interval` measured as fast or up to 7% slower there);
+* ``MAMDANI`` (the interpreter's code) for an exact output under BSUM, PROBOR or a sum of
+  MIN-activated sets, where :mod:`fuzzyctl.ir.builders.grid_pieces` cuts the sets at every
+  crossing and measured 2-28% slower (:func:`ir_exact`), and for what the IR does not
+  express: a method other than CoG on smooth sets, a smooth term given by variables;
 * ``EXPR`` (a function term; its IR twin is
   :meth:`~fuzzyctl.ir.builders.rules.RuleBuilder.function_term`): Python's arithmetic raises
   where the expression's IEEE value is ``inf`` or NaN, which ``eval_expr`` gives;
-* ``MAMDANI`` for what the IR does not express (a method other than CoG on smooth sets, a
-  smooth output term given by variables): the reference interpreter's own code for it;
 * ``HOLD`` (DEFAULT / NC / lock-range), which every renderer prints as a few lines.
 
 Python raises where C gives ``inf`` or NaN (a Tsukamoto sigmoid at its height: ``log(0)``):
@@ -53,10 +57,12 @@ class ScalarBuilder(NativeBuilder):
     def am_lines(
         self, x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...], args: list[Ex]
     ) -> tuple[Ex, Ex]:
-        """One or two sets on a shared interval: the IR (faster: 3.5 against 12 us a call
-        under MAX, 19 against 24 under PROBOR); three or more: the AM_LINES kernel (the IR's
-        cut-and-sort loop runs as fast or up to 7% slower in Python)."""
-        if len(geom) <= 2:
+        """The IR (:func:`~fuzzyctl.ir.builders.pieces.max_of_two`,
+        :func:`~fuzzyctl.ir.builders.pieces.interval`), except three or more MIN-activated sets
+        under MAX: there the AM_LINES kernel was measured as fast or up to 7% faster, while the
+        IR wins elsewhere (3.5 against 12 us a call for two sets under MAX, 18 against 24 for
+        PROBOR, 25-35% less for sums and PROD-activated sets)."""
+        if len(geom) <= 2 or accu != "MAX" or not all(mn for _l, _r, mn in geom):
             return super().am_lines(x0, x1, accu, geom, args)
         return FastBuilder.am_lines(self, x0, x1, accu, geom, args)
 
