@@ -29,6 +29,9 @@ independently by benchmarks/systems.py (tipper and grid49 are ../shared/bench/pe
    path with its hand-written kernels replaced by the native builder's IR printed as numpy
    ("np IR": the row that keeps ir/kernels/columns.py where it is faster), the native batch
    as a multiple of CoG's, and the native single evaluation (``--only methods``).
+7. Each hand-written kernel against its IR twin rendered in the same language, Python per
+   call and numpy per row (``--only kernels``; benchmarks/bench_kernels.py says how): a
+   kernel is kept only where this row shows the rendered IR slower.
 
 The machine's load average is printed at the start and the end: speed ratios measured in the
 same run are what counts on a shared machine.
@@ -58,6 +61,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 import systems as S  # noqa: E402
+from bench_kernels import section_kernels  # noqa: E402
 
 PEERS = ("pyfuzzylite", "skfuzzy", "simpful")
 N_BATCH = 100_000
@@ -564,7 +568,9 @@ def main() -> None:
         default=str(default_peers) if default_peers.exists() else None,
         help="python of the peers' virtual environment (default: .venv-peers)",
     )
-    ap.add_argument("--only", help="comma-separated sections: peers,handwritten,scaling,cold,memory,methods")
+    ap.add_argument(
+        "--only", help="comma-separated sections: peers,handwritten,scaling,cold,memory,methods,kernels"
+    )
     args = ap.parse_args()
     if args.peers is None:
         print("no .venv-peers: peers skipped (make .venv-peers)", file=sys.stderr)
@@ -582,6 +588,7 @@ def main() -> None:
         "cold": section_cold_start,
         "memory": section_memory,
         "methods": section_methods,
+        "kernels": section_kernels,
     }
     wanted = args.only.split(",") if args.only else list(sections)
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-bench-") as tmp:

@@ -81,12 +81,12 @@ class Controller:
         if self._fast_fn is None:
             self._fast_fn = False
             if self._specialise:
-                from fuzzyctl.ir.programs.evaluator import build_fast
+                from fuzzyctl.ir.programs.scalar import build_scalar
                 from fuzzyctl.ir.render.pysrc import specialise
                 from fuzzyctl.ir.state import CodegenError
 
                 with contextlib.suppress(CodegenError):  # the interpreter evaluates it
-                    self._fast_fn = specialise(build_fast(self.plan, "py"))
+                    self._fast_fn = specialise(build_scalar(self.plan))
         return self._fast_fn if callable(self._fast_fn) else None
 
     @property
@@ -149,7 +149,8 @@ class Controller:
         elif fast is not None:
             try:
                 res = fast(values, self._state)
-            except ArithmeticError:  # Python raises where numpy and C give inf/NaN: take the IEEE value
+            except (ArithmeticError, ValueError):  # Python raises where C gives inf/NaN (1/0, log(0))
+                # take the IEEE value
                 res = None
         if res is None:
             rec = self._interp.run(values, self._state)

@@ -18,6 +18,26 @@ twins are :meth:`fuzzyctl.ir.programs.evaluator.FastBuilder.closed_cog` with
 :func:`fuzzyctl.ir.builders.pieces.max_of_two` (:func:`centroid`, :func:`_max_of_two`) and
 :mod:`fuzzyctl.ir.builders.grid_pieces` (:func:`bisector_value`, :func:`maximum_point`), which the
 native backend compiles; each method's entry in :mod:`fuzzyctl.kinds.methods` names both.
+``benchmarks/bench_engine.py --only kernels`` times every kernel here against its twin
+printed as numpy:
+
+===============  ===============================================  ===========================
+kernel           IR twin                                          numpy IR
+===============  ===============================================  ===========================
+``AM_LINES``     :func:`fuzzyctl.ir.builders.pieces.max_of_two`,  2.5x slower (two sets);
+                 :func:`~fuzzyctl.ir.builders.pieces.interval`    more sets: not if-convertible
+``MAMDANI``      :mod:`fuzzyctl.ir.builders.grid_pieces`          1.7-5x slower, or not
+                                                                  if-convertible
+``TS``           :func:`fuzzyctl.ir.builders.terms.tsukamoto`     2.7x slower
+``SELECT``       ``NativeBuilder.select``                         a tie at 4 rules (+-10%);
+                 (:mod:`fuzzyctl.ir.programs.native`)             quadratic in the rule count
+``MEMBER``       ``NativeBuilder.member`` (run-time sort)         not if-convertible
+``EXPR``         ``RuleBuilder.function_term``                    not timed yet (Python and
+                                                                  numpy print no function IR)
+===============  ===============================================  ===========================
+
+"Not if-convertible": the IR indexes an array by a value that differs between rows, which
+:mod:`fuzzyctl.ir.render.npsrc` refuses to print.
 """
 
 from __future__ import annotations

@@ -4,6 +4,24 @@ output methods, :mod:`~fuzzyctl.engine.semantics.selection`), bound to its const
 program is rendered.
 
 ``make(name, data, plan)`` returns the callable the rendered source calls.
+
+Single evaluations run the native evaluator's IR printed as Python
+(:mod:`fuzzyctl.ir.programs.scalar`); of these kernels it keeps only those measured faster than
+their IR twin (``benchmarks/bench_engine.py --only kernels``) or that the IR does not express:
+
+============  ==========================================================  ====================
+kernel        IR twin                                                     kept for
+============  ==========================================================  ====================
+``AM_LINES``  :func:`fuzzyctl.ir.builders.pieces.interval`                3+ MIN sets on an
+                                                                          interval under MAX
+``MAMDANI``   :mod:`fuzzyctl.ir.builders.grid_pieces`,                    BSUM, PROBOR, sums of
+              :func:`fuzzyctl.ir.builders.quadrature.smooth_cog`          MIN sets; smooth sets
+                                                                          under LM/RM/MoM/CoA
+``EXPR``      :meth:`fuzzyctl.ir.builders.rules.RuleBuilder.function_term`  IEEE inf/NaN
+``SELECT``    :meth:`fuzzyctl.ir.programs.native.NativeBuilder.select`    a plan the IR refuses
+``MEMBER``    :meth:`fuzzyctl.ir.programs.native.NativeBuilder.member`    a plan the IR refuses
+``TS``        :func:`fuzzyctl.ir.builders.terms.tsukamoto`                a plan the IR refuses
+============  ==========================================================  ====================
 """
 
 from __future__ import annotations

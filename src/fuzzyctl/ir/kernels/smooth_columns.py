@@ -16,8 +16,11 @@ once, started from intervals cut at the set's kinks.
    relative; docs/engine.md).
 
 CoG is vectorised; CoA, LM, RM and MoM of smooth sets, and terms whose parameters are inputs,
-go row by row through the interpreter.  The Python path evaluates a single sample with the
-same code (one row).
+go row by row through the interpreter.  The IR twin is
+:func:`fuzzyctl.ir.builders.quadrature.smooth_cog` (the native backend's C, and the Python of
+single evaluations: :mod:`fuzzyctl.ir.programs.scalar`); printed as numpy it cannot be
+if-converted (each row opens its own intervals), so a batch keeps this kernel
+(``benchmarks/bench_engine.py --only kernels``, row "smooth CoG").
 """
 
 from __future__ import annotations
