@@ -61,14 +61,7 @@ def test_lowering_evaluates_every_name_as_a_method_without_aliases() -> None:
 
 #: Files that still compare method names, and why (the list only shrinks: the test fails
 #: when a listed file is clean).  Everything else reads the registry.
-NOT_YET: dict[str, str] = {
-    "engine/compat/jfl.py": "jFuzzyLogic's own defuzzifier switch, reproduced as its Java is written",
-    "engine/lowering/outputs.py": "the methods jFuzzyLogic's profile accepts (its Java's list)",
-    "fcl/checks.py": "COGF without function terms (a fuzzylite-specific warning)",
-    "fcl/conformance.py": "the IEC 61131-7 level of each method (Table 1 vs extensions)",
-    "formats/common/adapt.py": "writers' normal forms (COG of singletons is COGS, COGF as WTAVER)",
-    "formats/fis/writer.py": "MATLAB's default defuzzMethod of a Sugeno system",
-}
+NOT_YET: dict[str, str] = {}
 
 
 def _comparisons(path: Path) -> list[int]:

@@ -276,14 +276,7 @@ _COMPARE = re.compile(
 )
 #: Files that still compare shape names, and why (to be moved onto registry fields; the test
 #: fails when a listed file is clean, so the list only shrinks).
-NOT_YET: dict[str, str] = {
-    "engine/lowering/terms.py": "fuzzylite's formula on unordered triangle/trapezoid vertices",
-    "formats/common/adapt.py": "bounded support for the writers (the registry's support differs on "
-    "pishape and cosine_half: moving it changes what FPL/XFUZ write)",
-    "ir/builders/terms.py": "the Tsukamoto inverse of a constant points term (its breakpoints "
-    "inverted as an if-chain; the parametric shapes use the entry's inverse)",
-    "tune/gradient.py": "the analytic derivative of the gaussian (no registry derivative yet)",
-}
+NOT_YET: dict[str, str] = {}
 #: Files whose matches compare something else spelled like a shape (test signals, FMI's
 #: variability "constant").
 OTHER_MEANING: dict[str, int] = {"sim/profiles.py": 1, "studio/analysis.py": 2, "sim/plants/fmu.py": 1}

@@ -267,7 +267,11 @@ def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None
             d.span,
             "missing-default",
         )
-    if d.method == "COGF" and not any(isinstance(t.mf, FunctionMF) for t in d.terms):
+    if (
+        d.method in METHODS
+        and METHODS[d.method].for_function_terms
+        and not any(isinstance(t.mf, FunctionMF) for t in d.terms)
+    ):
         r.warning(
             f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function"
         )

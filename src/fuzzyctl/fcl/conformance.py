@@ -11,6 +11,7 @@ from enum import IntEnum
 from typing import Any
 
 from fuzzyctl.fcl.checks import is_singleton, uses_operator
+from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import (
     And,
     Condition,
@@ -163,9 +164,10 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
         for d in fb.defuzzify:
             if d.range is not None:
                 add(ext, "range", "RANGE(min..max) for an output")
-            if d.method in ("COG", "COA", "LM", "RM"):
+            level = "basic" if d.method is None else getattr(METHODS.get(d.method), "conformance", "open")
+            if level == "extension":
                 add(ext, "defuzzification method", f"METHOD: {d.method}")
-            elif d.method not in (None, "COGS"):
+            elif level == "open":
                 add(open_, "defuzzification method", f"METHOD: {d.method}")
             if d.accu is not None:
                 add(open_, "accumulation", "ACCU inside DEFUZZIFY (fuzzylite)")

@@ -66,6 +66,13 @@ class Method:
     #: a Takagi-Sugeno method (weights the values of singleton, linear or function terms);
     #: the others weighting points (COGS) are the IEC methods of singleton outputs
     takagi_sugeno: bool = False
+    #: its IEC 61131-7 conformance level: ``basic`` (COGS), ``extension`` (the other methods
+    #: of Table 1) or ``open`` (another tool's)
+    conformance: Literal["basic", "extension", "open"] = "open"
+    #: the FCL keywords jFuzzyLogic reads for it (empty: jFuzzyLogic has no such method)
+    jfl: tuple[str, ...] = ()
+    #: meant for FUNCTION terms (a warning when an output using it has none)
+    for_function_terms: bool = False
 
     @property
     def centroid(self) -> bool:
@@ -120,6 +127,8 @@ METHODS: dict[str, Method] = {
                 "xfuz": ("COG",),
             },
             aliases=("CENTROID",),
+            conformance="extension",
+            jfl=("COG",),
             integrating=True,
             reference=_PWL + ":centroid",
             ir="fuzzyctl.ir.programs.evaluator:FastBuilder.closed_cog",
@@ -131,6 +140,8 @@ METHODS: dict[str, Method] = {
             {"COGS": IEC + " Table 1: centre of gravity for singletons (fuzzylite: WeightedAverage)"},
             {"fpl": ("COGS",), "xfuz": ("COGS",)},
             weighted="average",
+            conformance="basic",
+            jfl=("COGS",),
             reference="fuzzyctl.engine.reference.interp:weighted_value",
             ir="fuzzyctl.ir.builders.rules:RuleBuilder.singleton",
             numpy="fuzzyctl.ir.render.npsrc:vectorise",
@@ -141,6 +152,8 @@ METHODS: dict[str, Method] = {
             {"COA": IEC + " Table 1: centre of area (bisector)", "BIS": "fuzzylite 4: Bisector"},
             {"fis": ("bisector",), "fll": ("Bisector",)},
             aliases=("BISECTOR",),
+            conformance="extension",
+            jfl=("COA",),
             integrating=True,
             bisects=True,
             reference=_PWL + ":bisector_value",
@@ -156,6 +169,8 @@ METHODS: dict[str, Method] = {
             },
             {"fis": ("som",), "fll": ("SmallestOfMaximum",)},
             maximum="left",
+            conformance="extension",
+            jfl=("LM",),
             reference=_PWL + ":leftmost",
             ir=_GRID + ":leftmost",
             numpy=_NP + ":maximum_point",
@@ -169,6 +184,8 @@ METHODS: dict[str, Method] = {
             },
             {"fis": ("lom",), "fll": ("LargestOfMaximum",)},
             maximum="right",
+            conformance="extension",
+            jfl=("RM",),
             reference=_PWL + ":rightmost",
             ir=_GRID + ":rightmost",
             numpy=_NP + ":maximum_point",
@@ -179,6 +196,7 @@ METHODS: dict[str, Method] = {
             {"MM": JFL + " / " + FL + ": mean of maximum", "MOM": "mean of maximum"},
             {"fis": ("mom",), "fll": ("MeanOfMaximum",), "xfuz": ("MOM",)},
             maximum="mean",
+            jfl=("MM", "MOM"),
             reference=_PWL + ":mean_of_maximum",
             ir=_GRID + ":mean_of_maximum",
             numpy=_NP + ":maximum_point",
@@ -191,6 +209,8 @@ METHODS: dict[str, Method] = {
             weighted="average",
             takagi_sugeno=True,
             lowers_to="WTAVER",  # jFuzzyLogic's COGF is the weighted average of the terms' values
+            jfl=("COGF",),
+            for_function_terms=True,
             **_WEIGHTED,
         ),
         _entry(
@@ -227,6 +247,11 @@ def method(code: str) -> Method:
 def spelled(fmt: str) -> dict[str, str]:
     """Spelling -> code for format ``fmt`` (what its reader accepts)."""
     return {s: m.code for m in METHODS.values() for s in m.spellings.get(fmt, ())}
+
+
+def jfl_spelled() -> dict[str, str]:
+    """jFuzzyLogic's FCL keyword -> code, for the methods it has."""
+    return {s: code for code, m in METHODS.items() for s in m.jfl}
 
 
 def lowering_aliases() -> dict[str, str]:
@@ -266,6 +291,12 @@ def ts_method(code: str | None) -> str:
     else the weighted average (COG, COGS or none written)."""
     m = METHODS.get(code or "")
     return m.code if m is not None and m.takagi_sugeno and m.lowers_to is None else _TS_AVERAGE
+
+
+def singleton_centroid(code: str | None) -> bool:
+    """Whether ``code`` is a centroid of singletons: COG, COGS or none written."""
+    m = METHODS.get(code or "COGS")
+    return m is not None and (m.centroid or (m.weighted == "average" and not m.takagi_sugeno))
 
 
 def singleton_method(code: str | None) -> str:

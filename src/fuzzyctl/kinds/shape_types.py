@@ -123,6 +123,12 @@ class Shape:
     jfl_refuses: Callable[[Sequence[float]], bool] | NA = field(
         default_factory=lambda: NA("jFuzzyLogic reads every value its spelling can write")
     )
+    zero_outside: Callable[[Sequence[float]], tuple[float, float]] | NA = field(
+        default_factory=lambda: NA("the writers do not bound it (FPL and XFUZ sample it over the range)")
+    )  # the interval outside which the degree is exactly 0, as the writers clip the shape
+    gradient: tuple[str, ...] | NA = field(
+        default_factory=lambda: NA("no analytic derivative written yet (the gradient tuner refuses it)")
+    )  # d(degree)/d(parameter i), over x, mu (the degree, height included) and the parameters
     compiled: dict[str, Any] = field(default_factory=dict, compare=False, repr=False)
 
     # ---- family flags
@@ -181,6 +187,19 @@ class Shape:
             assert isinstance(self.tsukamoto, str), self.kind
             self.compiled["tsukamoto"] = fm.parse(self.tsukamoto, ("y", "h", *self.params), HELPERS)
         f: fm.Formula = self.compiled["tsukamoto"]
+        return f
+
+    @property
+    def differentiable(self) -> bool:
+        """An analytic derivative per parameter (:attr:`gradient`) for the gradient tuner."""
+        return not isinstance(self.gradient, NA)
+
+    def parsed_gradient(self) -> tuple[fm.Formula, ...]:
+        if "gradient" not in self.compiled:
+            assert isinstance(self.gradient, tuple), self.kind
+            args = ("x", "mu", *self.params)
+            self.compiled["gradient"] = tuple(fm.parse(g, args, HELPERS) for g in self.gradient)
+        f: tuple[fm.Formula, ...] = self.compiled["gradient"]
         return f
 
     def parsed_jfl(self) -> fm.Formula:

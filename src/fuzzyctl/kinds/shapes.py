@@ -84,6 +84,7 @@ def _bell_span(p: Sequence[float]) -> tuple[float, float]:
 
 
 HULL = Span("the hull of its parameters", lambda p: (min(p), max(p)))
+_ZERO_OUTSIDE_HULL = HULL.of
 WHOLE_LINE = Span("the whole line (no parameter spans it)", lambda p: (-math.inf, math.inf))
 
 
@@ -265,6 +266,7 @@ ENTRIES: tuple[Shape, ...] = (
         "(1.0 if x == b else ((x - a) / (b - a) if x < b else 1 - (x - b) / (c - b)))",
         infinite=(0, 1, 2),
         vertices=(0.0, 1.0, 0.0),
+        zero_outside=_ZERO_OUTSIDE_HULL,
     ),
     Shape(
         "trapezoid",
@@ -295,6 +297,7 @@ ENTRIES: tuple[Shape, ...] = (
         "((x - a) / (b - a) if x < b else 1 - (x - c) / (d - c)))",
         infinite=(0, 1, 2, 3),
         vertices=(0.0, 1.0, 1.0, 0.0),
+        zero_outside=_ZERO_OUTSIDE_HULL,
     ),
     Shape(
         "rectangle",
@@ -320,6 +323,7 @@ ENTRIES: tuple[Shape, ...] = (
         ANY,
         HULL,
         NO_JFL,
+        zero_outside=_ZERO_OUTSIDE_HULL,
     ),
     _smooth(
         "gaussian",
@@ -340,6 +344,10 @@ ENTRIES: tuple[Shape, ...] = (
         span=Span("mean +- 4 sigma", lambda p: (p[0] - 4.0 * p[1], p[0] + 4.0 * p[1])),
         degenerate=_SD,
         jfl="exp(-(x - mean) * (x - mean) / (2 * sigma * sigma))",
+        gradient=(
+            "mu * (x - mean) / (sigma * sigma)",
+            "mu * (x - mean) * (x - mean) / (sigma * sigma * sigma)",
+        ),
     ),
     _smooth(
         "gaussian2",
@@ -492,6 +500,7 @@ ENTRIES: tuple[Shape, ...] = (
         studio=Studio(("c", "w"), (_h(0, 1), _h(1, 0, 0, 0.5))),
         span=Span("center +- width/2", lambda p: (p[0] - 0.5 * abs(p[1]), p[0] + 0.5 * abs(p[1]))),
         degenerate=_nonzero(1),
+        zero_outside=lambda p: (p[0] - abs(p[1]) / 2, p[0] + abs(p[1]) / 2),
         jfl="t = 0.5 * width; u = x - center\n(cos(u * (pi / t)) + 1) / 2 if -t <= u and u <= t else 0.0",
     ),
     _smooth(
@@ -681,6 +690,7 @@ ENTRIES: tuple[Shape, ...] = (
         probe=(2, 8),
         studio=Studio(("a", "b"), (_h(0, 0), _h(1, 0))),
         degenerate=Degenerate("needs start != end", lambda p: p[0] == p[1]),
+        zero_outside=_ZERO_OUTSIDE_HULL,
     ),
     Shape(
         "constant",
@@ -705,6 +715,7 @@ ENTRIES: tuple[Shape, ...] = (
         WHOLE_LINE,
         NA("jFuzzyLogic reads it as a singleton at its value"),
         probe_output=(5.0,),
+        zero_outside=lambda p: (p[0], p[0]),
     ),
     Shape(
         "linear",

@@ -31,13 +31,14 @@ engine's outputs.  Samples where no rule fires take the DEFAULT value (derivativ
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 import numpy as np
 import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
-from fuzzyctl.engine.semantics.shapes import pwl_value_np
+from fuzzyctl.engine.semantics.shapes import NUMPY, membership_np, pwl_value_np
+from fuzzyctl.kinds import formula
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
@@ -59,7 +60,8 @@ def _term_unsupported(t: TermPlan) -> str | None:
         if t.pwl is None or not all(np.isfinite(x) for x, _ in t.pwl):
             return f"term {t.name}: infinite vertices"
         return None
-    if t.kind == "gaussian":
+    shape = registry.SHAPES.get(t.kind)
+    if shape is not None and shape.differentiable:  # the registry writes its derivatives
         return None
     return f"term {t.name}: shape {t.kind}"
 
@@ -138,15 +140,23 @@ def _scale(g: Grad, s: Arr | float) -> Grad:
     return {k: v * s for k, v in g.items()}
 
 
+def _derivatives(shape: registry.Shape) -> list[Callable[..., Arr]]:
+    """The registry's derivative formulas of ``shape``, compiled for numpy once."""
+    if "gradient_np" not in shape.compiled:
+        fs = shape.parsed_gradient()
+        shape.compiled["gradient_np"] = [formula.vectorised(f, NUMPY, registry.HELPERS) for f in fs]
+    found: list[Callable[..., Arr]] = shape.compiled["gradient_np"]
+    return found
+
+
 def _term_degree(var: int, ti: int, t: TermPlan, x: Arr) -> tuple[Arr, Grad]:
     grad: Grad = {}
-    if t.kind == "gaussian":
-        m, s = float(t.params[0]), float(t.params[1])  # type: ignore[arg-type]
-        h = float(t.height)  # type: ignore[arg-type]
-        d = x - m
-        mu = h * np.exp(-(d * d) / (2.0 * s * s))
-        grad[("in", var, ti, 0)] = mu * d / (s * s)
-        grad[("in", var, ti, 1)] = mu * d * d / (s * s * s)
+    shape = registry.SHAPES.get(t.kind)
+    if shape is not None and shape.differentiable:
+        p64 = [np.float64(v) for v in t.params]  # type: ignore[arg-type]
+        mu = membership_np(t.kind, p64, float(t.height), x)  # type: ignore[arg-type]
+        for i, derivative in enumerate(_derivatives(shape)):
+            grad[("in", var, ti, i)] = derivative(x, mu, *p64)
         return mu, grad
     assert t.pwl is not None
     mu = pwl_value_np(t.pwl, x)

@@ -53,6 +53,7 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.engine.reference.interp import OutputRecord, Record
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.kinds import shapes as registry
+from fuzzyctl.kinds.methods import METHODS
 
 __all__ = ["SAMPLES", "JflEvaluator"]
 
@@ -309,17 +310,18 @@ class JflEvaluator:
         lo, step = op.low, (op.high - op.low) / SAMPLES
         index_x = lo + step * np.arange(SAMPLES)  # min + stepSize * i (LM, RM, MM, COA)
         with np.errstate(all="ignore"):
-            if op.method == "COG":
+            m = METHODS.get(op.method or "")
+            if m is not None and m.centroid:
                 s = v.sum(axis=1)
                 return np.where(s <= 0, np.nan, (v * self.xs[oi]).sum(axis=1) / s)
-            if op.method == "COA":
+            if m is not None and m.bisects:
                 return _coa(v, lo, step)
             clean = np.where(np.isnan(v), -np.inf, v)  # jFuzzyLogic's comparisons skip NaN
             top = clean.max(axis=1)
             at_top = clean == top[:, None]
-            if op.method == "LM":
+            if m is not None and m.maximum == "left":
                 x = index_x[np.argmax(at_top, axis=1)]
-            elif op.method == "RM":
+            elif m is not None and m.maximum == "right":
                 x = index_x[SAMPLES - 1 - np.argmax(at_top[:, ::-1], axis=1)]
             else:  # MM
                 x = (at_top * index_x).sum(axis=1) / at_top.sum(axis=1)

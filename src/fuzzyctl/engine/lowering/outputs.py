@@ -355,9 +355,8 @@ def _const(p: PParam) -> float:
     return float(p) if not isinstance(p, Slot) else 1.0
 
 
-#: jFuzzyLogic's discrete terms (a HashMap of points) and the methods that take them
+#: jFuzzyLogic's discrete terms (a HashMap of points), taken by its weighted methods
 _JFL_DISCRETE = {"singleton", "singletons", "function"}
-_JFL_DISCRETE_METHODS = {"COGS", "COGF"}
 
 
 def _jfl_terms_fit(
@@ -375,9 +374,10 @@ def _jfl_terms_fit(
         )
         return False
     meth = (db.method or "COG").upper()
-    discrete = meth in _JFL_DISCRETE_METHODS
+    code = methods.jfl_spelled().get(meth)
+    discrete = code is not None and methods.METHODS[code].weighted is not None
     wrong = sorted(kinds - _JFL_DISCRETE) if discrete else sorted(kinds & (_JFL_DISCRETE | {"function_of_x"}))
-    if meth not in {"COG", "COA", "LM", "RM", "MM", "MOM", *_JFL_DISCRETE_METHODS}:
+    if code is None:
         ctx.err(f"DEFUZZIFY {var.name}: jFuzzyLogic has no METHOD {db.method}", db.span, "jfl-method")
         return False
     if wrong:

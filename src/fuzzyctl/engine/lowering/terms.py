@@ -246,7 +246,7 @@ def _unordered_vertices(ctx: LowerContext, tp: TermPlan, span: m.Span | None, wh
     """A triangle or trapezoid whose vertices are not in ascending order (node-fuzzylite's
     ``Trapezoid 1 0 2 3``) is read as fuzzylite reads it - its formula compares x with each
     vertex in turn - with a warning; jFuzzyLogic refuses it, and so does its profile."""
-    if tp.kind not in ("triangle", "trapezoid") or not tp.constant:
+    if registry.vertices(tp.kind) is None or not tp.constant:  # triangle, trapezoid
         return tp
     p = [float(v) for v in tp.params if not isinstance(v, Slot)]
     if p == sorted(p) or not all(math.isfinite(v) for v in p) or ctx.options.emulate == "jfuzzylogic":
@@ -267,7 +267,7 @@ def fuzzylite_vertices(kind: str, p: list[float]) -> list[tuple[float, float]]:
     two successive vertices the same branch of the formula holds, and it is linear."""
 
     def branch(x: float) -> tuple[float, float, float] | None:  # (x0, y0, slope) of the branch at x
-        if kind == "triangle":
+        if len(p) == 3:  # the triangle's a, b, c (else the trapezoid's a, b, c, d)
             a, b, c = p
             if x < a or x > c:
                 return None

@@ -16,6 +16,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.basics import identifier, is_identifier
+from fuzzyctl.kinds import methods
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     DEFUZZ_METHODS,
@@ -57,7 +58,7 @@ from fuzzyctl.model import (
 # Defuzzification methods whose output terms act as points (a weighted average of term
 # values): activation MIN and PROD give the same result there, so an IEC WITH weight
 # equals a MATLAB/fuzzylite rule weight.
-POINT_METHODS = frozenset({"COGS", "WTAVER", "WTSUM"})
+POINT_METHODS = methods.codes(lambda m: m.weighted is not None and m.lowers_to is None)
 DEFAULT_WHEN_ABSENT = 0.0
 """What our engine outputs before any rule has fired when no DEFAULT value is written: an
 output without DEFAULT, or with ``DEFAULT := NC``, keeps its previous value (docs/engine.md),
@@ -170,17 +171,17 @@ def support(term: Term) -> tuple[float, float] | None:
         return float(mf.value), float(mf.value)
     if isinstance(mf, ShapeMF) and not any(isinstance(p, Ref) for p in mf.params):
         p = [float(v) for v in mf.params]  # type: ignore[arg-type]
-        if mf.kind == "triangle":
-            return min(p), max(p)
-        if mf.kind == "trapezoid":
-            return min(p), max(p)
-        if mf.kind in {"rectangle", "semiellipse"}:
-            return min(p), max(p)
-        if mf.kind == "cosine":
-            return p[0] - abs(p[1]) / 2, p[0] + abs(p[1]) / 2
-        if mf.kind == "constant":
-            return p[0], p[0]
+        shape = registry.SHAPES.get(mf.kind)
+        if shape is not None and not isinstance(shape.zero_outside, registry.NA):
+            return shape.zero_outside(p)
     return None
+
+
+def _lowered(method: str | None) -> str | None:
+    """The method a writer says for ``method`` (the registry's ``lowers_to``: COGF's weighted
+    average), ``method`` itself for the others."""
+    m = methods.METHODS.get(method or "")
+    return m.lowers_to if m is not None and m.lowers_to is not None else method
 
 
 def _method(name: str) -> str:
@@ -228,9 +229,7 @@ def prepare(
     if problems:
         raise DiagnosticError(problems)
     # jFuzzyLogic's COGF is the weighted average of the terms' values (docs/engine.md)
-    fb = replace(
-        fb, defuzzify=tuple(replace(d, method="WTAVER") if d.method == "COGF" else d for d in fb.defuzzify)
-    )
+    fb = replace(fb, defuzzify=tuple(replace(d, method=_lowered(d.method)) for d in fb.defuzzify))
     for other in document.blocks[1:]:
         losses.append(
             Loss(f"function block {other.name!r}", f"{target} holds one system per file; not written")
@@ -293,7 +292,11 @@ def prepare(
         if default.value is None:  # DEFAULT := NC: 0 until a rule fires (the engine's NC start)
             default = Default(DEFAULT_WHEN_ABSENT, default.no_change)
         method = d.method
-        if d.terms and all(isinstance(t.mf, SingletonMF) for t in d.terms) and method in (None, "COG"):
+        if (
+            d.terms
+            and all(isinstance(t.mf, SingletonMF) for t in d.terms)
+            and methods.singleton_centroid(method)
+        ):
             method = "COGS"  # CoG of singletons is CoGS (docs/engine.md): say it as a weighted average
         defuzzify.append(replace(d, default=default, method=method))
     # An input singleton is the triangle (v, v, v): degree 1 exactly at v, 0 elsewhere, in our
@@ -516,7 +519,7 @@ def point_accumulation(fb: FunctionBlock, block: DefuzzifyBlock) -> str | None:
         if rb.accu is not None and any(c.variable == block.variable for r in rb.rules for c in r.conclusions):
             return rb.accu
     singletons = bool(block.terms) and all(isinstance(t.mf, SingletonMF) for t in block.terms)
-    return "MAX" if singletons and (block.method or "COGS") in {"COGS", "COG"} else None
+    return "MAX" if singletons and methods.singleton_centroid(block.method) else None
 
 
 def term_concluded_twice(fb: FunctionBlock, variable: str) -> bool:

@@ -70,7 +70,7 @@ from fuzzyctl.model import (
 
 _AND = {v: k for k, v in AND_METHODS.items()}
 _OR = {v: k for k, v in OR_METHODS.items()}
-_AGG = {v: k for k, v in AGG_METHODS.items() if k != "centroid_integral"}
+_AGG = {v: k for k, v in AGG_METHODS.items()}
 _AGG["ASUM"] = "probor"
 _DEFUZZ = method_kinds.written("fis")
 _DEFUZZ["COGS"] = "wtaver"
@@ -559,9 +559,9 @@ def write(document: Document) -> str:
     fis_type = "sugeno" if point and all(point) else ("hybrid" if any(point) else "mamdani")
     mamdani_methods = [d.method or "COG" for d in fb.defuzzify if not is_point_output(d)]
     ts_methods = [d.method for d in fb.defuzzify if is_point_output(d)]
-    defuzz = (
-        _DEFUZZ[mamdani_methods[0]] if mamdani_methods else ("wtsum" if "WTSUM" in ts_methods else "wtaver")
-    )
+    # MATLAB's one defuzzMethod of a Sugeno system: the weighted sum when an output sums
+    summing = any(getattr(method_kinds.METHODS.get(m or ""), "weighted", None) == "sum" for m in ts_methods)
+    defuzz = _DEFUZZ[mamdani_methods[0]] if mamdani_methods else ("wtsum" if summing else "wtaver")
     accu = (
         next((d.accu for d in fb.defuzzify if d.accu and not is_point_output(d)), None) or block.accu or "MAX"
     )

@@ -486,32 +486,8 @@ def tsukamoto(g: Gen, kind: str, ps: list[Ex], h: Ex, y: Ex, points: Points | No
                 with b.elif_(y.ge(ys[j]).and_(y.lt(ys[-1]))):
                     b.set(out, slope * (y - ys[j]) + xs[j])
         return out
-    if kind == "ramp":
-        s, e = ps
-        return g.let(s + (e - s) * y / h, "TZ")
-    if kind == "sigmoid":
-        i, s = ps
-        return g.let(i + g.call("LN", h / y - 1.0) / -s, "TZ")
-    if kind == "concave":
-        i, e = ps
-        return g.let(h * (i - e) / y + 2.0 * e - i, "TZ")
-    if kind == "arc":
-        s, e = ps
-        r = g.let(e - s, "TR")
-        q = g.max_(r * r - (y * r / h) * (y * r / h), 0.0, "TQ")
-        sign = g.let(1.0, "TS")
-        with b.if_(s.lt(e)):
-            b.set(sign, -1.0)
-        return g.let(e + sign * g.call("SQRT", q), "TZ")
-    if kind in ("sshape", "zshape"):
-        s, e = ps
-        out = g.temp(hint="TZ")
-        low = g.call("SQRT", y / (2.0 * h))
-        high = g.call("SQRT", (h - y) / (2.0 * h))
-        first = y.le(0.5 * h) if kind == "sshape" else y.ge(0.5 * h)
-        with b.if_(first):
-            b.set(out, s + (e - s) * (low if kind == "sshape" else high))
-        with b.else_():
-            b.set(out, e - (e - s) * (high if kind == "sshape" else low))
-        return out
+    shape = registry.SHAPES.get(kind)
+    if shape is not None and shape.tsukamoto_invertible:  # the registry's inverse, written once
+        env = dict(zip(("y", "h", *shape.params), (y, h, *ps), strict=True))
+        return g.let(formula(g, shape.parsed_tsukamoto(), env), "TZ")
     raise g.refuse(f"a {kind} term", "not monotonic (no Tsukamoto inverse)")
