@@ -34,6 +34,7 @@ observed difference to the reference interpreter.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 from collections.abc import Callable
@@ -311,7 +312,6 @@ def panels(
     capped: Var,
     accept: Accept,
     keep_nodes: bool = False,
-    piece: Callable[[Ex], None] | None = None,
 ) -> None:
     """Step 3: the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod 7/15: a
     panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width (area;
@@ -320,7 +320,10 @@ def panels(
     panel accepted short of the tolerance sets ``capped``.  ``accept`` emits what is done
     with each accepted panel; panels are accepted in increasing x (the left half of a split
     panel first), so that the same code run twice visits the same panels in the same order.
-    ``piece`` is called with the start of every piece, narrow ones included."""
+    With ``keep_nodes`` the panels have 17 nodes (their ends too, with no weight), kept in
+    the table passed to ``accept``, and a piece too narrow to integrate is a panel of no
+    width (its start is a node of LM/RM/MoM: an isolated point where a drastic sum reaches
+    1 lies between two such pieces)."""
     from fuzzyctl.engine.reference.quadrature import NODES as GKX
     from fuzzyctl.engine.reference.quadrature import WG as GKG
     from fuzzyctl.engine.reference.quadrature import WK as GKK
@@ -350,14 +353,8 @@ def panels(
     v = (xs, wk, wg, tol, sl, sr, ys, sp, used)
     # pieces narrower than PIECE_MIN of the range are left out: bisection brackets a point to
     # a few ulps, and a node there would give an isolated point (DMIN's peak) a positive area
-    if piece is None:
-        with b.for_(p, 0, n - 2) as pv:
-            _wide_piece(g, op, sets, accu, pts, pv, width, capped, accept, v)
-        return
-    with b.for_(p, 0, n - 1) as pv:
-        piece(pts[pv])
-        with b.if_(pv.lt(n - 1)):
-            _wide_piece(g, op, sets, accu, pts, pv, width, capped, accept, v)
+    with b.for_(p, 0, n - 2) as pv:
+        _wide_piece(g, op, sets, accu, pts, pv, width, capped, accept, v)
 
 
 #: nodes of a panel with its two ends (:func:`panels` with ``keep_nodes``)
@@ -380,9 +377,15 @@ def _wide_piece(
     b = g.b
     low = float(op.low or 0.0)
     xs, wk, wg, tol, sl, sr, ys, sp, used = v
-    with b.if_((pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)):
+    wide = (pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)
+    with b.if_(wide) if ys is None else contextlib.nullcontext():
         b.set(sl[0], pts[pv])
-        b.set(sr[0], pts[pv + 1])
+        if ys is None:
+            b.set(sr[0], pts[pv + 1])
+        else:  # a narrow piece is a panel of no width: its start is a node, with no area
+            b.set(sr[0], pts[pv])
+            with b.if_(wide):
+                b.set(sr[0], pts[pv + 1])
         b.set(sp, 1)
         with b.while_(sp.gt(0)):
             b.set(sp, sp - 1)

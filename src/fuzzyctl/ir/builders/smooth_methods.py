@@ -177,39 +177,35 @@ def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, w
     accu = op.accu or "MAX"
     area = g.let(0.0, "QA")
     top = g.let(0.0, "TOP")  # the set is never below 0 (no function terms here)
+    count, last = g.let(0, "NACC", "DINT"), g.let(0, "LACC", "DINT")
     w = _Window(g, op, sets, top)
     xs = Q.gk_nodes(g, ends=True)
-    # two visits of the same panels and piece ends (one copy of the set's code): the area and
-    # the top value, then the nodes in increasing x through the window
+    # two visits of the same panels (one copy of the set's code): the area, the top value and
+    # the number of panels, then the nodes in increasing x through the window
     ps = g.counter("PASS")
     with b.for_(ps, 0, 1) as pv:
         second = pv.eq(1)
         with b.if_(pv.eq(0).or_(area.gt(0.0).and_(top.gt(0.0)))):
 
-            def node(x: Ex, y: Ex) -> None:
-                with b.if_(second):
-                    w.node(x, y)
-                with b.else_():
-                    b.set(top, g.max_(top, y, "TOP"))
-
             def visit(u: Var, d: Var, ka: Var, km: Var, ys: Var | None) -> None:
                 assert ys is not None
-                with b.if_(not_(second)):
-                    b.set(area, area + ka * d)
                 k = g.counter("QN")
-                with b.for_(k, 0, Q.NODES_WITH_ENDS - 1) as kv:
-                    node(g.let(u + xs[kv] * d, "XN"), ys[kv])
-
-            def piece(x: Ex) -> None:
-                xv = g.let(x, "XP")
-                node(xv, _at(g, op, sets, xv))
+                with b.if_(second):
+                    b.set(count, count + 1)
+                    with b.for_(k, 0, Q.NODES_WITH_ENDS - 1) as kv:
+                        w.push(g.let(u + xs[kv] * d, "XN"), ys[kv])
+                    w.drain(count.eq(last))
+                with b.else_():
+                    b.set(area, area + ka * d)
+                    b.set(last, last + 1)
+                    with b.for_(k, 0, Q.NODES_WITH_ENDS - 1) as kv:
+                        b.set(top, g.max_(top, ys[kv], "TOP"))
 
             capped = g.let(False, "QCAPPED", "BOOL")
-            Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True, piece=piece)
+            Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True)
     value = g.let(0.0, "Y")
     fired = g.let(area.gt(0.0).and_(top.gt(0.0)), "FIRED", "BOOL")
     with b.if_(fired):
-        w.finish()
         b.set(value, w.result(which))
     return value, fired
 
@@ -221,12 +217,17 @@ def _at(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], x: Ex) -> Var:
 
 
 class _Window:
-    """The nodes in increasing x, three at a time (``quadrature.maxima`` streamed): node i is
-    judged when node i + 1 arrives (or at the end)."""
+    """The nodes in increasing x, three at a time (``quadrature.maxima`` streamed): node b is
+    judged when the next one arrives, or the end.  Nodes are queued per panel and judged in
+    one loop, so that the searches below are written once."""
 
     def __init__(self, g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], top: Var) -> None:
         self.g, self.op, self.sets, self.top = g, op, sets, top
         let = g.let
+        self.qx = g.array("WQX", "REAL", Q.NODES_WITH_ENDS)
+        self.qy = g.array("WQY", "REAL", Q.NODES_WITH_ENDS)
+        self.qn = let(0, "WQN", "INT")
+        self.lastx, self.any = let(0.0, "WLX"), let(False, "WANY", "BOOL")
         self.seen = let(0, "WN", "INT")  # nodes seen (2 means: at least two)
         self.xa, self.ya, self.xb, self.yb = (let(0.0, h) for h in ("WXA", "WYA", "WXB", "WYB"))
         # the current run of nodes exactly at the top: its first node and the one before
@@ -238,37 +239,50 @@ class _Window:
         self.kx, self.kv = g.array("PKX", "REAL", PEAKS), g.array("PKV", "REAL", PEAKS)
         self.npk = let(0, "NPK", "INT")
 
-    def node(self, x: Ex, y: Ex) -> None:
+    def push(self, x: Ex, y: Ex) -> None:
+        """Queue a node (equal x: one node, as ``np.unique``)."""
+        b = self.g.b
+        with b.if_(not_(self.any).or_(x.gt(self.lastx))):
+            b.set(self.qx[self.qn], x)
+            b.set(self.qy[self.qn], y)
+            b.set(self.qn, self.qn + 1)
+            b.set(self.lastx, x)
+            b.set(self.any, True)
+
+    def drain(self, end: Ex) -> None:
+        """Judge the queued nodes (and, when ``end``, the last node: no right neighbour)."""
         g, b = self.g, self.g.b
-        with b.if_(self.seen.eq(0).or_(x.gt(self.xb))):  # equal x: one node (np.unique)
-            with b.if_(self.seen.ge(1)):
-                self._judge(x, y, True)
-            b.set(self.xa, self.xb)
-            b.set(self.ya, self.yb)
-            b.set(self.xb, x)
-            b.set(self.yb, y)
-            b.set(self.seen, g.min_(self.seen + 1, 2, "WN"))
+        i = g.counter("WQ")
+        with b.for_(i, 0, self.qn) as iv:  # one more than queued: the end
+            more = g.let(iv.lt(self.qn), "WMORE", "BOOL")
+            with b.if_(more.or_(end)):
+                xr, yr = g.let(self.xb, "WXR"), g.let(-1.0, "WYR")  # the end: no right node
+                with b.if_(more):
+                    b.set(xr, self.qx[iv])
+                    b.set(yr, self.qy[iv])
+                with b.if_(self.seen.ge(1)):
+                    self._judge(xr, yr, more)
+                with b.if_(more):
+                    b.set(self.xa, self.xb)
+                    b.set(self.ya, self.yb)
+                    b.set(self.xb, xr)
+                    b.set(self.yb, yr)
+                    b.set(self.seen, g.min_(self.seen + 1, 2, "WN"))
+        b.set(self.qn, 0)
 
-    def finish(self) -> None:
-        with self.g.b.if_(self.seen.ge(1)):
-            self._judge(self.xb, self.yb, False)
-
-    def _judge(self, xr: Ex, yr: Ex, has_right: bool) -> None:
+    def _judge(self, xr: Var, yr: Var, more: Var) -> None:
         """Node b (``xb``, ``yb``) with its left neighbour a (when ``seen`` is 2) and its right
-        one (``xr``, ``yr``) when ``has_right``."""
+        one (``xr``, ``yr``; at the end ``xb`` and -1)."""
         g, b = self.g, self.g.b
         top = self.top
         has_left = self.seen.ge(2)
         xb, yb, xa, ya = self.xb, self.yb, self.xa, self.ya
-        lower_left = not_(has_left).or_(ya.lt(yb))
-        peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(lower_left)
-        if has_right:
-            peak = peak.and_(yr.lt(yb))
+        peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(not_(has_left).or_(ya.lt(yb))).and_(yr.lt(yb))
         with b.if_(peak):
             lo = g.let(xb, "GLO")
             with b.if_(has_left):
                 b.set(lo, xa)
-            px, pv = self._golden(lo, xr if has_right else xb, xb, yb)
+            px, pv = self._golden(lo, xr, xb, yb)
             with b.if_(self.npk.lt(PEAKS)):
                 b.set(self.kx[self.npk], px)
                 b.set(self.kv[self.npk], pv)
@@ -280,13 +294,9 @@ class _Window:
                 b.set(self.rprev, xa)
                 b.set(self.rhas, has_left)
             b.set(self.run, self.run + 1)
-            ends = yr.ne(top) if has_right else None
-            with b.if_(ends) if ends is not None else _always(b):
+            with b.if_(yr.ne(top)):
                 with b.if_(self.run.ge(2)):
-                    left = g.let(self.rx, "EL")
-                    with b.if_(self.rhas):
-                        b.set(left, self._edge(self.rprev, self.rx))
-                    right = self._edge(xr, xb) if has_right else xb
+                    left, right = self._edges(xr, more)
                     with b.if_(self.nrun.eq(0)):
                         b.set(self.pl, left)
                     b.set(self.pr, right)
@@ -295,57 +305,70 @@ class _Window:
                     b.set(self.nrun, self.nrun + 1)
                 b.set(self.run, 0)
 
-    def _at(self, x: Ex) -> Var:
-        return _at(self.g, self.op, self.sets, x)
-
     def _golden(self, lo0: Ex, hi0: Ex, x0: Ex, y0: Ex) -> tuple[Var, Var]:
-        """``quadrature._golden``: the peak between ``lo0`` and ``hi0``, or (x0, y0)."""
+        """``quadrature._golden``: the peak between ``lo0`` and ``hi0``, or (x0, y0); the
+        two points of a step and the final one are evaluated by one copy of the set."""
         g, b = self.g, self.g.b
         r = (math.sqrt(5.0) - 1.0) / 2.0
         lo, hi = g.let(lo0, "GL"), g.let(hi0, "GH")
         it = g.let(0, "GIT", "INT")
         go = g.let(True, "GGO", "BOOL")
-        scale = g.max_(g.max_(1.0, g.call("ABS", lo), "GS"), g.call("ABS", hi), "GS")
+        at = g.array("GP", "REAL", 2)
+        val = g.array("GF", "REAL", 2)
         with b.while_(go):
+            scale = g.max_(g.max_(1.0, g.call("ABS", lo), "GS"), g.call("ABS", hi), "GS")
             with b.if_((hi - lo).le(1e-15 * scale).or_(it.ge(GOLDEN))):
                 b.set(go, False)
+                b.set(at[0], 0.5 * (lo + hi))
+                b.set(at[1], at[0])
             with b.else_():
-                c, d = g.let(hi - r * (hi - lo), "GC"), g.let(lo + r * (hi - lo), "GD")
-                fc, fd = g.let(self._at(c), "FC"), g.let(self._at(d), "FD")
-                with b.if_(fc.eq(fd)):  # both on the flat top: keep the middle
-                    b.set(lo, c)
-                    b.set(hi, d)
-                with b.elif_(fc.gt(fd)):
-                    b.set(hi, d)
+                b.set(at[0], hi - r * (hi - lo))
+                b.set(at[1], lo + r * (hi - lo))
+            k = g.counter("GK")
+            with b.for_(k, 0, 1) as kv:
+                b.set(val[kv], _at(g, self.op, self.sets, g.let(at[kv], "GXK")))
+            with b.if_(go):
+                with b.if_(val[0].eq(val[1])):  # both on the flat top: keep the middle
+                    b.set(lo, at[0])
+                    b.set(hi, at[1])
+                with b.elif_(val[0].gt(val[1])):
+                    b.set(hi, at[1])
                 with b.else_():
-                    b.set(lo, c)
+                    b.set(lo, at[0])
                 b.set(it, it + 1)
-                b.set(scale, g.max_(g.max_(1.0, g.call("ABS", lo), "GS"), g.call("ABS", hi), "GS"))
-        xm = g.let(0.5 * (lo + hi), "GX")
-        ym = g.let(self._at(xm), "GY")
         px, pv = g.let(x0, "PX"), g.let(y0, "PV")
-        with b.if_(ym.gt(y0)):
-            b.set(px, xm)
-            b.set(pv, ym)
+        with b.if_(val[0].gt(y0)):
+            b.set(px, at[0])
+            b.set(pv, val[0])
         return px, pv
 
-    def _edge(self, outside: Ex, inside: Ex) -> Var:
-        """``quadrature._edge``: where the set reaches the top between the two points."""
+    def _edges(self, xr: Var, more: Var) -> tuple[Var, Var]:
+        """The run's two edges (``quadrature._edge``, bisection for where the set reaches
+        the top): between the node before it and its first node (when there is one), and
+        between its last node and the next (when there is one)."""
         g, b = self.g, self.g.b
-        o, i = g.let(outside, "EO"), g.let(inside, "EI")
-        it = g.let(0, "EIT", "INT")
-        go = g.let(True, "EGO", "BOOL")
-        with b.while_(go):
-            mid = g.let(0.5 * (o + i), "EM")
-            with b.if_(mid.eq(o).or_(mid.eq(i)).or_(it.ge(HALVINGS))):
-                b.set(go, False)
-            with b.else_():
-                with b.if_(self._at(mid).ge(self.top)):
-                    b.set(i, mid)
+        out = g.array("EX", "REAL", 2)
+        k = g.counter("EK")
+        with b.for_(k, 0, 1) as kv:
+            o, i = g.let(xr, "EO"), g.let(self.xb, "EI")
+            search = g.let(more, "ES", "BOOL")
+            with b.if_(kv.eq(0)):
+                b.set(o, self.rprev)
+                b.set(i, self.rx)
+                b.set(search, self.rhas)
+            it = g.let(0, "EIT", "INT")
+            with b.while_(search):
+                mid = g.let(0.5 * (o + i), "EM")
+                with b.if_(mid.eq(o).or_(mid.eq(i)).or_(it.ge(HALVINGS))):
+                    b.set(search, False)
                 with b.else_():
-                    b.set(o, mid)
-                b.set(it, it + 1)
-        return i
+                    with b.if_(_at(g, self.op, self.sets, mid).ge(self.top)):
+                        b.set(i, mid)
+                    with b.else_():
+                        b.set(o, mid)
+                    b.set(it, it + 1)
+            b.set(out[kv], i)
+        return g.let(out[0], "EL"), g.let(out[1], "ER")
 
     def result(self, which: str) -> Ex:
         """LM, RM or MoM from the plateaus and the peaks within :data:`SAME_TOP` of the
@@ -391,16 +414,3 @@ class _Window:
                 b.set(tot, self.xb)
             b.set(out, {"left": lo, "right": hi, "mean": tot / g.call("TO_REAL", np_)}[which])
         return out
-
-
-class _always:
-    """A context manager doing nothing (an unconditional branch)."""
-
-    def __init__(self, _b: object) -> None:
-        pass
-
-    def __enter__(self) -> None:
-        return None
-
-    def __exit__(self, *_exc: object) -> None:
-        return None
