@@ -106,6 +106,11 @@ SYSTEMS: dict[str, str] = {
         "COG", terms="TERM s := (0,0) (4,1) (8,0); TERM m := (2,0) (5,1) (8,0); TERM l := (3,0) (7,1) (10,0);"
     ),
     "smooth-COG": mamdani("COG", terms=SMOOTH),
+    # CoA, LM, RM, MoM of smooth sets (ir/builders/smooth_methods.py): clipped (MIN, plateaus
+    # whose edges are located) and unclipped (PROD, smooth peaks)
+    **{f"smooth-{code}": mamdani(code, terms=SMOOTH) for code in ("COA", "LM", "RM", "MOM")},
+    **{f"smooth-{code}-prod": mamdani(code, act="PROD", terms=SMOOTH) for code in ("COA", "LM", "MOM")},
+    "smooth-COA-sum": mamdani("COA", accu="SUM", terms=SMOOTH),
     "singletons-COGS": sugeno("COGS", SINGLETONS),
     "singletons-COGF": sugeno("COGF", SINGLETONS),
     "ts-WTAVER": sugeno("WTAVER", LINEAR),
@@ -191,3 +196,33 @@ def test_every_registered_method_has_a_native_system() -> None:
     named = {k.split("-")[1] for k in SYSTEMS if k.startswith(("mamdani-", "singletons-", "ts-"))}
     for entry in M.METHODS.values():
         assert entry.code in named or any(s in named for s in entry.spellings.get("fcl", ())), entry.code
+
+
+def test_the_default_backend_says_once_why_a_system_is_not_native(
+    monkeypatch: pytest.MonkeyPatch, capfd: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Never a silent fallback: a system the C generator refuses is evaluated by the numpy
+    path with one line on stderr naming why, once per process and reason; backend="native"
+    warns.  (Every system above is native; the refusal is simulated.)"""
+    from fuzzyctl.engine import native
+    from fuzzyctl.ir.programs import native as native_program
+    from fuzzyctl.ir.state import CodegenError
+
+    def refuse(_plan: object) -> None:
+        raise CodegenError("term y.s: something the C cannot express")
+
+    monkeypatch.setattr(native_program, "build_native", refuse)
+    monkeypatch.setenv("FUZZYCTL_CACHE_DIR", str(tmp_path))  # no library built before
+    monkeypatch.delenv("FUZZYCTL_QUIET", raising=False)
+    monkeypatch.delenv("FUZZYCTL_BACKEND", raising=False)
+    monkeypatch.setattr(native, "_REASONS_SHOWN", set())
+    fb = fuzzyctl.load(SYSTEMS["mamdani-COG"]).main
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a notice, not a warning
+        first = fuzzyctl.compile(fb)
+        fuzzyctl.compile(fb)
+    assert type(first) is Controller
+    err = capfd.readouterr().err
+    assert err.count("\n") == 1 and "not evaluated natively" in err and "cannot express" in err, err
+    with pytest.warns(RuntimeWarning, match="cannot express"):
+        fuzzyctl.compile(fb, backend="native")

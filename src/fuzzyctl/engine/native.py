@@ -366,7 +366,8 @@ def compile_native(
 ) -> Controller:
     """A native controller for ``plan``, or the Python one when there is no compiler or the
     plan uses something the C generators cannot express: with a warning when native was
-    asked for (``explicit``), a one-line notice for a missing compiler otherwise."""
+    asked for (``explicit``), otherwise a one-line notice on stderr (once per process for a
+    missing compiler, once per reason for a system the C cannot express)."""
     try:
         return NativeController(plan, build(plan, hint, content_key), model)
     except NativeError as exc:
@@ -385,4 +386,18 @@ def compile_native(
             warnings.warn(
                 f"native backend unavailable, using the numpy path: {exc}", RuntimeWarning, stacklevel=3
             )
+        else:  # never a silent fallback: the default backend says why, once per reason
+            _not_native(str(exc))
     return Controller(plan, specialise=True, model=model)
+
+
+_REASONS_SHOWN: set[str] = set()
+
+
+def _not_native(reason: str) -> None:
+    """A one-line notice on stderr, once per process and reason: the default backend
+    evaluates a system the C generator cannot express with the numpy path."""
+    if reason in _REASONS_SHOWN or os.environ.get("FUZZYCTL_QUIET"):
+        return
+    _REASONS_SHOWN.add(reason)
+    print(f"fuzzyctl: not evaluated natively ({reason}): using the numpy path", file=sys.stderr)

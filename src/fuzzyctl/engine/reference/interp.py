@@ -37,6 +37,7 @@ from fuzzyctl.engine.reference import pwl, quadrature
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr, eval_expr_np
 from fuzzyctl.engine.semantics.operators import (
+    CLIP_BRANCH,
     SNORMS,
     TNORMS,
     accumulate,
@@ -497,7 +498,7 @@ def accumulated_branch(
     cut at 1.  Where this changes the set bends: the quadrature is cut there."""
     accu = op.accu or "MAX"
     sets = activated_sets(op, contribs, values, pv)
-    clip = [(k, a) for k, (_t, a, _w, act) in enumerate(contribs) if act == "MIN"]
+    clip = [(k, a) for k, (_t, a, _w, act) in enumerate(contribs) if act in CLIP_BRANCH]
 
     def branch(x: Any) -> list[tuple[int, ...]]:
         ss = sets(x)

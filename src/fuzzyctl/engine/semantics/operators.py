@@ -197,6 +197,12 @@ ACT_LEVELS: dict[str, tuple[tuple[float, float], ...]] = {
     "BDIF": ((1.0, -1.0),),
 }
 
+#: Activations whose clipping edge (the level ``a``) the reference's branch tests as
+#: ``mu < a`` (engine/reference/interp.py ``accumulated_branch``): a term exactly at the
+#: degree counts as clipped, so that at a = 1 the stretch where a smooth peak rounds to 1 is
+#: a plateau on every path (LM, RM and MoM read its edges).
+CLIP_BRANCH = frozenset({"MIN"})
+
 
 def activation_levels(act: str, a: float) -> list[float]:
     """The term degrees where ``act(a, mu)`` jumps or bends (:data:`ACT_LEVELS`), those

@@ -210,20 +210,29 @@ def bisector_by_intervals(g: Gen, grid: GridPlan, sets: list[Set], accu: str) ->
     with b.if_(fired):
         half = g.let(0.5 * total, "HALF")
         tol = g.let(COA_TOL * total, "CTOL")
-        ends = []
+        ends: list[Var] = []
+        # half the area reached inside a piece where the set is positive: the scan from the
+        # right ends at the same point (the same piece, the same area before it), so it is
+        # skipped - it differs only where half is reached at the end of a piece (a zero gap)
+        inside = g.let(False, "INSIDE", "BOOL")
         for left_side in (True, False):
             found = g.let(False, "FOUND", "BOOL")
             cum = g.let(0.0, "CUM")
             last = spans[-1] if left_side else spans[0]
             res = g.let(grid.xs[last[0] + 1] if left_side else grid.xs[last[0]], "END")
+            if not left_side:
+                b.set(found, inside)
+                with b.if_(inside):
+                    b.set(res, ends[0])
             for j, lines, a in spans if left_side else spans[::-1]:
                 with b.if_(not_(found).and_(a.gt(0.0)).and_((cum + a).ge(half - tol))):
                     p = Pieces()
                     _interval(g, grid.xs[j], grid.xs[j + 1], lines, accu, p)
                     areas = [g.let(0.5 * (x1 - x0) * (v0 + v1), "PA") for x0, x1, v0, v1 in _ends(p)]
                     order = range(len(areas)) if left_side else range(len(areas) - 1, -1, -1)
+                    flag = inside if left_side else None
                     for k in order:
-                        _bisect_piece(g, p, k, areas[k], left_side, half, tol, cum, found, res)
+                        _bisect_piece(g, p, k, areas[k], left_side, half, tol, cum, found, res, flag)
                 with b.if_(not_(found)):
                     b.set(cum, cum + a)
             ends.append(res)
@@ -236,9 +245,20 @@ def _ends(p: Pieces) -> list[tuple[Ex, Ex, Ex, Ex]]:
 
 
 def _bisect_piece(
-    g: Gen, p: Pieces, k: int, a: Var, left_side: bool, half: Var, tol: Var, cum: Var, found: Var, res: Var
+    g: Gen,
+    p: Pieces,
+    k: int,
+    a: Var,
+    left_side: bool,
+    half: Var,
+    tol: Var,
+    cum: Var,
+    found: Var,
+    res: Var,
+    inside: Var | None = None,
 ) -> None:
-    """One piece of pwl.bisector's scan (``cum``: the area before it from that side)."""
+    """One piece of pwl.bisector's scan (``cum``: the area before it from that side);
+    ``inside`` is set when the point is found inside the piece (not at its end)."""
     b = g.b
     with b.if_(not_(found)):
         with b.if_(a.gt(0.0).and_((cum + a).ge(half - tol))):
@@ -248,6 +268,8 @@ def _bisect_piece(
             with b.else_():
                 r = (half - cum) if left_side else a - (half - cum)
                 solve_linear(g, res, p.x0[k], p.x1[k], p.v0[k], p.v1[k], p.x1[k] - p.x0[k], r)
+                if inside is not None:
+                    b.set(inside, True)
         with b.else_():
             b.set(cum, cum + a)
 

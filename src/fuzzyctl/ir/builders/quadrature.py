@@ -34,8 +34,10 @@ observed difference to the reference interpreter.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -44,7 +46,7 @@ from fuzzyctl.engine.lowering.grid import left_limit, right_limit
 from fuzzyctl.engine.plan import OutputPlan, Slot, TermPlan
 from fuzzyctl.engine.reference.pwl import gauss_legendre
 from fuzzyctl.engine.semantics import shapes
-from fuzzyctl.engine.semantics.operators import ACT_LEVELS
+from fuzzyctl.engine.semantics.operators import ACT_LEVELS, CLIP_BRANCH
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Num, Var, not_
 from fuzzyctl.ir.state import Gen
@@ -178,7 +180,7 @@ def _const_pwl(g: Gen, pts: tuple[tuple[float, float], ...], x: Ex) -> Var:
     return out
 
 
-def _set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> tuple[Var, Var]:
+def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> tuple[Var, Var]:
     """The accumulated set at ``x`` and a code of the branch it took: a sum of distinct powers
     of two, one per comparison that decides a branch - each term against the levels where its
     activation jumps or bends (:data:`fuzzyctl.engine.semantics.operators.ACT_LEVELS`), which set is the
@@ -208,7 +210,9 @@ def _set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) ->
                 mu = g.let(Num(float(term.height)) * mu, "MU")  # type: ignore[arg-type]
         mu = mu if isinstance(mu, Var) else g.let(mu, "MU")
         for offset, slope in ACT_LEVELS.get(s.act, ()):
-            flag(mu.gt(Num(offset) + Num(slope) * s.a))
+            level = Num(offset) + Num(slope) * s.a
+            # the clipping edge as the reference's branch tests it (operators.CLIP_BRANCH)
+            flag(mu.ge(level) if s.act in CLIP_BRANCH and (offset, slope) == (0.0, 1.0) else mu.gt(level))
         c = g.let(T.mul(s.w, T.tnorm(g, s.act, s.a, mu)), "C")
         if accu in ("MAX", "NIPMAX"):
             flag(c.gt(acc))
@@ -230,14 +234,35 @@ def smooth_cog(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) 
     ``capped`` is TRUE when a panel was accepted short of :data:`QTOL` (iteration cap)."""
     b = g.b
     accu = op.accu or "MAX"
+    pts, n = smooth_pieces(g, op, sets, cal)
+    area, mom = g.let(0.0, "QA"), g.let(0.0, "QM")
+    value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
+    capped = g.let(False, "QCAPPED", "BOOL")
+
+    def accept(u: Var, d: Var, ka: Var, km: Var, ys: Var | None) -> None:
+        b.set(area, area + ka * d)
+        b.set(mom, mom + km * d)
+
+    panels(g, op, sets, accu, pts, n, capped, accept)
+    b.set(fired, area.gt(0.0))
+    with b.if_(fired):
+        b.set(value, float(op.low or 0.0) + mom / area)
+    with b.else_():
+        b.set(value, 0.0)
+    return value, fired, capped
+
+
+def smooth_pieces(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) -> tuple[Var, Var]:
+    """Steps 1 and 2 of the module docstring: the pieces ``pts[0..n-1]`` (sorted) between
+    which the accumulated set is smooth."""
+    b = g.b
+    accu = op.accu or "MAX"
     cuts = cal.cuts
     nc = len(cuts)
     cap = (nc - 1) * (SAMPLES * ROUNDS + 1) + 2
     ctab = g.declare(g.fresh("QCUT", "QCUT"), "REAL", "const", nc, cuts, f"{op.name}: breakpoints")
     pts = g.array("QPT", "REAL", cap)
     n = g.let(0, "NQ", "INT")
-    area, mom = g.let(0.0, "QA"), g.let(0.0, "QM")
-    value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
     i = g.counter("QI")
     with b.for_(i, 0, nc - 2) as iv:
         a_, b_ = g.let(ctab[iv], "QL"), g.let(ctab[iv + 1], "QR")
@@ -251,39 +276,54 @@ def smooth_cog(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) 
                 b.set(x, b_)
             with b.else_():
                 b.set(x, a_ + (b_ - a_) * (g.call("TO_REAL", jv) / float(SAMPLES - 1)))
-            _val, cx = _set_at(g, op, sets, x, accu)
+            _val, cx = set_at(g, op, sets, x, accu)
             with b.if_(jv.gt(0).and_(cx.ne(c0))):
                 _locate(g, op, sets, accu, xprev, x, c0, cx, pts, n, cap)
             b.set(xprev, x)
             b.set(c0, cx)
     b.set(pts[n], cuts[-1])
     b.set(n, n + 1)
-    capped = g.let(False, "QCAPPED", "BOOL")
-    _integrate(g, op, sets, accu, pts, n, area, mom, capped)
-    b.set(fired, area.gt(0.0))
-    with b.if_(fired):
-        b.set(value, float(op.low or 0.0) + mom / area)
-    with b.else_():
-        b.set(value, 0.0)
-    return value, fired, capped
+    return pts, n
 
 
-def _integrate(
+#: what :func:`panels` calls for each accepted panel: (start, width, Kronrod mean of the set,
+#: of the set times x - low, the 15 node values when asked for)
+Accept = Callable[[Var, Var, Var, Var, "Var | None"], None]
+
+
+def gk_nodes(g: Gen, ends: bool = False) -> Var:
+    """The 15 Gauss-Kronrod nodes on 0..1 (ascending), a constant table; with ``ends``, 0
+    and 1 around them (the nodes of :func:`panels` with ``keep_nodes``)."""
+    from fuzzyctl.engine.reference.quadrature import NODES as GKX
+
+    xv = tuple(0.5 * (float(v) + 1.0) for v in GKX)
+    if ends:
+        xv = (0.0, *xv, 1.0)
+    return g.declare(g.fresh("GKX", "GKX"), "REAL", "const", len(xv), xv, "Gauss-Kronrod nodes on 0..1")
+
+
+def panels(
     g: Gen,
     op: OutputPlan,
     sets: list[SmoothSet],
     accu: str,
     pts: Var,
     n: Var,
-    area: Var,
-    mom: Var,
     capped: Var,
+    accept: Accept,
+    keep_nodes: bool = False,
 ) -> None:
-    """Area and moment of the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod
-    7/15: a panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width
-    (area; times the range for the moment), else halved - at most :data:`QCAP` panels per
+    """Step 3: the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod 7/15: a
+    panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width (area;
+    times the range for the moment), else halved - at most :data:`QCAP` panels per
     evaluation and :data:`STACK` pending ones (depth first: STACK - 2 nested halvings); a
-    panel accepted short of the tolerance sets ``capped``."""
+    panel accepted short of the tolerance sets ``capped``.  ``accept`` emits what is done
+    with each accepted panel; panels are accepted in increasing x (the left half of a split
+    panel first), so that the same code run twice visits the same panels in the same order.
+    With ``keep_nodes`` the panels have 17 nodes (their ends too, with no weight), kept in
+    the table passed to ``accept``, and a piece too narrow to integrate is a panel of no
+    width (its start is a node of LM/RM/MoM: an isolated point where a drastic sum reaches
+    1 lies between two such pieces)."""
     from fuzzyctl.engine.reference.quadrature import NODES as GKX
     from fuzzyctl.engine.reference.quadrature import WG as GKG
     from fuzzyctl.engine.reference.quadrature import WK as GKK
@@ -291,25 +331,14 @@ def _integrate(
     b = g.b
     low = float(op.low or 0.0)
     width = float((op.high or 0.0) - low) or 1.0
-    xs = g.declare(
-        g.fresh("GKX", "GKX"),
-        "REAL",
-        "const",
-        15,
-        tuple(0.5 * (float(v) + 1.0) for v in GKX),
-        "Gauss-Kronrod nodes on 0..1",
-    )
-    wk = g.declare(
-        g.fresh("GKK", "GKK"), "REAL", "const", 15, tuple(0.5 * float(v) for v in GKK), "Kronrod weights"
-    )
-    wg = g.declare(
-        g.fresh("GKG", "GKG"),
-        "REAL",
-        "const",
-        15,
-        tuple(0.5 * float(v) for v in GKG),
-        "Gauss weights (0 off the 7 Gauss nodes)",
-    )
+    xv = tuple(0.5 * (float(v) + 1.0) for v in GKX)
+    kv_, gv = tuple(0.5 * float(v) for v in GKK), tuple(0.5 * float(v) for v in GKG)
+    if keep_nodes:  # the panel's ends too, with no weight (LM/RM/MoM read them)
+        xv, kv_, gv = (0.0, *xv, 1.0), (0.0, *kv_, 0.0), (0.0, *gv, 0.0)
+    m = len(xv)
+    xs = g.declare(g.fresh("GKX", "GKX"), "REAL", "const", m, xv, "Gauss-Kronrod nodes on 0..1")
+    wk = g.declare(g.fresh("GKK", "GKK"), "REAL", "const", m, kv_, "Kronrod weights")
+    wg = g.declare(g.fresh("GKG", "GKG"), "REAL", "const", m, gv, "Gauss weights (0 off the 7 Gauss nodes)")
     # the program is precision-neutral; in REAL (float) 1e-10 vanishes beside 1 and the
     # tolerance must be one REAL can reach, else every panel would run to the cap
     tol = g.let(QTOL, "QTOL")
@@ -317,23 +346,57 @@ def _integrate(
     with b.if_(probe.eq(1.0)):
         b.set(tol, QTOL_REAL)
     sl, sr = g.array("QSL", "REAL", STACK), g.array("QSR", "REAL", STACK)
+    ys = g.array("QY", "REAL", NODES_WITH_ENDS) if keep_nodes else None
     sp = g.let(0, "QSP", "INT")
     used = g.let(0, "QUSED", "DINT")
     p = g.counter("QP")
+    v = (xs, wk, wg, tol, sl, sr, ys, sp, used)
     # pieces narrower than PIECE_MIN of the range are left out: bisection brackets a point to
     # a few ulps, and a node there would give an isolated point (DMIN's peak) a positive area
-    with b.for_(p, 0, n - 2) as pv, b.if_((pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)):
+    with b.for_(p, 0, n - 2) as pv:
+        _wide_piece(g, op, sets, accu, pts, pv, width, capped, accept, v)
+
+
+#: nodes of a panel with its two ends (:func:`panels` with ``keep_nodes``)
+NODES_WITH_ENDS = 17
+
+
+def _wide_piece(
+    g: Gen,
+    op: OutputPlan,
+    sets: list[SmoothSet],
+    accu: str,
+    pts: Var,
+    pv: Var,
+    width: float,
+    capped: Var,
+    accept: Accept,
+    v: tuple[Var, Var, Var, Var, Var, Var, Var | None, Var, Var],
+) -> None:
+    """The panels of piece ``pv`` of :func:`panels` (``v``: its tables and variables)."""
+    b = g.b
+    low = float(op.low or 0.0)
+    xs, wk, wg, tol, sl, sr, ys, sp, used = v
+    wide = (pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)
+    with b.if_(wide) if ys is None else contextlib.nullcontext():
         b.set(sl[0], pts[pv])
-        b.set(sr[0], pts[pv + 1])
+        if ys is None:
+            b.set(sr[0], pts[pv + 1])
+        else:  # a narrow piece is a panel of no width: its start is a node, with no area
+            b.set(sr[0], pts[pv])
+            with b.if_(wide):
+                b.set(sr[0], pts[pv + 1])
         b.set(sp, 1)
         with b.while_(sp.gt(0)):
             b.set(sp, sp - 1)
             u, d = g.let(sl[sp], "QU"), g.let(sr[sp] - sl[sp], "QD")
             ka, km, ga, gm = (g.let(0.0, h) for h in ("KA", "KM", "GA", "GM"))
             k = g.counter("QK")
-            with b.for_(k, 0, 14) as kv:
+            with b.for_(k, 0, (NODES_WITH_ENDS if ys is not None else 15) - 1) as kv:
                 xq = g.let(u + xs[kv] * d, "XQ")
-                y, _code = _set_at(g, op, sets, xq, accu)
+                y, _code = set_at(g, op, sets, xq, accu)
+                if ys is not None:
+                    b.set(ys[kv], y)
                 ym = g.let(y * (xq - low), "YM")
                 b.set(ka, ka + wk[kv] * y)
                 b.set(km, km + wk[kv] * ym)
@@ -353,8 +416,7 @@ def _integrate(
                 b.set(sr[sp + 1], mid)
                 b.set(sp, sp + 2)
             with b.else_():
-                b.set(area, area + ka * d)
-                b.set(mom, mom + km * d)
+                accept(u, d, ka, km, ys)
                 with b.if_(not_(ok).and_(split)):
                     b.set(capped, True)
 
@@ -383,7 +445,7 @@ def _locate(
         k = g.counter("QB")
         with b.for_(k, 1, BISECTIONS):
             mid = g.let(0.5 * (lo + hi), "MID")
-            _v, cm = _set_at(g, op, sets, mid, accu)
+            _v, cm = set_at(g, op, sets, mid, accu)
             with b.if_(cm.eq(code)):
                 b.set(lo, mid)
             with b.else_():

@@ -11,15 +11,16 @@ exact Mamdani outputs    :func:`fuzzyctl.ir.builders.mamdani.exact_outputs` on t
                          grid (every method the methods registry marks exact)
 closed-form CoG          the shared intervals: :func:`fuzzyctl.ir.builders.pieces.max_of_two`
                          (two sets under MAX), else :func:`~fuzzyctl.ir.builders.pieces.interval`
-smooth CoG               :func:`fuzzyctl.ir.builders.quadrature.smooth_cog`
+smooth sets              :func:`fuzzyctl.ir.builders.quadrature.smooth_cog` (CoG),
+                         :mod:`fuzzyctl.ir.builders.smooth_methods` (CoA, LM, RM, MoM)
 terms given by inputs    their breakpoints sorted at run time (as in the PLC block)
 Tsukamoto terms          :func:`fuzzyctl.ir.builders.terms.tsukamoto`
 rule activation          :meth:`NativeBuilder.select` (``selection.select`` in the IR)
 =======================  =============================================================
 
 Takagi-Sugeno outputs (Tsukamoto terms included) and fuzzylite's rule activation methods
-are written here too.  A plan the IR builders cannot express (a method other than CoG on
-smooth sets, a Tsukamoto term whose points are inputs) raises :class:`CodegenError` saying why;
+are written here too.  A plan the IR builders cannot express (a smooth output term given by
+variables, a Tsukamoto term whose points are inputs) raises :class:`CodegenError` saying why;
 :func:`fuzzyctl.engine.native.compile_native` reports it once.
 """
 
@@ -33,6 +34,7 @@ from fuzzyctl.ir.builders import quadrature as Q
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders.pieces import ACCUS, Ctx, clipped_am, interval, max_of_two
 from fuzzyctl.ir.builders.rules import Contrib, Literals
+from fuzzyctl.ir.builders.smooth_methods import smooth_method
 from fuzzyctl.ir.nodes import Ex, Int, Var, ex
 from fuzzyctl.ir.programs.evaluator import FastBuilder, FastProgram, FastTarget, Group, merge
 from fuzzyctl.ir.state import CodegenError, Gen
@@ -118,17 +120,12 @@ class NativeBuilder(FastBuilder):
         groups = merge(self.g, contribs, op.accu or "MAX")
         if op.exact:
             return self._exact(op, groups)
-        if not METHODS[op.method].centroid:
-            raise self.g.refuse(
-                f"output {op.name}: METHOD : {op.method} of a smooth set",
-                "only the centre of gravity of smooth sets is integrated by the generated code",
-            )
         for t in op.terms:
             if not Q.constant_term(t) or t.kind == "function":
                 raise self.g.refuse(f"term {op.name}.{t.name}", "a smooth output term given by variables")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
-        value, fired, _capped = Q.smooth_cog(self.g, op, sets, Q.calibrate(op))
-        return value, fired
+        # every method: CoG as the PLC block integrates it, CoA/LM/RM/MoM on the same panels
+        return smooth_method(self.g, op, sets, Q.calibrate(op), self.plan.options.quad_rtol)
 
     def _exact(self, op: OutputPlan, groups: list[Group]) -> tuple[Ex, Ex]:
         """A piecewise-linear output by any exact method: the PLC block's defuzzification
