@@ -42,6 +42,8 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import terms as T
+from fuzzyctl.ir.builders.ruletext import rule_text
+from fuzzyctl.ir.coalesce import rename
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds import shapes as registry
@@ -174,7 +176,7 @@ class RuleBuilder:
             selected = self._selections(degrees, chained, bare)
             for ri in plan.order:
                 rule = plan.rules[ri]
-                b.comment(f"RULE {rule.label}" + (f" (block {rule.block})" if rule.block else ""))
+                b.comment(rule_text(plan, rule) + (f" (block {rule.block})" if rule.block else ""))
                 for ci in sorted(_chained_reads(rule.condition) - normalised):
                     normalised.add(ci)
                     self._normalise(ci, chained)
@@ -191,15 +193,33 @@ class RuleBuilder:
     ) -> Var:
         """``weight * condition``, 0 at or below the firing threshold (``interp.weighted``)."""
         g, rule = self.g, self.plan.rules[ri]
+        decl_mark, stmt_mark = len(g.decls), len(g.b.cur)
         c = self.cond(rule.condition, degrees, chained, bare)
         if isinstance(rule.weight, Slot) or rule.weight != 1.0:
             c = c * self.pv(rule.weight, None, "")
-        a = g.let(c, f"R{ri}")
+        a = self._adopt(c, f"RULE_{rule.label}", decl_mark, stmt_mark)
         threshold = self.plan.options.firing_threshold
         if threshold > 0.0:
             with g.b.if_(a.le(threshold)):
                 g.b.set(a, 0.0)
         return a
+
+    def _adopt(self, c: Ex, what: str, decl_mark: int, stmt_mark: int) -> Var:
+        """A variable named ``what`` holding ``c``: the temporary that already holds it when
+        it was made for this value (renamed: no copy), else a new one assigned ``c``."""
+        g = self.g
+        name = g.named(what)
+        if isinstance(c, Var):
+            for d in g.decls[decl_mark:]:
+                if d.name == c.name and d.storage == "temp" and d.type == "REAL" and d.size is None:
+                    g.names.discard(d.name.upper())
+                    g.names.add(name.upper())
+                    d.name = name
+                    rename(g.b.cur[stmt_mark:], c.name, name)
+                    return Var(name)
+        v = g.declare(name, "REAL", "temp")
+        g.b.set(v, c)
+        return v
 
     def _selections(
         self,
@@ -323,7 +343,7 @@ class RuleBuilder:
             with g.b.if_(h.gt(top)):
                 g.b.set(top, h)
         low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
-        with g.b.if_(low), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
+        with g.b.if_(low, rare=True), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
             g.b.set(top, top * pwl.TINY_FACTOR)
             for h in hs:
                 g.b.set(h, h * pwl.TINY_FACTOR)
@@ -350,7 +370,11 @@ class RuleBuilder:
                         )
                     )
                 entries.append(es)
-        acc = {(t, i): g.let(0.0, "ACC") for t, es in enumerate(entries) for i in range(len(es))}
+        acc = {
+            (t, i): g.let_named(0.0, f"ACC_{op.name}_{op.terms[t].name}" + (f"_{i}" if len(es) > 1 else ""))
+            for t, es in enumerate(entries)
+            for i in range(len(es))
+        }
         for t, a, w, act in contribs:
             assert t is not None
             with b.if_(T.mul(w, a).gt(0.0)):
