@@ -23,6 +23,7 @@ from fuzzyctl.ir.nodes import (
     Var,
     While,
 )
+from fuzzyctl.ir.state import Gen
 
 
 def rename_ex(e: Ex, old: str, new: str) -> Ex:
@@ -73,3 +74,26 @@ def rename(stmts: Sequence[Stmt], old: str, new: str) -> None:
         elif isinstance(s, Kernel):
             s.outs = tuple(_target(o, old, new) for o in s.outs)
             s.args = tuple(rename_ex(a, old, new) for a in s.args)
+
+
+def share_temps(
+    g: Gen, decl_mark: int, stmts: Sequence[Stmt], pool: list[tuple[str, str]], what: str
+) -> None:
+    """The scalar temporaries declared since ``decl_mark`` and used only in ``stmts`` (one
+    step whose value is consumed there: an activation, say) take the names of ``pool``, the
+    temporaries of the previous such steps, one per position and type; the pool grows with
+    new ones named ``what``.  Fewer temporaries: IEC 61131-3 initialises each VAR_TEMP on
+    every call."""
+    new = [d for d in g.decls[decl_mark:] if d.storage == "temp" and d.size is None]
+    for k, d in enumerate(new):
+        if k < len(pool) and pool[k][1] == d.type:
+            rename(stmts, d.name, pool[k][0])
+            g.decls.remove(d)
+            g.names.discard(d.name.upper())
+        elif k >= len(pool):
+            name = g.named(what)
+            rename(stmts, d.name, name)
+            g.names.discard(d.name.upper())
+            g.names.add(name.upper())
+            d.name = name
+            pool.append((name, d.type))

@@ -43,7 +43,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders.ruletext import rule_text
-from fuzzyctl.ir.coalesce import rename
+from fuzzyctl.ir.coalesce import rename, share_temps
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds import shapes as registry
@@ -96,6 +96,9 @@ class RuleBuilder:
         self.g = g
         self.inputs: list[Ex] = []
         self.params: list[Params] = []
+        #: temporaries that one contribution of one output reads and nothing else (set by a
+        #: builder that knows; scaled in place by :meth:`scale_tiny`)
+        self.single_use: set[str] = set()
 
     # ------------------------------------------------------------------ hooks
 
@@ -337,7 +340,8 @@ class RuleBuilder:
         if not contribs:
             return contribs
         g = self.g
-        hs = [g.let(a, "H") for _t, a, _w, _act in contribs]
+        # a degree read by this output only is scaled where it is (no copy)
+        hs = [a if _owned(a, self.single_use) else g.let(a, "H") for _t, a, _w, _act in contribs]
         top = g.let(hs[0], "TOP")
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
@@ -375,12 +379,15 @@ class RuleBuilder:
             for t, es in enumerate(entries)
             for i in range(len(es))
         }
+        pool: list[tuple[str, str]] = []  # the activation's temporaries, shared by the rules
         for t, a, w, act in contribs:
             assert t is not None
+            decl_mark, stmt_mark = len(g.decls), len(b.cur)
             with b.if_(T.mul(w, a).gt(0.0)):
                 for i, (_x, y) in enumerate(entries[t]):
                     c = T.mul(w, T.tnorm(g, act, a, y))
                     T.accumulate_into(g, accu, acc[(t, i)], c)
+            share_temps(g, decl_mark, b.cur[stmt_mark:], pool, f"ACT_{op.name}")
         used = sorted({t for t, _a, _w, _act in contribs if t is not None})
         keys = [(t, i) for t in used for i in range(len(entries[t]))]
         value = g.temp(hint="Y")
@@ -506,6 +513,22 @@ class RuleBuilder:
                 raise g.refuse(where, "a function of x on a Takagi-Sugeno output")
             zs[t] = g.let(self.function_term(term.expr, None, lambda o: values[o], where), "Z")
         return zs[t]
+
+
+def _owned(a: Ex, single_use: set[str]) -> bool:
+    return isinstance(a, Var) and a.name in single_use
+
+
+def single_use(g: Gen, contribs: dict[int, list[Contrib]]) -> set[str]:
+    """The REAL scalar temporaries that appear as exactly one contribution's degree over all
+    outputs (the rule variables of a rule with one conclusion, say)."""
+    seen: dict[str, int] = {}
+    for cs in contribs.values():
+        for _t, a, _w, _act in cs:
+            if isinstance(a, Var):
+                seen[a.name] = seen.get(a.name, 0) + 1
+    temps = {d.name for d in g.decls if d.storage == "temp" and d.type == "REAL" and d.size is None}
+    return {n for n, k in seen.items() if k == 1 and n in temps}
 
 
 def _no_outputs(_o: int) -> Ex:

@@ -26,7 +26,7 @@ from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import quadrature as Q
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders.mamdani import ExactOutput, Group, exact_outputs, term_points
-from fuzzyctl.ir.builders.rules import Contrib, Params, RuleBuilder, literal
+from fuzzyctl.ir.builders.rules import Contrib, Params, RuleBuilder, literal, single_use
 from fuzzyctl.ir.cost import cost
 from fuzzyctl.ir.nodes import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.ir.programs.guard import check_known_fields
@@ -330,7 +330,9 @@ class _Builder(RuleBuilder):
         if len(plan.rules) >= TABLE_THRESHOLD and table_applies(plan):
             return table_rules(self, degrees, sparse=False)  # type: ignore[arg-type]
         concl = self.rules(degrees, weights)
-        return {oi: self.contribs(op, concl) for oi, op in enumerate(plan.outputs)}
+        out = {oi: self.contribs(op, concl) for oi, op in enumerate(plan.outputs)}
+        self.single_use = single_use(self.g, out)
+        return out
 
     def _output(
         self, oi: int, op: OutputPlan, contribs: list[Contrib], values: dict[int, Ex]
