@@ -429,39 +429,37 @@ def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, span: 
     return out
 
 
-def pwl_value_fixed(
-    g: Gen, xs: Var, ys: Var, first: int, last: int, x: Ex, out: Var, flags: tuple[Var, Var]
-) -> None:
-    """:func:`pwl_value` on ``xs[first .. last]`` known to be in order, its loop unrolled
-    (constant indices: no loop counter, no table of offsets); ``flags`` are two BOOL
-    temporaries the terms share.  The same statements as the loop, so the same value."""
-    found, done = flags
-    with g.b.if_(x.lt(xs[first])):
-        g.b.set(out, ys[first])
-    with g.b.elif_(x.gt(xs[last])):
-        g.b.set(out, ys[last])
-    with g.b.else_():
-        g.b.set(found, False)
-        g.b.set(done, False)
-        # the loop's first step: nothing found yet, and no interpolation (xs[first] <= x here)
-        with g.b.if_(xs[first].eq(x)):
-            g.b.set(out, ys[first])
-            g.b.set(found, True)
-        for k in range(first + 1, last + 1):
-            with g.b.if_(not_(done)):
-                with g.b.if_(xs[k].eq(x)):
-                    with g.b.if_(not_(found)):
-                        g.b.set(out, ys[k])
-                        g.b.set(found, True)
-                    with g.b.elif_(ys[k].gt(out)):
-                        g.b.set(out, ys[k])
-                with g.b.elif_(xs[k].gt(x)):
-                    with g.b.if_(not_(found)):
-                        g.b.set(
+def pwl_value_fixed(g: Gen, xs: Var, ys: Var, first: int, last: int, x: Ex, out: Var, found: Var) -> None:
+    """:func:`pwl_value` on ``xs[first .. last]`` known to be in order, without a loop
+    (constant indices: no counter, no table of offsets): the upper value among the points at
+    ``x``, else the segment ``x`` falls in, found by one chain of comparisons (the loop's
+    first point to the right of ``x``).  ``found`` is a BOOL temporary the terms share."""
+    b = g.b
+    with b.if_(x.lt(xs[first])):
+        b.set(out, ys[first])
+    with b.elif_(x.gt(xs[last])):
+        b.set(out, ys[last])
+    with b.else_():
+        with b.if_(xs[first].eq(x)):
+            b.set(out, ys[first])
+            b.set(found, True)
+        with b.else_():
+            b.set(found, False)
+        for k in range(first + 1, last + 1):  # points at x: the first, then any larger
+            with b.if_(xs[k].eq(x)):
+                with b.if_(not_(found)):
+                    b.set(out, ys[k])
+                    b.set(found, True)
+                with b.elif_(ys[k].gt(out)):
+                    b.set(out, ys[k])
+        if last > first:
+            with b.if_(not_(found)):
+                for k in range(first + 1, last + 1):
+                    with b.if_(x.lt(xs[k])) if k == first + 1 else b.elif_(x.lt(xs[k])):
+                        b.set(
                             out,
                             ys[k - 1] + (ys[k] - ys[k - 1]) * ((x - xs[k - 1]) / (xs[k] - xs[k - 1])),
                         )
-                    g.b.set(done, True)
 
 
 def right_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:

@@ -245,14 +245,14 @@ class _Builder(RuleBuilder):
             assert span is not None
             xs, _ys, first, last = span
             checks += [xs[k + 1].lt(xs[k]) for k in range(first, last)]
-        flags = (g.temp_named("FOUND", "BOOL"), g.temp_named("DONE", "BOOL"))
+        found = g.temp_named("FOUND", "BOOL")
 
         def in_order() -> None:
             for (v, _ti, _p), span, out in zip(terms, fixed, named, strict=True):
                 assert span is not None
                 xs, ys, first, last = span
                 x = self.inputs[self.plan.fuzzy_inputs[v].slot]
-                T.pwl_value_fixed(g, xs, ys, first, last, x, out, flags)
+                T.pwl_value_fixed(g, xs, ys, first, last, x, out, found)
 
         if checks:
             disorder = checks[0]
