@@ -77,6 +77,7 @@ class Row:
     error: float  # largest |block - engine| over ROWS inputs, in % of the output range
     memory: tuple[int, int]  # instance bytes, temporaries bytes
     ops: tuple[int, int]  # usual, worst operations per cycle
+    bounded: bool  # False: loops without a static bound, counted once
     matiec_ns: float
     native_ns: float
 
@@ -147,7 +148,8 @@ def span(info: object) -> tuple[float, float]:
         return float(lo), float(hi)
     xs: list[float] = []
     for t in getattr(info, "terms", ()):
-        xs += [x for x, _y in t.points] if t.points else [float(p) for p in t.params]
+        numbers = [float(p) for p in t.params if isinstance(p, int | float)]  # not the variables
+        xs += [x for x, _y in t.points] if t.points else numbers
     return (min(xs), max(xs)) if xs and max(xs) > min(xs) else (0.0, 1.0)
 
 
@@ -156,7 +158,9 @@ def _inputs(ctl: fuzzyctl.engine.Controller, plan: Plan, rng: np.random.Generato
     cols = []
     for inp in plan.inputs:
         lo, hi = span(ctl.inputs[inp.name]) if inp.name in ctl.inputs else (0.0, 1.0)
-        pad = 0.1 * (hi - lo)
+        pad = 0.0 if inp.degree else 0.1 * (hi - lo)  # a degree stays in [0, 1]
+        if inp.degree:
+            lo, hi = 0.0, 1.0
         cols.append(rng.uniform(lo - pad, hi + pad, ROWS))
     return np.column_stack(cols) if cols else np.zeros((ROWS, 0))
 
@@ -225,6 +229,7 @@ def measure(example: str, form: Form, matiec: Path, where: Path) -> Row:
         error,
         memory(gen.program, form.real_bytes),
         (c.usual.operations, c.worst.operations),
+        c.worst.bounded,
         ns,
         native_ns(ctl, plan, data),
     )
@@ -240,7 +245,8 @@ def markdown(rows: list[Row]) -> str:
     for r in rows:
         out.append(
             f"| {r.example} | {r.form} | {r.error:.2g} | {r.memory[0]} + {r.memory[1]} | "
-            f"{r.ops[0]} / {r.ops[1]} | {r.matiec_ns:.0f} | {r.native_ns:.1f} | "
+            f"{r.ops[0]} / {r.ops[1]}{'' if r.bounded else ' (loops once)'} | {r.matiec_ns:.0f} | "
+            f"{r.native_ns:.1f} | "
             f"{r.matiec_ns / r.native_ns:.1f} |"
         )
     return "\n".join(out)

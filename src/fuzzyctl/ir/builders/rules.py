@@ -341,7 +341,10 @@ class RuleBuilder:
             return contribs
         g = self.g
         # a degree read by this output only is scaled where it is (no copy)
-        hs = [a if _owned(a, self.single_use) else g.let(a, "H") for _t, a, _w, _act in contribs]
+        hs = [
+            a if isinstance(a, Var) and a.name in self.single_use else g.let(a, "H")
+            for _t, a, _w, _act in contribs
+        ]
         top = g.let(hs[0], "TOP")
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
@@ -513,10 +516,6 @@ class RuleBuilder:
                 raise g.refuse(where, "a function of x on a Takagi-Sugeno output")
             zs[t] = g.let(self.function_term(term.expr, None, lambda o: values[o], where), "Z")
         return zs[t]
-
-
-def _owned(a: Ex, single_use: set[str]) -> bool:
-    return isinstance(a, Var) and a.name in single_use
 
 
 def single_use(g: Gen, contribs: dict[int, list[Contrib]]) -> set[str]:
