@@ -231,9 +231,9 @@ def test_each_rule_text_is_above_its_code() -> None:
     for line in CRANE.read_text().splitlines():
         m = re.match(r"\s*RULE (\d+) : (IF .*);", line)
         if m:
-            assert f"(* RULE {m.group(1)} : {m.group(2)} (block operator) *)" in text, line
-    rule13 = text.index("(* RULE 13 :")
-    assert text.index("FZ_RULE_13 :=", rule13) < text.index("(* RULE 14 :")
+            assert f"(* RULE {m.group(1)} (block operator) *)\n    (* {m.group(2)} *)" in text, line
+    rule13 = text.index("(* RULE 13 (")
+    assert text.index("FZ_RULE_13 :=", rule13) < text.index("(* RULE 14 (")
 
 
 def test_names_say_what_they_hold_and_stay_short_and_distinct() -> None:

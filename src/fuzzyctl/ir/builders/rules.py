@@ -99,6 +99,9 @@ class RuleBuilder:
         #: temporaries that one contribution of one output reads and nothing else (set by a
         #: builder that knows; scaled in place by :meth:`scale_tiny`)
         self.single_use: set[str] = set()
+        #: names from the model and rule text comments (the PLC block); the evaluators of
+        #: compile() keep names that do not depend on the model's text
+        self.readable = False
 
     # ------------------------------------------------------------------ hooks
 
@@ -179,7 +182,9 @@ class RuleBuilder:
             selected = self._selections(degrees, chained, bare)
             for ri in plan.order:
                 rule = plan.rules[ri]
-                b.comment(rule_text(plan, rule) + (f" (block {rule.block})" if rule.block else ""))
+                b.comment(f"RULE {rule.label}" + (f" (block {rule.block})" if rule.block else ""))
+                if self.readable:
+                    b.comment(rule_text(plan, rule))
                 for ci in sorted(_chained_reads(rule.condition) - normalised):
                     normalised.add(ci)
                     self._normalise(ci, chained)
@@ -200,7 +205,8 @@ class RuleBuilder:
         c = self.cond(rule.condition, degrees, chained, bare)
         if isinstance(rule.weight, Slot) or rule.weight != 1.0:
             c = c * self.pv(rule.weight, None, "")
-        a = self._adopt(c, f"RULE_{rule.label}", decl_mark, stmt_mark)
+        what = f"RULE_{rule.label}" if self.readable else f"R{ri}"
+        a = self._adopt(c, what, decl_mark, stmt_mark)
         threshold = self.plan.options.firing_threshold
         if threshold > 0.0:
             with g.b.if_(a.le(threshold)):
@@ -379,6 +385,8 @@ class RuleBuilder:
                 entries.append(es)
         acc = {
             (t, i): g.let_named(0.0, f"ACC_{op.name}_{op.terms[t].name}" + (f"_{i}" if len(es) > 1 else ""))
+            if self.readable
+            else g.let(0.0, "ACC")
             for t, es in enumerate(entries)
             for i in range(len(es))
         }
@@ -390,7 +398,7 @@ class RuleBuilder:
                 for i, (_x, y) in enumerate(entries[t]):
                     c = T.mul(w, T.tnorm(g, act, a, y))
                     T.accumulate_into(g, accu, acc[(t, i)], c)
-            share_temps(g, decl_mark, b.cur[stmt_mark:], pool, f"ACT_{op.name}")
+            share_temps(g, decl_mark, b.cur[stmt_mark:], pool, f"ACT_{op.name}" if self.readable else "ACT")
         used = sorted({t for t, _a, _w, _act in contribs if t is not None})
         keys = [(t, i) for t in used for i in range(len(entries[t]))]
         value = g.temp(hint="Y")

@@ -23,7 +23,8 @@ _STRENGTH = {CAnd: 2, COr: 1}
 
 
 def _param(plan: Plan, p: PParam) -> str:
-    return plan.inputs[p.index].name if isinstance(p, Slot) else f"{p:g}"
+    # a number is a tunable entry of the block (its value is in the parameter array)
+    return plan.inputs[p.index].name if isinstance(p, Slot) else "a weight"
 
 
 def condition_text(plan: Plan, c: CondPlan) -> str:
@@ -55,7 +56,7 @@ def condition_text(plan: Plan, c: CondPlan) -> str:
 
 
 def rule_text(plan: Plan, rule: RulePlan) -> str:
-    """``RULE label : IF condition THEN conclusions`` (``WITH`` weights included)."""
+    """``IF condition THEN conclusions`` of one rule (``WITH`` weights named, not printed)."""
     concl = []
     for cp in rule.conclusions:
         if cp.outputs:
@@ -68,9 +69,9 @@ def rule_text(plan: Plan, rule: RulePlan) -> str:
             term = ch.terms[cp.term] if cp.term is not None else None
         text = var if term is None else f"{var} IS {' '.join([*cp.hedges, term])}"
         if isinstance(cp.weight, Slot) or cp.weight != 1.0:
-            text += f" WITH {_param(plan, cp.weight)}"
+            text += f" WITH {_param(plan, cp.weight)}"  # numbers are tunable: named, not printed
         concl.append(text)
     weight = ""
     if isinstance(rule.weight, Slot) or rule.weight != 1.0:
-        weight = f" (weight {_param(plan, rule.weight)})"
-    return f"RULE {rule.label} : IF {condition_text(plan, rule.condition)} THEN {', '.join(concl)}{weight}"
+        weight = f" (weighted by {_param(plan, rule.weight)})"
+    return f"IF {condition_text(plan, rule.condition)} THEN {', '.join(concl)}{weight}"

@@ -49,6 +49,7 @@ class _Builder(RuleBuilder):
         super().__init__(plan, Gen(target))
         self.notes: list[str] = []  # header lines: how smooth outputs are integrated
         self.capped: dict[str, Var] = {}  # smooth output -> TRUE when its quadrature hit the cap
+        self.readable = True  # names from the model, rule text comments
 
     def pwl_points(self, t: TermPlan, xs: Params, ys: Params, where: str) -> list[tuple[Ex, Ex]]:
         """A piecewise-linear term as breakpoints, constant ones as tunable entries."""
