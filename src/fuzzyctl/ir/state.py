@@ -60,7 +60,8 @@ class Gen:
         """An unused internal identifier that says what it holds (``FZ_DEG_distance_far``):
         the model's words made identifier-safe, cut to :data:`MAX_IDENT` characters, and on a
         clash (names are case-insensitive in ST) numbered within the same limit."""
-        base = re.sub(r"_+", "_", PREFIX + re.sub(r"[^A-Za-z0-9_]", "_", what))[:MAX_IDENT]
+        # no trailing or double underscore (IEC 61131-3 identifiers allow neither)
+        base = re.sub(r"_+", "_", PREFIX + re.sub(r"[^A-Za-z0-9_]", "_", what))[:MAX_IDENT].rstrip("_")
         if base.upper() not in self.names:
             return base
         n = 1
