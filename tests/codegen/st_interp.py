@@ -12,8 +12,10 @@ which keeps the generator honest about its subset.
 
 from __future__ import annotations
 
+import ast
 import dataclasses
 import math
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
@@ -291,12 +293,24 @@ class _Translator:
 class STBlock:
     """One FUNCTION_BLOCK instance, from source text or a :class:`Translation`."""
 
-    def __init__(self, source: str | Translation, name: str | None = None) -> None:
+    def __init__(
+        self,
+        source: str | Translation,
+        name: str | None = None,
+        instrument: Callable[[ast.Module], tuple[ast.Module, dict[str, Any]]] | None = None,
+    ) -> None:
+        """``instrument``: rewrites the translated Python (its syntax tree) and gives the names
+        the rewritten code calls (tests that count what the text executes)."""
         tr = translate(source, name) if isinstance(source, str) else source
         self.name, self.vars, self.real, self.source = tr.name, tr.vars, tr.real, tr.source
         self.R = np.float32 if self.real == "REAL" else np.float64
         env: dict[str, Any] = {"np": np, "R": self.R, "C": tr.consts, "_ck": _ck, "_int": _int}
-        exec(compile(self.source, f"<st {self.name}>", "exec"), env)
+        code: Any = self.source
+        if instrument is not None:
+            tree, names = instrument(ast.parse(self.source))
+            code = ast.fix_missing_locations(tree)
+            env.update(names)
+        exec(compile(code, f"<st {self.name}>", "exec"), env)
         self._fn = env["_step"]
         self.reset()
 

@@ -9,6 +9,7 @@ from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.cost import cost
 from fuzzyctl.ir.nodes import Program
 from fuzzyctl.ir.programs.plc_block import build_program
 from fuzzyctl.ir.render.c import render_c
@@ -55,6 +56,7 @@ class Generated:
             "block": self.program.name,
             "renames": [r.to_dict() for r in self.renames],
             "notes": list(self.notes),
+            "cost": cost(self.program).to_dict(),
         }
 
 

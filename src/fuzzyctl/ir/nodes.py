@@ -218,6 +218,9 @@ class Assign:
 class If:
     branches: list[tuple[Ex, list[Stmt]]]
     orelse: list[Stmt] = field(default_factory=list)
+    #: the first branch is taken only in a rare case (a point retuned out of order): the
+    #: usual cost per cycle (:mod:`fuzzyctl.ir.cost`) leaves it out
+    rare: bool = False
 
 
 @dataclass
@@ -229,12 +232,15 @@ class For:
     stop: Ex
     body: list[Stmt]
     step: int = 1
+    #: most iterations, for bounds that are not literals (the cost per cycle needs it)
+    bound: int | None = None
 
 
 @dataclass
 class While:
     cond: Ex
     body: list[Stmt]
+    bound: int | None = None  # most iterations (for the cost per cycle)
 
 
 @dataclass
@@ -343,8 +349,8 @@ class Builder:
             self._stack.pop()
 
     @contextmanager
-    def if_(self, cond: Ex) -> Iterator[None]:
-        node = If([(cond, [])])
+    def if_(self, cond: Ex, rare: bool = False) -> Iterator[None]:
+        node = If([(cond, [])], rare=rare)
         self.add(node)
         with self._body(node.branches[0][1]):
             yield
@@ -370,16 +376,18 @@ class Builder:
         self._last_if = None
 
     @contextmanager
-    def for_(self, var: str, start: ExLike, stop: ExLike, step: int = 1) -> Iterator[Var]:
-        node = For(var, ex(start), ex(stop), [], step)
+    def for_(
+        self, var: str, start: ExLike, stop: ExLike, step: int = 1, bound: int | None = None
+    ) -> Iterator[Var]:
+        node = For(var, ex(start), ex(stop), [], step, bound)
         self.add(node)
         with self._body(node.body):
             yield Var(var)
         self._last_if = None
 
     @contextmanager
-    def while_(self, cond: Ex) -> Iterator[None]:
-        node = While(cond, [])
+    def while_(self, cond: Ex, bound: int | None = None) -> Iterator[None]:
+        node = While(cond, [], bound)
         self.add(node)
         with self._body(node.body):
             yield

@@ -56,6 +56,25 @@ class Gen:
             if cand.upper() not in self.names:
                 return cand
 
+    def named(self, what: str) -> str:
+        """An unused internal identifier that says what it holds (``FZ_DEG_distance_far``):
+        the model's words made identifier-safe, cut to :data:`MAX_IDENT` characters, and on a
+        clash (names are case-insensitive in ST) numbered within the same limit."""
+        # no trailing or double underscore (IEC 61131-3 identifiers allow neither)
+        base = re.sub(r"_+", "_", PREFIX + re.sub(r"[^A-Za-z0-9_]", "_", what))[:MAX_IDENT].rstrip("_")
+        if base.upper() not in self.names:
+            return base
+        n = 1
+        while True:
+            n += 1
+            cand = f"{base[: MAX_IDENT - len(str(n)) - 1].rstrip('_')}_{n}"
+            if cand.upper() not in self.names:
+                return cand
+
+    def temp_named(self, what: str, type_: Type = "REAL") -> Var:
+        """A new temporary named by :meth:`named`."""
+        return self.declare(self.named(what), type_, "temp")
+
     def declare(
         self,
         name: str,
@@ -87,6 +106,12 @@ class Gen:
     def let(self, value: ExLike, hint: str = "T", type_: Type = "REAL") -> Var:
         """Assign ``value`` to a new temporary and return it."""
         v = self.temp(type_, hint)
+        self.b.set(v, value)
+        return v
+
+    def let_named(self, value: ExLike, what: str, type_: Type = "REAL") -> Var:
+        """:meth:`let` into a temporary named by :meth:`named`."""
+        v = self.temp_named(what, type_)
         self.b.set(v, value)
         return v
 

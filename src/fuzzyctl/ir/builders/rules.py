@@ -42,6 +42,8 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders import terms as T
+from fuzzyctl.ir.builders.ruletext import rule_text
+from fuzzyctl.ir.coalesce import rename, share_temps
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds import shapes as registry
@@ -94,6 +96,12 @@ class RuleBuilder:
         self.g = g
         self.inputs: list[Ex] = []
         self.params: list[Params] = []
+        #: temporaries that one contribution of one output reads and nothing else (set by a
+        #: builder that knows; scaled in place by :meth:`scale_tiny`)
+        self.single_use: set[str] = set()
+        #: names from the model and rule text comments (the PLC block); the evaluators of
+        #: compile() keep names that do not depend on the model's text
+        self.readable = False
 
     # ------------------------------------------------------------------ hooks
 
@@ -175,6 +183,8 @@ class RuleBuilder:
             for ri in plan.order:
                 rule = plan.rules[ri]
                 b.comment(f"RULE {rule.label}" + (f" (block {rule.block})" if rule.block else ""))
+                if self.readable:
+                    b.comment(rule_text(plan, rule))
                 for ci in sorted(_chained_reads(rule.condition) - normalised):
                     normalised.add(ci)
                     self._normalise(ci, chained)
@@ -191,15 +201,34 @@ class RuleBuilder:
     ) -> Var:
         """``weight * condition``, 0 at or below the firing threshold (``interp.weighted``)."""
         g, rule = self.g, self.plan.rules[ri]
+        decl_mark, stmt_mark = len(g.decls), len(g.b.cur)
         c = self.cond(rule.condition, degrees, chained, bare)
         if isinstance(rule.weight, Slot) or rule.weight != 1.0:
             c = c * self.pv(rule.weight, None, "")
-        a = g.let(c, f"R{ri}")
+        what = f"RULE_{rule.label}" if self.readable else f"R{ri}"
+        a = self._adopt(c, what, decl_mark, stmt_mark)
         threshold = self.plan.options.firing_threshold
         if threshold > 0.0:
             with g.b.if_(a.le(threshold)):
                 g.b.set(a, 0.0)
         return a
+
+    def _adopt(self, c: Ex, what: str, decl_mark: int, stmt_mark: int) -> Var:
+        """A variable named ``what`` holding ``c``: the temporary that already holds it when
+        it was made for this value (renamed: no copy), else a new one assigned ``c``."""
+        g = self.g
+        name = g.named(what)
+        if isinstance(c, Var):
+            for d in g.decls[decl_mark:]:
+                if d.name == c.name and d.storage == "temp" and d.type == "REAL" and d.size is None:
+                    g.names.discard(d.name.upper())
+                    g.names.add(name.upper())
+                    d.name = name
+                    rename(g.b.cur[stmt_mark:], c.name, name)
+                    return Var(name)
+        v = g.declare(name, "REAL", "temp")
+        g.b.set(v, c)
+        return v
 
     def _selections(
         self,
@@ -317,13 +346,17 @@ class RuleBuilder:
         if not contribs:
             return contribs
         g = self.g
-        hs = [g.let(a, "H") for _t, a, _w, _act in contribs]
+        # a degree read by this output only is scaled where it is (no copy)
+        hs = [
+            a if isinstance(a, Var) and a.name in self.single_use else g.let(a, "H")
+            for _t, a, _w, _act in contribs
+        ]
         top = g.let(hs[0], "TOP")
         for h in hs[1:]:
             with g.b.if_(h.gt(top)):
                 g.b.set(top, h)
         low = top.lt(pwl.TINY_BELOW)  # checked once outside: the usual case costs one test
-        with g.b.if_(low), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
+        with g.b.if_(low, rare=True), g.b.for_(g.counter("K"), 1, pwl.TINY_COUNT), g.b.if_(low):
             g.b.set(top, top * pwl.TINY_FACTOR)
             for h in hs:
                 g.b.set(h, h * pwl.TINY_FACTOR)
@@ -350,13 +383,22 @@ class RuleBuilder:
                         )
                     )
                 entries.append(es)
-        acc = {(t, i): g.let(0.0, "ACC") for t, es in enumerate(entries) for i in range(len(es))}
+        acc = {
+            (t, i): g.let_named(0.0, f"ACC_{op.name}_{op.terms[t].name}" + (f"_{i}" if len(es) > 1 else ""))
+            if self.readable
+            else g.let(0.0, "ACC")
+            for t, es in enumerate(entries)
+            for i in range(len(es))
+        }
+        pool: list[tuple[str, str]] = []  # the activation's temporaries, shared by the rules
         for t, a, w, act in contribs:
             assert t is not None
+            decl_mark, stmt_mark = len(g.decls), len(b.cur)
             with b.if_(T.mul(w, a).gt(0.0)):
                 for i, (_x, y) in enumerate(entries[t]):
                     c = T.mul(w, T.tnorm(g, act, a, y))
                     T.accumulate_into(g, accu, acc[(t, i)], c)
+            share_temps(g, decl_mark, b.cur[stmt_mark:], pool, f"ACT_{op.name}" if self.readable else "ACT")
         used = sorted({t for t, _a, _w, _act in contribs if t is not None})
         keys = [(t, i) for t in used for i in range(len(entries[t]))]
         value = g.temp(hint="Y")
@@ -482,6 +524,18 @@ class RuleBuilder:
                 raise g.refuse(where, "a function of x on a Takagi-Sugeno output")
             zs[t] = g.let(self.function_term(term.expr, None, lambda o: values[o], where), "Z")
         return zs[t]
+
+
+def single_use(g: Gen, contribs: dict[int, list[Contrib]]) -> set[str]:
+    """The REAL scalar temporaries that appear as exactly one contribution's degree over all
+    outputs (the rule variables of a rule with one conclusion, say)."""
+    seen: dict[str, int] = {}
+    for cs in contribs.values():
+        for _t, a, _w, _act in cs:
+            if isinstance(a, Var):
+                seen[a.name] = seen.get(a.name, 0) + 1
+    temps = {d.name for d in g.decls if d.storage == "temp" and d.type == "REAL" and d.size is None}
+    return {n for n, k in seen.items() if k == 1 and n in temps}
 
 
 def _no_outputs(_o: int) -> Ex:

@@ -352,22 +352,23 @@ def expression(
 # --------------------------------------------------------------------------- breakpoint lists
 
 
-def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, last: ExLike) -> None:
+def sort_points(g: Gen, xs: Var, ys: Var | None, off: ExLike, last: ExLike, span: int | None = None) -> None:
     """Stable insertion sort of ``xs[off .. last]`` (and ``ys`` alongside) by x: the engine
-    sorts points given by variables stably at each evaluation (5.2.2)."""
+    sorts points given by variables stably at each evaluation (5.2.2).  ``span``: the most
+    points a segment holds (bounds the loops for the cost per cycle)."""
     i = g.counter("I")
     j = g.counter("J")
     kx = g.temp(hint="KX")
     ky = g.temp(hint="KY") if ys is not None else None
     moving = g.temp("BOOL", "MV")
-    with g.b.for_(i, ex(off) + 1, last) as iv:
+    with g.b.for_(i, ex(off) + 1, last, bound=None if span is None else span - 1) as iv:
         g.b.set(kx, xs[iv])
         if ys is not None and ky is not None:
             g.b.set(ky, ys[iv])
         g.b.set(Var(j), iv - 1)
         g.b.set(moving, True)
         # no short-circuit AND in ST: the bound check and the comparison are separate IFs
-        with g.b.while_(moving):
+        with g.b.while_(moving, bound=span):
             with g.b.if_(xs[Var(j)].gt(kx)):
                 g.b.set(xs[Var(j) + 1], xs[Var(j)])
                 if ys is not None:
@@ -397,9 +398,9 @@ def _interp(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, out: Var
         g.b.set(out, ys[last])
 
 
-def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
+def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex, span: int | None = None) -> Var:
     """shapes.pwl_value on the sorted segment: constant beyond the ends, the upper value on
-    a vertical edge, linear between points."""
+    a vertical edge, linear between points (``span``: as for :func:`sort_points`)."""
     out = g.temp(hint="MU")
     with g.b.if_(x.lt(xs[off])):
         g.b.set(out, ys[off])
@@ -411,7 +412,7 @@ def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var
         g.b.set(found, False)
         g.b.set(done, False)
         k = g.counter("K")
-        with g.b.for_(k, off, last) as kv, g.b.if_(not_(done)):
+        with g.b.for_(k, off, last, bound=span) as kv, g.b.if_(not_(done)):
             with g.b.if_(xs[kv].eq(x)):
                 with g.b.if_(not_(found)):
                     g.b.set(out, ys[kv])
@@ -426,6 +427,39 @@ def pwl_value(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var
                     )
                 g.b.set(done, True)
     return out
+
+
+def pwl_value_fixed(g: Gen, xs: Var, ys: Var, first: int, last: int, x: Ex, out: Var, found: Var) -> None:
+    """:func:`pwl_value` on ``xs[first .. last]`` known to be in order, without a loop
+    (constant indices: no counter, no table of offsets): the upper value among the points at
+    ``x``, else the segment ``x`` falls in, found by one chain of comparisons (the loop's
+    first point to the right of ``x``).  ``found`` is a BOOL temporary the terms share."""
+    b = g.b
+    with b.if_(x.lt(xs[first])):
+        b.set(out, ys[first])
+    with b.elif_(x.gt(xs[last])):
+        b.set(out, ys[last])
+    with b.else_():
+        with b.if_(xs[first].eq(x)):
+            b.set(out, ys[first])
+            b.set(found, True)
+        with b.else_():
+            b.set(found, False)
+        for k in range(first + 1, last + 1):  # points at x: the first, then any larger
+            with b.if_(xs[k].eq(x)):
+                with b.if_(not_(found)):
+                    b.set(out, ys[k])
+                    b.set(found, True)
+                with b.elif_(ys[k].gt(out)):
+                    b.set(out, ys[k])
+        if last > first:
+            with b.if_(not_(found)):
+                for k in range(first + 1, last + 1):
+                    with b.if_(x.lt(xs[k])) if k == first + 1 else b.elif_(x.lt(xs[k])):
+                        b.set(
+                            out,
+                            ys[k - 1] + (ys[k] - ys[k - 1]) * ((x - xs[k - 1]) / (xs[k] - xs[k - 1])),
+                        )
 
 
 def right_limit(g: Gen, xs: Var, ys: Var, off: ExLike, last: ExLike, x: Ex) -> Var:
