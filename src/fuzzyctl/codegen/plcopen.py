@@ -252,7 +252,10 @@ def generate_plcopen(
     from fuzzyctl import __version__
     from fuzzyctl.codegen.api import check_arith
 
-    check_arith(arith)
+    if check_arith(arith):
+        raise CodegenError(
+            f"PLCopen XML of --arith {arith} is not generated yet: use --lang st --arith {arith}"
+        )
     check_dialect(dialect)
     parts = st_blocks(model, block, dialect, lreal, options)
     name = project or (parts[0].name if parts else "fuzzyctl")

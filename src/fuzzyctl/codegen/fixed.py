@@ -1,0 +1,106 @@
+"""``codegen --arith int16|int32``: Structured Text and C in fixed point
+(:mod:`fuzzyctl.ir.programs.fixed_block`), with the ``--json`` report of every input's and
+output's type, ``scale`` and ``offset`` (``value = stored * scale + offset``) and every
+output's ``error_bound``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from fuzzyctl.codegen.defaults import apply_default, parse_default
+from fuzzyctl.codegen.rename import Rename, rename_plan
+from fuzzyctl.engine.plan import Plan
+from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
+from fuzzyctl.ir.render.fixed import render_fixed_c, render_fixed_st
+from fuzzyctl.kinds import arith as arith_kinds
+from fuzzyctl.kinds import targets
+
+__all__ = ["FixedGenerated", "build_fixed_block", "generate_c_fixed", "generate_st_fixed"]
+
+
+@dataclass
+class FixedGenerated:
+    """One integer block and what the generator changed to express it."""
+
+    program: FixedProgram
+    plan: Plan
+    lang: str  # st or c: the type names of the report
+    renames: list[Rename] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        prog = self.program
+        type_name = prog.arith.types[self.lang]
+        return {
+            "block": prog.name,
+            "arith": prog.arith.name,
+            "renames": [r.to_dict() for r in self.renames],
+            "notes": list(self.notes),
+            "inputs": [p.to_dict(type_name, False) for p in prog.inputs],
+            "outputs": [p.to_dict(type_name, True) for p in prog.outputs],
+        }
+
+
+def build_fixed_block(
+    plan: Plan, target: str, arith: str, default: float | str | None = None, int_output: str = "scaled"
+) -> FixedGenerated:
+    if default == "hold":
+        raise CodegenError("--default hold is not generated in integer arithmetic: give a number")
+    plan, notes = apply_default(plan, parse_default(default))
+    plan, renames = rename_plan(plan, target)
+    prog = build_fixed(plan, arith_kinds.get(arith), int_output)
+    if renames:
+        prog.header[1:1] = ["renamed for the target (model name -> generated name):"] + [
+            f"  {r.comment()}" for r in renames
+        ]
+    prog.header[1:1] = notes
+    return FixedGenerated(prog, plan, target, renames, notes)
+
+
+def _refuse_bench(testbench: int) -> None:
+    if testbench:
+        raise CodegenError("--testbench is not generated with integer arithmetic yet: use --arith float")
+
+
+def generate_st_fixed(
+    plans: list[Plan],
+    *,
+    arith: str,
+    dialect: str,
+    default: float | str | None = None,
+    report: list[Any] | None = None,
+    testbench: int = 0,
+    int_output: str = "scaled",
+) -> str:
+    _refuse_bench(testbench)
+    parts = []
+    for plan in plans:
+        gen = build_fixed_block(plan, "st", arith, default, int_output)
+        if report is not None:
+            report.append(gen)
+        parts.append(render_fixed_st(gen.program, dialect))
+    return "\n".join(parts)
+
+
+def generate_c_fixed(
+    plans: list[Plan],
+    *,
+    arith: str,
+    default: float | str | None = None,
+    report: list[Any] | None = None,
+    testbench: int = 0,
+    int_output: str = "scaled",
+) -> dict[str, str]:
+    _refuse_bench(testbench)
+    files: dict[str, str] = {}
+    for plan in plans:
+        gen = build_fixed_block(plan, "c", arith, default, int_output)
+        if report is not None:
+            report.append(gen)
+        header, source = render_fixed_c(gen.program)
+        h_ext, c_ext = targets.C.extensions
+        files[f"{gen.program.name}{h_ext}"] = header
+        files[f"{gen.program.name}{c_ext}"] = source
+    return files
