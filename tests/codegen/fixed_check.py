@@ -75,7 +75,12 @@ def run_c(
     rng = np.random.default_rng(seed)
     lo = np.array([p["stored_range"][0] for p in rep["inputs"]])
     hi = np.array([p["stored_range"][1] for p in rep["inputs"]])
+    low, high = (
+        np.iinfo(np.int16 if arith == "int16" else np.int32).min,
+        np.iinfo(np.int16 if arith == "int16" else np.int32).max,
+    )
     stored = rng.integers(lo, hi + 1, size=(rows, len(ins)))
+    stored[: rows // 20] = rng.integers(low, high + 1, size=(rows // 20, len(ins)))  # outside the range too
     # also the points just around the range's ends and every stored value near zero
     stored = np.vstack([stored, lo[None, :], hi[None, :], np.zeros((1, len(ins)), dtype=np.int64)])
     if extra is not None:
@@ -100,7 +105,8 @@ def run_c(
     )
     scale_in = np.array([p["scale"] for p in rep["inputs"]])
     off_in = np.array([p["offset"] for p in rep["inputs"]])
-    values = stored * scale_in + off_in
+    # the block limits each stored input to its stored range: the engine gets the same value
+    values = np.clip(stored, lo, hi) * scale_in + off_in
     ctl = fuzzyctl.compile(doc, out_of_range="ignore")
     cols = {n: values[:, k] for k, n in enumerate(ins)}
     for n in ctl.input_names if hasattr(ctl, "input_names") else []:

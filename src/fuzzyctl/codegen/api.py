@@ -108,7 +108,9 @@ def generate_st(
         from fuzzyctl.codegen.fixed import generate_st_fixed
 
         return generate_st_fixed(
-            plans(model, block, **options),
+            model,
+            block,
+            options,
             arith=arith,
             dialect=dialect,
             default=default,
@@ -149,7 +151,7 @@ def generate_c(
         from fuzzyctl.codegen.fixed import generate_c_fixed
 
         return generate_c_fixed(
-            plans(model, block, **options), arith=arith, default=default, report=report, testbench=testbench
+            model, block, options, arith=arith, default=default, report=report, testbench=testbench
         )
     files: dict[str, str] = {}
     for plan in plans(model, block, **options):

@@ -16,6 +16,7 @@ from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
 from fuzzyctl.ir.render.fixed import render_fixed_c, render_fixed_st
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
+from fuzzyctl.model import Document, FunctionBlock
 
 __all__ = ["FixedGenerated", "build_fixed_block", "generate_c_fixed", "generate_st_fixed"]
 
@@ -43,14 +44,41 @@ class FixedGenerated:
         }
 
 
+def input_ranges(model: Document | FunctionBlock | Plan, plan: Plan) -> dict[str, tuple[float, float]]:
+    """Each input's range as the engine takes it: the declared RANGE, else its terms' span."""
+    from fuzzyctl.engine.ranges import declared_ranges
+    from fuzzyctl.engine.variables import inputs_of
+
+    if isinstance(model, Plan):
+        fb = None
+    elif isinstance(model, FunctionBlock):
+        fb = model
+    else:
+        fb = model.block(plan.name)
+    return declared_ranges(dict(inputs_of(plan, fb).items()))
+
+
+def _plans(model: Document | FunctionBlock | Plan, block: str | None, options: dict[str, Any]) -> list[Plan]:
+    from fuzzyctl.codegen.api import plans
+
+    return plans(model, block, **options)
+
+
 def build_fixed_block(
-    plan: Plan, target: str, arith: str, default: float | str | None = None, int_output: str = "scaled"
+    plan: Plan,
+    target: str,
+    arith: str,
+    default: float | str | None = None,
+    int_output: str = "scaled",
+    ranges: dict[str, tuple[float, float]] | None = None,
 ) -> FixedGenerated:
     if default == "hold":
         raise CodegenError("--default hold is not generated in integer arithmetic: give a number")
     plan, notes = apply_default(plan, parse_default(default))
     plan, renames = rename_plan(plan, target)
-    prog = build_fixed(plan, arith_kinds.get(arith), int_output)
+    renamed = {r.original: r.name for r in renames if r.kind == "input"}
+    ranges = {renamed.get(k, k): v for k, v in (ranges or {}).items()}
+    prog = build_fixed(plan, arith_kinds.get(arith), int_output, ranges)
     if renames:
         prog.header[1:1] = ["renamed for the target (model name -> generated name):"] + [
             f"  {r.comment()}" for r in renames
@@ -65,7 +93,9 @@ def _refuse_bench(testbench: int) -> None:
 
 
 def generate_st_fixed(
-    plans: list[Plan],
+    model: Document | FunctionBlock | Plan,
+    block: str | None,
+    options: dict[str, Any],
     *,
     arith: str,
     dialect: str,
@@ -76,8 +106,8 @@ def generate_st_fixed(
 ) -> str:
     _refuse_bench(testbench)
     parts = []
-    for plan in plans:
-        gen = build_fixed_block(plan, "st", arith, default, int_output)
+    for plan in _plans(model, block, options):
+        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
         if report is not None:
             report.append(gen)
         parts.append(render_fixed_st(gen.program, dialect))
@@ -85,7 +115,9 @@ def generate_st_fixed(
 
 
 def generate_c_fixed(
-    plans: list[Plan],
+    model: Document | FunctionBlock | Plan,
+    block: str | None,
+    options: dict[str, Any],
     *,
     arith: str,
     default: float | str | None = None,
@@ -95,8 +127,8 @@ def generate_c_fixed(
 ) -> dict[str, str]:
     _refuse_bench(testbench)
     files: dict[str, str] = {}
-    for plan in plans:
-        gen = build_fixed_block(plan, "c", arith, default, int_output)
+    for plan in _plans(model, block, options):
+        gen = build_fixed_block(plan, "c", arith, default, int_output, input_ranges(model, plan))
         if report is not None:
             report.append(gen)
         header, source = render_fixed_c(gen.program)

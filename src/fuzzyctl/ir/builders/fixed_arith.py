@@ -145,21 +145,36 @@ def _trunc_div(n: int, k: int) -> int:
 
 
 def rdiv(w: Width, x: FX, k: int, what: str = "a rescaled value") -> FX:
-    """``x / k`` rounded (``(x + k DIV 2) / k``; ``k`` > 0): the scale grows by ``k``.  The
-    rounding adds at most half a unit of the new scale when the dividend cannot be negative
-    (truncation is then the floor), one unit otherwise."""
+    """``x / k`` rounded to nearest (``k`` > 0): the scale grows by ``k``.  Integer division
+    truncates toward zero in C and Structured Text, so a dividend that may be negative is
+    first shifted by a multiple of ``k`` that makes it non-negative (the floor, then the
+    multiple taken back): the rounding adds at most half a unit of the new scale.  When
+    the shifted dividend would not fit, truncation stays and the bound is one and a half."""
     assert k > 0
     if k == 1:
         return x
     half = k // 2
-    _check(w, x.lo + half, x.hi + half, x.wide, what)
-    lo, hi = _trunc_div(x.lo + half, k), _trunc_div(x.hi + half, k)
-    rounding = Fraction(1, 2) + (Fraction(1, 2 * k) if k % 2 else 0) if x.lo + half >= 0 else Fraction(1)
-    scale = x.scale * k
-    ex = x.ex + half if half else x.ex
-    wide = x.wide
+    _check(w, k, k, x.wide, "a divisor")
+    nearest = Fraction(1, 2) + (Fraction(1, 2 * k) if k % 2 else 0)
+    scale, wide = x.scale * k, x.wide
+    if isinstance(x.ex, Int):  # a constant: divided here, exactly as the target would
+        q = _trunc_div(x.lo + half, k)
+        _check(w, q, q, wide, what)
+        return FX(Int(q), q, q, scale, x.err + abs(q * scale - x.lo * x.scale), wide)
+    m = 0 if x.lo + half >= 0 else -((x.lo + half) // k)
+    if w.fits(x.lo + half + m * k, x.hi + half + m * k, wide):
+        lo, hi = (x.lo + half) // k, (x.hi + half) // k
+        ex = (x.ex + (half + m * k)) / Int(k)
+        rounding = nearest
+        if m:
+            ex = ex - m
+    else:
+        _check(w, x.lo + half, x.hi + half, wide, what)
+        lo, hi = _trunc_div(x.lo + half, k), _trunc_div(x.hi + half, k)
+        ex = (x.ex + half) / Int(k)
+        rounding = Fraction(3, 2)
     _check(w, lo, hi, wide, what)
-    return FX(ex / Int(k), lo, hi, scale, x.err + rounding * scale, wide)
+    return FX(ex, lo, hi, scale, x.err + rounding * scale, wide)
 
 
 def fx_min(a: FX, b: FX) -> tuple[int, int, Fraction]:

@@ -94,86 +94,89 @@ class FixedProgram:
 
 
 def _refuse(what: str) -> CodegenError:
-    return CodegenError(f"integer arithmetic: {what} (use --arith float)")
+    """A refusal naming the element first, then why, then the way past it."""
+    return CodegenError(f"{what} in integer arithmetic (use --arith float)")
 
 
 # --------------------------------------------------------------------------- what is computed
 
 
-def _check_cond(c: CondPlan, plan: Plan) -> None:
+def _check_cond(c: CondPlan, plan: Plan, rule: str) -> None:
     if isinstance(c, CTerm):
+        fi = plan.fuzzy_inputs[c.var]
         if c.hedges:
-            raise _refuse(f"hedges ({' '.join(c.hedges)}) are not computed in integers")
-        if plan.fuzzy_inputs[c.var].terms[c.term].pwl is None:
-            fi = plan.fuzzy_inputs[c.var]
+            raise _refuse(f"rule {rule}: hedges ({' '.join(c.hedges)}) are not computed")
+        if fi.terms[c.term].pwl is None:
+            term = fi.terms[c.term]
             raise _refuse(
-                f"term {fi.terms[c.term].name!r} of {fi.name!r} is not piecewise linear with constant points"
+                f"term {term.name!r} of input {fi.name!r}: a {term.kind} term (not piecewise linear with "
+                "constant points) is not computed"
             )
     elif isinstance(c, CNot):
-        _check_cond(c.operand, plan)
+        _check_cond(c.operand, plan, rule)
     elif isinstance(c, CAnd | COr):
         ops = _AND if isinstance(c, CAnd) else _OR
         if c.op not in ops:
-            raise _refuse(f"the operator {c.op} is not computed in integers (only {', '.join(ops)})")
+            raise _refuse(f"rule {rule}: the operator {c.op} is not computed (only {', '.join(ops)} are)")
         for o in c.operands:
-            _check_cond(o, plan)
+            _check_cond(o, plan, rule)
     elif not isinstance(c, CTrue):
-        raise _refuse(
-            f"the condition {type(c).__name__} (chained or degree inputs) is not computed in integers"
-        )
+        raise _refuse(f"rule {rule}: a chained variable or a degree input in a condition is not computed")
 
 
 def check_supported(plan: Plan) -> None:
     """Refuse what the integer block does not compute, naming it."""
+    block = f"function block {plan.name!r}"
     if plan.chained:
-        raise _refuse("chained inference is not computed in integers")
+        raise _refuse(f"{block}: chained inference is not computed")
     if plan.selections:
-        raise _refuse("rule activation methods are not computed in integers")
+        raise _refuse("rule block activation methods are not computed")
     if plan.options.firing_threshold != 0.0:
-        raise _refuse("a firing threshold is not computed in integers")
+        raise _refuse(f"{block}: a firing threshold is not computed")
     if plan.options.hedges_carry_over:
-        raise _refuse("carried-over hedges are not computed in integers")
-    if any(i.clamp is not None for i in plan.inputs):
-        raise _refuse("a locked input range is not computed in integers")
+        raise _refuse(f"{block}: carried-over hedges are not computed")
+    for i in plan.inputs:
+        if i.clamp is not None:
+            raise _refuse(f"input {i.name!r}: a locked range is not computed")
     for r in plan.rules:
-        if isinstance(r.weight, Slot) or r.accu is not None:
-            raise _refuse(f"rule {r.label}: a variable weight or a rule block's own ACCU")
-        if r.weight < 0:
-            raise _refuse(f"rule {r.label}: a negative weight")
-        _check_cond(r.condition, plan)
+        if isinstance(r.weight, Slot) or r.accu is not None or r.weight < 0:
+            raise _refuse(
+                f"rule {r.label}: a variable or negative weight, or a rule block's own ACCU, is not computed"
+            )
+        _check_cond(r.condition, plan, r.label)
         for cp in r.conclusions:
             if isinstance(cp.weight, Slot) or cp.hedges or cp.chained or cp.weight < 0:
-                raise _refuse(f"rule {r.label}: a variable or negative conclusion weight, or hedges")
+                raise _refuse(
+                    f"rule {r.label}: a variable or negative conclusion weight, or hedges, are not computed"
+                )
     for fi in plan.fuzzy_inputs:
         for t in fi.terms:
             if t.pwl is not None and any(not 0.0 <= y <= 1.0 for _x, y in t.pwl):
-                raise _refuse(f"term {t.name!r} of {fi.name!r} has degrees outside 0..1")
+                raise _refuse(f"term {t.name!r} of input {fi.name!r}: degrees outside 0..1 are not computed")
     for op in plan.outputs:
         _check_output(op)
 
 
 def _check_output(op: OutputPlan) -> None:
-    name = repr(op.name)
+    name = f"output {op.name!r}"
     if op.kind == "mamdani":
         raise _refuse(
-            f"output {name}: Mamdani defuzzification ({op.method}) over fuzzy sets is not computed in "
-            "integers yet (singleton and Takagi-Sugeno outputs are)"
+            f"{name}: Mamdani defuzzification ({op.method}) over fuzzy sets is not computed yet (singleton "
+            "and Takagi-Sugeno outputs are)"
         )
     if op.kind not in ("singleton", "ts"):
-        raise _refuse(f"output {name}: {op.kind} outputs are not computed in integers")
+        raise _refuse(f"{name}: a {op.kind} output is not computed")
     if op.kind == "singleton" and op.method != "COGS":
-        raise _refuse(f"output {name}: method {op.method} is not computed in integers (COGS is)")
+        raise _refuse(f"{name}: METHOD {op.method} is not computed (COGS is)")
     if op.accu is not None and op.accu not in _ACCU:
-        raise _refuse(f"output {name}: ACCU {op.accu} is not computed in integers (MAX, SUM are)")
+        raise _refuse(f"{name}: ACCU {op.accu} is not computed (MAX and SUM are)")
     if op.clamp is not None:
-        raise _refuse(f"output {name}: a locked output range is not computed in integers")
-    if op.default is not None and not math.isfinite(op.default):
-        raise _refuse(f"output {name}: DEFAULT := {op.default} has no integer form (give --default)")
+        raise _refuse(f"{name}: a locked range is not computed")
     if not op.is_output:
-        raise _refuse(f"output {name}: a local defuzzified variable is not computed in integers")
+        raise _refuse(f"{name}: a local defuzzified variable is not computed")
     for t in op.terms:
         if any(isinstance(p, Slot) for p in t.params):
-            raise _refuse(f"output {name}: term {t.name!r} has variable parameters")
+            raise _refuse(f"{name}: term {t.name!r} with variable parameters is not computed")
         ok = (
             t.kind == "singleton"
             if op.kind == "singleton"
@@ -182,7 +185,7 @@ def _check_output(op: OutputPlan) -> None:
             or registry.flag(t.kind, "ts_linear")
         )
         if not ok:
-            raise _refuse(f"output {name}: term {t.name!r} ({t.kind}) is not computed in integers")
+            raise _refuse(f"{name}: term {t.name!r} ({t.kind}) is not computed")
 
 
 # --------------------------------------------------------------------------- scaling
@@ -198,17 +201,23 @@ def _pow2_scale(half_span: Fraction, highest: int) -> Fraction:
     return Fraction(2) ** k
 
 
-def _input_port(plan: Plan, slot: int, arith: Arith) -> Port:
+def _input_port(plan: Plan, slot: int, arith: Arith, rng: tuple[float, float] | None) -> Port:
+    """The scaling of one input: ``rng`` (the declared RANGE, else its terms' span) fills the
+    type; stored values outside it are limited to it in the block."""
     name = plan.inputs[slot].name
-    xs = [
-        Fraction(x) for fi in plan.fuzzy_inputs if fi.slot == slot for t in fi.terms for x, _y in t.pwl or ()
-    ]
-    if not xs:
-        raise _refuse(f"input {name!r} has no piecewise-linear terms to choose its scaling from")
-    lo, hi = min(xs), max(xs)
+    if rng is None:
+        xs = [x for fi in plan.fuzzy_inputs if fi.slot == slot for t in fi.terms for x, _y in t.pwl or ()]
+        if not xs:
+            raise _refuse(f"input {name!r}: without RANGE or piecewise-linear terms it has no scaling")
+        rng = (min(xs), max(xs))
+    lo, hi = Fraction(rng[0]), Fraction(rng[1])
+    if not lo < hi:
+        raise _refuse(f"input {name!r}: the empty range {rng[0]:g}..{rng[1]:g} has no scaling")
     offset = Fraction(0) if lo <= 0 <= hi else Fraction(float((lo + hi) / 2))
     scale = _pow2_scale(max(hi - offset, offset - lo), arith.highest)
-    return Port(name, scale, offset, arith.lowest, arith.highest, comment=f"{float(lo):g}..{float(hi):g}")
+    low = max(arith.lowest, math.ceil((lo - offset) / scale))
+    high = min(arith.highest, math.floor((hi - offset) / scale))
+    return Port(name, scale, offset, low, high, comment=f"{rng[0]:g}..{rng[1]:g}")
 
 
 def output_scale(
@@ -220,12 +229,15 @@ def output_scale(
     if mode == "unit":
         offset = Fraction(round(offset))
         if max(hi - offset, offset - lo) > arith.highest:
-            raise _refuse(f"values {float(lo):g}..{float(hi):g} do not fit the type in their own unit")
+            raise _refuse(
+                f"output values {float(lo):g}..{float(hi):g}: too large for the type in their own unit"
+            )
         return Fraction(1), offset
     k = 0
-    while half > arith.highest * Fraction(10) ** k:
+    room = arith.highest - 2  # the rounding of the values may add a unit
+    while half > room * Fraction(10) ** k:
         k += 1
-    while half <= arith.highest * Fraction(10) ** (k - 1) and k > -30:
+    while half <= room * Fraction(10) ** (k - 1) and k > -30:
         k -= 1
     scale = Fraction(10) ** k
     return scale, Fraction(round(offset / scale)) * scale
@@ -235,7 +247,9 @@ def output_scale(
 
 
 class FixedBlock:
-    def __init__(self, plan: Plan, arith: Arith, name: str, int_output: str) -> None:
+    def __init__(
+        self, plan: Plan, arith: Arith, name: str, int_output: str, ranges: dict[str, tuple[float, float]]
+    ) -> None:
         self.plan = plan
         self.arith = arith
         self.w = Width(arith)
@@ -247,9 +261,10 @@ class FixedBlock:
         self.b = Builder()
         self.decls: list[FixedDecl] = []
         self.ntemp = 0
-        self.inputs = {s: _input_port(plan, s, arith) for s in self._slots()}
+        self.inputs = {s: _input_port(plan, s, arith, ranges.get(plan.inputs[s].name)) for s in self._slots()}
         self.x = {
-            s: FX(Var(p.name), p.low, p.high, Fraction(1), Fraction(0), False) for s, p in self.inputs.items()
+            s: FX(Var(f"X_{s}"), p.low, p.high, Fraction(1), Fraction(0), False)
+            for s, p in self.inputs.items()
         }
 
     def _slots(self) -> list[int]:
@@ -281,6 +296,17 @@ class FixedBlock:
 
     # ------------------------------------------------------------------ fuzzification
 
+    def limit_inputs(self) -> None:
+        """Each stored input limited to its range (what the engine's ``out_of_range="clamp"``
+        does): the proof covers exactly these values."""
+        for s, p in self.inputs.items():
+            v = self.declare(f"X_{s}", "narrow", comment=f"{p.name} limited to {p.low}..{p.high}")
+            self.b.set(v, Var(p.name))
+            with self.b.if_(v.lt(Int(p.low))):
+                self.b.set(v, Int(p.low))
+            with self.b.elif_(v.gt(Int(p.high))):
+                self.b.set(v, Int(p.high))
+
     def linear_piece(self, p: int, q: int, ua: Fraction, ya: float, ub: Fraction, yb: float, xv: Var) -> FX:
         """``ya + (yb - ya) (X - ua) / (ub - ua)`` for integer X in ``[p, q]``, as degree."""
         m = (Fraction(yb) - Fraction(ya)) / (ub - ua)
@@ -297,14 +323,14 @@ class FixedBlock:
                 return fa.rdiv(self.w, total, 1 << s)
             except CodegenError:
                 continue
-        raise _refuse("a membership slope does not fit the wide type")
+        raise _refuse("term: a membership slope does not fit the wide type")
 
     def membership(self, var: int, term: int) -> FX:
         fi = self.plan.fuzzy_inputs[var]
         t = fi.terms[term]
         pts = t.pwl
         assert pts is not None
-        port, xv = self.inputs[fi.slot], Var(self.inputs[fi.slot].name)
+        port, xv = self.inputs[fi.slot], Var(f"X_{fi.slot}")
         from fuzzyctl.engine.lowering.grid import left_limit, right_limit
         from fuzzyctl.engine.semantics.shapes import pwl_value
 
@@ -403,8 +429,9 @@ class FixedBlock:
             return self.minmax(a, b, op == "MIN")
         if op == "PROD":
             return self.product(a, b)
-        if op == "ASUM":
-            return fa.narrow(self.w, fa.sub(self.w, fa.add(self.w, a, b), self.product(a, b)), "ASUM")
+        if op == "ASUM":  # a + (1 - a) b: in 0..1, which the limit makes the interval know
+            rest = fa.narrow(self.w, fa.sub(self.w, self.degree_const(1.0), a), "NOT")
+            return self.limited(fa.add(self.w, a, self.product(rest, b)), 0, self.D)
         if op == "BSUM":
             return self.limited(fa.add(self.w, a, b), None, self.D)
         assert op == "BDIF"
@@ -442,18 +469,20 @@ class FixedBlock:
         return "TRUE"
 
 
-def build_fixed(plan: Plan, arith: Arith, int_output: str = "scaled") -> FixedProgram:
+def build_fixed(
+    plan: Plan, arith: Arith, int_output: str = "scaled", ranges: dict[str, tuple[float, float]] | None = None
+) -> FixedProgram:
     """The integer block of ``plan`` (raises :class:`CodegenError` naming what it cannot compute
     or prove)."""
     from fuzzyctl.ir.programs.fixed_outputs import emit_outputs
 
     if plan.options.emulate is not None:
-        raise _refuse(f"a plan emulating {plan.options.emulate}")
+        raise _refuse(f"function block {plan.name!r}: the {plan.options.emulate} profile is not computed")
     if int_output not in INT_OUTPUTS:
         raise CodegenError(f"unknown int_output {int_output!r} (known: {', '.join(INT_OUTPUTS)})")
     check_supported(plan)
     name = plan.name or "fuzzy"
-    blk = FixedBlock(plan, arith, name, int_output)
+    blk = FixedBlock(plan, arith, name, int_output, ranges or {})
     for p in blk.inputs.values():
         blk.declare(
             p.name,
@@ -467,6 +496,7 @@ def build_fixed(plan: Plan, arith: Arith, int_output: str = "scaled") -> FixedPr
     )
     outer = blk.b
     blk.b = Builder()
+    blk.limit_inputs()
     rule_fx = blk.rules()
     outputs = emit_outputs(blk, rule_fx, info)
     body: list[Stmt] = [Assign(info, Int(0))]
@@ -478,6 +508,7 @@ def build_fixed(plan: Plan, arith: Arith, int_output: str = "scaled") -> FixedPr
         f"function block {name}: generated by fuzzyctl in {arith.name} fixed point ({arith.help})",
         f"degrees stored as degree * {blk.D}; no floating point anywhere in the block",
         "every intermediate value's range proven at generation time (interval analysis): no overflow",
+        "inputs outside their range (RANGE, else the terms' span) are limited to it",
     ]
     for p in blk.inputs.values():
         header.append(f"input {p.name}: value = {p.formula()} (terms span {p.comment})")

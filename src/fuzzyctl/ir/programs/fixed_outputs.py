@@ -94,7 +94,10 @@ def _z_fx(blk: FixedBlock, op: OutputPlan, t: int, scale: Fraction, offset: Frac
             return fa.narrow(w, fa.rdiv(w, total, 1 << q), f"term {term.name!r}")
         except CodegenError:
             continue
-    raise CodegenError(f"integer arithmetic: term {term.name!r} does not fit the type (use --arith float)")
+    raise CodegenError(
+        f"output {op.name!r}: term {term.name!r} does not fit the type in integer arithmetic "
+        "(use --arith float)"
+    )
 
 
 def _weights(blk: FixedBlock, groups: list[Group], rules: list[FX]) -> list[FX]:
@@ -114,7 +117,7 @@ def _weights(blk: FixedBlock, groups: list[Group], rules: list[FX]) -> list[FX]:
     return out
 
 
-def _sums(blk: FixedBlock, gs: list[FX], zs: list[FX]) -> tuple[int, FX, FX, list[FX]]:
+def _sums(blk: FixedBlock, op: OutputPlan, gs: list[FX], zs: list[FX]) -> tuple[int, FX, FX, list[FX]]:
     """``(shift, numerator, denominator, shifted weights)``: the weights divided by
     ``2**shift``, the smallest shift whose sums fit the wide type."""
     w = blk.w
@@ -129,7 +132,10 @@ def _sums(blk: FixedBlock, gs: list[FX], zs: list[FX]) -> tuple[int, FX, FX, lis
             return r, num, den, g2
         except CodegenError:
             continue
-    raise CodegenError("integer arithmetic: the weighted sum does not fit the wide type (use --arith float)")
+    raise CodegenError(
+        f"output {op.name!r}: the weighted sum does not fit the wide type in integer arithmetic "
+        "(use --arith float)"
+    )
 
 
 def _up(x: Fraction) -> float:
@@ -143,7 +149,9 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     plan, w = blk.plan, blk.w
     groups, terms = _groups(op)
     if not groups:
-        raise CodegenError(f"integer arithmetic: output {op.name!r} is concluded by no rule")
+        raise CodegenError(
+            f"output {op.name!r}: concluded by no rule, it has no integer form (use --arith float)"
+        )
     average = op.kind == "singleton" or op.method != "WTSUM"
     zi = [_z_interval(blk, op, t) for t in terms]
     zlo, zhi = min(a for a, _b in zi), max(b for _a, b in zi)
@@ -156,13 +164,17 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         for fi in plan.fuzzy_inputs
     }
     bounds = weight_bounds(plan, groups, weights, domain)
-    default = Fraction(op.default if op.default is not None else 0.0)
+    # DEFAULT := nan has no integer form; it is never reached when the output is proven below
+    # to fire for every input (else the output is refused), so it is stored as 0
+    nan = op.default is not None and not math.isfinite(op.default)
+    default = Fraction(0.0 if op.default is None or nan else op.default)
     if average:
         lo, hi = zlo, zhi
     else:
         top = Fraction(bounds.high)
         lo, hi = min(Fraction(0), top * zlo), max(Fraction(0), top * zhi)
-    lo, hi = min(lo, default), max(hi, default)
+    if not nan:
+        lo, hi = min(lo, default), max(hi, default)
     if op.low is not None and op.high is not None:
         lo, hi = min(lo, Fraction(op.low)), max(hi, Fraction(op.high))
     scale, offset = output_scale(lo, hi, blk.arith, blk.int_output, not average)
@@ -176,14 +188,14 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         blk.temp(g, f"{op.name}: weight of {op.terms[t].name}") if not isinstance(g.ex, Var) else g
         for g, t in zip(_weights(blk, groups, rules), terms, strict=True)
     ]
-    shift, num, den, g2 = _sums(blk, gs, zs)
+    shift, num, den, g2 = _sums(blk, op, gs, zs)
     e_sum = sum((g.err for g in g2), Fraction(0))
     if Fraction(bounds.low) <= e_sum:
         where = ", ".join(f"{plan.inputs[s].name}={v:g}" for s, v in sorted(bounds.witness.items()))
         raise CodegenError(
-            f"integer arithmetic: output {op.name!r}: the rules' total weight comes down to "
-            f"{bounds.witness_total:.3g} (at {where}); near inputs where no rule fires an integer weighted "
-            "average has no worst-case error bound (use --arith float)"
+            f"output {op.name!r}: the rules' total weight comes down to {bounds.witness_total:.3g} (at "
+            f"{where}); near inputs where no rule fires, integer arithmetic has no worst-case error bound "
+            "(use --arith float, or write rules that cover the inputs' whole RANGE)"
         )
     n = blk.temp(num, f"{op.name}: weighted sum", f"NUM_{len(blk.decls)}")
     d = blk.temp(den, f"{op.name}: sum of weights", f"DEN_{len(blk.decls)}")
@@ -200,10 +212,14 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         slo, shi = min(z.lo for z in zs), max(z.hi for z in zs)
     else:
         res = fa.rdiv(w, fa.var(n.ex.name, num), round(1 / g2[0].scale))  # type: ignore[attr-defined]
-        err, slo, shi = res.err, res.lo, res.hi
+        # the exact sum lies in [lo, hi] (weights >= 0, values in [zlo, zhi]): tighter than
+        # the interval of the integer sum, whose terms are bounded one by one
+        err = res.err
+        slo = max(res.lo, math.floor((lo - err - offset) / scale))
+        shi = min(res.hi, math.ceil((hi + err - offset) / scale))
     if not w.fits(slo, shi, False):
         raise CodegenError(
-            f"integer arithmetic: output {op.name!r} may overflow its type (use --arith float)"
+            f"output {op.name!r}: may overflow its type in integer arithmetic (use --arith float)"
         )
     with blk.b.if_(d.ex.gt(Int(0))):
         if average:
