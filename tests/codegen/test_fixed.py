@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
+import subprocess
+from pathlib import Path
 
 import pytest
 
@@ -19,7 +22,7 @@ from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError
 from fuzzyctl.codegen.api import generate_c, generate_st
 from fuzzyctl.codegen.plcopen import generate_plcopen
-from tests.codegen.fixed_check import run_c
+from tests.codegen.fixed_check import STRICT, run_c
 from tests.codegen.fixed_systems import random_fcl
 from tests.conftest import EXAMPLES
 
@@ -128,9 +131,32 @@ def test_what_is_not_computed_is_refused_naming_it(text: str, message: str) -> N
             gen(doc, arith="int16")
 
 
-def test_forms_not_generated_yet_are_refused() -> None:
+def _bench(files: dict[str, str], where: Path) -> str:
+    for name, text in files.items():
+        (where / name).write_text(text)
+    cc = shutil.which("cc")
+    assert cc
+    sources = [str(where / n) for n in files if n.endswith(".c")]
+    exe = where / "tb"
+    subprocess.run([cc, *STRICT, "-DFUZZYCTL_TESTBENCH_MAIN", "-o", str(exe), *sources], check=True)
+    return subprocess.run([str(exe)], capture_output=True, text=True).stdout
+
+
+@pytest.mark.parametrize("arith", ["int16", "int32"])
+def test_c_test_bench_passes_and_catches_a_wrong_block(arith: str, tmp_path: Path) -> None:
+    files = generate_c(fuzzyctl.load(EXAMPLES / "crane.fcl"), arith=arith, testbench=80)
+    assert "covers 25 of 25 rules" in files["crane_testbench.c"]
+    (tmp_path / "ok").mkdir()
+    assert _bench(files, tmp_path / "ok").startswith("PASS FAIL_COUNT=0")
+    # a block whose pos_high singleton moved by 1 % of the range must fail
+    wrong = fuzzyctl.load((EXAMPLES / "crane.fcl").read_text().replace("pos_high := 100", "pos_high := 98"))
+    bad = dict(files)
+    bad.update({k: v for k, v in generate_c(wrong, arith=arith).items()})
+    (tmp_path / "bad").mkdir()
+    assert _bench(bad, tmp_path / "bad").startswith("FAIL")
+
+
+def test_plcopen_of_integer_forms_is_refused_until_written() -> None:
     doc = fuzzyctl.load(EXAMPLES / "crane.fcl")
     with pytest.raises(CodegenError, match="PLCopen XML of --arith int16 is not generated yet"):
         generate_plcopen(doc, arith="int16")
-    with pytest.raises(CodegenError, match="--testbench is not generated with integer arithmetic"):
-        generate_st(doc, arith="int16", testbench=5)

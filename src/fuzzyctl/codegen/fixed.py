@@ -87,11 +87,6 @@ def build_fixed_block(
     return FixedGenerated(prog, plan, target, renames, notes)
 
 
-def _refuse_bench(testbench: int) -> None:
-    if testbench:
-        raise CodegenError("--testbench is not generated with integer arithmetic yet: use --arith float")
-
-
 def generate_st_fixed(
     model: Document | FunctionBlock | Plan,
     block: str | None,
@@ -104,13 +99,16 @@ def generate_st_fixed(
     testbench: int = 0,
     int_output: str = "scaled",
 ) -> str:
-    _refuse_bench(testbench)
     parts = []
     for plan in _plans(model, block, options):
         gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
         if report is not None:
             report.append(gen)
         parts.append(render_fixed_st(gen.program, dialect))
+        if testbench:
+            from fuzzyctl.codegen.fixed_bench import choose_fixed, render_fixed_st_bench
+
+            parts.append(render_fixed_st_bench(choose_fixed(gen, testbench), dialect))
     return "\n".join(parts)
 
 
@@ -125,7 +123,6 @@ def generate_c_fixed(
     testbench: int = 0,
     int_output: str = "scaled",
 ) -> dict[str, str]:
-    _refuse_bench(testbench)
     files: dict[str, str] = {}
     for plan in _plans(model, block, options):
         gen = build_fixed_block(plan, "c", arith, default, int_output, input_ranges(model, plan))
@@ -135,4 +132,8 @@ def generate_c_fixed(
         h_ext, c_ext = targets.C.extensions
         files[f"{gen.program.name}{h_ext}"] = header
         files[f"{gen.program.name}{c_ext}"] = source
+        if testbench:
+            from fuzzyctl.codegen.fixed_bench import choose_fixed, render_fixed_c_bench
+
+            files[f"{gen.program.name}_testbench.c"] = render_fixed_c_bench(choose_fixed(gen, testbench))
     return files
