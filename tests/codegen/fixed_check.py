@@ -61,13 +61,13 @@ def _driver(name: str, n_in: int, n_out: int, inputs: list[str], outputs: list[s
 
 
 def run_c(
-    model: Any, arith: str, rows: int = 2000, seed: int = 0, extra: np.ndarray | None = None
+    model: Any, arith: str, rows: int = 2000, seed: int = 0, extra: np.ndarray | None = None, **kw: Any
 ) -> Outcome:
     """The block of ``model`` (a document or text) in ``arith`` on random stored inputs over
     the whole stored range (plus ``extra`` rows), against the engine."""
     doc = fuzzyctl.load(model) if isinstance(model, str) else model
     report: list[Any] = []
-    files = generate_c(doc, arith=arith, report=report)
+    files = generate_c(doc, arith=arith, report=report, **kw)
     rep = report[0].to_dict()
     name = rep["block"]
     ins = [p["name"] for p in rep["inputs"]]

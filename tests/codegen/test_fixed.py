@@ -41,6 +41,14 @@ def test_examples_within_the_stated_bound_and_the_goal(name: str, arith: str) ->
     assert (observed > 0).all()  # integer arithmetic: not bit-exact, so the check is not vacuous
 
 
+def test_outputs_in_their_own_unit() -> None:
+    """``int_output="unit"``: the stored output is the value in the output's unit."""
+    out = run_c(fuzzyctl.load(EXAMPLES / "crane.fcl"), "int16", rows=3000, int_output="unit")
+    (power,) = out.report["outputs"]
+    assert (power["scale"], power["offset"], power["stored_range"]) == (1.0, 0.0, [-100, 100])
+    assert (out.errors() <= out.bounds()).all() and 0.5 <= out.bounds()[0] < 1.0
+
+
 SEEDS = range(24)
 
 
@@ -156,7 +164,23 @@ def test_c_test_bench_passes_and_catches_a_wrong_block(arith: str, tmp_path: Pat
     assert _bench(bad, tmp_path / "bad").startswith("FAIL")
 
 
-def test_plcopen_of_integer_forms_is_refused_until_written() -> None:
+@pytest.mark.extra("plcopen")
+@pytest.mark.parametrize("dialect", ["codesys", "iec"])
+@pytest.mark.parametrize("arith", ["int16", "int32"])
+def test_plcopen_of_integer_forms_is_valid_and_holds_the_st(arith: str, dialect: str) -> None:
+    from lxml import etree
+
+    from tests.conftest import shared_path
+
+    schema = etree.XMLSchema(etree.parse(str(shared_path("tools", "plcopen", "tc6_xml_v201.xsd"))))
     doc = fuzzyctl.load(EXAMPLES / "crane.fcl")
-    with pytest.raises(CodegenError, match="PLCopen XML of --arith int16 is not generated yet"):
-        generate_plcopen(doc, arith="int16")
+    root = etree.fromstring(generate_plcopen(doc, arith=arith, dialect=dialect).encode())
+    assert schema.validate(root), schema.error_log
+    ns = {"p": "http://www.plcopen.org/xml/tc6_0201"}
+    (body,) = root.findall(".//p:pou/p:body/p:ST", ns)
+    text = "".join(body.itertext()).strip()
+    st = generate_st(doc, arith=arith, dialect=dialect)
+    assert text and text in st
+    assert "REAL" not in text
+    types = {el.tag.split("}")[1] for el in root.iterfind(".//p:variable/p:type/*", ns)}
+    assert types <= {"INT", "DINT", "LINT", "BOOL", "BYTE"} and "REAL" not in types

@@ -13,7 +13,8 @@ from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
-from fuzzyctl.ir.render.fixed import render_fixed_c, render_fixed_st
+from fuzzyctl.ir.render.fixed import fixed_st_parts, render_fixed_c, render_fixed_st
+from fuzzyctl.ir.render.st import STParts
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
@@ -99,6 +100,11 @@ def generate_st_fixed(
     testbench: int = 0,
     int_output: str = "scaled",
 ) -> str:
+    """The integer blocks as Structured Text (``int_output``: ``scaled``, each output stored
+    with the finest power-of-ten scale that holds it, or ``unit``, in its own unit; also read
+    from ``options``)."""
+    options = dict(options)
+    int_output = options.pop("int_output", int_output)
     parts = []
     for plan in _plans(model, block, options):
         gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
@@ -112,6 +118,26 @@ def generate_st_fixed(
     return "\n".join(parts)
 
 
+def fixed_st_blocks(
+    model: Document | FunctionBlock | Plan,
+    block: str | None,
+    options: dict[str, Any],
+    *,
+    arith: str,
+    dialect: str,
+    int_output: str = "scaled",
+) -> list[STParts]:
+    """The integer blocks :func:`generate_st_fixed` prints, as parts (for PLCopen XML)."""
+    options = dict(options)
+    int_output = options.pop("int_output", int_output)
+    default = options.pop("default", None)
+    out = []
+    for plan in _plans(model, block, options):
+        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
+        out.append(fixed_st_parts(gen.program, dialect))
+    return out
+
+
 def generate_c_fixed(
     model: Document | FunctionBlock | Plan,
     block: str | None,
@@ -123,6 +149,9 @@ def generate_c_fixed(
     testbench: int = 0,
     int_output: str = "scaled",
 ) -> dict[str, str]:
+    """The integer blocks as C files (``NAME.h``, ``NAME.c``, ``NAME_testbench.c``)."""
+    options = dict(options)
+    int_output = options.pop("int_output", int_output)
     files: dict[str, str] = {}
     for plan in _plans(model, block, options):
         gen = build_fixed_block(plan, "c", arith, default, int_output, input_ranges(model, plan))
