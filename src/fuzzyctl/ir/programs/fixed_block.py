@@ -511,7 +511,7 @@ def build_fixed(
         "inputs outside their range (RANGE, else the terms' span) are limited to it",
     ]
     for p in blk.inputs.values():
-        header.append(f"input {p.name}: value = {p.formula()} (terms span {p.comment})")
+        header.append(f"input {p.name}: value = {p.formula()} (range {p.comment})")
     for p in outputs:
         header.append(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
