@@ -163,7 +163,10 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         )
         for fi in plan.fuzzy_inputs
     }
-    bounds = weight_bounds(plan, groups, weights, domain)
+    # the search's cost grows with the rules each box evaluates
+    bounds = weight_bounds(
+        plan, groups, weights, domain, budget=max(500, min(6000, 600_000 // len(plan.rules)))
+    )
     # DEFAULT := nan has no integer form; it is never reached when the output is proven below
     # to fire for every input (else the output is refused), so it is stored as 0
     nan = op.default is not None and not math.isfinite(op.default)
@@ -192,10 +195,16 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     e_sum = sum((g.err for g in g2), Fraction(0))
     if Fraction(bounds.low) <= e_sum:
         where = ", ".join(f"{plan.inputs[s].name}={v:g}" for s, v in sorted(bounds.witness.items()))
+        if bounds.witness_total <= 2 * float(e_sum):
+            why = f"comes down to {bounds.witness_total:.3g} (at {where}): near inputs where no rule fires"
+        else:  # the search ran out before proving a useful lower bound
+            why = (
+                f"could not be bounded from below (the smallest found is {bounds.witness_total:.3g}, at "
+                f"{where}, but only {bounds.low:.3g} was proven within the search budget): then"
+            )
         raise CodegenError(
-            f"output {op.name!r}: the rules' total weight comes down to {bounds.witness_total:.3g} (at "
-            f"{where}); near inputs where no rule fires, integer arithmetic has no worst-case error bound "
-            "(use --arith float, or write rules that cover the inputs' whole RANGE)"
+            f"output {op.name!r}: the rules' total weight {why}, integer arithmetic has no worst-case "
+            "error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
         )
     n = blk.temp(num, f"{op.name}: weighted sum", f"NUM_{len(blk.decls)}")
     d = blk.temp(den, f"{op.name}: sum of weights", f"DEN_{len(blk.decls)}")
@@ -233,7 +242,7 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     with blk.b.else_():
         blk.b.set(info, Int(2))
         if not op.no_change:
-            blk.b.set(out, Int(round((default - offset) / scale)))
+            blk.b.set(out, Int(0 if nan else round((default - offset) / scale)))
     del shift
     return Port(op.name, scale, offset, slo, shi, _up(err), comment=f"{float(lo):g}..{float(hi):g}")
 
