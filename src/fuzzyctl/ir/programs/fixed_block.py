@@ -36,6 +36,7 @@ from fuzzyctl.ir.builders.fixed_arith import FX, Width
 from fuzzyctl.ir.nodes import Assign, Bool, Builder, Ex, Int, Stmt, Var
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.arith import Arith
+from fuzzyctl.kinds.methods import METHODS
 
 __all__ = ["FixedDecl", "FixedProgram", "Port", "build_fixed"]
 
@@ -166,8 +167,8 @@ def _check_output(op: OutputPlan) -> None:
         )
     if op.kind not in ("singleton", "ts"):
         raise _refuse(f"{name}: a {op.kind} output is not computed")
-    if op.kind == "singleton" and op.method != "COGS":
-        raise _refuse(f"{name}: METHOD {op.method} is not computed (COGS is)")
+    if METHODS[op.method].weighted is None:
+        raise _refuse(f"{name}: METHOD {op.method} is not computed (weighted averages and sums are)")
     if op.accu is not None and op.accu not in _ACCU:
         raise _refuse(f"{name}: ACCU {op.accu} is not computed (MAX and SUM are)")
     if op.clamp is not None:

@@ -16,13 +16,14 @@ import math
 from fractions import Fraction
 from typing import TYPE_CHECKING
 
-from fuzzyctl.engine.plan import OutputPlan, PParam, Slot
+from fuzzyctl.engine.plan import OutputPlan, Plan, PParam, Slot
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
-from fuzzyctl.ir.builders.fixed_bound import Group, weight_bounds
+from fuzzyctl.ir.builders.fixed_bound import Group, WeightBounds, weight_bounds
 from fuzzyctl.ir.nodes import Int, Var
 from fuzzyctl.kinds import shapes as registry
+from fuzzyctl.kinds.methods import METHODS
 
 if TYPE_CHECKING:
     from fuzzyctl.ir.programs.fixed_block import FixedBlock, Port
@@ -143,6 +144,23 @@ def _up(x: Fraction) -> float:
     return f if Fraction(f) >= x else math.nextafter(f, math.inf)
 
 
+def _unbounded(plan: Plan, op: OutputPlan, bounds: WeightBounds, e_sum: Fraction) -> CodegenError:
+    """Why no error bound was found: some input fires (nearly) no rule, or the search for a
+    lower bound of the total weight ran out."""
+    where = ", ".join(f"{plan.inputs[s].name}={v:g}" for s, v in sorted(bounds.witness.items()))
+    if bounds.witness_total <= 2 * float(e_sum):
+        why = f"comes down to {bounds.witness_total:.3g} (at {where}): near inputs where no rule fires"
+    else:
+        why = (
+            f"could not be bounded from below (the smallest found is {bounds.witness_total:.3g}, at "
+            f"{where}, but only {bounds.low:.3g} was proven within the search budget): then"
+        )
+    return CodegenError(
+        f"output {op.name!r}: the rules' total weight {why}, integer arithmetic has no worst-case "
+        "error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
+    )
+
+
 def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
 
@@ -152,7 +170,7 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         raise CodegenError(
             f"output {op.name!r}: concluded by no rule, it has no integer form (use --arith float)"
         )
-    average = op.kind == "singleton" or op.method != "WTSUM"
+    average = METHODS[op.method].weighted == "average"
     zi = [_z_interval(blk, op, t) for t in terms]
     zlo, zhi = min(a for a, _b in zi), max(b for _a, b in zi)
     weights = [constant(r.weight) for r in plan.rules]
@@ -194,18 +212,7 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     shift, num, den, g2 = _sums(blk, op, gs, zs)
     e_sum = sum((g.err for g in g2), Fraction(0))
     if Fraction(bounds.low) <= e_sum:
-        where = ", ".join(f"{plan.inputs[s].name}={v:g}" for s, v in sorted(bounds.witness.items()))
-        if bounds.witness_total <= 2 * float(e_sum):
-            why = f"comes down to {bounds.witness_total:.3g} (at {where}): near inputs where no rule fires"
-        else:  # the search ran out before proving a useful lower bound
-            why = (
-                f"could not be bounded from below (the smallest found is {bounds.witness_total:.3g}, at "
-                f"{where}, but only {bounds.low:.3g} was proven within the search budget): then"
-            )
-        raise CodegenError(
-            f"output {op.name!r}: the rules' total weight {why}, integer arithmetic has no worst-case "
-            "error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
-        )
+        raise _unbounded(plan, op, bounds, e_sum)
     n = blk.temp(num, f"{op.name}: weighted sum", f"NUM_{len(blk.decls)}")
     d = blk.temp(den, f"{op.name}: sum of weights", f"DEN_{len(blk.decls)}")
     out = blk.declare(
