@@ -489,7 +489,7 @@ def build_fixed(
             p.name,
             "narrow",
             "input",
-            comment=f"stored: value = stored * {float(p.scale):g} + {float(p.offset):g}",
+            comment=f"value = {p.formula()}",
         )
     enable = blk.declare("ENABLE", "bool", "input", comment="FALSE: outputs keep their values")
     info = blk.declare(

@@ -216,7 +216,7 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     n = blk.temp(num, f"{op.name}: weighted sum", f"NUM_{len(blk.decls)}")
     d = blk.temp(den, f"{op.name}: sum of weights", f"DEN_{len(blk.decls)}")
     out = blk.declare(
-        op.name, "narrow", "output", comment=f"value = stored * {float(scale):g} + {float(offset):g}"
+        op.name, "narrow", "output", comment=f"value = stored * {float(scale)!r} + {float(offset)!r}"
     )
     q = blk.declare(f"Q_{len(blk.decls)}", "wide")
     if average:
