@@ -33,7 +33,7 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
-from fuzzyctl.ir.nodes import Assign, Bool, Builder, Ex, Int, Stmt, Var
+from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.arith import Arith
 from fuzzyctl.kinds.methods import METHODS
@@ -247,6 +247,20 @@ def output_scale(
 # --------------------------------------------------------------------------- the block
 
 
+def _merged(branches: list[tuple[Ex | None, FX]]) -> list[tuple[Ex | None, FX]]:
+    """The if-chain without a branch whose constant the next branch gives too, when that
+    branch's condition (``X < c``, or none) also holds on the dropped one's values."""
+    out: list[tuple[Ex | None, FX]] = []
+    for cond, x in reversed(branches):
+        if out and isinstance(x.ex, Int):
+            nxt_cond, nxt = out[-1]
+            same = isinstance(nxt.ex, Int) and nxt.ex.value == x.ex.value
+            if same and (nxt_cond is None or (isinstance(nxt_cond, Bin) and nxt_cond.op == "<")):
+                continue
+        out.append((cond, x))
+    return out[::-1]
+
+
 class FixedBlock:
     def __init__(
         self, plan: Plan, arith: Arith, name: str, int_output: str, ranges: dict[str, tuple[float, float]]
@@ -356,6 +370,7 @@ class FixedBlock:
                 break
         if cur <= port.high:
             branches.append((None, self.degree_const(pts[-1][1])))
+        branches = _merged(branches)
         name = f"DEG_{var}_{term}"
         v = self.declare(name, "narrow", comment=f"{fi.name} IS {t.name}")
         lo = min(x.lo for _c, x in branches)
