@@ -106,7 +106,19 @@ def generate_st(
     ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`).
     Raises :class:`CodegenError` naming what cannot be expressed."""
     dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
-    check_arith(arith)
+    if check_arith(arith):
+        from fuzzyctl.codegen.fixed import generate_st_fixed
+
+        return generate_st_fixed(
+            model,
+            block,
+            options,
+            arith=arith,
+            dialect=dialect,
+            default=default,
+            report=report,
+            testbench=testbench,
+        )
     parts = []
     for plan in plans(model, block, **options):
         gen = build(plan, "st", default)
@@ -137,7 +149,12 @@ def generate_c(
     ``NAME_testbench.c`` checking the block on that many input vectors against the engine;
     ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does);
     ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`)."""
-    check_arith(arith)
+    if check_arith(arith):
+        from fuzzyctl.codegen.fixed import generate_c_fixed
+
+        return generate_c_fixed(
+            model, block, options, arith=arith, default=default, report=report, testbench=testbench
+        )
     files: dict[str, str] = {}
     for plan in plans(model, block, **options):
         gen = build(plan, "c", default)
@@ -156,11 +173,10 @@ def generate_c(
     return files
 
 
-def check_arith(arith: str) -> None:
-    """Refuse an arithmetic this generator does not write (integer forms: not yet)."""
+def check_arith(arith: str) -> bool:
+    """Whether ``arith`` is an integer arithmetic (:mod:`fuzzyctl.codegen.fixed` generates
+    it); an unknown name is refused."""
     try:
-        chosen = arith_kinds.get(arith)
+        return arith_kinds.get(arith).integer
     except ValueError as exc:
         raise CodegenError(str(exc)) from None
-    if chosen.integer:
-        raise CodegenError(f"--arith {chosen.name} is not generated yet: use --arith float")

@@ -41,7 +41,7 @@ PLAINTEXT_INTERFACE = "http://www.3s-software.com/plcopenxml/interfaceasplaintex
 VAR_LISTS = {"VAR_INPUT": "inputVars", "VAR_OUTPUT": "outputVars", "VAR": "localVars", "VAR_TEMP": "tempVars"}
 #: Array elements per line of an ``arrayValue`` (large rule tables stay readable and compact).
 VALUES_PER_LINE = 8
-_ELEMENTARY = frozenset({"REAL", "LREAL", "INT", "DINT", "BOOL", "BYTE"})
+_ELEMENTARY = frozenset({"REAL", "LREAL", "INT", "DINT", "LINT", "BOOL", "BYTE"})
 
 
 class _Xml:
@@ -252,8 +252,12 @@ def generate_plcopen(
     from fuzzyctl import __version__
     from fuzzyctl.codegen.api import check_arith
 
-    check_arith(arith)
     check_dialect(dialect)
-    parts = st_blocks(model, block, dialect, lreal, options)
+    if check_arith(arith):
+        from fuzzyctl.codegen.fixed import fixed_st_blocks
+
+        parts = fixed_st_blocks(model, block, options, arith=arith, dialect=dialect)
+    else:
+        parts = st_blocks(model, block, dialect, lreal, options)
     name = project or (parts[0].name if parts else "fuzzyctl")
     return render_plcopen(parts, project=name, version=__version__)

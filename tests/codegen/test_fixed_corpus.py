@@ -1,0 +1,85 @@
+"""Real systems in integer arithmetic: every corpus file that generates in REAL generates in
+int32, or the refusal names the element and the way past it (``--arith float``); the int32 C
+of a sample compiles with the strict flags.  The numbers are printed."""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import warnings
+from collections import Counter
+from pathlib import Path
+
+import pytest
+
+import fuzzyctl
+from fuzzyctl.codegen import CodegenError
+from fuzzyctl.codegen.api import generate_c, lower_block
+from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
+from tests.codegen.fixed_check import STRICT
+from tests.extras import extra_files
+
+pytestmark = pytest.mark.extra("corpus")
+
+FILES = [
+    p for p in extra_files("corpus", "corpus", recursive=True) if p.suffix.lower() in (".fcl", ".fis", ".fll")
+]
+ELEMENT = re.compile(r"^(output|term|input|rule|function block|rule block activation) ")
+WAY = re.compile(r"\(use --arith float")
+
+
+def _in_real(doc: fuzzyctl.model.Document) -> bool:
+    try:
+        plans = [lower_block(doc, fb.name) for fb in doc.blocks]
+        for plan in plans:
+            generate_c(plan, default=0.0)
+    except (DiagnosticError, CodegenError):
+        return False
+    return True
+
+
+def test_corpus_generates_in_int32_or_says_why(tmp_path: Path) -> None:
+    assert len(FILES) >= 400
+    real = done = 0
+    reasons: Counter[str] = Counter()
+    sample: list[dict[str, str]] = []
+    for path in FILES:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                doc = fuzzyctl.load(path)
+        except (FuzzyctlError, UnicodeDecodeError):
+            continue
+        if not _in_real(doc):
+            continue
+        real += 1
+        try:
+            files = generate_c(doc, arith="int32")
+        except CodegenError as exc:
+            message = str(exc)
+            assert ELEMENT.match(message) and WAY.search(message), (path.name, message)
+            reasons[re.sub(r"'[^']*'|\(at .*?\)|rule \S+:|-?\d[\d.e+-]*", "_", message)[:120]] += 1
+            continue
+        done += 1
+        if len(sample) < 12:
+            sample.append(files)
+    print(f"\nint32: {done} of {real} corpus files that generate in REAL")
+    for why, n in reasons.most_common():
+        print(f"  {n:3} x {why}")
+    assert done >= 30
+    cc = shutil.which("cc")
+    assert cc
+    for k, files in enumerate(sample):
+        where = tmp_path / f"s{k}"
+        where.mkdir()
+        for name, text in files.items():
+            (where / name).write_text(text)
+        for name in files:
+            if name.endswith(".c"):
+                res = subprocess.run(
+                    [cc, *STRICT, "-c", "-o", str(where / "x.o"), str(where / name)],
+                    capture_output=True,
+                    text=True,
+                )
+                assert res.returncode == 0, res.stderr[:2000]
