@@ -68,6 +68,33 @@ class LookupReport:
         return out
 
 
+def parse_tolerance(text: str | float) -> float:
+    """``--tolerance``: ``"1%"`` or a fraction of the output range (``0.01``)."""
+    from fuzzyctl.diagnostics import OptionError
+
+    raw = str(text).strip()
+    try:
+        value = float(raw[:-1]) / 100.0 if raw.endswith("%") else float(raw)
+    except ValueError:
+        value = math.nan
+    if not 0.0 < value < 1.0:
+        raise OptionError(
+            f"--tolerance {raw}: give a percentage of the output range (0.1%) or a fraction in (0, 1)",
+            "--tolerance",
+        )
+    return value
+
+
+def lookup_options(tolerance: str | float | None, max_bytes: int | None) -> dict[str, Any]:
+    """The generators' keywords for ``--lookup --tolerance --max-bytes``."""
+    out: dict[str, Any] = {"lookup": True}
+    if tolerance is not None:
+        out["tolerance"] = parse_tolerance(tolerance)
+    if max_bytes is not None:
+        out["max_bytes"] = max_bytes
+    return out
+
+
 def _fbs(model: Document | FunctionBlock, block: str | None) -> list[FunctionBlock]:
     if isinstance(model, FunctionBlock):
         return [model]
@@ -80,7 +107,7 @@ def _fbs(model: Document | FunctionBlock, block: str | None) -> list[FunctionBlo
 
 
 def tables(
-    model: Document | FunctionBlock,
+    model: Document | FunctionBlock | Plan,
     *,
     block: str | None,
     real: str,
@@ -93,20 +120,20 @@ def tables(
     from fuzzyctl.codegen.api import lower_block
 
     bits = arith_kinds.get(arith).bits
+    pairs: list[tuple[Plan, FunctionBlock | None]] = (
+        [(model, None)]  # no model: the ranges are the clamps' or the terms'
+        if isinstance(model, Plan)
+        else [(lower_block(fb, **options), fb) for fb in _fbs(model, block)]
+    )
     out = []
-    for fb in _fbs(model, block):
-        plan = lower_block(fb, **options)
+    for plan, fb in pairs:
         try:
-            out.append(
-                (
-                    plan,
-                    build_table(
-                        plan, tolerance=tolerance, max_bytes=max_bytes, bits=bits, real=real, model=fb
-                    ),
-                )
+            table = build_table(
+                plan, tolerance=tolerance, max_bytes=max_bytes, bits=bits, real=real, model=fb
             )
         except TableError as exc:
-            raise CodegenError(f"--lookup, block {fb.name}: {exc}") from None
+            raise CodegenError(f"--lookup, block {plan.name}: {exc}") from None
+        out.append((plan, table))
     return out
 
 

@@ -73,28 +73,7 @@ def st_parts(table: Table, dialect: str, lreal: bool, arith: str) -> STParts:
         temps += [STVar(f"{_P}F{i}", real, None, None, "") for i in range(d)]
     body = ["    (* each input limited to its range; its interval found by binary search *)"]
     for i, (name, bp) in enumerate(zip(table.inputs, bps, strict=True)):
-        n = len(table.axes[i])
-        x, lo, hi, mid = f"{p}{_P}X{i}", f"{p}{_P}LO", f"{p}{_P}HI", f"{p}{_P}MID"
-        body += [
-            f"    {x} := {p}{name};",
-            f"    IF {x} < {p}{bp}[0] THEN {x} := {p}{bp}[0]; END_IF;",
-            f"    IF {x} > {p}{bp}[{n - 1}] THEN {x} := {p}{bp}[{n - 1}]; END_IF;",
-            f"    {lo} := 0;",
-            f"    {hi} := {n - 1};",
-            f"    WHILE {hi} - {lo} > 1 DO",
-            f"        {mid} := ({lo} + {hi}) / 2;",
-            f"        IF {p}{bp}[{mid}] <= {x} THEN {lo} := {mid}; ELSE {hi} := {mid}; END_IF;",
-            "    END_WHILE;",
-            f"    {p}{_P}I{i} := {lo};",
-        ]
-        if kind.integer:
-            conv = f"{num}_TO_{wide}"
-            body += [
-                f"    {p}{_P}D{i} := {conv}({x} - {p}{bp}[{lo}]);",
-                f"    {p}{_P}W{i} := {conv}({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);",
-            ]
-        else:
-            body.append(f"    {p}{_P}F{i} := ({x} - {p}{bp}[{lo}]) / ({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);")
+        body += _interval(p, i, name, bp, len(table.axes[i]), f"{num}_TO_{wide}" if kind.integer else None)
     strides = [math.prod(table.shape[i + 1 :]) for i in range(d)]
     body.append(f"    {p}{_P}K := " + " + ".join(f"{p}{_P}I{i} * {s}" for i, s in enumerate(strides)) + ";")
     for name, tab in zip(table.outputs, tabs, strict=True):
@@ -131,12 +110,37 @@ def st_parts(table: Table, dialect: str, lreal: bool, arith: str) -> STParts:
     )
 
 
+def _interval(p: str, i: int, name: str, bp: str, n: int, widen: str | None) -> list[str]:
+    """Input ``i`` limited to its breakpoints, its interval by binary search, and its
+    fraction across it (REAL) or its offset and the interval's width (integers, widened)."""
+    x, lo, hi, mid = f"{p}{_P}X{i}", f"{p}{_P}LO", f"{p}{_P}HI", f"{p}{_P}MID"
+    lines = [
+        f"    {x} := {p}{name};",
+        f"    IF {x} < {p}{bp}[0] THEN {x} := {p}{bp}[0]; END_IF;",
+        f"    IF {x} > {p}{bp}[{n - 1}] THEN {x} := {p}{bp}[{n - 1}]; END_IF;",
+        f"    {lo} := 0;",
+        f"    {hi} := {n - 1};",
+        f"    WHILE {hi} - {lo} > 1 DO",
+        f"        {mid} := ({lo} + {hi}) / 2;",
+        f"        IF {p}{bp}[{mid}] <= {x} THEN {lo} := {mid}; ELSE {hi} := {mid}; END_IF;",
+        "    END_WHILE;",
+        f"    {p}{_P}I{i} := {lo};",
+    ]
+    if widen is not None:
+        return [
+            *lines,
+            f"    {p}{_P}D{i} := {widen}({x} - {p}{bp}[{lo}]);",
+            f"    {p}{_P}W{i} := {widen}({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);",
+        ]
+    return [*lines, f"    {p}{_P}F{i} := ({x} - {p}{bp}[{lo}]) / ({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);"]
+
+
 def _real_of(lreal: bool) -> str:
     return "LREAL" if lreal else "REAL"
 
 
 def generate_lookup_st(
-    model: Document | FunctionBlock,
+    model: Document | FunctionBlock | Plan,
     *,
     block: str | None = None,
     dialect: str = "codesys",
@@ -170,7 +174,7 @@ def generate_lookup_st(
 
 
 def generate_lookup_plcopen(
-    model: Document | FunctionBlock,
+    model: Document | FunctionBlock | Plan,
     *,
     block: str | None = None,
     dialect: str = "codesys",

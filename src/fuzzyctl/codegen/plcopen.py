@@ -41,7 +41,7 @@ PLAINTEXT_INTERFACE = "http://www.3s-software.com/plcopenxml/interfaceasplaintex
 VAR_LISTS = {"VAR_INPUT": "inputVars", "VAR_OUTPUT": "outputVars", "VAR": "localVars", "VAR_TEMP": "tempVars"}
 #: Array elements per line of an ``arrayValue`` (large rule tables stay readable and compact).
 VALUES_PER_LINE = 8
-_ELEMENTARY = frozenset({"REAL", "LREAL", "INT", "DINT", "BOOL", "BYTE"})
+_ELEMENTARY = frozenset({"REAL", "LREAL", "INT", "DINT", "LINT", "BOOL", "BYTE"})
 
 
 class _Xml:
@@ -243,6 +243,7 @@ def generate_plcopen(
     lreal: bool = False,
     project: str | None = None,
     arith: str = "float",
+    lookup: bool = False,
     **options: Any,
 ) -> str:
     """PLCopen TC6 XML 2.01 (one project, one ``functionBlock`` POU per function block) whose
@@ -252,6 +253,12 @@ def generate_plcopen(
     from fuzzyctl import __version__
     from fuzzyctl.codegen.api import check_arith
 
+    if lookup:  # the table blocks (codegen/lookup_st.py), in every arithmetic
+        from fuzzyctl.codegen.lookup_st import generate_lookup_plcopen
+
+        return generate_lookup_plcopen(
+            model, block=block, dialect=dialect, lreal=lreal, arith=arith, project=project, **options
+        )
     check_arith(arith)
     check_dialect(dialect)
     parts = st_blocks(model, block, dialect, lreal, options)

@@ -29,7 +29,7 @@ import numpy.typing as npt
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan, Slot
-from fuzzyctl.engine.table_bound import Certifier, refusal
+from fuzzyctl.engine.table_bound import BELL_KINDS, Certifier, refusal
 
 Arr = npt.NDArray[np.float64]
 
@@ -151,7 +151,7 @@ def input_range(plan: Plan, ctl: Controller, i: int) -> tuple[float, float]:
     for fi in plan.fuzzy_inputs:
         if fi.slot == i:
             for t in fi.terms:
-                if t.pwl is None and t.kind == "gaussian":
+                if t.pwl is None and t.kind in BELL_KINDS:
                     c, s = (float(p) for p in t.params if not isinstance(p, Slot))
                     xs += [c - 3 * abs(s), c + 3 * abs(s)]
     if not xs or min(xs) == max(xs):
@@ -466,7 +466,7 @@ def build_table(
         raise TableError("no rule fires somewhere in the input ranges: the output jumps to its DEFAULT there")
     if worst > tolerance:
         raise TableError(
-            f"a table within {tolerance:.4g} of the output range needs more than {max_bytes} bytes "
+            f"a table within {100 * tolerance:.3g}% of the output range needs more than {max_bytes} bytes "
             f"(--max-bytes); {'x'.join(map(str, table.shape))} in {table.size_bytes(real)} bytes is "
             f"within {worst:.3g} ({100 * worst:.3g}%): raise --max-bytes or --tolerance"
         )

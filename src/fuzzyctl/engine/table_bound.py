@@ -35,6 +35,7 @@ import numpy.typing as npt
 from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import membership_np
+from fuzzyctl.kinds import methods
 
 Arr = npt.NDArray[np.float64]
 
@@ -43,6 +44,8 @@ LIPSCHITZ_AND = frozenset({"MIN", "PROD", "BDIF"})
 LIPSCHITZ_OR = frozenset({"MAX", "ASUM", "BSUM"})
 ACCUS = frozenset({"MAX", "BSUM"})
 ACTS = frozenset({"MIN", "PROD"})
+#: the smooth shapes whose slope bound and box range are derived here (centre, sigma)
+BELL_KINDS = frozenset({"gaussian"})
 
 
 def term_slope(t: TermPlan) -> float | None:
@@ -57,7 +60,7 @@ def term_slope(t: TermPlan) -> float | None:
                 continue
             steep = max(steep, abs(y1 - y0) / (x1 - x0))
         return steep
-    if t.kind == "gaussian" and t.constant and len(t.params) == 2:
+    if t.kind in BELL_KINDS and t.constant and len(t.params) == 2:
         sigma, height = float(t.params[1]), float(t.height)  # type: ignore[arg-type]
         return abs(height) / (abs(sigma) * math.sqrt(math.e)) if sigma != 0.0 else None
     return None
@@ -98,7 +101,7 @@ def _output_refusal(o: OutputPlan) -> str | None:
         if accu not in ACCUS:
             return f"accumulation {accu} of {o.name}"
     elif o.kind == "mamdani":
-        if o.method != "COG" or accu not in ACCUS or o.low is None or o.high is None:
+        if not methods.method(o.method).centroid or accu not in ACCUS or o.low is None or o.high is None:
             return f"output {o.name} ({o.method}, {accu})"
         if any(t.pwl is None for t in o.terms):
             return f"output {o.name}: a term that is not piecewise linear"
