@@ -114,11 +114,12 @@ def test_a_system_without_a_derived_bound_is_refused_with_the_reason() -> None:
         .replace("METHOD : CoGS;", "METHOD : LM;")
         .replace(
             "TERM s0 := -50; TERM s1 := 10; TERM s2 := 80;",
-            "TERM s0 := (-50, 0) (-40, 1) (-30, 0); TERM s1 := (0, 0) (10, 1) (20, 0); TERM s2 := (70, 0) (80, 1) (90, 0);",
+            "TERM s0 := (-50, 0) (-40, 1) (-30, 0); TERM s1 := (0, 0) (10, 1) (20, 0); "
+            "TERM s2 := (70, 0) (80, 1) (90, 0);",
         )
         .replace("DEFAULT := 0;", "RANGE := (-50 .. 90);\nDEFAULT := 0;")
     )
-    with pytest.raises(CodegenError, match="no proven error bound .*LM"):
+    with pytest.raises(CodegenError, match=r"no proven error bound .*LM"):
         generate_st(fuzzyctl.load(text), lookup=True, tolerance=0.05)
 
 
