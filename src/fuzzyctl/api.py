@@ -27,7 +27,7 @@ if TYPE_CHECKING:
     from fuzzyctl.model import Document, FunctionBlock
 
 #: Backends of :func:`compile` (``auto``: native when possible, else python).
-BACKENDS = ("auto", "native", "python", "interpreted")
+BACKENDS = ("auto", "native", "python", "interpreted", "table")
 #: Content keys of documents this process loaded (by identity; a few recent ones).
 _KEYS: OrderedDict[int, tuple[Document, str]] = OrderedDict()
 
@@ -196,8 +196,10 @@ def compile(
     and the C generator expresses the system, else python; a missing compiler is a one-line
     notice), ``"native"`` (generated C compiled into a cached shared library, see
     docs/codegen.md; without a C compiler it warns and uses the Python path), ``"python"``
-    (generated Python for single evaluations, numpy for batches) or ``"interpreted"`` (the
-    reference interpreter only); ``compat="fuzzylite"`` etc. reproduces other tools'
+    (generated Python for single evaluations, numpy for batches), ``"interpreted"`` (the
+    reference interpreter only) or ``"table"`` (a lookup table with a proven error bound,
+    ``tolerance=`` a fraction of each output's range, default 0.001, and ``max_bytes=``: see
+    docs/codegen.md, lookup tables); ``compat="fuzzylite"`` etc. reproduces other tools'
     semantics (default IEC 61131-7).  ``strict=True`` refuses what a strict IEC 61131-7
     reading refuses and the engine otherwise settles with a warning: an output without RANGE
     whose terms do not fall to 0, identifiers that are Table 7 keywords; the warnings it
@@ -219,6 +221,11 @@ def compile(
     from fuzzyctl.model import Document
 
     check_mode(out_of_range)
+    table: dict[str, Any] = {k: options.pop(k) for k in ("tolerance", "max_bytes") if k in options}
+    if table and backend != "table":
+        from fuzzyctl.diagnostics import FuzzyctlError
+
+        raise FuzzyctlError(f"{', '.join(table)}: options of backend='table'")
     if isinstance(model, (str, Path)):  # a path, or FCL source text as load() takes it
         model = load(model, strict=bool(options.get("strict")))
     if options.get("strict"):
@@ -226,7 +233,7 @@ def compile(
     with gc_paused():  # lowering and generating build large acyclic structures
         plan, key, found = _plan(model, block, options)
         fb = model.block(block) if isinstance(model, Document) else model
-        ctl = _controller(plan, backend, key, fb, found)
+        ctl = _controller(plan, backend, key, fb, found, table)
     ctl.out_of_range = out_of_range
     return ctl
 
@@ -301,18 +308,25 @@ def _controller(
     key: str | None,
     model: FunctionBlock | None = None,
     found: tuple[Diagnostic, ...] = (),
+    table: dict[str, Any] | None = None,
 ) -> Controller:
-    ctl = _backend(plan, backend, key, model)
+    ctl = _backend(plan, backend, key, model, table or {})
     ctl.warnings = found
     return ctl
 
 
-def _backend(plan: Plan, backend: str | None, key: str | None, model: FunctionBlock | None) -> Controller:
+def _backend(
+    plan: Plan, backend: str | None, key: str | None, model: FunctionBlock | None, table: dict[str, Any]
+) -> Controller:
     backend = backend or os.environ.get("FUZZYCTL_BACKEND") or "auto"
     if backend not in BACKENDS:
         from fuzzyctl.diagnostics import FuzzyctlError
 
         raise FuzzyctlError(f"unknown backend {backend!r} (available: {', '.join(BACKENDS)})")
+    if backend == "table":
+        from fuzzyctl.engine.table import TableController, build_table
+
+        return TableController(plan, build_table(plan, model=model, **table), model)
     if backend in ("native", "auto") and plan.options.emulate is None:
         # (an emulated tool's arithmetic - jFuzzyLogic's 1000-point sets - has no C form: the
         # controller's own evaluator serves every path)

@@ -90,6 +90,29 @@ def codegen(
             + ".",
         ),
     ] = _DEFAULT_ARITH,
+    lookup: Annotated[
+        bool,
+        typer.Option(
+            "--lookup",
+            help=f"{' and '.join(accepting('lookup'))}: the block as a lookup table (1 to 3 inputs) with "
+            "multi-linear interpolation and a proven error bound in its header.",
+        ),
+    ] = False,
+    tolerance: Annotated[
+        str | None,
+        typer.Option(
+            "--tolerance",
+            help="--lookup: the error allowed, as a percentage of each output's range (default 0.1%) "
+            "or a fraction (0.001).",
+            show_default=False,
+        ),
+    ] = None,
+    max_bytes: Annotated[
+        int | None,
+        typer.Option(
+            "--max-bytes", help="--lookup: the largest table, in bytes (default 16384).", show_default=False
+        ),
+    ] = None,
     testbench: Annotated[
         int,
         typer.Option(
@@ -153,6 +176,9 @@ def codegen(
             fmi=fmi,
             binary=not no_binary,
             arith=arith.value,
+            lookup=lookup,
+            tolerance=tolerance,
+            max_bytes=max_bytes,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))

@@ -92,6 +92,7 @@ def generate_st(
     default: float | str | None = None,
     report: list[Generated] | None = None,
     arith: str = arith_kinds.DEFAULT,
+    lookup: bool = False,
     **options: Any,
 ) -> str:
     """Structured Text for every function block of ``model`` (or just ``block``).
@@ -104,8 +105,23 @@ def generate_st(
     ``default`` (a number or ``"hold"``) replaces ``DEFAULT := nan``.  Names the target cannot
     use are renamed (header comment; ``report`` receives one :class:`Generated` per block).
     ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`).
+    ``lookup`` writes each block as a lookup table (:mod:`fuzzyctl.codegen.lookup_st`;
+    ``tolerance`` and ``max_bytes`` keywords go to it).
     Raises :class:`CodegenError` naming what cannot be expressed."""
     dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
+    if lookup:  # before check_arith: tables are written in every arithmetic
+        from fuzzyctl.codegen.lookup_st import generate_lookup_st
+
+        return generate_lookup_st(
+            model,
+            block=block,
+            dialect=dialect,
+            lreal=lreal,
+            testbench=testbench,
+            arith=arith,
+            report=report,
+            **options,
+        )
     if check_arith(arith):
         from fuzzyctl.codegen.fixed import generate_st_fixed
 
@@ -142,13 +158,21 @@ def generate_c(
     default: float | str | None = None,
     report: list[Generated] | None = None,
     arith: str = arith_kinds.DEFAULT,
+    lookup: bool = False,
     **options: Any,
 ) -> dict[str, str]:
     """C99 files (``NAME.h``, ``NAME.c``) for every function block of ``model`` (or just
     ``block``); ``single`` computes in float instead of double; ``testbench`` > 0 adds
     ``NAME_testbench.c`` checking the block on that many input vectors against the engine;
     ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does);
-    ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`)."""
+    ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`); ``lookup`` writes each
+    block as a lookup table (:mod:`fuzzyctl.codegen.lookup_c`)."""
+    if lookup:  # before check_arith: tables are written in every arithmetic
+        from fuzzyctl.codegen.lookup_c import generate_lookup_c
+
+        return generate_lookup_c(
+            model, block=block, single=single, testbench=testbench, arith=arith, report=report, **options
+        )
     if check_arith(arith):
         from fuzzyctl.codegen.fixed import generate_c_fixed
 

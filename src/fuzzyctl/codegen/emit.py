@@ -94,6 +94,9 @@ def check_options(
     fmi: int | None = None,
     binary: bool = True,
     arith: str = arith_kinds.DEFAULT,
+    lookup: bool = False,
+    tolerance: str | float | None = None,
+    max_bytes: int | None = None,
 ) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
     (:class:`OptionError` names the option); what applies is the target's record."""
@@ -119,6 +122,7 @@ def check_options(
         arith_kinds.get(arith)
     except ValueError as exc:
         raise OptionError(str(exc), "--arith") from None
+    _check_lookup(lookup, tolerance, max_bytes, "lookup" in takes)
     refusal = targets.dialect(dialect).refused_by.get(caps.name) if dialect is not None else None
     if refusal is not None:
         raise OptionError(f"{refusal}: use --lang st --dialect {dialect}", "--dialect")
@@ -126,6 +130,19 @@ def check_options(
         parse_default(default)
     except CodegenError as exc:
         raise OptionError(str(exc), "--default") from None
+
+
+def _check_lookup(lookup: bool, tolerance: str | float | None, max_bytes: int | None, takes: bool) -> None:
+    from fuzzyctl.codegen.lookup import parse_tolerance
+
+    if lookup and not takes:
+        raise OptionError(f"--lookup applies to --lang {' and '.join(accepting('lookup'))}", "--lookup")
+    if not lookup and (tolerance is not None or max_bytes is not None):
+        raise OptionError("--tolerance and --max-bytes apply to --lookup", "--lookup")
+    if tolerance is not None:
+        parse_tolerance(tolerance)
+    if max_bytes is not None and max_bytes < 16:
+        raise OptionError(f"--max-bytes {max_bytes}: give at least 16 bytes", "--max-bytes")
 
 
 def _check_fmu_options(lang: str, fmi: int | None, other: bool) -> None:
@@ -159,6 +176,9 @@ def emit(
     fmi: int | None = None,
     binary: bool = True,
     arith: str = arith_kinds.DEFAULT,
+    lookup: bool = False,
+    tolerance: str | float | None = None,
+    max_bytes: int | None = None,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
         are checked first) and write it: ``st`` and ``plcopen`` to the file
@@ -178,6 +198,9 @@ def emit(
         fmi=fmi,
         binary=binary,
         arith=arith,
+        lookup=lookup,
+        tolerance=tolerance,
+        max_bytes=max_bytes,
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
@@ -201,6 +224,10 @@ def emit(
     ):
         if option in caps.cli_options:
             kwargs[keyword] = chosen[keyword]
+    if lookup:  # the table generators: codegen/lookup_st.py, lookup_c.py
+        from fuzzyctl.codegen.lookup import lookup_options
+
+        kwargs.update(lookup_options(tolerance, max_bytes))
     if caps.report:
         kwargs["report"] = emitted.blocks
     result = generator_of(caps)(document, **kwargs)

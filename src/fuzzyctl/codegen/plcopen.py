@@ -243,6 +243,7 @@ def generate_plcopen(
     lreal: bool = False,
     project: str | None = None,
     arith: str = "float",
+    lookup: bool = False,
     **options: Any,
 ) -> str:
     """PLCopen TC6 XML 2.01 (one project, one ``functionBlock`` POU per function block) whose
@@ -252,6 +253,12 @@ def generate_plcopen(
     from fuzzyctl import __version__
     from fuzzyctl.codegen.api import check_arith
 
+    if lookup:  # the table blocks (codegen/lookup_st.py), in every arithmetic
+        from fuzzyctl.codegen.lookup_st import generate_lookup_plcopen
+
+        return generate_lookup_plcopen(
+            model, block=block, dialect=dialect, lreal=lreal, arith=arith, project=project, **options
+        )
     check_dialect(dialect)
     if check_arith(arith):
         from fuzzyctl.codegen.fixed import fixed_st_blocks

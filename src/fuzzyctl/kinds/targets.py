@@ -258,7 +258,7 @@ ST = Target(
     cli="st",
     cli_help="Structured Text",
     generator="fuzzyctl.codegen.api:generate_st",
-    cli_options=frozenset({"dialect", "lreal", "testbench", "arith"}),
+    cli_options=frozenset({"dialect", "lreal", "testbench", "arith", "lookup"}),
     report=True,
     cli_dialect_help="codesys (default)",
 )
@@ -306,7 +306,7 @@ PLCOPEN = dataclasses.replace(
     cli="plcopen",
     cli_help="the same as PLCopen TC6 XML",
     generator="fuzzyctl.codegen.plcopen:generate_plcopen",
-    cli_options=frozenset({"dialect", "lreal", "arith"}),
+    cli_options=frozenset({"dialect", "lreal", "arith", "lookup"}),
     report=False,
 )
 
@@ -358,7 +358,7 @@ C = Target(
     cli="c",
     cli_help="C99",
     generator="fuzzyctl.codegen.api:generate_c",
-    cli_options=frozenset({"float", "testbench", "arith"}),
+    cli_options=frozenset({"float", "testbench", "arith", "lookup"}),
     report=True,
 )
 
@@ -494,7 +494,8 @@ def cli_target(choice: str) -> Target:
 #: Intrinsics every builder needs (smooth shapes, CoA, the POW fallback EXP(y * LN(x))).
 CORE_FUNCTIONS = frozenset({"EXP", "LN", "SQRT", "ABS"})
 #: CLI options a target may accept.
-CLI_OPTIONS = frozenset({"dialect", "lreal", "float", "testbench", "fmi", "arith"})
+#: ``lookup`` also admits ``--tolerance`` and ``--max-bytes`` (they go with it).
+CLI_OPTIONS = frozenset({"dialect", "lreal", "float", "testbench", "fmi", "arith", "lookup"})
 
 
 def incomplete(t: Target) -> list[str]:

@@ -1,0 +1,211 @@
+"""The lookup-table block (:mod:`fuzzyctl.codegen.lookup`) in C99: ``NAME.h`` (the instance
+struct, ``NAME_init``, ``NAME_step``) and ``NAME.c``, and its test bench ``NAME_testbench.c``
+(``-DFUZZYCTL_TESTBENCH_MAIN`` makes it a program printing PASS or FAIL)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.engine.plan import Plan
+from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
+from fuzzyctl.escape import c_ident
+from fuzzyctl.kinds import arith as arith_kinds
+from fuzzyctl.kinds import targets
+
+
+def _num(v: float) -> str:
+    return repr(float(v)) if v >= 0 else f"({float(v)!r})"
+
+
+def c_files(table: Table, single: bool, arith: str) -> dict[str, str]:
+    """``NAME.h`` and ``NAME.c`` of ``table``."""
+    kind = arith_kinds.get(arith)
+    name = c_ident(table.name or "FUZZY", "function block name")
+    for v in table.inputs + table.outputs:
+        c_ident(v, "variable")
+    real = targets.C.real_type(single)
+    num = kind.types["c"] if kind.integer else real
+    wide = kind.wide_types["c"] if kind.integer else real
+    com = targets.C.comment
+    real_name = "REAL" if single else "LREAL"
+    head = [com(line) for line in header(table, real_name, f"C99, {kind.name if kind.integer else real}")]
+    guard = f"FUZZYCTL_LOOKUP_{name.upper()}_H"
+    h = [*head, f"#ifndef {guard}", f"#define {guard}", ""]
+    if kind.integer:
+        h += ["#include <stdint.h>", ""]
+    h += [f"typedef {num} {name}_real;", "", "typedef struct {"]
+    h += [f"    {num} {v};" for v in table.inputs]
+    h += [f"    {num} {v};" for v in table.outputs]
+    h += [
+        "    unsigned char INFO; /* always 0: rules fire everywhere in the input ranges */",
+        f"}} {name};",
+        "",
+    ]
+    h += [
+        f"void {name}_init({name} *fb);",
+        f"unsigned char {name}_step({name} *fb);",
+        "",
+        f"#endif /* {guard} */",
+    ]
+    axes = table.stored_axes() if kind.integer else table.axes
+    vals = table.stored_values() if kind.integer else table.values
+
+    def arr(values: Any) -> str:
+        return (
+            ", ".join(str(int(v)) for v in values)
+            if kind.integer
+            else ", ".join(_num(float(v)) for v in values)
+        )
+
+    c = [*head, f'#include "{name}.h"', ""]
+    for i, a in enumerate(axes):
+        c.append(f"static const {num} {name}_BP{i}[{len(a)}] = {{{arr(a)}}}; /* {table.inputs[i]} */")
+    for k, entries in enumerate(vals):
+        c.append(
+            f"static const {num} {name}_TAB{k}[{entries.size}] = {{{arr(entries.ravel())}}}; "
+            f"/* {table.outputs[k]} */"
+        )
+    c += ["", f"void {name}_init({name} *fb)", "{"]
+    c += [f"    fb->{v} = 0;" for v in table.inputs + table.outputs]
+    c += ["    fb->INFO = 0;", "}", "", f"unsigned char {name}_step({name} *fb)", "{"]
+    d = len(table.axes)
+    c.append(f"    long i[{d}], lo, hi, mid, k;")
+    c.append(f"    {wide} f[{d}], w[{d}];" if kind.integer else f"    {real} f[{d}];")
+    c.append(f"    {num} x;")
+    for j, v in enumerate(table.inputs):
+        n = len(table.axes[j])
+        bp = f"{name}_BP{j}"
+        c += [
+            f"    x = fb->{v};",
+            f"    if (x < {bp}[0]) x = {bp}[0];",
+            f"    if (x > {bp}[{n - 1}]) x = {bp}[{n - 1}];",
+            f"    lo = 0; hi = {n - 1};",
+            "    while (hi - lo > 1) {",
+            "        mid = (lo + hi) / 2;",
+            f"        if ({bp}[mid] <= x) lo = mid; else hi = mid;",
+            "    }",
+            f"    i[{j}] = lo;",
+        ]
+        if kind.integer:
+            c += [f"    f[{j}] = ({wide})x - {bp}[lo];", f"    w[{j}] = ({wide}){bp}[lo + 1] - {bp}[lo];"]
+        else:
+            c.append(f"    f[{j}] = (x - {bp}[lo]) / ({bp}[lo + 1] - {bp}[lo]);")
+    strides = [math.prod(table.shape[j + 1 :]) for j in range(d)]
+    c.append("    k = " + " + ".join(f"i[{j}] * {s}" for j, s in enumerate(strides)) + ";")
+    for k_out, v in enumerate(table.outputs):
+        tab = f"{name}_TAB{k_out}"
+        c.append("    {")
+
+        def read(off: int, tab: str = tab) -> str:
+            return f"({wide}){tab}[k + {off}]" if kind.integer else f"{tab}[k + {off}]"
+
+        def lerp(a: str, b: str, axis: int) -> str:
+            if kind.integer:
+                return f"{a} + (({b} - {a}) * f[{axis}]) / w[{axis}]"
+            return f"{a} + ({b} - {a}) * f[{axis}]"
+
+        steps, final = interpolation(table.shape, read, lerp, lambda s: f"v{s}")
+        for tmp, expr in steps:
+            c.append(f"        {wide} {tmp} = {expr};")
+        c.append(f"        fb->{v} = ({num})({final});")
+        c.append("    }")
+    c += ["    fb->INFO = 0;", "    return 0;", "}"]
+    h_ext, c_ext = targets.C.extensions
+    return {f"{name}{h_ext}": "\n".join(h) + "\n", f"{name}{c_ext}": "\n".join(c) + "\n"}
+
+
+def c_bench(plan: Plan, table: Table, n: int, single: bool) -> str:
+    """``int NAME_testbench(int *first_fail)`` returning FAIL_COUNT, and with
+    ``-DFUZZYCTL_TESTBENCH_MAIN`` a ``main`` printing ``PASS``/``FAIL FAIL_COUNT=.. FIRST_FAIL=..``."""
+    name = c_ident(table.name or "FUZZY", "function block name")
+    rows = sample_rows(table, n)
+    exp = expected(plan, rows, single=single and not table.bits)
+    lines = [targets.C.comment(f"test bench of {name}: {n} vectors, outputs within the stated bound"), ""]
+    lines += ["#include <stdio.h>", f'#include "{name}.h"', ""]
+    for i in range(len(table.inputs)):
+        if table.bits:
+            sc, off = table.in_scale[i]
+            vals = ", ".join(str(round((r[i] - off) / sc)) for r in rows)
+            lines.append(f"static const long {name}_TB_X{i}[{n}] = {{{vals}}};")
+        else:
+            lines.append(
+                f"static const double {name}_TB_X{i}[{n}] = {{{', '.join(_num(r[i]) for r in rows)}}};"
+            )
+    for k in range(len(table.outputs)):
+        if table.bits:
+            sc, off = table.out_scale[k]
+            vals = ", ".join(str(round((e[k] - off) / sc)) for e in exp)
+            lines.append(f"static const long {name}_TB_Y{k}[{n}] = {{{vals}}};")
+            lines.append(f"static const long {name}_TB_TOL{k} = {math.ceil(table.bound[k] / sc + 0.5)};")
+        else:
+            lines.append(
+                f"static const double {name}_TB_Y{k}[{n}] = {{{', '.join(_num(e[k]) for e in exp)}}};"
+            )
+            lines.append(f"static const double {name}_TB_TOL{k} = {_num(table.bound[k] * (1 + 1e-6))};")
+    diff = "long" if table.bits else "double"
+    lines += [
+        "",
+        f"int {name}_testbench(int *first_fail)",
+        "{",
+        f"    {name} fb;",
+        "    int k, bad, fails = 0;",
+        f"    {diff} d;",
+        f"    {name}_init(&fb);",
+        "    *first_fail = 0;",
+        f"    for (k = 0; k < {n}; k++) {{",
+    ]
+    for i, v in enumerate(table.inputs):
+        lines.append(f"        fb.{v} = ({name}_real){name}_TB_X{i}[k];")
+    lines.append(f"        bad = {name}_step(&fb) != 0;")
+    for k, v in enumerate(table.outputs):
+        lines.append(f"        d = ({diff})fb.{v} - {name}_TB_Y{k}[k];")
+        lines.append(f"        if (!((d < 0 ? -d : d) <= {name}_TB_TOL{k})) bad = 1;")
+    lines += [
+        "        if (bad) {",
+        "            fails++;",
+        "            if (*first_fail == 0) *first_fail = k + 1;",
+        "        }",
+        "    }",
+        "    return fails;",
+        "}",
+        "",
+        "#ifdef FUZZYCTL_TESTBENCH_MAIN",
+        "int main(void)",
+        "{",
+        "    int first;",
+        f"    int fails = {name}_testbench(&first);",
+        '    printf("%s FAIL_COUNT=%d FIRST_FAIL=%d\\n", fails ? "FAIL" : "PASS", fails, first);',
+        "    return fails != 0;",
+        "}",
+        "#endif",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def generate_lookup_c(
+    model: Any,
+    *,
+    block: str | None = None,
+    single: bool = False,
+    testbench: int = 0,
+    arith: str = arith_kinds.DEFAULT,
+    tolerance: float = DEFAULT_TOLERANCE,
+    max_bytes: int = DEFAULT_MAX_BYTES,
+    report: list[Any] | None = None,
+    default: Any = None,
+    **options: Any,
+) -> dict[str, str]:
+    """C99 files: each function block as a lookup table (and its test bench)."""
+    real = "REAL" if single else "LREAL"
+    files: dict[str, str] = {}
+    for plan, table in tables(
+        model, block=block, real=real, arith=arith, tolerance=tolerance, max_bytes=max_bytes, **options
+    ):
+        if report is not None:
+            report.append(LookupReport(table, real))
+        files.update(c_files(table, single, arith))
+        if testbench:
+            files[f"{table.name}_testbench.c"] = c_bench(plan, table, testbench, single)
+    return files
