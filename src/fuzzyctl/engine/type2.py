@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,6 +32,7 @@ import numpy as np
 
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine import type2_sets as sets
+from fuzzyctl.engine.ranges import check_values
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.engine.semantics import shapes as sem
 from fuzzyctl.kinds import methods
@@ -137,17 +138,39 @@ def _is_ts(term: Term) -> bool:
     )
 
 
+@dataclass(frozen=True)
+class InputSpec:
+    """An input as the data-file evaluation asks for it (type-2 inputs have no default)."""
+
+    name: str
+    default: float | None = None
+
+
+@dataclass(frozen=True)
+class Type2Plan:
+    """What a type-2 controller shows of its plan: its inputs."""
+
+    inputs: tuple[InputSpec, ...]
+
+
 class Type2Controller:
     """Evaluates an interval type-2 function block (see the module docstring)."""
 
     def __init__(self, fb: FunctionBlock, *, samples: int | None = None, method: str | None = None) -> None:
         self.model = fb
+        self.name = fb.name
+        self.plan = Type2Plan(tuple(InputSpec(v.name) for v in fb.inputs))
         self.samples = samples
         self.method_override = method
         self.inputs = {v.name: v for v in fb.inputs}
         self.outputs = {v.name: v for v in fb.outputs}
         self.warnings: tuple[Any, ...] = ()
-        self.out_of_range = "ignore"
+        self.out_of_range = "warn"
+        self.input_ranges: dict[str, tuple[float, float]] = {
+            f.variable: (f.range.low, f.range.high)
+            for f in fb.fuzzify
+            if f.range is not None and f.range.low < f.range.high
+        }
         self.and_op, self.or_op, self.act, self.accu = _norms(fb)
         if len(fb.rule_blocks) > 1:
             raise Type2Unsupported("interval type-2 systems with more than one rule block are not supported")
@@ -345,7 +368,7 @@ class Type2Controller:
         return OutputInterval(d.variable, value, yl, yr, method, exact)
 
     # ------------------------------------------------------------------ public
-    def _values(self, inputs: Mapping[str, Any]) -> dict[str, float]:
+    def _values(self, inputs: Mapping[str, Any], mode: str | None = None) -> dict[str, float]:
         unknown = set(inputs) - set(self.inputs)
         if unknown:
             raise FuzzyctlError(
@@ -354,10 +377,18 @@ class Type2Controller:
         missing = [n for n in self.inputs if n not in inputs]
         if missing:
             raise FuzzyctlError(f"missing input(s) {', '.join(missing)}")
-        return {n: float(inputs[n]) for n in self.inputs}
+        names = tuple(self.inputs)
+        values = check_values(
+            self.input_ranges, names, [float(inputs[n]) for n in names], mode or self.out_of_range
+        )
+        return dict(zip(names, values, strict=True))
 
-    def explain(self, inputs: Mapping[str, Any] | None = None, **kw: Any) -> Type2Explanation:
-        x = self._values({**(inputs or {}), **kw})
+    def explain(
+        self, inputs: Mapping[str, Any] | None = None, *, out_of_range: str | None = None, **kw: Any
+    ) -> Type2Explanation:
+        """Evaluate once and show the firing interval of every rule and the type-reduced
+        interval of every output.  ``out_of_range`` as for type-1 controllers."""
+        x = self._values({**(inputs or {}), **kw}, out_of_range)
         fired = self.firing(x)
         outs = []
         for d in self.model.defuzzify:
@@ -366,17 +397,27 @@ class Type2Controller:
         rules = tuple(RuleInterval(r.label, lo, up) for r, (lo, up) in fired)
         return Type2Explanation(x, rules, tuple(outs))
 
-    def evaluate(self, inputs: Mapping[str, Any] | None = None, **kw: Any) -> dict[str, float]:
-        return self.explain(inputs, **kw).values
+    def evaluate(
+        self, inputs: Mapping[str, Any] | None = None, *, out_of_range: str | None = None, **kw: Any
+    ) -> dict[str, float]:
+        return self.explain(inputs, out_of_range=out_of_range, **kw).values
 
     def evaluate_batch(
-        self, data: Mapping[str, Sequence[float]] | None = None, **columns: Any
+        self, data: Any, *, out_of_range: str | None = None, rows: int | None = None, **options: Any
     ) -> dict[str, np.ndarray]:
-        cols = {**(data or {}), **columns}
-        n = len(next(iter(cols.values()))) if cols else 0
+        """Evaluate every row of ``data`` (input name -> sequence), one row at a time (type-2
+        has no vectorised path yet).  ``chunk`` / ``on_invalid`` of type-1 controllers are
+        accepted; an invalid row raises."""
+        cols = {k: np.asarray(data[k], dtype=float) for k in self.inputs}
+        n = len(next(iter(cols.values()))) if cols else int(rows or 0)
         out = {name: np.empty(n) for name in self.outputs}
         for i in range(n):
-            row = self.evaluate({k: v[i] for k, v in cols.items()})
+            x = {k: v[i] for k, v in cols.items()}
+            if not all(math.isfinite(v) for v in x.values()) and options.get("on_invalid") == "nan":
+                for name in out:
+                    out[name][i] = math.nan
+                continue
+            row = self.evaluate(x, out_of_range=out_of_range)
             for name, v in row.items():
                 out[name][i] = v
         return out

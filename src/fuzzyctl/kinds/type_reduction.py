@@ -98,7 +98,7 @@ class Consumer:
 
 _GENERATE = (
     "interval type-2 code generation is not available yet; evaluate the system with "
-    "`fuzzyctl eval`, or convert it to type-1 (`fuzzyctl convert --to-type1`) first"
+    "`fuzzyctl eval`, or convert it to type-1 (`fuzzyctl convert --type1`) first"
 )
 
 CONSUMERS: dict[str, Consumer] = {
