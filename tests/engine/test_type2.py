@@ -18,6 +18,7 @@ from fuzzyctl import model as m
 from fuzzyctl.diagnostics import DiagnosticError, FuzzyctlError
 from fuzzyctl.engine import type2_sets
 from fuzzyctl.engine.type2 import Type2Controller, Type2Unsupported
+from fuzzyctl.formats.common.type2 import to_type1
 from fuzzyctl.kinds import type_reduction as tr
 from tests.engine.type2_systems import random_it2, with_lower_equal_upper
 
@@ -101,14 +102,16 @@ def test_exact_centroid_against_fine_sampling(seed: int) -> None:
 def test_lower_equal_upper_is_the_type1_engine(seed: int, sugeno: bool) -> None:
     fb = random_it2(seed, sugeno=sugeno)
     t2 = Type2Controller(with_lower_equal_upper(fb))
-    t1_model = formats.convert(m.Document((fb,)), "fcl", lossy=True)[0]
-    t1 = fuzzyctl.compile(fuzzyctl.load(t1_model), backend="interpreted")
+    t1 = fuzzyctl.compile(to_type1(fb), backend="interpreted")  # the upper functions alone
     rng = random.Random(seed)
     for _ in range(10):
         x = {"x0": rng.uniform(0, 10), "x1": rng.uniform(0, 10)}
         want = t1.evaluate(x)["y"]
         got = t2.evaluate(x)["y"]
-        assert got == pytest.approx(want, rel=1e-12, abs=1e-12), (x, got, want)
+        if sugeno:  # the same weighted mean, in the same order
+            assert got == want, (x, got, want)
+        else:  # the same integrals, summed in another order: within a few ulp (measured 2)
+            assert got == pytest.approx(want, rel=1e-14, abs=1e-14), (x, got, want)
 
 
 def test_interval_contains_the_value_and_methods_agree() -> None:

@@ -152,3 +152,22 @@ def test_random_systems_round_trip_through_fcl_and_json() -> None:
             again = fuzzyctl.load(text, format=fmt).main
             a, b = Type2Controller(doc.main), Type2Controller(again)
             assert a.evaluate(x0=3.0, x1=6.0) == b.evaluate(x0=3.0, x1=6.0)
+
+
+def test_type1_lowering_and_its_consumers_refuse(capsys: pytest.CaptureFixture[str]) -> None:
+    from fuzzyctl.codegen.api import generate_st
+    from fuzzyctl.sim.runtimes import make_runtime
+    from fuzzyctl.type2 import Type2NotSupported
+
+    doc = fuzzyctl.load(EXAMPLE)
+    with pytest.raises(Type2NotSupported, match="type-1 lowering"):
+        generate_st(doc)
+    for kind in ("native", "siemens", "xfuz"):
+        with pytest.raises(Type2NotSupported, match="interval type-2 system"):
+            make_runtime(doc, kind)
+    engine = make_runtime(doc, "engine")  # the loop runs on the type-2 engine
+    assert engine.evaluate({"service": 3.0, "food": 8.0}) == fuzzyctl.compile(doc).evaluate(service=3, food=8)
+    assert main(["analyze", EXAMPLE]) == 1
+    assert "analysis (coverage, cells, surface) reads the type-1 plan" in capsys.readouterr().err.replace(
+        "\n", " "
+    )

@@ -172,7 +172,7 @@ def emit(
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
-    refuse_type2(document.block(block) if block else document, "codegen", caps.type2)
+    refuse_type2(document, "codegen", caps.type2)  # (any block: --block errors come later)
     if "fmi" in caps.cli_options:
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     emitted = Emitted(lang)

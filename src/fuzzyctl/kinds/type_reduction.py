@@ -113,6 +113,18 @@ CONSUMERS: dict[str, Consumer] = {
             "the native backend does not evaluate interval type-2 systems yet; use backend='python'",
         ),
         Consumer("codegen", False, _GENERATE),
+        Consumer(
+            "analyze",
+            False,
+            "the analysis (coverage, cells, surface) reads the type-1 plan; evaluate the system "
+            "with `fuzzyctl eval`, or convert it to type-1 (`fuzzyctl convert --type1`) first",
+        ),
+        Consumer(
+            "type-1 engine",
+            False,
+            "the type-1 lowering (code generators, analysis, PLC blocks) does not take it; "
+            "fuzzyctl.compile and `fuzzyctl eval` evaluate it",
+        ),
         Consumer("blocks", False, _GENERATE),
         Consumer(
             "studio",
