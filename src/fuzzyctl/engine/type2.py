@@ -175,6 +175,13 @@ class Type2Controller:
         if len(fb.rule_blocks) > 1:
             raise Type2Unsupported("interval type-2 systems with more than one rule block are not supported")
         self._check()
+        # the breakpoints of every term's upper and lower function (None: smooth), once
+        self._points: dict[int, tuple[sets.Points | None, sets.Points | None]] = {
+            id(t): (sets.points_of(t.mf, t.name), sets.lower_points(t, t.name))
+            for terms in (*(f.terms for f in fb.fuzzify), *(d.terms for d in fb.defuzzify))
+            for t in terms
+            if not _is_ts(t)
+        }
 
     # ------------------------------------------------------------------ checks
     def _check(self) -> None:
@@ -240,11 +247,7 @@ class Type2Controller:
             term = fz.term(c.term) if fz else None
             if term is None:
                 raise Type2Unsupported(f"no input term {c.variable}.{c.term}")
-            where = f"term {c.variable}.{c.term}"
-            lo, up = (
-                sets.lower_value(term, x[c.variable], where),
-                sets.mf_value(term.mf, x[c.variable], where),
-            )
+            lo, up = self._bounds(term, x[c.variable], f"term {c.variable}.{c.term}")
             for h in reversed(c.hedges):
                 f = sem.hedge_function(h)
                 lo, up = f(lo), f(up)
@@ -260,6 +263,13 @@ class Type2Controller:
                 lo, up = norm(lo, a), norm(up, b)
             return lo, up
         raise Type2Unsupported(f"{type(c).__name__} conditions are not supported in type-2 systems")
+
+    def _bounds(self, term: Term, x: float, where: str) -> Bounds:
+        """``[lower(x), upper(x)]`` of an input term."""
+        up_pts, lo_pts = self._points.get(id(term), (None, None))
+        up = sem.pwl_value(up_pts, x) if up_pts is not None else sets.mf_value(term.mf, x, where)
+        lo = sem.pwl_value(lo_pts, x) if lo_pts is not None else sets.lower_value(term, x, where)
+        return lo, up
 
     def firing(self, x: Mapping[str, float]) -> list[tuple[Rule, Bounds]]:
         out = []
@@ -333,7 +343,7 @@ class Type2Controller:
         self, d: DefuzzifyBlock, t: Term, fl: float, fu: float
     ) -> tuple[sets.Points, sets.Points] | None:
         where = f"term {d.variable}.{t.name}"
-        up, lo = sets.points_of(t.mf, where), sets.lower_points(t, where)
+        up, lo = self._points.get(id(t)) or (sets.points_of(t.mf, where), sets.lower_points(t, where))
         if up is None or lo is None:
             return None
         return _activated(up, fu, self.act), _activated(lo, fl, self.act)
