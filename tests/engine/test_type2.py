@@ -222,3 +222,49 @@ def test_batch_matches_single_rows() -> None:
     out = ctl.evaluate_batch({"service": xs, "food": xs[::-1]})
     for i, x in enumerate(xs):
         assert out["tip"][i] == ctl.evaluate(service=x, food=xs[::-1][i])["tip"]
+
+
+def _gaussian_system(lower_sigma: float) -> m.FunctionBlock:
+    def g(name: str, mean: float) -> m.Term:
+        upper = m.ShapeMF("gaussian", (mean, 2.0))
+        return m.Term(name, upper, lower=m.LowerMF(mf=m.ShapeMF("gaussian", (mean, lower_sigma), 0.8)))
+
+    return m.FunctionBlock(
+        "g",
+        (m.Variable("x", m.VarKind.INPUT, range=m.Range(0, 10)), m.Variable("y", m.VarKind.OUTPUT)),
+        (m.FuzzifyBlock("x", (g("lo", 0.0), g("hi", 10.0)), m.Range(0, 10)),),
+        (m.DefuzzifyBlock("y", (g("a", 2.0), g("b", 8.0)), m.Range(0, 10), "COG", type_reduction="EIASC"),),
+        (
+            m.RuleBlock(
+                "r",
+                (
+                    m.Rule("1", m.Is("x", "lo"), (m.Conclusion("y", "a"),)),
+                    m.Rule("2", m.Is("x", "hi"), (m.Conclusion("y", "b"),)),
+                ),
+            ),
+        ),
+    )
+
+
+def test_smooth_output_sets_are_sampled_and_brute_force_agrees() -> None:
+    fb = _gaussian_system(1.5)
+    ctl = Type2Controller(fb, samples=201)
+    o = ctl.explain(x=3.0).outputs[0]
+    assert not o.exact and o.method == "EIASC"
+    # the same discrete problem, every switch point tried
+    ys = np.linspace(0, 10, 201)
+    lo_f = [(0.8 * math.exp(-(3.0**2) / (2 * 1.5**2))), 0.8 * math.exp(-(7.0**2) / (2 * 1.5**2))]
+    up_f = [math.exp(-(3.0**2) / 8), math.exp(-(7.0**2) / 8)]
+    lower = np.maximum(
+        np.minimum(lo_f[0], 0.8 * np.exp(-((ys - 2) ** 2) / (2 * 1.5**2))),
+        np.minimum(lo_f[1], 0.8 * np.exp(-((ys - 8) ** 2) / (2 * 1.5**2))),
+    )
+    upper = np.maximum(
+        np.minimum(up_f[0], np.exp(-((ys - 2) ** 2) / 8)), np.minimum(up_f[1], np.exp(-((ys - 8) ** 2) / 8))
+    )
+    assert (o.yl, o.yr) == pytest.approx(brute_force(list(ys), list(lower), list(upper)), rel=1e-12)
+
+
+def test_smooth_lower_above_upper_is_found_by_sampling() -> None:
+    with pytest.raises(Type2Unsupported, match="exceeds the upper"):
+        Type2Controller(_gaussian_system(2.5))  # wider than the upper: above it in the tails
