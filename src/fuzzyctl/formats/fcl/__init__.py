@@ -9,9 +9,8 @@ from fuzzyctl.formats.fcl.names import fcl_api
 from fuzzyctl.formatspec import SPECS
 
 _read = on_use("fuzzyctl.formats.fcl.reader", "read")
-# (through .type2: interval type-2 terms, docs/fcl.md; type-1 models as .writer writes them)
-_write = on_use("fuzzyctl.formats.fcl.type2", "write")
-_adapt = on_use("fuzzyctl.formats.fcl.type2", "adapt")
+_write = on_use("fuzzyctl.formats.fcl.writer", "write")
+_adapt = on_use("fuzzyctl.formats.fcl.writer", "adapt")
 _notes = on_use("fuzzyctl.formats.fcl.writer", "notes")
 
 _available = fcl_api() is not None
@@ -22,5 +21,4 @@ FORMAT = Format.builtin(
     adapt=_adapt,
     notes=_notes,
     validates=True,
-    type2=True,
 )

@@ -16,5 +16,4 @@ FORMAT = Format.builtin(
     read=_read,
     write=_write,
     place=at_json_paths,
-    type2=True,
 )
