@@ -15,6 +15,7 @@ import random
 from dataclasses import dataclass
 
 from fuzzyctl.codegen.fixed import FixedGenerated
+from fuzzyctl.codegen.testbench import st_bench_tail
 from fuzzyctl.engine.reference.interp import Interpreter
 from fuzzyctl.escape import CodegenError, c_ident, st_ident
 from fuzzyctl.ir.programs.fixed_block import Port
@@ -133,21 +134,7 @@ def render_fixed_st_bench(bench: FixedBench, dialect: str = "codesys") -> str:
         out.append(f"    TB_D := {conv}(TB_FB.{p.name}) - {conv}(TB_Y{c}[TB_K]);")
         out += [f"    IF TB_D > {bench.tolerance[c]} OR TB_D < -{bench.tolerance[c]} THEN"]
         out += ["        TB_BAD := TRUE;", "    END_IF;"]
-    out += [
-        "    IF TB_BAD THEN",
-        "        FAIL_COUNT := FAIL_COUNT + 1;",
-        "        IF FIRST_FAIL = 0 THEN",
-        "            FIRST_FAIL := TB_K + 1;",
-        "        END_IF;",
-        "    END_IF;",
-        "    TB_K := TB_K + 1;",
-        f"    IF TB_K >= {n} THEN",
-        "        DONE := TRUE;",
-        "        PASS := FAIL_COUNT = 0;",
-        "    END_IF;",
-        "END_IF;",
-        "END_PROGRAM",
-    ]
+    out += st_bench_tail(n)
     return "\n".join(out) + "\n"
 
 

@@ -7,6 +7,7 @@ import math
 from typing import Any
 
 from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.codegen.testbench import st_bench_tail
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
 from fuzzyctl.ir.render.st import STParts, STSection, STVar, format_st
@@ -259,19 +260,5 @@ def st_bench(plan: Plan, table: Table, n: int, dialect: str, lreal: bool) -> str
         got = f"{num}_TO_LINT(TB_FB.{name})" if table.bits else f"TB_FB.{name}"
         lines.append(f"    IF NOT (ABS({got} - TB_Y{k}[TB_K]) <= TB_TOL{k}) THEN")
         lines += ["        TB_BAD := TRUE;", "    END_IF;"]
-    lines += [
-        "    IF TB_BAD THEN",
-        "        FAIL_COUNT := FAIL_COUNT + 1;",
-        "        IF FIRST_FAIL = 0 THEN",
-        "            FIRST_FAIL := TB_K + 1;",
-        "        END_IF;",
-        "    END_IF;",
-        "    TB_K := TB_K + 1;",
-        f"    IF TB_K >= {n} THEN",
-        "        DONE := TRUE;",
-        "        PASS := FAIL_COUNT = 0;",
-        "    END_IF;",
-        "END_IF;",
-        "END_PROGRAM",
-    ]
+    lines += st_bench_tail(n)
     return "\n".join(lines) + "\n"

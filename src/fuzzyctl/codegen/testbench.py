@@ -259,21 +259,7 @@ def render_st_bench(bench: Bench, *, dialect: str = "codesys", lreal: bool = Fal
     for c, op in enumerate(outs):  # NOT (... <= tol): a NaN output fails too
         out.append(f"    IF NOT (ABS(TB_FB.{op.name} - TB_Y{c}[TB_K]) <= TB_TOL{c}) THEN")
         out += ["        TB_BAD := TRUE;", "    END_IF;"]
-    out += [
-        "    IF TB_BAD THEN",
-        "        FAIL_COUNT := FAIL_COUNT + 1;",
-        "        IF FIRST_FAIL = 0 THEN",
-        "            FIRST_FAIL := TB_K + 1;",
-        "        END_IF;",
-        "    END_IF;",
-        "    TB_K := TB_K + 1;",
-        f"    IF TB_K >= {n} THEN",
-        "        DONE := TRUE;",
-        "        PASS := FAIL_COUNT = 0;",
-        "    END_IF;",
-        "END_IF;",
-        "END_PROGRAM",
-    ]
+    out += st_bench_tail(n)
     return "\n".join(out) + "\n"
 
 
@@ -341,3 +327,23 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
         "#endif",
     ]
     return "\n".join(lines) + "\n"
+
+
+def st_bench_tail(n: int) -> list[str]:
+    """The end of a Structured Text test bench PROGRAM: count the vector that failed, step to
+    the next of ``n`` and set DONE and PASS after the last (every bench form shares it)."""
+    return [
+        "    IF TB_BAD THEN",
+        "        FAIL_COUNT := FAIL_COUNT + 1;",
+        "        IF FIRST_FAIL = 0 THEN",
+        "            FIRST_FAIL := TB_K + 1;",
+        "        END_IF;",
+        "    END_IF;",
+        "    TB_K := TB_K + 1;",
+        f"    IF TB_K >= {n} THEN",
+        "        DONE := TRUE;",
+        "        PASS := FAIL_COUNT = 0;",
+        "    END_IF;",
+        "END_IF;",
+        "END_PROGRAM",
+    ]
