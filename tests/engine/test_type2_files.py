@@ -66,6 +66,44 @@ def test_fcl_form_round_trips_and_keeps_positions() -> None:
     assert d.span is not None and (d.span.line, d.span.column) == (12, 40)  # at LOWER
 
 
+NAMES_SPELLED_LIKE_THE_WORDS = """FUNCTION_BLOCK names
+VAR_INPUT lower : REAL; type_reduction : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY lower
+    TERM lower := (0, 1) (3, 0);
+    TERM upper := (0, 0) (3, 1);
+END_FUZZIFY
+FUZZIFY type_reduction
+    TERM lower := (0, 1) (3, 0);
+END_FUZZIFY
+DEFUZZIFY y
+    TERM lower := (0, 1) (3, 0);   (* LOWER SCALE 0.5 LAG 0.1; in a comment *)
+    TERM higher := (0, 0) (3, 1);
+    METHOD : COG;
+END_DEFUZZIFY
+RULEBLOCK r
+    RULE 1 : IF lower IS lower AND type_reduction IS lower THEN y IS lower WITH 0.3;
+    RULE 2 : IF lower IS upper THEN y IS higher;
+END_RULEBLOCK
+END_FUNCTION_BLOCK
+"""
+
+
+def test_lower_and_type_reduction_stay_usable_as_names() -> None:
+    # the words are keywords only where the type-2 form puts them (after a term's function;
+    # at the start of a DEFUZZIFY statement): a type-1 file naming a term or a variable so
+    # reads as before, as a type-1 system
+    fb = fuzzyctl.load(NAMES_SPELLED_LIKE_THE_WORDS).main
+    lower = fb.fuzzify_block("lower")
+    assert lower is not None and [t.name for t in lower.terms] == ["lower", "upper"]
+    assert all(t.lower is None for f in fb.fuzzify for t in f.terms)
+    assert all(t.lower is None for d in fb.defuzzify for t in d.terms)
+    y = fb.defuzzify_block("y")
+    assert y is not None and y.type_reduction is None
+    rules = [rule for _, rule in fb.rules()]
+    assert len(rules) == 2 and rules[0].conclusions[0].weight == 0.3
+
+
 def test_fis_to_fcl_to_fis_computes_the_same() -> None:
     doc = fuzzyctl.load(EXAMPLE)
     fcl = formats.convert(doc, "fcl")[0]

@@ -24,8 +24,13 @@ from fuzzyctl.kinds import type_reduction as tr
 from fuzzyctl.model import Document, FunctionBlock, LowerMF, MembershipFunction, Span
 
 _WORD = re.compile(r"\b(LOWER|TYPE_REDUCTION)\b", re.IGNORECASE)
+# LOWER is a keyword only inside a TERM statement, after its membership function (so a term,
+# variable or rule word spelled ``lower`` stays a name); TYPE_REDUCTION only where a
+# DEFUZZIFY statement starts and ``:`` follows it.
 _TOKENS = re.compile(
-    r"\(\*.*?\*\)|/\*.*?\*/|//[^\n]*|\b(FUZZIFY|DEFUZZIFY|TERM|LOWER|TYPE_REDUCTION)\b\s*([A-Za-z_]\w*)?|;",
+    r"\(\*.*?\*\)|/\*.*?\*/|//[^\n]*"
+    r"|\b(FUZZIFY|DEFUZZIFY|TERM)\b\s*([A-Za-z_]\w*)?"
+    r"|\b(END_FUZZIFY|END_DEFUZZIFY|LOWER|TYPE_REDUCTION)\b|:=|;",
     re.IGNORECASE | re.DOTALL,
 )
 _SCALE_LAG = re.compile(
@@ -62,29 +67,81 @@ def split(text: str) -> tuple[str, Extras]:
     if _WORD.search(text) is None:  # (the common case: one scan of the text)
         return text, extras
     chars = list(text)
-    block = term = ""
-    pending: tuple[str, int, int] | None = None  # keyword, its start, where its text starts
+    scan = _Scan(text)
     for m in _TOKENS.finditer(text):
-        word = (m.group(1) or "").upper()
-        if m.group(0).startswith(("(*", "/*", "//")):
+        found = scan.step(m)
+        if found is None:
             continue
-        if word in ("FUZZIFY", "DEFUZZIFY"):
-            block = m.group(2) or ""
-        elif word == "TERM":
-            term = m.group(2) or ""
-        elif word in ("LOWER", "TYPE_REDUCTION") and pending is None:
-            pending = (word, m.start(), m.start(1) + len(m.group(1)))
-        elif m.group(0) == ";" and pending is not None:
-            word, start, body = pending
-            value = text[body : m.start()].strip()
-            if word == "LOWER":
-                extras.lowers[(block, term)] = (value, _span(text, start))
-                _blank(chars, start, m.start())
-            else:
-                extras.reductions[block] = (value.lstrip(":").strip(), _span(text, start))
-                _blank(chars, start, m.end())
-            pending = None
+        word, start, body, end = found
+        value = text[body:end].strip()
+        if word == "LOWER":
+            extras.lowers[(scan.block, scan.term)] = (value, _span(text, start))
+            _blank(chars, start, end)
+        else:
+            extras.reductions[scan.block] = (value.lstrip(":").strip(), _span(text, start))
+            _blank(chars, start, end + 1)
     return "".join(chars), extras
+
+
+@dataclass
+class _Scan:
+    """Where the scan of :func:`split` is: the block and term it is in, whether the term's
+    membership function has started, and an open LOWER / TYPE_REDUCTION."""
+
+    text: str
+    block: str = ""
+    term: str = ""
+    in_term: bool = False
+    mf_start: int = -1  # where the term's text after ``:=`` starts (-1: no ``:=`` yet)
+    statement_start: int = 0  # where the current statement of a DEFUZZIFY block starts
+    in_defuzzify: bool = False
+    pending: tuple[str, int, int] | None = None  # keyword, its start, where its text starts
+
+    def step(self, m: re.Match[str]) -> tuple[str, int, int, int] | None:
+        """Advance over one token; a finished LOWER / TYPE_REDUCTION as (keyword, start,
+        start of its text, end of its text)."""
+        token = m.group(0)
+        if token.startswith(("(*", "/*", "//")):
+            return None
+        head = (m.group(1) or "").upper()
+        word = (m.group(3) or "").upper()
+        if head in ("FUZZIFY", "DEFUZZIFY"):
+            self.block, self.in_defuzzify = m.group(2) or "", head == "DEFUZZIFY"
+            self.statement_start = m.end()
+        elif head == "TERM" and self.pending is None:
+            self.term, self.in_term, self.mf_start = m.group(2) or "", True, -1
+        elif word in ("END_FUZZIFY", "END_DEFUZZIFY"):
+            self.in_term = self.in_defuzzify = False
+            self.pending = None
+        elif token == ":=" and self.in_term and self.mf_start < 0:
+            self.mf_start = m.end()
+        elif self.pending is None and self._opens(word, m):
+            self.pending = (word, m.start(), m.end())
+        elif token == ";":
+            found = None if self.pending is None else (*self.pending, m.start())
+            self.pending, self.in_term = None, False
+            self.statement_start = m.end()
+            return found
+        return None
+
+    def _opens(self, word: str, m: re.Match[str]) -> bool:
+        if word == "LOWER":
+            return self._after_mf(m.start())
+        return word == "TYPE_REDUCTION" and self._starts_statement(m)
+
+    def _after_mf(self, at: int) -> bool:
+        return self.in_term and self.mf_start >= 0 and self.text[self.mf_start : at].strip() != ""
+
+    def _starts_statement(self, m: re.Match[str]) -> bool:
+        before = self.text[self.statement_start : m.start()]
+        return (
+            self.in_defuzzify
+            and _COMMENTS.sub("", before).strip() == ""
+            and self.text[m.end() :].lstrip().startswith(":")
+        )
+
+
+_COMMENTS = re.compile(r"\(\*.*?\*\)|/\*.*?\*/|//[^\n]*", re.DOTALL)
 
 
 def _lower(value: str, span: Span, path: str | None) -> LowerMF | Diagnostic:
