@@ -33,6 +33,7 @@ RANK: dict[str, float] = {
     "fuzzyctl.formatspec": 0,  # the format registry's table: names, extensions, size limits
     "fuzzyctl.jsonsafe": 0,
     "fuzzyctl.validation": 1,
+    "fuzzyctl.type2": 1,  # which consumers refuse interval type-2 systems (model + kinds)
     "fuzzyctl.engine.plan": 1,  # the lowered form: plain data every layer of the engine reads
     # readers and the engine by layer
     "fuzzyctl.fcl": 2,

@@ -230,6 +230,11 @@ def compile(
         model = load(model, strict=bool(options.get("strict")))
     if options.get("strict"):
         _refuse_reserved(model)
+    fb = model.block(block) if isinstance(model, Document) else model
+    if fb.is_type2:  # interval type-2: its own evaluator (fuzzyctl.engine.type2)
+        from fuzzyctl.engine.type2 import compile_type2
+
+        return compile_type2(fb, backend or os.environ.get("FUZZYCTL_BACKEND"), **options)  # type: ignore[return-value]
     with gc_paused():  # lowering and generating build large acyclic structures
         plan, key, found = _plan(model, block, options)
         fb = model.block(block) if isinstance(model, Document) else model

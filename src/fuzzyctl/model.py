@@ -216,6 +216,20 @@ MembershipFunction: TypeAlias = PointsMF | SingletonMF | SingletonsMF | ShapeMF 
 
 
 @dataclass(frozen=True)
+class LowerMF:
+    """The lower membership function of an interval type-2 term (the term's ``mf`` is the
+    upper one).  Either an explicit function (``mf``: any membership function the engine
+    reads) or MATLAB's form derived from the upper function (``mf`` is None):
+    ``scale * max(0, (upper(x) - lag) / (1 - lag))``, with one ``lag`` for both sides or
+    ``(left, right)`` for the rising and the falling side (``LowerScale`` / ``LowerLag``).
+    :func:`fuzzyctl.type2.lower_problem` checks lower <= upper."""
+
+    mf: MembershipFunction | None = None
+    scale: float = 1.0
+    lag: tuple[float, ...] = (0.0,)
+
+
+@dataclass(frozen=True)
 class Term:
     """A linguistic term ``TERM name := membership_function;``."""
 
@@ -224,6 +238,8 @@ class Term:
     span: Span | None = field(default=None, compare=False, repr=False)
     comments: tuple[str, ...] = field(default=(), compare=False, repr=False)
     placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
+    lower: LowerMF | None = None
+    """Interval type-2: the lower membership function (``mf`` is then the upper one)."""
 
 
 # --------------------------------------------------------------------------- variables and blocks
@@ -309,6 +325,9 @@ class DefuzzifyBlock:
     item_spans: tuple[tuple[str, Span], ...] = field(default=(), compare=False, repr=False)
     """Where the single-valued items were written: ``("method", span)``, ``("accu", ...)``."""
     placed_comments: PlacedComments = field(default=(), compare=False, repr=False)
+    type_reduction: str | None = None
+    """Interval type-2: the type-reduction method (a code of
+    :mod:`fuzzyctl.kinds.type_reduction`, ``None``: Karnik-Mendel)."""
 
     def term(self, name: str) -> Term | None:
         return next((t for t in self.terms if t.name == name), None)
@@ -538,6 +557,12 @@ class FunctionBlock:
         for block in self.rule_blocks:
             for rule in block.rules:
                 yield block, rule
+
+    @property
+    def is_type2(self) -> bool:
+        """An interval type-2 system: a term has a lower membership function."""
+        blocks: tuple[FuzzifyBlock | DefuzzifyBlock, ...] = (*self.fuzzify, *self.defuzzify)
+        return any(t.lower is not None for v in blocks for t in v.terms)
 
 
 @dataclass(frozen=True)

@@ -46,8 +46,10 @@ def build_context(model: Document | FunctionBlock, block: str | None = None) -> 
     """Compile ``model`` (interpreted backend: no C compiler needed) and gather its names."""
     from fuzzyctl.api import compile as compile_model
     from fuzzyctl.model import Document
+    from fuzzyctl.type2 import refuse
 
     fb = model.block(block) if isinstance(model, Document) else model
+    refuse(fb, "analyze")
     path = model.path if isinstance(model, Document) else None
     ctl = compile_model(fb, backend="python")
     plan = ctl.plan

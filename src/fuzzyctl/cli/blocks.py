@@ -56,6 +56,9 @@ def _load(path: Path, fmt: str | None = None) -> Any:
 
     require_file(path)
     loaded = read_path(path, fmt)
+    from fuzzyctl.type2 import refuse
+
+    refuse(loaded.document, "blocks")
     for d in loaded.diagnostics:
         if d.severity.value == "warning":
             err_console.print(d.render(), markup=False)

@@ -29,6 +29,13 @@ def convert(
         ),
     ] = False,
     force: Annotated[bool, typer.Option("--force", help="Replace TARGET even when it is read-only.")] = False,
+    type1: Annotated[
+        bool,
+        typer.Option(
+            "--type1",
+            help="Write an interval type-2 system as type-1: each term its upper function (listed).",
+        ),
+    ] = False,
 ) -> None:
     """Convert a fuzzy system to another format.
 
@@ -41,7 +48,13 @@ def convert(
     for diagnostic in loaded.diagnostics:
         err_console.print(diagnostic.render(), markup=False)
     fmt = formats.get(to_format) if to_format else formats.for_path(target)
-    text, losses = formats.convert(loaded.document, fmt.name, lossy=lossy)
+    document, dropped = loaded.document, list[formats.Loss]()
+    if type1:
+        from fuzzyctl.formats.common.type2 import drop_type2
+
+        document, dropped = drop_type2(document, "a type-1 system")
+    text, losses = formats.convert(document, fmt.name, lossy=lossy)
+    losses = dropped + losses
     formats.write_atomic(target, text, force=force, hint=FORCE_HINT)
     for note in fmt.notes(loaded.document):
         err_console.print(f"warning: {note}", markup=False)

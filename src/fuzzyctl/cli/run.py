@@ -282,6 +282,13 @@ def explain(
     ctl = _controller(file, block, compat, strict, from_format)
     values, mode = _checked_sets(ctl, set_, out_of_range)
     e = ctl.explain(values, out_of_range=mode)
+    from fuzzyctl.engine.type2 import Type2Explanation
+
+    if isinstance(e, Type2Explanation):  # firing intervals and type-reduced intervals
+        if png is not None:
+            raise typer.BadParameter("--png draws type-1 sets; not for type-2 systems", param_hint="--png")
+        typer.echo(json.dumps(e.to_dict(), indent=2) if as_json else e.text())
+        return
     if png is not None:
         from fuzzyctl.engine.plot import save_png
 

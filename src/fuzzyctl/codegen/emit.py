@@ -15,6 +15,7 @@ from fuzzyctl.diagnostics import OptionError
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document
+from fuzzyctl.type2 import refuse as refuse_type2
 
 if TYPE_CHECKING:
     from fuzzyctl.codegen.api import Generated
@@ -204,6 +205,7 @@ def emit(
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
+    refuse_type2(document, "codegen", caps.type2)  # (any block: --block errors come later)
     if "fmi" in caps.cli_options:
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     emitted = Emitted(lang)

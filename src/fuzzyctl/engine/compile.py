@@ -66,6 +66,10 @@ def compile_block(
         fb = model
     else:
         raise TypeError(f"compile() takes a Document or a FunctionBlock, not {type(model).__name__}")
+    if fb.is_type2:  # the type-1 lowering would take each term's upper function silently
+        from fuzzyctl.type2 import refuse
+
+        refuse(fb, "type-1 engine")
     if compat not in COMPAT_PROFILES:
         raise FuzzyctlError(f"unknown compat profile {compat!r} (known: {', '.join(COMPAT_PROFILES)})")
     opts = COMPAT_PROFILES[compat]

@@ -9,7 +9,7 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, has_errors
 from fuzzyctl.fcl.checks import CheckContext, register_provider, run_checks
@@ -54,9 +54,15 @@ def check_source(source: Source, *, strict: bool = False, compat: str = "iec") -
         check_text(source.text, source.path, "fcl")
     except DiagnosticError as exc:  # over the size limit: said, not parsed
         return LoadResult(None, exc.diagnostics, source)
-    parsed = parse_source(source)
+    from fuzzyctl.fcl import type2
+
+    masked, extras = type2.split(source.text)  # interval type-2 terms (Open level), if any
+    parsed = parse_source(replace(source, text=masked) if extras else source)
     diagnostics = list(parsed.diagnostics)
     document = parsed.document
+    if document is not None and extras and not has_errors(diagnostics):
+        document, found = type2.attach(document, extras, source.path)
+        diagnostics.extend(found)
     if document is not None and not has_errors(diagnostics):
         diagnostics.extend(check_document(document, source.path))
     if document is not None and not has_errors(diagnostics):

@@ -162,6 +162,8 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
                 for t in b.terms:
                     _term_features(t, side, add)
         for d in fb.defuzzify:
+            if d.type_reduction is not None:
+                add(open_, "type reduction", f"TYPE_REDUCTION: {d.type_reduction} (interval type-2)")
             if d.range is not None:
                 add(ext, "range", "RANGE(min..max) for an output")
             level = "basic" if d.method is None else getattr(METHODS.get(d.method), "conformance", "open")
@@ -223,6 +225,9 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
 def _term_features(t: Term, side: str, add: object) -> None:
     assert callable(add)
     ext, open_ = Level.EXTENSION, Level.OPEN
+    if t.lower is not None:  # docs/fcl.md, interval type-2 terms
+        form = "SCALE/LAG" if t.lower.mf is None else "membership function"
+        add(open_, "membership function", f"{side}: interval type-2 term (LOWER {form})")
     mf = t.mf
     n = _points(t)
     if isinstance(mf, ShapeMF):

@@ -113,6 +113,9 @@ class Format:
     at the spans the reader kept (file:line:column), or at JSON paths."""
     validates: bool = False
     """The reader runs :func:`fuzzyctl.validation.validate` itself (FCL, among its checks)."""
+    type2: bool = False
+    """The format expresses interval type-2 terms (lower membership functions); converting a
+    type-2 model to one that does not drops them, as a loss (:mod:`.common.type2`)."""
 
     @classmethod
     def builtin(cls, spec: FormatSpec, **parts: Any) -> Format:
@@ -255,7 +258,13 @@ def convert(document: Document, format: str, *, lossy: bool = False) -> tuple[st
     fmt = get(format)
     if fmt.write is None:
         raise FuzzyctlError(f"format {fmt.name!r} can be read but not written")
+    dropped: list[Loss] = []
+    if not fmt.type2 and any(b.is_type2 for b in document.blocks):
+        from fuzzyctl.formats.common.type2 import drop_type2
+
+        document, dropped = drop_type2(document, fmt.name)
     adapted, losses = fmt.adapt(document)
+    losses = dropped + losses
     if losses and not lossy:
         raise LossError(fmt.name, losses)
     return fmt.write(adapted), losses

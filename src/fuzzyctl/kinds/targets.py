@@ -153,6 +153,7 @@ class Target:
     kernels: frozenset[str] = frozenset()
     function_terms: bool = True  # function terms inline as IR (else the EXPR kernel)
     data_dependent_loops: bool = True  # loops may run a number of times the input decides
+    type2: bool = False  # generates interval type-2 systems (else they are refused, docs/type2.md)
     # --- the CLI (``fuzzyctl codegen --lang``); None: not a CLI choice
     cli: str | None = None
     cli_help: str = ""

@@ -61,7 +61,9 @@ class NativeRuntime(EngineRuntime):
         import fuzzyctl
         from fuzzyctl.codegen import CodegenError
         from fuzzyctl.engine.native import NativeController, NativeError, build
+        from fuzzyctl.type2 import refuse
 
+        refuse(model, "native")
         plan = fuzzyctl.compile(model, block=block, backend="interpreted").plan
         try:
             library = build(plan)
@@ -83,6 +85,10 @@ def make_runtime(
     """The runtime ``kind`` (one of :data:`RUNTIMES`) for a model."""
     if kind == "engine":
         return EngineRuntime(model, block=block)
+    if kind in ("siemens", "xfuz"):  # the PLC blocks' emulations are type-1
+        from fuzzyctl.type2 import refuse
+
+        refuse(model, "blocks")
     if kind == "siemens":
         from fuzzyctl.sim.plc_runtimes import SiemensRuntime
 

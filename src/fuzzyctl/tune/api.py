@@ -131,6 +131,9 @@ def tune(
     if loss not in LOSSES:
         raise InputError(f"--loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     doc = _document(model)
+    from fuzzyctl.type2 import refuse
+
+    refuse(doc, "tune")
     try:
         fb = doc.block(block)
     except KeyError as exc:

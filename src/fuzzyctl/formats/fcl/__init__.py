@@ -9,8 +9,9 @@ from fuzzyctl.formats.fcl.names import fcl_api
 from fuzzyctl.formatspec import SPECS
 
 _read = on_use("fuzzyctl.formats.fcl.reader", "read")
-_write = on_use("fuzzyctl.formats.fcl.writer", "write")
-_adapt = on_use("fuzzyctl.formats.fcl.writer", "adapt")
+# (through .type2: interval type-2 terms, docs/fcl.md; type-1 models as .writer writes them)
+_write = on_use("fuzzyctl.formats.fcl.type2", "write")
+_adapt = on_use("fuzzyctl.formats.fcl.type2", "adapt")
 _notes = on_use("fuzzyctl.formats.fcl.writer", "notes")
 
 _available = fcl_api() is not None
@@ -21,4 +22,5 @@ FORMAT = Format.builtin(
     adapt=_adapt,
     notes=_notes,
     validates=True,
+    type2=True,
 )

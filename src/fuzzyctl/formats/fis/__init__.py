@@ -7,13 +7,15 @@ from __future__ import annotations
 from fuzzyctl.formats import Format, on_use
 from fuzzyctl.formatspec import SPECS
 
-_read = on_use("fuzzyctl.formats.fis.reader", "read")
-_write = on_use("fuzzyctl.formats.fis.writer", "write")
-_adapt = on_use("fuzzyctl.formats.fis.writer", "adapt")
+# (through .type2: MATLAB's interval type-2 files; type-1 ones go on to .reader / .writer)
+_read = on_use("fuzzyctl.formats.fis.type2", "read")
+_write = on_use("fuzzyctl.formats.fis.type2", "write")
+_adapt = on_use("fuzzyctl.formats.fis.type2", "adapt")
 
 FORMAT = Format.builtin(
     SPECS["fis"],
     read=_read,
     write=_write,
     adapt=_adapt,
+    type2=True,
 )

@@ -16,4 +16,5 @@ FORMAT = Format.builtin(
     read=_read,
     write=_write,
     place=at_json_paths,
+    type2=True,
 )

@@ -20,6 +20,7 @@ TAGS: dict[type, str] = {
     m.SingletonsMF: "singletons",
     m.ShapeMF: "shape",
     m.FunctionMF: "function",
+    m.LowerMF: "lower",
     m.Num: "num",
     m.Name: "name",
     m.Unary: "unary",

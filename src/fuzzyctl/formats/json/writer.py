@@ -15,7 +15,10 @@ from fuzzyctl import model as m
 from fuzzyctl.escape import json_text
 from fuzzyctl.formats.json.names import FORMAT_NAME, TAGS, VERSION
 
-_OPTIONAL_WHEN_EMPTY = frozenset({"span", "comments", "placed_comments", "item_spans", "grouped"})
+# (``lower`` and ``type_reduction``: type-2 only, so a type-1 model is written as before)
+_OPTIONAL_WHEN_EMPTY = frozenset(
+    {"span", "comments", "placed_comments", "item_spans", "grouped", "lower", "type_reduction"}
+)
 
 
 def _number(value: float) -> float | str:
