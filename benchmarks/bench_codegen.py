@@ -39,8 +39,9 @@ ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT))  # tests.codegen.matiec builds and drives matiec
 
 import fuzzyctl  # noqa: E402
-from fuzzyctl.codegen.api import CodegenError, Generated, generate_st, lower_block  # noqa: E402
+from fuzzyctl.codegen.api import Generated, generate_st, lower_block  # noqa: E402
 from fuzzyctl.engine.plan import Plan  # noqa: E402
+from fuzzyctl.escape import CodegenError  # noqa: E402
 from fuzzyctl.ir.cost import cost  # noqa: E402
 from fuzzyctl.ir.nodes import Program  # noqa: E402
 
