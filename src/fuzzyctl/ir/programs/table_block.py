@@ -83,12 +83,14 @@ def build_table_block(
     values: Sequence[Sequence[float]],
     *,
     integer: bool,
+    arrays: tuple[list[str], list[str]] | None = None,
 ) -> TableBlock:
     """The block of a table: ``axes[i]`` input ``i``'s breakpoints, ``values[k]`` output
-    ``k``'s entries (last input fastest); stored integers when ``integer``."""
+    ``k``'s entries (last input fastest); stored integers when ``integer``; ``arrays``: the
+    breakpoint and entry arrays' names (default :func:`names`)."""
     d = len(axes)
     shape = [len(a) for a in axes]
-    bps, tabs = names(inputs, outputs)
+    bps, tabs = arrays or names(inputs, outputs)
     decls = [TableDecl(n, "value", "input") for n in inputs]
     decls += [TableDecl(n, "value", "output") for n in outputs]
     decls.append(
