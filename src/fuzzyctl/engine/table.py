@@ -483,6 +483,24 @@ def build_table(
         if worst <= tolerance or limited:
             break
         target *= max(0.3, min(0.8, 0.95 * tolerance / worst))
+    if math.isinf(worst) or worst > tolerance:
+        _refuse(plan, table, worst, limited, (ev, design, cert), max_bytes, real)
+    return table
+
+
+def _refuse(
+    plan: Plan,
+    table: Table,
+    worst: float,
+    limited: bool,
+    ctx: tuple[Any, Any, Any],
+    max_bytes: int,
+    real: str,
+) -> None:
+    """Raise the reason a table within the tolerance could not be proven: no rule fires
+    somewhere, the output jumps, the bound stays wide, or the size limit."""
+    ev, design, cert = ctx
+    tolerance = table.tolerance
     if math.isinf(worst):
         raise TableError("no rule fires somewhere in the input ranges: the output jumps to its DEFAULT there")
     jump = find_jump(ev, design, tolerance) if worst > tolerance else None
@@ -504,7 +522,6 @@ def build_table(
             f"(--max-bytes); {'x'.join(map(str, table.shape))} in {table.size_bytes(real)} bytes is "
             f"within {worst:.3g} ({100 * worst:.3g}%): raise --max-bytes or --tolerance"
         )
-    return table
 
 
 def _refuse_jump(plan: Plan, jump: tuple[int, float, list[float]] | None, tolerance: float) -> None:
@@ -560,8 +577,25 @@ class TableController(Controller):
         super().__init__(plan, specialise=False, model=model)
         self.table = table
 
+        from fuzzyctl.ir.programs.table_block import build_table_block
+        from fuzzyctl.ir.render.pysrc import table_function
+
+        d, m = len(table.inputs), len(table.outputs)
+        block = build_table_block(
+            "table",
+            [f"FZ_IN{i}" for i in range(d)],
+            [f"FZ_OUT{k}" for k in range(m)],
+            [[float(x) for x in a] for a in table.axes],
+            [[float(x) for x in v.ravel()] for v in table.values],
+            integer=False,
+            arrays=([f"FZ_BP{i}" for i in range(d)], [f"FZ_TAB{k}" for k in range(m)]),
+        )
+        # one evaluation runs the table's IR program printed as Python (the same program
+        # the ST and C blocks print); batches interpolate with numpy
+        program = table_function(block, d, m)
+
         def one(values: list[float], _state: list[float | None]) -> list[float]:
-            return [float(v[0]) for v in table.interpolate([np.array([x]) for x in values])]
+            return program(values)
 
         def many(part: list[Arr], _state: list[float | None], _m: int) -> list[Arr]:
             return table.interpolate(part)
