@@ -6,13 +6,20 @@ evaluation (a batch, per row).
 
     python benchmarks/bench_codegen.py              # a plain table
     python benchmarks/bench_codegen.py --markdown   # the table of docs/codegen.md
+    python benchmarks/bench_codegen.py --markdown --side-by-side   # REAL/LREAL/int16/int32/lookup
+
+``--side-by-side`` gives the table of issue-29 point 3: crane, figure 7, tank and tipper in
+every form, with the error each form's header states beside the one observed (integer forms
+and the lookup table state a proven bound; REAL/LREAL state none).  The integer forms and the
+table read their inputs within the input ranges (a stored integer cannot go beyond them), so
+their inputs, and the engine's, are limited to the ranges first.
 
 matiec is built on first use into the test cache (tests/codegen/matiec.py, ~2 min), from
 ``../shared/tools/matiec-src.tar.gz``.
 
 A form of arithmetic is one :class:`Form` in :data:`FORMS` (a column group of the table): its
-Structured Text and how the driver hands it numbers.  A new form (integer, lookup table)
-adds an entry; nothing else changes.
+Structured Text and how the driver hands it numbers (:class:`Block`).  A new form adds an
+entry; nothing else changes.
 """
 
 from __future__ import annotations
@@ -24,6 +31,7 @@ import tempfile
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -33,6 +41,7 @@ sys.path.insert(0, str(ROOT))  # tests.codegen.matiec builds and drives matiec
 import fuzzyctl  # noqa: E402
 from fuzzyctl.codegen.api import Generated, generate_st, lower_block  # noqa: E402
 from fuzzyctl.engine.plan import Plan  # noqa: E402
+from fuzzyctl.escape import CodegenError  # noqa: E402
 from fuzzyctl.ir.cost import cost  # noqa: E402
 from fuzzyctl.ir.nodes import Program  # noqa: E402
 
@@ -41,33 +50,113 @@ ROWS = 2000  # inputs for the error, and the timed cycles (repeated)
 BYTES = {"REAL": 4, "LREAL": 8, "INT": 2, "DINT": 4, "BOOL": 1, "BYTE": 1}
 
 
+@dataclass
+class Block:
+    """One generated block as the benchmark drives it: its ``--dialect iec`` text, its name
+    and outputs, the statements one cycle runs (for :func:`fuzzyctl.ir.cost.cost`), its memory
+    (instance, temporaries), the error its header states per output (fraction of the output
+    range; None: none stated), and how the driver converts engineering values to what the
+    block reads and back."""
+
+    text: str
+    name: str
+    outputs: list[str]
+    body: Any
+    memory: tuple[int, int]
+    stated: list[float | None]
+    encode: Callable[[np.ndarray], np.ndarray] = lambda x: x
+    decode: Callable[[int, np.ndarray], np.ndarray] = lambda k, y: y
+    limited: bool = False  # the inputs are limited to their ranges first
+
+
 @dataclass(frozen=True)
 class Form:
-    """One form of generated arithmetic.  ``st(plan)`` gives the ``--dialect iec`` text and the
-    report of its block; ``c_type`` is the C type the driver converts inputs and outputs
-    through (an integer form would also scale them: give it ``encode``/``decode``)."""
+    """One form of generated arithmetic.  ``make(plan, model)`` gives its :class:`Block`;
+    ``c_type`` is the C type the driver converts inputs and outputs through."""
 
     name: str
     c_type: str
-    real_bytes: int
-    st: Callable[[Plan], tuple[str, Generated]]
-    encode: Callable[[np.ndarray], np.ndarray] = lambda x: x
-    decode: Callable[[np.ndarray], np.ndarray] = lambda y: y
+    make: Callable[[Plan, Any], Block]
 
 
-def _st(lreal: bool) -> Callable[[Plan], tuple[str, Generated]]:
-    def make(plan: Plan) -> tuple[str, Generated]:
+def _st(lreal: bool) -> Callable[[Plan, Any], Block]:
+    def make(plan: Plan, model: Any) -> Block:
         report: list[Generated] = []
         text = generate_st(plan, dialect="iec", lreal=lreal, report=report)
-        return text, report[0]
+        gen = report[0]
+        outputs = [op.name for op in gen.plan.outputs if op.is_output]
+        mem = memory(gen.program, 8 if lreal else 4)
+        return Block(text, gen.program.name, outputs, gen.program, mem, [None] * len(outputs))
+
+    return make
+
+
+def _scaled(ports: Any) -> tuple[list[float], list[float]]:
+    return [float(p.scale) for p in ports], [float(p.offset) for p in ports]
+
+
+def _int(arith: str) -> Callable[[Plan, Any], Block]:
+    def make(plan: Plan, model: Any) -> Block:
+        report: list[Any] = []
+        text = generate_st(model, dialect="iec", arith=arith, report=report)
+        prog = report[0].program
+        isc, ioff = _scaled(prog.inputs)
+        osc, ooff = _scaled(prog.outputs)
+        lows, highs = [p.low for p in prog.inputs], [p.high for p in prog.inputs]
+        width = {"narrow": prog.arith.bits // 8, "wide": prog.arith.bits // 4, "bool": 1, "byte": 1}
+        inst = sum(width[d.kind] for d in prog.decls if d.storage != "temp")
+        temp = sum(width[d.kind] for d in prog.decls if d.storage == "temp")
+        stated = [
+            p.error_bound / (hi - lo)
+            for p, (lo, hi) in zip(prog.outputs, _out_ranges(model, prog.outputs), strict=True)
+        ]
+
+        def encode(x: np.ndarray) -> np.ndarray:
+            return np.column_stack(
+                [np.clip(np.rint((x[:, i] - ioff[i]) / isc[i]), lows[i], highs[i]) for i in range(x.shape[1])]
+            )
+
+        def decode(k: int, y: np.ndarray) -> np.ndarray:
+            return y * osc[k] + ooff[k]
+
+        names = [p.name for p in prog.outputs]
+        return Block(text, prog.name, names, prog, (inst, temp), list(stated), encode, decode, True)
+
+    return make
+
+
+def _out_ranges(model: Any, ports: Any) -> list[tuple[float, float]]:
+    ctl = fuzzyctl.compile(model, backend="interpreted")
+    return [span(ctl.outputs[p.name]) for p in ports]
+
+
+def _lookup(tolerance: float) -> Callable[[Plan, Any], Block]:
+    def make(plan: Plan, model: Any) -> Block:
+        from fuzzyctl.ir.programs.table_block import build_table_block
+
+        report: list[Any] = []
+        text = generate_st(model, dialect="iec", lookup=True, tolerance=tolerance, report=report)
+        t = report[0].table
+        block = build_table_block(
+            t.name, t.inputs, t.outputs, t.axes, [v.ravel() for v in t.values], integer=False
+        )
+        inst = 4 * (len(t.inputs) + len(t.outputs)) + 1 + t.size_bytes("REAL")
+        temp = sum(4 for d in block.decls if d.storage == "temp")
+        return Block(text, t.name, list(t.outputs), block, (inst, temp), t.relative(t.bound), limited=True)
 
     return make
 
 
 FORMS: dict[str, Form] = {
-    "REAL": Form("REAL", "float", 4, _st(False)),
-    "LREAL": Form("LREAL", "double", 8, _st(True)),
+    "REAL": Form("REAL", "float", _st(False)),
+    "LREAL": Form("LREAL", "double", _st(True)),
+    "int16": Form("int16", "IEC_INT", _int("int16")),
+    "int32": Form("int32", "IEC_DINT", _int("int32")),
+    "lookup 1%": Form("lookup 1%", "float", _lookup(0.01)),
 }
+#: the forms and examples of the side-by-side table (issue 29, point 3)
+SIDE_FORMS = ["REAL", "LREAL", "int16", "int32", "lookup 1%"]
+SIDE_EXAMPLES = ["crane.fcl", "figure7.fcl", "tank.fcl", "tipper.fis"]
 
 
 @dataclass
@@ -76,10 +165,12 @@ class Row:
     form: str
     error: float  # largest |block - engine| over ROWS inputs, in % of the output range
     memory: tuple[int, int]  # instance bytes, temporaries bytes
+    stated: float | None  # the largest error the header states, in % of the output range
     ops: tuple[int, int]  # usual, worst operations per cycle
     bounded: bool  # False: loops without a static bound, counted once
     matiec_ns: float
     native_ns: float
+    refused: str | None = None  # why the form cannot express the example (the generator's reason)
 
 
 def memory(prog: Program, real_bytes: int) -> tuple[int, int]:
@@ -189,19 +280,30 @@ def native_ns(ctl: fuzzyctl.engine.Controller, plan: Plan, data: np.ndarray) -> 
     return best / len(big) * 1e9
 
 
+def _limited(ctl: fuzzyctl.engine.Controller, plan: Plan, data: np.ndarray) -> np.ndarray:
+    """``data`` with each input limited to its span (what an integer or table block reads)."""
+    cols = []
+    for i, inp in enumerate(plan.inputs):
+        lo, hi = span(ctl.inputs[inp.name]) if inp.name in ctl.inputs else (0.0, 1.0)
+        cols.append(np.clip(data[:, i], lo, hi))
+    return np.column_stack(cols) if cols else data
+
+
 def measure(example: str, form: Form, matiec: Path, where: Path) -> Row:
     from tests.codegen.matiec import iec2c
 
     path = ROOT / "examples" / example
-    plan = lower_block(fuzzyctl.load(path))
+    model = fuzzyctl.load(path)
+    plan = lower_block(model)
     ctl = fuzzyctl.compile(path, backend="native", out_of_range="ignore")
     data = _inputs(ctl, plan, np.random.default_rng(7))
-    text, gen = form.st(plan)
-    outputs = [op.name for op in gen.plan.outputs if op.is_output]
+    block = form.make(plan, model)
+    if block.limited:
+        data = _limited(ctl, plan, data)
     where.mkdir(parents=True, exist_ok=True)
-    iec2c(matiec, text, where)
+    iec2c(matiec, block.text, where)
     (where / "driver.c").write_text(
-        _driver(gen.program.name, [i.name for i in plan.inputs], outputs, form.c_type)
+        _driver(block.name, [i.name for i in plan.inputs], block.outputs, form.c_type)
     )
     subprocess.run(
         ["gcc", "-O2", "-w", "-I", str(matiec / "lib" / "C"), "-o", "driver", "driver.c", "-lm"],
@@ -209,33 +311,53 @@ def measure(example: str, form: Form, matiec: Path, where: Path) -> Row:
         check=True,
     )
     exe = where / "driver"
-    got = np.array(
-        [
-            [float.fromhex(v) for v in line.split()]
-            for line in _run(exe, form.encode(data), "run").splitlines()
-        ]
-    )
+    fed = block.encode(data)
+    got = np.array([[float.fromhex(v) for v in line.split()] for line in _run(exe, fed, "run").splitlines()])
+    if block.limited:  # the engine at the inputs the block reads
+        isc = getattr(block.body, "inputs", None)
+        if isc is not None:  # integer: the stored inputs, back in engineering units
+            data = np.column_stack(
+                [fed[:, i] * float(p.scale) + float(p.offset) for i, p in enumerate(block.body.inputs)]
+            )
     want = ctl.evaluate_batch({inp.name: data[:, i] for i, inp in enumerate(plan.inputs)})
     error = 0.0
-    for k, name in enumerate(outputs):
+    stated = [s for s in block.stated if s is not None]
+    for k, name in enumerate(block.outputs):
         lo, hi = span(ctl.outputs[name])
-        diff = np.abs(form.decode(got[:, k]) - np.asarray(want[name], dtype=np.float64))
+        diff = np.abs(block.decode(k, got[:, k]) - np.asarray(want[name], dtype=np.float64))
         error = max(error, float(np.nanmax(diff)) / (hi - lo) * 100.0)
-    ns = min(float(_run(exe, data, "time", "200").split()[0]) for _ in range(3))
-    c = cost(gen.program)
+    ns = min(float(_run(exe, fed, "time", "200").split()[0]) for _ in range(3))
+    c = cost(block.body)
     return Row(
-        example.removesuffix(".fcl"),
+        example.rsplit(".", 1)[0],
         form.name,
         error,
-        memory(gen.program, form.real_bytes),
-        (c.usual.operations, c.worst.operations),
-        c.worst.bounded,
-        ns,
-        native_ns(ctl, plan, data),
+        memory=block.memory,
+        stated=100.0 * max(stated) if stated else None,
+        ops=(c.usual.operations, c.worst.operations),
+        bounded=c.worst.bounded,
+        matiec_ns=ns,
+        native_ns=native_ns(ctl, plan, data),
     )
 
 
-def markdown(rows: list[Row]) -> str:
+def markdown(rows: list[Row], side: bool = False) -> str:
+    if side:
+        out = [
+            "| example | form | error stated / observed (% of output range) | memory: instance + temporaries "
+            "(bytes) | operations per cycle: usual / worst | matiec + gcc -O2 (ns per cycle) |",
+            "|---|---|---:|---:|---:|---:|",
+        ]
+        for r in rows:
+            if r.refused:
+                out.append(f"| {r.example} | {r.form} | refused: {r.refused.split(' (use ')[0]} | | | |")
+                continue
+            stated = "-" if r.stated is None else f"{r.stated:.2g}"
+            out.append(
+                f"| {r.example} | {r.form} | {stated} / {r.error:.2g} | {r.memory[0]} + {r.memory[1]} | "
+                f"{r.ops[0]} / {r.ops[1]}{'' if r.bounded else ' (loops once)'} | {r.matiec_ns:.0f} |"
+            )
+        return "\n".join(out)
     out = [
         "| example | form | largest error (% of output range) | memory: instance + temporaries (bytes) "
         "| operations per cycle: usual / worst | matiec + gcc -O2 (ns per cycle) "
@@ -243,6 +365,9 @@ def markdown(rows: list[Row]) -> str:
         "|---|---|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
+        if r.refused:
+            out.append(f"| {r.example} | {r.form} | refused: {r.refused} | | | | | |")
+            continue
         out.append(
             f"| {r.example} | {r.form} | {r.error:.2g} | {r.memory[0]} + {r.memory[1]} | "
             f"{r.ops[0]} / {r.ops[1]}{'' if r.bounded else ' (loops once)'} | {r.matiec_ns:.0f} | "
@@ -255,28 +380,49 @@ def markdown(rows: list[Row]) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--markdown", action="store_true", help="print the table of docs/codegen.md")
-    ap.add_argument("--forms", default=",".join(FORMS), help="comma-separated forms (columns)")
-    ap.add_argument("--examples", default=",".join(EXAMPLES), help="comma-separated example files")
+    ap.add_argument(
+        "--side-by-side",
+        action="store_true",
+        help="REAL, LREAL, int16, int32 and lookup side by side on crane, figure 7, tank and tipper",
+    )
+    ap.add_argument("--forms", default=None, help="comma-separated forms (columns)")
+    ap.add_argument("--examples", default=None, help="comma-separated example files")
     args = ap.parse_args()
+    forms = args.forms.split(",") if args.forms else (SIDE_FORMS if args.side_by_side else ["REAL", "LREAL"])
+    examples = (
+        args.examples.split(",") if args.examples else (SIDE_EXAMPLES if args.side_by_side else EXAMPLES)
+    )
     from tests.codegen.matiec import build
 
     matiec = build()
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        for ex in args.examples.split(","):
-            for name in args.forms.split(","):
-                rows.append(measure(ex, FORMS[name], matiec, Path(tmp) / f"{ex}-{name}"))
-                if not args.markdown:
-                    r = rows[-1]
+        for ex in examples:
+            for name in forms:
+                try:
+                    rows.append(
+                        measure(ex, FORMS[name], matiec, Path(tmp) / f"{ex}-{name}".replace(" ", "_"))
+                    )
+                except CodegenError as exc:
+                    why = str(exc).split(": ", 1)[-1] if "--lookup" in str(exc) else str(exc)
+                    rows.append(
+                        Row(ex.rsplit(".", 1)[0], name, 0.0, (0, 0), None, (0, 0), True, 0.0, 1.0, why)
+                    )
+                r = rows[-1]
+                if r.refused and not args.markdown:
+                    print(f"{r.example:18} {r.form:9} refused: {r.refused}", flush=True)
+                elif not args.markdown:
+                    stated = "-" if r.stated is None else f"{r.stated:.2g}%"
                     print(
-                        f"{r.example:18} {r.form:6} err {r.error:.2g}%  mem {r.memory[0]}+{r.memory[1]} B  "
+                        f"{r.example:18} {r.form:9} err {stated} / {r.error:.2g}%  "
+                        f"mem {r.memory[0]}+{r.memory[1]} B  "
                         f"ops {r.ops[0]}/{r.ops[1]}  matiec {r.matiec_ns:.0f} ns  "
                         f"native {r.native_ns:.1f} ns  "
                         f"x{r.matiec_ns / r.native_ns:.1f}",
                         flush=True,
                     )
     if args.markdown:
-        print(markdown(rows))
+        print(markdown(rows, args.side_by_side))
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ from __future__ import annotations
 import itertools
 import math
 import random
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -25,6 +24,9 @@ import numpy as np
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import Table, TableError, build_table
+from fuzzyctl.ir.cost import Cost, cost
+from fuzzyctl.ir.nodes import Program
+from fuzzyctl.ir.programs.table_block import TableBlock, build_table_block
 from fuzzyctl.ir.state import CodegenError
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.model import Document, FunctionBlock
@@ -48,6 +50,7 @@ class LookupReport:
                 "tolerance": t.tolerance,
                 "samples": t.samples,
             },
+            "cost": table_cost(t).to_dict(),
             "outputs": {},
             "renames": [],
             "notes": [],
@@ -137,6 +140,28 @@ def tables(
     return out
 
 
+def table_block(table: Table, names: tuple[list[str], list[str]] | None = None) -> TableBlock:
+    """The IR program of ``table`` (stored integers when it is an integer table); ``names``:
+    the breakpoint and entry arrays' names, when the target wants others."""
+    axes = table.stored_axes() if table.bits else table.axes
+    values = table.stored_values() if table.bits else table.values
+    return build_table_block(
+        table.name or "FUZZY",
+        table.inputs,
+        table.outputs,
+        [[float(x) for x in a] for a in axes],
+        [[float(x) for x in v.ravel()] for v in values],
+        integer=bool(table.bits),
+        arrays=names,
+    )
+
+
+def table_cost(table: Table) -> Cost:
+    """What one cycle of the table block costs (:mod:`fuzzyctl.ir.cost`, on its program)."""
+    block = table_block(table)
+    return cost(Program(block.name, [], block.body))
+
+
 def header(table: Table, real: str, comment_target: str) -> list[str]:
     """The header lines: shape, ranges, the bound and how it was proven, the size."""
     shape = " x ".join(f"{n} {name}" for n, name in zip(table.shape, table.inputs, strict=True))
@@ -158,6 +183,8 @@ def header(table: Table, real: str, comment_target: str) -> list[str]:
     lines.append(
         f"table size: {table.size_bytes(real)} bytes ({real if not table.bits else f'int{table.bits}'})"
     )
+    spent = table_cost(table).worst
+    lines.append(f"cost per cycle (each binary search at its most steps): {spent.summary()}")
     if table.bits:
         lines.append("stored integers: value = stored * scale + offset")
         for name, (sc, off) in zip(
@@ -165,43 +192,6 @@ def header(table: Table, real: str, comment_target: str) -> list[str]:
         ):
             lines.append(f"  {name}: scale {sc!r}, offset {off!r}")
     return lines
-
-
-# --------------------------------------------------------------------------- the interpolation
-
-
-def _strides(shape: Sequence[int]) -> list[int]:
-    return [math.prod(shape[i + 1 :]) for i in range(len(shape))]
-
-
-def interpolation(
-    shape: Sequence[int],
-    read: Callable[[int], str],
-    lerp: Callable[[str, str, int], str],
-    temp: Callable[[str], str],
-) -> tuple[list[tuple[str, str]], str]:
-    """Assignments ``(temporary, expression)`` reducing the 2^d corners of the cell along the
-    last input first, and the final expression; ``read(offset)`` reads the table at the cell
-    index plus ``offset``."""
-    d = len(shape)
-    strides = _strides(shape)
-    values = {
-        c: read(sum(ci * s for ci, s in zip(c, strides, strict=True)))
-        for c in itertools.product((0, 1), repeat=d)
-    }
-    steps: list[tuple[str, str]] = []
-    for axis in range(d - 1, -1, -1):
-        reduced = {}
-        for prefix in itertools.product((0, 1), repeat=axis):
-            expr = lerp(values[(*prefix, 0)], values[(*prefix, 1)], axis)
-            if axis == 0:
-                reduced[prefix] = expr
-            else:
-                name = temp("".join(map(str, prefix)) + f"_{axis}")
-                steps.append((name, expr))
-                reduced[prefix] = name
-        values = reduced
-    return steps, values[()]
 
 
 def sample_rows(table: Table, n: int, seed: int = 0) -> list[list[float]]:

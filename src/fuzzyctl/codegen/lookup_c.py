@@ -1,22 +1,44 @@
 """The lookup-table block (:mod:`fuzzyctl.codegen.lookup`) in C99: ``NAME.h`` (the instance
 struct, ``NAME_init``, ``NAME_step``) and ``NAME.c``, and its test bench ``NAME_testbench.c``
-(``-DFUZZYCTL_TESTBENCH_MAIN`` makes it a program printing PASS or FAIL)."""
+(``-DFUZZYCTL_TESTBENCH_MAIN`` makes it a program printing PASS or FAIL).  ``NAME_step`` is
+the IR program of :mod:`fuzzyctl.ir.programs.table_block` printed by the IR's C printer."""
 
 from __future__ import annotations
 
 import math
 from typing import Any
 
-from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.codegen.lookup import LookupReport, expected, header, sample_rows, table_block, tables
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
 from fuzzyctl.escape import c_ident
+from fuzzyctl.ir.nodes import Call
+from fuzzyctl.ir.programs.table_block import TableBlock
+from fuzzyctl.ir.render.printer import Printer
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 
 
 def _num(v: float) -> str:
     return repr(float(v)) if v >= 0 else f"({float(v)!r})"
+
+
+class _CTable(Printer):
+    """C99 statements of the table program: the block's inputs and outputs are the
+    instance's fields, integer widening and narrowing are casts."""
+
+    def __init__(self, block: TableBlock, real: str, num: str, wide: str, single: bool) -> None:
+        super().__init__(targets.C, real=real, single=single)
+        self.fields = {d.name for d in block.decls if d.storage in ("input", "output")}
+        self.casts = {"WIDEN": wide, "NARROW": num}
+
+    def name(self, n: str) -> str:
+        return f"fb->{n}" if n in self.fields else n
+
+    def call(self, e: Call) -> str:
+        if e.function in self.casts:
+            return f"(({self.casts[e.function]})({self.ex(e.args[0])}))"
+        return super().call(e)
 
 
 def c_files(table: Table, single: bool, arith: str) -> dict[str, str]:
@@ -70,48 +92,14 @@ def c_files(table: Table, single: bool, arith: str) -> dict[str, str]:
     c += ["", f"void {name}_init({name} *fb)", "{"]
     c += [f"    fb->{v} = 0;" for v in table.inputs + table.outputs]
     c += ["    fb->INFO = 0;", "}", "", f"unsigned char {name}_step({name} *fb)", "{"]
-    d = len(table.axes)
-    c.append(f"    long i[{d}], lo, hi, mid, k;")
-    c.append(f"    {wide} f[{d}], w[{d}];" if kind.integer else f"    {real} f[{d}];")
-    c.append(f"    {num} x;")
-    for j, v in enumerate(table.inputs):
-        n = len(table.axes[j])
-        bp = f"{name}_BP{j}"
-        c += [
-            f"    x = fb->{v};",
-            f"    if (x < {bp}[0]) x = {bp}[0];",
-            f"    if (x > {bp}[{n - 1}]) x = {bp}[{n - 1}];",
-            f"    lo = 0; hi = {n - 1};",
-            "    while (hi - lo > 1) {",
-            "        mid = (lo + hi) / 2;",
-            f"        if ({bp}[mid] <= x) lo = mid; else hi = mid;",
-            "    }",
-            f"    i[{j}] = lo;",
-        ]
-        if kind.integer:
-            c += [f"    f[{j}] = ({wide})x - {bp}[lo];", f"    w[{j}] = ({wide}){bp}[lo + 1] - {bp}[lo];"]
-        else:
-            c.append(f"    f[{j}] = (x - {bp}[lo]) / ({bp}[lo + 1] - {bp}[lo]);")
-    strides = [math.prod(table.shape[j + 1 :]) for j in range(d)]
-    c.append("    k = " + " + ".join(f"i[{j}] * {s}" for j, s in enumerate(strides)) + ";")
-    for k_out, v in enumerate(table.outputs):
-        tab = f"{name}_TAB{k_out}"
-        c.append("    {")
-
-        def read(off: int, tab: str = tab) -> str:
-            return f"({wide}){tab}[k + {off}]" if kind.integer else f"{tab}[k + {off}]"
-
-        def lerp(a: str, b: str, axis: int) -> str:
-            if kind.integer:
-                return f"{a} + (({b} - {a}) * f[{axis}]) / w[{axis}]"
-            return f"{a} + ({b} - {a}) * f[{axis}]"
-
-        steps, final = interpolation(table.shape, read, lerp, lambda s: f"v{s}")
-        for tmp, expr in steps:
-            c.append(f"        {wide} {tmp} = {expr};")
-        c.append(f"        fb->{v} = ({num})({final});")
-        c.append("    }")
-    c += ["    fb->INFO = 0;", "    return 0;", "}"]
+    arrays = ([f"{name}_BP{i}" for i in range(len(axes))], [f"{name}_TAB{k}" for k in range(len(vals))])
+    block = table_block(table, arrays)
+    types = {"value": num, "wide": wide, "index": "long"}
+    c += [f"    {types[d.kind]} {d.name};" for d in block.decls if d.storage == "temp"]
+    printer = _CTable(block, real, num, wide, single)
+    printer.stmts(block.body, 1)
+    c += printer.lines
+    c += ["    return fb->INFO;", "}"]
     h_ext, c_ext = targets.C.extensions
     return {f"{name}{h_ext}": "\n".join(h) + "\n", f"{name}{c_ext}": "\n".join(c) + "\n"}
 

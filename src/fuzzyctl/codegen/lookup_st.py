@@ -1,139 +1,59 @@
 """The lookup-table block (:mod:`fuzzyctl.codegen.lookup`) in Structured Text and PLCopen
-XML, and its test bench PROGRAM."""
+XML, and its test bench PROGRAM.  The block is the IR program of
+:mod:`fuzzyctl.ir.programs.table_block`, printed by the ST renderers (REAL/LREAL:
+:mod:`fuzzyctl.ir.render.st`; integers: :mod:`fuzzyctl.ir.render.fixed`)."""
 
 from __future__ import annotations
 
 import math
 from typing import Any
 
-from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.codegen.lookup import LookupReport, expected, header, sample_rows, table_block, tables
 from fuzzyctl.codegen.testbench import st_bench_tail
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
-from fuzzyctl.ir.render.st import STParts, STSection, STVar, format_st
+from fuzzyctl.ir.nodes import Decl, Program
+from fuzzyctl.ir.programs.fixed_block import FixedDecl, FixedProgram
+from fuzzyctl.ir.render.fixed import fixed_st_parts
+from fuzzyctl.ir.render.st import STParts, format_st
+from fuzzyctl.ir.render.st import st_parts as program_st_parts
 from fuzzyctl.ir.state import CodegenError
 from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
-#: the block's own names (inputs and outputs are the model's; these cannot clash with them
-#: since model names are checked identifiers without this prefix's double meaning)
-_P = "LK_"
-
-
-def _names(table: Table) -> tuple[list[str], list[str]]:
-    return [f"BP_{n}" for n in table.inputs], [f"TAB_{n}" for n in table.outputs]
-
 
 def st_parts(table: Table, dialect: str, lreal: bool, arith: str) -> STParts:
-    """The FUNCTION_BLOCK of ``table`` as parts (for ST and PLCopen XML)."""
+    """The FUNCTION_BLOCK of ``table`` as parts (for ST and PLCopen XML): its IR program
+    (:func:`fuzzyctl.codegen.lookup.table_block`) printed by the ST renderer of its
+    arithmetic, under the table's header."""
     record = targets.dialect(dialect)
-    check = record.identifiers.check
     kind = arith_kinds.get(arith)
     real = record.real_type(not lreal)
-    num = kind.types["st"] if kind.integer else real
-    wide = kind.wide_types["st"] if kind.integer else real
-    bps, tabs = _names(table)
-    check(table.name or "FUZZY", "function block name")
-    for name in (*table.inputs, *table.outputs, *bps, *tabs):
-        check(name, "variable")
-    p = record.var_prefix
-
-    def lit(v: float) -> str:
-        return record.real(v, parens=False)
-
-    def arr(values: Any) -> tuple[str, ...]:
-        return tuple(str(int(v)) for v in values) if kind.integer else tuple(lit(float(v)) for v in values)
-
-    axes = table.stored_axes() if kind.integer else table.axes
-    vals = table.stored_values() if kind.integer else table.values
-    d = len(table.axes)
-    inputs = STSection("VAR_INPUT", "", tuple(STVar(n, num, None, None, "") for n in table.inputs))
-    outputs = STSection(
-        "VAR_OUTPUT",
-        "",
-        (
-            *(STVar(n, num, None, None, "") for n in table.outputs),
-            STVar("INFO", "BYTE", None, None, "always 16#00: rules fire everywhere in the input ranges"),
-        ),
-    )
-    consts = [
-        STVar(b, num, len(a), arr(a), f"breakpoints of {n}")
-        for b, a, n in zip(bps, axes, table.inputs, strict=True)
-    ]
-    consts += [
-        STVar(t, num, v.size, arr(v.ravel()), f"{n} at the breakpoints (last input fastest)")
-        for t, v, n in zip(tabs, vals, table.outputs, strict=True)
-    ]
-    temps = [STVar(f"{_P}{w}", "DINT", None, None, "") for w in ("LO", "HI", "MID", "K")]
-    temps += [STVar(f"{_P}X{i}", num, None, None, "") for i in range(d)]
-    temps += [STVar(f"{_P}I{i}", "DINT", None, None, "") for i in range(d)]
+    head = header(table, real, f"{record.label}, {'int' + str(table.bits) if table.bits else real}")
+    block = table_block(table)
     if kind.integer:
-        temps += [STVar(f"{_P}{w}{i}", wide, None, None, "") for i in range(d) for w in ("D", "W")]
-    else:
-        temps += [STVar(f"{_P}F{i}", real, None, None, "") for i in range(d)]
-    body = ["    (* each input limited to its range; its interval found by binary search *)"]
-    for i, (name, bp) in enumerate(zip(table.inputs, bps, strict=True)):
-        body += _interval(p, i, name, bp, len(table.axes[i]), f"{num}_TO_{wide}" if kind.integer else None)
-    strides = [math.prod(table.shape[i + 1 :]) for i in range(d)]
-    body.append(f"    {p}{_P}K := " + " + ".join(f"{p}{_P}I{i} * {s}" for i, s in enumerate(strides)) + ";")
-    for name, tab in zip(table.outputs, tabs, strict=True):
-        body.append(f"    (* {name}: the cell's corners interpolated, last input first *)")
-
-        def read(off: int, tab: str = tab) -> str:
-            at = f"{p}{tab}[{p}{_P}K + {off}]" if off else f"{p}{tab}[{p}{_P}K]"
-            return f"{num}_TO_{wide}({at})" if kind.integer else at
-
-        def lerp(a: str, b: str, axis: int) -> str:
-            if kind.integer:
-                return f"{a} + (({b} - {a}) * {p}{_P}D{axis}) / {p}{_P}W{axis}"
-            return f"{a} + ({b} - {a}) * {p}{_P}F{axis}"
-
-        steps, final = interpolation(table.shape, read, lerp, lambda s: f"{p}{_P}V{s}")
-        for tmp, expr in steps:
-            decl = tmp[len(p) :]
-            if all(t.name != decl for t in temps):
-                temps.append(STVar(decl, wide, None, None, ""))
-            body.append(f"    {tmp} := {expr};")
-        body.append(
-            f"    {p}{name} := {wide}_TO_{num}({final});" if kind.integer else f"    {p}{name} := {final};"
-        )
-    body.append(f"    {p}INFO := 0;")
-    for t in temps:
-        check(t.name, "identifier")
-    return STParts(
-        table.name or "FUZZY",
-        record.name,
-        real,
-        tuple(header(table, real, f"{record.label}, {'int' + str(table.bits) if table.bits else real}")),
-        (inputs, outputs, STSection("VAR", "", tuple(consts)), STSection("VAR_TEMP", "", tuple(temps))),
-        tuple(body),
-    )
-
-
-def _interval(p: str, i: int, name: str, bp: str, n: int, widen: str | None) -> list[str]:
-    """Input ``i`` limited to its breakpoints, its interval by binary search, and its
-    fraction across it (REAL) or its offset and the interval's width (integers, widened)."""
-    x, lo, hi, mid = f"{p}{_P}X{i}", f"{p}{_P}LO", f"{p}{_P}HI", f"{p}{_P}MID"
-    lines = [
-        f"    {x} := {p}{name};",
-        f"    IF {x} < {p}{bp}[0] THEN {x} := {p}{bp}[0]; END_IF;",
-        f"    IF {x} > {p}{bp}[{n - 1}] THEN {x} := {p}{bp}[{n - 1}]; END_IF;",
-        f"    {lo} := 0;",
-        f"    {hi} := {n - 1};",
-        f"    WHILE {hi} - {lo} > 1 DO",
-        f"        {mid} := ({lo} + {hi}) / 2;",
-        f"        IF {p}{bp}[{mid}] <= {x} THEN {lo} := {mid}; ELSE {hi} := {mid}; END_IF;",
-        "    END_WHILE;",
-        f"    {p}{_P}I{i} := {lo};",
-    ]
-    if widen is not None:
-        return [
-            *lines,
-            f"    {p}{_P}D{i} := {widen}({x} - {p}{bp}[{lo}]);",
-            f"    {p}{_P}W{i} := {widen}({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);",
+        decls = [
+            FixedDecl(
+                d.name,
+                {"value": "narrow"}.get(d.kind, d.kind),
+                d.storage,
+                comment=d.comment,
+                size=d.size,
+                values=None if d.init is None else tuple(int(v) for v in d.init),
+            )
+            for d in block.decls
         ]
-    return [*lines, f"    {p}{_P}F{i} := ({x} - {p}{bp}[{lo}]) / ({p}{bp}[{lo} + 1] - {p}{bp}[{lo}]);"]
+        fixed = FixedProgram(block.name, kind, [], [], decls, block.body, list(head))
+        return fixed_st_parts(fixed, record)
+    types = {"value": "REAL", "wide": "REAL", "index": "DINT", "byte": "BYTE"}
+    prog = Program(
+        block.name,
+        [Decl(d.name, types[d.kind], d.storage, d.size, d.init, d.comment) for d in block.decls],  # type: ignore[arg-type]
+        block.body,
+        list(head),
+    )
+    return program_st_parts(prog, dialect=record, lreal=lreal)
 
 
 def _real_of(lreal: bool) -> str:
@@ -168,7 +88,7 @@ def generate_lookup_st(
     ):
         if report is not None:
             report.append(LookupReport(table, _real_of(lreal)))
-        parts.append(format_st(st_parts(table, dialect, lreal, arith)))
+        parts.append(format_st(st_parts(table, dialect, lreal, arith), targets.dialect(dialect)))
         if testbench:
             parts.append(st_bench(plan, table, testbench, dialect, lreal))
     return "\n".join(parts)

@@ -30,6 +30,7 @@ from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.engine.table_bound import BELL_KINDS, Certifier, refusal
+from fuzzyctl.kinds import shapes as registry
 
 Arr = npt.NDArray[np.float64]
 
@@ -41,6 +42,9 @@ DEFAULT_MAX_BYTES = 16384
 _DESIGN = {1: 4001, 2: 241, 3: 49}
 #: certification samples at most, by input count
 _SAMPLES = {1: 400_000, 2: 3_000_000, 3: 4_000_000}
+#: certification boxes at most for CoA/LM/RM/MoM outputs (each box costs a pass over the
+#: output cells)
+_SAMPLES_ENCLOSED = {1: 40_000, 2: 60_000, 3: 80_000}
 #: stored-integer span of an input or output, by width: products of two fit the wide type
 QUANTA = {16: 16383, 32: 1 << 20}
 #: bytes of a stored value, by arithmetic
@@ -159,12 +163,26 @@ def input_range(plan: Plan, ctl: Controller, i: int) -> tuple[float, float]:
     return min(xs), max(xs)
 
 
-def output_range(plan: Plan, ctl: Controller, k: int) -> tuple[float, float]:
+def output_range(
+    plan: Plan, ctl: Controller, k: int, in_r: Sequence[tuple[float, float]]
+) -> tuple[float, float]:
+    """Output ``k``'s range: its RANGE, else the hull of its terms' values (a linear term's
+    over the input ranges)."""
     o = plan.outputs[k]
     declared = ctl.outputs[o.name].range
     if declared is not None:
         return declared
-    zs = [float(t.params[0]) for t in o.terms if t.params and not isinstance(t.params[0], Slot)]
+    zs = []
+    for t in o.terms:
+        if not t.params or any(isinstance(p, Slot) for p in t.params):
+            continue
+        if o.kind == "ts" and registry.flag(t.kind, "ts_linear"):
+            cs = [float(p) for p in t.params]  # type: ignore[arg-type]
+            const = cs[len(in_r)] if len(cs) > len(in_r) else 0.0
+            for corner in itertools.product(*in_r):
+                zs.append(const + sum(c * x for c, x in zip(cs, corner, strict=False)))
+        else:
+            zs.append(float(t.params[0]))  # type: ignore[arg-type]
     if not zs or min(zs) == max(zs):
         raise TableError(f"output {o.name} has no range: declare RANGE")
     return min(zs), max(zs)
@@ -399,7 +417,7 @@ def build_table(
     ctl = Controller(plan, model=model)
     d = len(plan.inputs)
     in_r = [input_range(plan, ctl, i) for i in range(d)]
-    out_r = [output_range(plan, ctl, k) for k in range(len(plan.outputs))]
+    out_r = [output_range(plan, ctl, k, in_r) for k in range(len(plan.outputs))]
     in_scale = [((hi - lo) / QUANTA[bits], lo) for lo, hi in in_r] if bits else []
     out_scale = [((hi - lo) / QUANTA[bits], lo) for lo, hi in out_r] if bits else []
 
@@ -426,7 +444,10 @@ def build_table(
         wanted = snap_in(i, np.array([in_r[i][0], in_r[i][1], *kinks(plan, i, *in_r[i])]))
         design.chosen.append(sorted({int(np.argmin(np.abs(g - w))) for w in wanted}))
     per = VALUE_BYTES[bits] if bits else VALUE_BYTES[real]
-    cert = Certifier(plan)
+    if Certifier(plan).heavy():  # LM, RM, MoM and CoA can jump: say so before refining
+        _refuse_jump(plan, find_jump(ev, design, tolerance), tolerance)
+    cert = Certifier(plan, cells=min(4096, max(256, int(4.0 / tolerance))))
+    cap = (_SAMPLES_ENCLOSED if cert.heavy() else _SAMPLES)[d]
     target, limited = tolerance * 0.8, False
     for _round in range(6):
         while True:
@@ -454,7 +475,7 @@ def build_table(
             in_scale=in_scale,
             out_scale=out_scale,
         )
-        bound, seen, n = certify(table, ev, cert, _SAMPLES[d])
+        bound, seen, n = certify(table, ev, cert, cap)
         extra = _rounding(table, real)
         table.bound = [b + e for b, e in zip(bound, extra, strict=True)]
         table.observed, table.samples = seen, n
@@ -462,15 +483,89 @@ def build_table(
         if worst <= tolerance or limited:
             break
         target *= max(0.3, min(0.8, 0.95 * tolerance / worst))
+    if math.isinf(worst) or worst > tolerance:
+        _refuse(plan, table, worst, limited, (ev, design, cert), max_bytes, real)
+    return table
+
+
+def _refuse(
+    plan: Plan,
+    table: Table,
+    worst: float,
+    limited: bool,
+    ctx: tuple[Any, Any, Any],
+    max_bytes: int,
+    real: str,
+) -> None:
+    """Raise the reason a table within the tolerance could not be proven: no rule fires
+    somewhere, the output jumps, the bound stays wide, or the size limit."""
+    ev, design, cert = ctx
+    tolerance = table.tolerance
     if math.isinf(worst):
         raise TableError("no rule fires somewhere in the input ranges: the output jumps to its DEFAULT there")
+    jump = find_jump(ev, design, tolerance) if worst > tolerance else None
+    _refuse_jump(plan, jump, tolerance)
+    if worst > tolerance and not limited:
+        raise TableError(
+            f"the error bound proven for a {'x'.join(map(str, table.shape))} table is {100 * worst:.3g}% "
+            f"of the output range, above --tolerance {100 * tolerance:.3g}%: raise --tolerance"
+            + (
+                " (for LM, RM and MoM the bound is where the maximum can lie on each box, wide"
+                " where the highest degree moves its plateau)"
+                if cert.heavy()
+                else ""
+            )
+        )
     if worst > tolerance:
         raise TableError(
             f"a table within {100 * tolerance:.3g}% of the output range needs more than {max_bytes} bytes "
             f"(--max-bytes); {'x'.join(map(str, table.shape))} in {table.size_bytes(real)} bytes is "
             f"within {worst:.3g} ({100 * worst:.3g}%): raise --max-bytes or --tolerance"
         )
-    return table
+
+
+def _refuse_jump(plan: Plan, jump: tuple[int, float, list[float]] | None, tolerance: float) -> None:
+    if jump is None:
+        return
+
+    k, size, where = jump
+    o = plan.outputs[k]
+    at = ", ".join(f"{inp.name} = {x:.6g}" for inp, x in zip(plan.inputs, where, strict=True))
+    raise TableError(
+        f"no proven error bound within {100 * tolerance:.3g}% for this block: output {o.name} "
+        f"({o.method}) jumps by {size:.6g} near {at}, and a table interpolates continuously "
+        "(LM, RM and MoM jump where another term's maximum becomes the highest, CoA across "
+        "a gap where the set is 0)"
+    )
+
+
+def find_jump(ev: Evaluator, design: _Design, tolerance: float) -> tuple[int, float, list[float]] | None:
+    """Where an output jumps: the largest step between neighbours of the design grid, cut
+    in half 40 times towards the larger step; a step still above ``tolerance`` (fraction of
+    the output range) across 1e-12 of the input range is a jump.  ``(output, size, point)``."""
+    for k, v in enumerate(design.values):
+        for ax, g in enumerate(design.grid):
+            step = np.abs(np.diff(v, axis=ax))
+            at = [int(i) for i in np.unravel_index(int(np.argmax(step)), step.shape)]
+            point = [float(gr[i]) for gr, i in zip(design.grid, at, strict=True)]
+            a, b = float(g[at[ax]]), float(g[at[ax] + 1])
+
+            def value(x: float, ax: int = ax, point: list[float] = point, k: int = k) -> float:
+                cols = [np.array([x if j == ax else p]) for j, p in enumerate(point)]
+                return float(ev.points(cols)[k][0])
+
+            fa, fb = value(a), value(b)
+            for _ in range(40):
+                m = 0.5 * (a + b)
+                fm = value(m)
+                if abs(fm - fa) >= abs(fb - fm):
+                    b, fb = m, fm
+                else:
+                    a, fa = m, fm
+            if abs(fb - fa) > tolerance * design.spans[k]:
+                point[ax] = 0.5 * (a + b)
+                return k, abs(fb - fa), point
+    return None
 
 
 class TableController(Controller):
@@ -482,8 +577,25 @@ class TableController(Controller):
         super().__init__(plan, specialise=False, model=model)
         self.table = table
 
+        from fuzzyctl.ir.programs.table_block import build_table_block
+        from fuzzyctl.ir.render.pysrc import table_function
+
+        d, m = len(table.inputs), len(table.outputs)
+        block = build_table_block(
+            "table",
+            [f"FZ_IN{i}" for i in range(d)],
+            [f"FZ_OUT{k}" for k in range(m)],
+            [[float(x) for x in a] for a in table.axes],
+            [[float(x) for x in v.ravel()] for v in table.values],
+            integer=False,
+            arrays=([f"FZ_BP{i}" for i in range(d)], [f"FZ_TAB{k}" for k in range(m)]),
+        )
+        # one evaluation runs the table's IR program printed as Python (the same program
+        # the ST and C blocks print); batches interpolate with numpy
+        program = table_function(block, d, m)
+
         def one(values: list[float], _state: list[float | None]) -> list[float]:
-            return [float(v[0]) for v in table.interpolate([np.array([x]) for x in values])]
+            return program(values)
 
         def many(part: list[Arr], _state: list[float | None], _m: int) -> list[Arr]:
             return table.interpolate(part)

@@ -17,17 +17,27 @@ these finite-difference inequalities, derived for the systems this module accept
 * centre of gravity on ``[a, b]``: ``F(x) - F(x') = int (t - F(x')) (mu_x - mu_x') dt /
   D(x)``, so ``|F(x) - F(x')| <= sup|dmu| ((F(x') - a)^2 + (b - F(x'))^2) / 2 / D(x)``, and
   since ``act(w a, mu) >= w a mu``, ``D(x) >= max_r A_r lo_r`` with
-  ``A_r`` the area of rule r's concluded term on ``[a, b]``.
+  ``A_r`` the area of rule r's concluded term on ``[a, b]``;
+* Takagi-Sugeno (WTAVER, WTSUM) with constant or linear terms: each weight ``W_i`` lies in
+  ``[lo_i, hi_i]`` and each value ``z_i`` moves by at most ``sum_k |c_ik| h_k`` on the box, and
+  ``F(x) - F(x') = sum_i [(W_i(x) - W_i(x')) (z_i(x) - F(x')) + W_i(x') (z_i(x) - z_i(x'))]
+  / D(x)`` (WTAVER; the same without ``F(x')`` and ``D`` for WTSUM);
+* CoA, LM, RM, MoM (:mod:`fuzzyctl.engine.table_methods`): not a move bound but the box's
+  value range, from the accumulated set's least and greatest value on every cell of the output
+  range.  These outputs can jump (LM, RM and MoM when another term's plateau becomes the
+  highest, CoA across a gap where the set is 0): a table cannot follow a jump, so the bound
+  stays above the tolerance there and the table is refused, naming where it jumps.
 
 Where no rule fires the output jumps to its DEFAULT: no table can bound that, and
-:class:`Certifier` reports an infinite bound there.
+:class:`Certifier` reports an infinite bound there (a WTSUM output whose DEFAULT is 0 does
+not jump).
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -35,6 +45,7 @@ import numpy.typing as npt
 from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import membership_np
+from fuzzyctl.engine.table_methods import OutputCells, enclosure_move, ts_move, ts_term_refusal
 from fuzzyctl.kinds import methods
 
 Arr = npt.NDArray[np.float64]
@@ -43,6 +54,8 @@ Arr = npt.NDArray[np.float64]
 LIPSCHITZ_AND = frozenset({"MIN", "PROD", "BDIF"})
 LIPSCHITZ_OR = frozenset({"MAX", "ASUM", "BSUM"})
 ACCUS = frozenset({"MAX", "BSUM"})
+#: Takagi-Sugeno accumulations (monotone in each operand)
+TS_ACCUS = frozenset({"MAX", "BSUM", "SUM", "PROBOR"})
 ACTS = frozenset({"MIN", "PROD"})
 #: the smooth shapes whose slope bound and box range are derived here (centre, sigma)
 BELL_KINDS = frozenset({"gaussian"})
@@ -101,14 +114,22 @@ def _output_refusal(o: OutputPlan) -> str | None:
         if accu not in ACCUS:
             return f"accumulation {accu} of {o.name}"
     elif o.kind == "mamdani":
-        if not methods.method(o.method).centroid or accu not in ACCUS or o.low is None or o.high is None:
+        entry = methods.method(o.method)
+        if not (entry.integrating or entry.maximum) or accu not in ACCUS or o.low is None or o.high is None:
             return f"output {o.name} ({o.method}, {accu})"
         if any(t.pwl is None for t in o.terms):
             return f"output {o.name}: a term that is not piecewise linear"
+    elif o.kind == "ts":
+        if o.accu is not None and o.accu not in TS_ACCUS:
+            return f"accumulation {o.accu} of {o.name}"
+        for t in o.terms:
+            why = ts_term_refusal(t)
+            if why:
+                return f"term {o.name}.{t.name}: {why}"
     else:
         return f"output {o.name} ({o.kind})"
     for c in o.contributions:
-        if c.term is None or c.act not in ACTS or not isinstance(c.weight, float):
+        if c.term is None or not isinstance(c.weight, float) or (o.kind != "ts" and c.act not in ACTS):
             return f"a conclusion on {o.name} (activation {c.act})"
     return None
 
@@ -169,6 +190,13 @@ class Certifier:
     the move bound of every output (see the module)."""
 
     plan: Plan
+    #: equal steps of an output range in the CoA/LM/RM/MoM value ranges (their resolution)
+    cells: int = 512
+    _cells: dict[int, OutputCells] = field(default_factory=dict)
+
+    def heavy(self) -> bool:
+        """Whether some output needs the (costlier) value ranges on output cells."""
+        return any(o.kind == "mamdani" and not methods.method(o.method).centroid for o in self.plan.outputs)
 
     def rules(self, centre: Sequence[Arr], half: Sequence[Arr]) -> list[tuple[Arr, Arr, Arr]]:
         """Each rule's condition at the centres and its least and greatest value on the
@@ -209,10 +237,27 @@ class Certifier:
         """Per output, a bound of ``|F(x) - F(x')|`` for every box centre ``x'`` and every
         ``x`` within ``half[i]`` of it along each input ``i`` (``values``: F at the centres)."""
         degs = self.rules(centre, half)
-        return [self._output_move(o, degs, f) for o, f in zip(self.plan.outputs, values, strict=True)]
+        return [self._output_move(k, degs, f, centre, half) for k, f in enumerate(values)]
 
-    def _output_move(self, o: OutputPlan, degs: list[tuple[Arr, Arr, Arr]], f: Arr) -> Arr:
+    def _output_move(
+        self, k: int, degs: list[tuple[Arr, Arr, Arr]], f: Arr, centre: Sequence[Arr], half: Sequence[Arr]
+    ) -> Arr:
         plan = self.plan
+        o = plan.outputs[k]
+        if o.kind == "ts":
+            weighted = []
+            for c in o.contributions:
+                w = float(plan.rules[c.rule].weight) * c.weight  # type: ignore[arg-type,operator]
+                weighted.append((c.term, tuple(w * v for v in degs[c.rule])))
+            return ts_move(o, weighted, centre, half)  # type: ignore[arg-type]
+        if o.kind == "mamdani" and not methods.method(o.method).centroid:
+            if k not in self._cells:
+                self._cells[k] = OutputCells.of(o, self.cells)
+            contribs = [
+                (c.term, c.act, float(plan.rules[c.rule].weight) * c.weight, degs[c.rule])  # type: ignore[arg-type,operator]
+                for c in o.contributions
+            ]
+            return enclosure_move(plan, o, self._cells[k], contribs, f)  # type: ignore[arg-type]
         n = len(f)
         bsum = (o.accu or "MAX") == "BSUM"
         per_term: dict[int, tuple[Arr, Arr, Arr]] = {}  # term -> mu at x', least, greatest

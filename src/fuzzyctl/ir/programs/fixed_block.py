@@ -77,10 +77,12 @@ class Port:
 @dataclass
 class FixedDecl:
     name: str
-    kind: str  # narrow, wide, bool, byte
-    storage: str  # input, output, temp
+    kind: str  # narrow, wide, bool, byte, index (DINT: an array index)
+    storage: str  # input, output, temp, const (an array: ``size`` and its ``values``)
     init: int | None = None
     comment: str = ""
+    size: int | None = None
+    values: tuple[int, ...] | None = None
 
 
 @dataclass

@@ -16,9 +16,15 @@ __all__ = ["fixed_st_parts", "render_fixed_c", "render_fixed_st"]
 
 
 def _types(prog: FixedProgram, lang: str) -> dict[str, str]:
-    bools = {"st": ("BOOL", "BYTE"), "c": ("unsigned char", "unsigned char")}[lang]
+    bools = {"st": ("BOOL", "BYTE", "DINT"), "c": ("unsigned char", "unsigned char", "long")}[lang]
     a = prog.arith
-    return {"narrow": a.types[lang], "wide": a.wide_types[lang], "bool": bools[0], "byte": bools[1]}
+    return {
+        "narrow": a.types[lang],
+        "wide": a.wide_types[lang],
+        "bool": bools[0],
+        "byte": bools[1],
+        "index": bools[2],
+    }
 
 
 class _STInt(Printer):
@@ -55,6 +61,9 @@ def fixed_st_parts(prog: FixedProgram, dialect: str | targets.Target = "codesys"
     r.stmts(prog.body, record.body_indent)
 
     def var(d: FixedDecl) -> STVar:
+        if d.size is not None:  # a constant table (lookup blocks)
+            values = None if d.values is None else tuple(str(int(v)) for v in d.values)
+            return STVar(d.name, types[d.kind], d.size, values, d.comment)
         if d.kind == "bool":
             init: tuple[str, ...] | None = (record.boolean(True),)
         else:
@@ -64,6 +73,7 @@ def fixed_st_parts(prog: FixedProgram, dialect: str | targets.Target = "codesys"
     groups = (
         ("VAR_INPUT", [d for d in prog.decls if d.storage == "input"]),
         ("VAR_OUTPUT", [d for d in prog.decls if d.storage == "output"]),
+        ("VAR", [d for d in prog.decls if d.storage == "const"]),
         ("VAR_TEMP", [d for d in prog.decls if d.storage == "temp"]),
     )
     sections = tuple(STSection(kw, "", tuple(var(d) for d in ds)) for kw, ds in groups if ds)

@@ -19,11 +19,13 @@ from fuzzyctl.escape import py_ident, py_str
 from fuzzyctl.ir.kernels import scalar as kernels
 from fuzzyctl.ir.nodes import (
     Assign,
+    Bin,
     Bool,
     Ex,
     For,
     If,
     Index,
+    Int,
     Kernel,
     Pwl,
     Region,
@@ -253,3 +255,49 @@ def needs_init(body: Sequence[Stmt], scalars: set[str]) -> list[str]:
 
     run(body, [])
     return sorted(out)
+
+
+class _PyTable(PythonPrinter):
+    """The table block (:mod:`fuzzyctl.ir.programs.table_block`) in Python: a division of
+    two index expressions is Python's integer division (``//``), as in ST and C."""
+
+    def __init__(self, ints: set[str]) -> None:
+        super().__init__(targets.PY)
+        self.ints = ints
+
+    def _integral(self, e: Ex) -> bool:
+        if isinstance(e, Var):
+            return e.name in self.ints
+        if isinstance(e, Int):
+            return True
+        return (
+            isinstance(e, Bin)
+            and e.op in ("+", "-", "*")
+            and self._integral(e.left)
+            and self._integral(e.right)
+        )
+
+    def bin(self, e: Bin, parent: int, right: bool) -> str:
+        if e.op == "/" and self._integral(e.left) and self._integral(e.right):
+            return f"({self.ex(e.left, 5)} // {self.ex(e.right, 5, True)})"
+        return super().bin(e, parent, right)
+
+
+def table_function(block: Any, n_inputs: int, n_outputs: int) -> Callable[[Sequence[float]], list[float]]:
+    """The table block as a Python function ``values -> outputs``.  ``block`` is built with
+    the names ``FZ_IN<i>``, ``FZ_OUT<k>``, ``FZ_BP<i>``, ``FZ_TAB<k>`` (no model name reaches
+    the source; every name is checked by :func:`fuzzyctl.escape.py_ident`)."""
+    r = _PyTable({d.name for d in block.decls if d.kind == "index"})
+    env: dict[str, Any] = {}
+    for d in block.decls:
+        py_ident(d.name, "generated name")
+        if d.storage == "const":
+            env[d.name] = tuple(float(v) for v in d.init)
+    r.block(block.body, 1)
+    head = [f"    FZ_IN{i} = v[{i}]" for i in range(n_inputs)]
+    outs = ", ".join(f"FZ_OUT{k}" for k in range(n_outputs))
+    src = "def _table(v):\n" + "\n".join(head + r.lines) + f"\n    return [{outs}]\n"
+    exec(compile(src, "<fuzzyctl table>", "exec"), env)
+    fn: Callable[[Sequence[float]], list[float]] = env["_table"]
+    fn.__source__ = src  # type: ignore[attr-defined]
+    return fn
