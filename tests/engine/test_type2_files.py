@@ -119,7 +119,6 @@ def test_cli_eval_explain_check(tmp_path: Path, capsys: pytest.CaptureFixture[st
     [
         (["codegen", EXAMPLE], "code generation is not available"),
         (["codegen", EXAMPLE, "--lang", "c"], "code generation is not available"),
-        (["studio", EXAMPLE, "--no-open"], "studio does not edit interval type-2"),
     ],
 )
 def test_consumers_refuse_with_a_message(
