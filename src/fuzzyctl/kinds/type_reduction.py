@@ -127,12 +127,7 @@ CONSUMERS: dict[str, Consumer] = {
         ),
         Consumer("blocks", False, _GENERATE),
         Consumer("studio", True),  # (footprint drawn and edited; docs/type2.md, "Studio")
-        Consumer(
-            "tune",
-            False,
-            "tune/learn do not free the lower and upper parameters of interval "
-            "type-2 terms yet; convert the system to type-1 first",
-        ),
+        Consumer("tune", True),  # (lower functions free, kept below the upper; docs/type2.md, "Tune")
     )
 }
 
