@@ -97,8 +97,23 @@ def test_evaluation_views_use_the_type2_engine(client: TestClient) -> None:
     for j, fy in enumerate(s["y"]):
         for i, sx in enumerate(s["x"]):
             assert z[j][i] == controller.evaluate(service=sx, food=fy)["tip"]
-    r = client.post("/api/ruleview", json=body(data, inputs={"service": 3, "food": 8}))
-    assert r.status_code == 422 and "Explain view" in r.json()["detail"]
+    view = client.post("/api/ruleview", json=body(data, inputs={"service": 3, "food": 8})).json()
+    first = view["rules"][0]  # IF service IS poor OR food IS rancid THEN tip IS cheap
+    assert (first["lower"], first["degree"]) == pytest.approx((0.25, 0.4), rel=1e-15)
+    poor = first["literals"][0]
+    assert (poor["term"], poor["lower"], poor["degree"]) == ("poor", pytest.approx(0.25), pytest.approx(0.4))
+    [cheap] = first["conclusions"]
+
+    # upper: min(0.4, cheap(x)); lower: min(0.25, (cheap(x) - 0.2) / 0.8), cheap = TRIAN 0 5 10
+    def cheap_at(x: float) -> float:
+        return max(0.0, min(x / 5, (10 - x) / 5))
+
+    for x, y in zip(cheap["set"]["x"], cheap["set"]["y"], strict=True):
+        assert y == pytest.approx(min(0.4, cheap_at(x)), abs=1e-12)
+    for x, y in zip(cheap["lower_set"]["x"], cheap["lower_set"]["y"], strict=True):
+        assert y == pytest.approx(min(0.25, max(0.0, (cheap_at(x) - 0.2) / 0.8)), abs=1e-12)
+    assert len(cheap["lower_set"]["x"]) > 50
+    assert view["outputs"][0]["interval"] == [yl, yr]
 
 
 def test_saved_fcl_keeps_the_lower_functions(client: TestClient, tmp_path: Path) -> None:

@@ -1,8 +1,8 @@
-"""An interval type-2 system in the browser (docs/type2.md, "Studio"): the footprint of
+"""An interval type-2 system in the browser (docs/type2.md, "Studio"): the explain view and
+the rule viewer with firing intervals and the type-reduced interval, the footprint of
 uncertainty drawn between the upper and the lower curve, the scale and lags edited in
 their fields and written back as FCL, an explicit lower function above the upper one
-refused with the term's message, and the explain view showing firing intervals and the
-type-reduced interval.
+refused with the term's message.
 
 Expected values are closed forms of MATLAB's lower function (scale * max(0, (upper - lag)
 / (1 - lag))) on examples/tipper_type2.fis, and the firing intervals worked by hand."""
@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from tests.conftest import EXAMPLES
-from tests.studio.browser import fcl_text, settle, tab
+from tests.studio.browser import fcl_text, settle, shot, tab
 
 FIS = EXAMPLES / "tipper_type2.fis"
 
@@ -47,17 +47,38 @@ def test_footprint_drawn_edited_and_checked(page: Any) -> None:
     pg.wait_for_function("document.querySelector('#status').textContent.includes('imported')")
     settle(pg)
 
+    # the check panel names the FIS as MATLAB does (mamfistype2: Type and TypeReductionMethod)
+    system = pg.inner_text("#matlab-system")
+    assert "'mamdanitype2'" in system and "'karnikmendel'" in system
+
     # explain at service 3, food 8: the firing intervals worked by hand (tests/engine)
     tab(pg, "explain")
     for name, value in (("service", "3"), ("food", "8")):
         pg.fill(f"#ex-in-{name}", value)
     pg.wait_for_function("(document.querySelector('#ex-chart').dataset.interval || '').length > 0")
-    pg.wait_for_function("document.querySelector('#ex-rules tbody').textContent.includes('0.250 … 0.400')")
+    pg.wait_for_function(
+        "(() => { const t = document.querySelector('#ex-rules tbody').textContent;"
+        " return t.includes('0.250 … 0.400') && t.includes('0.300 … 0.500'); })()"
+    )
     rules = pg.inner_text("#ex-rules tbody")
     assert "0.450 … 0.600" in rules and "0.300 … 0.500" in rules
     yl, yr = pg.evaluate("JSON.parse(document.querySelector('#ex-chart').dataset.interval)")
     value = float(pg.evaluate("document.querySelector('#ex-chart').dataset.value"))
     assert yl < value < yr and value == pytest.approx((yl + yr) / 2, rel=1e-12)
+
+    # the rule viewer at the same point: firing intervals, lower activated sets, the interval
+    tab(pg, "ruleviewer")
+    for name, typed in (("service", "3"), ("food", "8")):
+        pg.fill(f"#rv-in-{name}", typed)
+        pg.press(f"#rv-in-{name}", "Enter")
+    pg.wait_for_function(
+        "document.querySelector('#rv-table tr[data-label=\"1\"] td.deg').textContent === '0.250 … 0.400'"
+    )
+    assert pg.locator("#rv-table .fill-out-lower").count() == 3  # one per fired rule
+    assert pg.locator("#rv-table .fill-interval").count() == 1
+    shown = pg.evaluate("JSON.parse(document.querySelector('#view-ruleviewer').dataset.outputs)")
+    assert shown["tip"] == value
+    shot(pg, "type2-ruleviewer")
 
     # the footprint of food.rancid: lower lags 0.1 (rising) and 0.3 (falling), scale 1
     tab(pg, "variable")

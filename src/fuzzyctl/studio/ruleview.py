@@ -15,7 +15,6 @@ from typing import Any
 
 import numpy as np
 
-from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.semantics.operators import TNORMS
 from fuzzyctl.engine.semantics.shapes import FloatArray, membership_np, pwl_points
 from fuzzyctl.fcl.writer import conclusion_text, condition_text
@@ -119,13 +118,10 @@ def rule_view(
     controller: Any, fb: FunctionBlock, inputs: dict[str, float], ranges: dict[str, list[float]]
 ) -> dict[str, Any]:
     """The rows of the rule viewer at ``inputs`` (a fresh evaluation)."""
-    from fuzzyctl.studio.type2view import is_type2
+    from fuzzyctl.studio import type2view
 
-    if is_type2(controller):
-        raise FuzzyctlError(
-            "the rule viewer draws type-1 sets; for an interval type-2 system the Explain view "
-            "shows each rule's firing interval and each output's type-reduced interval"
-        )
+    if type2view.is_type2(controller):
+        return type2view.rule_view(controller, fb, inputs, ranges)
     controller.reset()
     explanation = controller.explain(inputs)
     plan = controller.plan

@@ -133,3 +133,86 @@ def explain(controller: Any, fb: FunctionBlock, inputs: dict[str, float]) -> dic
         for o in e.outputs
     ]
     return {"type2": True, "inputs": x, "terms": terms, "rules": rules, "outputs": outputs}
+
+
+def _lower_set(term: Term, act: str, firing: float, low: float, high: float) -> dict[str, Any] | None:
+    """The set a conclusion activates on the lower function: ``act(firing, lower(x))``
+    over the output's range (the lower curve's breakpoints included)."""
+    from fuzzyctl.engine.semantics.operators import TNORMS
+
+    curve = _lower_curve(term, low, high)
+    if curve is None:
+        return None
+    xs = sorted({low + (high - low) * i / (SAMPLES - 1) for i in range(SAMPLES)} | {p[0] for p in curve})
+    xs = [x for x in xs if low <= x <= high]
+    where = f"term {term.name}"
+    norm = TNORMS[act].scalar
+    return {"x": xs, "y": [float(norm(firing, sets.lower_value(term, x, where))) for x in xs]}
+
+
+def rule_view(
+    controller: Any, fb: FunctionBlock, inputs: dict[str, float], ranges: dict[str, list[float]]
+) -> dict[str, Any]:
+    """The rule viewer's rows for a type-2 system: each literal's degree interval
+    (``lower``, ``degree`` the upper), each rule's firing interval, each conclusion's
+    activated upper set (``set``) and lower set (``lower_set``), and each output's
+    type-reduced ``interval`` with its value."""
+    from fuzzyctl.studio.ruleview import activated, literals, rule_text
+
+    e = controller.explain(inputs)
+    x = e.inputs
+    rows: list[dict[str, Any]] = []
+    fired = iter(e.rules)
+    for bi, rb in enumerate(fb.rule_blocks):
+        for ri, rule in enumerate(rb.rules):
+            interval = next(fired)
+            lits = []
+            for lit in literals(rule.condition):
+                blk = fb.fuzzify_block(lit.variable)
+                term = blk.term(lit.term) if blk is not None else None
+                where = f"term {lit.variable}.{lit.term}"
+                up = sets.mf_value(term.mf, x[lit.variable], where) if term is not None else None
+                lo = sets.lower_value(term, x[lit.variable], where) if term is not None else None
+                lits.append(
+                    {
+                        "variable": lit.variable,
+                        "term": lit.term,
+                        "negated": lit.negated,
+                        "hedges": list(lit.hedges),
+                        "degree": up,
+                        "lower": lo,
+                    }
+                )
+            conclusions = []
+            for c in rule.conclusions:
+                dblk = fb.defuzzify_block(c.variable)
+                term = dblk.term(c.term) if dblk is not None and c.term is not None else None
+                low, high = ranges.get(c.variable, [0.0, 1.0])
+                conclusions.append(
+                    {
+                        "variable": c.variable,
+                        "term": c.term,
+                        "weight": 1.0,
+                        "degree": interval.upper,
+                        "lower": interval.lower,
+                        "set": activated(term, controller.act, interval.upper, 1.0, False, low, high),
+                        "lower_set": _lower_set(term, controller.act, interval.lower, low, high)
+                        if term is not None and term.lower is not None
+                        else None,
+                    }
+                )
+            rows.append(
+                {
+                    "block": bi,
+                    "index": ri,
+                    "label": rule.label,
+                    "text": rule_text(rule.condition, rule.conclusions),
+                    "literals": lits,
+                    "evaluated": True,
+                    "degree": interval.upper,
+                    "lower": interval.lower,
+                    "conclusions": conclusions,
+                }
+            )
+    outputs = [{"name": o.name, "value": o.value, "interval": [o.yl, o.yr]} for o in e.outputs]
+    return {"inputs": x, "rules": rows, "outputs": outputs, "type2": True}

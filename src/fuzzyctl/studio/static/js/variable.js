@@ -337,7 +337,10 @@ async function setRange() {
   }
   if (adjust) {
     const k = (hi - lo) / (oldHi - oldLo);
-    for (const t of blk.terms) rescale(t.mf, (x) => lo + (x - oldLo) * k, k);
+    for (const t of blk.terms) {
+      rescale(t.mf, (x) => lo + (x - oldLo) * k, k);
+      if (t.lower && t.lower.mf) rescale(t.lower.mf, (x) => lo + (x - oldLo) * k, k); // an explicit lower function moves with it
+    }
   }
   if (blk.range) blk.range = { low: lo, high: hi };
   else state.settings.ranges = { ...(state.settings.ranges || {}), [current]: [lo, hi] };
