@@ -137,3 +137,27 @@ def test_launch_opens_a_type2_file(tmp_path: Path) -> None:
         assert launch.url.startswith("http://127.0.0.1:")
     finally:
         launch.sock.close()
+
+
+@pytest.mark.parametrize(("sugeno", "explicit"), [(True, False), (False, True), (True, True)])
+def test_sugeno_and_explicit_systems(client: TestClient, sugeno: bool, explicit: bool) -> None:
+    from fuzzyctl.engine.type2 import Type2Controller
+    from fuzzyctl.model import Document
+    from fuzzyctl.studio.analysis import document_to_json
+    from tests.engine.type2_systems import random_it2
+
+    fb = random_it2(7, sugeno=sugeno, explicit=explicit)
+    data = {"document": document_to_json(Document((fb,))), "settings": {}}
+    report = client.post("/api/check", json=body(data)).json()
+    assert report["ok"], report["diagnostics"]
+    x0 = report["curves"]["x0"]
+    assert all("lower" in c for c in x0.values())
+    if explicit:
+        assert {c["lower_kind"] for c in x0.values()} == {"mf"}
+    point = {v.name: 3.7 for v in fb.inputs}
+    e = client.post("/api/explain", json=body(data, inputs=point)).json()
+    expected = Type2Controller(fb).explain(point)
+    assert e["outputs"][0]["value"] == expected.outputs[0].value
+    assert e["outputs"][0]["interval"] == [expected.outputs[0].yl, expected.outputs[0].yr]
+    view = client.post("/api/ruleview", json=body(data, inputs=point)).json()
+    assert [(r["lower"], r["degree"]) for r in view["rules"]] == [(r.lower, r.upper) for r in expected.rules]
