@@ -161,3 +161,27 @@ def test_space_frees_the_lower_parameters() -> None:
     # as written, the space decodes to the system (scale and lags within the boxes)
     fb = space.decode(space.initial())
     assert fb.fuzzify[1].terms[0].lower == target().fuzzify[1].terms[0].lower
+
+
+def test_cli_learn_type2_and_widen(tmp_path: Any, capsys: pytest.CaptureFixture[str]) -> None:
+    from fuzzyctl.cli.app import main
+
+    rng = np.random.default_rng(5)
+    x, z = rng.uniform(0, 10, 60), rng.uniform(0, 10, 60)
+    y = np.sin(x / 2) + 0.1 * z + rng.normal(0, 0.2, 60)
+    csv = tmp_path / "d.csv"
+    csv.write_text("x,z,y\n" + "".join(f"{a},{b},{c}\n" for a, b, c in zip(x, z, y, strict=True)))
+    out = tmp_path / "t2.fcl"
+    argv = ["learn", str(csv), "--inputs", "x,z", "--target", "y", "--terms", "2", "--type2", "-o", str(out)]
+    assert main(argv) == 0
+    assert "interval type-2: training RMSE" in capsys.readouterr().out
+    learned = fuzzyctl.load(out).main
+    assert learned.is_type2 and problems(learned) == []
+    # a system with singleton outputs (COGS) has no interval type-2 form: said, exit 1
+    crane = EXAMPLES / "crane.fcl"
+    data_csv = tmp_path / "c.csv"
+    data_csv.write_text("distance,angle,power\n1,0,0\n5,2,10\n", encoding="utf-8")
+    argv = ["tune", str(crane), "--data", str(data_csv), "--widen", "-o", str(tmp_path / "c.fcl")]
+    assert main(argv) == 1
+    err = capsys.readouterr().err.replace("\n", " ")
+    assert "--widen" in err and "COGS" in err
