@@ -157,7 +157,6 @@ def test_cli_eval_explain_check(tmp_path: Path, capsys: pytest.CaptureFixture[st
     [
         (["codegen", EXAMPLE], "code generation is not available"),
         (["codegen", EXAMPLE, "--lang", "c"], "code generation is not available"),
-        (["studio", EXAMPLE, "--no-open"], "studio does not edit interval type-2"),
     ],
 )
 def test_consumers_refuse_with_a_message(
@@ -167,11 +166,14 @@ def test_consumers_refuse_with_a_message(
     assert words in capsys.readouterr().err.replace("\n", " ")
 
 
-def test_tune_refuses(tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_tune_writes_the_lower_functions(tmp_path: Path) -> None:
     data = tmp_path / "d.csv"
-    data.write_text("service,food,tip\n3,8,15\n5,5,15\n", encoding="utf-8")
-    assert main(["tune", EXAMPLE, "--data", str(data), "-o", str(tmp_path / "o.fis")]) == 1
-    assert "do not free the lower and upper parameters" in capsys.readouterr().err.replace("\n", " ")
+    data.write_text("service,food,tip\n3,8,15\n5,5,15\n1,2,6\n9,9,24\n", encoding="utf-8")
+    out = tmp_path / "o.fcl"
+    argv = ["tune", EXAMPLE, "--data", str(data), "-o", str(out), "--budget", "5", "--workers", "0"]
+    assert main([*argv, "--validation", "0"]) == 0
+    tuned = fuzzyctl.load(out).main
+    assert tuned.is_type2 and all(t.lower is not None for f in tuned.fuzzify for t in f.terms)
 
 
 def test_convert_type1_option(tmp_path: Path) -> None:

@@ -134,6 +134,13 @@ def learn(
         str | None, typer.Option("--name", help="FUNCTION_BLOCK name (default: learned).")
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the errors as JSON.")] = False,
+    type2: Annotated[
+        bool,
+        typer.Option(
+            "--type2",
+            help="Widen the learned system into interval type-2 (lower scale/lag fitted to the data).",
+        ),
+    ] = False,
 ) -> None:
     """Learn a fuzzy system from data: grid partition or clustering, consequents by least squares."""
     from fuzzyctl.cli.app import split_names
@@ -157,6 +164,7 @@ def learn(
         seed=seed,
         name=name,
         shape=shape,
+        type2=type2,
     )
     result.write_fcl(out)
     if as_json:
@@ -249,6 +257,13 @@ def tune(
     ] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the result as JSON.")] = False,
     from_format: FromOpt = None,
+    widen: Annotated[
+        bool,
+        typer.Option(
+            "--widen",
+            help="Make a type-1 system interval type-2 (lower = upper) and tune only the lower scale/lag.",
+        ),
+    ] = False,
 ) -> None:
     """Tune a fuzzy system against data or a closed-loop cost (Ctrl-C keeps the best so far)."""
     from fuzzyctl.cli.app import split_names
@@ -276,6 +291,7 @@ def tune(
             runtime=runtime,
             keep_zero=keep_zero,
             progress=tick,
+            widen=widen,
         )
     files = result.save(out, report=report)
     if as_json:

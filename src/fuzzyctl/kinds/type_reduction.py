@@ -126,18 +126,8 @@ CONSUMERS: dict[str, Consumer] = {
             "fuzzyctl.compile and `fuzzyctl eval` evaluate it",
         ),
         Consumer("blocks", False, _GENERATE),
-        Consumer(
-            "studio",
-            False,
-            "the studio does not edit interval type-2 systems yet (the footprint "
-            "of uncertainty is not drawn); edit the file, or convert it to type-1 first",
-        ),
-        Consumer(
-            "tune",
-            False,
-            "tune/learn do not free the lower and upper parameters of interval "
-            "type-2 terms yet; convert the system to type-1 first",
-        ),
+        Consumer("studio", True),  # (footprint drawn and edited; docs/type2.md, "Studio")
+        Consumer("tune", True),  # (lower functions free, kept below the upper; docs/type2.md, "Tune")
     )
 }
 

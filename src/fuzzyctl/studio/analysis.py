@@ -36,6 +36,7 @@ from fuzzyctl.model import (
     Span,
     Term,
 )
+from fuzzyctl.studio import type2view
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -72,7 +73,8 @@ def document_to_json(document: Document) -> dict[str, Any]:
 
 
 def fcl_text(document: Document) -> str:
-    from fuzzyctl.fcl import write
+    # (the FCL form with interval type-2 terms; a type-1 model is written as fuzzyctl.fcl does)
+    from fuzzyctl.formats.fcl.type2 import write
 
     return write(document)
 
@@ -131,7 +133,7 @@ def check_text(text: str, path: str | None = None) -> Report:
     if document is not None and not has_errors(diagnostics):
         seen = {(d.code, d.span.line if d.span else None) for d in diagnostics}
         for fb in document.blocks:
-            for d in unsupported(fb):
+            for d in [*unsupported(fb), *type2view.lower_diagnostics(fb)]:
                 if (d.code, d.span.line if d.span else None) not in seen:
                     diagnostics.append(replace(d, file=d.file or path))
     ok = document is not None and not has_errors(diagnostics)
@@ -324,6 +326,7 @@ def curves(fb: FunctionBlock, ranges: dict[str, list[float]]) -> dict[str, dict[
             shape["fcl"] = mf_text(mf)
             terms[t.name] = shape
         out[v.name] = terms
+    type2view.add_lower_curves(fb, ranges, out)
     return out
 
 
@@ -444,6 +447,8 @@ def explain(controller: Any, inputs: dict[str, float]) -> dict[str, Any]:
     """Term degrees, rule degrees, accumulated output sets and values at one point (a
     fresh evaluation: the controller is reset first)."""
     controller.reset()
+    if type2view.is_type2(controller):
+        return type2view.explain(controller, controller.model, inputs)
     result: dict[str, Any] = controller.explain(inputs).to_dict()
     return result
 

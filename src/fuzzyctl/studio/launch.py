@@ -75,17 +75,6 @@ def prepare(
     from fuzzyctl.studio import create_app
 
     project_root, relative = project(file, root)
-    if file is not None and file.is_file():
-        import fuzzyctl
-        from fuzzyctl.diagnostics import DiagnosticError
-        from fuzzyctl.type2 import refuse
-
-        try:
-            document = fuzzyctl.load(file)
-        except DiagnosticError:
-            document = None  # the studio shows what is wrong with it
-        if document is not None:
-            refuse(document, "studio")
     token = studio_token(token, no_token)
     application = create_app(project_root, file=relative, host=host, token=token, api_docs=api_docs)
     sock = _listen(host, port)

@@ -118,6 +118,10 @@ def rule_view(
     controller: Any, fb: FunctionBlock, inputs: dict[str, float], ranges: dict[str, list[float]]
 ) -> dict[str, Any]:
     """The rows of the rule viewer at ``inputs`` (a fresh evaluation)."""
+    from fuzzyctl.studio import type2view
+
+    if type2view.is_type2(controller):
+        return type2view.rule_view(controller, fb, inputs, ranges)
     controller.reset()
     explanation = controller.explain(inputs)
     plan = controller.plan

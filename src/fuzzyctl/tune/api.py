@@ -52,8 +52,8 @@ class TuneResult:
 
     def write_fcl(self, path: str | Path) -> Path:
         """The tuned document as FCL (comments kept, one added saying how it was tuned)."""
-        from fuzzyctl.fcl import write
         from fuzzyctl.files import write_atomic
+        from fuzzyctl.formats.fcl.type2 import write  # (type-1 models: fuzzyctl.fcl's text)
 
         path = Path(path)
         write_atomic(path, write(self.document))
@@ -113,6 +113,7 @@ def tune(
     keep_zero: bool | None = None,
     progress: optimize.Progress | None = None,
     options: dict[str, Any] | None = None,
+    widen: bool = False,
 ) -> TuneResult:
     """Tune the parameters ``free`` names (see :func:`fuzzyctl.tune.space.parse_free`) of a
     function block against ``data`` (columns named like the inputs, and ``output``: the
@@ -125,22 +126,28 @@ def tune(
     (default: one per CPU; 0 runs in this process), or ``scheduler`` / ``client`` for an
     existing cluster.  ``keep_zero`` (default: True against the plant, False against data)
     keeps abscissae and singletons at 0 where they are: the loop's equilibrium.  Ctrl-C
-    stops the search and keeps the best candidate so far."""
+    stops the search and keeps the best candidate so far.
+
+    Interval type-2 terms: their lower functions are free with their term (scale and lag,
+    or an explicit function kept below the upper one; :mod:`fuzzyctl.tune.type2`).
+    ``widen``: a type-1 block is first made type-2 with lower functions equal to the upper
+    ones (scale 1, lag 0: the same outputs), then only the lower functions are tuned."""
     if (data is None) == (plant_config is None):
         raise InputError("give either data (--data) or a plant configuration (--plant)")
     if loss not in LOSSES:
         raise InputError(f"--loss must be one of {', '.join(LOSSES)}, got {loss!r}")
     doc = _document(model)
-    from fuzzyctl.type2 import refuse
-
-    refuse(doc, "tune")
     try:
         fb = doc.block(block)
     except KeyError as exc:
         raise InputError(str(exc.args[0])) from None
     index = doc.blocks.index(fb)
+    if widen:
+        doc, fb = _widened(doc, index)
     kind = "data" if data is not None else "plant"
-    space = build_space(fb, free, keep_zero=kind == "plant" if keep_zero is None else keep_zero)
+    space = build_space(
+        fb, free, keep_zero=kind == "plant" if keep_zero is None else keep_zero, lower_only=widen
+    )
     opt = optimizer or ("lsq" if kind == "data" else "cmaes")
     if opt not in optimize.OPTIMIZERS:
         raise InputError(f"--optimizer must be one of {', '.join(optimize.OPTIMIZERS)}, got {opt!r}")
@@ -168,6 +175,23 @@ def tune(
     finally:
         execu.close()
     return _result(doc, index, fb, space, problem, kind, opt, seed, budget, outcome, workers_used, cost_name)
+
+
+def _widened(doc: Document, index: int) -> tuple[Document, FunctionBlock]:
+    from fuzzyctl.diagnostics import FuzzyctlError
+    from fuzzyctl.engine.type2 import Type2Controller
+    from fuzzyctl.tune.type2 import widen
+
+    fb = widen(doc.blocks[index])
+    if not fb.is_type2:
+        raise InputError("--widen: the block has no fuzzy-set term to give a lower function")
+    try:
+        Type2Controller(fb)  # what the type-2 engine does not evaluate is said here, once
+    except FuzzyctlError as exc:
+        raise InputError(f"--widen: {exc}") from None
+    blocks = list(doc.blocks)
+    blocks[index] = fb
+    return dataclasses.replace(doc, blocks=tuple(blocks)), fb
 
 
 def _data_problem(

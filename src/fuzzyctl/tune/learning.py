@@ -101,7 +101,7 @@ class LearnResult:
         return self.document.main
 
     def write_fcl(self, path: str | Path) -> Path:
-        from fuzzyctl.fcl import write
+        from fuzzyctl.formats.fcl.type2 import write  # (type-1 models: fuzzyctl.fcl's text)
 
         path = Path(path)
         path.write_text(write(self.document), encoding="utf-8")
@@ -159,15 +159,26 @@ def learn(
     seed: int = 0,
     name: str | None = None,
     shape: str = "triangle",
+    type2: bool = False,
+    budget: int = 100,
 ) -> LearnResult:
     """Learn a fuzzy system mapping ``inputs`` to ``output`` from a table (CSV/Parquet path,
-    mapping of columns or DataFrame); see the module docstring for the methods."""
+    mapping of columns or DataFrame); see the module docstring for the methods.
+    ``type2``: the learned system is then widened into an interval type-2 one (every
+    fuzzy-set term gets a lower function, scale 1 and lag 0, equal to the upper one) and
+    the lower functions' scale and lag are tuned on the training rows (``budget``
+    evaluations), kept only when they lower the training error."""
     if method not in METHODS:
         raise InputError(f"--method must be one of {', '.join(METHODS)}, got {method!r}")
     if kind not in KINDS:
         raise InputError(f"--type must be one of {', '.join(KINDS)}, got {kind!r}")
     if shape not in SHAPES:
         raise InputError(f"--shape must be one of {', '.join(SHAPES)}, got {shape!r}")
+    if type2 and kind != "tsk":
+        raise InputError(
+            "--type2 needs --type tsk: the Mamdani systems learned here have singleton outputs "
+            "(COGS), which interval type-2 inference does not define"
+        )
     and_op = and_op.upper()
     if and_op not in ("MIN", "PROD"):
         raise InputError(f"--and must be MIN or PROD, got {and_op!r}")
@@ -239,6 +250,9 @@ def learn(
         if and_op.upper() != "MIN":
             notes.append("the Siemens FUZZY block takes AND MIN: learn with --and min (and_op='min') for it")
     fb = _with_comment(fb, method, kind, inputs, output, n, and_op)
+    if type2:
+        fb, note = _widened(fb, parts_train, output, seed, budget)
+        notes.append(note)
     doc = Document((fb,))
     scores = _scores(doc, parts_train, parts_val, inputs, output)
     return LearnResult(doc, method, kind, len(antecedents), scores, notes)
@@ -477,11 +491,26 @@ def _with_comment(
     return dataclasses.replace(fb, comments=(text,))
 
 
+def _widened(
+    fb: FunctionBlock, train: Columns, output: str, seed: int, budget: int
+) -> tuple[FunctionBlock, str]:
+    from fuzzyctl.tune.api import tune
+
+    result = tune(
+        fb, data=train, output=output, widen=True, validation=0.0, seed=seed, budget=budget, workers=0
+    )
+    return (
+        result.block,
+        f"interval type-2: training RMSE {result.before:.6g} -> {result.after:.6g} (lower scale/lag)",
+    )
+
+
 def _scores(
     doc: Document, train: Columns, val: Columns | None, inputs: Sequence[str], output: str
 ) -> dict[str, float]:
     import fuzzyctl
-    from fuzzyctl.fcl import load_text, write
+    from fuzzyctl.fcl import load_text
+    from fuzzyctl.formats.fcl.type2 import write  # (type-1 models: fuzzyctl.fcl's text)
 
     # Evaluate what is written: the file read back, through the public compile().
     written = load_text(write(doc)).raise_for_errors()

@@ -62,6 +62,11 @@ class DataProblem:
             span = float(np.max(y) - np.min(y))
             self.scales.setdefault(o, (span or 1.0) if len(self.outputs) > 1 else 1.0)
         self.penalty = {o: max(1.0, float(np.ptp(self.train[o]))) for o in self.outputs}
+        self.type2 = self.space.block.is_type2
+        if self.type2:
+            # the type-reduced centroid's switch points have no closed-form gradient here
+            self.gradient_note: str | None = "an interval type-2 system"
+            return
         plan0 = _plan(self.space.block, self.compat)
         self.gradient_note = gradient.unsupported(plan0, self.outputs)
         if self.gradient_note is None and gradient.slot_map(self.space.block, plan0) is None:
@@ -89,12 +94,25 @@ class DataProblem:
         return fb, plan
 
     def predict(self, cand: Candidate, cols: Columns, sl: slice | None = None) -> dict[str, Arr]:
-        _fb, plan = self.candidate_plan(cand)
         part = {k: v[sl] if sl is not None else v for k, v in cols.items()}
         n = rows(part)
+        if self.type2:
+            return self._predict_type2(cand, part, n)
+        _fb, plan = self.candidate_plan(cand)
         vals = [part[i.name] if i.name in part else np.full(n, float(i.default or 0.0)) for i in plan.inputs]
         outs = BatchEvaluator(plan).run(vals, [None] * len(plan.outputs))
         return {o.name: outs[k] for k, o in enumerate(plan.outputs) if o.name in self.outputs}
+
+    def _predict_type2(self, cand: Candidate, part: Columns, n: int) -> dict[str, Arr]:
+        """The type-2 engine's outputs (one row at a time: it has no batch path yet)."""
+        from fuzzyctl.engine.type2 import Type2Controller
+
+        fb = cand if isinstance(cand, FunctionBlock) else self.space.decode(cand)
+        data = {
+            v.name: part[v.name] if v.name in part else np.full(n, float(v.initial or 0.0)) for v in fb.inputs
+        }
+        outs = Type2Controller(fb).evaluate_batch(data, out_of_range="ignore")
+        return {o: outs[o] for o in self.outputs}
 
     def residuals(self, cand: Candidate, key: int, cols: Columns | None = None) -> Arr:
         """Scaled residuals (prediction - target) of one chunk, outputs one after the other."""

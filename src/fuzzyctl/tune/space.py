@@ -20,6 +20,9 @@ into a function block that is valid by construction:
   ``[v/4, 4 v]`` and keep their sign.
 * **Takagi-Sugeno coefficients** move in a box around their value (see :func:`_coef_box`).
 * **Weights** (WITH, rule weights) move in ``[0, 1]``.
+* **Lower functions** of interval type-2 terms (:mod:`fuzzyctl.tune.type2`): scale in
+  ``[0.01, 1]`` and lags in ``[0, 0.95]``, or an explicit function's parameters as above,
+  projected below the upper function.
 
 The degrees (``y``) of points stay as written.
 """
@@ -50,6 +53,7 @@ from fuzzyctl.model import (
     SingletonsMF,
     Term,
 )
+from fuzzyctl.tune import type2
 
 Vector = npt.NDArray[np.float64]
 
@@ -242,6 +246,8 @@ def catalogue(fb: FunctionBlock) -> dict[SlotKey, Slot]:
         for ti, t in enumerate(blk.terms):
             for tkey, value, role, label in _term_slots(var, ti, t, inputs):
                 slots[tkey] = Slot(tkey, value, role, var, t.name, label)
+            for tkey, value, role, label in _lower_slots(var, ti, t, inputs):
+                slots[tkey] = Slot(tkey, value, role, var, t.name, label)
     key: SlotKey
     for bi, rb in enumerate(fb.rule_blocks):
         for ri, rule in enumerate(rb.rules):
@@ -264,6 +270,20 @@ def _num(p: object) -> float:
 
 def _const(p: object) -> bool:
     return isinstance(p, float | int) and not isinstance(p, bool) and math.isfinite(float(p))
+
+
+def _lower_slots(
+    var: str, ti: int, t: Term, inputs: Sequence[str]
+) -> Iterable[tuple[SlotKey, float, str, str]]:
+    """An interval type-2 term's lower function: scale and lags, or the parameters of an
+    explicit function (keyed ``("lower", var, ti, ...)``; see :mod:`fuzzyctl.tune.type2`)."""
+    if t.lower is None:
+        return
+    if t.lower.mf is None:
+        yield from type2.scale_lag_slots(var, ti, t)
+        return
+    for key, value, role, label in _term_slots(var, ti, Term(f"{t.name} lower", t.lower.mf), inputs):
+        yield ("lower", *key[1:]), value, role, label
 
 
 def _term_slots(
@@ -363,14 +383,21 @@ def parse_free(
 
 
 def build_space(
-    fb: FunctionBlock, free: str | Sequence[str] | None = "all", *, keep_zero: bool = False
+    fb: FunctionBlock,
+    free: str | Sequence[str] | None = "all",
+    *,
+    keep_zero: bool = False,
+    lower_only: bool = False,
 ) -> Space:
     """The free parameters of ``fb`` for a ``--free`` specification (see :func:`parse_free`).
 
     ``keep_zero``: abscissae and singletons at exactly 0 stay there.  In a closed loop the
     terms at zero error and the zero output make the equilibrium (no error, no action):
-    moving them moves where the loop settles."""
+    moving them moves where the loop settles.  ``lower_only``: only the lower functions of
+    interval type-2 terms move (what widening a type-1 system tunes)."""
     slots = catalogue(fb)
+    if lower_only:
+        slots = {k: v for k, v in slots.items() if k[0] in ("lower", "with", "rule")}
     free_terms, free_weights, _ = parse_free(free, fb)
     notes: list[str] = []
     groups: list[Group] = []
@@ -423,6 +450,9 @@ def build_space(
             elif s.role == "coef":
                 lo_c, hi_c = _coef_box(fb, s)
                 groups.append(Group("box", lo_c, hi_c, ((s.key,),), start))
+            elif s.role in ("lower_scale", "lag"):
+                lo_b, hi_b = type2.box(s.role)
+                groups.append(Group("box", lo_b, hi_b, ((s.key,),), start))
             else:
                 continue
             start += 1
@@ -486,9 +516,12 @@ def apply_values(fb: FunctionBlock, values: dict[SlotKey, float]) -> FunctionBlo
     by_term: dict[tuple[str, int], dict[int, float]] = {}
     withs: dict[tuple[int, int, int], float] = {}
     rule_w: dict[tuple[int, int], float] = {}
+    lowers: dict[tuple[str, int], dict[SlotKey, float]] = {}
     for key, v in values.items():
         if key[0] == "term":
             by_term.setdefault((str(key[1]), int(key[2])), {})[int(key[3])] = v
+        elif key[0] == "lower":
+            lowers.setdefault((str(key[1]), int(key[2])), {})[key[3:]] = v
         elif key[0] == "with":
             withs[(int(key[1]), int(key[2]), int(key[3]))] = v
         else:
@@ -498,7 +531,9 @@ def apply_values(fb: FunctionBlock, values: dict[SlotKey, float]) -> FunctionBlo
         out = []
         for ti, t in enumerate(ts):
             new = by_term.get((var, ti))
-            out.append(t if not new else dataclasses.replace(t, mf=_replace_mf(t.mf, new)))
+            t = t if not new else dataclasses.replace(t, mf=_replace_mf(t.mf, new))
+            low = lowers.get((var, ti))
+            out.append(t if not low else type2.with_values(t, low, _replace_mf))
         return tuple(out)
 
     fuzz = tuple(dataclasses.replace(b, terms=terms(b.variable, b.terms)) for b in fb.fuzzify)
@@ -518,7 +553,8 @@ def apply_values(fb: FunctionBlock, values: dict[SlotKey, float]) -> FunctionBlo
                 new_rule = dataclasses.replace(new_rule, weight=rule_w[(bi, ri)])
             rules.append(new_rule)
         rbs.append(dataclasses.replace(rb, rules=tuple(rules)))
-    return dataclasses.replace(fb, fuzzify=fuzz, defuzzify=defz, rule_blocks=tuple(rbs))
+    out = dataclasses.replace(fb, fuzzify=fuzz, defuzzify=defz, rule_blocks=tuple(rbs))
+    return type2.project(out) if out.is_type2 else out
 
 
 def _replace_mf(mf: object, new: dict[int, float]) -> PointsMF | SingletonsMF | SingletonMF | ShapeMF:

@@ -76,13 +76,15 @@ export async function run() {
     return;
   }
   const terms = $("#ex-terms tbody");
-  terms.replaceChildren(...e.terms.map((t) => el("tr", { class: t.degree > 0 ? "fired" : null }, el("td", {}, t.variable), el("td", {}, t.term), el("td", { class: "num" }, deg(t.degree)), el("td", {}, bar(t.degree)))));
+  // an interval type-2 system: each degree is an interval, lower … upper
+  const shown = (x) => (x.lower === undefined ? deg(x.degree) : `${deg(x.lower)} … ${deg(x.degree)}`);
+  terms.replaceChildren(...e.terms.map((t) => el("tr", { class: t.degree > 0 ? "fired" : null }, el("td", {}, t.variable), el("td", {}, t.term), el("td", { class: "num" }, shown(t)), el("td", {}, bar(t.degree)))));
   const rules = $("#ex-rules tbody");
   rules.replaceChildren(
     ...e.rules.map((r) => {
       const rule = modelRule(r.block, r.label);
       const text = rule ? ruleText(rule) : r.conclusions.map((c) => `${c.variable} IS ${c.term}`).join(", ");
-      return el("tr", { class: r.degree > 0 ? "fired" : null }, el("td", { class: "num", title: r.block ? `rule block ${r.block}` : null }, r.label), el("td", { class: "num" }, deg(r.degree)), el("td", {}, bar(r.degree)), el("td", { class: "mono rule-text" }, text));
+      return el("tr", { class: r.degree > 0 ? "fired" : null }, el("td", { class: "num", title: r.block ? `rule block ${r.block}` : null }, r.label), el("td", { class: "num" }, shown(r)), el("td", {}, bar(r.degree)), el("td", { class: "mono rule-text" }, text));
     }),
   );
   const o = e.outputs.find((x) => x.name === output) || e.outputs[0];
@@ -94,6 +96,10 @@ export async function run() {
   // below the axis and its label above the chart read apart from the singletons
   const traces = [];
   if (typeof value === "number") traces.push({ x: [value, value], y: [0, 1.08], mode: "lines", line: { color: COLORS[1], dash: "dot", width: 1.5 }, hoverinfo: "skip", name: label });
+  if (o.interval) {
+    const [yl, yr] = o.interval;
+    traces.push({ x: [yl, yl, yr, yr], y: [0, 1, 1, 0], mode: "lines", fill: "toself", fillcolor: "rgba(31,119,180,0.2)", line: { color: COLORS[0] }, name: "type-reduced interval" });
+  }
   if (o.breakpoints && o.breakpoints.length) traces.push({ x: o.breakpoints.map((p) => p[0]), y: o.breakpoints.map((p) => p[1]), mode: "lines", fill: "tozeroy", line: { color: COLORS[0] }, name: "accumulated set" });
   const names = singletonNames(o.name);
   const marks = [];
@@ -110,6 +116,7 @@ export async function run() {
   plot($("#ex-chart"), traces, { xaxis: { range: [Math.min(lo, value ?? lo) - pad, Math.max(hi, value ?? hi) + pad], zeroline: false, title: { text: `${o.name} (${o.method}); ▲ the result` }, nticks: 11, showgrid: true }, yaxis: { range: [-0.09, 1.25], tickvals: [0, 0.25, 0.5, 0.75, 1], zeroline: true, zerolinecolor: "#888", title: { text: "degree" } }, annotations, showlegend: false, margin: { l: 55, r: 20, t: 10, b: 45 } });
   $("#ex-chart").dataset.labels = JSON.stringify(marks);
   $("#ex-chart").dataset.value = String(o.value);
+  $("#ex-chart").dataset.interval = o.interval ? JSON.stringify(o.interval) : "";
 }
 
 export function init() {

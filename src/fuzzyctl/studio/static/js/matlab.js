@@ -8,6 +8,7 @@ const OR = { MAX: "max", ASUM: "probor", BSUM: "bounded sum", NSUM: "normalized 
 const IMP = { MIN: "min", PROD: "prod" };
 const AGG = { MAX: "max", SUM: "sum", BSUM: "bounded sum", NSUM: "normalized sum", ASUM: "probor" };
 const DEFUZZ = { COG: "centroid", COA: "bisector", MM: "mom", LM: "lom", RM: "som", COGS: "wtaver (singletons)" };
+const TR = { KM: "karnikmendel", EKM: "ekm", IASC: "iasc", EIASC: "eiasc" };
 const MF = { triangle: "trimf", trapezoid: "trapmf", gaussian: "gaussmf", gaussian2: "gauss2mf", bell: "gbellmf", sigmoid: "sigmf", dsigmoid: "dsigmf", psigmoid: "psigmf", zshape: "zmf", sshape: "smf", pishape: "pimf", linear: "linear", constant: "constant" };
 
 function mfName(mf) {
@@ -27,6 +28,8 @@ export function matlabSummary(b) {
   const rules = b.rule_blocks.reduce((n, r) => n + r.rules.length, 0);
   const ins = b.variables.filter((v) => v.kind === "VAR_INPUT").length;
   const outs = b.variables.filter((v) => v.kind === "VAR_OUTPUT").length;
+  // an interval type-2 system (a term with a lower function): mamfistype2 / sugfistype2
+  const type2 = [...b.fuzzify, ...b.defuzzify].some((f) => f.terms.some((t) => t.lower));
   const row = (k, v) => el("tr", {}, el("th", {}, k), el("td", { class: "mono" }, v));
   const table = el(
     "table",
@@ -35,7 +38,7 @@ export function matlabSummary(b) {
     el(
       "tbody",
       {},
-      row("Type", isSugeno(b) ? "'sugeno'" : "'mamdani'"),
+      row("Type", `'${isSugeno(b) ? "sugeno" : "mamdani"}${type2 ? "type2" : ""}'`),
       row("NumInputs / NumOutputs", `${ins} / ${outs}`),
       row("NumRules", String(rules)),
       row("AndMethod", `'${AND[rb.and_op || "MIN"] || rb.and_op}'`),
@@ -43,6 +46,7 @@ export function matlabSummary(b) {
       row("ImpMethod", `'${IMP[rb.act || "MIN"] || rb.act}'`),
       row("AggMethod", `'${AGG[d.accu || rb.accu || "MAX"] || d.accu || rb.accu}'`),
       row("DefuzzMethod", `'${DEFUZZ[d.method] || d.method}'`),
+      ...(type2 ? [row("TypeReductionMethod", `'${TR[d.type_reduction || "KM"] || d.type_reduction}'`)] : []),
     ),
   );
   const used = new Map();

@@ -77,10 +77,13 @@ function inputCell(name, lits) {
       const fill = polygon(clip(pts, d), s, "fill-in");
       if (fill) root.append(fill);
       root.append(polyline(pts, s));
+      if (curve.lower) root.append(polyline(lit.negated ? curve.lower.map(([x, y]) => [x, 1 - y]) : curve.lower, s, "mf lower"));
     } else if (curve && curve.singleton !== undefined) {
       root.append(svg("line", { x1: s.sx(curve.singleton), x2: s.sx(curve.singleton), y1: s.sy(0), y2: s.sy(1), class: "mf" }));
     }
-    text += `${text ? ", " : ""}${lit.negated ? "NOT " : ""}${lit.term} ${deg(d)}`;
+    // an interval type-2 term: its degree is an interval (NOT turns [l, u] into [1 - u, 1 - l])
+    const shown = lit.lower === undefined ? deg(d) : lit.negated ? `${deg(1 - lit.degree)} … ${deg(1 - lit.lower)}` : `${deg(lit.lower)} … ${deg(d)}`;
+    text += `${text ? ", " : ""}${lit.negated ? "NOT " : ""}${lit.term} ${shown}`;
   }
   if (values[name] !== undefined) root.append(svg("line", { x1: s.sx(values[name]), x2: s.sx(values[name]), y1: 0, y2: H, class: "value-line" }));
   root.append(svg("title", {}, lits.length ? `${name} IS ${text}` : `${name} is not in this rule`));
@@ -98,6 +101,12 @@ function outputCell(name, concls) {
       const fill = polygon(set.x.map((x, i) => [x, set.y[i]]), s, "fill-out");
       if (fill) root.append(fill);
     }
+    const lower = c.lower_set;
+    if (lower && lower.x) {
+      const fill = polygon(lower.x.map((x, i) => [x, lower.y[i]]), s, "fill-out-lower");
+      if (fill) root.append(fill);
+    }
+    if (curve && curve.lower) root.append(polyline(curve.lower, s, "mf lower"));
     if (set && set.spikes) for (const [x, y] of set.spikes) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), class: "spike-out" }));
     if (curve && curve.points) root.append(polyline(curve.points, s));
     else if (curve && curve.singleton !== undefined) root.append(svg("line", { x1: s.sx(curve.singleton), x2: s.sx(curve.singleton), y1: s.sy(0), y2: s.sy(1), class: "mf" }));
@@ -115,6 +124,7 @@ function totalCell(o) {
     if (fill) root.append(fill);
   }
   for (const [x, y] of o.singletons || []) root.append(svg("line", { x1: s.sx(x), x2: s.sx(x), y1: s.sy(0), y2: s.sy(y), class: "spike-out" }));
+  if (o.interval) root.append(polygon([[o.interval[0], 1], [o.interval[1], 1]], s, "fill-interval")); // the type-reduced interval
   if (o.value !== null && o.value !== undefined) root.append(svg("line", { x1: s.sx(o.value), x2: s.sx(o.value), y1: 0, y2: H, class: "value-line" }));
   return el("td", { class: "rv-total", "data-var": o.name, "data-value": o.value ?? "" }, root, el("div", { class: "num", id: `rv-value-${o.name}` }, `${o.name} = ${fmtVar(o.name, o.value)}`));
 }
@@ -135,7 +145,7 @@ function draw(view) {
     shown++;
     const tr = el("tr", { class: row.degree > 0 ? "fired" : null, "data-label": row.label }, el("th", { class: "rule", scope: "row", title: row.text }, `${row.label}. ${row.text}`));
     for (const v of ins) tr.append(inputCell(v.name, row.literals.filter((l) => l.variable === v.name)));
-    tr.append(el("td", { class: "deg" }, row.evaluated ? deg(row.degree) : "—"));
+    tr.append(el("td", { class: "deg" }, !row.evaluated ? "—" : row.lower === undefined ? deg(row.degree) : `${deg(row.lower)} … ${deg(row.degree)}`));
     for (const v of outs) tr.append(outputCell(v.name, row.conclusions.filter((c) => c.variable === v.name)));
     tbody.append(tr);
   }

@@ -8,6 +8,7 @@ import { state, on, fb, inputs, outputs, termBlock, range, changed, diagnosticsF
 import { post } from "./api.js";
 import { nameWarning } from "./names.js";
 import { $, el, confirmDialog, fillDiagnostics, plot, COLORS } from "./ui.js";
+import { footprintTraces, renderLower } from "./footprint.js";
 import { SHAPES, kindOf, kindLabel, kinds, handles, placeOf, convert, paramName, readParam, paramText, positions, rescale, localCurve } from "./terms.js";
 
 let current = null; // variable name
@@ -88,6 +89,7 @@ function renderChart() {
       traces.push({ x: [curve.singleton, curve.singleton], y: [0, 1], mode: "lines", line, name: t.name });
     } else if (curve.points) {
       traces.push({ x: curve.points.map((p) => p[0]), y: curve.points.map((p) => p[1]), mode: "lines", line, name: t.name });
+      if (t.lower) traces.push(...footprintTraces(t.name, curve.points, serverCurve(t.name).lower, color, active));
     } else if (curve.spikes) {
       for (const [x, y] of curve.spikes) traces.push({ x: [x, x], y: [0, y], mode: "lines", line, name: t.name });
     }
@@ -198,6 +200,7 @@ function renderTerm() {
   $("#term-kind").replaceChildren(...list.map((k) => el("option", { value: k, selected: k === kind }, kindLabel(k))));
   renderParams(t);
   renderPoints(t);
+  renderLower(t, current, { changed: () => changed("points"), status, body: bodyWithoutRules, diagnostics: diagnosticsFor(`term:${current}:${t.name}`) });
   const fcl = serverCurve(t.name).fcl;
   const field = $("#term-fcl");
   const key = `${current}\u0000${t.name}`;
@@ -334,7 +337,10 @@ async function setRange() {
   }
   if (adjust) {
     const k = (hi - lo) / (oldHi - oldLo);
-    for (const t of blk.terms) rescale(t.mf, (x) => lo + (x - oldLo) * k, k);
+    for (const t of blk.terms) {
+      rescale(t.mf, (x) => lo + (x - oldLo) * k, k);
+      if (t.lower && t.lower.mf) rescale(t.lower.mf, (x) => lo + (x - oldLo) * k, k); // an explicit lower function moves with it
+    }
   }
   if (blk.range) blk.range = { low: lo, high: hi };
   else state.settings.ranges = { ...(state.settings.ranges || {}), [current]: [lo, hi] };
