@@ -28,12 +28,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from fuzzyctl.engine import type2_sets as sets
+import fuzzyctl.engine.type2_sets as sets
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders import type2_reduce as R
 from fuzzyctl.ir.builders.rules import literal
-from fuzzyctl.ir.nodes import Ex, Num, Var
+from fuzzyctl.ir.nodes import Ex, Int, Num, Var
 from fuzzyctl.ir.state import CodegenError, Gen
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds import type_reduction as tr
@@ -41,6 +41,8 @@ from fuzzyctl.model import And, Condition, DefuzzifyBlock, FunctionBlock, Is, No
 
 #: Output samples of a Mamdani output when none are asked for (MATLAB's OutputSampleNumber).
 SAMPLES = 101
+#: The PLC block's INFO when no rule fired for an output (as the type-1 block's).
+INFO_DEFAULT = 0x02
 
 Bounds = tuple[Ex, Ex]
 
@@ -200,7 +202,7 @@ class Type2Builder:
 
     # ------------------------------------------------------------------ the whole evaluation
 
-    def build(self, inputs: list[Var], outputs: list[Var]) -> Type2Build:
+    def build(self, inputs: list[Var], outputs: list[Var], info: Var | None = None) -> Type2Build:
         fb, g = self.fb, self.g
         x: dict[str, Ex] = {v.name: var for v, var in zip(fb.inputs, inputs, strict=True)}
         fired = self.firing(x)
@@ -218,9 +220,11 @@ class Type2Builder:
                 with g.b.if_(total.gt(0.0)):
                     yl, yr = R.reduce(g, method, p)
                     g.b.set(out, 0.5 * (yl + yr))
-                with g.b.else_():
+                with g.b.else_():  # no upper weight: the DEFAULT (INFO says so)
                     dv = d.default.value if d.default is not None else None
                     g.b.set(out, literal(math.nan if dv is None else float(dv)))
+                    if info is not None:
+                        g.b.set(info, Int(INFO_DEFAULT))
             kind = "sugeno" if ts else "mamdani"
             result.info.append(OutputInfo(d.variable, kind, method, p.n, R.iterations(method, p.n)))
         return result
@@ -319,7 +323,8 @@ class Type2Builder:
     def _merged(self, contribs: list[tuple[Term, Var, Var]]) -> list[tuple[Term, Var, Var]]:
         """Under MAX the activations of one term merge into one (every t-norm is
         non-decreasing): the firing bounds' maxima."""
-        if self.accu != "MAX":
+        # the only idempotent t-conorm is MAX: tested on the operators table's entry
+        if not all(ops.accumulate(self.accu, v, v) == v for v in (0.25, 0.5, 0.75)):
             return contribs
         by_term: dict[str, list[tuple[Term, Var, Var]]] = {}
         for c in contribs:
@@ -330,8 +335,8 @@ class Type2Builder:
             if len(cs) > 1:
                 fl, fu = self.g.let(fl, "HL"), self.g.let(fu, "HU")
                 for _t, a, b in cs[1:]:
-                    T.accumulate_into(self.g, "MAX", fl, a)
-                    T.accumulate_into(self.g, "MAX", fu, b)
+                    T.accumulate_into(self.g, self.accu, fl, a)
+                    T.accumulate_into(self.g, self.accu, fu, b)
             out.append((t, fl, fu))
         return out
 
