@@ -31,7 +31,7 @@ def _systems() -> list[tuple[str, Document]]:
     out = [("tipper", fuzzyctl.load(EXAMPLE))]
     for seed, sugeno in ((1, False), (2, True)):
         fb = random_it2(seed, sugeno=sugeno, explicit=seed == 2)
-        out.append((fb.name, Document((fb,))))
+        out.append((fb.name or "", Document((fb,))))
     return out
 
 
@@ -53,7 +53,7 @@ def test_json_report_has_the_cost() -> None:
     from fuzzyctl.codegen.type2 import Type2Generated
 
     report: list[Type2Generated] = []
-    generate_st(fuzzyctl.load(EXAMPLE), report=report)
+    generate_st(fuzzyctl.load(EXAMPLE), report=report)  # type: ignore[arg-type]
     d = report[0].to_dict()
     assert d["cost"]["worst"]["operations"] > 0 and "sampled at 101 points" in d["notes"][0]
 
@@ -120,7 +120,7 @@ def test_matiec_block_matches_the_engine_and_its_bench_passes(lreal: bool, tmp_p
     text = "\n".join(generate_st(doc, dialect="iec", lreal=lreal) for _n, doc in systems)
     blocks = [
         M.Block(
-            doc.main.name,
+            doc.main.name or "",
             tuple(v.name for v in doc.main.inputs),
             tuple(d.variable for d in doc.main.defuzzify),
         )

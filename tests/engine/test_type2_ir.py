@@ -56,16 +56,18 @@ def _gaussian_system(sugeno: bool) -> m.FunctionBlock:
     rules = (
         m.Rule(
             "1",
-            m.Or((m.Is("x0", "t0", ("very",)), m.Is("x1", "t1"))),
+            m.Or((m.Is("x0", "t0", hedges=("very",)), m.Is("x1", "t1"))),
             (m.Conclusion("y", fb.defuzzify[0].terms[0].name),),
         ),
         m.Rule(
             "2",
             m.And((m.Not(m.Is("x0", "t2")), m.Is("x1", "t2", negated=True))),
             (m.Conclusion("y", fb.defuzzify[0].terms[1].name),),
-            0.6,
+            weight=0.6,
         ),
-        m.Rule("3", m.Is("x1", "t0", ("somewhat",)), (m.Conclusion("y", fb.defuzzify[0].terms[2].name),)),
+        m.Rule(
+            "3", m.Is("x1", "t0", hedges=("somewhat",)), (m.Conclusion("y", fb.defuzzify[0].terms[2].name),)
+        ),
     )
     block = dataclasses.replace(fb.rule_blocks[0], rules=rules)
     return dataclasses.replace(fb, fuzzify=fz, rule_blocks=(block,))
@@ -110,7 +112,7 @@ def test_sampled_ir_within_the_sampling_bound_of_the_exact_centroid(seed: int) -
 @pytest.mark.parametrize("sugeno", [False, True])
 def test_numpy_batch_equals_rows(sugeno: bool) -> None:
     fb = random_it2(21, sugeno=sugeno)
-    ctl = fuzzyctl.compile(fb, samples=101)
+    ctl: object = fuzzyctl.compile(fb, samples=101)
     assert isinstance(ctl, Type2Compiled)
     rows = _rows(fb, 3, 40)
     data = {v.name: np.array([r[v.name] for r in rows]) for v in fb.inputs}
