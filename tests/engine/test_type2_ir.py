@@ -117,6 +117,8 @@ def test_numpy_batch_equals_rows(sugeno: bool) -> None:
     rows = _rows(fb, 3, 40)
     data = {v.name: np.array([r[v.name] for r in rows]) for v in fb.inputs}
     out = ctl.evaluate_batch(data, out_of_range="ignore")["y"]
+    chunked = ctl.evaluate_batch(data, out_of_range="ignore", chunk=7)["y"]
+    assert np.array_equal(out, chunked, equal_nan=True)
     for i, r in enumerate(rows):
         assert _close(out[i], ctl.evaluate(r, out_of_range="ignore")["y"], 1e-12)
 

@@ -20,6 +20,9 @@ from fuzzyctl.engine.type2 import SAMPLES, Type2Controller
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.model import FunctionBlock
 
+#: Rows x samples per numpy chunk (the aggregated sets of a chunk: 2 x 8 bytes each).
+CHUNK_VALUES = 1 << 22
+
 
 class Type2Compiled(Type2Controller):
     """A type-2 controller evaluating the IR program: ``backend`` ``"native"`` (C, one call
@@ -104,8 +107,14 @@ class Type2Compiled(Type2Controller):
             src = (ctypes.c_void_p * max(1, len(cols)))(*[c.ctypes.data for c in cols])
             dst = (ctypes.c_void_p * max(1, len(outs)))(*[o.ctypes.data for o in outs])
             self._lib.fz_batch(self._prev, n, src, dst)
-        else:
-            outs = [np.asarray(o, dtype=float) for o in self._batch(cols, [0.0], n)]
+        else:  # in chunks: each sample of a Mamdani output is a column of the chunk's rows
+            step = int(options.get("chunk") or max(256, CHUNK_VALUES // (self.samples or SAMPLES)))
+            outs = [np.empty(n) for _ in self._out_names]
+            for start in range(0, n, step):
+                stop = min(n, start + step)
+                part = self._batch([c[start:stop] for c in cols], [0.0], stop - start)
+                for o, p in zip(outs, part, strict=True):
+                    o[start:stop] = p
         if invalid.any():
             for o in outs:
                 o[invalid] = math.nan
