@@ -38,6 +38,9 @@ RANK: dict[str, float] = {
     # readers and the engine by layer
     "fuzzyctl.fcl": 2,
     "fuzzyctl.engine.semantics": 2,
+    # interval type-2 sets (lower/upper degrees, breakpoints): formulas the type-2 engine and
+    # the type-2 IR builder both read
+    "fuzzyctl.engine.type2_sets": 2,
     "fuzzyctl.formats": 3,
     "fuzzyctl.engine.lowering": 3,
     "fuzzyctl.engine.reference": 4,

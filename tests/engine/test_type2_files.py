@@ -155,8 +155,9 @@ def test_cli_eval_explain_check(tmp_path: Path, capsys: pytest.CaptureFixture[st
 @pytest.mark.parametrize(
     ("argv", "words"),
     [
-        (["codegen", EXAMPLE], "code generation is not available"),
-        (["codegen", EXAMPLE, "--lang", "c"], "code generation is not available"),
+        (["codegen", EXAMPLE, "--lang", "fmu"], "code generation is not available"),
+        (["codegen", EXAMPLE, "--lookup"], "--lookup is not available"),
+        (["codegen", EXAMPLE, "--arith", "int32"], "--arith int32 is not available"),
     ],
 )
 def test_consumers_refuse_with_a_message(
@@ -195,16 +196,23 @@ def test_random_systems_round_trip_through_fcl_and_json() -> None:
 
 
 def test_type1_lowering_and_its_consumers_refuse(capsys: pytest.CaptureFixture[str]) -> None:
-    from fuzzyctl.codegen.api import generate_st
+    from fuzzyctl.codegen.api import generate_st, lower_block
     from fuzzyctl.sim.runtimes import make_runtime
     from fuzzyctl.type2 import Type2NotSupported
 
     doc = fuzzyctl.load(EXAMPLE)
     with pytest.raises(Type2NotSupported, match="type-1 lowering"):
-        generate_st(doc)
-    for kind in ("native", "siemens", "xfuz"):
+        lower_block(doc)
+    assert "FUNCTION_BLOCK tipper_type2" in generate_st(doc)  # the type-2 generator
+    for kind in ("siemens", "xfuz"):
         with pytest.raises(Type2NotSupported, match="interval type-2 system"):
             make_runtime(doc, kind)
+    from fuzzyctl.engine.native import compiler
+
+    if compiler() is not None:  # the native runtime runs the type-2 IR program in C
+        native = make_runtime(doc, "native")
+        got = native.evaluate({"service": 3.0, "food": 8.0})["tip"]
+        assert got == fuzzyctl.compile(doc, backend="native").evaluate(service=3, food=8)["tip"]
     engine = make_runtime(doc, "engine")  # the loop runs on the type-2 engine
     assert engine.evaluate({"service": 3.0, "food": 8.0}) == fuzzyctl.compile(doc).evaluate(service=3, food=8)
     assert main(["analyze", EXAMPLE]) == 1

@@ -109,6 +109,19 @@ def generate_st(
     ``tolerance`` and ``max_bytes`` keywords go to it).
     Raises :class:`CodegenError` naming what cannot be expressed."""
     dialect = targets.dialect(dialect).name  # an alias as its dialect; unknown names refused
+    if _type2(model, arith, lookup, default):
+        from fuzzyctl.codegen.type2 import generate_st_type2
+
+        assert not isinstance(model, Plan)
+        return generate_st_type2(
+            model,
+            block=block,
+            dialect=dialect,
+            lreal=lreal,
+            testbench=testbench,
+            report=report,
+            **_samples(options),
+        )
     if lookup:  # before check_arith: tables are written in every arithmetic
         from fuzzyctl.codegen.lookup_st import generate_lookup_st
 
@@ -167,6 +180,13 @@ def generate_c(
     ``default`` replaces ``DEFAULT := nan`` (without it the C outputs NaN as the engine does);
     ``arith`` chooses the arithmetic (:mod:`fuzzyctl.kinds.arith`); ``lookup`` writes each
     block as a lookup table (:mod:`fuzzyctl.codegen.lookup_c`)."""
+    if _type2(model, arith, lookup, default):
+        from fuzzyctl.codegen.type2 import generate_c_type2
+
+        assert not isinstance(model, Plan)
+        return generate_c_type2(
+            model, block=block, single=single, testbench=testbench, report=report, **_samples(options)
+        )
     if lookup:  # before check_arith: tables are written in every arithmetic
         from fuzzyctl.codegen.lookup_c import generate_lookup_c
 
@@ -204,3 +224,21 @@ def check_arith(arith: str) -> bool:
         return arith_kinds.get(arith).integer
     except ValueError as exc:
         raise CodegenError(str(exc)) from None
+
+
+def _type2(model: Document | FunctionBlock | Plan, arith: str, lookup: bool, default: object) -> bool:
+    """Whether ``model`` is an interval type-2 system (:mod:`fuzzyctl.codegen.type2`
+    generates it); the options it does not take are refused."""
+    from fuzzyctl.type2 import is_type2
+
+    if isinstance(model, Plan) or not is_type2(model):
+        return False
+    from fuzzyctl.codegen.type2 import refuse_options
+
+    refuse_options(arith, lookup, default)
+    return True
+
+
+def _samples(options: dict[str, Any]) -> dict[str, Any]:
+    """The ``samples`` keyword of the type-2 generators (other engine options do not apply)."""
+    return {"samples": int(options["samples"])} if options.get("samples") is not None else {}

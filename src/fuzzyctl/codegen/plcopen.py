@@ -260,7 +260,17 @@ def generate_plcopen(
             model, block=block, dialect=dialect, lreal=lreal, arith=arith, project=project, **options
         )
     check_dialect(dialect)
-    if check_arith(arith):
+    from fuzzyctl.type2 import is_type2
+
+    if is_type2(model):
+        from fuzzyctl.codegen.type2 import refuse_options, st_blocks_type2
+
+        refuse_options(arith, False, options.get("default"))
+        samples = options.get("samples")
+        parts = st_blocks_type2(
+            model, block, targets.dialect(dialect).name, lreal, *([int(samples)] if samples else [])
+        )
+    elif check_arith(arith):
         from fuzzyctl.codegen.fixed import fixed_st_blocks
 
         parts = fixed_st_blocks(model, block, options, arith=arith, dialect=dialect)

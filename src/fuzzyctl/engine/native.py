@@ -149,6 +149,14 @@ def build(plan: Plan, hint: Path | None = None, content_key: str | None = None) 
         cache.touch(lib)
         return lib
     _kind, files = sources(plan)
+    compile_files(lib, files, cc)
+    return lib
+
+
+def compile_files(lib: Path, files: Mapping[str, str | bytes], cc: str) -> None:
+    """Compile ``fz_native.c`` of ``files`` (with its tables) into the library ``lib``
+    (atomically: a temporary file renamed into place), then prune the cache."""
+    out_dir = lib.parent
     out_dir.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix="fuzzyctl-build-") as tmp:
         for fname, content in files.items():
@@ -169,6 +177,21 @@ def build(plan: Plan, hint: Path | None = None, content_key: str | None = None) 
             raise NativeError(f"the C compiler failed on the generated code:\n{res.stderr.strip()}")
         os.replace(partial, lib)  # atomic: a concurrent build of the same key writes the same bytes
     cache.prune(out_dir, cache.limit_bytes(), keep=lib)
+
+
+def build_source(text: str) -> Path:
+    """Compile (or find in the cache) a library from the C source ``text`` alone (the
+    type-2 evaluator), keyed by the text, the flags and the compiler."""
+    cc = compiler()
+    if cc is None:
+        raise NativeError("no C compiler found (set CC or install cc)")
+    h = hashlib.sha256(b"source\0" + text.encode())
+    h.update(" ".join(CFLAGS).encode() + b"\0" + _compiler_id(cc).encode())
+    lib = cache_dir() / "native" / f"{h.hexdigest()[:32]}.so"
+    if lib.exists():
+        cache.touch(lib)
+        return lib
+    compile_files(lib, {"fz_native.c": text}, cc)
     return lib
 
 

@@ -16,8 +16,9 @@ each bound: NOT swaps them, ``[1 - upper, 1 - lower]``), times its weight.
   the type-reduction method gives ``[yl, yr]`` of these points, the output is the mean.
 
 When no rule fires an output takes its DEFAULT (else NaN).  :class:`Type2Controller` is the
-python path (one row at a time; ``evaluate_batch`` loops); the native backend and the code
-generators refuse type-2 systems (:data:`fuzzyctl.kinds.type_reduction.CONSUMERS`).
+python path (one row at a time; ``evaluate_batch`` loops); ``compile(..., backend="native")``
+and ``compile(..., samples=N)`` evaluate the IR program instead
+(:class:`fuzzyctl.engine.type2_compiled.Type2Compiled`: C, or Python and numpy batches).
 """
 
 from __future__ import annotations
@@ -484,4 +485,11 @@ def compile_type2(fb: FunctionBlock, backend: str | None = None, **options: Any)
     why = tr.refusal(backend or "auto")
     if why:
         raise Type2Unsupported(why)
-    return Type2Controller(fb, samples=options.get("samples"), method=options.get("type_reduction"))
+    samples, method = options.get("samples"), options.get("type_reduction")
+    if backend == "native" or (backend in (None, "auto", "python") and samples is not None):
+        # the IR evaluator (fuzzyctl.engine.type2_compiled): C, or Python and numpy
+        from fuzzyctl.engine.type2_compiled import Type2Compiled
+
+        kind = "native" if backend == "native" else "python"
+        return Type2Compiled(fb, kind, samples=samples, method=method)
+    return Type2Controller(fb, samples=samples, method=method)

@@ -29,7 +29,7 @@ class Type2Error(ValueError):
     """A type-2 term the engine cannot evaluate, or whose lower exceeds its upper."""
 
 
-def _floats(params: Sequence[object], where: str) -> list[float]:
+def floats(params: Sequence[object], where: str) -> list[float]:
     if any(isinstance(p, Ref) for p in params):
         raise Type2Error(f"{where}: parameters given by variables are not supported in type-2 terms")
     return [float(p) for p in params]  # type: ignore[arg-type]
@@ -38,22 +38,22 @@ def _floats(params: Sequence[object], where: str) -> list[float]:
 def points_of(mf: MembershipFunction, where: str) -> Points | None:
     """The breakpoints of a piecewise-linear function, None for a smooth one."""
     if isinstance(mf, PointsMF):
-        xs, ys = _floats([p.x for p in mf.points], where), _floats([p.y for p in mf.points], where)
+        xs, ys = floats([p.x for p in mf.points], where), floats([p.y for p in mf.points], where)
         return sem.sort_points(list(zip(xs, ys, strict=True)))
     if isinstance(mf, ShapeMF):
-        return sem.pwl_points(mf.kind, _floats(mf.params, where), float(_floats([mf.height], where)[0]))
+        return sem.pwl_points(mf.kind, floats(mf.params, where), float(floats([mf.height], where)[0]))
     raise Type2Error(f"{where}: {type(mf).__name__} terms are not supported in type-2 systems")
 
 
 def mf_value(mf: MembershipFunction, x: float, where: str) -> float:
     if isinstance(mf, ShapeMF):
-        return sem.membership(mf.kind, _floats(mf.params, where), float(_floats([mf.height], where)[0]), x)
+        return sem.membership(mf.kind, floats(mf.params, where), float(floats([mf.height], where)[0]), x)
     pts = points_of(mf, where)
     assert pts is not None
     return sem.pwl_value(pts, x)
 
 
-def _lags(lower: LowerMF, where: str) -> tuple[float, float]:
+def lags(lower: LowerMF, where: str) -> tuple[float, float]:
     if not 0.0 < lower.scale <= 1.0:
         raise Type2Error(f"{where}: LowerScale must be in (0, 1], found {lower.scale:g}")
     if len(lower.lag) not in (1, 2) or not all(0.0 <= v < 1.0 for v in lower.lag):
@@ -74,7 +74,7 @@ def lower_points(term: Term, where: str) -> Points | None:
         return points_of(term.mf, where)
     if lower.mf is not None:
         return points_of(lower.mf, where)
-    left, right = _lags(lower, where)
+    left, right = lags(lower, where)
     up = points_of(term.mf, where)
     if up is None:
         return None
@@ -99,7 +99,7 @@ def lower_value(term: Term, x: float, where: str) -> float:
         return mf_value(term.mf, x, where)
     if lower.mf is not None:
         return mf_value(lower.mf, x, where)
-    left, right = _lags(lower, where)
+    left, right = lags(lower, where)
     pts = lower_points(term, where)
     if pts is not None:
         return sem.pwl_value(pts, x)

@@ -70,13 +70,12 @@ def _ekm_end(x: list[float], lo: list[float], up: list[float], left_upper: bool)
         k2 = sum(1 for v in x if v <= y)
         if k2 == k:
             return y
-        lo_i, hi_i = (k, k2) if k2 > k else (k2, k)
-        sign = 1.0 if k2 > k else -1.0
-        for i in range(lo_i, hi_i):  # points that change side: move their weight
-            d = sign * (first[i] - rest[i])
-            a += x[i] * d
-            b += d
         k = k2
+        # the sums of the new switch point, summed exactly: updating them by the points that
+        # change side (Wu and Mendel's saving) cancels catastrophically when the weights left
+        # are small (lower weights of zero), giving a mean outside the points
+        a = math.fsum(x[i] * first[i] for i in range(k)) + math.fsum(x[i] * rest[i] for i in range(k, n))
+        b = math.fsum(first[:k]) + math.fsum(rest[k:])
         if b <= 0.0:  # every weight on this side zero: KM's search handles it
             return _km_end(x, lo, up, left_upper)
         y = a / b
@@ -84,8 +83,8 @@ def _ekm_end(x: list[float], lo: list[float], up: list[float], left_upper: bool)
 
 
 def enhanced_karnik_mendel(x: Sequence[float], lower: Sequence[float], upper: Sequence[float]) -> Interval:
-    """EKM (Wu and Mendel 2009): KM from the switch points n/2.4 and n/1.7, updating the
-    sums by the points that change side only."""
+    """EKM (Wu and Mendel 2009): KM from the switch points n/2.4 and n/1.7 (the sums of each
+    new switch point are summed exactly, not updated: see :func:`_ekm_end`)."""
     xs, lo, up = _sorted(x, lower, upper)
     if not xs:
         return math.nan, math.nan

@@ -153,7 +153,7 @@ class Target:
     kernels: frozenset[str] = frozenset()
     function_terms: bool = True  # function terms inline as IR (else the EXPR kernel)
     data_dependent_loops: bool = True  # loops may run a number of times the input decides
-    type2: bool = False  # generates interval type-2 systems (else they are refused, docs/type2.md)
+    type2: bool = False  # generates interval type-2 systems (codegen/type2.py; else refused, docs/type2.md)
     # --- the CLI (``fuzzyctl codegen --lang``); None: not a CLI choice
     cli: str | None = None
     cli_help: str = ""
@@ -243,6 +243,7 @@ _PRECEDENCE_OPS = MappingProxyType({"=": "=", "<>": "<>", "AND": "AND", "OR": "O
 ST = Target(
     name="st",
     label="Structured Text",
+    type2=True,
     language="st",
     numbers=Numbers(real=st_real, nan=None, inf=None, negative_parens=True),
     functions=MappingProxyType({f: f for f in _IEC_FUNCTIONS}),
@@ -338,6 +339,7 @@ _C_HELPERS = {
 C = Target(
     name="c",
     label="C",
+    type2=True,
     language="c",
     numbers=Numbers(
         real=_c_real, nan="NAN", inf="INFINITY", negative_parens=True, single_suffix="f", true="1", false="0"
@@ -439,6 +441,7 @@ FMU = dataclasses.replace(
     C,
     name="fmu",
     label="FMU",
+    type2=False,  # (the FMU wraps the type-1 block)
     extensions=(".fmu",),
     cli="fmu",
     cli_help="an FMI co-simulation FMU (sources and this platform's binary)",

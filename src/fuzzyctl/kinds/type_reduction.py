@@ -107,11 +107,7 @@ CONSUMERS: dict[str, Consumer] = {
         Consumer("interpreted", True),
         Consumer("python", True),
         Consumer("auto", True),  # (auto picks the Python path for type-2)
-        Consumer(
-            "native",
-            False,
-            "the native backend does not evaluate interval type-2 systems yet; use backend='python'",
-        ),
+        Consumer("native", True),  # the IR evaluator in C, Mamdani outputs sampled
         Consumer("codegen", False, _GENERATE),
         Consumer(
             "analyze",

@@ -61,9 +61,17 @@ class NativeRuntime(EngineRuntime):
         import fuzzyctl
         from fuzzyctl.codegen import CodegenError
         from fuzzyctl.engine.native import NativeController, NativeError, build
-        from fuzzyctl.type2 import refuse
+        from fuzzyctl.type2 import is_type2
 
-        refuse(model, "native")
+        self.name = "native"
+        if is_type2(model):  # the type-2 IR program in C (fuzzyctl.engine.type2_compiled)
+            from fuzzyctl.engine.type2_compiled import Type2Compiled
+
+            fb = model if isinstance(model, FunctionBlock) else model.block(block)
+            self.controller = Type2Compiled(fb, "native")  # type: ignore[assignment]
+            self.inputs = tuple(self.controller.inputs)
+            self.outputs = tuple(self.controller.outputs)
+            return
         plan = fuzzyctl.compile(model, block=block, backend="interpreted").plan
         try:
             library = build(plan)

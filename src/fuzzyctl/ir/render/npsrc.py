@@ -10,8 +10,10 @@ t := a``) become ``numpy.minimum``/``numpy.maximum``.  Kernels are the vectorise
 :mod:`fuzzyctl.ir.kernels.columns`; DEFAULT := NC is a running fill along the batch (rows are
 successive evaluations of one instance).
 
-A program that loops a number of times depending on the sample cannot be if-converted: that is
-refused (:class:`~fuzzyctl.ir.state.CodegenError`); the evaluator program never does it.
+A WHILE loop whose end depends on the sample runs while some sample's condition holds, its
+body masked to those samples (the type reduction of type-2 systems); a FOR loop whose bounds
+depend on the sample, or an array index that does, is refused
+(:class:`~fuzzyctl.ir.state.CodegenError`).
 """
 
 from __future__ import annotations
@@ -158,9 +160,18 @@ class _Np(PythonPrinter):
         super().for_(s, ind)
 
     def while_(self, s: While, ind: int) -> None:
-        if self.varies(s.cond):
-            raise CodegenError("a loop whose end differs between samples cannot be if-converted")
-        super().while_(s, ind)
+        """A loop whose end differs between samples runs while some sample's condition
+        holds, its body under the mask of those samples (each sample iterates exactly as
+        often as alone)."""
+        if not self.varies(s.cond):
+            super().while_(s, ind)
+            return
+        m = self.mask_name()
+        c = self.ex(s.cond)
+        self.emit(f"{m} = {c}" if self.mask is None else f"{m} = _and({self.mask}, {c})", ind)
+        self.emit(f"while _np.any({m}):", ind)
+        self.masked(s.body, ind + 1, m)
+        self.emit(f"{m} = _and({m}, {self.ex(s.cond)})", ind + 1)
 
     def if_(self, s: If, ind: int) -> None:
         if not any(self.varies(c) for c, _b in s.branches):
