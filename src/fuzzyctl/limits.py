@@ -33,25 +33,9 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import MAX_DIAGNOSTICS_SHOWN, Diagnostic, DiagnosticError, error
 from fuzzyctl.formatspec import DEFAULT_MAX_BYTES, SPECS
-from fuzzyctl.model import (
-    And,
-    Binary,
-    Call,
-    DefuzzifyBlock,
-    Degree,
-    Document,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    Is,
-    Not,
-    Or,
-    Range,
-    Span,
-    Unary,
-)
 
 DEFAULT_MAX_INPUT_BYTES = DEFAULT_MAX_BYTES
 
@@ -161,23 +145,23 @@ def depth(node: object) -> int:
     """How deep a condition or an expression nests (``a IS b``: 1, ``NOT (a IS b)``: 2; a
     chain ``x + y + z`` counts each operator), computed without recursion so that any tree
     can be measured."""
-    if isinstance(node, Is | Degree):
+    if isinstance(node, m.Is | m.Degree):
         return 1
-    if isinstance(node, And | Or) and all(isinstance(o, Is | Degree) for o in node.operands):
+    if isinstance(node, m.And | m.Or) and all(isinstance(o, m.Is | m.Degree) for o in node.operands):
         return 2  # the common rule, measured without the stack
     deepest = 0
     stack = [(node, 1)]
     while stack:
         item, level = stack.pop()
         deepest = max(deepest, level)
-        if isinstance(item, Not | Unary):
+        if isinstance(item, m.Not | m.Unary):
             stack.append((item.operand, level + 1))
-        elif isinstance(item, And | Or):
+        elif isinstance(item, m.And | m.Or):
             stack.extend((o, level + 1) for o in item.operands)
-        elif isinstance(item, Binary):
+        elif isinstance(item, m.Binary):
             stack.append((item.left, level + 1))
             stack.append((item.right, level + 1))
-        elif isinstance(item, Call):
+        elif isinstance(item, m.Call):
             stack.extend((a, level + 1) for a in item.args)
     return deepest
 
@@ -185,7 +169,7 @@ def depth(node: object) -> int:
 expr_depth = depth
 
 
-def check_document(document: Document, path: str | None = None) -> list[Diagnostic]:
+def check_document(document: m.Document, path: str | None = None) -> list[Diagnostic]:
     """What every reader refuses, whatever the format says: a rule condition or function
     term nesting deeper than :data:`MAX_NESTING` (it would overflow the stack of every later
     step) and a RANGE with a NaN bound (``RANGE := (nan .. 100)``: no value is inside it)."""
@@ -212,11 +196,11 @@ def check_document(document: Document, path: str | None = None) -> list[Diagnost
                         file=path,
                     )
                 )
-        blocks: tuple[FuzzifyBlock | DefuzzifyBlock, ...] = (*fb.fuzzify, *fb.defuzzify)
+        blocks: tuple[m.FuzzifyBlock | m.DefuzzifyBlock, ...] = (*fb.fuzzify, *fb.defuzzify)
         for block in blocks:
             for term in block.terms:
                 mf = term.mf
-                if isinstance(mf, FunctionMF) and (d := depth(mf.expr)) > MAX_NESTING:
+                if isinstance(mf, m.FunctionMF) and (d := depth(mf.expr)) > MAX_NESTING:
                     out.append(
                         error(
                             f"term {term.name}: the function nests {d} levels deep "
@@ -229,16 +213,16 @@ def check_document(document: Document, path: str | None = None) -> list[Diagnost
     return out
 
 
-def _ranges(fb: FunctionBlock) -> list[tuple[str, Range]]:
+def _ranges(fb: m.FunctionBlock) -> list[tuple[str, m.Range]]:
     out = [(f"variable {v.name}", v.range) for v in fb.variables if v.range is not None]
     out += [(f"FUZZIFY {b.variable}", b.range) for b in fb.fuzzify if b.range is not None]
     out += [(f"DEFUZZIFY {b.variable}", b.range) for b in fb.defuzzify if b.range is not None]
     return out
 
 
-def _line_column(text: str, position: int) -> Span:
+def _line_column(text: str, position: int) -> m.Span:
     line = text.count("\n", 0, position) + 1
-    return Span(line, position - (text.rfind("\n", 0, position) + 1) + 1)
+    return m.Span(line, position - (text.rfind("\n", 0, position) + 1) + 1)
 
 
 def _deep_position(text: str) -> int:
@@ -314,7 +298,7 @@ def load_json(text: str, path: str | None = None, code: str = "json-syntax") -> 
         data = json.loads(text, parse_constant=lambda name: _Spelt(name.lower().replace("infinity", "inf")))
     except json.JSONDecodeError as exc:
         raise DiagnosticError(
-            [error(f"invalid JSON: {exc.msg}", Span(exc.lineno, exc.colno), code=code, file=path)], text
+            [error(f"invalid JSON: {exc.msg}", m.Span(exc.lineno, exc.colno), code=code, file=path)], text
         ) from None
     except RecursionError:  # the json module's own limit, far above ours
         problem = "depth"

@@ -10,7 +10,7 @@ from typing import Annotated, Any
 import typer
 
 from fuzzyctl import formats
-from fuzzyctl.cli.app import app
+from fuzzyctl.cli.app import app, stderr_progress
 from fuzzyctl.cli.eval_dask import SchedulerOpt, WorkersOpt
 
 
@@ -122,8 +122,7 @@ def _dask_coverage(
 ) -> Any:
     """Coverage on Dask: a local cluster (``--workers``, default one per CPU; 0: this process)
     or an existing scheduler, with a progress bar on stderr as ``eval --dask`` shows."""
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import MofNCompleteColumn, TimeElapsedColumn
 
     from fuzzyctl.analysis import usage as cov_mod
     from fuzzyctl.analysis import usage_dask
@@ -134,14 +133,7 @@ def _dask_coverage(
         raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
     execu = parallel.executor(workers, scheduler)
     try:
-        with Progress(
-            TextColumn("[bold]{task.description}"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=Console(stderr=True),
-            transient=True,
-        ) as progress:
+        with stderr_progress(MofNCompleteColumn(), TimeElapsedColumn(), hidden=False) as progress:
             task = progress.add_task("coverage", total=None)
 
             def tick(done: int, total: int) -> None:

@@ -47,10 +47,10 @@ def run(
     workers: int | None,
     scheduler: str | None,
 ) -> None:
-    from rich.console import Console
-    from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
+    from rich.progress import MofNCompleteColumn, TimeElapsedColumn
 
     import fuzzyctl
+    from fuzzyctl.cli.app import stderr_progress
     from fuzzyctl.tune import frames, parallel
 
     frames.require_dask()
@@ -62,16 +62,8 @@ def run(
         raise typer.BadParameter("give either --workers or --scheduler", param_hint="--scheduler")
     model = fuzzyctl.load(file)
     execu: Any = parallel.executor(workers, scheduler)
-    console = Console(stderr=True)
     try:
-        with Progress(
-            TextColumn("[bold]{task.description}"),
-            BarColumn(),
-            MofNCompleteColumn(),
-            TimeElapsedColumn(),
-            console=console,
-            transient=True,
-        ) as progress:
+        with stderr_progress(MofNCompleteColumn(), TimeElapsedColumn(), hidden=False) as progress:
             task = progress.add_task(f"scoring {source}", total=None)
 
             def tick(done: int, total: int) -> None:

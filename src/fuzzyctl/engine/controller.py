@@ -367,6 +367,15 @@ def _columns(data: Any) -> dict[str, Any]:
     raise InputError("batch data must map input names to columns (a dict of arrays or a DataFrame)")
 
 
+def _check_rows(name: str, raw: Any) -> None:
+    """Raise the :func:`_number` error of the first row that is not a number, naming it."""
+    for i, v in enumerate(list(raw)):
+        try:
+            _number(name, v)
+        except InputError as exc:
+            raise InputError(f"{exc} (row {i})") from None
+
+
 def _column_array(name: str, col: Any, finite: bool = True) -> npt.NDArray[np.float64]:
     import numpy as np
 
@@ -374,22 +383,12 @@ def _column_array(name: str, col: Any, finite: bool = True) -> npt.NDArray[np.fl
     try:
         arr = np.asarray(raw, dtype=np.float64)
     except (TypeError, ValueError):
-        items = list(raw)
-        for i, v in enumerate(items):
-            try:
-                _number(name, v)
-            except InputError as exc:
-                raise InputError(f"{exc} (row {i})") from None
+        _check_rows(name, raw)
         raise InputError(f"input {name!r} is not numeric") from None
     if arr.ndim != 1:
         arr = arr.reshape(-1)
     if np.asarray(raw).dtype.kind in "USO":  # strings that happen to parse are still strings
-        items = list(raw)
-        for i, v in enumerate(items):
-            try:
-                _number(name, v)
-            except InputError as exc:
-                raise InputError(f"{exc} (row {i})") from None
+        _check_rows(name, raw)
     # min and max are NaN or infinite when an element is: no temporary array
     if finite and arr.size and not (np.isfinite(arr.min()) and np.isfinite(arr.max())):
         bad = np.flatnonzero(~np.isfinite(arr))

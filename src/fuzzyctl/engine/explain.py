@@ -4,7 +4,6 @@ and activation, each output's accumulated set (as breakpoints) and the defuzzifi
 from __future__ import annotations
 
 import dataclasses
-import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
@@ -13,6 +12,7 @@ import numpy as np
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.reference.interp import OutputRecord, Record
+from fuzzyctl.jsonsafe import clean
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -95,18 +95,8 @@ class Explanation:
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready (NaN becomes None)."""
-        out: dict[str, Any] = _clean(dataclasses.asdict(self))
+        out: dict[str, Any] = clean(dataclasses.asdict(self))
         return out
-
-
-def _clean(v: Any) -> Any:
-    if isinstance(v, float):
-        return v if math.isfinite(v) else None
-    if isinstance(v, dict):
-        return {k: _clean(x) for k, x in v.items()}
-    if isinstance(v, list | tuple):
-        return [_clean(x) for x in v]
-    return v
 
 
 def polyline(pieces: list[pwl.Piece], samples_per_poly: int = 16) -> list[tuple[float, float]]:

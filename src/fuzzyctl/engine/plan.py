@@ -26,6 +26,7 @@ IEC 61131-7 5.2.2 / 5.2.4: points and weights may be variables).
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Iterator
 from dataclasses import dataclass
 from typing import Any, TypeAlias
 
@@ -85,6 +86,23 @@ class ECall:
 
 
 ExprPlan: TypeAlias = ENum | EInput | EOutput | EX | EUnary | EBinary | ECall
+
+
+def expr_children(e: ExprPlan) -> tuple[ExprPlan, ...]:
+    """The expressions ``e`` applies its operator or function to (none for a leaf)."""
+    if isinstance(e, EUnary):
+        return (e.operand,)
+    if isinstance(e, EBinary):
+        return (e.left, e.right)
+    return e.args if isinstance(e, ECall) else ()
+
+
+def expr_nodes(e: ExprPlan) -> Iterator[ExprPlan]:
+    """``e`` and every expression inside it, depth first (what a question such as "does it
+    read x?" walks)."""
+    yield e
+    for child in expr_children(e):
+        yield from expr_nodes(child)
 
 
 # --------------------------------------------------------------------------- terms

@@ -11,38 +11,12 @@ from __future__ import annotations
 from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, field
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl.jfl import check_jfuzzylogic
 from fuzzyctl.fcl.reserved import check_reserved_words
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
-from fuzzyctl.model import (
-    OPERATOR_PAIRS,
-    Condition,
-    DefuzzifyBlock,
-    Degree,
-    Document,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    Is,
-    Name,
-    Not,
-    Param,
-    PointsMF,
-    Ref,
-    Rule,
-    RuleBlock,
-    ShapeMF,
-    SingletonMF,
-    SingletonsMF,
-    Span,
-    Term,
-    Variable,
-    VarKind,
-    walk_condition,
-    walk_expr,
-)
 from fuzzyctl.validation import at_spans, validate
 
 
@@ -54,7 +28,7 @@ class CheckContext:
     options: dict[str, object] = field(default_factory=dict)
 
 
-Provider = Callable[[Document, CheckContext], Iterable[Diagnostic]]
+Provider = Callable[[m.Document, CheckContext], Iterable[Diagnostic]]
 
 _PROVIDERS: dict[str, Provider] = {}
 
@@ -68,7 +42,7 @@ def providers() -> dict[str, Provider]:
     return dict(_PROVIDERS)
 
 
-def run_checks(doc: Document, context: CheckContext | None = None) -> list[Diagnostic]:
+def run_checks(doc: m.Document, context: CheckContext | None = None) -> list[Diagnostic]:
     """Every provider's diagnostics, sorted by position."""
     ctx = context or CheckContext(doc.path)
     out: list[Diagnostic] = []
@@ -80,7 +54,7 @@ def run_checks(doc: Document, context: CheckContext | None = None) -> list[Diagn
 # --------------------------------------------------------------------------- helpers
 
 
-def term_blocks(fb: FunctionBlock) -> list[FuzzifyBlock | DefuzzifyBlock]:
+def term_blocks(fb: m.FunctionBlock) -> list[m.FuzzifyBlock | m.DefuzzifyBlock]:
     """The FUZZIFY then DEFUZZIFY blocks of ``fb``."""
     return [*fb.fuzzify, *fb.defuzzify]
 
@@ -90,53 +64,53 @@ class _Reporter:
         self.ctx = ctx
         self.found: list[Diagnostic] = []
 
-    def error(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+    def error(self, message: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
         self.found.append(error(message, span, code=code, file=self.ctx.file, hint=hint))
 
-    def warning(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+    def warning(self, message: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
         self.found.append(warning(message, span, code=code, file=self.ctx.file, hint=hint))
 
-    def note(self, message: str, span: Span | None, code: str) -> None:
+    def note(self, message: str, span: m.Span | None, code: str) -> None:
         self.found.append(Diagnostic(Severity.NOTE, message, span, self.ctx.file, code))
 
 
-def uses_operator(c: Condition | None, kind: type) -> bool:
-    if c is None or isinstance(c, Is | Degree):
+def uses_operator(c: m.Condition | None, kind: type) -> bool:
+    if c is None or isinstance(c, m.Is | m.Degree):
         return False
     if isinstance(c, kind):
         return True
-    if isinstance(c, Not):
+    if isinstance(c, m.Not):
         return uses_operator(c.operand, kind)
     return any(uses_operator(o, kind) for o in c.operands)
 
 
-def mf_params(mf: object) -> list[Param]:
-    if isinstance(mf, PointsMF | SingletonsMF):
+def mf_params(mf: object) -> list[m.Param]:
+    if isinstance(mf, m.PointsMF | m.SingletonsMF):
         return [v for p in mf.points for v in (p.x, p.y)]
-    if isinstance(mf, SingletonMF):
+    if isinstance(mf, m.SingletonMF):
         return [mf.value]
-    if isinstance(mf, ShapeMF):
+    if isinstance(mf, m.ShapeMF):
         return [*mf.params, mf.height]
     return []
 
 
 def is_singleton(mf: object) -> bool:
-    return isinstance(mf, SingletonMF | SingletonsMF) or (
-        isinstance(mf, ShapeMF) and registry.flag(mf.kind, "ts_constant")
+    return isinstance(mf, m.SingletonMF | m.SingletonsMF) or (
+        isinstance(mf, m.ShapeMF) and registry.flag(mf.kind, "ts_constant")
     )
 
 
 # --------------------------------------------------------------------------- built-in checks
 
 
-def check_declarations(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+def check_declarations(doc: m.Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     r = _Reporter(ctx)
-    names: dict[str | None, Span | None] = {}
+    names: dict[str | None, m.Span | None] = {}
     for fb in doc.blocks:
         if fb.name in names and len(doc.blocks) > 1:
             r.error(f"function block {fb.name!r} defined twice", fb.span, "duplicate-block")
         names[fb.name] = fb.span
-        seen: dict[str, Span | None] = {}
+        seen: dict[str, m.Span | None] = {}
         for v in fb.variables:
             if v.name in seen:
                 r.error(
@@ -150,28 +124,28 @@ def check_declarations(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]
     yield from r.found
 
 
-def _line(span: Span | None) -> str:
+def _line(span: m.Span | None) -> str:
     return str(span.line) if span else "?"
 
 
 def _check_block(
-    fb: FunctionBlock,
-    block: FuzzifyBlock | DefuzzifyBlock,
-    seen: dict[str, Span | None],
+    fb: m.FunctionBlock,
+    block: m.FuzzifyBlock | m.DefuzzifyBlock,
+    seen: dict[str, m.Span | None],
     r: _Reporter,
 ) -> None:
     """What FUZZIFY and DEFUZZIFY blocks share: a declared variable of the kind the block
     takes (5.2.2, 5.2.3), one block per variable, no term defined twice."""
     word, takes, section, code = (
-        ("FUZZIFY", VarKind.INPUT, "5.2.2", "fuzzify-non-input")
-        if isinstance(block, FuzzifyBlock)
-        else ("DEFUZZIFY", VarKind.OUTPUT, "5.2.3", "defuzzify-non-output")
+        ("FUZZIFY", m.VarKind.INPUT, "5.2.2", "fuzzify-non-input")
+        if isinstance(block, m.FuzzifyBlock)
+        else ("DEFUZZIFY", m.VarKind.OUTPUT, "5.2.3", "defuzzify-non-output")
     )
     name = block.variable
     var = fb.variable(name)
     if var is None:
         r.error(f"{word} {name}: no variable {name} is declared", block.span, "undeclared-variable")
-    elif var.kind is not takes and var.kind is not VarKind.LOCAL:
+    elif var.kind is not takes and var.kind is not m.VarKind.LOCAL:
         r.error(
             f"{word} {name}: {name} is a {var.kind.value}; {word} takes a {takes.value} ({section})",
             block.span,
@@ -183,11 +157,11 @@ def _check_block(
     _check_terms(block.terms, name, r)
 
 
-def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
-    fuzzified: dict[str, Span | None] = {}
+def _check_blocks(fb: m.FunctionBlock, r: _Reporter) -> None:
+    fuzzified: dict[str, m.Span | None] = {}
     for f in fb.fuzzify:
         var = fb.variable(f.variable)
-        if var is not None and var.kind is VarKind.LOCAL:
+        if var is not None and var.kind is m.VarKind.LOCAL:
             r.warning(
                 f"FUZZIFY {f.variable}: {f.variable} is a local VAR; the standard fuzzifies VAR_INPUT "
                 "variables (5.2.2)",
@@ -195,12 +169,12 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
                 "fuzzify-local",
             )
         _check_block(fb, f, fuzzified, r)
-    defuzzified: dict[str, Span | None] = {}
+    defuzzified: dict[str, m.Span | None] = {}
     for d in fb.defuzzify:
         _check_block(fb, d, defuzzified, r)
         _check_defuzzify(fb, d, r)
     for v in fb.variables:
-        if v.kind is VarKind.OUTPUT and v.name not in defuzzified and not _assigned_bare(fb, v.name):
+        if v.kind is m.VarKind.OUTPUT and v.name not in defuzzified and not _assigned_bare(fb, v.name):
             r.warning(f"output {v.name} has no DEFUZZIFY block", v.span, "output-without-defuzzify")
     for term, p in _refs_in_terms(fb):
         var = fb.variable(p.name)
@@ -210,7 +184,7 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
                 p.span or term.span,
                 "undeclared-variable",
             )
-        elif var.kind is VarKind.OUTPUT:
+        elif var.kind is m.VarKind.OUTPUT:
             r.warning(
                 f"TERM {term.name}: parameter {p.name} is an output; variable points are VAR_INPUTs (5.2.2)",
                 p.span or term.span,
@@ -218,20 +192,20 @@ def _check_blocks(fb: FunctionBlock, r: _Reporter) -> None:
             )
 
 
-def _assigned_bare(fb: FunctionBlock, name: str) -> bool:
+def _assigned_bare(fb: m.FunctionBlock, name: str) -> bool:
     return any(c.variable == name and c.term is None for _, rule in fb.rules() for c in rule.conclusions)
 
 
-def _refs_in_terms(fb: FunctionBlock) -> Iterator[tuple[Term, Ref]]:
+def _refs_in_terms(fb: m.FunctionBlock) -> Iterator[tuple[m.Term, m.Ref]]:
     for block in term_blocks(fb):
         for t in block.terms:
             for p in mf_params(t.mf):
-                if isinstance(p, Ref):
+                if isinstance(p, m.Ref):
                     yield t, p
 
 
-def _check_terms(terms: tuple[Term, ...], variable: str, r: _Reporter) -> None:
-    seen: dict[str, Span | None] = {}
+def _check_terms(terms: tuple[m.Term, ...], variable: str, r: _Reporter) -> None:
+    seen: dict[str, m.Span | None] = {}
     for t in terms:
         if t.name in seen:
             r.warning(
@@ -245,7 +219,7 @@ def _check_terms(terms: tuple[Term, ...], variable: str, r: _Reporter) -> None:
     # the points of each term: fuzzyctl.validation (one validation for every reader)
 
 
-def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None:
+def _check_defuzzify(fb: m.FunctionBlock, d: m.DefuzzifyBlock, r: _Reporter) -> None:
     method_span = d.item_span("method")
     if d.method is not None and METHODS[d.method].bisects and any(is_singleton(t.mf) for t in d.terms):
         r.error(
@@ -270,17 +244,17 @@ def _check_defuzzify(fb: FunctionBlock, d: DefuzzifyBlock, r: _Reporter) -> None
     if (
         d.method in METHODS
         and METHODS[d.method].for_function_terms
-        and not any(isinstance(t.mf, FunctionMF) for t in d.terms)
+        and not any(isinstance(t.mf, m.FunctionMF) for t in d.terms)
     ):
         r.warning(
             f"DEFUZZIFY {d.variable}: COGF is meant for FUNCTION terms", method_span, "cogf-without-function"
         )
 
 
-def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+def check_rules(doc: m.Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     r = _Reporter(ctx)
     for fb in doc.blocks:
-        names: dict[str | None, Span | None] = {}
+        names: dict[str | None, m.Span | None] = {}
         for rb in fb.rule_blocks:
             if rb.name is not None and rb.name in names:
                 r.error(f"rule block {rb.name} defined twice", rb.span, "duplicate-block")
@@ -290,16 +264,16 @@ def check_rules(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     yield from r.found
 
 
-def _terms_of(fb: FunctionBlock, name: str) -> frozenset[str] | None:
+def _terms_of(fb: m.FunctionBlock, name: str) -> frozenset[str] | None:
     """The terms of ``name`` in its FUZZIFY and DEFUZZIFY blocks (``None``: no such block)."""
     return fb.term_names(name)
 
 
-def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
-    if rb.and_op and rb.or_op and OPERATOR_PAIRS.get(rb.and_op) != rb.or_op:
+def _check_rule_block(fb: m.FunctionBlock, rb: m.RuleBlock, r: _Reporter) -> None:
+    if rb.and_op and rb.or_op and m.OPERATOR_PAIRS.get(rb.and_op) != rb.or_op:
         r.warning(
             f"AND : {rb.and_op} and OR : {rb.or_op} are not a pair of Table 3 "
-            f"(AND {rb.and_op} goes with OR {OPERATOR_PAIRS.get(rb.and_op, '?')})",
+            f"(AND {rb.and_op} goes with OR {m.OPERATOR_PAIRS.get(rb.and_op, '?')})",
             rb.item_span("or_op"),
             "operator-pair",
         )
@@ -323,7 +297,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             rb.span,
             "missing-act",
         )
-    labels: dict[str, Span | None] = {}
+    labels: dict[str, m.Span | None] = {}
     for rule in rb.rules:
         if rule.label in labels:
             r.warning(
@@ -333,10 +307,10 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                 "duplicate-rule",
             )
         labels[rule.label] = rule.span
-        for sub in walk_condition(rule.condition):
+        for sub in m.walk_condition(rule.condition):
             if _declared(fb, rule, sub.variable, sub.span, r) is None:
                 continue
-            if isinstance(sub, Is):
+            if isinstance(sub, m.Is):
                 terms = _terms_of(fb, sub.variable)
                 if terms is None:
                     r.error(
@@ -357,7 +331,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             var = _declared(fb, rule, c.variable, c.span, r)
             if var is None:
                 continue
-            if var.kind is VarKind.INPUT:
+            if var.kind is m.VarKind.INPUT:
                 r.error(
                     f"RULE {rule.label}: {c.variable} is a VAR_INPUT and cannot be a conclusion",
                     c.span or rule.span,
@@ -375,7 +349,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                 elif terms is not None and c.term not in terms:
                     _no_term(rule, c.variable, c.term, terms, c.span, r)
             w = c.weight
-            if isinstance(w, Ref):
+            if isinstance(w, m.Ref):
                 wvar = fb.variable(w.name)
                 if wvar is None:
                     r.error(
@@ -383,7 +357,7 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
                         w.span or c.span,
                         "undeclared-variable",
                     )
-                elif wvar.kind is not VarKind.INPUT:
+                elif wvar.kind is not m.VarKind.INPUT:
                     r.warning(
                         f"RULE {rule.label}: weight {w.name} is not a VAR_INPUT (5.2.4)",
                         w.span or c.span,
@@ -398,7 +372,9 @@ def _check_rule_block(fb: FunctionBlock, rb: RuleBlock, r: _Reporter) -> None:
             # a numeric weight: fuzzyctl.validation (one validation for every reader)
 
 
-def _declared(fb: FunctionBlock, rule: Rule, name: str, span: Span | None, r: _Reporter) -> Variable | None:
+def _declared(
+    fb: m.FunctionBlock, rule: m.Rule, name: str, span: m.Span | None, r: _Reporter
+) -> m.Variable | None:
     """The variable ``name`` a rule uses, or None after reporting it undeclared."""
     var = fb.variable(name)
     if var is None:
@@ -407,7 +383,7 @@ def _declared(fb: FunctionBlock, rule: Rule, name: str, span: Span | None, r: _R
 
 
 def _no_term(
-    rule: Rule, variable: str, term: str, terms: Iterable[str], span: Span | None, r: _Reporter
+    rule: m.Rule, variable: str, term: str, terms: Iterable[str], span: m.Span | None, r: _Reporter
 ) -> None:
     r.error(
         f"RULE {rule.label}: {variable} has no term {term}",
@@ -417,7 +393,7 @@ def _no_term(
     )
 
 
-def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
+def _check_cycles(fb: m.FunctionBlock, r: _Reporter) -> None:
     """Rule blocks feed each other through local variables; a cycle has no evaluation order."""
     locals_ = {v.name for v in fb.locals}
     if not locals_ or len(fb.rule_blocks) < 2:
@@ -426,7 +402,7 @@ def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
     reads: dict[int, set[str]] = {}
     for i, rb in enumerate(fb.rule_blocks):
         writes[i] = {c.variable for rule in rb.rules for c in rule.conclusions} & locals_
-        reads[i] = {s.variable for rule in rb.rules for s in walk_condition(rule.condition)} & locals_
+        reads[i] = {s.variable for rule in rb.rules for s in m.walk_condition(rule.condition)} & locals_
     edges = {i: {j for j in writes if j != i and writes[i] & reads[j]} for i in writes}
     state: dict[int, int] = {}
 
@@ -457,14 +433,14 @@ def _check_cycles(fb: FunctionBlock, r: _Reporter) -> None:
                 return
 
 
-def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
+def check_functions(doc: m.Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     """FUNCTION terms may only name declared variables."""
     r = _Reporter(ctx)
     for fb in doc.blocks:
         for block in term_blocks(fb):
             for t in block.terms:
-                if isinstance(t.mf, FunctionMF):
-                    for name in sorted({n.name for n in walk_expr(t.mf.expr) if isinstance(n, Name)}):
+                if isinstance(t.mf, m.FunctionMF):
+                    for name in sorted({n.name for n in m.walk_expr(t.mf.expr) if isinstance(n, m.Name)}):
                         if fb.variable(name) is None and name not in ("x", "pi", "e"):
                             r.error(
                                 f"TERM {t.name}: FUNCTION uses undeclared variable {name}",
@@ -474,12 +450,12 @@ def check_functions(doc: Document, ctx: CheckContext) -> Iterator[Diagnostic]:
     yield from r.found
 
 
-def check_reserved(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+def check_reserved(doc: m.Document, ctx: CheckContext) -> list[Diagnostic]:
     """Identifiers that are IEC 61131-7 Table 7 keywords (:mod:`fuzzyctl.fcl.reserved`)."""
     return check_reserved_words(doc, ctx.file, bool(ctx.options.get("strict")))
 
 
-def check_model(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+def check_model(doc: m.Document, ctx: CheckContext) -> list[Diagnostic]:
     """The rules every reader applies (:mod:`fuzzyctl.validation`: points, degrees, weights),
     at FCL's own positions; ``strict``: a weight above 1 is an error."""
     compat = str(ctx.options.get("compat") or "iec")
@@ -492,7 +468,7 @@ register_provider("functions", check_functions)
 register_provider("model", check_model)
 
 
-def check_jfl(doc: Document, ctx: CheckContext) -> list[Diagnostic]:
+def check_jfl(doc: m.Document, ctx: CheckContext) -> list[Diagnostic]:
     """Under ``compat="jfuzzylogic"``: what jFuzzyLogic 3.3 would reject or read differently
     (:mod:`fuzzyctl.fcl.jfl`)."""
     if ctx.options.get("compat") != "jfuzzylogic":

@@ -21,26 +21,9 @@ import re
 from dataclasses import dataclass, field
 from typing import Any
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic, warning
 from fuzzyctl.fcl.shapes import JFL, lookup
-from fuzzyctl.model import (
-    Call,
-    DefuzzifyBlock,
-    Degree,
-    Document,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    Name,
-    PointsMF,
-    Ref,
-    ShapeMF,
-    SingletonMF,
-    SingletonsMF,
-    Span,
-    walk_condition,
-    walk_expr,
-)
 
 __all__ = ["check_jfuzzylogic"]
 
@@ -70,9 +53,9 @@ class _Found:
     """Warnings grouped by reason: the first place is shown, the others counted."""
 
     file: str | None
-    reasons: dict[tuple[str, str], list[Span | None]] = field(default_factory=dict)
+    reasons: dict[tuple[str, str], list[m.Span | None]] = field(default_factory=dict)
 
-    def add(self, code: str, reason: str, span: Span | None) -> None:
+    def add(self, code: str, reason: str, span: m.Span | None) -> None:
         self.reasons.setdefault((code, reason), []).append(span)
 
     def diagnostics(self) -> list[Diagnostic]:
@@ -87,7 +70,7 @@ class _Found:
         return out
 
 
-def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> list[Diagnostic]:
+def check_jfuzzylogic(doc: m.Document, file: str | None, parsed: Any = None) -> list[Diagnostic]:
     """The ``jfl-rejects`` and ``jfl-differs`` warnings for ``doc`` (``parsed``: the
     :class:`~fuzzyctl.fcl.parser.ParseResult`, for what only the text or the parser's own
     warnings show)."""
@@ -112,12 +95,12 @@ def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> li
     code = _code(text)
     # its parser stops at the last END_FUNCTION_BLOCK: what trails it (a file name pasted
     # after it, in the corpus) is never lexed
-    ends = [m.end() for m in re.finditer(r"(?i)\bEND_FUNCTION_BLOCK\b", code)]
+    ends = [hit.end() for hit in re.finditer(r"(?i)\bEND_FUNCTION_BLOCK\b", code)]
     lexed = code[: ends[-1]] if ends else code
-    for m in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d|\d\.(?![\d.])", lexed):
-        line = text.count("\n", 0, m.start()) + 1
+    for match in re.finditer(r"\d\.\.|\.\.\d|\.\.\s*\.\d|\(\s*\.\d|\s\.\d|\d\.(?![\d.])", lexed):
+        line = text.count("\n", 0, match.start()) + 1
         found.add("jfl-rejects", "its lexer reads a number only with digits before '.' and '..' "
-                  "between spaces", Span(line, 1))  # fmt: skip
+                  "between spaces", m.Span(line, 1))  # fmt: skip
     for fb in doc.blocks:
         _block(fb, found, lines)
     return found.diagnostics()
@@ -126,21 +109,21 @@ def check_jfuzzylogic(doc: Document, file: str | None, parsed: Any = None) -> li
 def _code(text: str) -> str:
     """``text`` with comments blanked (same length, so offsets keep their lines)."""
 
-    def blank(m: re.Match[str]) -> str:
-        return re.sub(r"[^\n]", " ", m.group(0))
+    def blank(match: re.Match[str]) -> str:
+        return re.sub(r"[^\n]", " ", match.group(0))
 
     return re.sub(r"\(\*.*?\*\)|/\*.*?\*/|//[^\n]*", blank, text, flags=re.DOTALL)
 
 
-def _written(lines: list[str], span: Span | None) -> str:
+def _written(lines: list[str], span: m.Span | None) -> str:
     """The word after ':' (or ':=') of a one-line item such as ``ACCU : MAX;``."""
     if span is None or not 0 < span.line <= len(lines):
         return ""
-    m = re.match(r"\s*\w+\s*:=?\s*(\w+)", lines[span.line - 1][span.column - 1 :])
-    return m.group(1).upper() if m else ""
+    match = re.match(r"\s*\w+\s*:=?\s*(\w+)", lines[span.line - 1][span.column - 1 :])
+    return match.group(1).upper() if match else ""
 
 
-def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
+def _block(fb: m.FunctionBlock, found: _Found, lines: list[str]) -> None:
     rejects = "jfl-rejects"
     for v in fb.variables:
         if v.kind.value == "VAR":
@@ -164,12 +147,12 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
                 v.span,
             )
     defined: set[str] = set()
-    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    blocks: list[m.FuzzifyBlock | m.DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for block in sorted(blocks, key=lambda b: b.span.line if b.span else 0):
-        kind = "FUZZIFY" if isinstance(block, FuzzifyBlock) else "DEFUZZIFY"
-        if isinstance(block, FuzzifyBlock) and block.range is not None:
+        kind = "FUZZIFY" if isinstance(block, m.FuzzifyBlock) else "DEFUZZIFY"
+        if isinstance(block, m.FuzzifyBlock) and block.range is not None:
             found.add(rejects, "its grammar has no RANGE in FUZZIFY", block.range.span)
-        if isinstance(block, DefuzzifyBlock):
+        if isinstance(block, m.DefuzzifyBlock):
             db = block
             if db.accu is not None:
                 found.add(rejects, "ACCU belongs in the RULEBLOCK, not in DEFUZZIFY", db.item_span("accu"))
@@ -193,12 +176,12 @@ def _block(fb: FunctionBlock, found: _Found, lines: list[str]) -> None:
                         "(it only knows variables from those blocks)",
                         t.span,
                     )
-            if isinstance(t.mf, SingletonsMF):
+            if isinstance(t.mf, m.SingletonsMF):
                 found.add(rejects, f"term {t.name}: its parser fails on SINGLETONS terms", t.span)
-            if isinstance(t.mf, ShapeMF) and t.mf.height != 1.0:
+            if isinstance(t.mf, m.ShapeMF) and t.mf.height != 1.0:
                 found.add(rejects, f"term {t.name}: its shapes have no height parameter", t.span)
-            if isinstance(t.mf, FunctionMF):
-                calls = {n.function.upper() for n in walk_expr(t.mf.expr) if isinstance(n, Call)}
+            if isinstance(t.mf, m.FunctionMF):
+                calls = {n.function.upper() for n in m.walk_expr(t.mf.expr) if isinstance(n, m.Call)}
                 for call in sorted(calls - _FUNCTIONS):
                     found.add(rejects, f"term {t.name}: it has no function {call.lower()}", t.span)
         defined.add(block.variable)
@@ -223,8 +206,8 @@ def _rule(rule: Any, found: _Found) -> None:
     rejects = "jfl-rejects"
     if rule.condition is None:
         found.add(rejects, f"RULE {rule.label} has no condition", rule.span)
-    for c in walk_condition(rule.condition):
-        if isinstance(c, Degree):
+    for c in m.walk_condition(rule.condition):
+        if isinstance(c, m.Degree):
             found.add(rejects, f"RULE {rule.label}: a bare variable is not a condition", c.span)
         elif c.hedges:
             found.add(rejects, f"RULE {rule.label}: it has no hedges", c.span)
@@ -236,11 +219,11 @@ def _rule(rule: Any, found: _Found) -> None:
             found.add(rejects, f"RULE {rule.label}: a conclusion needs IS and a term", c.span)
         if c.hedges:
             found.add(rejects, f"RULE {rule.label}: it has no hedges", c.span)
-        if c.weight is not None and (i < len(weights) - 1 or isinstance(c.weight, Ref)):
+        if c.weight is not None and (i < len(weights) - 1 or isinstance(c.weight, m.Ref)):
             found.add(rejects, f"RULE {rule.label}: WITH takes a number and ends the rule", c.span)
 
 
-def _name(name: str, what: str, span: Span | None, found: _Found) -> None:
+def _name(name: str, what: str, span: m.Span | None, found: _Found) -> None:
     if not _ID.fullmatch(name):
         found.add("jfl-rejects", f"{what} name {name!r} is not one of its identifiers", span)
     elif name.upper() in _KEYWORDS:
@@ -248,12 +231,12 @@ def _name(name: str, what: str, span: Span | None, found: _Found) -> None:
 
 
 def _refs(mf: object) -> list[str]:
-    if isinstance(mf, PointsMF | SingletonsMF):
-        return [p.name for pt in mf.points for p in (pt.x, pt.y) if isinstance(p, Ref)]
-    if isinstance(mf, SingletonMF):
-        return [mf.value.name] if isinstance(mf.value, Ref) else []
-    if isinstance(mf, ShapeMF):
-        return [p.name for p in (*mf.params, mf.height) if isinstance(p, Ref)]
-    if isinstance(mf, FunctionMF):
-        return sorted({n.name for n in walk_expr(mf.expr) if isinstance(n, Name)} - {"x", "pi", "e"})
+    if isinstance(mf, m.PointsMF | m.SingletonsMF):
+        return [p.name for pt in mf.points for p in (pt.x, pt.y) if isinstance(p, m.Ref)]
+    if isinstance(mf, m.SingletonMF):
+        return [mf.value.name] if isinstance(mf.value, m.Ref) else []
+    if isinstance(mf, m.ShapeMF):
+        return [p.name for p in (*mf.params, mf.height) if isinstance(p, m.Ref)]
+    if isinstance(mf, m.FunctionMF):
+        return sorted({n.name for n in m.walk_expr(mf.expr) if isinstance(n, m.Name)} - {"x", "pi", "e"})
     return []

@@ -21,6 +21,7 @@ from typing import Any, cast
 from lark import Lark, Token, Transformer
 from lark.exceptions import UnexpectedInput, VisitError
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.fcl import keywords, shapes
 from fuzzyctl.fcl.fast import FastResult
@@ -29,47 +30,11 @@ from fuzzyctl.fcl.grammar import cached_lark, terminal_names
 from fuzzyctl.fcl.names import resolve_names
 from fuzzyctl.fcl.source import Source
 from fuzzyctl.limits import MAX_NESTING, shorten
-from fuzzyctl.model import (
-    And,
-    Binary,
-    Call,
-    Conclusion,
-    Condition,
-    Default,
-    DefuzzifyBlock,
-    Degree,
-    Document,
-    Expr,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    Is,
-    MembershipFunction,
-    Name,
-    Not,
-    Num,
-    OptionsBlock,
-    Or,
-    Param,
-    Point,
-    PointsMF,
-    Range,
-    Ref,
-    Rule,
-    RuleBlock,
-    SingletonMF,
-    SingletonsMF,
-    Span,
-    Term,
-    Unary,
-    Variable,
-    VarKind,
-)
 
 _MINUS_SIGNS = str.maketrans({"\u2212": "-", "\u2013": "-"})
 
 
-def _between(first: Any, last: Any) -> Span | None:
+def _between(first: Any, last: Any) -> m.Span | None:
     """The span from the start of ``first`` to the end of ``last`` (tokens or model
     objects with a span); ``None`` when a position is unknown."""
     a = _start(first)
@@ -78,27 +43,27 @@ def _between(first: Any, last: Any) -> Span | None:
         return None
     if b is None:
         return a
-    return Span(a.line, a.column, b.end_line, b.end_column)
+    return m.Span(a.line, a.column, b.end_line, b.end_column)
 
 
-def _start(obj: Any) -> Span | None:
+def _start(obj: Any) -> m.Span | None:
     if isinstance(obj, Token):
         return _tok_span(obj)
     span = getattr(obj, "span", None)
-    return span if isinstance(span, Span) else None
+    return span if isinstance(span, m.Span) else None
 
 
-def _end(obj: Any) -> Span | None:
+def _end(obj: Any) -> m.Span | None:
     return _start(obj)
 
 
-def _outer(children: Sequence[Any]) -> Span | None:
+def _outer(children: Sequence[Any]) -> m.Span | None:
     located = [c for c in children if _start(c) is not None]
     return _between(located[0], located[-1]) if located else None
 
 
-def _tok_span(tok: Token) -> Span:
-    return Span(tok.line or 0, tok.column or 0, tok.end_line, tok.end_column)
+def _tok_span(tok: Token) -> m.Span:
+    return m.Span(tok.line or 0, tok.column or 0, tok.end_line, tok.end_column)
 
 
 def _number(tok: Token) -> float:
@@ -115,23 +80,23 @@ class _Item:
 
     key: str
     value: Any
-    span: Span
+    span: m.Span
 
 
 @dataclass
 class _Decls:
-    names: list[tuple[str, Span]]
+    names: list[tuple[str, m.Span]]
     data_type: str
     initial: float | bool | str | None
-    range: Range | None
-    span: Span | None
+    range: m.Range | None
+    span: m.Span | None
 
 
 @dataclass
 class _Function:
     """A FUNCTION term before its source text is known (the TERM's ';' ends it)."""
 
-    expr: Expr
+    expr: m.Expr
     start: int
 
 
@@ -173,13 +138,13 @@ class ParseState:
         merged.sort(key=lambda x: (x.span.line, x.span.column))
         return merged
 
-    def error(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+    def error(self, message: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
         self.diagnostics.append(error(message, span, code=code, file=self.source.path, hint=hint))
 
-    def warn(self, message: str, span: Span | None, code: str, hint: str | None = None) -> None:
+    def warn(self, message: str, span: m.Span | None, code: str, hint: str | None = None) -> None:
         self.diagnostics.append(warning(message, span, code=code, file=self.source.path, hint=hint))
 
-    def note(self, message: str, span: Span | None, code: str) -> None:
+    def note(self, message: str, span: m.Span | None, code: str) -> None:
         self.diagnostics.append(Diagnostic(Severity.NOTE, message, span, self.source.path, code))
 
 
@@ -194,22 +159,22 @@ class _Builder(Transformer[Token, Any]):
     def number(self, children: list[Token]) -> float:
         return _number(children[0])
 
-    def ref(self, children: list[Token]) -> Ref:
-        return Ref(str(children[0]), _tok_span(children[0]))
+    def ref(self, children: list[Token]) -> m.Ref:
+        return m.Ref(str(children[0]), _tok_span(children[0]))
 
-    def point(self, children: list[Param]) -> Point:
-        return Point(children[1], children[2], _outer(children))
+    def point(self, children: list[m.Param]) -> m.Point:
+        return m.Point(children[1], children[2], _outer(children))
 
     # ---------------------------------------------------------------- membership functions
-    def points(self, children: list[Point]) -> PointsMF:
-        return PointsMF(tuple(children))
+    def points(self, children: list[m.Point]) -> m.PointsMF:
+        return m.PointsMF(tuple(children))
 
-    def singleton(self, children: list[Param]) -> SingletonMF:
-        return SingletonMF(children[0])
+    def singleton(self, children: list[m.Param]) -> m.SingletonMF:
+        return m.SingletonMF(children[0])
 
-    def shape(self, children: list[Any]) -> MembershipFunction:
+    def shape(self, children: list[Any]) -> m.MembershipFunction:
         name_tok: Token = children[0]
-        args: list[Param] = children[1:]
+        args: list[m.Param] = children[1:]
         name = str(name_tok)
         if name.upper() == "DISCRETE":
             # fuzzylite's Discrete x1 y1 x2 y2 ... is the IEC point list.
@@ -219,9 +184,9 @@ class _Builder(Transformer[Token, Any]):
                     _tok_span(name_tok),
                     "shape-arity",
                 )
-                return PointsMF(())
+                return m.PointsMF(())
             self.state.spellings.add("Discrete")
-            return PointsMF(tuple(Point(args[i], args[i + 1]) for i in range(0, len(args), 2)))
+            return m.PointsMF(tuple(m.Point(args[i], args[i + 1]) for i in range(0, len(args), 2)))
         spelling = shapes.lookup(name)
         if spelling is None:
             self.state.error(
@@ -230,15 +195,15 @@ class _Builder(Transformer[Token, Any]):
                 "unknown-shape",
                 hint="known shapes: " + ", ".join(s.written for s in shapes.SPELLINGS),
             )
-            return PointsMF(())
+            return m.PointsMF(())
         self.state.spellings.add(spelling.written)
         try:
             return shapes.build(spelling, args)
         except shapes.ShapeError as exc:
             self.state.error(str(exc), _outer(children), "shape-arity")
-            return PointsMF(())
+            return m.PointsMF(())
 
-    def singletons(self, children: list[Any]) -> MembershipFunction:
+    def singletons(self, children: list[Any]) -> m.MembershipFunction:
         name_tok: Token = children[0]
         if str(name_tok).upper() != "SINGLETONS":
             self.state.error(
@@ -248,20 +213,20 @@ class _Builder(Transformer[Token, Any]):
                 hint="a list of points is written without a name: TERM t := (0, 0) (1, 1);"
                 " jFuzzyLogic's discrete singletons are SINGLETONS (x, y) ...",
             )
-            return PointsMF(())
+            return m.PointsMF(())
         self.state.spellings.add("SINGLETONS")
-        return SingletonsMF(tuple(children[1:]))
+        return m.SingletonsMF(tuple(children[1:]))
 
     def function(self, children: list[Any]) -> _Function:
         self.state.spellings.add("FUNCTION")
         return _Function(children[1], children[0].end_pos or 0)
 
     # ---- expressions
-    def num(self, children: list[Token]) -> Num:
-        return Num(_number(children[0]))
+    def num(self, children: list[Token]) -> m.Num:
+        return m.Num(_number(children[0]))
 
-    def expr_name(self, children: list[Token]) -> Name:
-        return Name(str(children[0]))
+    def expr_name(self, children: list[Token]) -> m.Name:
+        return m.Name(str(children[0]))
 
     def name(self, children: list[Token]) -> Token:
         if len(children) == 1:
@@ -284,27 +249,27 @@ class _Builder(Transformer[Token, Any]):
             end_pos=last.end_pos,
         )
 
-    def call(self, children: list[Any]) -> Call:
-        return Call(str(children[0]).lower(), tuple(c for c in children[1:] if c is not None))
+    def call(self, children: list[Any]) -> m.Call:
+        return m.Call(str(children[0]).lower(), tuple(c for c in children[1:] if c is not None))
 
-    def binary(self, children: list[Any]) -> Binary:
-        return Binary(str(children[1]), children[0], children[2])
+    def binary(self, children: list[Any]) -> m.Binary:
+        return m.Binary(str(children[1]), children[0], children[2])
 
-    def unary(self, children: list[Any]) -> Unary:
-        return Unary(str(children[0]), children[1])
+    def unary(self, children: list[Any]) -> m.Unary:
+        return m.Unary(str(children[0]), children[1])
 
     # ---------------------------------------------------------------- terms and blocks
-    def term(self, children: list[Any]) -> Term:
+    def term(self, children: list[Any]) -> m.Term:
         name, mf, semi = children[1], children[2], children[3]
         fast = self.state.fast
-        if fast is not None and isinstance(mf, SingletonMF) and fast.points:
+        if fast is not None and isinstance(mf, m.SingletonMF) and fast.points:
             mf = fast.points_at(_tok_span(children[0])) or mf  # points the fast reader read
         span = _outer(children)
         if semi is None:
-            end = Span(span.line, span.column) if span else None
+            end = m.Span(span.line, span.column) if span else None
             if isinstance(mf, _Function):  # its ';' is what ends the expression's text
                 self.state.error(f"missing ';' at the end of FUNCTION TERM {name}", end, "missing-semicolon")
-                return Term(str(name), FunctionMF(mf.expr, ""), span)
+                return m.Term(str(name), m.FunctionMF(mf.expr, ""), span)
             self.state.warn(
                 f"missing ';' at the end of TERM {name} (read as if it were there, as scalablurry does)",
                 end,
@@ -312,17 +277,17 @@ class _Builder(Transformer[Token, Any]):
             )
         if isinstance(mf, _Function):
             text = self.state.source.text[mf.start : semi.start_pos]
-            mf = FunctionMF(mf.expr, " ".join(text.split()))
-        return Term(str(name), mf, span)
+            mf = m.FunctionMF(mf.expr, " ".join(text.split()))
+        return m.Term(str(name), mf, span)
 
-    def range_stmt(self, children: list[Any]) -> Range:
+    def range_stmt(self, children: list[Any]) -> m.Range:
         low, high = (_number(t) for t in _tokens(children, "NUMBER"))
         span = _outer(children)
         if low > high:
             self.state.error(f"RANGE({low:g}..{high:g}): the minimum is above the maximum", span, "bad-range")
         elif low == high:
             self.state.warn(f"RANGE({low:g}..{high:g}) is empty", span, "empty-range")
-        return Range(low, high, span)
+        return m.Range(low, high, span)
 
     def _keyword_item(
         self, key: str, label: str, table: keywords.Synonyms, children: list[Any], tok: Token
@@ -330,7 +295,7 @@ class _Builder(Transformer[Token, Any]):
         spelling = str(tok)
         span = _outer(children) or _tok_span(tok)
         if not _tokens(children, "SEMI"):
-            end = Span(tok.end_line or 0, tok.end_column or 0)
+            end = m.Span(tok.end_line or 0, tok.end_column or 0)
             self.state.warn(f"missing ';' after {children[0].type} : {spelling}", end, "missing-semicolon")
         if spelling.upper() in keywords.NONE_SPELLINGS:
             return _Item(key, None, span)
@@ -365,14 +330,14 @@ class _Builder(Transformer[Token, Any]):
             return self._keyword_item("and_op", "AND operator", keywords.AND_SYNONYMS, children, children[1])
         return self._keyword_item("or_op", "OR operator", keywords.OR_SYNONYMS, children, children[1])
 
-    def default_value(self, children: list[Token]) -> Default:
+    def default_value(self, children: list[Token]) -> m.Default:
         numbers = _tokens(children, "NUMBER")
         no_change = bool(_tokens(children, "NC"))
         value = _number(numbers[0]) if numbers else None
-        return Default(value, no_change, _outer(children))
+        return m.Default(value, no_change, _outer(children))
 
     def default_stmt(self, children: list[Any]) -> _Item:
-        default: Default = next(c for c in children if isinstance(c, Default))
+        default: m.Default = next(c for c in children if isinstance(c, m.Default))
         span = _outer(children)
         if _tokens(children, "EQUAL"):
             self.state.warn(
@@ -380,9 +345,9 @@ class _Builder(Transformer[Token, Any]):
             )
         if not _tokens(children, "SEMI"):
             self.state.warn("missing ';' after DEFAULT", span, "missing-semicolon")
-        return _Item("default", replace(default, span=span), span or Span(0, 0))
+        return _Item("default", replace(default, span=span), span or m.Span(0, 0))
 
-    def _items(self, children: list[Any], block: str, span: Span | None) -> dict[str, _Item]:
+    def _items(self, children: list[Any], block: str, span: m.Span | None) -> dict[str, _Item]:
         items: dict[str, _Item] = {}
         for c in children:
             if isinstance(c, _Item):
@@ -398,26 +363,26 @@ class _Builder(Transformer[Token, Any]):
 
     def _terms_and_range(
         self, children: list[Any], block: str
-    ) -> tuple[str, Span | None, tuple[Term, ...], Range | None]:
+    ) -> tuple[str, m.Span | None, tuple[m.Term, ...], m.Range | None]:
         """The name, span, terms and (one) RANGE of a FUZZIFY or DEFUZZIFY block."""
         name: Token = children[1]
-        terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Term)]))
-        ranges = [c for c in children if isinstance(c, Range)]
+        terms = tuple(self.state.fast_items(children, [c for c in children if isinstance(c, m.Term)]))
+        ranges = [c for c in children if isinstance(c, m.Range)]
         if len(ranges) > 1:
             self.state.error(f"RANGE given twice in this {block} block", ranges[1].span, "duplicate-item")
         return str(name), _outer(children), terms, ranges[0] if ranges else None
 
-    def fuzzify_block(self, children: list[Any]) -> FuzzifyBlock:
+    def fuzzify_block(self, children: list[Any]) -> m.FuzzifyBlock:
         name, span, terms, rng = self._terms_and_range(children, "FUZZIFY")
-        return FuzzifyBlock(name, terms, rng, span)
+        return m.FuzzifyBlock(name, terms, rng, span)
 
-    def defuzzify_block(self, children: list[Any]) -> DefuzzifyBlock:
+    def defuzzify_block(self, children: list[Any]) -> m.DefuzzifyBlock:
         name, span, terms, rng = self._terms_and_range(children, "DEFUZZIFY")
         items = self._items(children, "DEFUZZIFY block", span)
         method = items.get("method")
         default = items.get("default")
         accu = items.get("accu")
-        return DefuzzifyBlock(
+        return m.DefuzzifyBlock(
             name,
             terms,
             rng,
@@ -443,55 +408,55 @@ class _Builder(Transformer[Token, Any]):
         initial = next(
             (c for c in children if isinstance(c, float | bool | str) and not isinstance(c, Token)), None
         )
-        rng = next((c for c in children if isinstance(c, Range)), None)
+        rng = next((c for c in children if isinstance(c, m.Range)), None)
         names = [(str(t), _tok_span(t)) for t in ids[:-1]]
         return _Decls(names, str(ids[-1]).upper(), initial, rng, _outer(children))
 
-    def var_block(self, children: list[Any]) -> list[Variable]:
-        kind = VarKind(str(children[0].type))
-        out: list[Variable] = []
+    def var_block(self, children: list[Any]) -> list[m.Variable]:
+        kind = m.VarKind(str(children[0].type))
+        out: list[m.Variable] = []
         for decls in children:
             if not isinstance(decls, _Decls):
                 continue
             for name, span in decls.names:
                 where = span if len(decls.names) > 1 else decls.span
-                out.append(Variable(name, kind, decls.data_type, decls.initial, decls.range, where))
+                out.append(m.Variable(name, kind, decls.data_type, decls.initial, decls.range, where))
         if self.state.fast is not None and self.state.fast.decls:
             merge_decls(self.state.fast, children, out)
         return out
 
     # ---------------------------------------------------------------- rules
-    def is_condition(self, children: list[Token]) -> Is:
+    def is_condition(self, children: list[Token]) -> m.Is:
         ids = _tokens(children, "ID")
         negated = bool(_tokens(children, "NOT"))
-        return Is(str(ids[0]), str(ids[-1]), negated, tuple(str(t) for t in ids[1:-1]), _outer(children))
+        return m.Is(str(ids[0]), str(ids[-1]), negated, tuple(str(t) for t in ids[1:-1]), _outer(children))
 
-    def degree_condition(self, children: list[Token]) -> Degree:
-        return Degree(str(children[0]), _outer(children))
+    def degree_condition(self, children: list[Token]) -> m.Degree:
+        return m.Degree(str(children[0]), _outer(children))
 
-    def negation(self, children: list[Any]) -> Not:
-        return Not(children[1], _outer(children))
+    def negation(self, children: list[Any]) -> m.Not:
+        return m.Not(children[1], _outer(children))
 
-    def group(self, children: list[Any]) -> Condition:
-        inner: Condition = children[0]
-        if isinstance(inner, And | Or):
+    def group(self, children: list[Any]) -> m.Condition:
+        inner: m.Condition = children[0]
+        if isinstance(inner, m.And | m.Or):
             inner = replace(inner, grouped=True)  # for jFuzzyLogic's left-to-right reading
         return inner
 
-    def and_condition(self, children: list[Any]) -> And:
-        return And(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
+    def and_condition(self, children: list[Any]) -> m.And:
+        return m.And(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
 
-    def or_condition(self, children: list[Any]) -> Or:
-        return Or(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
+    def or_condition(self, children: list[Any]) -> m.Or:
+        return m.Or(tuple(c for c in children if not isinstance(c, Token)), _outer(children))
 
-    def conclusion(self, children: list[Any]) -> Conclusion:
+    def conclusion(self, children: list[Any]) -> m.Conclusion:
         ids = _tokens(children, "ID")
         weight = next((c for c in children if not isinstance(c, Token)), None)
         term = str(ids[-1]) if len(ids) > 1 else None
         hedges = tuple(str(t) for t in ids[1:-1])
-        return Conclusion(str(ids[0]), term, weight, _outer(children), hedges)
+        return m.Conclusion(str(ids[0]), term, weight, _outer(children), hedges)
 
-    def paren_conclusion(self, children: list[Any]) -> Conclusion:
+    def paren_conclusion(self, children: list[Any]) -> m.Conclusion:
         made = self.conclusion(children)
         self.state.warn(
             f"parentheses around a subconclusion are not FCL (5.4.1); read as {made.variable} IS {made.term}",
@@ -500,19 +465,21 @@ class _Builder(Transformer[Token, Any]):
         )
         return made
 
-    def conclusions(self, children: list[Any]) -> tuple[Conclusion, ...]:
-        return tuple(c for c in children if isinstance(c, Conclusion))
+    def conclusions(self, children: list[Any]) -> tuple[m.Conclusion, ...]:
+        return tuple(c for c in children if isinstance(c, m.Conclusion))
 
-    def rule(self, children: list[Any]) -> Rule:
+    def rule(self, children: list[Any]) -> m.Rule:
         from fuzzyctl.limits import MAX_NESTING, depth
 
         label: Token = children[1]
-        condition: Condition | None = next(c for c in children if isinstance(c, Is | Degree | Not | And | Or))
+        condition: m.Condition | None = next(
+            c for c in children if isinstance(c, m.Is | m.Degree | m.Not | m.And | m.Or)
+        )
         conclusions = next(c for c in children if isinstance(c, tuple))
         span = _outer(children)
         fast = self.state.fast
         found = None
-        if fast is not None and isinstance(condition, Degree) and condition.variable == "_":
+        if fast is not None and isinstance(condition, m.Degree) and condition.variable == "_":
             found = fast.condition_at(condition.span)  # a condition the fast reader read
         if found is not None:
             condition, d = found
@@ -526,9 +493,9 @@ class _Builder(Transformer[Token, Any]):
                 "too-deep",
             )
             condition = None
-        return Rule(str(label), condition, conclusions, span)
+        return m.Rule(str(label), condition, conclusions, span)
 
-    def rule_block(self, children: list[Any]) -> RuleBlock:
+    def rule_block(self, children: list[Any]) -> m.RuleBlock:
         name = next((str(c) for c in children if isinstance(c, Token) and c.type == "ID"), None)
         span = _outer(children)
         items = self._items(children, "RULEBLOCK", span)
@@ -537,9 +504,9 @@ class _Builder(Transformer[Token, Any]):
             item = items.get(key)
             return item.value if item else None
 
-        return RuleBlock(
+        return m.RuleBlock(
             name,
-            tuple(self.state.fast_items(children, [c for c in children if isinstance(c, Rule)])),
+            tuple(self.state.fast_items(children, [c for c in children if isinstance(c, m.Rule)])),
             value("and_op"),
             value("or_op"),
             value("act"),
@@ -548,36 +515,36 @@ class _Builder(Transformer[Token, Any]):
             item_spans=tuple((k, v.span) for k, v in items.items()),
         )
 
-    def options_block(self, children: list[Token]) -> OptionsBlock:
+    def options_block(self, children: list[Token]) -> m.OptionsBlock:
         body = _tokens(children, "OPTIONS_BODY")
         text = textwrap.dedent(str(body[0])).strip() if body else ""
-        return OptionsBlock(text, str(children[0].type), _outer(children))
+        return m.OptionsBlock(text, str(children[0].type), _outer(children))
 
     # ---------------------------------------------------------------- function blocks
     def fb_name(self, children: list[Token]) -> str:
         return str(children[0])
 
-    def function_block(self, children: list[Any]) -> FunctionBlock:
+    def function_block(self, children: list[Any]) -> m.FunctionBlock:
         name = next((c for c in children if isinstance(c, str) and not isinstance(c, Token)), None)
         if self.state.fast is not None and self.state.fast.blocks:
             children = merge_blocks(self.state.fast, children)
-        variables: list[Variable] = []
+        variables: list[m.Variable] = []
         for c in children:
             if isinstance(c, list):
                 variables.extend(c)
-        fb = FunctionBlock(
+        fb = m.FunctionBlock(
             name,
             tuple(variables),
-            tuple(c for c in children if isinstance(c, FuzzifyBlock)),
-            tuple(c for c in children if isinstance(c, DefuzzifyBlock)),
-            tuple(c for c in children if isinstance(c, RuleBlock)),
-            tuple(c for c in children if isinstance(c, OptionsBlock)),
+            tuple(c for c in children if isinstance(c, m.FuzzifyBlock)),
+            tuple(c for c in children if isinstance(c, m.DefuzzifyBlock)),
+            tuple(c for c in children if isinstance(c, m.RuleBlock)),
+            tuple(c for c in children if isinstance(c, m.OptionsBlock)),
             _outer(children),
         )
         return resolve_names(fb, lambda message, span, code: self.state.warn(message, span, code))
 
-    def start(self, children: list[FunctionBlock]) -> Document:
-        return Document(tuple(children), self.state.source.path)
+    def start(self, children: list[m.FunctionBlock]) -> m.Document:
+        return m.Document(tuple(children), self.state.source.path)
 
 
 _COMMENT_TYPES = ("COMMENT_IEC", "COMMENT_C", "COMMENT_LINE")
@@ -620,7 +587,7 @@ def _parser() -> Lark:
 class ParseResult:
     """The document (``None`` after a syntax error) and every diagnostic found."""
 
-    document: Document | None
+    document: m.Document | None
     diagnostics: list[Diagnostic]
     source: Source
     spellings: frozenset[str] = frozenset()
@@ -645,7 +612,7 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
     builder.state = state
     _ACTIVE.append(state)
     try:
-        document: Document | None = cast(Document, lark.parse(text))
+        document: m.Document | None = cast(m.Document, lark.parse(text))
         _merge_comments(state, None)
     except UnexpectedInput as exc:
         recovered = _recover(lark, state, exc, text)
@@ -661,7 +628,7 @@ def parse_source(source: Source, *, fast: bool = True) -> ParseResult:
         _ACTIVE.pop()
         _LOCK.release()
     if document is not None and not document.blocks:
-        state.error("no FUNCTION_BLOCK in this file", Span(1, 1), "no-function-block")
+        state.error("no FUNCTION_BLOCK in this file", m.Span(1, 1), "no-function-block")
         document = None
     if document is not None:
         from fuzzyctl.fcl.comments import attach_comments
@@ -691,7 +658,7 @@ def _paren_run(state: ParseState, text: str) -> bool:
     state.error(
         f"{count:,} parentheses open in a row: fuzzyctl reads at most {MAX_PAREN_RUN:,} "
         f"(a condition nests at most {MAX_NESTING} levels)",
-        Span(line, column, line, column + 1),
+        m.Span(line, column, line, column + 1),
         "too-deep",
     )
     return True
@@ -727,17 +694,17 @@ def _ignored_comments(state: ParseState, pos: int) -> None:
     text = state.source.text
     # line and line start counted on from one comment to the next (linear in the text)
     line, at, start = text.count("\n", 0, pos) + 1, pos, text.rfind("\n", 0, pos) + 1
-    for m in _COMMENTS.finditer(text, pos):
-        line += text.count("\n", at, m.start())
-        start = max(start, text.rfind("\n", at, m.start()) + 1)
-        at = m.start()
-        state.comments.append(_Comment(m.group(0), line, at - start + 1, line + m.group(0).count("\n")))
-        line += m.group(0).count("\n")
-        start = max(start, text.rfind("\n", at, m.end()) + 1)
-        at = m.end()
+    for hit in _COMMENTS.finditer(text, pos):
+        line += text.count("\n", at, hit.start())
+        start = max(start, text.rfind("\n", at, hit.start()) + 1)
+        at = hit.start()
+        state.comments.append(_Comment(hit.group(0), line, at - start + 1, line + hit.group(0).count("\n")))
+        line += hit.group(0).count("\n")
+        start = max(start, text.rfind("\n", at, hit.end()) + 1)
+        at = hit.end()
 
 
-def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> Document | None:
+def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> m.Document | None:
     """Text after the last END_FUNCTION_BLOCK is ignored with a warning (jFuzzyLogic's
     ANTLR grammar stops there too); any other syntax error is not recovered.  ``text`` is
     what lark reads (see parse_source)."""
@@ -752,14 +719,14 @@ def _recover(lark: Lark, state: ParseState, exc: UnexpectedInput, text: str) -> 
     state.comments.clear()
     state.spellings.clear()
     try:
-        document = cast(Document, lark.parse(text[:pos]))
+        document = cast(m.Document, lark.parse(text[:pos]))
     except UnexpectedInput:
         return None
     _merge_comments(state, pos)
     _ignored_comments(state, pos)
     state.warn(
         "text after END_FUNCTION_BLOCK is ignored",
-        Span(exc.token.line or 0, exc.token.column or 0),
+        m.Span(exc.token.line or 0, exc.token.column or 0),
         "trailing-text",
     )
     return document

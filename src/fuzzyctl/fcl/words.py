@@ -13,33 +13,9 @@ from __future__ import annotations
 import re
 from collections.abc import Iterator
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic, error
 from fuzzyctl.fcl.identifiers import fcl_term
-from fuzzyctl.model import (
-    And,
-    Binary,
-    Call,
-    Condition,
-    DefuzzifyBlock,
-    Degree,
-    Expr,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    Is,
-    MembershipFunction,
-    Name,
-    Not,
-    Or,
-    Param,
-    PointsMF,
-    Ref,
-    ShapeMF,
-    SingletonMF,
-    SingletonsMF,
-    Span,
-    Unary,
-)
 
 __all__ = ["unwritable_words"]
 
@@ -47,64 +23,64 @@ _WORD = re.compile(r"[^\W\d]\w*")  # fcl.lark's ID (keywords such as MIN are wor
 _OPERATORS = frozenset("+-*/%^")  # fcl/writer.py's _PRECEDENCE
 
 
-def _params(mf: MembershipFunction) -> Iterator[Param]:
-    if isinstance(mf, PointsMF | SingletonsMF):
+def _params(mf: m.MembershipFunction) -> Iterator[m.Param]:
+    if isinstance(mf, m.PointsMF | m.SingletonsMF):
         for p in mf.points:
             yield p.x
             yield p.y
-    elif isinstance(mf, SingletonMF):
+    elif isinstance(mf, m.SingletonMF):
         yield mf.value
-    elif isinstance(mf, ShapeMF):
+    elif isinstance(mf, m.ShapeMF):
         yield from mf.params
 
 
-def _expr_words(e: Expr) -> Iterator[tuple[str, str, str]]:
+def _expr_words(e: m.Expr) -> Iterator[tuple[str, str, str]]:
     """(what, text, kind) of every word of an expression (kind: ``name``, ``word`` or ``bad``,
     an operator that is not one of FCL's)."""
-    if isinstance(e, Name):
+    if isinstance(e, m.Name):
         yield "variable", e.name, "name"
-    elif isinstance(e, Call):
+    elif isinstance(e, m.Call):
         yield "function", e.function, "word"
         for a in e.args:
             yield from _expr_words(a)
-    elif isinstance(e, Unary):
+    elif isinstance(e, m.Unary):
         if e.op not in ("+", "-"):
             yield "operator", e.op, "bad"
         yield from _expr_words(e.operand)
-    elif isinstance(e, Binary):
+    elif isinstance(e, m.Binary):
         if e.op not in _OPERATORS:
             yield "operator", e.op, "bad"
         yield from _expr_words(e.left)
         yield from _expr_words(e.right)
 
 
-def _condition_words(c: Condition | None) -> Iterator[tuple[str, str, str]]:
-    if isinstance(c, Is):
+def _condition_words(c: m.Condition | None) -> Iterator[tuple[str, str, str]]:
+    if isinstance(c, m.Is):
         yield "variable", c.variable, "name"
         yield "term", c.term, "name"
         yield from (("hedge", h, "word") for h in c.hedges)
-    elif isinstance(c, Degree):
+    elif isinstance(c, m.Degree):
         yield "variable", c.variable, "name"
-    elif isinstance(c, Not):
+    elif isinstance(c, m.Not):
         yield from _condition_words(c.operand)
-    elif isinstance(c, And | Or):
+    elif isinstance(c, m.And | m.Or):
         for operand in c.operands:
             yield from _condition_words(operand)
 
 
-def _block_words(fb: FunctionBlock) -> Iterator[tuple[str, str, str, Span | None]]:
+def _block_words(fb: m.FunctionBlock) -> Iterator[tuple[str, str, str, m.Span | None]]:
     for v in fb.variables:
         yield "data type", v.data_type, "word", v.span
         if isinstance(v.initial, str):
             yield "initial value", v.initial, "word", v.span
-    blocks: list[FuzzifyBlock | DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
+    blocks: list[m.FuzzifyBlock | m.DefuzzifyBlock] = [*fb.fuzzify, *fb.defuzzify]
     for blk in blocks:
         yield "variable", blk.variable, "name", blk.span
         for t in blk.terms:
             for p in _params(t.mf):
-                if isinstance(p, Ref):
+                if isinstance(p, m.Ref):
                     yield "variable", p.name, "name", t.span
-            if isinstance(t.mf, FunctionMF):
+            if isinstance(t.mf, m.FunctionMF):
                 yield from ((*w, t.span) for w in _expr_words(t.mf.expr))
     for d in fb.defuzzify:
         for what, value in (("METHOD", d.method), ("ACCU", d.accu)):
@@ -121,14 +97,14 @@ def _block_words(fb: FunctionBlock) -> Iterator[tuple[str, str, str, Span | None
                 if c.term is not None:
                     yield "term", c.term, "name", c.span
                 yield from (("hedge", h, "word", c.span) for h in c.hedges)
-                if isinstance(c.weight, Ref):
+                if isinstance(c.weight, m.Ref):
                     yield "variable", c.weight.name, "name", c.span
     for o in fb.options:
         if o.keyword.upper() not in ("OPTIONS", "OPTION"):
             yield "options keyword", o.keyword, "bad", o.span
 
 
-def unwritable_words(fb: FunctionBlock) -> list[Diagnostic]:
+def unwritable_words(fb: m.FunctionBlock) -> list[Diagnostic]:
     """Operators, methods, hedges, data types, initial values, functions and the names rules
     and terms refer to that FCL would not read back as the same one word."""
     found: list[Diagnostic] = []

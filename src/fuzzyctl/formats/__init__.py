@@ -89,6 +89,17 @@ def on_use(module: str, function: str) -> Callable[..., Any]:
     return call
 
 
+def losses_of(adapt: Callable[[Document], tuple[Document, Sequence[tuple[str, str]]]]) -> Adapter:
+    """An :data:`Adapter` of a writer's ``adapt`` that names its losses as ``(element, reason)``
+    pairs (the PLC formats' writers, which the blocks use without the registry)."""
+
+    def adapted(document: Document) -> tuple[Document, list[Loss]]:
+        result, losses = adapt(document)
+        return result, [Loss(element, reason) for element, reason in losses]
+
+    return adapted
+
+
 @dataclass(frozen=True)
 class Format:
     """A file format: name, file extensions, size limit, reader, writer and expressibility
@@ -122,6 +133,16 @@ class Format:
         """A built-in format: its name, extensions, size limit and description from its
         entry in :mod:`fuzzyctl.formatspec`, the reader, writer, ... from ``parts``."""
         return cls(spec.name, spec.extensions, spec.description, max_bytes=spec.max_bytes, **parts)
+
+    @classmethod
+    def lazy(cls, spec: FormatSpec, **parts: Any) -> Format:
+        """:meth:`builtin`, where a part given as ``"module:function"`` names a function of the
+        format's own package (``fuzzyctl.formats.<name>.module``), imported on first use."""
+        for key, part in parts.items():
+            if isinstance(part, str):
+                module, _, function = part.partition(":")
+                parts[key] = on_use(f"fuzzyctl.formats.{spec.name}.{module}", function)
+        return cls.builtin(spec, **parts)
 
     def losses(self, document: Document) -> list[Loss]:
         """What this format cannot express of ``document`` (empty: a lossless write)."""

@@ -115,6 +115,13 @@ class Connector(abc.ABC):
         """Where this connector connects or listens, for logs and the live table."""
         return self.name
 
+    def live(self, link: T | None, state: str = "not connected") -> T:
+        """``link`` (the client or server object of a subclass), or :class:`LinkError` naming
+        :meth:`endpoint` when it is closed: ``read`` and ``write`` start with it."""
+        if link is None:
+            raise LinkError(f"{self.endpoint()}: {state}")
+        return link
+
 
 # type name in the configuration -> (module, factory function)
 CONNECTION_TYPES: dict[str, tuple[str, str]] = {

@@ -200,9 +200,7 @@ class ModbusClient(Connector):
         return response
 
     async def read(self, points: Sequence[Point]) -> list[float]:
-        client = self._client
-        if client is None:
-            raise LinkError(f"{self.endpoint()}: not connected")
+        client = self.live(self._client)
         pts: list[ModbusPoint] = list(points)  # type: ignore[arg-type]
         out = [math.nan] * len(pts)
         unit = self.options.unit
@@ -219,9 +217,7 @@ class ModbusClient(Connector):
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
-        client = self._client
-        if client is None:
-            raise LinkError(f"{self.endpoint()}: not connected")
+        client = self.live(self._client)
         for table, start, regs in plan_writes(list(points), values):  # type: ignore[arg-type]
             if table != "holding":
                 raise LinkError(f"{self.endpoint()}: input registers are read-only for a client")
@@ -325,9 +321,7 @@ class ModbusServer(Connector):
         return plan
 
     async def read(self, points: Sequence[Point]) -> list[float]:
-        server = self._server
-        if server is None:
-            raise LinkError(f"{self.endpoint()}: not serving")
+        server = self.live(self._server, "not serving")
         plan = self._plan(points)
         if plan is not None:
             return [p.decode(regs[a : a + p.width]) for regs, a, p in plan]
@@ -341,9 +335,7 @@ class ModbusServer(Connector):
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
-        server = self._server
-        if server is None:
-            raise LinkError(f"{self.endpoint()}: not serving")
+        server = self.live(self._server, "not serving")
         plan = self._plan(points)
         if plan is not None:
             for (regs, a, p), v in zip(plan, values, strict=True):

@@ -138,8 +138,7 @@ class OpcUaClient(Connector):
         return out
 
     async def read(self, points: Sequence[Point]) -> list[float]:
-        if self._client is None:
-            raise LinkError(f"{self.options.url}: not connected")
+        self.live(self._client)
         pts: list[OpcUaPoint] = list(points)  # type: ignore[arg-type]
         try:
             nodes = await self._resolve(pts)
@@ -151,8 +150,7 @@ class OpcUaClient(Connector):
         return [from_value(v) for v in values]
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
-        if self._client is None:
-            raise LinkError(f"{self.options.url}: not connected")
+        self.live(self._client)
         pts: list[OpcUaPoint] = list(points)  # type: ignore[arg-type]
         try:
             nodes = await self._resolve(pts)
@@ -277,8 +275,7 @@ class OpcUaServer(Connector):
             await self._node(p)
 
     async def read(self, points: Sequence[Point]) -> list[float]:
-        if self._server is None:
-            raise LinkError(f"{self.url}: not serving")
+        self.live(self._server, "not serving")
         out = []
         for p in points:
             assert isinstance(p, OpcUaServerPoint)
@@ -287,8 +284,7 @@ class OpcUaServer(Connector):
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
-        if self._server is None:
-            raise LinkError(f"{self.url}: not serving")
+        self.live(self._server, "not serving")
         for p, v in zip(points, values, strict=True):
             assert isinstance(p, OpcUaServerPoint)
             node = await self._node(p)

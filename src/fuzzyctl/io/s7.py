@@ -192,9 +192,7 @@ class S7Client(Connector):
         self._client = client
 
     async def read(self, points: Sequence[Point]) -> list[float]:
-        client = self._client
-        if client is None:
-            raise LinkError(f"{self.endpoint()}: not connected")
+        client = self.live(self._client)
         pts: list[S7Point] = list(points)  # type: ignore[arg-type]
         out = [math.nan] * len(pts)
         by_db: dict[int, list[int]] = {}
@@ -218,9 +216,7 @@ class S7Client(Connector):
         return out
 
     async def write(self, points: Sequence[Point], values: Sequence[float]) -> None:
-        client = self._client
-        if client is None:
-            raise LinkError(f"{self.endpoint()}: not connected")
+        client = self.live(self._client)
         cells: dict[tuple[int, int], int] = {}
         for p, v in zip(points, values, strict=True):
             assert isinstance(p, S7Point)

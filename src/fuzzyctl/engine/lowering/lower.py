@@ -484,27 +484,23 @@ def _cond(scope: _RuleScope, c: m.Condition) -> CondPlan | None:
         hs = _hedges(ctx, c.hedges, c.span, where)
         if hs is None:
             return None
-        if c.variable in chained_index:
-            names = b.chained_term_names[c.variable]
-            scope.deps.add(c.variable)
-            if c.term.lower() == "any" and c.term not in names:
+        chained = c.variable in chained_index
+        if chained or c.variable in fuzzy_index:
+            # a chained variable's accumulated degree, or a fuzzified input's term
+            leaf = CChained if chained else CTerm
+            slot = chained_index[c.variable] if chained else fuzzy_index[c.variable]
+            names = b.chained_term_names[c.variable] if chained else ctx.fuzzy_terms(c.variable)
+            if chained:
+                scope.deps.add(c.variable)
+            if c.term.lower() == "any" and c.term not in names:  # fuzzylite "x is any"
                 hs = (*hs, "any")
             if "any" in hs:
-                return CChained(chained_index[c.variable], 0, hs, c.negated)
+                return leaf(slot, 0, hs, c.negated)
             if c.term not in names:
                 ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
                 return None
-            return CChained(chained_index[c.variable], names.index(c.term), hs, c.negated)
-        if c.variable in fuzzy_index:
-            index = ctx.fuzzy_terms(c.variable)
-            if c.term.lower() == "any" and c.term not in index:  # fuzzylite "x is any"
-                hs = (*hs, "any")
-            if "any" in hs:
-                return CTerm(fuzzy_index[c.variable], 0, hs, c.negated)
-            if c.term not in index:
-                ctx.err(f"{where}: {c.variable} has no term {c.term!r}", c.span, "undeclared-term")
-                return None
-            return CTerm(fuzzy_index[c.variable], index[c.term], hs, c.negated)
+            term = names[c.term] if isinstance(names, dict) else names.index(c.term)
+            return leaf(slot, term, hs, c.negated)
         var = ctx.fb.variable(c.variable)
         if var is None:
             ctx.err(f"{where}: undeclared variable {c.variable!r}", c.span, "undeclared-variable")

@@ -4,7 +4,8 @@
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from dataclasses import dataclass
+from typing import Any, Protocol
 
 from fuzzyctl import model as m
 from fuzzyctl.engine.lowering.grid import build_grid
@@ -32,6 +33,31 @@ class BlockSoFar(Protocol):
     concluded_bare: dict[str, list[tuple[int, m.Conclusion]]]
 
     def accu_for(self, name: str, db: m.DefuzzifyBlock | None) -> str | None: ...
+
+
+@dataclass(frozen=True)
+class _Defuzzified:
+    """What every kind of plan of an output with a DEFUZZIFY block is made of."""
+
+    var: m.Variable
+    db: m.DefuzzifyBlock
+    tps: tuple[TermPlan, ...]
+    kinds: frozenset[str]
+    method: str | None
+    accu: str | None
+    contributions: tuple[Contribution, ...]
+    default: float | None
+    no_change: bool
+
+    def plan(
+        self, kind: str, method: str, accu: str | None, terms: tuple[TermPlan, ...] | None = None, **more: Any
+    ) -> OutputPlan:
+        """The output's plan as ``kind`` (``terms``: other terms than its own; ``more``: the
+        universe and grid of a Mamdani one)."""
+        tps = self.tps if terms is None else terms
+        return OutputPlan(
+            self.var.name, kind, method, accu, tps, self.contributions, self.default, self.no_change, **more
+        )
 
 
 def lower_output(ctx: LowerContext, var: m.Variable, oi: int, b: BlockSoFar) -> OutputPlan | None:
@@ -112,6 +138,7 @@ def _defuzzified(
         return None
     if ctx.options.emulate == "jfuzzylogic" and not _jfl_terms_fit(ctx, var, db, method, kinds):
         return None
+    out = _Defuzzified(var, db, tps, frozenset(kinds), method, accu, tuple(contributions), default, no_change)
     singletonish = kinds <= {"singleton", "singletons"}
     ts_terms = bool(kinds & shapes.TS_KINDS)
     if (
@@ -128,19 +155,9 @@ def _defuzzified(
                 db.span,
                 "tsukamoto-points",
             )
-        ts_accu = accu if accu is not None else ctx.options.ts_default_accu
-        return OutputPlan(
-            var.name,
-            "ts",
-            methods.ts_method(method),
-            ts_accu,
-            tps,
-            tuple(contributions),
-            default,
-            no_change,
-        )
+        return _ts_plan(ctx, out)
     if ts_terms or (singletonish and method in methods.TAKAGI_SUGENO):
-        return _ts_output(ctx, var, db, tps, kinds, method, accu, contributions, default, no_change)
+        return _ts_output(ctx, out)
     if singletonish:
         if method is not None and methods.METHODS[method].bisects:
             ctx.err(
@@ -151,7 +168,7 @@ def _defuzzified(
             return None
         meth = methods.singleton_method(method)
         s_accu = accu or ctx.options.singleton_default_accu or "MAX"
-        return OutputPlan(var.name, "singleton", meth, s_accu, tps, tuple(contributions), default, no_change)
+        return out.plan("singleton", meth, s_accu)
     if kinds & {"singleton", "singletons"}:
         ctx.err(
             f"DEFUZZIFY {var.name}: singletons cannot be mixed with fuzzy sets in one output",
@@ -159,24 +176,13 @@ def _defuzzified(
             "mixed-terms",
         )
         return None
-    return _mamdani_output(ctx, var, db, tps, kinds, method, accu, contributions, default, no_change)
+    return _mamdani_output(ctx, out)
 
 
-def _ts_output(
-    ctx: LowerContext,
-    var: m.Variable,
-    db: m.DefuzzifyBlock,
-    tps: tuple[TermPlan, ...],
-    kinds: set[str],
-    method: str | None,
-    accu: str | None,
-    contributions: list[Contribution],
-    default: float | None,
-    no_change: bool,
-) -> OutputPlan | None:
+def _ts_output(ctx: LowerContext, out: _Defuzzified) -> OutputPlan | None:
     """A Takagi-Sugeno output (constant, linear, function terms; singletons under WTAVER)."""
-    fb = ctx.fb
-    if not kinds <= shapes.TS_KINDS | {"singleton"}:
+    fb, var, db = ctx.fb, out.var, out.db
+    if not out.kinds <= shapes.TS_KINDS | {"singleton"}:
         ctx.err(
             f"DEFUZZIFY {var.name}: Takagi-Sugeno terms (constant, linear, function) "
             "cannot be mixed with fuzzy sets",
@@ -184,14 +190,16 @@ def _ts_output(
             "mixed-terms",
         )
         return None
-    if method is not None and not (method in methods.WEIGHTED or methods.METHODS[method].centroid):
+    if out.method is not None and not (
+        out.method in methods.WEIGHTED or methods.METHODS[out.method].centroid
+    ):
         ctx.err(
-            f"DEFUZZIFY {var.name}: {method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
+            f"DEFUZZIFY {var.name}: {out.method} does not apply to Takagi-Sugeno terms (use WTAVER or WTSUM)",
             db.span,
             "method-ts",
         )
         return None
-    for t in tps:
+    for t in out.tps:
         if registry.flag(t.kind, "ts_linear") and len(t.params) > len(fb.inputs) + 1:
             ctx.err(
                 f"term {var.name}.{t.name}: linear has {len(t.params)} coefficients for "
@@ -200,33 +208,19 @@ def _ts_output(
                 "linear-arity",
             )
             return None
-    ts_accu = accu if accu is not None else ctx.options.ts_default_accu
-    return OutputPlan(
-        var.name,
-        "ts",
-        methods.ts_method(method),
-        ts_accu,
-        tps,
-        tuple(contributions),
-        default,
-        no_change,
-    )
+    return _ts_plan(ctx, out)
 
 
-def _mamdani_output(
-    ctx: LowerContext,
-    var: m.Variable,
-    db: m.DefuzzifyBlock,
-    tps: tuple[TermPlan, ...],
-    kinds: set[str],
-    method: str | None,
-    accu: str | None,
-    contributions: list[Contribution],
-    default: float | None,
-    no_change: bool,
-) -> OutputPlan | None:
+def _ts_plan(ctx: LowerContext, out: _Defuzzified) -> OutputPlan:
+    """The plan of a weighted (Takagi-Sugeno or Tsukamoto) output."""
+    accu = out.accu if out.accu is not None else ctx.options.ts_default_accu
+    return out.plan("ts", methods.ts_method(out.method), accu)
+
+
+def _mamdani_output(ctx: LowerContext, out: _Defuzzified) -> OutputPlan | None:
     """A Mamdani output: its method, universe, and the grid of a constant piecewise-linear one."""
-    meth = method or "COG"
+    var, db, tps, accu = out.var, out.db, out.tps, out.accu
+    meth = out.method or "COG"
     if meth in methods.WEIGHTED:
         ctx.err(
             f"DEFUZZIFY {var.name}: {meth} needs singleton or Takagi-Sugeno terms", db.span, "method-terms"
@@ -247,23 +241,19 @@ def _mamdani_output(
             )
             for t in tps
         )
-        return OutputPlan(
-            var.name, "singleton", "COGS", accu or "MAX", point, tuple(contributions), default, no_change
-        )
+        return out.plan("singleton", "COGS", accu or "MAX", point)
     acc = accu or "MAX"
-    acts = {c.act for c in contributions}
-    exact = kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
+    acts = {c.act for c in out.contributions}
+    exact = out.kinds <= shapes.PWL_KINDS and acts <= {"MIN", "PROD"} and acc in ops.EXACT_ACCU
     grid = None
     if exact and all(t.constant for t in tps):
-        used = {c.term for c in contributions if c.term is not None}
+        used = {c.term for c in out.contributions if c.term is not None}
         grid = build_grid([t.pwl for t in tps if t.pwl is not None], low, high, used)
         if not _finite_grid(grid):
             # closed forms whose coefficients overflow (a term rising 2e-308 over 2e-308, points
             # at 1e300): the integrals are taken numerically, as for curved terms
             grid, exact = None, False
-    return OutputPlan(
-        var.name, "mamdani", meth, acc, tps, tuple(contributions), default, no_change, low, high, exact, grid
-    )
+    return out.plan("mamdani", meth, acc, low=low, high=high, exact=exact, grid=grid)
 
 
 def _finite_grid(grid: GridPlan) -> bool:

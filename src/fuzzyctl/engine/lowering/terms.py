@@ -23,6 +23,7 @@ from fuzzyctl.engine.plan import (
     PParam,
     Slot,
     TermPlan,
+    expr_nodes,
 )
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.kinds import shapes as registry
@@ -334,14 +335,4 @@ def first_terms(ctx: LowerContext, var: str, terms: Iterable[m.Term]) -> list[m.
 def uses_x(e: ExprPlan | None) -> bool:
     """Whether a function term reads ``x``: then it is a membership function of x (fuzzylite
     Function as a fuzzy set), not a Takagi-Sugeno value."""
-    if e is None:
-        return False
-    if isinstance(e, EX):
-        return True
-    if isinstance(e, EUnary):
-        return uses_x(e.operand)
-    if isinstance(e, EBinary):
-        return uses_x(e.left) or uses_x(e.right)
-    if isinstance(e, ECall):
-        return any(uses_x(a) for a in e.args)
-    return False
+    return e is not None and any(isinstance(node, EX) for node in expr_nodes(e))

@@ -4,18 +4,8 @@ reader and writer load on first use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, on_use
+from fuzzyctl.formats import Format
 from fuzzyctl.formatspec import SPECS
 
 # (through .type2: MATLAB's interval type-2 files; type-1 ones go on to .reader / .writer)
-_read = on_use("fuzzyctl.formats.fis.type2", "read")
-_write = on_use("fuzzyctl.formats.fis.type2", "write")
-_adapt = on_use("fuzzyctl.formats.fis.type2", "adapt")
-
-FORMAT = Format.builtin(
-    SPECS["fis"],
-    read=_read,
-    write=_write,
-    adapt=_adapt,
-    type2=True,
-)
+FORMAT = Format.lazy(SPECS["fis"], read="type2:read", write="type2:write", adapt="type2:adapt", type2=True)

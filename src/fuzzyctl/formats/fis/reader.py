@@ -22,7 +22,9 @@ from __future__ import annotations
 
 import math
 import re
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
+from typing import TypeVar
 
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.formats import Loaded
@@ -323,12 +325,7 @@ def _variable(
         var.terms.append(Term(unique, mf, rep.span(line)))
     declared = section.get("NumMFs")
     if declared is not None:
-        try:
-            count = parse_count(declared[0])
-        except ValueError:
-            raise rep.fail(
-                f"NumMFs must be a whole number, found {declared[0]!r}", declared[1], code="fis-number"
-            ) from None
+        count = _value(declared, parse_count, "NumMFs", "a whole number", rep)
         if count != len(var.terms):
             rep.warning(
                 f"NumMFs={count} but {len(var.terms)} membership functions are listed",
@@ -350,10 +347,19 @@ def _flag(section: _Section, key: str, rep: Reporter) -> bool:
     entry = section.get(key)
     if entry is None:
         return False
+    return _value(entry, parse_number, key, "0 or 1", rep) == 1.0
+
+
+_T = TypeVar("_T")
+
+
+def _value(entry: tuple[str, int], parse: Callable[[str], _T], key: str, what: str, rep: Reporter) -> _T:
+    """The value of ``key``'s ``(text, line)`` entry read by ``parse``; an error saying it must be
+    ``what`` when it is not."""
     try:
-        return parse_number(entry[0]) == 1.0
+        return parse(entry[0])
     except ValueError:
-        raise rep.fail(f"{key} must be 0 or 1, found {entry[0]!r}", entry[1], code="fis-number") from None
+        raise rep.fail(f"{key} must be {what}, found {entry[0]!r}", entry[1], code="fis-number") from None
 
 
 def read(text: str, path: str | None = None, *, dialect: str | None = None) -> Loaded:
@@ -387,12 +393,7 @@ def read(text: str, path: str | None = None, *, dialect: str | None = None) -> L
         entry = system_value(key)
         if entry is None:
             return None
-        try:
-            return parse_count(entry[0])
-        except ValueError:
-            raise rep.fail(
-                f"{key} must be a whole number, found {entry[0]!r}", entry[1], code="fis-number"
-            ) from None
+        return _value(entry, parse_count, key, "a whole number", rep)
 
     for key, found in (("NumInputs", len(inputs_s)), ("NumOutputs", len(outputs_s))):
         declared = count(key)
@@ -548,13 +549,7 @@ def _default(var: _Var, rep: Reporter, dialect: str) -> Default:
     entry = var.entries.get("Default")
     lock_previous = _flag(var.entries, "LockPrevious", rep)
     if entry is not None:
-        try:
-            value = parse_number(entry[0])
-        except ValueError:
-            raise rep.fail(
-                f"Default must be a number, found {entry[0]!r}", entry[1], code="fis-number"
-            ) from None
-        return Default(value, lock_previous)
+        return Default(_value(entry, parse_number, "Default", "a number", rep), lock_previous)
     if dialect == "fuzzylite":
         return Default(math.nan, lock_previous)
     # MATLAB: "no rules fired ... output set to its mean range value"

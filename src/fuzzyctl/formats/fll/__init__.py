@@ -4,16 +4,7 @@ first use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, on_use
+from fuzzyctl.formats import Format
 from fuzzyctl.formatspec import SPECS
 
-_read = on_use("fuzzyctl.formats.fll.reader", "read")
-_write = on_use("fuzzyctl.formats.fll.writer", "write")
-_adapt = on_use("fuzzyctl.formats.fll.writer", "adapt")
-
-FORMAT = Format.builtin(
-    SPECS["fll"],
-    read=_read,
-    write=_write,
-    adapt=_adapt,
-)
+FORMAT = Format.lazy(SPECS["fll"], read="reader:read", write="writer:write", adapt="writer:adapt")

@@ -26,45 +26,25 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from fuzzyctl import model as m
 from fuzzyctl.formats import Loaded
 from fuzzyctl.formats.common.basics import Reporter, parse_number
 from fuzzyctl.formats.common.expr import ExprError, parse_function
 from fuzzyctl.formats.common.terms import FLL_TS_TYPES, FLL_TYPES
 from fuzzyctl.formats.fll.names import DEFUZZIFIERS, SNORMS_ACCU, SNORMS_OR, TNORMS
 from fuzzyctl.formats.fll.rules import Lookup, RuleError, parse_rule
-from fuzzyctl.model import (
-    Default,
-    DefuzzifyBlock,
-    Document,
-    FunctionBlock,
-    FunctionMF,
-    FuzzifyBlock,
-    MembershipFunction,
-    Name,
-    Num,
-    Point,
-    PointsMF,
-    Range,
-    Rule,
-    RuleBlock,
-    ShapeMF,
-    Span,
-    Term,
-    Variable,
-    VarKind,
-)
 
 _LINE = re.compile(r"^(?P<indent>\s*)(?P<key>[A-Za-z][A-Za-z-]*)\s*:\s?(?P<value>.*)$")
 
 
 @dataclass
 class _Variable:
-    kind: VarKind
+    kind: m.VarKind
     name: str
     line: int
-    range: Range | None = None
+    range: m.Range | None = None
     clamp: bool = False
-    terms: list[Term] = field(default_factory=list)
+    terms: list[m.Term] = field(default_factory=list)
     term_names: set[str] = field(default_factory=set)
     #: the next suffix to try for each duplicated term name (see _unique_term)
     next_suffix: dict[str, int] = field(default_factory=dict)
@@ -93,9 +73,9 @@ class _Reporter(Reporter):
 
     def __init__(self, path: str | None, lines: list[str]) -> None:
         super().__init__(path, lines)
-        self.line_spans: dict[int, Span] = {}
+        self.line_spans: dict[int, m.Span] = {}
 
-    def span(self, line: int, column: int = 1, width: int = 0) -> Span:
+    def span(self, line: int, column: int = 1, width: int = 0) -> m.Span:
         if column != 1 or width:
             return super().span(line, column, width)
         span = self.line_spans.get(line)
@@ -129,26 +109,26 @@ def _term(
     var: _Variable,
     n_inputs: int,
     names: set[str],
-    leaves: dict[str, Num | Name],
-) -> Term:
+    leaves: dict[str, m.Num | m.Name],
+) -> m.Term:
     words = value.split()
     if len(words) < 2:
         raise rep.fail("term: expected 'name Class parameters'", line, code="fll-term")
     name, cls = words[0], words[1]
     rest = value.split(None, 2)[2] if len(words) > 2 else ""
-    mf: MembershipFunction
+    mf: m.MembershipFunction
     if cls == "Function":
         try:
             expr, reads = parse_function(rest, leaves)
         except ExprError as exc:
             raise rep.fail(f"Function {name!r}: {exc}", line, code="fll-function") from None
         argument = "x" if "x" in reads and "x" not in names else None
-        mf = FunctionMF(expr, rest.strip(), argument)
+        mf = m.FunctionMF(expr, rest.strip(), argument)
     elif cls == "Constant":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) != 1:
             raise rep.fail(f"Constant {name!r} takes one value, found {len(params)}", line, code="fll-term")
-        mf = ShapeMF(FLL_TS_TYPES[cls], (params[0],))
+        mf = m.ShapeMF(FLL_TS_TYPES[cls], (params[0],))
     elif cls == "Linear":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         if len(params) == n_inputs:
@@ -160,7 +140,7 @@ def _term(
                 line,
                 code="fll-term",
             )
-        mf = ShapeMF(FLL_TS_TYPES[cls], tuple(params))
+        mf = m.ShapeMF(FLL_TS_TYPES[cls], tuple(params))
     elif cls == "Discrete":
         params = _numbers(words[2:], rep, line, f"term {name!r}")
         height = params.pop() if len(params) % 2 == 1 else 1.0
@@ -169,7 +149,7 @@ def _term(
         xs, ys = params[0::2], params[1::2]
         # one pair is a constant degree (fuzzylite); the model says it with two points (5.2.2)
         xs, ys = (xs * 2, ys * 2) if len(xs) == 1 else (xs, ys)
-        mf = PointsMF(tuple(Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
+        mf = m.PointsMF(tuple(m.Point(x, y * height) for x, y in zip(xs, ys, strict=True)))
     else:
         mapping = FLL_TYPES.get(cls)
         if mapping is None:
@@ -184,7 +164,7 @@ def _term(
                 code="fll-term",
             )
         height = params[mapping.arity] if len(params) > mapping.arity else 1.0
-        mf = ShapeMF(mapping.kind, mapping.to_model(params), height)
+        mf = m.ShapeMF(mapping.kind, mapping.to_model(params), height)
     unique = _unique_term(name, var)
     if unique != name:
         rep.warning(
@@ -193,7 +173,7 @@ def _term(
             line,
             code="duplicate-term",
         )
-    return Term(unique, mf, rep.span(line))
+    return m.Term(unique, mf, rep.span(line))
 
 
 def _unique_term(name: str, var: _Variable) -> str:
@@ -228,16 +208,16 @@ def read(text: str, path: str | None = None) -> Loaded:
         line = raw.split("#", 1)[0].rstrip()
         if not line.strip():
             continue
-        m = _LINE.match(line)
-        if m is None:
+        found = _LINE.match(line)
+        if found is None:
             raise rep.fail("expected 'key: value'", number, code="fll-syntax")
-        key, value = m.group("key"), m.group("value").strip()
+        key, value = found.group("key"), found.group("value").strip()
         if key == "Engine":
             engine_name, engine_line, saw_engine, current = (value or None), number, True, None
         elif key in {"InputVariable", "OutputVariable"}:
             if not value:
                 raise rep.fail(f"{key} needs a name", number, code="fll-syntax")
-            kind = VarKind.INPUT if key == "InputVariable" else VarKind.OUTPUT
+            kind = m.VarKind.INPUT if key == "InputVariable" else m.VarKind.OUTPUT
             current = _Variable(kind, value.split()[0], number)
             variables.append(current)
         elif key == "RuleBlock":
@@ -269,18 +249,18 @@ def read(text: str, path: str | None = None) -> Loaded:
             if v.name in seen:
                 raise rep.fail(f"two variables are called {v.name!r}", v.line, code="duplicate-variable")
             seen.add(v.name)
-    n_inputs = sum(1 for v in variables if v.kind is VarKind.INPUT)
-    leaves: dict[str, Num | Name] = {}  # the Function terms' numbers and names, one object each
+    n_inputs = sum(1 for v in variables if v.kind is m.VarKind.INPUT)
+    leaves: dict[str, m.Num | m.Name] = {}  # the Function terms' numbers and names, one object each
     for var, value, number in pending_terms:
         var.terms.append(_term(value, rep, number, var, n_inputs, names, leaves))
     rule_blocks = _rule_blocks(blocks, variables, rep)
     rep.raise_if_errors()
-    inputs = [v for v in variables if v.kind is VarKind.INPUT]
-    outputs = [v for v in variables if v.kind is VarKind.OUTPUT]
-    fb = FunctionBlock(
+    inputs = [v for v in variables if v.kind is m.VarKind.INPUT]
+    outputs = [v for v in variables if v.kind is m.VarKind.OUTPUT]
+    fb = m.FunctionBlock(
         name=engine_name,
         variables=tuple(
-            Variable(
+            m.Variable(
                 v.name,
                 v.kind,
                 range=v.range,
@@ -290,15 +270,15 @@ def read(text: str, path: str | None = None) -> Loaded:
             for v in variables
         ),
         fuzzify=tuple(
-            FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.line), clamp=v.clamp) for v in inputs
+            m.FuzzifyBlock(v.name, tuple(v.terms), v.range, rep.span(v.line), clamp=v.clamp) for v in inputs
         ),
         defuzzify=tuple(
-            DefuzzifyBlock(
+            m.DefuzzifyBlock(
                 v.name,
                 tuple(v.terms),
                 v.range,
                 v.method,
-                Default(v.default, v.lock_previous),
+                m.Default(v.default, v.lock_previous),
                 v.accu,
                 rep.span(v.line),
                 clamp=v.clamp,
@@ -308,23 +288,23 @@ def read(text: str, path: str | None = None) -> Loaded:
         rule_blocks=tuple(rule_blocks),
         span=rep.span(engine_line),
     )
-    return Loaded(Document((fb,), path), rep.warnings)
+    return Loaded(m.Document((fb,), path), rep.warnings)
 
 
-def _rule_blocks(blocks: list[_Block], variables: list[_Variable], rep: Reporter) -> list[RuleBlock]:
+def _rule_blocks(blocks: list[_Block], variables: list[_Variable], rep: Reporter) -> list[m.RuleBlock]:
     lookup: Lookup = {
-        v.name: (v.name, v.kind is VarKind.OUTPUT, {t: t for t in v.term_names}) for v in variables
+        v.name: (v.name, v.kind is m.VarKind.OUTPUT, {t: t for t in v.term_names}) for v in variables
     }
-    out: list[RuleBlock] = []
+    out: list[m.RuleBlock] = []
     for block in blocks:
-        rules: list[Rule] = []
+        rules: list[m.Rule] = []
         for i, (text, number) in enumerate(block.rules, start=1):
             try:
                 rules.append(parse_rule(text, str(i), rep.span(number), lookup))
             except RuleError as exc:
                 raise rep.fail(f"rule: {exc}", number, code="fll-rule") from None
         out.append(
-            RuleBlock(
+            m.RuleBlock(
                 block.name,
                 tuple(rules),
                 block.and_op,
@@ -347,7 +327,7 @@ def _variable_key(
     number: int,
     pending_terms: list[tuple[_Variable, str, int]],
 ) -> None:
-    output = var.kind is VarKind.OUTPUT
+    output = var.kind is m.VarKind.OUTPUT
     if key == "enabled":
         if not _bool(value, rep, number, key):
             raise rep.fail(
@@ -365,7 +345,7 @@ def _variable_key(
                 number,
                 code="fll-value",
             )
-        var.range = Range(numbers[0], numbers[1], rep.span(number))
+        var.range = m.Range(numbers[0], numbers[1], rep.span(number))
     elif key == "lock-range":
         var.clamp = _bool(value, rep, number, key)
     elif key == "term":

@@ -4,17 +4,8 @@ use."""
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, on_use
+from fuzzyctl.formats import Format
 from fuzzyctl.formatspec import SPECS
 from fuzzyctl.validation import at_json_paths
 
-_read = on_use("fuzzyctl.formats.json.reader", "read")
-_write = on_use("fuzzyctl.formats.json.writer", "dumps")
-
-FORMAT = Format.builtin(
-    SPECS["json"],
-    read=_read,
-    write=_write,
-    place=at_json_paths,
-    type2=True,
-)
+FORMAT = Format.lazy(SPECS["json"], read="reader:read", write="writer:dumps", place=at_json_paths, type2=True)

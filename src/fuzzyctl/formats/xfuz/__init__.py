@@ -4,28 +4,9 @@ layout the XFUZ block shares in :mod:`.tables`.  The reader and writer load on f
 
 from __future__ import annotations
 
-from fuzzyctl.formats import Format, Loaded, Loss
+from fuzzyctl.formats import Format, Loss, losses_of, on_use
 from fuzzyctl.formatspec import SPECS
 from fuzzyctl.model import Document
-
-
-def _read(text: str, path: str | None) -> Loaded:
-    from fuzzyctl.formats.xfuz.reader import read
-
-    return read(text, path)
-
-
-def _write(document: Document) -> str:
-    from fuzzyctl.formats.xfuz.writer import write_xfuz
-
-    return write_xfuz(document)
-
-
-def _adapt(document: Document) -> tuple[Document, list[Loss]]:
-    from fuzzyctl.formats.xfuz.writer import adapt_xfuz
-
-    adapted, losses = adapt_xfuz(document)
-    return adapted, [Loss(element, reason) for element, reason in losses]
 
 
 def _notes(document: Document) -> list[Loss]:
@@ -34,10 +15,10 @@ def _notes(document: Document) -> list[Loss]:
     return [Loss(element, reason) for element, reason in notes(document)]
 
 
-FORMAT = Format.builtin(
+FORMAT = Format.lazy(
     SPECS["xfuz"],
-    read=_read,
-    write=_write,
-    adapt=_adapt,
+    read="reader:read",
+    write="writer:write_xfuz",
+    adapt=losses_of(on_use("fuzzyctl.formats.xfuz.writer", "adapt_xfuz")),
     notes=_notes,
 )

@@ -41,6 +41,7 @@ from collections.abc import Iterator
 from dataclasses import replace
 from typing import Any
 
+from fuzzyctl import model as m
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, Severity, error, warning
 from fuzzyctl.fcl.identifiers import fcl_name
 from fuzzyctl.formats import Loaded
@@ -60,29 +61,6 @@ from fuzzyctl.formats.xfuz.tables import (
     slot_kind,
 )
 from fuzzyctl.limits import shorten
-from fuzzyctl.model import (
-    And,
-    Conclusion,
-    Condition,
-    Default,
-    DefuzzifyBlock,
-    Document,
-    FunctionBlock,
-    FuzzifyBlock,
-    Is,
-    MembershipFunction,
-    OptionsBlock,
-    Point,
-    PointsMF,
-    Range,
-    Rule,
-    RuleBlock,
-    SingletonMF,
-    Span,
-    Term,
-    Variable,
-    VarKind,
-)
 
 # --------------------------------------------------------------------------- table files
 
@@ -183,7 +161,7 @@ def _read_csv(text: str, path: str | None) -> XfuzConstants:
         cells = [c.strip() for c in row]
         if cells[0].lower() == "table" and len(cells) > 2 and cells[2].lower() == "value":
             continue  # the header row
-        span = Span(lineno, 1)
+        span = m.Span(lineno, 1)
         if len(cells) < 3:
             diags.append(error("expected table,index,value[,note]", span, code="xfuz-csv", file=path))
             continue
@@ -243,7 +221,7 @@ def _csv_rows(text: str, path: str | None, diags: list[Diagnostic]) -> Iterator[
         except StopIteration:
             return
         except csv.Error as exc:
-            diags.append(error(f"not a CSV row: {exc}", Span(start, 1), code="xfuz-csv", file=path))
+            diags.append(error(f"not a CSV row: {exc}", m.Span(start, 1), code="xfuz-csv", file=path))
             continue
         yield start, row
 
@@ -261,9 +239,9 @@ __all__ = ["model_from_constants", "read", "read_tables", "read_xfuz"]
 # --------------------------------------------------------------------------- tables -> model
 
 
-def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
+def _mf_model(mf: XMembership, singleton: bool) -> m.MembershipFunction:
     if singleton:
-        return SingletonMF(float(mf.singleton()))
+        return m.SingletonMF(float(mf.singleton()))
     a, b, c, d = (float(x) for x in mf.points)
     left_open, right_open = mf.a == OPEN_LOW and mf.b == OPEN_LOW, mf.c == OPEN_HIGH and mf.d == OPEN_HIGH
     pts: list[tuple[float, float]]
@@ -277,7 +255,7 @@ def _mf_model(mf: XMembership, singleton: bool) -> MembershipFunction:
         pts = [(a, 0.0), (b, 1.0), (d, 0.0)]
     else:
         pts = [(a, 0.0), (b, 1.0), (c, 1.0), (d, 0.0)]
-    return PointsMF(tuple(Point(float(x), y) for x, y in pts))
+    return m.PointsMF(tuple(m.Point(float(x), y) for x, y in pts))
 
 
 def _options_text(c: XfuzConstants, renamed: list[tuple[str, str]], discr: list[tuple[str, int]]) -> str:
@@ -288,7 +266,7 @@ def _options_text(c: XfuzConstants, renamed: list[tuple[str, str]], discr: list[
     return "\n".join(lines)
 
 
-def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[FunctionBlock, list[Diagnostic]]:
+def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[m.FunctionBlock, list[Diagnostic]]:
     """Decode the tables into a function block.  Errors (a table that cannot be decoded)
     and warnings (what the block would flag in STATUS, what changes on the way) come back
     as diagnostics; the block is only meaningful when there is no error."""
@@ -337,10 +315,12 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
             names[v.slot] = label
     # Variables in the order their functions appear in FA, then the ones without functions.
     order = list(
-        dict.fromkeys([m.slot for m in kb.memberships if 0 <= m.slot < 18] + [v.slot for v in kb.variables])
+        dict.fromkeys(
+            [ms.slot for ms in kb.memberships if 0 <= ms.slot < 18] + [v.slot for v in kb.variables]
+        )
     )
     term_names: dict[int, str] = {}
-    terms: dict[int, list[Term]] = {slot: [] for slot in order}
+    terms: dict[int, list[m.Term]] = {slot: [] for slot in order}
     last_slot, regrouped = -1, False
     for mf in kb.memberships:
         if not 0 <= mf.slot < 18:
@@ -374,7 +354,7 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
                     code="xfuz-singleton",
                 )
             )
-        terms[mf.slot].append(Term(tname, _mf_model(mf, singleton)))
+        terms[mf.slot].append(m.Term(tname, _mf_model(mf, singleton)))
     if regrouped:
         diags.append(
             warning(
@@ -388,56 +368,56 @@ def model_from_constants(c: XfuzConstants, *, name: str = "xfuz") -> tuple[Funct
         kb.memberships[n].slot for r in kb.rules for n, _ in r.predicates if 0 <= n < len(kb.memberships)
     }
     method = "COGS" if c.out_pt else ("MOM" if c.op_defuz == 1 else "COG")
-    variables: list[Variable] = []
-    fuzzify: list[FuzzifyBlock] = []
-    defuzzify: list[DefuzzifyBlock] = []
+    variables: list[m.Variable] = []
+    fuzzify: list[m.FuzzifyBlock] = []
+    defuzzify: list[m.DefuzzifyBlock] = []
     discr: list[tuple[str, int]] = []
     for slot in order:
         v = kb.variable(slot)
         kind = slot_kind(slot)
         vname = names[slot]
-        rng = Range(float(v.low), float(v.high)) if (v.low, v.high) != (0, 0) else None
-        vk = {SlotKind.INPUT: VarKind.INPUT, SlotKind.OUTPUT: VarKind.OUTPUT}.get(kind, VarKind.LOCAL)
-        variables.append(Variable(vname, vk, "INT", range=rng))
+        rng = m.Range(float(v.low), float(v.high)) if (v.low, v.high) != (0, 0) else None
+        vk = {SlotKind.INPUT: m.VarKind.INPUT, SlotKind.OUTPUT: m.VarKind.OUTPUT}.get(kind, m.VarKind.LOCAL)
+        variables.append(m.Variable(vname, vk, "INT", range=rng))
         tt = tuple(terms[slot])
         if (kind is SlotKind.INPUT or slot in as_predicate) and tt:
-            fuzzify.append(FuzzifyBlock(vname, tt))
+            fuzzify.append(m.FuzzifyBlock(vname, tt))
         if kind is not SlotKind.INPUT:
             discr.append((vname, v.discr))
             if tt:
-                default = Default(float(c.o_def[slot - 8])) if kind is SlotKind.OUTPUT else None
-                defuzzify.append(DefuzzifyBlock(vname, tt, range=rng, method=method, default=default))
-    rules: list[Rule] = []
+                default = m.Default(float(c.o_def[slot - 8])) if kind is SlotKind.OUTPUT else None
+                defuzzify.append(m.DefuzzifyBlock(vname, tt, range=rng, method=method, default=default))
+    rules: list[m.Rule] = []
     for rule in kb.rules:
-        conds: list[Condition] = []
+        conds: list[m.Condition] = []
         for number, negated in rule.predicates:
             pred_mf = kb.membership(number)
             if pred_mf is None or not 0 <= pred_mf.slot < 18:
                 continue
-            conds.append(Is(names[pred_mf.slot], term_names[number], negated=negated))
+            conds.append(m.Is(names[pred_mf.slot], term_names[number], negated=negated))
         concl = tuple(
-            Conclusion(names[kb.memberships[n].slot], term_names[n])
+            m.Conclusion(names[kb.memberships[n].slot], term_names[n])
             for n in rule.conclusions
             if 0 <= n < len(kb.memberships) and n in term_names
         )
-        cond: Condition | None = conds[0] if len(conds) == 1 else (And(tuple(conds)) if conds else None)
-        rules.append(Rule(str(rule.number), cond, concl))
+        cond: m.Condition | None = conds[0] if len(conds) == 1 else (m.And(tuple(conds)) if conds else None)
+        rules.append(m.Rule(str(rule.number), cond, concl))
     rules, fuzzify = _rules_without_if(kb, rules, fuzzify, term_names)
     ops = {0: "MIN", 1: "PROD"}
-    block = FunctionBlock(
+    block = m.FunctionBlock(
         name,
         tuple(variables),
         tuple(fuzzify),
         tuple(defuzzify),
-        (RuleBlock("xfuz", tuple(rules), and_op=ops[c.op_et], act=ops[c.op_impl], accu="MAX"),),
-        (OptionsBlock(_options_text(c, renamed, discr)),),
+        (m.RuleBlock("xfuz", tuple(rules), and_op=ops[c.op_et], act=ops[c.op_impl], accu="MAX"),),
+        (m.OptionsBlock(_options_text(c, renamed, discr)),),
     )
     return block, diags
 
 
 def _rules_without_if(
-    kb: KnowledgeBase, rules: list[Rule], fuzzify: list[FuzzifyBlock], term_names: dict[int, str]
-) -> tuple[list[Rule], list[FuzzifyBlock]]:
+    kb: KnowledgeBase, rules: list[m.Rule], fuzzify: list[m.FuzzifyBlock], term_names: dict[int, str]
+) -> tuple[list[m.Rule], list[m.FuzzifyBlock]]:
     """The form the writer gives a rule without an IF part (Siemens 1.5), read back: a rule
     whose only predicate is an input function named ``ALWAYS`` (``ALWAYS2``, ...) open on both
     sides (1 for every input word) has no IF part; the function goes when no rule is left
@@ -451,15 +431,15 @@ def _rules_without_if(
         and (mf.a, mf.b, mf.c, mf.d) == (OPEN_LOW, OPEN_LOW, OPEN_HIGH, OPEN_HIGH)
     }
 
-    def bare(cond: Condition | None) -> bool:
-        return isinstance(cond, Is) and not cond.negated and cond.term in always
+    def bare(cond: m.Condition | None) -> bool:
+        return isinstance(cond, m.Is) and not cond.negated and cond.term in always
 
     if not any(bare(r.condition) for r in rules):
         return rules, fuzzify
     carried = {
         (r.condition.variable, r.condition.term)
         for r in rules
-        if isinstance(r.condition, Is) and bare(r.condition)
+        if isinstance(r.condition, m.Is) and bare(r.condition)
     }
     rules = [replace(r, condition=None) if bare(r.condition) else r for r in rules]
     still = {(leaf.variable, leaf.term) for r in rules for leaf in _predicates(r.condition)}
@@ -470,15 +450,15 @@ def _rules_without_if(
     return rules, [f for f in fuzzify if f.terms]
 
 
-def _predicates(cond: Condition | None) -> Iterator[Is]:
-    if isinstance(cond, Is):
+def _predicates(cond: m.Condition | None) -> Iterator[m.Is]:
+    if isinstance(cond, m.Is):
         yield cond
-    elif isinstance(cond, And):
+    elif isinstance(cond, m.And):
         for c in cond.operands:
             yield from _predicates(c)
 
 
-def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
+def _decode(text: str, path: str | None) -> tuple[m.Document, list[Diagnostic]]:
     constants = read_tables(text, path=path)
     stem = (path or "xfuz").replace("\\", "/").rsplit("/", 1)[-1].split(".", 1)[0]
     block, diags = model_from_constants(constants, name=stem if fcl_name(stem) else "xfuz")
@@ -495,10 +475,10 @@ def _decode(text: str, path: str | None) -> tuple[Document, list[Diagnostic]]:
     diags = [replace(d, file=path) for d in diags]
     if any(d.is_error for d in diags):
         raise DiagnosticError(diags, text)
-    return Document((block,), path=path), diags
+    return m.Document((block,), path=path), diags
 
 
-def read_xfuz(text: str, *, path: str | None = None) -> Document:
+def read_xfuz(text: str, *, path: str | None = None) -> m.Document:
     """Read a table file into a Document (raises DiagnosticError when it cannot be decoded)."""
     return _decode(text, path)[0]
 
