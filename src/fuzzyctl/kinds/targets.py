@@ -365,6 +365,23 @@ C = Target(
     report=True,
 )
 
+#: The native evaluator of ``compile()`` (ir/render/c.py ``render_native``): the C above,
+#: compiled on the host with its libm, whose ``sqrt`` is the correctly rounded square root
+#: (the reference's ``math.sqrt``, one instruction): the CoA's root costs no Newton
+#: iterations.  Not a CLI choice.
+NATIVE_C = dataclasses.replace(
+    C,
+    name="native",
+    label="native C",
+    functions=MappingProxyType({**C.functions, "SQRT": "sqrt"}),
+    library=C.library | {"SQRT"},
+    cli=None,
+    cli_help="",
+    generator="",
+    cli_options=frozenset(),
+    report=False,
+)
+
 _PY_KERNELS = frozenset({"HOLD", "AM_LINES", "SELECT", "EXPR", "MEMBER", "TS", "MAMDANI"})
 
 #: The evaluator of ``compile()`` as one Python function (ir/render/pysrc.py).

@@ -25,6 +25,11 @@ share it (the reference is :mod:`fuzzyctl.engine.reference.quadrature`):
    the bounded work a PLC cycle needs.  A panel accepted short of the tolerance (cap
    reached) sets INFO 16#04.
 
+A function term of x alone (the native evaluator; the PLC block refuses it) is the IR of its
+expression at x; a set of no degree is left out (it may be negative or NaN), NaN wins under
+MAX, and a panel that is not finite makes the output NaN (:func:`undefined`), as in the
+reference.
+
 Calibration (generation time) halves each interval until the :data:`NODES`-point and
 ``2*NODES``-point Gauss-Legendre rules agree on every term to :data:`PANEL_TOL`: it makes the
 sampling of step 2 dense where terms are narrow.  The error aimed at (:func:`cog_bound`, in
@@ -43,9 +48,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from fuzzyctl.engine.lowering.grid import left_limit, right_limit
-from fuzzyctl.engine.plan import OutputPlan, Slot, TermPlan
+from fuzzyctl.engine.plan import EX, EBinary, ECall, ENum, EUnary, ExprPlan, OutputPlan, Slot, TermPlan
 from fuzzyctl.engine.reference.pwl import gauss_legendre
 from fuzzyctl.engine.semantics import shapes
+from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import ACT_LEVELS, CLIP_BRANCH
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Num, Var, not_
@@ -82,12 +88,49 @@ class Calibration:
 
 
 def constant_term(t: TermPlan) -> bool:
+    """Parameters known when the code is generated (a function term: of x and constants
+    only; one reading inputs or outputs changes with them, and the calibration below
+    samples every term then)."""
+    if t.kind == "function":
+        return _of_x_only(t.expr)
     return not isinstance(t.height, Slot) and not any(isinstance(p, Slot) for p in t.params)
+
+
+def _of_x_only(e: ExprPlan | None) -> bool:
+    if isinstance(e, ENum | EX):
+        return True
+    if isinstance(e, EUnary):
+        return _of_x_only(e.operand)
+    if isinstance(e, EBinary):
+        return _of_x_only(e.left) and _of_x_only(e.right)
+    if isinstance(e, ECall):
+        return all(_of_x_only(a) for a in e.args)
+    return False  # an input, an output (or none)
+
+
+def has_function_terms(op: OutputPlan, sets: list[SmoothSet]) -> bool:
+    """A set's term is a function term: it may be negative, NaN or infinite (a 0/0), which
+    the reference answers with NaN (engine/reference/interp.py ``_smooth``)."""
+    return any(op.terms[s.term].kind == "function" for s in sets)
+
+
+def _no_outputs(_o: int) -> Ex:
+    raise AssertionError("a function of x alone reads no output")
+
+
+def finite(v: Ex) -> Ex:
+    """``v`` is neither infinite nor NaN (``v - v`` is 0 only then)."""
+    return (v - v).eq(0.0)
 
 
 def _degree_np(t: TermPlan, x: np.ndarray) -> np.ndarray:
     if t.pwl is not None:
         return shapes.pwl_value_np(t.pwl, x)
+    if t.kind == "function":
+        assert t.expr is not None
+        y = np.broadcast_to(np.asarray(eval_expr_np(t.expr, [], [], x), dtype=np.float64), x.shape)
+        # a 0/0 somewhere calibrates nothing (the run time answers NaN there)
+        return np.where(np.isfinite(y), y, 0.0)
     return shapes.membership_np(t.kind, [float(p) for p in t.params], float(t.height), x)  # type: ignore[arg-type]
 
 
@@ -98,6 +141,8 @@ def _breakpoints(op: OutputPlan) -> list[float]:
     for t in op.terms:
         if t.pwl is not None:
             cand = [x for x, _y in t.pwl]
+        elif t.kind == "function":
+            cand = []  # no characteristic points known (the reference's cuts: none either)
         else:
             cand = list(shapes.characteristic_points(t.kind, [float(p) for p in t.params]))  # type: ignore[arg-type]
         pts.update(c for c in cand if lo < c < hi and math.isfinite(c))
@@ -203,6 +248,9 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
         mu: Ex
         if term.pwl is not None:
             mu = _const_pwl(g, term.pwl, x)
+        elif term.kind == "function":
+            assert term.expr is not None
+            mu = T.expression(g, term.expr, [], _no_outputs, x, where)
         else:
             ps: list[Ex] = [Num(float(p)) for p in term.params]  # type: ignore[arg-type]
             mu = T.smooth(g, term.kind, ps, x, where)
@@ -214,6 +262,11 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
             # the clipping edge as the reference's branch tests it (operators.CLIP_BRANCH)
             flag(mu.ge(level) if s.act in CLIP_BRANCH and (offset, slope) == (0.0, 1.0) else mu.gt(level))
         c = g.let(T.mul(s.w, T.tnorm(g, s.act, s.a, mu)), "C")
+        if term.kind == "function":
+            # the reference leaves out a set of no degree (a function term may be negative
+            # or NaN where min(0, mu) would not be 0)
+            with b.if_(not_((s.a * s.w).gt(0.0))):
+                b.set(c, 0.0)
         if accu in ("MAX", "NIPMAX"):
             flag(c.gt(acc))
         if accu == "NIPMAX":
@@ -221,6 +274,10 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
         if accu == "DMAX":
             flag(c.gt(0.0).and_(acc.gt(0.0)))
         T.accumulate_into(g, accu, acc, c)
+        if term.kind == "function":
+            # NaN wins, as in the reference's numpy (MAX's ``c > acc`` alone would drop it)
+            with b.if_(c.ne(c)):
+                b.set(acc, c)
     if accu == "BSUM":
         flag(acc.ge(1.0))
     return acc, code
@@ -238,18 +295,29 @@ def smooth_cog(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) 
     area, mom = g.let(0.0, "QA"), g.let(0.0, "QM")
     value, fired = g.temp(hint="Y"), g.temp("BOOL", "FIRED")
     capped = g.let(False, "QCAPPED", "BOOL")
+    bad = g.let(False, "QBAD", "BOOL") if has_function_terms(op, sets) else None
 
     def accept(u: Var, d: Var, ka: Var, km: Var, ys: Var | None) -> None:
         b.set(area, area + ka * d)
         b.set(mom, mom + km * d)
 
-    panels(g, op, sets, accu, pts, n, capped, accept)
+    panels(g, op, sets, accu, pts, n, capped, accept, bad=bad)
     b.set(fired, area.gt(0.0))
     with b.if_(fired):
         b.set(value, float(op.low or 0.0) + mom / area)
     with b.else_():
         b.set(value, 0.0)
+    if bad is not None:
+        undefined(g, bad, value, fired)
     return value, fired, capped
+
+
+def undefined(g: Gen, bad: Var, value: Var, fired: Var) -> None:
+    """A panel was not finite (a function term's 0/0): the output is NaN, fired - not the
+    DEFAULT of "no rule fired" (the reference's ``_smooth``)."""
+    with g.b.if_(bad):
+        g.b.set(fired, True)
+        g.b.set(value, g.call("NAN"))
 
 
 def smooth_pieces(g: Gen, op: OutputPlan, sets: list[SmoothSet], cal: Calibration) -> tuple[Var, Var]:
@@ -312,6 +380,7 @@ def panels(
     capped: Var,
     accept: Accept,
     keep_nodes: bool = False,
+    bad: Var | None = None,
 ) -> None:
     """Step 3: the set over the pieces ``pts[0..n-1]`` by adaptive Gauss-Kronrod 7/15: a
     panel is accepted when Kronrod and Gauss agree to :data:`QTOL` per unit of width (area;
@@ -323,7 +392,9 @@ def panels(
     With ``keep_nodes`` the panels have 17 nodes (their ends too, with no weight), kept in
     the table passed to ``accept``, and a piece too narrow to integrate is a panel of no
     width (its start is a node of LM/RM/MoM: an isolated point where a drastic sum reaches
-    1 lies between two such pieces)."""
+    1 lies between two such pieces).  With ``bad`` (function terms), a panel whose area or
+    moment is not finite is accepted at once and sets ``bad`` (the reference's NaN: no
+    halving makes it a number)."""
     from fuzzyctl.engine.reference.quadrature import NODES as GKX
     from fuzzyctl.engine.reference.quadrature import WG as GKG
     from fuzzyctl.engine.reference.quadrature import WK as GKK
@@ -350,7 +421,7 @@ def panels(
     sp = g.let(0, "QSP", "INT")
     used = g.let(0, "QUSED", "DINT")
     p = g.counter("QP")
-    v = (xs, wk, wg, tol, sl, sr, ys, sp, used)
+    v = (xs, wk, wg, tol, sl, sr, ys, sp, used, bad)
     # pieces narrower than PIECE_MIN of the range are left out: bisection brackets a point to
     # a few ulps, and a node there would give an isolated point (DMIN's peak) a positive area
     with b.for_(p, 0, n - 2) as pv:
@@ -371,12 +442,12 @@ def _wide_piece(
     width: float,
     capped: Var,
     accept: Accept,
-    v: tuple[Var, Var, Var, Var, Var, Var, Var | None, Var, Var],
+    v: tuple[Var, Var, Var, Var, Var, Var, Var | None, Var, Var, Var | None],
 ) -> None:
     """The panels of piece ``pv`` of :func:`panels` (``v``: its tables and variables)."""
     b = g.b
     low = float(op.low or 0.0)
-    xs, wk, wg, tol, sl, sr, ys, sp, used = v
+    xs, wk, wg, tol, sl, sr, ys, sp, used, bad = v
     wide = (pts[pv + 1] - pts[pv]).gt(PIECE_MIN * width)
     with b.if_(wide) if ys is None else contextlib.nullcontext():
         b.set(sl[0], pts[pv])
@@ -403,7 +474,12 @@ def _wide_piece(
                 b.set(ga, ga + wg[kv] * y)
                 b.set(gm, gm + wg[kv] * ym)
             b.set(used, used + 1)
-            ok = g.call("ABS", ka - ga).le(tol).and_(g.call("ABS", km - gm).le(tol * width))
+            ok: Ex = g.call("ABS", ka - ga).le(tol).and_(g.call("ABS", km - gm).le(tol * width))
+            if bad is not None:
+                nonfinite = g.let(not_(finite(ka).and_(finite(km))), "QNF", "BOOL")
+                with b.if_(nonfinite):
+                    b.set(bad, True)
+                ok = ok.or_(nonfinite)
             mid = g.let(u + 0.5 * d, "QMID")
             # a panel a few ulps wide holds a jump the bisection placed to the last bit: its
             # share is rounding, not a missed tolerance (no halving, no INFO)

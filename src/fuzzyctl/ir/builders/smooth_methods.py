@@ -74,6 +74,7 @@ def _bisector(
     found = g.let(False, "FOUND", "BOOL")
     lu, ld, lk, lb = (g.let(0.0, h) for h in ("LU", "LD", "LK", "LB"))
     ru, rd, rk, rb = (g.let(0.0, h) for h in ("RU", "RD", "RK", "RB"))
+    bad = g.let(False, "QBAD", "BOOL") if Q.has_function_terms(op, sets) else None
     # two visits of the same panels (one copy of the set's code): the total area, then the
     # panels where the area from the left and from the right reach half
     ps = g.counter("PASS")
@@ -96,7 +97,7 @@ def _bisector(
                             b.set(var, val)
                 b.set(cum, cum + k)
 
-            Q.panels(g, op, sets, accu, pts, n, g.let(False, "QCAPPED", "BOOL"), visit)
+            Q.panels(g, op, sets, accu, pts, n, g.let(False, "QCAPPED", "BOOL"), visit, bad=bad)
             b.set(half, 0.5 * total)
             b.set(tol, max(COA_TOL, 10.0 * rtol) * total)
             b.set(cum, 0.0)
@@ -126,6 +127,8 @@ def _bisector(
             with b.else_():
                 b.set(side[jv], _solve(g, op, sets, a, d, tgt))
         b.set(value, 0.5 * (side[0] + side[1]))
+    if bad is not None:
+        Q.undefined(g, bad, value, fired)
     return value, fired
 
 
@@ -176,7 +179,8 @@ def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, w
     b = g.b
     accu = op.accu or "MAX"
     area = g.let(0.0, "QA")
-    top = g.let(0.0, "TOP")  # the set is never below 0 (no function terms here)
+    top = g.let(0.0, "TOP")  # a set below 0 (a function term) has no maximum that fires
+    bad = g.let(False, "QBAD", "BOOL") if Q.has_function_terms(op, sets) else None
     count, last = g.let(0, "NACC", "DINT"), g.let(0, "LACC", "DINT")
     w = _Window(g, op, sets, top)
     xs = Q.gk_nodes(g, ends=True)
@@ -202,11 +206,13 @@ def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, w
                         b.set(top, g.max_(top, ys[kv], "TOP"))
 
             capped = g.let(False, "QCAPPED", "BOOL")
-            Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True)
+            Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True, bad=bad)
     value = g.let(0.0, "Y")
     fired = g.let(area.gt(0.0).and_(top.gt(0.0)), "FIRED", "BOOL")
     with b.if_(fired):
         b.set(value, w.result(which))
+    if bad is not None:
+        Q.undefined(g, bad, value, fired)
     return value, fired
 
 

@@ -4,6 +4,8 @@
 No allocation, no globals besides constant tables; libm only for ``exp`` (smooth shapes):
 ``sqrt`` (exact CoA, some shapes and hedges), ``pow``, ``cos`` and the functions of function
 terms are static helpers of :mod:`fuzzyctl.ir.render.c_helpers`, emitted only when used.
+The native evaluator (:func:`render_native`, compiled on the host) takes ``sqrt`` from libm
+too (:data:`fuzzyctl.kinds.targets.NATIVE_C`).
 """
 
 from __future__ import annotations
@@ -40,7 +42,14 @@ C = targets.C
 # libm itself is used for ``exp`` only; every other intrinsic is one of the static helpers
 # of :mod:`fuzzyctl.ir.render.c_helpers` (written with + - * / and exp), emitted on demand.
 _LIBM = {f: C.functions[f] for f in C.library}
-_HELPER_OF = {f: spelled for f, spelled in C.functions.items() if f not in C.library}
+
+
+def _helper_of(target: targets.Target) -> dict[str, str]:
+    """Intrinsic -> the static helper spelling it (those not taken from libm)."""
+    return {f: spelled for f, spelled in target.functions.items() if f not in target.library}
+
+
+_HELPER_OF = _helper_of(C)
 
 
 def helper_functions(prog: Program) -> list[str]:
@@ -264,7 +273,7 @@ class _Native(_C):
     (every variable is an ``FZ_`` identifier; comments are not printed)."""
 
     def __init__(self, fp: FastProgram) -> None:
-        super().__init__(fp.program, False)
+        super().__init__(fp.program, False, targets.NATIVE_C)
         self.comments = False  # no model text in the native evaluator
         self.fp = fp
         self.real = "double"
@@ -390,8 +399,8 @@ def render_native(fp: FastProgram, tables: dict[str, bytes] | None = None) -> st
             continue
         vals = ", ".join(str(int(v)) if d.type != "REAL" else r.num(v) for v in d.init)
         c.append(f"static const {ctype} fz_c_{d.name}[{d.size}] = {{{vals}}};")
-    helpers = helper_functions(prog)
-    helpers = c_helpers.closure(set(helpers) | {_HELPER_OF[f] for f in r.uses if f in _HELPER_OF})
+    helper_of = _helper_of(r.caps)
+    helpers = c_helpers.closure({helper_of[f] for f in prog.uses | r.uses if f in helper_of})
     c += c_helpers.render(set(helpers))
     c += r.pwl_code()
     n_out = len(fp.outputs)
