@@ -35,7 +35,7 @@ import numpy.typing as npt
 from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import membership_np
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods, norms
 
 Arr = npt.NDArray[np.float64]
 
@@ -214,7 +214,7 @@ class Certifier:
     def _output_move(self, o: OutputPlan, degs: list[tuple[Arr, Arr, Arr]], f: Arr) -> Arr:
         plan = self.plan
         n = len(f)
-        bsum = (o.accu or "MAX") == "BSUM"
+        bsum = norms.bounded(o.accu)
         per_term: dict[int, tuple[Arr, Arr, Arr]] = {}  # term -> mu at x', least, greatest
         d_low = np.zeros(n)
         sup = np.zeros(n)

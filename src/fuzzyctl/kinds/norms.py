@@ -302,3 +302,18 @@ def conformance(role: Role, name: str | None) -> Level:
     if t is None:
         return "open"
     return t.and_conformance if role == "AND" else t.act_conformance
+
+
+def keeps_lines(name: str | None) -> bool:
+    """``name`` is MIN or PROD (:attr:`TNorm.keeps_lines`)."""
+    e = tnorm(name)
+    return e is not None and e.keeps_lines
+
+
+def plain_sum_or_max(name: str | None, bounded_too: bool = False) -> bool:
+    """An accumulation by ``name`` (absent: MAX) is the maximum or the unnormalised sum (and,
+    with ``bounded_too``, the bounded sum): the ones the tuner differentiates in closed form."""
+    e = accumulation(name or "MAX")
+    if e is None:
+        return False
+    return e.idempotent or (e.additive and not e.normalised) or (bounded_too and e.bounded)

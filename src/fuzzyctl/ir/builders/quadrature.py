@@ -50,6 +50,7 @@ from fuzzyctl.engine.semantics.operators import ACT_LEVELS, CLIP_BRANCH
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Num, Var, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import norms
 
 SAMPLES = 8  # points per interval where the branch taken is compared
 BISECTIONS = 46  # halvings locating a kink (to 2^-46 ~ 1.4e-14 of the sample spacing)
@@ -190,6 +191,8 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
     acc = g.let(0.0, "ACC")
     code = g.let(0.0, "CODE")
     bit = itertools.count()
+    entry = norms.accumulation(accu)
+    tests = entry.branch_tests if entry is not None else frozenset()
 
     def flag(cond: Ex) -> None:
         # 2^(k mod CODE_BITS): exact in LREAL; beyond CODE_BITS comparisons two flips could
@@ -214,14 +217,14 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
             # the clipping edge as the reference's branch tests it (operators.CLIP_BRANCH)
             flag(mu.ge(level) if s.act in CLIP_BRANCH and (offset, slope) == (0.0, 1.0) else mu.gt(level))
         c = g.let(T.mul(s.w, T.tnorm(g, s.act, s.a, mu)), "C")
-        if accu in ("MAX", "NIPMAX"):
+        if "larger" in tests:
             flag(c.gt(acc))
-        if accu == "NIPMAX":
+        if "sum_below_one" in tests:
             flag((acc + c).lt(1.0))
-        if accu == "DMAX":
+        if "both_positive" in tests:
             flag(c.gt(0.0).and_(acc.gt(0.0)))
         T.accumulate_into(g, accu, acc, c)
-    if accu == "BSUM":
+    if "at_one" in tests:
         flag(acc.ge(1.0))
     return acc, code
 
