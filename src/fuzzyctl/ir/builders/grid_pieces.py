@@ -38,8 +38,9 @@ from fuzzyctl.ir.nodes import Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds import norms
 
-#: Accumulations whose accumulated set is linear between the candidate points.
-LINEAR_ACCUS = frozenset({"MAX", "SUM", "NSUM"})
+#: Accumulations whose accumulated set is linear between the candidate points (the maximum
+#: and the plain sums).
+LINEAR_ACCUS = frozenset(name for name, e in norms.ACCUMULATIONS.items() if e.idempotent or e.additive)
 
 
 @dataclass(frozen=True)

@@ -169,11 +169,11 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
             entry = norms.accumulation(accu)
-            if entry is not None and entry.saturates:  # the bound reached (a jump to 1 for NIPMAX/DMAX)
+            # the bound reached (a jump to 1 for NIPMAX/DMAX)
+            if entry is not None and entry.saturates:
                 code |= (acc >= 1.0).astype(np.int64) << 62
-            if (
-                entry is not None and entry.picks_largest
-            ):  # which set is the largest: kinks where that changes
+            # which set is the largest (NIPMAX/DMAX; MAX took the branch above): kinks where that changes
+            if entry is not None and entry.picks_largest:
                 code ^= (np.argmax(c, axis=0).astype(np.int64) + 1) << 52
         return acc, code
 
