@@ -27,6 +27,7 @@ from fuzzyctl.analysis.context import Context, FloatArray, term_values
 from fuzzyctl.analysis.table import Row
 from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.engine.plan import CTerm, TermPlan
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
@@ -152,7 +153,10 @@ def proven(ctx: Context, used: list[tuple[Row, int]], d: Declaration) -> bool:
     if op.kind not in ("singleton", "ts") or not used:
         return False
     slots = set(used[0][0].leaves)
-    if any(set(r.leaves) != slots or r.weight != 1.0 or (len(slots) > 1 and r.op != "PROD") for r, _ in used):
+    if any(
+        set(r.leaves) != slots or r.weight != 1.0 or (len(slots) > 1 and not norms.is_prod(r.op))
+        for r, _ in used
+    ):
         return False
     if len(used) != sum(
         1

@@ -18,6 +18,7 @@ import numpy as np
 
 from fuzzyctl.analysis.context import Context
 from fuzzyctl.analysis.table import AxisLeaves, Row, leaf_matrix
+from fuzzyctl.kinds import norms
 
 
 @dataclass(frozen=True)
@@ -44,9 +45,9 @@ def _max_accumulation(ctx: Context, row: Row) -> bool:
     for cp in plan.rules[row.rule].conclusions:
         for o in cp.outputs:
             op = plan.outputs[o]
-            if op.kind == "ts" or (op.accu or "MAX") != "MAX":
+            if op.kind == "ts" or not norms.accumulates_by_max(op.accu):
                 return False
-        if any(plan.chained[c].accu != "MAX" for c in cp.chained):
+        if any(not norms.is_max(plan.chained[c].accu) for c in cp.chained):
             return False
     return True
 
@@ -80,7 +81,7 @@ def _group(
     )  # b reads a subset of a
     weights = np.array([r.weight for r in group])
     ops = np.array([r.op for r in group])
-    single = np.array([len(r.leaves) <= 1 or r.op == "MIN" for r in group])
+    single = np.array([len(r.leaves) <= 1 or norms.is_min(r.op) for r in group])
     ops_ok = single[:, None] | (ops[:, None] == ops[None, :])
     cover &= subset & (weights[:, None] >= weights[None, :]) & ops_ok
     np.fill_diagonal(cover, False)

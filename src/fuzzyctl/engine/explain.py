@@ -13,6 +13,7 @@ from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.reference.interp import OutputRecord, Record
 from fuzzyctl.jsonsafe import clean
+from fuzzyctl.kinds import norms
 
 if TYPE_CHECKING:
     from matplotlib.figure import Figure
@@ -157,7 +158,7 @@ def _output(plan: Plan, index: int, o: OutputRecord) -> OutputTrace:
     if o.pieces:
         bps = polyline(o.pieces)
         exact = all(p[4] is None for p in o.pieces)
-        if op.accu == "NSUM":
+        if norms.normalised(op.accu):
             top = max([1.0, *(v for _x, v in bps)])
             bps = [(x, v / top) for x, v in bps]
     elif o.samples is not None:

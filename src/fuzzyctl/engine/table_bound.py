@@ -46,7 +46,7 @@ from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, Output
 from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import membership_np
 from fuzzyctl.engine.table_methods import OutputCells, enclosure_move, ts_move, ts_term_refusal
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods, norms
 
 Arr = npt.NDArray[np.float64]
 
@@ -259,7 +259,7 @@ class Certifier:
             ]
             return enclosure_move(plan, o, self._cells[k], contribs, f)  # type: ignore[arg-type]
         n = len(f)
-        bsum = (o.accu or "MAX") == "BSUM"
+        bsum = norms.bounded(o.accu)
         per_term: dict[int, tuple[Arr, Arr, Arr]] = {}  # term -> mu at x', least, greatest
         d_low = np.zeros(n)
         sup = np.zeros(n)

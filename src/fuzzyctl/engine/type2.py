@@ -36,7 +36,7 @@ from fuzzyctl.engine import type2_sets as sets
 from fuzzyctl.engine.ranges import check_values
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.engine.semantics import shapes as sem
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods, norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds import type_reduction as tr
 from fuzzyctl.model import And, Condition, DefuzzifyBlock, FunctionBlock, Is, Not, Or, Rule, ShapeMF, Term
@@ -323,7 +323,7 @@ class Type2Controller:
         method = self._method(d)
         if not parts:
             return self._finish(d, math.nan, math.nan, method, True)
-        exact = self.samples is None and self.accu == "MAX" and self.act in ("MIN", "PROD")
+        exact = self.samples is None and norms.is_max(self.accu) and norms.keeps_lines(self.act)
         pieces = [self._pwl(d, t, fl, fu) for t, fl, fu in parts] if exact else []
         if exact and all(p is not None for p in pieces):
             yl, yr = self._exact(span, pieces)  # type: ignore[arg-type]
@@ -444,7 +444,7 @@ class Type2Controller:
 
 def _activated(points: sets.Points, f: float, act: str) -> sets.Points:
     """``act(f, mu)`` of a breakpoint list (MIN clips, cutting segments at the level)."""
-    if act == "PROD":
+    if norms.is_prod(act):
         return tuple((x, f * y) for x, y in points)
     out: list[tuple[float, float]] = []
     for i, (x, y) in enumerate(points):

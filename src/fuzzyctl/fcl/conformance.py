@@ -11,6 +11,7 @@ from enum import IntEnum
 from typing import Any
 
 from fuzzyctl.fcl.checks import is_singleton, uses_operator
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import (
     And,
@@ -180,22 +181,16 @@ def features(doc: Document, spellings: frozenset[str] = frozenset()) -> list[Fea
         if len(fb.rule_blocks) > 1:
             add(ext, "ruleblock", f"{len(fb.rule_blocks)} rule blocks")
         for rb in fb.rule_blocks:
-            if rb.and_op in ("PROD", "BDIF"):
-                add(ext, "conditional aggregation", f"AND: {rb.and_op}")
-            elif rb.and_op not in (None, "MIN"):
-                add(open_, "conditional aggregation", f"AND: {rb.and_op}")
-            if rb.or_op in ("MAX", "ASUM", "BSUM"):
-                add(ext, "conditional aggregation", f"OR: {rb.or_op}")
-            elif rb.or_op is not None:
-                add(open_, "conditional aggregation", f"OR: {rb.or_op}")
-            if rb.act in ("MIN", "PROD"):
-                add(ext, "activation", f"ACT: {rb.act}")
-            elif rb.act is not None:
-                add(open_, "activation", f"ACT: {rb.act}")
-            if rb.accu in ("BSUM", "NSUM"):
-                add(ext, "accumulation", f"ACCU: {rb.accu}")
-            elif rb.accu not in (None, "MAX"):
-                add(open_, "accumulation", f"ACCU: {rb.accu}")
+            operators: tuple[tuple[norms.Role, str, str | None], ...] = (
+                ("AND", "conditional aggregation", rb.and_op),
+                ("OR", "conditional aggregation", rb.or_op),
+                ("ACT", "activation", rb.act),
+                ("ACCU", "accumulation", rb.accu),
+            )
+            for role, feature, name in operators:
+                op_level = norms.conformance(role, name)
+                if op_level != "basic":
+                    add(ext if op_level == "extension" else open_, feature, f"{role}: {name}")
             for rule in rb.rules:
                 c = rule.condition
                 if c is None:  # written IF ALWAYS THEN (fcl/no_if.py): a degree input

@@ -5,8 +5,9 @@ engine's evaluators and lowering, the code generators, the tuner, the conformanc
 the studio) reads the entry instead of keeping its own table or comparing kind names.
 
 * :mod:`fuzzyctl.kinds.shapes` - parametric membership-function shapes;
-* ``methods`` - defuzzification, activation and accumulation methods;
-* ``norms`` - AND/OR operators;
+* ``methods`` - defuzzification methods;
+* ``norms`` - AND/OR operators, activation and accumulation methods (their formulas are the
+  operators table, :mod:`fuzzyctl.engine.semantics.operators`);
 * ``targets`` - code-generation targets (a capabilities record each).
 
 This package sits at the bottom of the stack, next to :mod:`fuzzyctl.model`: it imports

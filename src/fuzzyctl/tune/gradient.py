@@ -38,7 +38,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import CAnd, CondPlan, CTerm, CTrue, OutputPlan, Plan, TermPlan
 from fuzzyctl.engine.semantics.shapes import NUMPY, membership_np, pwl_value_np
-from fuzzyctl.kinds import formula
+from fuzzyctl.kinds import formula, norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 from fuzzyctl.model import DefuzzifyBlock, FunctionBlock, FuzzifyBlock
@@ -72,7 +72,7 @@ def _cond_unsupported(c: CondPlan) -> str | None:
     if isinstance(c, CTerm):
         return "hedges or IS NOT in a condition" if c.hedges or c.negated else None
     if isinstance(c, CAnd):
-        if c.op not in ("MIN", "PROD"):
+        if not norms.keeps_lines(c.op):
             return f"AND {c.op}"
         for o in c.operands:
             why = _cond_unsupported(o)
@@ -111,12 +111,12 @@ def unsupported(plan: Plan, outputs: Sequence[str]) -> str | None:
         if op is None:
             return f"no output {name}"
         if op.kind == "singleton":
-            if METHODS[op.method].weighted is None or (op.accu or "MAX") not in ("MAX", "SUM", "BSUM"):
+            if METHODS[op.method].weighted is None or not norms.plain_sum_or_max(op.accu, bounded_too=True):
                 return f"{name}: {op.method} with ACCU {op.accu}"
             if any(t.kind != "singleton" or not t.constant for t in op.terms):
                 return f"{name}: SINGLETONS terms"
         elif op.kind == "ts":
-            if not METHODS[op.method].takagi_sugeno or (op.accu or "MAX") not in ("MAX", "SUM"):
+            if not METHODS[op.method].takagi_sugeno or not norms.plain_sum_or_max(op.accu):
                 return f"{name}: {op.method} with ACCU {op.accu}"
             if any(
                 not (t.kind == "singleton" or registry.flag(t.kind, "takagi_sugeno")) or not t.constant
@@ -193,7 +193,7 @@ def _condition(c: CondPlan, degrees: dict[tuple[int, int], tuple[Arr, Grad]], n:
     parts = [_condition(o, degrees, n) for o in c.operands]
     vals = np.stack([np.broadcast_to(v, (n,)) for v, _ in parts])
     grad: Grad = {}
-    if c.op == "MIN":
+    if norms.is_min(c.op):
         pick = np.argmin(vals, axis=0)
         for k, (_v, g) in enumerate(parts):
             sel = pick == k
@@ -252,7 +252,7 @@ def _contributions(op: OutputPlan, fired: list[tuple[Arr, Grad]]) -> list[tuple[
 def _accumulate(accu: str, items: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, Grad]:
     vals = np.stack([np.broadcast_to(v, (n,)) for v, _ in items])
     grad: Grad = {}
-    if accu == "MAX":
+    if norms.is_max(accu):
         pick = np.argmax(vals, axis=0)
         for k, (_v, g) in enumerate(items):
             for key, d in g.items():
@@ -262,7 +262,7 @@ def _accumulate(accu: str, items: list[tuple[Arr, Grad]], n: int) -> tuple[Arr, 
     for _v, g in items:
         for key, d in g.items():
             _add(grad, key, d)
-    if accu == "BSUM":
+    if norms.bounded(accu):
         # min(1, s): at s == 1 exactly (a degree-1 plateau under weight 1, common) the
         # left derivative, the one in the direction weights can move from 1
         grad = {k: np.where(total <= 1.0, d, 0.0) for k, d in grad.items()}

@@ -58,6 +58,7 @@ import numpy.typing as npt
 
 from fuzzyctl.engine.plan import OutputPlan, TermPlan
 from fuzzyctl.ir.kernels.columns import coa_columns  # the engine's bisector: the same x* to the last bit
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
@@ -91,7 +92,7 @@ def unsupported(op: OutputPlan) -> str | None:
     if accu not in ACCUS:
         return f"{op.name}: COG with ACCU {accu} (closed form for MAX, SUM, BSUM)"
     for c in op.contributions:
-        if c.act not in ("MIN", "PROD") or c.term is None:
+        if not norms.keeps_lines(c.act) or c.term is None:
             return f"{op.name}: activation {c.act}"
         if not isinstance(c.weight, float | int):
             return f"{op.name}: WITH given by a variable"
@@ -150,15 +151,15 @@ def _groups(
     accu = op.accu or "MAX"
     keyed: dict[object, list[int]] = {}
     for ci, c in enumerate(op.contributions):
-        is_min = c.act == "MIN"
+        is_min = norms.is_min(c.act)
         scaled = before or not is_min  # w min(a, mu) keeps w outside; a w mu folds it in
         w = 1.0 if scaled else weights[ci]
-        key = (c.term, is_min, w, scaled) if accu == "MAX" else ci
+        key = (c.term, is_min, w, scaled) if norms.is_max(accu) else ci
         keyed.setdefault(key, []).append(ci)
     out = []
     for members in keyed.values():
         c0 = op.contributions[members[0]]
-        is_min = c0.act == "MIN"
+        is_min = norms.is_min(c0.act)
         scaled = before or not is_min
         degs = [
             np.broadcast_to(degrees[op.contributions[ci].rule] * (weights[ci] if scaled else 1.0), (n,))
@@ -212,10 +213,10 @@ def _values(lines: Sequence[Line], kinks: Sequence[Arr | None], T: Arr) -> list[
 def _combine(vs: list[Arr], accu: str) -> Arr:
     if len(vs) == 1:
         return np.asarray(vs[0])
-    if accu == "MAX":
+    if norms.is_max(accu):
         return np.asarray(np.maximum.reduce(vs))
     s = np.asarray(np.add.reduce(vs))
-    return np.minimum(1.0, s) if accu == "BSUM" else s
+    return np.minimum(1.0, s) if norms.bounded(accu) else s
 
 
 def _cuts(
@@ -238,7 +239,7 @@ def _cuts(
             cands.append(np.where(inside, tk, 0.0))
         else:
             kinks.append(None)
-    if accu == "MAX" and len(lines) > 1:
+    if norms.is_max(accu) and len(lines) > 1:
         # the linear parts (value at t = 0, slope) of each activated set
         parts: list[list[tuple[Arr | float, Arr | float]]] = [
             [(w * L, w * (R - L)), (w * a, 0.0)] if mn else [(w * a * L, w * a * (R - L))]
@@ -253,7 +254,7 @@ def _cuts(
                             cands.append(np.where((t > 0.0) & (t < 1.0), t, 0.0))
     T = np.sort(np.stack(cands, axis=1), axis=1)
     V = _combine(_values(lines, kinks, T), accu)
-    if accu == "BSUM" and len(lines) > 1:
+    if norms.bounded(accu) and len(lines) > 1:
         S = np.add.reduce(_values(lines, kinks, T))
         s0, s1 = S[:, :-1], S[:, 1:]
         with np.errstate(all="ignore"):
@@ -284,12 +285,12 @@ def _selection(lines: Sequence[Line], accu: str, tm: Arr) -> tuple[list[Bool], l
             clipped.append(None)
     if len(lines) == 1:
         return [every], clipped, no_tie
-    if accu == "MAX":
+    if norms.is_max(accu):
         stack = np.stack(vals)
         pick = np.argmax(stack, axis=0)
         tie: Bool = np.asarray((stack == stack.max(axis=0)).sum(axis=0) > 1, dtype=bool)
         return [pick == i for i in range(len(lines))], clipped, tie
-    if accu == "BSUM":
+    if norms.bounded(accu):
         below: Bool = np.asarray(np.add.reduce(vals) <= 1.0, dtype=bool)
         return [below] * len(lines), clipped, no_tie
     return [every] * len(lines), clipped, no_tie

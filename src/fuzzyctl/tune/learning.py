@@ -43,6 +43,7 @@ import numpy.typing as npt
 from fuzzyctl.diagnostics import InputError
 from fuzzyctl.engine.compile import COMPAT_PROFILES
 from fuzzyctl.engine.lowering.lower import lower
+from fuzzyctl.kinds import norms
 from fuzzyctl.model import (
     And,
     Conclusion,
@@ -180,7 +181,7 @@ def learn(
             "(COGS), which interval type-2 inference does not define"
         )
     and_op = and_op.upper()
-    if and_op not in ("MIN", "PROD"):
+    if not norms.keeps_lines(and_op):
         raise InputError(f"--and must be MIN or PROD, got {and_op!r}")
     inputs = list(dict.fromkeys(inputs))
     if not inputs:
@@ -247,7 +248,7 @@ def learn(
             seed,
         )
         notes.append(note)
-        if and_op.upper() != "MIN":
+        if not norms.is_min(and_op.upper()):
             notes.append("the Siemens FUZZY block takes AND MIN: learn with --and min (and_op='min') for it")
     fb = _with_comment(fb, method, kind, inputs, output, n, and_op)
     if type2:
@@ -430,7 +431,7 @@ def _mamdani(
 ) -> tuple[FunctionBlock, str]:
     from scipy.optimize import lsq_linear
 
-    plc = and_op.upper() == "MIN"  # what the Siemens FUZZY block takes
+    plc = norms.is_min(and_op.upper())  # what the Siemens FUZZY block takes
     z = np.clip(theta, out_range.low, out_range.high)
     k = max(1, min(out_terms, len(np.unique(np.round(z, 12)))))
     if k < len(z):

@@ -30,6 +30,7 @@ from collections.abc import Iterable
 from fuzzyctl.diagnostics import Diagnostic, Severity, error, warning
 from fuzzyctl.formats.fpl.names import ADDING_ACCU, shared_conclusions
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
@@ -291,13 +292,13 @@ def _check_rules(fb: FunctionBlock, r: _Report) -> None:
     input_names = {v.name for v in fb.inputs}
     output_names = {v.name for v in fb.outputs}
     for rb in fb.rule_blocks:
-        if rb.and_op not in (None, "MIN"):
+        if rb.and_op is not None and not norms.is_min(rb.and_op):
             r.err(f"AND : {rb.and_op}; the block uses MIN", rb.span, "operator")
         if not rb.enabled or rb.rule_activation is not None:
             r.err(
                 f"rule block {rb.name}: the FUZZY block always fires every rule", rb.span, "rule-activation"
             )
-        if rb.act not in (None, "MIN", "PROD"):
+        if rb.act is not None and not (norms.is_min(rb.act) or norms.is_prod(rb.act)):
             r.err(f"ACT : {rb.act}; the block uses MIN", rb.span, "operator")
         for rule in rb.rules:
             _check_rule(rule, rb.span, input_names, output_names, r)

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 from fuzzyctl import model as m
 from fuzzyctl.engine.semantics import operators as ops
+from fuzzyctl.kinds import norms
 
 __all__ = ["accumulation", "left_to_right", "operator_pair"]
 
@@ -53,7 +54,7 @@ def operator_pair(rb: m.RuleBlock) -> tuple[str, str]:
 def accumulation(rb: m.RuleBlock) -> str:
     """A rule block's ACCU as jFuzzyLogic applies it: SUM when absent, NSUM as BSUM."""
     accu = ops.resolve_accu(rb.accu) if rb.accu is not None else "SUM"
-    return "BSUM" if accu == "NSUM" else accu
+    return norms.ACCUMULATIONS[accu].jfl
 
 
 def left_to_right(c: m.Condition) -> m.Condition:

@@ -46,6 +46,7 @@ from fuzzyctl.engine.semantics.operators import (
     clamp,
     fsum,
 )
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
@@ -116,7 +117,7 @@ class Interpreter:
             got = chained_read[var]
             if got is None:
                 accs = chained_acc[var]
-                if plan.chained[var].accu == "NSUM":
+                if norms.normalised(plan.chained[var].accu):
                     top = max([1.0, *accs])
                     accs = [a / top for a in accs]
                 got = accs
@@ -348,7 +349,7 @@ class Interpreter:
                 assert got is not None
                 pts.append(got)
             grid = build_grid(pts, op.low, op.high)
-        cs = [(t, a, w, act == "MIN") for t, a, w, act in contribs if t is not None]
+        cs = [(t, a, w, norms.is_min(act)) for t, a, w, act in contribs if t is not None]
         accu = op.accu or "MAX"
         pieces = pwl.grid_pieces(grid, cs, accu)
         pv = pwl.point_values(grid, cs, accu)
@@ -365,7 +366,7 @@ class Interpreter:
         assert op.low is not None and op.high is not None
         rec = OutputRecord(math.nan, False)
         f = accumulated_function(op, contribs, values, self.pv)
-        sets = merged_max(contribs) if (op.accu or "MAX") == "MAX" else contribs
+        sets = merged_max(contribs) if norms.accumulates_by_max(op.accu) else contribs
         cuts = smooth_cuts(op, values, self.pv, sets)
         cuts += crossing_cuts(op, sets, values, self.pv, sorted(set(cuts)))
         # what the level and crossing cuts cannot foresee (a clipped Function term's kink):
@@ -503,10 +504,10 @@ def accumulated_branch(
     def branch(x: Any) -> list[tuple[int, ...]]:
         ss = sets(x)
         cols = [ss[k][0] < a for k, a in clip]
-        if ss and accu == "MAX":
+        if ss and norms.is_max(accu):
             c = np.stack([c for _mu, c in ss])
             cols += [np.argmax(c, axis=0), c.max(axis=0) < 0.0]
-        elif ss and accu == "BSUM":
+        elif ss and norms.bounded(accu):
             cols.append(sum(c for _mu, c in ss) >= 1.0)
         return [tuple(int(v) for v in row) for row in zip(*cols, strict=True)] if cols else [()] * len(x)
 
@@ -578,8 +579,8 @@ def crossing_cuts(
     """Where two activated sets cross under MAX (and DMAX, NIPMAX: the largest changes) and,
     under NIPMAX, where two of them sum to 1 (a jump to 1): kinks and jumps that the error
     estimate of the quadrature can misjudge (a kink left inside an interval costs 1e-8)."""
-    accu = op.accu or "MAX"
-    if accu not in ("MAX", "DMAX", "NIPMAX") or not 2 <= len(contribs) <= MAX_CROSSING_SETS:
+    entry = norms.accumulation(op.accu or "MAX")
+    if entry is None or not entry.picks_largest or not 2 <= len(contribs) <= MAX_CROSSING_SETS:
         return []
     if any(t is None or op.terms[t].kind == "function" for t, _a, _w, _act in contribs):
         return []
@@ -588,7 +589,7 @@ def crossing_cuts(
     for i, j in itertools.combinations(range(len(sets)), 2):
         fi, fj = sets[i], sets[j]
         out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) - fj(x), 0.0, cuts)
-        if accu == "NIPMAX":
+        if "sum_below_one" in entry.branch_tests:
             out += level_crossings(lambda x, fi=fi, fj=fj: fi(x) + fj(x), 1.0, cuts)
     return out
 

@@ -22,6 +22,7 @@ import numpy as np
 
 from fuzzyctl.engine.plan import GridPlan
 from fuzzyctl.engine.semantics.operators import fsum
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS, implementation
 
 #: Relative tolerance deciding that a computed vertex reaches the maximum (LM, RM, MoM).
@@ -82,7 +83,7 @@ def _combine(xa: float, xb: float, p0: list[float], p1: list[float], accu: str, 
     if n == 1:
         out.append((xa, xb, p0[0], p1[0], None))
         return
-    if accu == "MAX":
+    if norms.is_max(accu):
         cuts: list[float] = []
         for i in range(n):
             for j in range(i + 1, n):
@@ -105,9 +106,9 @@ def _combine(xa: float, xb: float, p0: list[float], p1: list[float], accu: str, 
         return
     s0 = fsum(p0)
     s1 = fsum(p1)
-    if accu in ("SUM", "NSUM"):
+    if norms.adds(accu):
         out.append((xa, xb, s0, s1, None))
-    elif accu == "BSUM":
+    elif norms.bounded(accu):
         if (s0 - 1.0) * (s1 - 1.0) < 0.0:
             s = (1.0 - s0) / (s1 - s0)
             xm = xa + s * (xb - xa)
@@ -115,7 +116,7 @@ def _combine(xa: float, xb: float, p0: list[float], p1: list[float], accu: str, 
             out.append((xm, xb, 1.0, min(1.0, s1), None))
         else:
             out.append((xa, xb, min(1.0, s0), min(1.0, s1), None))
-    elif accu == "PROBOR":
+    elif norms.probabilistic(accu):
         factors = tuple(zip(p0, p1, strict=True))
         out.append((xa, xb, _poly_value(factors, 0.0), _poly_value(factors, 1.0), factors))
     else:  # pragma: no cover - lowering sends other accumulations to quadrature

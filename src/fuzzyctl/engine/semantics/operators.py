@@ -19,6 +19,7 @@ from typing import Any
 
 import numpy as np
 
+from fuzzyctl.kinds import norms
 from fuzzyctl.model import OPERATOR_PAIRS
 
 
@@ -201,7 +202,7 @@ ACT_LEVELS: dict[str, tuple[tuple[float, float], ...]] = {
 #: ``mu < a`` (engine/reference/interp.py ``accumulated_branch``): a term exactly at the
 #: degree counts as clipped, so that at a = 1 the stretch where a smooth peak rounds to 1 is
 #: a plateau on every path (LM, RM and MoM read its edges).
-CLIP_BRANCH = frozenset({"MIN"})
+CLIP_BRANCH = frozenset(name for name, e in norms.TNORMS.items() if e.clips)
 
 
 def activation_levels(act: str, a: float) -> list[float]:
@@ -237,7 +238,7 @@ ACCU_ALIASES = {
     "USUM": "SUM",
 }
 #: Accumulations whose result on piecewise-linear activated sets is integrated exactly.
-EXACT_ACCU = frozenset({"MAX", "BSUM", "NSUM", "SUM", "PROBOR"})
+EXACT_ACCU = frozenset(name for name, e in norms.ACCUMULATIONS.items() if e.exact)
 
 
 def resolve_accu(accu: str | None) -> str:

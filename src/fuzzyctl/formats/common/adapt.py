@@ -16,7 +16,7 @@ from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, error
 from fuzzyctl.engine.semantics import operators as ops
 from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.basics import identifier, is_identifier
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods, norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     DEFUZZ_METHODS,
@@ -128,7 +128,7 @@ def split_rules(
         w_rule = 1.0 if rule.weight is None else float(rule.weight)
         out = fb.defuzzify_block(c.variable)
         points = out is not None and (out.method or "") in POINT_METHODS
-        if w_conclusion != 1.0 and w_rule != 1.0 and not (points or act == "PROD"):
+        if w_conclusion != 1.0 and w_rule != 1.0 and not (points or norms.is_prod(act)):
             losses.append(
                 Loss(
                     rule_label(block, rule),
@@ -136,7 +136,7 @@ def split_rules(
                 )
             )
             return []
-        if w_conclusion != 1.0 and not (points or act == "PROD"):
+        if w_conclusion != 1.0 and not (points or norms.is_prod(act)):
             losses.append(
                 Loss(
                     rule_label(block, rule),

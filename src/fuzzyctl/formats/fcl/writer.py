@@ -17,6 +17,7 @@ from fuzzyctl.formats import Loss
 from fuzzyctl.formats.common.adapt import rename
 from fuzzyctl.formats.common.basics import hedge_power, identifier
 from fuzzyctl.formats.fcl.names import fcl_api
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     POWER_HEDGE_PREFIX,
@@ -47,7 +48,7 @@ def _rule_weight_to_conclusions(fb: FunctionBlock, block: RuleBlock, rule: Rule,
     for c in rule.conclusions:
         out = fb.defuzzify_block(c.variable)
         points = out is not None and (out.method or "") in _POINT_METHODS
-        if not (points or act == "PROD"):
+        if not (points or norms.is_prod(act)):
             losses.append(
                 Loss(
                     f"rule {rule.label!r}",

@@ -45,6 +45,7 @@ from fuzzyctl.formats.fis.names import (
     OR_METHODS,
 )
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds import norms
 from fuzzyctl.model import (
     OPERATOR_PAIRS,
     And,
@@ -360,13 +361,16 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
             Loss("aggregation", f"FIS has one AggMethod; the outputs use {', '.join(sorted(accu_values))}")
         )
     for d in fb.defuzzify:
-        if (d.accu or "") == "NSUM":
-            losses.append(Loss(f"output {d.variable!r}", "FIS has no NSUM"))
-    if "NSUM" in accu_values and not any(d.accu == "NSUM" for d in fb.defuzzify):
-        losses.append(Loss("aggregation", "FIS has no NSUM"))
+        if norms.stand_in(d.accu):
+            losses.append(Loss(f"output {d.variable!r}", f"FIS has no {d.accu}"))
+    for name in sorted(n for n in accu_values if norms.stand_in(n)):
+        if not any(d.accu == name for d in fb.defuzzify):
+            losses.append(Loss("aggregation", f"FIS has no {name}"))
     # what is written anyway (--lossy) says the nearest FIS aggregation
-    accu_values = {"SUM" if a == "NSUM" else a for a in accu_values}
-    fb = replace(fb, defuzzify=tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify))
+    accu_values = {norms.stand_in(a) or a for a in accu_values}
+    fb = replace(
+        fb, defuzzify=tuple(replace(d, accu=s) if (s := norms.stand_in(d.accu)) else d for d in fb.defuzzify)
+    )
     methods = {d.method or "COG" for d in fb.defuzzify if not is_point_output(d)}
     if len(methods) > 1:
         losses.append(
@@ -442,9 +446,9 @@ def _one_level(fb: FunctionBlock, block: RuleBlock, rule: Rule) -> list[Rule]:
     flat = _flat(rule.condition)
     if _fis_form(flat):
         return [replace(rule, condition=flat)]
-    and_op = block.and_op or ("MIN" if block.or_op in (None, "MAX") else None)
+    and_op = block.and_op or ("MIN" if block.or_op is None or norms.is_max(block.or_op) else None)
     or_op = block.or_op or OPERATOR_PAIRS.get(and_op or "", None)
-    if (and_op, or_op) != ("MIN", "MAX"):
+    if not (norms.is_min(and_op) and norms.is_max(or_op)):
         return [rule]
     for c in rule.conclusions:
         d = fb.defuzzify_block(c.variable)
@@ -454,7 +458,7 @@ def _one_level(fb: FunctionBlock, block: RuleBlock, rule: Rule) -> list[Rule]:
             if b.accu and any(x.variable == c.variable for r in b.rules for x in r.conclusions)
         ]
         accu = (d.accu if d else None) or (concluding[0] if concluding else "MAX")
-        if d is None or is_point_output(d) or accu != "MAX":
+        if d is None or is_point_output(d) or not norms.is_max(accu):
             return [rule]
     disjuncts = _dnf(flat)
     if disjuncts is None or len(disjuncts) > MAX_SPLIT:

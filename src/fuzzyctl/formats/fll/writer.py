@@ -20,7 +20,7 @@ from fuzzyctl.formats.common.basics import fmt_number
 from fuzzyctl.formats.common.expr import format_expr
 from fuzzyctl.formats.common.terms import FLL_OF_KIND, FLL_TYPES, TS_KINDS, fll_ts_name
 from fuzzyctl.formats.fll.names import DEFUZZIFIERS, HEDGE_WORDS, KEYWORDS, SNORMS_ACCU, SNORMS_OR, TNORMS
-from fuzzyctl.kinds import methods
+from fuzzyctl.kinds import methods, norms
 from fuzzyctl.model import (
     HEDGES,
     And,
@@ -84,7 +84,7 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
     for d in fb.defuzzify:
         if d.method in methods.POINT_OUTPUTS:
             continue  # NSUM adds the degrees of a weighted average, written UnboundedSum
-        if (d.accu or "") == "NSUM" or any((b.accu or "") == "NSUM" for b in fb.rule_blocks):
+        if norms.stand_in(d.accu) or any(norms.stand_in(b.accu) for b in fb.rule_blocks):
             losses.append(
                 Loss(
                     f"output {d.variable!r}",
@@ -93,8 +93,8 @@ def adapt(document: Document) -> tuple[Document, list[Loss]]:
             )
     # what is written instead (--lossy): UnboundedSum, which NSUM only scales by a constant
     # (the same centroid; a weighted average writes SUM already)
-    blocks = [replace(b, accu="SUM") if b.accu == "NSUM" else b for b in blocks]
-    defuzzify = tuple(replace(d, accu="SUM") if d.accu == "NSUM" else d for d in fb.defuzzify)
+    blocks = [replace(b, accu=a) if (a := norms.stand_in(b.accu)) else b for b in blocks]
+    defuzzify = tuple(replace(d, accu=a) if (a := norms.stand_in(d.accu)) else d for d in fb.defuzzify)
     return Document((replace(fb, rule_blocks=tuple(blocks), defuzzify=defuzzify),), document.path), losses
 
 

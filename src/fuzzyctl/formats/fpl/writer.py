@@ -18,6 +18,7 @@ from fuzzyctl.formats.fpl.names import (
     shared_conclusions,
 )
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
@@ -101,7 +102,7 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
         err("FPL for Fuzzy Control has no intermediate variables", block.locals[0].span, "fpl-expr-local")
     for rb in block.rule_blocks:
         and_op = implied_operators(rb.and_op, rb.or_op)[0]  # OR : ASUM alone means AND : PROD
-        if and_op != "MIN":
+        if not norms.is_min(and_op):
             err(
                 f"AND : {and_op}{'' if rb.and_op else f' (the pair of OR : {rb.or_op})'} cannot be "
                 "written in FPL (Fuzzy Control uses MIN)",
@@ -112,7 +113,10 @@ def check_fpl(block: FunctionBlock) -> list[Diagnostic]:
         if accu_problem is not None:
             hint = "write ACCU : NSUM to say what Fuzzy Control computes"
             err(accu_problem, rb.item_span("accu"), "fpl-expr-op", hint=hint)
-        if rb.act not in (None, "MIN", "PROD") or (rb.act == "PROD" and not _all_singletons(block)):
+        # PROD on singletons is MIN: a singleton's degree is 1
+        if rb.act is not None and not (
+            norms.is_min(rb.act) or (norms.is_prod(rb.act) and _all_singletons(block))
+        ):
             err(f"ACT : {rb.act} cannot be written in FPL (Fuzzy Control uses MIN)", rb.span, "fpl-expr-op")
         if not rb.enabled or rb.rule_activation is not None:
             err(
@@ -388,7 +392,7 @@ def adapt_fpl(document: Document) -> tuple[Document, list[tuple[str, str]]]:
                 and_op="MIN",
                 or_op=None,
                 accu=SIEMENS_ACCU,
-                act=None if rb.act in (None, "MIN") else "MIN",
+                act=None if rb.act is None or norms.is_min(rb.act) else "MIN",
                 enabled=True,
                 rule_activation=None,
             )

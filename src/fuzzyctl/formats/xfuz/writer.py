@@ -29,6 +29,7 @@ from fuzzyctl.formats.xfuz.tables import (
     slot_label,
 )
 from fuzzyctl.kinds import methods as method_kinds
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.model import (
     And,
@@ -310,13 +311,12 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
             "xfuz-expr-ruleblocks",
         )
     rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
-    op = {None: 0, "MIN": 0, "PROD": 1}
     and_op = implied_operators(rb.and_op, rb.or_op)[0] if rb.or_op else rb.and_op  # OR : ASUM alone: PROD
-    if and_op not in op:
+    if norms.xfuz_code(and_op) is None:
         err(f"AND : {and_op}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
-    if rb.act not in op:
+    if norms.xfuz_code(rb.act) is None:
         err(f"ACT : {rb.act}: XFUZ offers MIN or PROD", rb.span, "xfuz-expr-op")
-    if rb.accu not in (None, "MAX"):
+    if rb.accu is not None and not norms.is_max(rb.accu):
         err(f"ACCU : {rb.accu}: XFUZ aggregates with MAX", rb.span, "xfuz-expr-op")
     local_names = {v.name for v in fb.locals}
     methods = {d.method or "COG" for d in fb.defuzzify if d.terms and d.variable not in local_names}
@@ -486,8 +486,8 @@ def constants_from_model(block: FunctionBlock | Document) -> tuple[XfuzConstants
         )
     esv, fa, rg = encode_kb(kb)
     constants = XfuzConstants(
-        op_et=op.get(and_op, 0),
-        op_impl=op.get(rb.act, 0),
+        op_et=norms.xfuz_code(and_op) or 0,
+        op_impl=norms.xfuz_code(rb.act) or 0,
         op_defuz=op_defuz,
         out_pt=out_pt,
         contask=opts.contask,
@@ -616,11 +616,11 @@ def adapt_xfuz(document: Document) -> tuple[Document, list[tuple[str, str]]]:
     rb = fb.rule_blocks[0] if fb.rule_blocks else RuleBlock("xfuz", ())
     losses += [(f"rule block {b.name}", "XFUZ holds one rule base") for b in fb.rule_blocks[1:]]
     implied_and = implied_operators(rb.and_op, rb.or_op)[0] if rb.or_op else rb.and_op  # Table 3
-    and_op = implied_and if implied_and in (None, "MIN", "PROD") else "MIN"
-    act = rb.act if rb.act in (None, "MIN", "PROD") else "MIN"
-    if and_op != implied_and or act != rb.act or rb.accu not in (None, "MAX"):
+    and_op = implied_and if norms.xfuz_code(implied_and) is not None else "MIN"
+    act = rb.act if norms.xfuz_code(rb.act) is not None else "MIN"
+    if and_op != implied_and or act != rb.act or (rb.accu is not None and not norms.is_max(rb.accu)):
         losses.append((f"rule block {rb.name}", "XFUZ offers AND MIN/PROD, ACT MIN/PROD and ACCU MAX only"))
-    or_is_max = rb.or_op == "MAX" or (rb.or_op is None and and_op in (None, "MIN"))
+    or_is_max = norms.is_max(rb.or_op) or (rb.or_op is None and (and_op is None or norms.is_min(and_op)))
     local_names = {v.name for v in fb.locals}
     methods = {d.method or "COG" for d in fb.defuzzify if d.terms and d.variable not in local_names}
     method = methods.pop() if len(methods) == 1 else "COG"

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 from fuzzyctl.engine.lowering.grid import left_limit, right_limit
 from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, Plan
 from fuzzyctl.engine.semantics.shapes import pwl_value
+from fuzzyctl.kinds import norms
 
 __all__ = ["Group", "WeightBounds", "weight_bounds"]
 
@@ -48,21 +49,28 @@ def _hull(points: Points, a: float, b: float) -> Iv:
 
 
 def _and(op: str, p: Iv, q: Iv) -> Iv:
-    if op == "MIN":
-        return min(p[0], q[0]), min(p[1], q[1])
-    if op == "PROD":
-        return p[0] * q[0], p[1] * q[1]
-    assert op == "BDIF"
-    return max(0.0, p[0] + q[0] - 1.0), max(0.0, p[1] + q[1] - 1.0)
+    """``p AND q`` on intervals: a t-norm is monotone in each argument, so the images of the
+    bounds, in the operator's fixed-point form (the integer code computes only those)."""
+    match norms.TNORMS[op].fixed:
+        case "min":
+            return min(p[0], q[0]), min(p[1], q[1])
+        case "product":
+            return p[0] * q[0], p[1] * q[1]
+        case "bounded_difference":
+            return max(0.0, p[0] + q[0] - 1.0), max(0.0, p[1] + q[1] - 1.0)
+    raise AssertionError(op)
 
 
 def _or(op: str, p: Iv, q: Iv) -> Iv:
-    if op == "MAX":
-        return max(p[0], q[0]), max(p[1], q[1])
-    if op == "ASUM":
-        return p[0] + q[0] - p[0] * q[0], p[1] + q[1] - p[1] * q[1]
-    assert op == "BSUM"
-    return min(1.0, p[0] + q[0]), min(1.0, p[1] + q[1])
+    """``p OR q`` on intervals (monotone, as :func:`_and`)."""
+    match norms.SNORMS[op].fixed:
+        case "max":
+            return max(p[0], q[0]), max(p[1], q[1])
+        case "probabilistic_sum":
+            return p[0] + q[0] - p[0] * q[0], p[1] + q[1] - p[1] * q[1]
+        case "bounded_sum":
+            return min(1.0, p[0] + q[0]), min(1.0, p[1] + q[1])
+    raise AssertionError(op)
 
 
 def _cond(c: CondPlan, deg: Callable[[int, int], Iv]) -> Iv:
@@ -104,7 +112,7 @@ def _total(plan: Plan, groups: Sequence[Group], box: dict[int, Iv], weights: Seq
                 r = _cond(plan.rules[ri].condition, deg)
                 rules[ri] = (r[0] * weights[ri], r[1] * weights[ri])
             rlo, rhi = rules[ri]
-            if accu == "MAX":
+            if norms.is_max(accu):
                 glo, ghi = max(glo, w * rlo), max(ghi, w * rhi)
             else:
                 glo, ghi = glo + w * rlo, ghi + w * rhi

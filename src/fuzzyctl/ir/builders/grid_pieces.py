@@ -36,9 +36,11 @@ from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders.pieces import Ctx, candidate, clipped_am, max_of_two, solve_linear
 from fuzzyctl.ir.nodes import Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import norms
 
-#: Accumulations whose accumulated set is linear between the candidate points.
-LINEAR_ACCUS = frozenset({"MAX", "SUM", "NSUM"})
+#: Accumulations whose accumulated set is linear between the candidate points (the maximum
+#: and the plain sums).
+LINEAR_ACCUS = frozenset(name for name, e in norms.ACCUMULATIONS.items() if e.idempotent or e.additive)
 
 
 @dataclass(frozen=True)
@@ -106,7 +108,7 @@ def _interval(g: Gen, x0: float, x1: float, lines: list[Line], accu: str, out: P
             cands.append(g.max_(kt, 0.0, "CT"))
         else:
             kinks.append(None)
-    if accu == "MAX" and len(lines) > 1:
+    if norms.is_max(accu) and len(lines) > 1:
         parts = [_parts(left, right, s) for left, right, s in lines]
         for i in range(len(lines)):
             for k in range(i + 1, len(lines)):
@@ -277,14 +279,14 @@ def _bisect_piece(
 def _interval_area(g: Gen, x0: float, x1: float, lines: list[Line], accu: str) -> Var:
     """The area of the accumulated sets on one interval, in closed form where it has one."""
     as_static = [(left, right, s.a, s.w, s.is_min) for left, right, s in lines]
-    if len(lines) == 1 or accu in ("SUM", "NSUM"):
+    if len(lines) == 1 or norms.adds(accu):
         total = g.let(0.0, "IA")
         for line in as_static:
             with g.b.if_((line[2] * line[3]).gt(0.0)):
                 a, _m = clipped_am(g, x0, x1 - x0, line)
                 g.b.set(total, total + a)
         return total
-    if len(lines) == 2 and accu == "MAX":
+    if len(lines) == 2 and norms.is_max(accu):
         return max_of_two(g, x0, x1, as_static[0], as_static[1])[0]
     p = Pieces()
     _interval(g, x0, x1, lines, accu, p)

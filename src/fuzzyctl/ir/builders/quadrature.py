@@ -56,6 +56,7 @@ from fuzzyctl.engine.semantics.operators import ACT_LEVELS, CLIP_BRANCH
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Num, Var, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import norms
 
 SAMPLES = 8  # points per interval where the branch taken is compared
 BISECTIONS = 46  # halvings locating a kink (to 2^-46 ~ 1.4e-14 of the sample spacing)
@@ -235,6 +236,8 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
     acc = g.let(0.0, "ACC")
     code = g.let(0.0, "CODE")
     bit = itertools.count()
+    entry = norms.accumulation(accu)
+    tests = entry.branch_tests if entry is not None else frozenset()
 
     def flag(cond: Ex) -> None:
         # 2^(k mod CODE_BITS): exact in LREAL; beyond CODE_BITS comparisons two flips could
@@ -267,18 +270,18 @@ def set_at(g: Gen, op: OutputPlan, sets: list[SmoothSet], x: Var, accu: str) -> 
             # or NaN where min(0, mu) would not be 0)
             with b.if_(not_((s.a * s.w).gt(0.0))):
                 b.set(c, 0.0)
-        if accu in ("MAX", "NIPMAX"):
+        if "larger" in tests:
             flag(c.gt(acc))
-        if accu == "NIPMAX":
+        if "sum_below_one" in tests:
             flag((acc + c).lt(1.0))
-        if accu == "DMAX":
+        if "both_positive" in tests:
             flag(c.gt(0.0).and_(acc.gt(0.0)))
         T.accumulate_into(g, accu, acc, c)
         if term.kind == "function":
             # NaN wins, as in the reference's numpy (MAX's ``c > acc`` alone would drop it)
             with b.if_(c.ne(c)):
                 b.set(acc, c)
-    if accu == "BSUM":
+    if "at_one" in tests:
         flag(acc.ge(1.0))
     return acc, code
 

@@ -46,6 +46,7 @@ from fuzzyctl.ir.builders.ruletext import rule_text
 from fuzzyctl.ir.coalesce import rename, share_temps
 from fuzzyctl.ir.nodes import Call, Decl, Ex, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
@@ -253,7 +254,7 @@ class RuleBuilder:
     def _normalise(self, ci: int, chained: dict[tuple[int, int], Var]) -> None:
         """NSUM: a chained variable's degrees divided by max(1, their maximum) before reading."""
         g, b = self.g, self.g.b
-        if self.plan.chained[ci].accu == "NSUM" and self.plan.chained[ci].terms:
+        if norms.normalised(self.plan.chained[ci].accu) and self.plan.chained[ci].terms:
             top = g.let(1.0, "TOP")
             names = [chained[(ci, t)] for t in range(len(self.plan.chained[ci].terms))]
             for n in names:  # max([1.0, *accs])

@@ -19,6 +19,7 @@ from fuzzyctl.engine.semantics.operators import SNORMS, TNORMS
 from fuzzyctl.engine.semantics.shapes import Points, power_of
 from fuzzyctl.ir.nodes import Bin, Ex, ExLike, Index, Neg, Num, Var, ex, not_
 from fuzzyctl.ir.state import Gen
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.formula import Formula
 
@@ -132,9 +133,9 @@ def snorm(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
 def accumulate(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
     """:func:`fuzzyctl.engine.semantics.operators.accumulate` (MAX, SUM/NSUM, BSUM, PROBOR, the
     other OR norms)."""
-    if name in ("SUM", "NSUM"):
+    if norms.adds(name):
         return ex(a) + ex(b)
-    if name == "PROBOR":
+    if norms.probabilistic(name):
         return template(g, SNORMS["ASUM"].source, a, b)
     return snorm(g, name, a, b)
 
@@ -142,7 +143,7 @@ def accumulate(g: Gen, name: str, a: ExLike, b: ExLike) -> Ex:
 def accumulate_into(g: Gen, name: str, target: Var | Index, value: ExLike) -> None:
     """``target := accumulate(name, target, value)``; MAX as one IF (``a if a > b else b``
     keeps ``a`` unless ``b`` is larger)."""
-    if name == "MAX":
+    if norms.is_max(name):
         v = _simple(g, value)
         with g.b.if_(v.gt(target)):
             g.b.set(target, v)

@@ -54,6 +54,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import accumulate_np, clamp_np
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS, implementation
 
@@ -107,7 +108,7 @@ def am_lines(x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bo
             (left, right, col(n, hw[2 * k]), hw[2 * k + 1], is_min)
             for k, (left, right, is_min) in enumerate(geom)
         ]
-        if accu == "MAX" and len(lines) == 2:
+        if norms.is_max(accu) and len(lines) == 2:
             return _max_of_two(x0, x1, lines[0], lines[1])
         if len(lines) == 1:
             return _clipped_line_am(x0, x1 - x0, lines[0])
@@ -199,8 +200,12 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
         if op.kind == "ts":
             return _ts(op, contribs, vals, outs, n)
         contribs = _scale_tiny(contribs, n)
-        if op.exact and op.grid is not None and not (op.accu == "PROBOR" and METHODS[op.method].bisects):
-            groups = [(t or 0, a, w, act == "MIN") for t, a, w, act in contribs]
+        if (
+            op.exact
+            and op.grid is not None
+            and not (norms.probabilistic(op.accu) and METHODS[op.method].bisects)
+        ):
+            groups = [(t or 0, a, w, norms.is_min(act)) for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
         from fuzzyctl.ir.kernels.smooth_columns import smooth_output
 
@@ -303,7 +308,7 @@ def centroid(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Res
         per_term[t] = per_term.get(t, 0) + 1
     area = np.zeros(n)
     moment = np.zeros(n)
-    closed = {t for t, k in per_term.items() if k == 1 or accu in ("SUM", "NSUM")}
+    closed = {t for t, k in per_term.items() if k == 1 or norms.adds(accu)}
     for t, a, w, is_min in groups:
         if t not in closed or not grid.solo[t]:
             continue
@@ -321,7 +326,7 @@ def centroid(op: OutputPlan, grid: GridPlan, groups: list[Group], n: int) -> Res
         ]
         if not lines:
             continue
-        if accu == "MAX" and len(lines) == 2:
+        if norms.is_max(accu) and len(lines) == 2:
             ar2, mo2 = _max_of_two(grid.xs[j], grid.xs[j + 1], lines[0], lines[1])
             area += ar2
             moment += mo2
@@ -493,7 +498,7 @@ def _interval(
             cands.append(np.where(inside, tk, 0.0))
         else:
             kinks.append(None)
-    if accu == "MAX" and len(lines) > 1:
+    if norms.is_max(accu) and len(lines) > 1:
         parts: list[list[tuple[Any, Any]]] = []  # per line: linear parts (A + B t)
         for L, R, a, w, mn in lines:
             if mn:
@@ -527,12 +532,12 @@ def _interval(
     def combine(vs: list[Arr]) -> Arr:
         if len(vs) == 1:
             return np.asarray(vs[0])
-        if accu == "MAX":
+        if norms.is_max(accu):
             return np.asarray(np.maximum.reduce(vs))
         s = np.add.reduce(vs)
-        if accu == "BSUM":
+        if norms.bounded(accu):
             return np.asarray(np.minimum(1.0, s))
-        if accu == "PROBOR":
+        if norms.probabilistic(accu):
             acc = np.zeros_like(s)
             for v in vs:
                 acc = acc + v - acc * v
@@ -541,7 +546,7 @@ def _interval(
 
     vs = values(T)
     V = combine(vs)
-    if accu == "BSUM" and len(lines) > 1:
+    if norms.bounded(accu) and len(lines) > 1:
         S = np.add.reduce(vs)
         s0, s1 = S[:, :-1], S[:, 1:]
         with np.errstate(all="ignore"):
@@ -552,7 +557,7 @@ def _interval(
         V = combine(values(T))
     X = x0 + T * (x1 - x0)
     extra_am = None
-    if accu == "PROBOR" and len(lines) > 1:
+    if norms.probabilistic(accu) and len(lines) > 1:
         nodes, weights = pwl.gauss_legendre((len(lines) + 3) // 2 + 1)
         area = np.zeros(n)
         moment = np.zeros(n)

@@ -33,6 +33,7 @@ from typing import Any
 from fuzzyctl.engine.plan import Plan, Slot, TermPlan
 from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
 Kernel = Callable[..., Any]
@@ -56,7 +57,7 @@ def make(name: str, data: Any, plan: Plan) -> Kernel:
 def am_lines(x0: float, x1: float, accu: str, geom: tuple[tuple[float, float, bool], ...]) -> Kernel:
     """Area and moment of the accumulated activated sets on ``[x0, x1]`` (each term linear
     from L to R there); arguments: the degree and weight of each set."""
-    if accu == "MAX" and len(geom) == 2:
+    if norms.is_max(accu) and len(geom) == 2:
         return _am_two(x0, x1, geom[0], geom[1])
 
     def f(*hw: float) -> tuple[float, float]:

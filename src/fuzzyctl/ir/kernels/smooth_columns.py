@@ -35,6 +35,7 @@ from fuzzyctl.engine.reference import quadrature
 from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import ACT_LEVELS, TNORMS, accumulate_np
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
 Arr = Any
@@ -117,7 +118,7 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
     # MIN activation a function term below 0 would otherwise still reach the sum
     live = A * W > 0.0
     acts = [act for _t, _a, _w, act in cs]
-    is_min = np.array([act == "MIN" for act in acts])[:, None]
+    is_min = np.array([norms.is_min(act) for act in acts])[:, None]
     by_kind: dict[str, list[int]] = {}
     single: list[int] = []
     for g, (t, _a, _w, _act) in enumerate(cs):
@@ -142,18 +143,18 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         for g in single:
             mu[g] = _membership(op.terms[cs[g][0]], vals, rows, x, r)
         a = A[:, r]
-        if all(act == "MIN" for act in acts):
+        if all(norms.is_min(act) for act in acts):
             c = np.minimum(a, mu)
-        elif all(act == "PROD" for act in acts):
+        elif all(norms.is_prod(act) for act in acts):
             c = a * mu
         else:
             c = np.stack([TNORMS[act].array(a[g], mu[g]) for g, act in enumerate(acts)])
         c = np.where(live[:, r], W[:, r] * c, 0.0)  # 0: what every accumulation leaves alone
-        if accu == "MAX":
+        if norms.is_max(accu):
             # from the empty set, as interp.accumulated_function: a term below 0 is cut at 0
             top = c.max(axis=0)
             acc = np.maximum(top, 0.0)
-        elif accu in ("SUM", "NSUM"):
+        elif norms.adds(accu):
             acc = c.sum(axis=0)
         else:
             acc = np.zeros(len(x))
@@ -162,14 +163,17 @@ def _integrand(op: OutputPlan, cs: list[tuple[int, Arr, Any, str]], vals: list[A
         if not branch:
             return acc
         clipped = is_min & (a < mu)
-        if accu == "MAX":
+        if norms.is_max(accu):
             win = np.argmax(c, axis=0)
             code = np.where(top < 0.0, -1, 2 * win + clipped[win, np.arange(len(x))])
         else:
             code = (clipped[:62].astype(np.int64) << np.arange(min(k, 62))[:, None]).sum(axis=0)
-            if accu in ("BSUM", "NIPMAX", "DMAX"):  # the bound reached (a jump to 1 for NIPMAX/DMAX)
+            entry = norms.accumulation(accu)
+            # the bound reached (a jump to 1 for NIPMAX/DMAX)
+            if entry is not None and entry.saturates:
                 code |= (acc >= 1.0).astype(np.int64) << 62
-            if accu in ("NIPMAX", "DMAX"):  # which set is the largest: kinks where that changes
+            # which set is the largest (NIPMAX/DMAX; MAX took the branch above): kinks where that changes
+            if entry is not None and entry.picks_largest:
                 code ^= (np.argmax(c, axis=0).astype(np.int64) + 1) << 52
         return acc, code
 

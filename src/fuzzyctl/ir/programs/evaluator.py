@@ -63,6 +63,7 @@ from fuzzyctl.engine.semantics import shapes
 from fuzzyctl.ir.builders.rules import Contrib, Literals, Params, RuleBuilder
 from fuzzyctl.ir.nodes import Ex, Kernel, Num, Program, Pwl, Var, ex
 from fuzzyctl.ir.state import CodegenError, Gen
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
 #: A key of :data:`fuzzyctl.kinds.targets.TARGETS` whose renderer prints the evaluator
@@ -268,7 +269,7 @@ class FastBuilder(RuleBuilder):
         per_term: dict[int, int] = {}
         for gr in groups:
             per_term[gr.term] = per_term.get(gr.term, 0) + 1
-        closed = {t for t, k in per_term.items() if k == 1 or accu in ("SUM", "NSUM")}
+        closed = {t for t, k in per_term.items() if k == 1 or norms.adds(accu)}
         for gr in groups:
             if gr.term in closed and grid.solo[gr.term]:
                 with b.if_(_positive(gr)):
@@ -283,7 +284,7 @@ class FastBuilder(RuleBuilder):
                 cond = cond.or_(_positive(gr))
             with b.if_(cond):
                 geom = tuple(
-                    (grid.left[gr.term][j], grid.right[gr.term][j], gr.act == "MIN") for gr in members
+                    (grid.left[gr.term][j], grid.right[gr.term][j], norms.is_min(gr.act)) for gr in members
                 )
                 args: list[Ex] = []
                 for gr in members:
@@ -309,7 +310,7 @@ class FastBuilder(RuleBuilder):
         def scale(e: Ex) -> Ex:
             return e if one else w * e
 
-        if gr.act != "MIN":
+        if not norms.is_min(gr.act):
             fa, fm = grid.full[gr.term]
             b.set(area, area + scale(gr.a * fa))
             b.set(moment, moment + scale(gr.a * fm))
@@ -344,9 +345,9 @@ def merge(g: Gen, contribs: list[Contrib], accu: str) -> list[Group]:
     keyed: dict[tuple[int, object], list[tuple[Ex, Ex]]] = {}
     for t, a, w, act in contribs:
         assert t is not None
-        if accu == "MAX" and isinstance(w, Num):
+        if norms.is_max(accu) and isinstance(w, Num):
             key: tuple[int, object] = (t, ("max", act, w.value))
-        elif accu in ("SUM", "NSUM") and act == "PROD":
+        elif norms.adds(accu) and norms.is_prod(act):
             key = (t, ("sum",))
         else:
             out.append(Group(t, a, w, act))

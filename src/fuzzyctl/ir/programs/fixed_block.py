@@ -34,6 +34,7 @@ from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
 from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.arith import Arith
 from fuzzyctl.kinds.methods import METHODS
@@ -41,8 +42,9 @@ from fuzzyctl.kinds.methods import METHODS
 __all__ = ["FixedDecl", "FixedProgram", "Port", "build_fixed"]
 
 INT_OUTPUTS = ("scaled", "unit")
-_AND = ("MIN", "PROD", "BDIF")
-_OR = ("MAX", "ASUM", "BSUM")
+# the operators with a fixed-point form (their registry entry's ``fixed``)
+_AND = tuple(name for name, e in norms.TNORMS.items() if e.fixed is not None)
+_OR = tuple(name for name, e in norms.SNORMS.items() if e.fixed is not None)
 _ACCU = ("MAX", "SUM")
 
 
@@ -443,16 +445,17 @@ class FixedBlock:
         return one
 
     def combine(self, op: str, a: FX, b: FX, is_and: bool) -> FX:
-        if op in ("MIN", "MAX"):
-            return self.minmax(a, b, op == "MIN")
-        if op == "PROD":
+        form = norms.TNORMS[op].fixed if is_and else norms.SNORMS[op].fixed
+        if form in ("min", "max"):
+            return self.minmax(a, b, form == "min")
+        if form == "product":
             return self.product(a, b)
-        if op == "ASUM":  # a + (1 - a) b: in 0..1, which the limit makes the interval know
+        if form == "probabilistic_sum":  # a + (1 - a) b: in 0..1, which the limit makes the interval know
             rest = fa.narrow(self.w, fa.sub(self.w, self.degree_const(1.0), a), "NOT")
             return self.limited(fa.add(self.w, a, self.product(rest, b)), 0, self.D)
-        if op == "BSUM":
+        if form == "bounded_sum":
             return self.limited(fa.add(self.w, a, b), None, self.D)
-        assert op == "BDIF"
+        assert form == "bounded_difference", op
         return self.limited(fa.sub(self.w, fa.add(self.w, a, b), self.degree_const(1.0)), 0, None)
 
     def weighted(self, a: FX, w: float) -> FX:

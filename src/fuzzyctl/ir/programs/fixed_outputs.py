@@ -22,6 +22,7 @@ from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
 from fuzzyctl.ir.builders.fixed_bound import Group, WeightBounds, weight_bounds
 from fuzzyctl.ir.nodes import Int, Var
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS
 
@@ -109,7 +110,7 @@ def _weights(blk: FixedBlock, groups: list[Group], rules: list[FX]) -> list[FX]:
             a = blk.weighted(rules[ri], wt)
             if g is None:
                 g = a
-            elif accu == "MAX":
+            elif norms.is_max(accu):
                 g = blk.minmax(g, a, False)
             else:
                 g = fa.add(blk.w, g, a)

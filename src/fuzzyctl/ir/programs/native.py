@@ -38,6 +38,7 @@ from fuzzyctl.ir.builders.smooth_methods import smooth_method
 from fuzzyctl.ir.nodes import Ex, Int, Var, ex
 from fuzzyctl.ir.programs.evaluator import FastBuilder, FastProgram, FastTarget, Group, merge
 from fuzzyctl.ir.state import CodegenError, Gen
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS, implementation
 
 
@@ -143,7 +144,7 @@ class NativeBuilder(FastBuilder):
             op.low,
             op.high,
             points,
-            [M.Group(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups],
+            [M.Group(gr.term, gr.a, gr.w, norms.is_min(gr.act)) for gr in groups],
         )
         value, fired = M.exact_outputs(self.g, [spec], None if op.grid is None else [op.grid])
         return value[0], fired[0]
@@ -153,9 +154,9 @@ class NativeBuilder(FastBuilder):
         (:mod:`~fuzzyctl.ir.builders.grid_pieces`), then the method's IR builder (its registry
         entry's ``ir``)."""
         g = self.g
-        sets = [GP.Set(gr.term, gr.a, gr.w, gr.act == "MIN") for gr in groups]
+        sets = [GP.Set(gr.term, gr.a, gr.w, norms.is_min(gr.act)) for gr in groups]
         entry = METHODS[op.method]
-        if accu == "MAX" and entry.maximum is not None:
+        if norms.is_max(accu) and entry.maximum is not None:
             # the height from each set's peak and fired from the closed-form area: LM and RM
             # stop at the first point reaching it, MoM cuts only the intervals that can
             _cog, fired = self.closed_cog(op, grid, groups)
@@ -189,7 +190,7 @@ class NativeBuilder(FastBuilder):
         b = g.b
         n = len(geom)
         lines = [(left, right, args[2 * i], args[2 * i + 1], mn) for i, (left, right, mn) in enumerate(geom)]
-        if n == 2 and accu == "MAX":
+        if n == 2 and norms.is_max(accu):
             return max_of_two(g, x0, x1, lines[0], lines[1])
         if n == 1:
             area, mom = g.let(0.0, "IA"), g.let(0.0, "IM")

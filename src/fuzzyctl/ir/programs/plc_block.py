@@ -31,6 +31,7 @@ from fuzzyctl.ir.cost import cost
 from fuzzyctl.ir.nodes import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.ir.programs.guard import check_known_fields
 from fuzzyctl.ir.state import CodegenError, Gen, Target
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
 #: INFO codes (modelled on the Siemens FUZZY block's INFO byte).
@@ -376,12 +377,12 @@ class _Builder(RuleBuilder):
         merged: dict[tuple[int, bool, int], Group] = {}
         for t, a, w, act in contribs:
             assert t is not None
-            is_min = act == "MIN"
-            if accu == "MAX" and not is_min:
+            is_min = norms.is_min(act)
+            if norms.is_max(accu) and not is_min:
                 key = (t, False, 0)
                 a = g.let(w * a, "AW") if not (isinstance(w, Num) and w.value == 1.0) else a
                 w = ex(1.0)
-            elif accu == "MAX" and isinstance(w, Num | Index):
+            elif norms.is_max(accu) and isinstance(w, Num | Index):
                 key = (t, True, _weight_key(w))
             else:
                 groups.append(Group(t, a, w, is_min))

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING
 from fuzzyctl.engine.plan import CAnd, CTerm, Plan, RulePlan, Slot
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.nodes import Ex, Int, Num, Var
+from fuzzyctl.kinds import norms
 
 if TYPE_CHECKING:
     from fuzzyctl.ir.builders.rules import Contrib
@@ -59,9 +60,13 @@ def _output_ok(plan: Plan, oi: int) -> bool:
     op = plan.outputs[oi]
     accu = op.accu or "MAX"
     if op.kind == "mamdani":
-        return accu == "MAX" or (accu in ("SUM", "NSUM") and all(c.act == "PROD" for c in op.contributions))
+        return norms.is_max(accu) or (
+            norms.adds(accu) and all(norms.is_prod(c.act) for c in op.contributions)
+        )
     if op.kind == "singleton":
-        return accu == "MAX" or (accu in ("SUM", "NSUM") and all(c.act == "PROD" for c in op.contributions))
+        return norms.is_max(accu) or (
+            norms.adds(accu) and all(norms.is_prod(c.act) for c in op.contributions)
+        )
     if op.kind == "ts":
         return op.accu is None or op.accu in _KINDS
     return accu in _KINDS  # degree
@@ -109,7 +114,7 @@ def _slots(plan: Plan) -> tuple[list[_Slot], list[list[tuple[int, float]]]]:
         for c in op.contributions:
             cp = plan.rules[c.rule].conclusions[c.conclusion]
             w = float(cp.weight)  # type: ignore[arg-type]
-            if op.kind in ("mamdani", "singleton") and accu == "MAX" and not before:
+            if op.kind in ("mamdani", "singleton") and norms.is_max(accu) and not before:
                 key: tuple[object, ...] = (oi, c.term, w, c.act)
                 slot, mult = _Slot(oi, c.term or 0, w, c.act, 1), 1.0
             elif op.kind in ("mamdani", "singleton"):

@@ -39,6 +39,7 @@ from fuzzyctl.ir.nodes import Ex
 from fuzzyctl.ir.programs.evaluator import FastBuilder, FastProgram
 from fuzzyctl.ir.programs.native import NativeBuilder
 from fuzzyctl.ir.state import CodegenError
+from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
 
@@ -62,7 +63,7 @@ class ScalarBuilder(NativeBuilder):
         under MAX: there the AM_LINES kernel was measured as fast or up to 7% faster, while the
         IR wins elsewhere (3.5 against 12 us a call for two sets under MAX, 18 against 24 for
         PROBOR, 25-35% less for sums and PROD-activated sets)."""
-        if len(geom) <= 2 or accu != "MAX" or not all(mn for _l, _r, mn in geom):
+        if len(geom) <= 2 or not norms.is_max(accu) or not all(mn for _l, _r, mn in geom):
             return super().am_lines(x0, x1, accu, geom, args)
         return FastBuilder.am_lines(self, x0, x1, accu, geom, args)
 
@@ -86,7 +87,7 @@ def ir_exact(op: OutputPlan) -> bool:
     the IR cuts the sets at every crossing, which Python runs slower than the interpreter
     (the dryer's PROBOR CoA: 82 against 64 us a call)."""
     accu = op.accu or "MAX"
-    return accu == "MAX" or (accu in ("SUM", "NSUM") and all(c.act == "PROD" for c in op.contributions))
+    return norms.is_max(accu) or (norms.adds(accu) and all(norms.is_prod(c.act) for c in op.contributions))
 
 
 def ir_smooth(op: OutputPlan) -> bool:
