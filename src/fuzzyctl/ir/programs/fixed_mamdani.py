@@ -36,22 +36,29 @@ from fractions import Fraction
 from typing import TYPE_CHECKING
 
 from fuzzyctl.engine.plan import OutputPlan
+from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
 from fuzzyctl.ir.builders.fixed_bound import Group, weight_bounds
 from fuzzyctl.ir.nodes import Int, Var
+from fuzzyctl.kinds.methods import METHODS
 
 if TYPE_CHECKING:
     from fuzzyctl.ir.programs.fixed_block import FixedBlock, Port
 
 __all__ = ["check_mamdani", "mamdani_output"]
 
-#: accumulations and activations computed
-_ACCU = ("MAX", "SUM")
+#: the accumulations computed, and how the activated sets combine under each: their upper
+#: envelope (cut where two lines cross) or their sum
+_COMBINE = {"MAX": "envelope", "SUM": "sum"}
+#: the activations computed (MIN clips a set, operators.CLIP_BRANCH; PROD scales it)
 _ACT = ("MIN", "PROD")
-#: methods computed on Mamdani outputs
-METHODS_DONE = ("COG",)
+
+
+def _combine(op: OutputPlan) -> str:
+    """How ``op``'s activated sets combine (its accumulation was checked to be computed)."""
+    return _COMBINE[op.accu or "MAX"]
 
 
 def _refuse(what: str) -> CodegenError:
@@ -61,13 +68,17 @@ def _refuse(what: str) -> CodegenError:
 def check_mamdani(op: OutputPlan, weight_before_activation: bool) -> None:
     """Refuse what the integer Mamdani output does not compute, naming it."""
     name = f"output {op.name!r}"
-    if op.method not in METHODS_DONE:
+    method = METHODS[op.method]
+    if method.maximum is not None:
         raise _refuse(
-            f"{name}: Mamdani METHOD {op.method} is not computed (only {', '.join(METHODS_DONE)} is)"
+            f"{name}: Mamdani METHOD {op.method} is not computed (only COG is): a maximum jumps from one "
+            "set to another where their heights tie, so rounding has no worst-case error bound"
         )
+    if not method.integrating or method.bisects:
+        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (only COG is)")
     if not op.exact or op.grid is None:
         raise _refuse(f"{name}: terms that are not piecewise linear with constant points are not computed")
-    if op.accu not in _ACCU:
+    if op.accu not in _COMBINE:
         raise _refuse(f"{name}: ACCU {op.accu} is not computed on fuzzy sets (MAX and SUM are)")
     for c in op.contributions:
         if c.term is None:
@@ -100,7 +111,7 @@ def _sets(blk: FixedBlock, op: OutputPlan, rules: list[FX]) -> list[_Set]:
     for k, c in enumerate(op.contributions):
         if constant(c.weight) == 0.0:
             continue
-        key: object = (c.term, c.act, constant(c.weight)) if op.accu == "MAX" else k
+        key: object = (c.term, c.act, constant(c.weight)) if _combine(op) == "envelope" else k
         keyed.setdefault(key, []).append(k)
     out = []
     for ks in keyed.values():
@@ -109,7 +120,7 @@ def _sets(blk: FixedBlock, op: OutputPlan, rules: list[FX]) -> list[_Set]:
         for k in ks[1:]:
             g = blk.minmax(g, rules[op.contributions[k].rule], False)
         w = constant(c.weight)
-        is_min = c.act == "MIN"
+        is_min = c.act in CLIP_BRANCH
         assert c.term is not None
         out.append(_Set(c.term, blk.weighted(g, w), Fraction(w) if is_min else Fraction(1), is_min))
     return out
@@ -252,7 +263,7 @@ class _Pieces:
         """Area and moment on the part ``[ta, tb]`` of an interval where no two lines cross."""
         blk, w = self.blk, self.blk.w
         ends = [(k, y0 + (y1 - y0) * ta, y0 + (y1 - y0) * tb) for k, y0, y1 in lines]
-        if self.op.accu == "SUM" or len(ends) == 1:
+        if _combine(self.op) == "sum" or len(ends) == 1:
             out = []
             for k, y0, y1 in ends:
                 s = self.sets[k]
@@ -289,7 +300,7 @@ class _Pieces:
             lines = _lines(self.op, self.sets, j)
             if not lines:
                 continue
-            ts = _cuts(lines) if self.op.accu == "MAX" else [Fraction(0), Fraction(1)]
+            ts = _cuts(lines) if _combine(self.op) == "envelope" else [Fraction(0), Fraction(1)]
             for ta, tb in itertools.pairwise(ts):
                 a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
                 out.append(_Piece(a, b, self.piece(lines, ta, tb)))
