@@ -52,6 +52,8 @@ __all__ = ["check_mamdani", "mamdani_output"]
 #: the accumulations computed, and how the activated sets combine under each: their upper
 #: envelope (cut where two lines cross) or their sum
 _COMBINE = {"MAX": "envelope", "SUM": "sum"}
+#: the most integrals of clipped sets one output may compute per cycle
+MAX_CLIPS = 600
 #: the activations computed (MIN clips a set, operators.CLIP_BRANCH; PROD scales it)
 _ACT = ("MIN", "PROD")
 
@@ -293,7 +295,7 @@ class _Pieces:
         return [(area, moment)]
 
     def all(self, xi: tuple[Fraction, ...]) -> list[_Piece]:
-        out = []
+        todo = []
         for j in range(len(xi) - 1):
             if xi[j + 1] <= xi[j]:
                 continue
@@ -301,9 +303,19 @@ class _Pieces:
             if not lines:
                 continue
             ts = _cuts(lines) if _combine(self.op) == "envelope" else [Fraction(0), Fraction(1)]
-            for ta, tb in itertools.pairwise(ts):
-                a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
-                out.append(_Piece(a, b, self.piece(lines, ta, tb)))
+            todo += [(j, lines, ta, tb) for ta, tb in itertools.pairwise(ts)]
+        # the work grows with the pieces times the sets over each (distinct weights make distinct
+        # sets): past a limit the block would be too long for a PLC cycle and for its compiler
+        work = sum(2 * len(lines) - 1 for _j, lines, _a, _b in todo)
+        if work > MAX_CLIPS:
+            raise _refuse(
+                f"output {self.op.name!r}: {len(self.sets)} activated sets over {len(todo)} pieces need "
+                f"{work} clipped-set integrals per cycle (more than {MAX_CLIPS})"
+            )
+        out = []
+        for j, lines, ta, tb in todo:
+            a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
+            out.append(_Piece(a, b, self.piece(lines, ta, tb)))
         return out
 
 
