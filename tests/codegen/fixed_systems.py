@@ -6,6 +6,8 @@ engine reads them as any user's file."""
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 
 AND_OR = [("MIN", "MAX"), ("PROD", "ASUM"), ("BDIF", "BSUM")]
@@ -92,3 +94,37 @@ def random_fcl(seed: int) -> str:
         lines.append(f"    RULE {k} : IF {names[0]} IS NOT {terms[0][0]} THEN out IS o0;")
     lines += ["END_RULEBLOCK", "END_FUNCTION_BLOCK"]
     return "\n".join(lines) + "\n"
+
+
+def random_mamdani_fcl(seed: int, method: str = "COG") -> str:
+    """A random system as :func:`random_fcl` draws its inputs and rules, with a Mamdani
+    output: 2-5 piecewise-linear terms covering its RANGE, ACCU MAX or SUM, ACT MIN or PROD."""
+    rng = np.random.default_rng(10_000 + seed)
+    text = random_fcl(seed)
+    head, _sep, tail = text.partition("DEFUZZIFY out")
+    _old, _sep, rest = tail.partition("END_DEFUZZIFY")
+    out_lo = float(rng.choice([-100.0, 0.0, 20.0, -0.5]))
+    out_hi = out_lo + float(rng.choice([1.0, 200.0, 5000.0, 7.5]))
+    terms = _terms(rng, out_lo, out_hi)
+    used = sorted({int(t) for t in re.findall(r"THEN out IS o(\d+)", rest)})
+    lines = ["DEFUZZIFY out", f"    RANGE := ({out_lo!r} .. {out_hi!r});"]
+    for k in range(max(used) + 1):
+        lines.append(f"    TERM o{k} := {terms[k % len(terms)]};")
+    lines += [f"    METHOD : {method};", "    DEFAULT := 0;", f"    ACCU : {rng.choice(['MAX', 'SUM'])};", ""]
+    act = "PROD" if rng.random() < 0.25 else "MIN"
+    rest = rest.replace("RULEBLOCK rb\n", f"RULEBLOCK rb\n    ACT : {act};\n")
+    return head + "\n".join(lines) + "END_DEFUZZIFY" + rest
+
+
+def mamdani_variant(text: str, half_width: float = 50.0, low: float = -150.0, high: float = 150.0) -> str:
+    """A singleton (COGS) system turned Mamdani: each singleton ``v`` becomes the triangle
+    ``(v - half_width, 0) (v, 1) (v + half_width, 0)``, CoG over ``RANGE (low .. high)``; the
+    block is renamed ``<name>_m``."""
+
+    def triangle(m: re.Match[str]) -> str:
+        v = float(m.group(2))
+        return f"TERM {m.group(1)} := ({v - half_width!r}, 0) ({v!r}, 1) ({v + half_width!r}, 0);"
+
+    text = re.sub(r"TERM (\w+) := (-?[\d.]+);", triangle, text)
+    text = re.sub(r"METHOD\s*:\s*CoGS;", f"METHOD : CoG; RANGE := ({low!r} .. {high!r});", text, flags=re.I)
+    return re.sub(r"FUNCTION_BLOCK (\w+)", r"FUNCTION_BLOCK \1_m", text, count=1)

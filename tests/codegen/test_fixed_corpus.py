@@ -67,7 +67,7 @@ def test_corpus_generates_in_int32_or_says_why(tmp_path: Path) -> None:
     print(f"\nint32: {done} of {real} corpus files that generate in REAL")
     for why, n in reasons.most_common():
         print(f"  {n:3} x {why}")
-    assert done >= 30
+    assert done >= 85  # 92 with Mamdani CoG (38 before)
     cc = shutil.which("cc")
     assert cc
     for k, files in enumerate(sample):

@@ -15,7 +15,7 @@ import fuzzyctl
 from fuzzyctl.codegen import CodegenError
 from fuzzyctl.codegen.api import generate_st
 from tests.codegen import matiec as M
-from tests.codegen.fixed_systems import random_fcl
+from tests.codegen.fixed_systems import mamdani_variant, random_fcl, random_mamdani_fcl
 from tests.conftest import EXAMPLES
 
 pytestmark = pytest.mark.extra("matiec")
@@ -29,6 +29,13 @@ def _systems(arith: str) -> list[tuple[str, fuzzyctl.model.Document, dict]]:
     docs = [(p.name, fuzzyctl.load(p)) for p in (EXAMPLES / "crane.fcl", EXAMPLES / "figure7.fcl")]
     for seed in range(16):
         docs.append((f"random {seed}", fuzzyctl.load(random_fcl(seed).replace("rnd", f"rnd{seed}"))))
+    # Mamdani outputs (CoG of piecewise-linear sets)
+    for p in (EXAMPLES / "crane.fcl", EXAMPLES / "figure7.fcl"):
+        docs.append((f"{p.name} mamdani", fuzzyctl.load(mamdani_variant(p.read_text()))))
+    for seed in (1, 3, 4):
+        docs.append(
+            (f"mamdani {seed}", fuzzyctl.load(random_mamdani_fcl(seed).replace("rnd", f"rndm{seed}")))
+        )
     out = []
     for label, doc in docs:
         report: list = []

@@ -29,6 +29,8 @@ Dialect = StrEnum("Dialect", [(d, d) for d in targets.dialect_names()])  # type:
 #: ``--arith`` choices: the arithmetic records.
 Arith = StrEnum("Arith", [(a, a) for a in arith_kinds.choices()])  # type: ignore[misc]
 _DEFAULT_ARITH = Arith(arith_kinds.DEFAULT)
+#: ``--int-output`` choices
+IntOutput = StrEnum("IntOutput", [(a, a) for a in arith_kinds.INT_OUTPUTS])  # type: ignore[misc]
 _DEFAULT_LANG = Lang(targets.cli_choices()[0])
 
 
@@ -90,6 +92,17 @@ def codegen(
             + ".",
         ),
     ] = _DEFAULT_ARITH,
+    int_output: Annotated[
+        IntOutput | None,
+        typer.Option(
+            "--int-output",
+            help="--arith int16/int32: how each output is stored (value = stored * scale + offset, both "
+            "in the header and --json); "
+            + "; ".join(f"{k}: {v}" for k, v in arith_kinds.INT_OUTPUTS.items())
+            + ".",
+            show_default=False,
+        ),
+    ] = None,
     lookup: Annotated[
         bool,
         typer.Option(
@@ -179,6 +192,7 @@ def codegen(
             lookup=lookup,
             tolerance=tolerance,
             max_bytes=max_bytes,
+            int_output=None if int_output is None else int_output.value,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))

@@ -98,6 +98,7 @@ def check_options(
     lookup: bool = False,
     tolerance: str | float | None = None,
     max_bytes: int | None = None,
+    int_output: str | None = None,
 ) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
     (:class:`OptionError` names the option); what applies is the target's record."""
@@ -124,6 +125,15 @@ def check_options(
     except ValueError as exc:
         raise OptionError(str(exc), "--arith") from None
     _check_lookup(lookup, tolerance, max_bytes, "lookup" in takes)
+    if int_output is not None:
+        if not arith_kinds.get(arith).integer or lookup:
+            raise OptionError(
+                "--int-output applies to --arith int16 and int32 (without --lookup)", "--int-output"
+            )
+        if int_output not in arith_kinds.INT_OUTPUTS:
+            raise OptionError(
+                f"--int-output {int_output!r}: choose {' or '.join(arith_kinds.INT_OUTPUTS)}", "--int-output"
+            )
     refusal = targets.dialect(dialect).refused_by.get(caps.name) if dialect is not None else None
     if refusal is not None:
         raise OptionError(f"{refusal}: use --lang st --dialect {dialect}", "--dialect")
@@ -180,6 +190,7 @@ def emit(
     lookup: bool = False,
     tolerance: str | float | None = None,
     max_bytes: int | None = None,
+    int_output: str | None = None,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
         are checked first) and write it: ``st`` and ``plcopen`` to the file
@@ -202,6 +213,7 @@ def emit(
         lookup=lookup,
         tolerance=tolerance,
         max_bytes=max_bytes,
+        int_output=int_output,
     )
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
@@ -230,6 +242,8 @@ def emit(
         from fuzzyctl.codegen.lookup import lookup_options
 
         kwargs.update(lookup_options(tolerance, max_bytes))
+    if int_output is not None:  # the integer generators: codegen/fixed.py
+        kwargs["int_output"] = int_output
     if caps.report:
         kwargs["report"] = emitted.blocks
     result = generator_of(caps)(document, **kwargs)

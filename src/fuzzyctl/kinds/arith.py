@@ -14,7 +14,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
 
-__all__ = ["ARITH", "DEFAULT", "Arith", "choices", "get"]
+__all__ = ["ARITH", "DEFAULT", "INT_OUTPUTS", "Arith", "choices", "get"]
 
 
 @dataclass(frozen=True)
@@ -76,3 +76,13 @@ def get(name: str) -> Arith:
         return ARITH[name]
     except KeyError:
         raise ValueError(f"unknown arithmetic {name!r} (known: {', '.join(ARITH)})") from None
+
+
+#: ``codegen --int-output``: how an integer block stores an output (``value = stored * scale +
+#: offset`` either way; the header and ``--json`` give both numbers).
+INT_OUTPUTS: MappingProxyType[str, str] = MappingProxyType(
+    {
+        "scaled": "the finest power-of-ten scale that holds the output's values (default)",
+        "unit": "the output's own engineering unit (scale 1): coarser, rounded to whole units",
+    }
+)

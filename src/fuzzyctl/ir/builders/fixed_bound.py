@@ -135,9 +135,11 @@ def weight_bounds(
     weights: Sequence[float],
     domain: dict[int, Iv],
     budget: int = 6000,
+    enough: float = 0.9,
 ) -> WeightBounds:
     """Bounds of ``sum over groups`` on ``domain`` (input slot -> interval of the values the
-    block can be given); ``weights[r]`` is rule ``r``'s constant weight."""
+    block can be given); ``weights[r]`` is rule ``r``'s constant weight.  The search stops
+    when the lower bound reaches ``enough`` times the smallest total seen."""
     slots = sorted(domain)
     # start from the cells between breakpoints, where every degree is linear
     boxes: list[dict[int, Iv]] = [{}]
@@ -167,7 +169,7 @@ def weight_bounds(
         push(bx)
     while heap and count < budget:
         lo, _n, bx = heap[0]
-        if lo >= 0.9 * best or best <= 0.0:
+        if lo >= enough * best or best <= 0.0:
             break
         heapq.heappop(heap)
         s = max(slots, key=lambda k: (bx[k][1] - bx[k][0]) / max(domain[k][1] - domain[k][0], 1e-300))

@@ -36,12 +36,11 @@ from fuzzyctl.ir.builders.fixed_arith import FX, Width
 from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
-from fuzzyctl.kinds.arith import Arith
+from fuzzyctl.kinds.arith import INT_OUTPUTS, Arith
 from fuzzyctl.kinds.methods import METHODS
 
 __all__ = ["FixedDecl", "FixedProgram", "Port", "build_fixed"]
 
-INT_OUTPUTS = ("scaled", "unit")
 # the operators with a fixed-point form (their registry entry's ``fixed``)
 _AND = tuple(name for name, e in norms.TNORMS.items() if e.fixed is not None)
 _OR = tuple(name for name, e in norms.SNORMS.items() if e.fixed is not None)
@@ -159,16 +158,18 @@ def check_supported(plan: Plan) -> None:
             if t.pwl is not None and any(not 0.0 <= y <= 1.0 for _x, y in t.pwl):
                 raise _refuse(f"term {t.name!r} of input {fi.name!r}: degrees outside 0..1 are not computed")
     for op in plan.outputs:
-        _check_output(op)
+        _check_output(op, plan.options.weight_before_activation)
 
 
-def _check_output(op: OutputPlan) -> None:
+def _check_output(op: OutputPlan, weight_before_activation: bool) -> None:
+    from fuzzyctl.ir.programs.fixed_mamdani import check_mamdani
+
     name = f"output {op.name!r}"
     if op.kind == "mamdani":
-        raise _refuse(
-            f"{name}: Mamdani defuzzification ({op.method}) over fuzzy sets is not computed yet (singleton "
-            "and Takagi-Sugeno outputs are)"
-        )
+        if op.clamp is not None or not op.is_output:
+            raise _refuse(f"{name}: a locked range or a local defuzzified variable is not computed")
+        check_mamdani(op, weight_before_activation)
+        return
     if op.kind not in ("singleton", "ts"):
         raise _refuse(f"{name}: a {op.kind} output is not computed")
     if METHODS[op.method].weighted is None:

@@ -140,7 +140,17 @@ def _sums(blk: FixedBlock, op: OutputPlan, gs: list[FX], zs: list[FX]) -> tuple[
     )
 
 
-def _up(x: Fraction) -> float:
+def input_domain(blk: FixedBlock) -> dict[int, tuple[float, float]]:
+    """Each fuzzified input's interval of values the block can be given (its stored range)."""
+    out = {}
+    for fi in blk.plan.fuzzy_inputs:
+        p = blk.inputs[fi.slot]
+        out[fi.slot] = (float(p.low * p.scale + p.offset), float(p.high * p.scale + p.offset))
+    return out
+
+
+def round_up(x: Fraction) -> float:
+    """``x`` as the nearest float not below it (a stated bound never rounds down)."""
     f = float(x)
     return f if Fraction(f) >= x else math.nextafter(f, math.inf)
 
@@ -175,13 +185,7 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
     zi = [_z_interval(blk, op, t) for t in terms]
     zlo, zhi = min(a for a, _b in zi), max(b for _a, b in zi)
     weights = [constant(r.weight) for r in plan.rules]
-    domain = {
-        fi.slot: (
-            float(blk.inputs[fi.slot].low * blk.inputs[fi.slot].scale + blk.inputs[fi.slot].offset),
-            float(blk.inputs[fi.slot].high * blk.inputs[fi.slot].scale + blk.inputs[fi.slot].offset),
-        )
-        for fi in plan.fuzzy_inputs
-    }
+    domain = input_domain(blk)
     # the search's cost grows with the rules each box evaluates
     bounds = weight_bounds(
         plan, groups, weights, domain, budget=max(500, min(6000, 600_000 // len(plan.rules)))
@@ -252,8 +256,13 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
         if not op.no_change:
             blk.b.set(out, Int(0 if nan else round((default - offset) / scale)))
     del shift
-    return Port(op.name, scale, offset, slo, shi, _up(err), comment=f"{float(lo):g}..{float(hi):g}")
+    return Port(op.name, scale, offset, slo, shi, round_up(err), comment=f"{float(lo):g}..{float(hi):g}")
 
 
 def emit_outputs(blk: FixedBlock, rules: list[FX], info: Var) -> list[Port]:
-    return [_output(blk, op, rules, info) for op in blk.plan.outputs]
+    from fuzzyctl.ir.programs.fixed_mamdani import mamdani_output
+
+    return [
+        mamdani_output(blk, op, rules, info) if op.kind == "mamdani" else _output(blk, op, rules, info)
+        for op in blk.plan.outputs
+    ]
