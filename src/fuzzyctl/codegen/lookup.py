@@ -174,6 +174,15 @@ def _strides(shape: Sequence[int]) -> list[int]:
     return [math.prod(shape[i + 1 :]) for i in range(len(shape))]
 
 
+def lerp_text(a: str, b: str, frac: str, width: str | None = None) -> str:
+    """The text of ``a`` moved toward ``b`` by ``frac`` (a float fraction), or by ``frac /
+    width`` in integers (``width`` given): the product first, so that only the one division
+    rounds.  Every target's table interpolation writes its steps with it."""
+    if width is not None:
+        return f"{a} + (({b} - {a}) * {frac}) / {width}"
+    return f"{a} + ({b} - {a}) * {frac}"
+
+
 def interpolation(
     shape: Sequence[int],
     read: Callable[[int], str],

@@ -7,7 +7,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.codegen.lookup import (
+    LookupReport,
+    expected,
+    header,
+    interpolation,
+    lerp_text,
+    sample_rows,
+    tables,
+)
 from fuzzyctl.codegen.testbench import c_bench_driver
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
@@ -103,9 +111,7 @@ def c_files(table: Table, single: bool, arith: str) -> dict[str, str]:
             return f"({wide}){tab}[k + {off}]" if kind.integer else f"{tab}[k + {off}]"
 
         def lerp(a: str, b: str, axis: int) -> str:
-            if kind.integer:
-                return f"{a} + (({b} - {a}) * f[{axis}]) / w[{axis}]"
-            return f"{a} + ({b} - {a}) * f[{axis}]"
+            return lerp_text(a, b, f"f[{axis}]", f"w[{axis}]" if kind.integer else None)
 
         steps, final = interpolation(table.shape, read, lerp, lambda s: f"v{s}")
         for tmp, expr in steps:

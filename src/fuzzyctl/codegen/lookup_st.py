@@ -6,7 +6,15 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from fuzzyctl.codegen.lookup import LookupReport, expected, header, interpolation, sample_rows, tables
+from fuzzyctl.codegen.lookup import (
+    LookupReport,
+    expected,
+    header,
+    interpolation,
+    lerp_text,
+    sample_rows,
+    tables,
+)
 from fuzzyctl.codegen.testbench import st_bench_tail
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
@@ -86,8 +94,8 @@ def st_parts(table: Table, dialect: str, lreal: bool, arith: str) -> STParts:
 
         def lerp(a: str, b: str, axis: int) -> str:
             if kind.integer:
-                return f"{a} + (({b} - {a}) * {p}{_P}D{axis}) / {p}{_P}W{axis}"
-            return f"{a} + ({b} - {a}) * {p}{_P}F{axis}"
+                return lerp_text(a, b, f"{p}{_P}D{axis}", f"{p}{_P}W{axis}")
+            return lerp_text(a, b, f"{p}{_P}F{axis}")
 
         steps, final = interpolation(table.shape, read, lerp, lambda s: f"{p}{_P}V{s}")
         for tmp, expr in steps:
