@@ -4,15 +4,28 @@ from __future__ import annotations
 
 import shutil
 import subprocess
+import warnings
 from collections.abc import Sequence
 from pathlib import Path
 
+import fuzzyctl
+from fuzzyctl.diagnostics import FuzzyctlError
 from tests.extras import extra_files
 
 #: Every corpus file in a format that code generation reads (FCL, FIS, FLL).
 FILES = [
     p for p in extra_files("corpus", "corpus", recursive=True) if p.suffix.lower() in (".fcl", ".fis", ".fll")
 ]
+
+
+def load(path: Path) -> fuzzyctl.model.Document | None:
+    """The corpus file ``path`` loaded without its warnings, or None where it does not load."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            return fuzzyctl.load(path)
+    except (FuzzyctlError, UnicodeDecodeError):
+        return None
 
 
 def compile_sample(samples: list[dict[str, str]], where: Path, flags: Sequence[str]) -> None:
