@@ -76,6 +76,17 @@ def compile_c(matiec: Path, where: Path, driver: str, exe: str = "driver") -> Pa
     return where / exe
 
 
+#: The start of a C driver: matiec's translation included, and the globals its library expects.
+PRELUDE = (
+    "#include <stdio.h>",
+    "#include <stdlib.h>",
+    '#include "POUS.h"',
+    '#include "POUS.c"',
+    "IEC_TIME __CURRENT_TIME;",
+    "IEC_BOOL __DEBUG;",
+)
+
+
 @dataclass(frozen=True)
 class Block:
     """One FUNCTION_BLOCK in a translated program: its ST name and interface (matiec
@@ -89,14 +100,7 @@ class Block:
 def driver(blocks: Sequence[Block], real: str) -> str:
     """A C program: ``driver K`` runs block K on rows read from stdin (first the row count,
     then one row of hexadecimal floats per line) and prints each row's outputs and INFO."""
-    parts = [
-        "#include <stdio.h>",
-        "#include <stdlib.h>",
-        '#include "POUS.h"',
-        '#include "POUS.c"',
-        "IEC_TIME __CURRENT_TIME;",
-        "IEC_BOOL __DEBUG;",
-    ]
+    parts = list(PRELUDE)
     for k, b in enumerate(blocks):
         name = b.name.upper()
         n_in = max(1, len(b.inputs))
@@ -134,3 +138,22 @@ def run_block(exe: Path, k: int, data: np.ndarray) -> tuple[np.ndarray, np.ndarr
     )
     info = np.array([int(r[-1]) for r in rows], dtype=np.int64)
     return outs, info
+
+
+def bench_driver(names: Sequence[str]) -> str:
+    """A C program: ``driver K`` runs the test bench PROGRAM ``names[K]`` cycle by cycle until
+    DONE and prints ``PASS FAIL_COUNT FIRST_FAIL cycles``."""
+    parts = list(PRELUDE)
+    for k, name in enumerate(names):
+        n = name.upper()
+        parts.append(
+            f"static int run{k}(void) {{\n  static {n} p;\n  long cycles = 0;\n  {n}_init__(&p, 0);\n"
+            f"  while (!__GET_VAR(p.DONE) && cycles < 100000) {{ {n}_body__(&p); cycles++; }}\n"
+            '  printf("%d %d %d %ld\\n", (int)__GET_VAR(p.PASS), (int)__GET_VAR(p.FAIL_COUNT),'
+            " (int)__GET_VAR(p.FIRST_FAIL), cycles);\n  return 0;\n}"
+        )
+    cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
+    parts.append(
+        f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}"
+    )
+    return "\n".join(parts) + "\n"

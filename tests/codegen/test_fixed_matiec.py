@@ -82,23 +82,6 @@ def test_matiec_runs_the_integer_blocks_within_their_bound(arith: str, tmp_path:
     print(f"\nmatiec {arith}: " + "; ".join(f"{k} {e:.2g} <= {b:.2g}" for k, (e, b) in worst.items()))
 
 
-def _program_driver(names: list[str]) -> str:
-    parts = ["#include <stdio.h>", "#include <stdlib.h>", '#include "POUS.h"', '#include "POUS.c"']
-    parts += ["IEC_TIME __CURRENT_TIME;", "IEC_BOOL __DEBUG;"]
-    for k, name in enumerate(names):
-        n = name.upper()
-        parts.append(
-            f"static int run{k}(void) {{\n  static {n} p;\n  long cycles = 0;\n  {n}_init__(&p, 0);\n"
-            f"  while (!__GET_VAR(p.DONE) && cycles < 100000) {{ {n}_body__(&p); cycles++; }}\n"
-            '  printf("%d %d\\n", (int)__GET_VAR(p.PASS), (int)__GET_VAR(p.FAIL_COUNT));\n  return 0;\n}'
-        )
-    cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
-    parts.append(
-        f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}"
-    )
-    return "\n".join(parts) + "\n"
-
-
 @pytest.mark.parametrize("arith", ["int16", "int32"])
 def test_the_integer_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     arith: str, tmp_path: Path
@@ -117,6 +100,6 @@ def test_the_integer_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
         where = tmp_path / label
         where.mkdir()
         M.iec2c(matiec, text, where)
-        exe = M.compile_c(matiec, where, _program_driver(["TB_crane"]))
+        exe = M.compile_c(matiec, where, M.bench_driver(["TB_crane"]))
         out = subprocess.run([str(exe), "0"], capture_output=True, text=True, timeout=60).stdout
         assert out.startswith(want), (label, out)

@@ -183,24 +183,6 @@ def _tamper_expected(text: str, vector: int) -> str:
     return text[: m.start(2)] + ", ".join(values) + text[m.end(2) :]
 
 
-def _program_driver(names: list[str]) -> str:
-    parts = ["#include <stdio.h>", "#include <stdlib.h>", '#include "POUS.h"', '#include "POUS.c"']
-    parts += ["IEC_TIME __CURRENT_TIME;", "IEC_BOOL __DEBUG;"]
-    for k, name in enumerate(names):
-        n = name.upper()
-        parts.append(
-            f"static int run{k}(void) {{\n  static {n} p;\n  long cycles = 0;\n  {n}_init__(&p, 0);\n"
-            f"  while (!__GET_VAR(p.DONE) && cycles < 100000) {{ {n}_body__(&p); cycles++; }}\n"
-            '  printf("%d %d %d %ld\\n", (int)__GET_VAR(p.PASS), (int)__GET_VAR(p.FAIL_COUNT),'
-            " (int)__GET_VAR(p.FIRST_FAIL), cycles);\n  return 0;\n}"
-        )
-    cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
-    parts.append(
-        f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}"
-    )
-    return "\n".join(parts) + "\n"
-
-
 def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     matiec: Path, tmp_path: Path, record_property: pytest.RecordProperty
 ) -> None:
@@ -232,7 +214,7 @@ def test_the_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
     texts.append(wrong.replace("[-100.0, 0.0, 100.0]", "[-100.0, 0.0, 99.0]"))  # inlet at 99
     names.append(f"TB_B{k + 1}")
     M.iec2c(matiec, "\n".join(texts), tmp_path)
-    exe = M.compile_c(matiec, tmp_path, _program_driver(names), "benches")
+    exe = M.compile_c(matiec, tmp_path, M.bench_driver(names), "benches")
     results = []
     for j in range(len(names)):
         res = subprocess.run([str(exe), str(j)], capture_output=True, text=True, timeout=60)

@@ -26,24 +26,6 @@ def matiec() -> Path:
     return M.build()
 
 
-def _driver(names: list[str]) -> str:
-    parts = ["#include <stdio.h>", "#include <stdlib.h>", '#include "POUS.h"', '#include "POUS.c"']
-    parts += ["IEC_TIME __CURRENT_TIME;", "IEC_BOOL __DEBUG;"]
-    for k, name in enumerate(names):
-        n = name.upper()
-        parts.append(
-            f"static int run{k}(void) {{\n  static {n} p;\n  long cycles = 0;\n  {n}_init__(&p, 0);\n"
-            f"  while (!__GET_VAR(p.DONE) && cycles < 100000) {{ {n}_body__(&p); cycles++; }}\n"
-            '  printf("%d %d %d %ld\\n", (int)__GET_VAR(p.PASS), (int)__GET_VAR(p.FAIL_COUNT),'
-            " (int)__GET_VAR(p.FIRST_FAIL), cycles);\n  return 0;\n}"
-        )
-    cases = "".join(f"  case {k}: return run{k}();\n" for k in range(len(names)))
-    parts.append(
-        f"int main(int argc, char **argv) {{\n  switch (atoi(argv[1])) {{\n{cases}  }}\n  return 2;\n}}"
-    )
-    return "\n".join(parts) + "\n"
-
-
 @pytest.mark.extra("matiec")
 def test_matiec_runs_the_table_benches(matiec: Path, tmp_path: Path) -> None:
     cases = [
@@ -72,7 +54,7 @@ def test_matiec_runs_the_table_benches(matiec: Path, tmp_path: Path) -> None:
     )
     names.append(f"TB_L{k}")
     M.iec2c(matiec, "\n".join(texts), tmp_path)
-    exe = M.compile_c(matiec, tmp_path, _driver(names), "benches")
+    exe = M.compile_c(matiec, tmp_path, M.bench_driver(names), "benches")
     for j, label in enumerate([*cases, "random int16"]):
         res = subprocess.run([str(exe), str(j)], capture_output=True, text=True, timeout=60)
         assert res.returncode == 0, res.stderr

@@ -15,7 +15,7 @@ import random
 from dataclasses import dataclass
 
 from fuzzyctl.codegen.fixed import FixedGenerated
-from fuzzyctl.codegen.testbench import st_bench_tail
+from fuzzyctl.codegen.testbench import c_bench_driver, st_bench_tail
 from fuzzyctl.engine.reference.interp import Interpreter
 from fuzzyctl.escape import CodegenError, c_ident, st_ident
 from fuzzyctl.ir.programs.fixed_block import Port
@@ -154,40 +154,10 @@ def render_fixed_c_bench(bench: FixedBench) -> str:
     for c, _p in enumerate(prog.outputs):
         vals = ", ".join(str(e[c]) for e in bench.expected)
         lines.append(f"static const {narrow} {name}_TB_Y{c}[{n}] = {{{vals}}};")
-    lines += [
-        "",
-        f"int {name}_testbench(int *first_fail)",
-        "{",
-        f"    {name} fb;",
-        "    int k, bad, fails = 0;",
-        "    long long d;",
-        f"    {name}_init(&fb);",
-        "    *first_fail = 0;",
-        f"    for (k = 0; k < {n}; k++) {{",
-    ]
-    for i, p in enumerate(prog.inputs):
-        lines.append(f"        fb.{p.name} = {name}_TB_X{i}[k];")
-    lines.append(f"        bad = {name}_step(&fb) != 0;")
+    body = [f"fb.{p.name} = {name}_TB_X{i}[k];" for i, p in enumerate(prog.inputs)]
+    body.append(f"bad = {name}_step(&fb) != 0;")
     for c, p in enumerate(prog.outputs):
-        lines.append(f"        d = (long long)fb.{p.name} - (long long){name}_TB_Y{c}[k];")
-        lines.append(f"        if (d > {bench.tolerance[c]} || d < -{bench.tolerance[c]}) bad = 1;")
-    lines += [
-        "        if (bad) {",
-        "            fails++;",
-        "            if (*first_fail == 0) *first_fail = k + 1;",
-        "        }",
-        "    }",
-        "    return fails;",
-        "}",
-        "",
-        "#ifdef FUZZYCTL_TESTBENCH_MAIN",
-        "int main(void)",
-        "{",
-        "    int first;",
-        f"    int fails = {name}_testbench(&first);",
-        '    printf("%s FAIL_COUNT=%d FIRST_FAIL=%d\\n", fails ? "FAIL" : "PASS", fails, first);',
-        "    return fails != 0;",
-        "}",
-        "#endif",
-    ]
+        body.append(f"d = (long long)fb.{p.name} - (long long){name}_TB_Y{c}[k];")
+        body.append(f"if (d > {bench.tolerance[c]} || d < -{bench.tolerance[c]}) bad = 1;")
+    lines += c_bench_driver(name, n, "long long", body)
     return "\n".join(lines) + "\n"

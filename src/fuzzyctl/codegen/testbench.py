@@ -290,24 +290,31 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
     lines.append(
         f"static const unsigned char {name}_TB_INFO[{n}] = {{{', '.join(str(v) for v in bench.info)}}};"
     )
-    lines += [
+    body = [f"fb.{inp.name} = ({name}_real){name}_TB_X{i}[k];" for i, inp in enumerate(plan.inputs)]
+    body.append(f"bad = {name}_step(&fb) != {name}_TB_INFO[k];")
+    for c, op in enumerate(outs):
+        body.append(f"d = (double)fb.{op.name} - {name}_TB_Y{c}[k];")
+        body.append(f"if (!((d < 0 ? -d : d) <= {_c_num(bench.tolerance[c])})) bad = 1;")
+    lines += c_bench_driver(name, n, "double", body)
+    return "\n".join(lines) + "\n"
+
+
+def c_bench_driver(name: str, n: int, diff: str, body: list[str]) -> list[str]:
+    """The end of a C test bench (every bench form shares it): ``int NAME_testbench(int
+    *first_fail)`` running ``body`` (which sets ``bad``, with ``d`` of type ``diff`` at hand) on
+    each of ``n`` vectors and returning FAIL_COUNT, then a ``main`` printing PASS or FAIL under
+    ``-DFUZZYCTL_TESTBENCH_MAIN``."""
+    return [
         "",
         f"int {name}_testbench(int *first_fail)",
         "{",
         f"    {name} fb;",
         "    int k, bad, fails = 0;",
-        "    double d;",
+        f"    {diff} d;",
         f"    {name}_init(&fb);",
         "    *first_fail = 0;",
         f"    for (k = 0; k < {n}; k++) {{",
-    ]
-    for i, inp in enumerate(plan.inputs):
-        lines.append(f"        fb.{inp.name} = ({name}_real){name}_TB_X{i}[k];")
-    lines.append(f"        bad = {name}_step(&fb) != {name}_TB_INFO[k];")
-    for c, op in enumerate(outs):
-        lines.append(f"        d = (double)fb.{op.name} - {name}_TB_Y{c}[k];")
-        lines.append(f"        if (!((d < 0 ? -d : d) <= {_c_num(bench.tolerance[c])})) bad = 1;")
-    lines += [
+        *(f"        {line}" for line in body),
         "        if (bad) {",
         "            fails++;",
         "            if (*first_fail == 0) *first_fail = k + 1;",
@@ -326,7 +333,6 @@ def render_c_bench(bench: Bench, *, single: bool = False) -> str:
         "}",
         "#endif",
     ]
-    return "\n".join(lines) + "\n"
 
 
 def st_bench_tail(n: int) -> list[str]:

@@ -37,7 +37,9 @@ from fuzzyctl.ir.nodes import (
     Pwl,
     Region,
     Stmt,
+    StmtVisitor,
     While,
+    subexprs,
 )
 
 #: The counted categories, in the order they are printed.
@@ -116,26 +118,20 @@ class Cost:
 
 def expr(e: Ex, c: Counts) -> None:
     """Count the operations of evaluating ``e`` into ``c``."""
-    if isinstance(e, Index):
-        c.add("array_reads")
-        expr(e.index, c)
-    elif isinstance(e, Bin):
-        c.add(_OPS[e.op])
-        expr(e.left, c)
-        expr(e.right, c)
-    elif isinstance(e, Neg):
-        c.add("add")
-        expr(e.operand, c)
-    elif isinstance(e, Not):
-        c.add("logic")
-        expr(e.operand, c)
-    elif isinstance(e, Call):
-        c.add(f"call:{e.function}")
-        for a in e.args:
-            expr(a, c)
-    elif isinstance(e, Pwl):
-        c.add("call:PWL")
-        expr(e.x, c)
+    for x in subexprs(e):
+        t = type(x)
+        if t is Index:
+            c.add("array_reads")
+        elif t is Bin:
+            c.add(_OPS[x.op])  # type: ignore[attr-defined]
+        elif t is Neg:
+            c.add("add")
+        elif t is Not:
+            c.add("logic")
+        elif t is Call:
+            c.add(f"call:{x.function}")  # type: ignore[attr-defined]
+        elif t is Pwl:
+            c.add("call:PWL")
 
 
 def _trips(s: For) -> int | None:
@@ -144,58 +140,80 @@ def _trips(s: For) -> int | None:
     return s.bound
 
 
+class _Walk(StmtVisitor):
+    """The bound on one execution of each statement (``usual``: rare branches left out)."""
+
+    def __init__(self, usual: bool) -> None:
+        self.usual = usual
+
+    def stmts(self, body: Sequence[Stmt]) -> Counts:
+        c = Counts()
+        for s in body:
+            c.plus(self.stmt(s))
+        return c
+
+    def assign(self, s: Assign) -> Counts:
+        c = Counts()
+        c.add("assignments")
+        if isinstance(s.target, Index):
+            expr(s.target.index, c)
+        expr(s.value, c)
+        return c
+
+    def if_(self, s: If) -> Counts:
+        paths: list[Counts] = []
+        tested = Counts()
+        for k, (cond, body) in enumerate(s.branches):
+            expr(cond, tested)
+            if not (self.usual and s.rare and k == 0):
+                taken = tested.copy()
+                taken.plus(self.stmts(body))
+                paths.append(taken)
+        last = tested.copy()
+        last.plus(self.stmts(s.orelse))
+        paths.append(last)
+        return Counts.most(paths)
+
+    def for_(self, s: For) -> Counts:
+        c = Counts()
+        expr(s.start, c)
+        expr(s.stop, c)
+        trips = _trips(s)
+        step = self.stmts(s.body)
+        step.add("compare")  # the counter's test
+        step.add("add")  # and increment
+        c.plus(step, 1 if trips is None else trips)
+        c.add("compare")  # the test that ends the loop
+        c.bounded = c.bounded and trips is not None
+        return c
+
+    def while_(self, s: While) -> Counts:
+        c = Counts()
+        step = self.stmts(s.body)
+        expr(s.cond, step)
+        c.plus(step, 1 if s.bound is None else s.bound)
+        expr(s.cond, c)
+        c.bounded = c.bounded and s.bound is not None
+        return c
+
+    def note(self, s: Comment) -> Counts:
+        return Counts()
+
+    def region(self, s: Region) -> Counts:
+        return self.stmts(s.body)
+
+    def kernel(self, s: Kernel) -> Counts:
+        c = Counts()
+        c.add(f"call:{s.name}")
+        c.add("assignments", len(s.outs))
+        for a in s.args:
+            expr(a, c)
+        return c
+
+
 def stmts(body: Sequence[Stmt], usual: bool) -> Counts:
     """The bound on one execution of ``body`` (``usual``: rare branches left out)."""
-    c = Counts()
-    for s in body:
-        if isinstance(s, Assign):
-            c.add("assignments")
-            if isinstance(s.target, Index):
-                expr(s.target.index, c)
-            expr(s.value, c)
-        elif isinstance(s, If):
-            c.plus(_if(s, usual))
-        elif isinstance(s, For):
-            expr(s.start, c)
-            expr(s.stop, c)
-            trips = _trips(s)
-            step = stmts(s.body, usual)
-            step.add("compare")  # the counter's test
-            step.add("add")  # and increment
-            c.plus(step, 1 if trips is None else trips)
-            c.add("compare")  # the test that ends the loop
-            c.bounded = c.bounded and trips is not None
-        elif isinstance(s, While):
-            step = stmts(s.body, usual)
-            expr(s.cond, step)
-            c.plus(step, 1 if s.bound is None else s.bound)
-            expr(s.cond, c)
-            c.bounded = c.bounded and s.bound is not None
-        elif isinstance(s, Region):
-            c.plus(stmts(s.body, usual))
-        elif isinstance(s, Kernel):
-            c.add(f"call:{s.name}")
-            c.add("assignments", len(s.outs))
-            for a in s.args:
-                expr(a, c)
-        else:
-            assert isinstance(s, Comment), s
-    return c
-
-
-def _if(s: If, usual: bool) -> Counts:
-    paths: list[Counts] = []
-    tested = Counts()
-    for k, (cond, body) in enumerate(s.branches):
-        expr(cond, tested)
-        if not (usual and s.rare and k == 0):
-            taken = tested.copy()
-            taken.plus(stmts(body, usual))
-            paths.append(taken)
-    last = tested.copy()
-    last.plus(stmts(s.orelse, usual))
-    paths.append(last)
-    return Counts.most(paths)
+    return _Walk(usual).stmts(body)
 
 
 def cost(prog: Program) -> Cost:

@@ -25,7 +25,7 @@ import math
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any, ClassVar, Literal
 
 #: DINT: 32-bit integers (table indices of large rule bases; INT is 16-bit in Structured Text)
 Type = Literal["REAL", "INT", "DINT", "BOOL", "BYTE"]
@@ -269,6 +269,26 @@ class Kernel:
 
 
 Stmt = Assign | If | For | While | Comment | Region | Kernel
+
+
+class StmtVisitor:
+    """The statement walk the printer and the cost share: :meth:`stmt` calls the method named
+    for the statement's class (``assign``, ``if_``, ``for_``, ``while_``, ``note`` for a
+    comment, ``region``, ``kernel``) with the extra arguments given; a subclass writes what each does."""
+
+    #: The method for each statement class (the classes are final: an exact type lookup).
+    METHODS: ClassVar[dict[type, str]] = {
+        Assign: "assign",
+        If: "if_",
+        For: "for_",
+        While: "while_",
+        Comment: "note",
+        Region: "region",
+        Kernel: "kernel",
+    }
+
+    def stmt(self, s: Stmt, *args: Any) -> Any:
+        return getattr(self, self.METHODS[type(s)])(s, *args)
 
 
 # --------------------------------------------------------------------------- declarations

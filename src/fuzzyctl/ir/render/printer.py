@@ -37,6 +37,7 @@ from fuzzyctl.ir.nodes import (
     Pwl,
     Region,
     Stmt,
+    StmtVisitor,
     Var,
     While,
 )
@@ -60,7 +61,7 @@ PRECEDENCE = {
 UNARY = 6
 
 
-class Printer:
+class Printer(StmtVisitor):
     """Prints IR expressions and statements as lines of one target's source.
 
     ``caps`` is the target's record, ``real`` the REAL type's name in the text (``TO_REAL``),
@@ -173,23 +174,9 @@ class Printer:
         if len(self.lines) == start and self.EMPTY is not None:
             self.emit(self.EMPTY, ind)
 
-    def stmt(self, s: Stmt, ind: int) -> None:
-        if isinstance(s, Assign):
-            self.assign(s, ind)
-        elif isinstance(s, If):
-            self.if_(s, ind)
-        elif isinstance(s, For):
-            self.for_(s, ind)
-        elif isinstance(s, While):
-            self.while_(s, ind)
-        elif isinstance(s, Region):
-            self.region(s, ind)
-        elif isinstance(s, Kernel):
-            self.kernel(s, ind)
-        else:
-            assert isinstance(s, Comment), s
-            if self.comments:
-                self.emit(self.comment(s.text), ind)
+    def note(self, s: Comment, ind: int) -> None:
+        if self.comments:
+            self.emit(self.comment(s.text), ind)
 
     def assign(self, s: Assign, ind: int) -> None:
         self.emit(self.ASSIGN.format(self.ex(s.target), self.ex(s.value)), ind)
