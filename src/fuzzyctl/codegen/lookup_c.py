@@ -9,6 +9,7 @@ import math
 from typing import Any
 
 from fuzzyctl.codegen.lookup import LookupReport, expected, header, sample_rows, table_block, tables
+from fuzzyctl.codegen.testbench import c_bench_driver
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.engine.table import DEFAULT_MAX_BYTES, DEFAULT_TOLERANCE, Table
 from fuzzyctl.escape import c_ident
@@ -133,42 +134,12 @@ def c_bench(plan: Plan, table: Table, n: int, single: bool) -> str:
             )
             lines.append(f"static const double {name}_TB_TOL{k} = {_num(table.bound[k] * (1 + 1e-6))};")
     diff = "long" if table.bits else "double"
-    lines += [
-        "",
-        f"int {name}_testbench(int *first_fail)",
-        "{",
-        f"    {name} fb;",
-        "    int k, bad, fails = 0;",
-        f"    {diff} d;",
-        f"    {name}_init(&fb);",
-        "    *first_fail = 0;",
-        f"    for (k = 0; k < {n}; k++) {{",
-    ]
-    for i, v in enumerate(table.inputs):
-        lines.append(f"        fb.{v} = ({name}_real){name}_TB_X{i}[k];")
-    lines.append(f"        bad = {name}_step(&fb) != 0;")
+    body = [f"fb.{v} = ({name}_real){name}_TB_X{i}[k];" for i, v in enumerate(table.inputs)]
+    body.append(f"bad = {name}_step(&fb) != 0;")
     for k, v in enumerate(table.outputs):
-        lines.append(f"        d = ({diff})fb.{v} - {name}_TB_Y{k}[k];")
-        lines.append(f"        if (!((d < 0 ? -d : d) <= {name}_TB_TOL{k})) bad = 1;")
-    lines += [
-        "        if (bad) {",
-        "            fails++;",
-        "            if (*first_fail == 0) *first_fail = k + 1;",
-        "        }",
-        "    }",
-        "    return fails;",
-        "}",
-        "",
-        "#ifdef FUZZYCTL_TESTBENCH_MAIN",
-        "int main(void)",
-        "{",
-        "    int first;",
-        f"    int fails = {name}_testbench(&first);",
-        '    printf("%s FAIL_COUNT=%d FIRST_FAIL=%d\\n", fails ? "FAIL" : "PASS", fails, first);',
-        "    return fails != 0;",
-        "}",
-        "#endif",
-    ]
+        body.append(f"d = ({diff})fb.{v} - {name}_TB_Y{k}[k];")
+        body.append(f"if (!((d < 0 ? -d : d) <= {name}_TB_TOL{k})) bad = 1;")
+    lines += c_bench_driver(name, n, diff, body)
     return "\n".join(lines) + "\n"
 
 
