@@ -202,8 +202,9 @@ PLATEAU_TOL = 1e-14
 def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, float, float]:
     """``(height, LM, RM, MoM)`` of a smooth accumulated set.
 
-    Plateaus (clipping makes the set constant) are runs of nodes at the largest value, their edges found by bisection; smooth peaks are local maxima of the nodes
-    refined by golden-section search.  The maximising set is the plateaus when the largest
+    Plateaus (clipping makes the set constant) are runs of nodes at the largest value,
+    their edges found by bisection; smooth peaks are local maxima of the nodes refined by
+    golden-section search.  The maximising set is the plateaus when the largest
     value is reached on one (MoM: their centroid), else the peaks within 1e-12 of the
     height (MoM: their mean).
 
