@@ -193,14 +193,27 @@ def _solve(f: Integrand, a: float, b: float, target: float) -> float:
     return 0.5 * (lo + hi)
 
 
+#: Nodes this close (relative) below the top of a smooth set count as at the top
+#: (:func:`maxima`): about 45 ulps, the rounding of a few PROBOR/Einstein/Hamacher steps; a
+#: smooth peak is that flat over 1e-7 of its width only (docs/engine.md allows 1.5e-6).
+PLATEAU_TOL = 1e-14
+
+
 def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, float, float]:
     """``(height, LM, RM, MoM)`` of a smooth accumulated set.
 
-    Plateaus (clipping makes the set *exactly* constant) are runs of nodes with exactly the
-    largest value, their edges found by bisection; smooth peaks are local maxima of the nodes
-    refined by golden-section search.  The maximising set is the plateaus when the largest
+    Plateaus (clipping makes the set constant) are runs of nodes at the largest value,
+    their edges found by bisection; smooth peaks are local maxima of the nodes refined by
+    golden-section search.  The maximising set is the plateaus when the largest
     value is reached on one (MoM: their centroid), else the peaks within 1e-12 of the
-    height (MoM: their mean)."""
+    height (MoM: their mean).
+
+    A plateau is exactly constant in exact arithmetic only: PROBOR's ``a + b - a b`` (and
+    Einstein, Hamacher) is not monotone in double, so the node at a clipping edge, where
+    the term is a hair below the clip level, can come out an ulp above the plateau.  Nodes
+    within :data:`PLATEAU_TOL` of the top therefore count as at the top (with an exact
+    comparison that one node was the "maximum" and LM/RM/MoM jumped to the plateau's
+    edge)."""
     half = 0.5 * (B - A)
     x = np.concatenate(
         [(0.5 * (A + B))[:, None] + half[:, None] * NODES[None, :], A[:, None], B[:, None]], axis=1
@@ -211,32 +224,35 @@ def maxima(f: Integrand, A: FloatArray, B: FloatArray) -> tuple[float, float, fl
     top = float(np.max(ys))
     if not top > 0.0:
         return top, math.nan, math.nan, math.nan
+    thr = top * (1.0 - PLATEAU_TOL)
     # smooth peaks between nodes
     peaks: list[tuple[float, float]] = []
     for index in np.flatnonzero(ys >= top * (1.0 - 1e-6)):
         i = int(index)
         if (i > 0 and ys[i - 1] > ys[i]) or (i + 1 < n and ys[i + 1] > ys[i]):
             continue
-        if (i > 0 and ys[i - 1] == ys[i]) or (i + 1 < n and ys[i + 1] == ys[i]):
+        level = min(ys[i], thr)  # equal neighbours, or both at the top
+        if (i > 0 and ys[i - 1] >= level) or (i + 1 < n and ys[i + 1] >= level):
             continue  # a node of a plateau (below: its edges), not a peak between nodes
         peaks.append(
             _golden(f, float(xs[max(i - 1, 0)]), float(xs[min(i + 1, n - 1)]), float(xs[i]), float(ys[i]))
         )
     sup = max([top, *(v for _x, v in peaks)])
-    # plateaus: runs of at least two nodes exactly at the top value
+    # plateaus: runs of at least two nodes at the top value (to rounding)
     runs: list[tuple[float, float]] = []
+    at_top = ys >= thr
     if top >= sup * (1.0 - 1e-12):
         j = 0
         while j < n:
-            if ys[j] != top:
+            if not at_top[j]:
                 j += 1
                 continue
             k = j
-            while k + 1 < n and ys[k + 1] == top:
+            while k + 1 < n and at_top[k + 1]:
                 k += 1
             if k > j:
-                left = _edge(f, float(xs[j - 1]), float(xs[j]), top) if j > 0 else float(xs[j])
-                right = _edge(f, float(xs[k + 1]), float(xs[k]), top) if k + 1 < n else float(xs[k])
+                left = _edge(f, float(xs[j - 1]), float(xs[j]), thr) if j > 0 else float(xs[j])
+                right = _edge(f, float(xs[k + 1]), float(xs[k]), thr) if k + 1 < n else float(xs[k])
                 runs.append((left, right))
             j = k + 1
     points = sorted({px for px, pv in peaks if pv >= sup * (1.0 - 1e-12)})

@@ -15,7 +15,7 @@ every method in C.
   where a drastic sum reaches 1 lies between two pieces too narrow to integrate); the
   second walks those nodes in increasing x with a window of three: a node with both
   neighbours lower and within 1e-6 of the top is a smooth peak refined by golden-section
-  search (at most :data:`PEAKS` of them are kept), a run of nodes exactly at the top is a
+  search (at most :data:`PEAKS` of them are kept), a run of nodes at the top (to :data:`PLATEAU_TOL`) is a
   plateau whose edges are found by bisection.  The maximum is the plateaus when the top is
   reached on one (MoM: their centroid), else the peaks within 1e-12 of the height (MoM:
   their mean).
@@ -33,6 +33,7 @@ import math
 
 from fuzzyctl.engine.plan import OutputPlan
 from fuzzyctl.engine.reference.pwl import COA_TOL
+from fuzzyctl.engine.reference.quadrature import PLATEAU_TOL
 from fuzzyctl.ir.builders import quadrature as Q
 from fuzzyctl.ir.nodes import Ex, Var, not_
 from fuzzyctl.ir.state import Gen
@@ -236,7 +237,7 @@ class _Window:
         self.lastx, self.any = let(0.0, "WLX"), let(False, "WANY", "BOOL")
         self.seen = let(0, "WN", "INT")  # nodes seen (2 means: at least two)
         self.xa, self.ya, self.xb, self.yb = (let(0.0, h) for h in ("WXA", "WYA", "WXB", "WYB"))
-        # the current run of nodes exactly at the top: its first node and the one before
+        # the current run of nodes at the top: its first node and the one before
         self.run = let(0, "RUN", "INT")
         self.rx, self.rprev, self.rhas = let(0.0, "RX"), let(0.0, "RXP"), let(False, "RHAS", "BOOL")
         # plateaus: how many, first left edge, last right edge, total length and moment
@@ -283,7 +284,12 @@ class _Window:
         top = self.top
         has_left = self.seen.ge(2)
         xb, yb, xa, ya = self.xb, self.yb, self.xa, self.ya
-        peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(not_(has_left).or_(ya.lt(yb))).and_(yr.lt(yb))
+        # at the top to rounding (PLATEAU_TOL: PROBOR's a + b - ab is not monotone in double,
+        # a clipping edge's node can be an ulp above the plateau); a node with a neighbour at
+        # its value, or both at the top, belongs to a plateau, not a peak
+        thr = g.let(top * (1.0 - PLATEAU_TOL), "WTHR")
+        level = g.min_(yb, thr, "WLV")
+        peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(not_(has_left).or_(ya.lt(level))).and_(yr.lt(level))
         with b.if_(peak):
             lo = g.let(xb, "GLO")
             with b.if_(has_left):
@@ -293,16 +299,16 @@ class _Window:
                 b.set(self.kx[self.npk], px)
                 b.set(self.kv[self.npk], pv)
                 b.set(self.npk, self.npk + 1)
-        # runs at exactly the top
-        with b.if_(yb.eq(top)):
+        # runs at the top
+        with b.if_(yb.ge(thr)):
             with b.if_(self.run.eq(0)):
                 b.set(self.rx, xb)
                 b.set(self.rprev, xa)
                 b.set(self.rhas, has_left)
             b.set(self.run, self.run + 1)
-            with b.if_(yr.ne(top)):
+            with b.if_(yr.lt(thr)):
                 with b.if_(self.run.ge(2)):
-                    left, right = self._edges(xr, more)
+                    left, right = self._edges(xr, more, thr)
                     with b.if_(self.nrun.eq(0)):
                         b.set(self.pl, left)
                     b.set(self.pr, right)
@@ -348,7 +354,7 @@ class _Window:
             b.set(pv, val[0])
         return px, pv
 
-    def _edges(self, xr: Var, more: Var) -> tuple[Var, Var]:
+    def _edges(self, xr: Var, more: Var, thr: Var) -> tuple[Var, Var]:
         """The run's two edges (``quadrature._edge``, bisection for where the set reaches
         the top): between the node before it and its first node (when there is one), and
         between its last node and the next (when there is one)."""
@@ -368,7 +374,7 @@ class _Window:
                 with b.if_(mid.eq(o).or_(mid.eq(i)).or_(it.ge(HALVINGS))):
                     b.set(search, False)
                 with b.else_():
-                    with b.if_(_at(g, self.op, self.sets, mid).ge(self.top)):
+                    with b.if_(_at(g, self.op, self.sets, mid).ge(thr)):
                         b.set(i, mid)
                     with b.else_():
                         b.set(o, mid)
