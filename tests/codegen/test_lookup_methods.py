@@ -95,7 +95,6 @@ def test_a_takagi_sugeno_c_table_builds_strictly_and_its_bench_passes(arith: str
 @pytest.mark.extra("matiec")
 def test_matiec_runs_takagi_sugeno_and_coa_table_benches(tmp_path: Path) -> None:
     from tests.codegen import matiec as M
-    from tests.codegen.test_matiec_lookup import _driver
 
     n = 60
     matiec = M.build()
@@ -106,7 +105,7 @@ def test_matiec_runs_takagi_sugeno_and_coa_table_benches(tmp_path: Path) -> None
         for doc, arith, tol in cases
     ]
     M.iec2c(matiec, "\n".join(texts), tmp_path)
-    exe = M.compile_c(matiec, tmp_path, _driver(["TB_M0", "TB_M1", "TB_M2"]), "benches")
+    exe = M.compile_c(matiec, tmp_path, M.bench_driver(["TB_M0", "TB_M1", "TB_M2"]), "benches")
     for j in range(len(cases)):
         res = subprocess.run([str(exe), str(j)], capture_output=True, text=True, timeout=60)
         assert res.returncode == 0, res.stderr

@@ -148,10 +148,8 @@ def test_matiec_block_matches_the_engine_and_its_bench_passes(lreal: bool, tmp_p
     where = tmp_path / "bench"
     where.mkdir()
     M.iec2c(matiec, benches, where)
-    from tests.codegen.test_matiec import _program_driver
-
     names = [f"TB_{doc.main.name}" for _n, doc in systems]
-    exe = M.compile_c(matiec, where, _program_driver(names), "benches")
+    exe = M.compile_c(matiec, where, M.bench_driver(names), "benches")
     for j in range(len(names)):
         res = subprocess.run([str(exe), str(j)], capture_output=True, text=True, timeout=60)
         assert res.returncode == 0, res.stderr

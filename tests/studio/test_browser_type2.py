@@ -76,6 +76,12 @@ def test_footprint_drawn_edited_and_checked(page: Any) -> None:
     )
     assert pg.locator("#rv-table .fill-out-lower").count() == 3  # one per fired rule
     assert pg.locator("#rv-table .fill-interval").count() == 1
+    # both inputs applied (rule 1 reads service only: food may still be on its way)
+    pg.wait_for_function(
+        "v => { const o = document.querySelector('#view-ruleviewer').dataset.outputs;"
+        " return !!o && Math.abs(JSON.parse(o).tip - v) <= 1e-9 * Math.abs(v); }",
+        arg=value,
+    )
     shown = pg.evaluate("JSON.parse(document.querySelector('#view-ruleviewer').dataset.outputs)")
     assert shown["tip"] == value
     shot(pg, "type2-ruleviewer")
