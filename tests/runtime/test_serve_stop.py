@@ -388,7 +388,7 @@ def test_a_link_that_is_down_at_the_stop_connects_once_to_write_the_safe_values(
     try:
         rt.start()
         want = running_values(plc)
-        wait_until(lambda: running(plc, want), 10)
+        wait_until(lambda: running(plc, want), 30)
         plc.stop()
         # Down, and waiting out its 30 s back-off (not in the middle of an attempt).
         wait_until(lambda: any(e.kind == "link-retry" for e in rt.events.since(0)), 15)
