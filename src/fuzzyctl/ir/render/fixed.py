@@ -9,7 +9,7 @@ from fuzzyctl.escape import CodegenError, c_ident
 from fuzzyctl.ir.nodes import Call
 from fuzzyctl.ir.programs.fixed_block import FixedDecl, FixedProgram
 from fuzzyctl.ir.render.printer import Printer
-from fuzzyctl.ir.render.st import STParts, STSection, STVar, format_st
+from fuzzyctl.ir.render.st import STParts, STSection, STSyntax, STVar, format_st
 from fuzzyctl.kinds import targets
 
 __all__ = ["fixed_st_parts", "render_fixed_c", "render_fixed_st"]
@@ -27,16 +27,7 @@ def _types(prog: FixedProgram, lang: str) -> dict[str, str]:
     }
 
 
-class _STInt(Printer):
-    ASSIGN = "{0} := {1};"
-    IF = "IF {0} THEN"
-    ELIF = "ELSIF {0} THEN"
-    ELSE = "ELSE"
-    END_IF = "END_IF;"
-    WHILE = "WHILE {0} DO"
-    END_WHILE = "END_WHILE;"
-    EMPTY = ";"
-
+class _STInt(STSyntax):
     def __init__(self, record: targets.Target, types: dict[str, str]) -> None:
         super().__init__(record, real="REAL")
         self.types = types

@@ -23,12 +23,22 @@ from fuzzyctl.ir.state import CodegenError
 from fuzzyctl.kinds import targets
 from fuzzyctl.kinds.targets import st_real
 
-__all__ = ["CodegenError", "STParts", "STSection", "STVar", "format_st", "render_st", "st_parts", "st_real"]
+__all__ = [
+    "CodegenError",
+    "STParts",
+    "STSection",
+    "STSyntax",
+    "STVar",
+    "format_st",
+    "render_st",
+    "st_parts",
+    "st_real",
+]
 
 
-class _ST(Printer):
-    """Structured Text syntax; the dialect's record says how variables, regions, loops and
-    the block are written."""
+class STSyntax(Printer):
+    """Structured Text's statement syntax, shared by the REAL block's printer and the
+    integer block's (:mod:`fuzzyctl.ir.render.fixed`)."""
 
     ASSIGN = "{0} := {1};"
     IF = "IF {0} THEN"
@@ -38,6 +48,11 @@ class _ST(Printer):
     WHILE = "WHILE {0} DO"
     END_WHILE = "END_WHILE;"
     EMPTY = ";"
+
+
+class _ST(STSyntax):
+    """Structured Text syntax; the dialect's record says how variables, regions, loops and
+    the block are written."""
 
     def __init__(self, prog: Program, dialect: targets.Target, lreal: bool) -> None:
         super().__init__(dialect, real=dialect.real_type(not lreal))
