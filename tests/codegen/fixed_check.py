@@ -116,3 +116,31 @@ def run_c(
     scale_out = np.array([p["scale"] for p in rep["outputs"]])
     off_out = np.array([p["offset"] for p in rep["outputs"]])
     return Outcome(rep, stored, got_stored, values, exact, got_stored * scale_out + off_out)
+
+
+def within_bound_or_refused(text: str, rows: int, seed: int) -> None:
+    """In int16 and int32, the block compiled and run stays within the error bound its
+    header states, or the generator refuses it pointing to ``--arith float``."""
+    from fuzzyctl.codegen import CodegenError
+
+    for arith in ("int16", "int32"):
+        try:
+            out = run_c(text, arith, rows=rows, seed=seed)
+        except CodegenError as exc:
+            assert "(use --arith float" in str(exc)
+            continue
+        assert (out.errors() <= out.bounds()).all(), (arith, out.errors(), out.bounds())
+
+
+def generated_in_int32(texts: list[str]) -> int:
+    """How many of ``texts`` the int32 generator accepts."""
+    from fuzzyctl.codegen import CodegenError
+
+    done = 0
+    for text in texts:
+        try:
+            generate_c(fuzzyctl.load(text), arith="int32")
+            done += 1
+        except CodegenError:
+            pass
+    return done

@@ -22,7 +22,7 @@ from fuzzyctl.cli.app import main
 from fuzzyctl.codegen import CodegenError
 from fuzzyctl.codegen.api import generate_c, generate_st
 from fuzzyctl.codegen.plcopen import generate_plcopen
-from tests.codegen.fixed_check import STRICT, run_c
+from tests.codegen.fixed_check import STRICT, generated_in_int32, run_c, within_bound_or_refused
 from tests.codegen.fixed_systems import random_fcl
 from tests.conftest import EXAMPLES
 
@@ -54,24 +54,11 @@ SEEDS = range(24)
 
 @pytest.mark.parametrize("seed", SEEDS)
 def test_random_systems_within_the_stated_bound_or_refused(seed: int) -> None:
-    text = random_fcl(seed)
-    for arith in ("int16", "int32"):
-        try:
-            out = run_c(text, arith, rows=1500, seed=seed)
-        except CodegenError as exc:
-            assert "(use --arith float" in str(exc)
-            continue
-        assert (out.errors() <= out.bounds()).all(), (arith, out.errors(), out.bounds())
+    within_bound_or_refused(random_fcl(seed), rows=1500, seed=seed)
 
 
 def test_most_random_systems_generate() -> None:
-    done = 0
-    for seed in SEEDS:
-        try:
-            generate_c(fuzzyctl.load(random_fcl(seed)), arith="int32")
-            done += 1
-        except CodegenError:
-            pass
+    done = generated_in_int32([random_fcl(seed) for seed in SEEDS])
     assert done >= len(SEEDS) // 2
 
 
