@@ -192,3 +192,14 @@ class OptionError(FuzzyctlError):
 class InputError(FuzzyctlError, ValueError):
     """A bad value given to an evaluation (missing input, NaN, not a number); the message
     names the parameter."""
+
+
+def apart(a: float, b: float, digits: int = 3) -> tuple[str, str]:
+    """``a`` and ``b`` written with ``digits`` significant digits, or more where that is what
+    tells them apart: a message comparing a bound with a limit it misses by a hair must not
+    read "1% exceeds 1%".  The two texts are the same only when the numbers are."""
+    for d in range(digits, 18):  # 17 significant digits tell any two doubles apart
+        first, second = f"{a:.{d}g}", f"{b:.{d}g}"
+        if first != second or a == b:
+            return first, second
+    return repr(a), repr(b)  # NaN: nothing to align

@@ -4,7 +4,7 @@ consumer's record in :data:`fuzzyctl.kinds.type_reduction.CONSUMERS` says whethe
 
 from __future__ import annotations
 
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.diagnostics import FuzzyctlError, OptionError
 from fuzzyctl.kinds import type_reduction as tr
 from fuzzyctl.model import Document, FunctionBlock
 
@@ -28,3 +28,20 @@ def refuse(model: Document | FunctionBlock, consumer: str, supported: bool | Non
     if why:
         name = model.main.name if isinstance(model, Document) else model.name
         raise Type2NotSupported(f"{consumer}: {name or 'this system'} is an {why}")
+
+
+def check_samples(samples: int | None, model: Document | FunctionBlock | None = None) -> None:
+    """Refuse a ``--samples`` the command cannot use (:class:`OptionError` naming it): fewer
+    than 2 points, or a model with no type-2 block - its outputs are integrated exactly and a
+    sample count there would silently mean nothing.  ``model`` None checks the count only."""
+    if samples is None:
+        return
+    if samples < 2:
+        raise OptionError(f"--samples {samples}: at least 2 output samples are needed", "--samples")
+    if model is not None and not is_type2(model):
+        name = model.main.name if isinstance(model, Document) else model.name
+        raise OptionError(
+            f"--samples applies to interval type-2 systems; {name or 'this system'} is type-1 "
+            "(its outputs are integrated exactly, not sampled)",
+            "--samples",
+        )

@@ -108,6 +108,46 @@ def test_a_size_limit_too_small_is_refused_with_the_tolerance_it_allows() -> Non
         generate_st(fuzzyctl.load(EXAMPLES / "figure7.fcl"), lookup=True, tolerance=0.001, max_bytes=2000)
 
 
+def test_a_tolerance_missed_by_a_hair_prints_two_different_numbers(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """The bound the size limit allows, asked for a hair below it: the refusal's two
+    percentages differ as text (not "5.21% ... 5.21%") and read in the right order."""
+    from fuzzyctl.api import compile_plan
+    from fuzzyctl.engine.table import build_table
+
+    fig7 = EXAMPLES / "figure7.fcl"
+    # (codegen --lookup stores REAL: the table of that type)
+    t = build_table(compile_plan(fuzzyctl.load(fig7)), tolerance=0.06, max_bytes=64, real="REAL")
+    worst = max(t.relative(t.bound))
+    for tolerance in (worst * (1 - 1e-9), np.nextafter(worst, 0.0)):
+        args = ["codegen", str(fig7), "--lookup", "--max-bytes", "64", "--tolerance", repr(float(tolerance))]
+        assert main(args) == 1
+        err = " ".join(capsys.readouterr().err.split())
+        m = re.search(r"a table within ([0-9.e+-]+)% .* is within ([0-9.e+-]+) [(]([0-9.e+-]+)%[)]", err)
+        assert m is not None, err
+        limit, bound = m.group(1), m.group(3)
+        assert limit != bound and float(limit) < float(bound), err
+        assert float(m.group(2)) == pytest.approx(worst, rel=1e-3)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_apart_tells_numbers_apart_with_the_fewest_digits(seed: int) -> None:
+    from fuzzyctl.diagnostics import apart
+
+    rng = random.Random(seed)
+    for _ in range(2000):
+        a = rng.uniform(-1e3, 1e3) * 10.0 ** rng.randint(-8, 8)
+        near = a * (1 + rng.choice([1e-2, 1e-6, 1e-12]))
+        b = float(np.nextafter(a, np.inf)) if rng.random() < 0.3 else near
+        sa, sb = apart(a, b)
+        assert sa != sb and (float(sa) < float(sb)) == (a < b)
+        n = len(re.sub(r"e.*|[-.]", "", sa).lstrip("0"))  # significant digits written
+        if n > 3:  # one digit fewer would not tell them apart
+            assert f"{a:.{n - 1}g}" == f"{b:.{n - 1}g}"
+        assert apart(a, a) == (f"{a:.3g}", f"{a:.3g}")
+
+
 def test_a_system_without_a_derived_bound_is_refused_with_the_reason() -> None:
     text = (
         _random_system(0)

@@ -22,7 +22,18 @@ from fuzzyctl.ir.builders import terms as irterms
 from fuzzyctl.ir.nodes import Assign, Bin, Call, Ex, If, Neg, Num, Stmt, Var
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds import formula
-from fuzzyctl.kinds.shapes import ENTRIES, NA, SHAPES, Degenerate, Shape, Span, Spellings, Studio, Written
+from fuzzyctl.kinds.shapes import (
+    ENTRIES,
+    NA,
+    SHAPES,
+    Degenerate,
+    Shape,
+    Span,
+    Spellings,
+    Studio,
+    Written,
+    self_check,
+)
 
 ROLES = {"x", "width", "slope", "number", "coef"}
 SRC = Path(__file__).resolve().parents[2] / "src" / "fuzzyctl"
@@ -34,6 +45,18 @@ def _filled(value: Any) -> bool:
     if isinstance(value, str):
         return bool(value.strip())
     return value is not None
+
+
+def test_every_formula_of_the_registry_parses(monkeypatch: pytest.MonkeyPatch) -> None:
+    """(Checked here rather than at each import of the registry.)"""
+    self_check()
+    from fuzzyctl.kinds import shapes as registry
+
+    smooth = next(s for s in ENTRIES if isinstance(s.formula, str))
+    broken = dataclasses.replace(smooth, kind="broken", formula="x +")
+    monkeypatch.setattr(registry, "ENTRIES", (*ENTRIES, broken))
+    with pytest.raises(formula.FormulaError):
+        self_check()
 
 
 @pytest.mark.parametrize("shape", ENTRIES, ids=lambda s: s.kind)

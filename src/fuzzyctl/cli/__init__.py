@@ -1,5 +1,6 @@
 """The ``fuzzyctl`` command.  Each command group lives in its own module and registers
-itself on :data:`app`; :func:`main` turns every error into a message and an exit code.
+itself on :data:`app`; :func:`main` imports only the module of the command it is given
+(:mod:`fuzzyctl.cli.commands`) and turns every error into a message and an exit code.
 
 The console script starts in :mod:`fuzzyctl.cli.entry`, which answers the simplest
 ``fuzzyctl eval`` invocations without importing the command framework (see

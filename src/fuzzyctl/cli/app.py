@@ -145,9 +145,34 @@ def _root(
 
 
 def _register_commands() -> None:
-    """Import the command modules so that they attach themselves to ``app``."""
-    # Imported for their side effect; keep heavy imports inside the command functions.
-    from fuzzyctl.cli import commands  # noqa: F401
+    """Import every command module so that each attaches its commands to ``app``."""
+    from fuzzyctl.cli import commands
+
+    commands.import_all()
+
+
+def command_for(args: list[str]) -> Any:
+    """The click command that runs ``args``, with only what it needs imported: the module of
+    the command ``args`` names, or - for ``fuzzyctl`` alone, ``--help`` and ``--version`` -
+    none: the help lists every command from :data:`fuzzyctl.cli.commands.COMMANDS` (what
+    importing them all and building their options cost ``--help`` about 100 ms)."""
+    from fuzzyctl.cli import commands
+
+    first = args[0] if args else None
+    if first is not None and commands.import_for(first):
+        return typer.main.get_command(app)
+    if first is not None and first not in ("--help", "--version"):
+        commands.import_all()  # an unknown command or option: the message names what exists
+        return typer.main.get_command(app)
+    from typer.core import TyperCommand
+
+    group = typer.main.get_command(app)  # the commands imported so far, if any
+    real = dict(getattr(group, "commands", {}))
+    group.commands = {  # type: ignore[attr-defined]
+        name: real.get(name) or TyperCommand(name, help=listed.summary, rich_markup_mode="markdown")
+        for name, listed in commands.COMMANDS.items()
+    } | real
+    return group
 
 
 def _given_twice(argv: list[str]) -> None:
@@ -217,11 +242,10 @@ def _renamed_hint(exc: Exception) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; never lets a Python traceback reach the user."""
-    _register_commands()
-    command = typer.main.get_command(app)
     try:
         args = spread_lists(sys.argv[1:] if argv is None else argv)
         _given_twice(args)
+        command = command_for(args)
         result = command.main(args=args, prog_name="fuzzyctl", standalone_mode=False)
     except typer.Exit as exc:
         return int(exc.exit_code or 0)

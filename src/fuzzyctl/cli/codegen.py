@@ -135,6 +135,16 @@ def codegen(
             "random) with the engine's outputs; st: a PROGRAM after the block, c: NAME_testbench.c.",
         ),
     ] = 0,
+    samples: Annotated[
+        int | None,
+        typer.Option(
+            "--samples",
+            metavar="N",
+            help="Interval type-2 systems: sample each Mamdani output at N >= 2 points (default 101, "
+            "stated in the header). Refused for a type-1 system.",
+            show_default=False,
+        ),
+    ] = None,
     block: Annotated[
         str | None, typer.Option("--block", help="Only this function block (default: every block).")
     ] = None,
@@ -193,6 +203,7 @@ def codegen(
             tolerance=tolerance,
             max_bytes=max_bytes,
             int_output=None if int_output is None else int_output.value,
+            samples=samples,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))

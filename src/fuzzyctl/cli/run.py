@@ -40,15 +40,38 @@ OutOfRangeOpt = Annotated[
     ),
 ]
 
+SamplesOpt = Annotated[
+    int | None,
+    typer.Option(
+        "--samples",
+        metavar="N",
+        help="Interval type-2 systems: sample each Mamdani output at N >= 2 points and run the "
+        "compiled program, as the generated code does (default: the exact centroid where there is "
+        "one, else 1001 samples). Refused for a type-1 system, whose outputs are integrated exactly.",
+        show_default=False,
+    ),
+]
+
 
 def _controller(
-    file: Path, block: str | None, compat: str, strict: bool = False, fmt: str | None = None
+    file: Path,
+    block: str | None,
+    compat: str,
+    strict: bool = False,
+    fmt: str | None = None,
+    samples: int | None = None,
 ) -> Any:
     import fuzzyctl
-    from fuzzyctl.cli.app import err_console
+    from fuzzyctl.cli.app import err_console, usage_errors
+    from fuzzyctl.type2 import check_samples
 
+    with usage_errors():
+        check_samples(samples)  # before the file is read
     doc = fuzzyctl.load(file, strict=strict, format=fmt, compat=compat)
-    ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict)
+    with usage_errors():
+        check_samples(samples, doc.block(block))
+    extra: dict[str, Any] = {} if samples is None else {"samples": samples}
+    ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict, **extra)
     from fuzzyctl.diagnostics import render_all
 
     # what the engine settled with a warning (a universe from the terms, ...), capped: a file
@@ -151,6 +174,7 @@ def eval_(
     strict: StrictOpt = False,
     out_of_range: OutOfRangeOpt = "warn",
     from_format: FromOpt = None,
+    samples: SamplesOpt = None,
     dask_in: DaskOpt = None,
     workers: WorkersOpt = None,
     scheduler: SchedulerOpt = None,
@@ -160,6 +184,10 @@ def eval_(
     if dask_in is not None:
         if set_ or data is not None:
             raise typer.BadParameter("use --dask alone, without --set or --data", param_hint="--dask")
+        if samples is not None:
+            raise typer.BadParameter(
+                "--samples goes with --set or --data, not --dask", param_hint="--samples"
+            )
         from fuzzyctl.cli import eval_dask
 
         out_dir = Path(output) if output not in (None, "-") else None
@@ -168,7 +196,7 @@ def eval_(
         )
         return
     _check_eval(workers, scheduler, data, set_, output, decimal, as_json, as_table)
-    ctl = _controller(file, block, compat, strict, from_format)
+    ctl = _controller(file, block, compat, strict, from_format, samples)
     if data is not None:
         from fuzzyctl.cli.app import err_console
         from fuzzyctl.cli.eval_data import evaluate_file
@@ -277,9 +305,10 @@ def explain(
     strict: StrictOpt = False,
     out_of_range: OutOfRangeOpt = "warn",
     from_format: FromOpt = None,
+    samples: SamplesOpt = None,
 ) -> None:
     """Evaluate once and show why: term degrees, rule degrees, accumulated sets, values."""
-    ctl = _controller(file, block, compat, strict, from_format)
+    ctl = _controller(file, block, compat, strict, from_format, samples)
     values, mode = _checked_sets(ctl, set_, out_of_range)
     e = ctl.explain(values, out_of_range=mode)
     from fuzzyctl.engine.type2 import Type2Explanation

@@ -191,14 +191,17 @@ def emit(
     tolerance: str | float | None = None,
     max_bytes: int | None = None,
     int_output: str | None = None,
+    samples: int | None = None,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
         are checked first) and write it: ``st`` and ``plcopen`` to the file
         ``output`` (None: the text is returned), ``c`` into the directory ``output`` (default: the
         current one), every file checked writable before any is replaced; ``fmu`` one block
     (``block``, default the first) as an FMI ``fmi`` (2 or 3, default 3) co-simulation FMU in the
-    file ``output`` (default ``NAME.fmu``), with this platform's binary unless not ``binary``."""
+    file ``output`` (default ``NAME.fmu``), with this platform's binary unless not ``binary``;
+    ``samples``: the output sample count of a type-2 system (refused for a type-1 one)."""
     import fuzzyctl
+    from fuzzyctl.type2 import check_samples
 
     check_options(
         lang,
@@ -215,9 +218,11 @@ def emit(
         max_bytes=max_bytes,
         int_output=int_output,
     )
+    check_samples(samples)
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
     refuse_type2(document, "codegen", caps.type2)  # (any block: --block errors come later)
+    check_samples(samples, document if block is None else document.block(block))
     if "fmi" in caps.cli_options:
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     emitted = Emitted(lang)
@@ -244,6 +249,8 @@ def emit(
         kwargs.update(lookup_options(tolerance, max_bytes))
     if int_output is not None:  # the integer generators: codegen/fixed.py
         kwargs["int_output"] = int_output
+    if samples is not None:  # the type-2 generators: codegen/type2.py
+        kwargs["samples"] = samples
     if caps.report:
         kwargs["report"] = emitted.blocks
     result = generator_of(caps)(document, **kwargs)

@@ -55,12 +55,17 @@ class Type2Generated:
     program: Program
     notes: list[str]
 
+    @property
+    def renames(self) -> list[Any]:
+        """What was renamed for the target: nothing (``codegen -o`` prints this list)."""
+        return []
+
     def to_dict(self) -> dict[str, Any]:
         from fuzzyctl.ir.cost import cost
 
         return {
             "block": self.program.name,
-            "renames": [],
+            "renames": self.renames,
             "notes": list(self.notes),
             "cost": cost(self.program).to_dict(),
         }

@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from fuzzyctl.diagnostics import FuzzyctlError
+from fuzzyctl.diagnostics import FuzzyctlError, apart
 from fuzzyctl.engine.controller import Controller
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.engine.table_bound import BELL_KINDS, Certifier, refusal
@@ -505,10 +505,11 @@ def _refuse(
         raise TableError("no rule fires somewhere in the input ranges: the output jumps to its DEFAULT there")
     jump = find_jump(ev, design, tolerance) if worst > tolerance else None
     _refuse_jump(plan, jump, tolerance)
+    bound, limit = apart(100 * worst, 100 * tolerance)  # percents; distinct when they differ
     if worst > tolerance and not limited:
         raise TableError(
-            f"the error bound proven for a {'x'.join(map(str, table.shape))} table is {100 * worst:.3g}% "
-            f"of the output range, above --tolerance {100 * tolerance:.3g}%: raise --tolerance"
+            f"the error bound proven for a {'x'.join(map(str, table.shape))} table is {bound}% "
+            f"of the output range, above --tolerance {limit}%: raise --tolerance"
             + (
                 " (for LM, RM and MoM the bound is where the maximum can lie on each box, wide"
                 " where the highest degree moves its plateau)"
@@ -518,9 +519,9 @@ def _refuse(
         )
     if worst > tolerance:
         raise TableError(
-            f"a table within {100 * tolerance:.3g}% of the output range needs more than {max_bytes} bytes "
+            f"a table within {limit}% of the output range needs more than {max_bytes} bytes "
             f"(--max-bytes); {'x'.join(map(str, table.shape))} in {table.size_bytes(real)} bytes is "
-            f"within {worst:.3g} ({100 * worst:.3g}%): raise --max-bytes or --tolerance"
+            f"within {apart(worst, tolerance)[0]} ({bound}%): raise --max-bytes or --tolerance"
         )
 
 

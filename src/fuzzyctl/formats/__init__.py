@@ -29,14 +29,16 @@ import importlib.util
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from fuzzyctl.diagnostics import Diagnostic, DiagnosticError, FuzzyctlError
 from fuzzyctl.files import write_atomic
 from fuzzyctl.formatspec import DEFAULT_MAX_BYTES, SPECS, FormatSpec
 from fuzzyctl.gcpause import gc_paused
-from fuzzyctl.model import Document
-from fuzzyctl.validation import Placer, at_spans
+
+if TYPE_CHECKING:  # the model and its checks load on first use: the CLI's help needs names only
+    from fuzzyctl.model import Document
+    from fuzzyctl.validation import Placer
 
 
 @dataclass(frozen=True)
@@ -63,9 +65,9 @@ class Loaded:
 
 Reader = Callable[[str, "str | None"], Loaded]
 """``read(text, path) -> Loaded``; raises :class:`DiagnosticError` on invalid input."""
-Writer = Callable[[Document], str]
+Writer = Callable[["Document"], str]
 """``write(document) -> text``; expects a document :attr:`Format.adapt` returned."""
-Adapter = Callable[[Document], "tuple[Document, list[Loss]]"]
+Adapter = Callable[["Document"], "tuple[Document, list[Loss]]"]
 """``adapt(document) -> (document, losses)``: the model in what the format can say."""
 
 
@@ -119,7 +121,7 @@ class Format:
     """What the writer says in a nearest form of its own rather than as the model does: not a
     loss (the written file computes the same), but worth a warning to whoever reads the file
     with another tool (FCL: a rule without an IF part becomes ``IF ALWAYS THEN``)."""
-    place: Placer = field(default=at_spans)
+    place: Placer = field(default_factory=lambda: on_use("fuzzyctl.validation", "at_spans"))
     """Where this format's diagnostics put what :func:`fuzzyctl.validation.validate` finds:
     at the spans the reader kept (file:line:column), or at JSON paths."""
     validates: bool = False

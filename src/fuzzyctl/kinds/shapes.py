@@ -63,6 +63,7 @@ __all__ = [
     "get",
     "kinds_where",
     "placement_tree",
+    "self_check",
     "vertices",
 ]
 
@@ -795,7 +796,10 @@ def placement_tree(text: str) -> Any:
     return tree(ast.parse(text, mode="eval").body)
 
 
-def _self_check() -> None:
+def self_check() -> None:
+    """Every entry's formulas parse and its parts agree with its parameters: a check of this
+    file, run by tests/kinds/test_shapes_registry.py rather than at every import (it parses
+    some 150 formulas; each is parsed again on its first use)."""
     for s in ENTRIES:
         assert len(s.roles) == len(s.params), s.kind
         for f in (s.formula, s.jfl):
@@ -807,6 +811,3 @@ def _self_check() -> None:
             fm.parse(text, ("a", "b", "c", "w"))
         if not s.variadic:
             assert len(s.studio.placement) == len(s.params), s.kind
-
-
-_self_check()

@@ -318,7 +318,7 @@ class JflEvaluator:
                 return _coa(v, lo, step)
             clean = np.where(np.isnan(v), -np.inf, v)  # jFuzzyLogic's comparisons skip NaN
             top = clean.max(axis=1)
-            at_top = clean == top[:, None]
+            at_top = _at_top(clean, top[:, None])
             if m is not None and m.maximum == "left":
                 x = index_x[np.argmax(at_top, axis=1)]
             elif m is not None and m.maximum == "right":
@@ -368,6 +368,13 @@ def _cogs(points: list[tuple[Arr, Arr, Arr]], n: int) -> Arr:
         weighted = np.where(held, weighted + x * y, weighted)
     with np.errstate(all="ignore"):
         return np.where(total != 0, weighted / total, np.nan)
+
+
+def _at_top(values: Arr, top: Arr) -> Arr:
+    """The samples LM, RM and MM take as the maximum: jFuzzyLogic compares doubles exactly,
+    so a sample that PROBOR or BSUM rounded an ulp above the others is the maximum alone
+    (unlike the IEC paths' 1e-14; measured against jFuzzyLogic, docs/engine.md)."""
+    return values == top
 
 
 def _java_equal(a: Arr, b: Arr) -> Arr:
