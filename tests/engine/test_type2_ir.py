@@ -187,3 +187,18 @@ def test_ekm_with_zero_lower_weights_matches_brute_force() -> None:
 def test_stated_iteration_bounds() -> None:
     assert iterations("KM", 101) == iterations("EKM", 101) == 103
     assert iterations("IASC", 101) == iterations("EIASC", 101) == 101
+
+
+@pytest.mark.parametrize("samples", [0, 1, -5, 2.5, True])
+@pytest.mark.parametrize("backend", [None, "python", "native"])
+def test_a_sample_count_below_two_is_refused_not_replaced(samples: object, backend: str | None) -> None:
+    # 0 once fell back to the default 101 samples silently
+    with pytest.raises(ValueError, match="samples="):
+        fuzzyctl.compile(EXAMPLE, backend=backend, samples=samples)
+    with pytest.raises(ValueError, match="samples="):
+        Type2Controller(fuzzyctl.load(EXAMPLE).main, samples=samples)  # type: ignore[arg-type]
+
+
+def test_two_samples_are_accepted() -> None:
+    ctl = fuzzyctl.compile(EXAMPLE, samples=2)
+    assert all(math.isfinite(v) for v in ctl.evaluate({"service": 5, "food": 5}).values())

@@ -158,6 +158,7 @@ class Type2Controller:
     """Evaluates an interval type-2 function block (see the module docstring)."""
 
     def __init__(self, fb: FunctionBlock, *, samples: int | None = None, method: str | None = None) -> None:
+        _check_samples(samples)
         self.model = fb
         self.name = fb.name
         self.plan = Type2Plan(tuple(InputSpec(v.name) for v in fb.inputs))
@@ -479,6 +480,14 @@ def _envelope(a: float, b: float, lines: list[Bounds], e0: float, e1: float) -> 
     return at(best, e0), at(best, e1)
 
 
+def _check_samples(samples: object) -> None:
+    """A sample count is a whole number of at least 2 (0 once fell back to the default)."""
+    if samples is None:
+        return
+    if isinstance(samples, bool) or not isinstance(samples, int) or samples < 2:
+        raise ValueError(f"samples={samples!r}: give a whole number of output samples, at least 2")
+
+
 def compile_type2(fb: FunctionBlock, backend: str | None = None, **options: Any) -> Type2Controller:
     """The controller of a type-2 block; a backend whose record says it cannot evaluate
     type-2 systems is refused (:func:`fuzzyctl.kinds.type_reduction.refusal`)."""
@@ -486,6 +495,7 @@ def compile_type2(fb: FunctionBlock, backend: str | None = None, **options: Any)
     if why:
         raise Type2Unsupported(why)
     samples, method = options.get("samples"), options.get("type_reduction")
+    _check_samples(samples)
     if backend == "native" or (backend in (None, "auto", "python") and samples is not None):
         # the IR evaluator (fuzzyctl.engine.type2_compiled): C, or Python and numpy
         from fuzzyctl.engine.type2_compiled import Type2Compiled
