@@ -224,3 +224,21 @@ def test_cli_options(capsys: pytest.CaptureFixture[str], tmp_path: Path) -> None
     out = block["outputs"]["valve"]
     assert out["observed"] <= out["error_bound"] <= 2.0 and out["scale"] > 0
     assert "REAL" not in report["text"].split("FUNCTION_BLOCK", 1)[1]
+
+
+def test_a_table_never_exceeds_max_bytes_even_when_the_tolerance_is_met() -> None:
+    """The coarsest crane table (axis ends and kinks) meets a loose tolerance but is larger
+    than a tiny size limit: refused naming the limit, never built over it."""
+    crane = EXAMPLES / "crane.fcl"
+    coarse = fuzzyctl.compile(crane, backend="table", tolerance=0.5).table  # type: ignore[attr-defined]
+    size = coarse.size_bytes("LREAL")
+    from fuzzyctl.engine.table import TableError
+
+    with pytest.raises(
+        TableError, match=rf"smallest table, .* in {size} bytes, is larger than --max-bytes {size - 1}"
+    ):
+        fuzzyctl.compile(crane, backend="table", tolerance=0.5, max_bytes=size - 1)
+    assert (
+        fuzzyctl.compile(crane, backend="table", tolerance=0.5, max_bytes=size).table.size_bytes("LREAL")
+        <= size
+    )  # type: ignore[attr-defined]

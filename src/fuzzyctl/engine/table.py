@@ -483,7 +483,7 @@ def build_table(
         if worst <= tolerance or limited:
             break
         target *= max(0.3, min(0.8, 0.95 * tolerance / worst))
-    if math.isinf(worst) or worst > tolerance:
+    if math.isinf(worst) or worst > tolerance or table.size_bytes(real) > max_bytes:
         _refuse(plan, table, worst, limited, (ev, design, cert), max_bytes, real)
     return table
 
@@ -516,6 +516,12 @@ def _refuse(
                 if cert.heavy()
                 else ""
             )
+        )
+    shape, size = "x".join(map(str, table.shape)), table.size_bytes(real)
+    if size > max_bytes:  # the coarsest table (its axes' ends and kinks) is already too big
+        raise TableError(
+            f"the smallest table, {shape} in {size} bytes, is larger than --max-bytes {max_bytes} "
+            f"(it is within {apart(worst, tolerance)[0]} ({bound}%) of the output range): raise --max-bytes"
         )
     if worst > tolerance:
         raise TableError(
