@@ -54,6 +54,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import accumulate_np, clamp_np
+from fuzzyctl.ir.kernels.rendered import output_kernel
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS, implementation
@@ -187,6 +188,7 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
     Takagi-Sugeno outputs vectorised, the rest row by row through the interpreter."""
     op = plan.outputs[oi]
     n_in = len(plan.inputs)
+    rendered: list[Any] = []  # a method without a numpy kernel: its IR rendered, made once
 
     def f(n: int, *args: Any) -> Result:
         vals = [col(n, a) for a in args[:n_in]]
@@ -205,6 +207,10 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
             and op.grid is not None
             and not (norms.probabilistic(op.accu) and METHODS[op.method].bisects)
         ):
+            if not METHODS[op.method].numpy:
+                if not rendered:
+                    rendered.append(output_kernel(plan, op, [(t or 0, act) for t, _a, _w, act in contribs]))
+                return rendered[0](n, [x for _t, a, w, _act in contribs for x in (a, w)])  # type: ignore[no-any-return]
             groups = [(t or 0, a, w, norms.is_min(act)) for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
         from fuzzyctl.ir.kernels.smooth_columns import smooth_output
