@@ -46,7 +46,7 @@ def output_kernel(plan: Plan, op: OutputPlan, layout: Sequence[tuple[int, str]])
         fp = _program(plan, op, layout, "np")
         from fuzzyctl.ir.render.npsrc import vectorise
 
-        batch = vectorise(fp)
+        batch = vectorise(fp, gather=True)
     except CodegenError:
         pass
     else:
