@@ -6,9 +6,10 @@ the pieces of :mod:`fuzzyctl.ir.builders.grid_pieces`, then the builder the entr
 ``ir``), built once per output as a small program whose inputs are the degree and the
 weight of each activated set, and printed
 
-* as numpy (:mod:`fuzzyctl.ir.render.npsrc`, if-converted: every row at once), or, where that
-  printer refuses (an array indexed by a value that differs between rows, a loop whose end
-  does),
+* as numpy (:mod:`fuzzyctl.ir.render.npsrc`, if-converted: every row at once; an array
+  indexed by a value that differs between rows is read with a gather and written with
+  masked stores, a loop whose end does runs masked: ``gather=True``), or, should that
+  printer still refuse,
 * as Python (:mod:`fuzzyctl.ir.render.pysrc`), called row by row.
 
 Where the IR has no form of the method (a grid cut at run time, an accumulation whose pieces
