@@ -42,7 +42,9 @@ Columns = Callable[[int, list[Any]], Result]
 def output_kernel(plan: Plan, op: OutputPlan, layout: Sequence[tuple[int, str]]) -> Columns:
     """``f(n, [a0, w0, a1, w1, ...]) -> (value, fired)`` for output ``op`` whose activated
     sets are ``layout`` (term, activation) in this order: the IR printed as numpy, else as
-    Python row by row, else the reference row by row (see the module docstring)."""
+    Python row by row, else the reference row by row (see the module docstring); the
+    function's ``how`` attribute says which (``"numpy"``, ``"python rows"``,
+    ``"reference rows"``)."""
     try:
         fp = _program(plan, op, layout, "np")
         from fuzzyctl.ir.render.npsrc import vectorise
