@@ -9,7 +9,9 @@ base per kernel, so that a kernel stays only where the rendered IR was measured 
 * numpy (ns per row of a 20,000-row batch, one core): ``kernels`` = ir/kernels/columns.py
   (what ``evaluate_batch`` runs), ``IR`` = the native IR printed as numpy (``nan``: the IR
   indexes arrays by a value that differs between rows, which numpy's if-conversion cannot
-  print - the kernel is then the only numpy form).
+  print), ``gather`` = the same IR printed with gathers and masked loops for those
+  (``npsrc.vectorise(..., gather=True)``, what a method without a numpy kernel runs:
+  ir/kernels/rendered.py).
 
 Run alone: ``python benchmarks/bench_kernels.py [--quick]``.
 """
@@ -125,9 +127,11 @@ def numpy_ns(plan: Plan, cols: list[np.ndarray], rounds: int) -> dict[str, float
 
     n = len(cols[0])
     fns = {"kernels": vectorise(build_fast(plan, "np"))}
-    out = {"IR": math.nan}  # NaN: the IR cannot be if-converted (an index that differs per row)
+    out = {"IR": math.nan, "gather": math.nan}  # NaN: the IR cannot be if-converted
     with contextlib.suppress(CodegenError):
         fns["IR"] = vectorise(NativeBuilder(plan, "np").build())
+    with contextlib.suppress(CodegenError):
+        fns["gather"] = vectorise(NativeBuilder(plan, "np").build(), gather=True)
     state: list[float | None] = [0.0] * len(plan.outputs)
     for k, fn in fns.items():
         fn(cols, state, n)
@@ -148,7 +152,7 @@ def section_kernels(args: argparse.Namespace, work: Path, results: dict[str, Any
     print("\n7. kernels: hand-written against the IR rendered in the same language")
     print(
         f"{'row':22s} {'kernel':9s} {'py kernels':>10s} {'py IR':>8s} {'py used':>8s} "
-        f"{'np kernels':>10s} {'np IR':>8s}"
+        f"{'np kernels':>10s} {'np IR':>8s} {'np gather':>9s}"
     )
     out: dict[str, Any] = {}
     with warnings.catch_warnings():
@@ -160,7 +164,7 @@ def section_kernels(args: argparse.Namespace, work: Path, results: dict[str, Any
             out[row[0]] = {"kernel": row[1], "py_us": py, "np_ns": npy}
             print(
                 f"{row[0]:22s} {row[1]:9s} {py['kernels']:8.2f}us {py['IR']:6.2f}us {py['used']:6.2f}us "
-                f"{npy['kernels']:8.0f}ns {npy['IR']:6.0f}ns"
+                f"{npy['kernels']:8.0f}ns {npy['IR']:6.0f}ns {npy['gather']:7.0f}ns"
             )
     results["kernels"] = out
 

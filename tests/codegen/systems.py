@@ -9,16 +9,34 @@
 from __future__ import annotations
 
 import dataclasses
+import os
+from collections.abc import Iterator
 from functools import cache
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 import fuzzyctl
 from fuzzyctl.diagnostics import DiagnosticError
 from fuzzyctl.engine.plan import Plan, Slot
 from fuzzyctl.model import Document
 from tests.conftest import DATA, EXAMPLES
+
+
+@pytest.fixture(scope="module", autouse=True)
+def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """The module's builds go to a fresh cache directory (and the user's cache is left
+    alone); a test module takes it with ``private_cache = S.private_cache``."""
+    path = tmp_path_factory.mktemp("cache")
+    old = os.environ.get("FUZZYCTL_CACHE_DIR")
+    os.environ["FUZZYCTL_CACHE_DIR"] = str(path)
+    yield path
+    if old is None:
+        del os.environ["FUZZYCTL_CACHE_DIR"]
+    else:
+        os.environ["FUZZYCTL_CACHE_DIR"] = old
+
 
 #: Conformance systems the C generator refuses, and why (docs/codegen.md repeats this).
 NOT_EXPRESSIBLE_C = {

@@ -14,7 +14,6 @@ import os
 import re
 import threading
 import warnings
-from collections.abc import Iterator
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
@@ -33,17 +32,7 @@ from tests.engine import randsys
 TOL = 1e-12
 
 
-@pytest.fixture(scope="module", autouse=True)
-def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    """Builds go to a fresh cache directory (and the user's cache is left alone)."""
-    path = tmp_path_factory.mktemp("cache")
-    old = os.environ.get("FUZZYCTL_CACHE_DIR")
-    os.environ["FUZZYCTL_CACHE_DIR"] = str(path)
-    yield path
-    if old is None:
-        del os.environ["FUZZYCTL_CACHE_DIR"]
-    else:
-        os.environ["FUZZYCTL_CACHE_DIR"] = old
+private_cache = S.private_cache  # builds go to a fresh cache directory (autouse)
 
 
 def _files() -> list[tuple[str, Path]]:

@@ -11,7 +11,6 @@ inputs, one row at a time (NC state carried) and as a batch."""
 from __future__ import annotations
 
 import dataclasses
-import os
 import warnings
 from collections.abc import Iterator
 from pathlib import Path
@@ -26,20 +25,12 @@ from fuzzyctl.ir.kernels import columns as kernels_np
 from fuzzyctl.ir.kernels import scalar as kernels
 from fuzzyctl.ir.nodes import For, If, Kernel, Region, Stmt, While
 from fuzzyctl.ir.programs.native import build_native
+from tests.codegen import systems as S
 
 TOL = 1e-9
 
 
-@pytest.fixture(scope="module", autouse=True)
-def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    path = tmp_path_factory.mktemp("cache")
-    old = os.environ.get("FUZZYCTL_CACHE_DIR")
-    os.environ["FUZZYCTL_CACHE_DIR"] = str(path)
-    yield path
-    if old is None:
-        del os.environ["FUZZYCTL_CACHE_DIR"]
-    else:
-        os.environ["FUZZYCTL_CACHE_DIR"] = old
+private_cache = S.private_cache  # builds go to a fresh cache directory (autouse)
 
 
 INPUTS = """

@@ -13,8 +13,6 @@ from __future__ import annotations
 import math
 import os
 import warnings
-from collections.abc import Iterator
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -24,6 +22,7 @@ from hypothesis import strategies as st
 import fuzzyctl
 from fuzzyctl import model as m
 from fuzzyctl.engine.native import NativeController
+from tests.codegen import systems as S
 from tests.engine import bruteforce, opsweep
 from tests.extras import extra_path
 
@@ -31,16 +30,7 @@ TOL = 1e-9  # of the output range
 FUZZ = os.environ.get("HYPOTHESIS_PROFILE") == "fuzz"
 
 
-@pytest.fixture(scope="module", autouse=True)
-def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    path = tmp_path_factory.mktemp("cache")
-    old = os.environ.get("FUZZYCTL_CACHE_DIR")
-    os.environ["FUZZYCTL_CACHE_DIR"] = str(path)
-    yield path
-    if old is None:
-        del os.environ["FUZZYCTL_CACHE_DIR"]
-    else:
-        os.environ["FUZZYCTL_CACHE_DIR"] = old
+private_cache = S.private_cache  # builds go to a fresh cache directory (autouse)
 
 
 def _same(a: float, b: float, span: float, tol: float = TOL) -> bool:

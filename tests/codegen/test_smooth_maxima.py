@@ -16,15 +16,14 @@ plateau's other edge (0.1 of the range), and the native and interpreted paths di
 from __future__ import annotations
 
 import math
-import os
 import warnings
-from collections.abc import Callable, Iterator
-from pathlib import Path
+from collections.abc import Callable
 
 import numpy as np
 import pytest
 
 import fuzzyctl
+from tests.codegen import systems as S
 from tests.engine import bruteforce
 
 MAX_TOL = 1.5e-6  # of the range: an unclipped smooth maximum (docs/engine.md)
@@ -37,16 +36,7 @@ CASES = 18  # each accumulation twice, each activation three times
 ROWS = 6
 
 
-@pytest.fixture(scope="module", autouse=True)
-def private_cache(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
-    path = tmp_path_factory.mktemp("cache")
-    old = os.environ.get("FUZZYCTL_CACHE_DIR")
-    os.environ["FUZZYCTL_CACHE_DIR"] = str(path)
-    yield path
-    if old is None:
-        del os.environ["FUZZYCTL_CACHE_DIR"]
-    else:
-        os.environ["FUZZYCTL_CACHE_DIR"] = old
+private_cache = S.private_cache  # builds go to a fresh cache directory (autouse)
 
 
 def _term(rng: np.random.Generator, name: str) -> str:

@@ -27,11 +27,13 @@ def test_every_entry_is_complete(code: str) -> None:
     assert m.spellings["fcl"] and m.spellings["json"] == (code,)
     assert set(m.notes) == set(m.spellings["fcl"]), "a note per FCL spelling"
     kinds = [m.integrating, m.maximum is not None, m.weighted is not None]
-    assert sum(kinds) == 1, "integrating, a maximum or weighted: exactly one"
+    assert sum(kinds) == 1 or m.on_pieces, "integrating, a maximum or weighted: at most one"
     assert not m.bisects or m.integrating
     assert not m.takagi_sugeno or m.weighted is not None
     for what in ("reference", "ir", "numpy"):
         path = getattr(m, what)
+        if what == "numpy" and not path:
+            continue  # no hand-written kernel: a batch renders the IR
         assert re.fullmatch(r"fuzzyctl(\.\w+)+:\w+(\.\w+)*", path), (what, path)
         assert callable(M.implementation(path)), (what, path)
     if m.lowers_to is not None:

@@ -57,34 +57,36 @@ def karnik_mendel(x: Sequence[float], lower: Sequence[float], upper: Sequence[fl
     return _km_end(xs, lo, up, True), _km_end(xs, lo, up, False)
 
 
+def _split_mean(x: list[float], first: list[float], rest: list[float], k: int) -> float | None:
+    """The weighted mean with the first ``k`` points weighted by ``first`` and the others by
+    ``rest``, each side summed exactly (None: every weight zero).  Updating the sums by the
+    points that change side (Wu and Mendel's saving) cancels catastrophically when the
+    weights left are small (lower weights of zero), giving a mean outside the points."""
+    n = len(x)
+    a = math.fsum(x[i] * first[i] for i in range(k)) + math.fsum(x[i] * rest[i] for i in range(k, n))
+    b = math.fsum(first[:k]) + math.fsum(rest[k:])
+    return a / b if b > 0.0 else None
+
+
 def _ekm_end(x: list[float], lo: list[float], up: list[float], left_upper: bool) -> float:
     n = len(x)
     k = max(1, min(n - 1, round(n / 2.4 if left_upper else n / 1.7)))
     first, rest = (up, lo) if left_upper else (lo, up)
-    a = math.fsum(x[i] * first[i] for i in range(k)) + math.fsum(x[i] * rest[i] for i in range(k, n))
-    b = math.fsum(first[:k]) + math.fsum(rest[k:])
-    if b <= 0.0:
-        return _km_end(x, lo, up, left_upper)
-    y = a / b
+    y = _split_mean(x, first, rest, k)
     for _ in range(n + 2):
+        if y is None:  # every weight on this side zero: KM's search handles it
+            return _km_end(x, lo, up, left_upper)
         k2 = sum(1 for v in x if v <= y)
         if k2 == k:
             return y
         k = k2
-        # the sums of the new switch point, summed exactly: updating them by the points that
-        # change side (Wu and Mendel's saving) cancels catastrophically when the weights left
-        # are small (lower weights of zero), giving a mean outside the points
-        a = math.fsum(x[i] * first[i] for i in range(k)) + math.fsum(x[i] * rest[i] for i in range(k, n))
-        b = math.fsum(first[:k]) + math.fsum(rest[k:])
-        if b <= 0.0:  # every weight on this side zero: KM's search handles it
-            return _km_end(x, lo, up, left_upper)
-        y = a / b
-    return y
+        y = _split_mean(x, first, rest, k)
+    return y if y is not None else _km_end(x, lo, up, left_upper)
 
 
 def enhanced_karnik_mendel(x: Sequence[float], lower: Sequence[float], upper: Sequence[float]) -> Interval:
     """EKM (Wu and Mendel 2009): KM from the switch points n/2.4 and n/1.7 (the sums of each
-    new switch point are summed exactly, not updated: see :func:`_ekm_end`)."""
+    new switch point are summed exactly, not updated: see :func:`_split_mean`)."""
     xs, lo, up = _sorted(x, lower, upper)
     if not xs:
         return math.nan, math.nan

@@ -7,14 +7,18 @@ the output range, CoG and CoA; ``maximum``: which point of the set's maximum it 
 RM and MoM; ``weighted``: a weighted mean or sum of points, singletons and Takagi-Sugeno),
 how each file format spells it (the first spelling is the one written), and where its
 implementations live: ``reference`` (the readable definition every path is tested against),
-``ir`` (the IR builder of the native evaluator) and ``numpy`` (the hand-written vectorised
-kernel).  Implementations are named ``"module:qualified.name"`` (resolved by
+``ir`` (the IR builder of the native evaluator) and, optionally, ``numpy`` (a hand-written
+vectorised kernel, kept only where it was measured faster than the IR rendered as numpy;
+without one a batch runs the IR rendered: :mod:`fuzzyctl.ir.kernels.rendered`).
+Implementations are named ``"module:qualified.name"`` (resolved by
 :func:`implementation`) so that this module stays at the bottom of the import stack.
 
-Adding a method: an entry here, its reference function in :mod:`fuzzyctl.engine.reference.pwl` (and
-:mod:`fuzzyctl.engine.reference.quadrature` for smooth sets), its IR builder in
-:mod:`fuzzyctl.ir.builders.grid_pieces`, its numpy kernel in :mod:`fuzzyctl.ir.kernels.columns`;
-tests/kinds/test_methods.py checks that every entry is complete and resolves.
+Adding a method: an entry here, its reference function in :mod:`fuzzyctl.engine.reference.pwl`
+(``(pieces, points, area, moment) -> value``) and its IR builder in
+:mod:`fuzzyctl.ir.builders.grid_pieces` (``(g, pieces, grid, areas, total) -> value``), the
+entry's kind flags left unset (:attr:`Method.on_pieces`: piecewise-linear outputs only; the
+PLC block's run-time grid refuses it).  tests/kinds/test_methods.py checks that every entry
+is complete and resolves; tests/engine/test_rendered_method.py adds one at test time.
 """
 
 from __future__ import annotations
@@ -78,6 +82,13 @@ class Method:
     def centroid(self) -> bool:
         """CoG: the centroid of the accumulated set."""
         return self.integrating and not self.bisects
+
+    @property
+    def on_pieces(self) -> bool:
+        """A method of none of the kinds above (not integrating, no maximum, not weighted):
+        defined only by its ``reference`` and ``ir`` on the linear pieces of an exact
+        (piecewise-linear) accumulated set; the lowering refuses it on other outputs."""
+        return not (self.integrating or self.maximum is not None or self.weighted is not None)
 
     @property
     def on_sets(self) -> bool:

@@ -158,6 +158,13 @@ def _defuzzified(
         return _ts_plan(ctx, out)
     if ts_terms or (singletonish and method in methods.TAKAGI_SUGENO):
         return _ts_output(ctx, out)
+    if method is not None and methods.METHODS[method].on_pieces and (singletonish or ts_terms):
+        ctx.err(
+            f"DEFUZZIFY {var.name}: {method} applies to piecewise-linear fuzzy sets only",
+            db.span,
+            "method-terms",
+        )
+        return None
     if singletonish:
         if method is not None and methods.METHODS[method].bisects:
             ctx.err(
@@ -253,6 +260,14 @@ def _mamdani_output(ctx: LowerContext, out: _Defuzzified) -> OutputPlan | None:
             # closed forms whose coefficients overflow (a term rising 2e-308 over 2e-308, points
             # at 1e300): the integrals are taken numerically, as for curved terms
             grid, exact = None, False
+    if methods.METHODS[meth].on_pieces and not exact:
+        ctx.err(
+            f"DEFUZZIFY {var.name}: {meth} applies to piecewise-linear fuzzy sets only "
+            "(points or triangle/trapezoid-like terms, MIN or PROD activation)",
+            db.span,
+            "method-terms",
+        )
+        return None
     return out.plan("mamdani", meth, acc, low=low, high=high, exact=exact, grid=grid)
 
 

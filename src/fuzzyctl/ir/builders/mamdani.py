@@ -115,6 +115,9 @@ def exact_outputs(
     b = g.b
     n_out = len(outs)
     methods = {o.method for o in outs}
+    for o in outs:
+        if o.method not in METHODS:  # a method of a new kind: only its constant-grid IR exists
+            raise g.refuse(f"output {o.name}", f"METHOD {o.method} on a grid cut at run time")
     accus = {ACCUS[o.accu] for o in outs if len(o.groups) > 1}
     # ---- tables: terms and their points, activated sets, per-output data
     term_pts: list[list[tuple[Ex, Ex]]] = []

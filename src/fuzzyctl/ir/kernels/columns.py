@@ -12,32 +12,37 @@ by row by the interpreter.
 Every kernel takes the number of rows first; its other arguments are arrays of that length or
 numbers (the same for every row).
 
-These are hand-written because printing their IR twins as numpy was measured slower
-(benchmarks/bench_engine.py, section 6, column "np IR": 2-4x on CoG, CoA, LM, RM, MoM): the
+These are hand-written because printing their IR twins as numpy was measured slower: the
 twins are :meth:`fuzzyctl.ir.programs.evaluator.FastBuilder.closed_cog` with
 :func:`fuzzyctl.ir.builders.pieces.max_of_two` (:func:`centroid`, :func:`_max_of_two`) and
 :mod:`fuzzyctl.ir.builders.grid_pieces` (:func:`bisector_value`, :func:`maximum_point`), which the
-native backend compiles; each method's entry in :mod:`fuzzyctl.kinds.methods` names both.
-``benchmarks/bench_engine.py --only kernels`` times every kernel here against its twin
-printed as numpy:
+native backend compiles; each method's entry in :mod:`fuzzyctl.kinds.methods` names both.  A
+method's kernel is optional: an entry naming none runs its IR rendered
+(:mod:`fuzzyctl.ir.kernels.rendered`).  ``benchmarks/bench_engine.py --only kernels`` times
+every kernel here against its twin printed as numpy (column "np IR"; "np gather": printed
+with a gather for an array index that differs between rows and a masked loop for a loop
+whose end does, which plain if-conversion refuses).  Measured 2026-12-06 (``--quick``, ns
+per row, one core):
 
 ===============  ===============================================  ===========================
-kernel           IR twin                                          numpy IR
+kernel           IR twin                                          numpy IR (gather)
 ===============  ===============================================  ===========================
 ``AM_LINES``     :func:`fuzzyctl.ir.builders.pieces.max_of_two`,  2.5x slower (two sets);
-                 :func:`~fuzzyctl.ir.builders.pieces.interval`    more sets: not if-convertible
-``MAMDANI``      :mod:`fuzzyctl.ir.builders.grid_pieces`          1.7-5x slower, or not
-                                                                  if-convertible
-``TS``           :func:`fuzzyctl.ir.builders.terms.tsukamoto`     2.7x slower
+                 :func:`~fuzzyctl.ir.builders.pieces.interval`    three sets 1.16x, PROBOR
+                                                                  1.6x slower (gather)
+``MAMDANI``      :mod:`fuzzyctl.ir.builders.grid_pieces`          CoA 5.3x, LM 2.7x, RM 2.6x,
+                                                                  MoM 2.0x, MoM BSUM 3.3x,
+                                                                  CoA PROBOR 1.3x slower
+``TS``           :func:`fuzzyctl.ir.builders.terms.tsukamoto`     2.1x slower
 ``SELECT``       ``NativeBuilder.select``                         a tie at 4 rules (+-10%);
                  (:mod:`fuzzyctl.ir.programs.native`)             quadratic in the rule count
-``MEMBER``       ``NativeBuilder.member`` (run-time sort)         not if-convertible
+``MEMBER``       ``NativeBuilder.member`` (run-time sort)         1.16x slower (gather)
 ``EXPR``         ``RuleBuilder.function_term``                    not timed yet (Python and
                                                                   numpy print no function IR)
 ===============  ===============================================  ===========================
 
-"Not if-convertible": the IR indexes an array by a value that differs between rows, which
-:mod:`fuzzyctl.ir.render.npsrc` refuses to print.
+A smooth output's quadrature (``smooth CoG``) printed with gathers was 10x slower than
+:mod:`fuzzyctl.ir.kernels.smooth_columns`.
 """
 
 from __future__ import annotations
@@ -54,6 +59,7 @@ from fuzzyctl.engine.reference import pwl
 from fuzzyctl.engine.semantics import selection, shapes
 from fuzzyctl.engine.semantics.expr import eval_expr_np
 from fuzzyctl.engine.semantics.operators import accumulate_np, clamp_np
+from fuzzyctl.ir.kernels.rendered import output_kernel
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.methods import METHODS, implementation
@@ -187,6 +193,7 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
     Takagi-Sugeno outputs vectorised, the rest row by row through the interpreter."""
     op = plan.outputs[oi]
     n_in = len(plan.inputs)
+    rendered: list[Any] = []  # a method without a numpy kernel: its IR rendered, made once
 
     def f(n: int, *args: Any) -> Result:
         vals = [col(n, a) for a in args[:n_in]]
@@ -205,6 +212,10 @@ def whole_output(plan: Plan, oi: int, earlier: tuple[int, ...], sets: tuple[tupl
             and op.grid is not None
             and not (norms.probabilistic(op.accu) and METHODS[op.method].bisects)
         ):
+            if not METHODS[op.method].numpy:
+                if not rendered:
+                    rendered.append(output_kernel(plan, op, [(t or 0, act) for t, _a, _w, act in contribs]))
+                return rendered[0](n, [x for _t, a, w, _act in contribs for x in (a, w)])  # type: ignore[no-any-return]
             groups = [(t or 0, a, w, norms.is_min(act)) for t, a, w, act in contribs]
             return _mamdani(op, op.grid, groups, n)
         from fuzzyctl.ir.kernels.smooth_columns import smooth_output

@@ -120,7 +120,7 @@ class NativeBuilder(FastBuilder):
     def _mamdani_kernel(self, oi: int, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
         groups = merge(self.g, contribs, op.accu or "MAX")
         if op.exact:
-            return self._exact(op, groups)
+            return self.exact_output(op, groups)
         for t in op.terms:
             if not Q.constant_term(t):  # a function term of x alone is constant
                 raise self.g.refuse(f"term {op.name}.{t.name}", "a smooth output term given by variables")
@@ -128,9 +128,10 @@ class NativeBuilder(FastBuilder):
         # every method: CoG as the PLC block integrates it, CoA/LM/RM/MoM on the same panels
         return smooth_method(self.g, op, sets, Q.calibrate(op), self.plan.options.quad_rtol)
 
-    def _exact(self, op: OutputPlan, groups: list[Group]) -> tuple[Ex, Ex]:
+    def exact_output(self, op: OutputPlan, groups: list[Group]) -> tuple[Ex, Ex]:
         """A piecewise-linear output by any exact method: the PLC block's defuzzification
-        on this output's constant grid (or its run-time one when points are inputs)."""
+        on this output's constant grid (or its run-time one when points are inputs: a method
+        the PLC block has no run-time form of is refused there, :func:`M.exact_outputs`)."""
         assert op.low is not None and op.high is not None
         accu = op.accu or "MAX"
         if op.grid is not None and GP.applies(accu):
@@ -169,8 +170,8 @@ class NativeBuilder(FastBuilder):
             return value, fired
         if entry.bisects:
             return GP.bisector_by_intervals(g, grid, sets, accu)
-        maxima = entry.maximum is not None
-        p = GP.pieces(g, grid, sets, accu, maxima)
+        # the grid points' degrees: the maxima read them, and so may a method of a new kind
+        p = GP.pieces(g, grid, sets, accu, not entry.integrating)
         fired = g.let(ex(False), "FIRED", "BOOL")
         value = g.let(0.0, "Y")
         if not p.x0:

@@ -11,9 +11,13 @@ t := a``) become ``numpy.minimum``/``numpy.maximum``.  Kernels are the vectorise
 successive evaluations of one instance).
 
 A WHILE loop whose end depends on the sample runs while some sample's condition holds, its
-body masked to those samples (the type reduction of type-2 systems); a FOR loop whose bounds
+body masked to those samples (the type reduction of type-2 systems).  A FOR loop whose bounds
 depend on the sample, or an array index that does, is refused
-(:class:`~fuzzyctl.ir.state.CodegenError`).
+(:class:`~fuzzyctl.ir.state.CodegenError`) unless the program is printed with ``gather``:
+then the loop runs from the smallest start to the largest stop of the samples, its body
+masked to the samples inside their own bounds, an array read at a per-sample index is a
+gather (``take_along_axis``) and a write a masked store into every element the index may
+name (what :mod:`fuzzyctl.ir.kernels.rendered` prints a method's IR with).
 """
 
 from __future__ import annotations
@@ -99,9 +103,10 @@ class _Np(PythonPrinter):
     """The Python printer, if-converted: ``self.mask`` is the mask of the samples the
     statements being printed apply to (None: all)."""
 
-    def __init__(self, fp: FastProgram) -> None:
+    def __init__(self, fp: FastProgram, gather: bool = False) -> None:
         super().__init__(targets.NP)
         self.fp = fp
+        self.gather = gather
         self.vary = varying_names(fp.program, fp.inputs)
         self.mask: str | None = None
         self.env: dict[str, Any] = {
@@ -114,6 +119,8 @@ class _Np(PythonPrinter):
             "_real": lambda x: x * 1.0,
             "_NAN": math.nan,
             "_INF": math.inf,
+            "_take": _take,
+            "_span": _span,
         }
         self.n_bound = 0
         self.n_masks = 0
@@ -131,7 +138,9 @@ class _Np(PythonPrinter):
 
     def index(self, e: Index) -> str:
         if self.varies(e.index):
-            raise CodegenError("an array index that differs between samples cannot be if-converted")
+            if not self.gather:
+                raise CodegenError("an array index that differs between samples cannot be if-converted")
+            return f"_take({self.name(e.name)}, {self.ex(e.index)})"
         return super().index(e)
 
     def pwl(self, e: Pwl) -> str:
@@ -148,6 +157,15 @@ class _Np(PythonPrinter):
             self.mask = outer
 
     def store(self, target: Ex, value: str, ind: int) -> None:
+        if isinstance(target, Index) and self.varies(target.index):
+            # every element the per-sample index may name, each where the index names it
+            arr, k, v = self.name(target.name), self.mask_name(), self.mask_name()
+            self.emit(f"{v} = {value}", ind)
+            self.emit(f"{k} = {self.ex(target.index)}", ind)
+            self.emit(f"for _j in range(len({arr})):", ind)
+            hit = f"{k} == _j" if self.mask is None else f"_and({self.mask}, {k} == _j)"
+            self.emit(f"{arr}[_j] = _w({hit}, {v}, {arr}[_j])", ind + 1)
+            return
         t = self.ex(target)
         self.emit(f"{t} = {value}" if self.mask is None else f"{t} = _w({self.mask}, {value}, {t})", ind)
 
@@ -155,9 +173,19 @@ class _Np(PythonPrinter):
         self.store(s.target, self.ex(s.value), ind)
 
     def for_(self, s: For, ind: int) -> None:
-        if self.varies(s.start) or self.varies(s.stop):
+        if not (self.varies(s.start) or self.varies(s.stop)):
+            super().for_(s, ind)
+            return
+        if not self.gather:
             raise CodegenError("a loop whose bounds differ between samples cannot be if-converted")
-        super().for_(s, ind)
+        lo, hi, m = self.mask_name(), self.mask_name(), self.mask_name()
+        self.emit(f"{lo} = {self.ex(s.start)}", ind)
+        self.emit(f"{hi} = {self.ex(s.stop)}", ind)
+        self.emit(f"for {s.var} in _span({lo}, {hi}, {self.mask}, {s.step}):", ind)
+        first, last = (lo, hi) if s.step > 0 else (hi, lo)
+        inside = f"({first} <= {s.var}) & ({s.var} <= {last})"
+        self.emit(f"{m} = {inside}" if self.mask is None else f"{m} = _and({self.mask}, {inside})", ind + 1)
+        self.masked(s.body, ind + 1, m)
 
     def while_(self, s: While, ind: int) -> None:
         """A loop whose end differs between samples runs while some sample's condition
@@ -220,6 +248,27 @@ class _Np(PythonPrinter):
             self.store(o, t, ind)
 
 
+def _take(arr: Sequence[Any], idx: Any) -> Any:
+    """``arr[idx]`` per sample (a list of columns or numbers; indices out of range, which only
+    masked-off samples can hold, are clipped)."""
+    cols = np.broadcast_arrays(*(np.asarray(a) for a in arr), np.asarray(idx))
+    at = np.clip(cols[-1].astype(np.intp), 0, len(arr) - 1)
+    return np.take_along_axis(np.stack(cols[:-1]), at[None, ...], 0)[0]
+
+
+def _span(lo: Any, hi: Any, mask: Any, step: int) -> range:
+    """The counter values a loop from ``lo`` to ``hi`` takes in some sample under ``mask``."""
+    lo, hi = np.broadcast_arrays(np.asarray(lo), np.asarray(hi))
+    if mask is not None:
+        sel = np.broadcast_to(mask, lo.shape)
+        lo, hi = lo[sel], hi[sel]
+    if lo.size == 0:
+        return range(0)
+    if step > 0:
+        return range(int(lo.min()), int(hi.max()) + 1)
+    return range(int(lo.max()), int(hi.min()) - 1, -1)
+
+
 def _tuple1(k: Kernel) -> bool:
     """A kernel returning a tuple of one value (SELECT of a one-rule block)."""
     return len(k.outs) == 1 and k.name == "SELECT"
@@ -258,9 +307,10 @@ def _same(a: Ex, b: Ex) -> bool:
     return a is b
 
 
-def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
-    """The source of ``_batch`` and the globals it needs."""
-    r = _Np(fp)
+def render_np(fp: FastProgram, gather: bool = False) -> tuple[str, dict[str, Any]]:
+    """The source of ``_batch`` and the globals it needs (``gather``: see the module
+    docstring)."""
+    r = _Np(fp, gather)
     prog = fp.program
     check_names(fp)
     for d in prog.of("const"):
@@ -289,9 +339,9 @@ def render_np(fp: FastProgram) -> tuple[str, dict[str, Any]]:
     return src, r.env
 
 
-def vectorise(fp: FastProgram) -> Batch:
+def vectorise(fp: FastProgram, gather: bool = False) -> Batch:
     """Compile the rendered source into the function."""
-    src, env = render_np(fp)
+    src, env = render_np(fp, gather)
     exec(compile(src, f"<fuzzyctl batch evaluator {py_str(fp.plan.name or '')}>", "exec"), env)
     fn: Batch = env["_batch"]
     fn.__source__ = src  # type: ignore[attr-defined]
