@@ -97,6 +97,7 @@ class Cell:
     a: Fraction
     b: Fraction
     parts: list[FX]
+    slope: Fraction  # a bound of the accumulated set's slope there (degree per stored unit)
 
 
 def _cells(
@@ -135,7 +136,14 @@ def _cells(
     out = []
     for j, lines, ta, tb in plan:
         a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
-        out.append(Cell(a, b, [area for area, _m in pieces.piece(lines, ta, tb)]))
+        # each set's line (MIN: clipped, PROD: scaled by its level) has at most its slope
+        slopes = []
+        for k, y0, y1 in lines:
+            st = pieces.sets[k]
+            top = Fraction(1) if st.is_min else st.level.hi * blk.dscale + st.level.err
+            slopes.append(abs(y1 - y0) * top / (xi[j + 1] - xi[j]))
+        slope = max(slopes) if combine(op) == "envelope" else sum(slopes, Fraction(0))
+        out.append(Cell(a, b, [area for area, _m in pieces.piece(lines, ta, tb)], slope))
     return out
 
 
@@ -159,10 +167,12 @@ def _first_reach(pieces: list[tuple[float, float, float, float]], level: float, 
     return None
 
 
-def band_width(blk: FixedBlock, op: OutputPlan, e: float) -> tuple[float, dict[int, float]]:
-    """An upper bound, over every input the block can be given, of the width of
-    ``{x : |F(x) - A/2| <= e}`` (engine units; ``e`` in engine units times degree), and the
-    input where the widest band was seen."""
+def band_width(
+    blk: FixedBlock, op: OutputPlan, options: list[tuple[float, float]]
+) -> tuple[float, dict[int, float]]:
+    """An upper bound, over every input the block can be given, of ``min over (e, add) in
+    options`` of the width of ``{x : |F(x) - A/2| <= e}`` plus ``add`` (engine units; ``e`` in
+    engine units times degree), and the input where the largest was seen."""
     from fuzzyctl.ir.programs.fixed_outputs import constant, input_domain
 
     assert op.grid is not None and op.low is not None and op.high is not None
@@ -185,13 +195,16 @@ def band_width(blk: FixedBlock, op: OutputPlan, e: float) -> tuple[float, dict[i
         ivs = rule_intervals(plan, box, weights)
         p_lo, a_lo = pieces([lo for lo, _hi in ivs])
         p_hi, a_hi = pieces([hi for _lo, hi in ivs])
-        slack = 1e-12 * a_hi  # the floats' rounding, far below it
-        ta, tb = 0.5 * a_lo - e - slack, 0.5 * a_hi + e + slack
-        xa = _first_reach(p_hi, ta, False) if ta > 0.0 else None
-        xb = _first_reach(p_lo, tb, True)
-        left = lo_x if xa is None else xa - margin
-        right = hi_x if xb is None else xb + margin
-        return max(0.0, right - left)
+        slack = 4e-12 * a_hi  # the floats' rounding and the reference's COA_TOL, far below it
+        best = math.inf
+        for e, add in options:
+            ta, tb = 0.5 * a_lo - e - slack, 0.5 * a_hi + e + slack
+            xa = _first_reach(p_hi, ta, False) if ta > 0.0 else None
+            xb = _first_reach(p_lo, tb, True)
+            left = lo_x if xa is None else xa - margin
+            right = hi_x if xb is None else xb + margin
+            best = min(best, max(0.0, right - left) + add)
+        return best
 
     domain = input_domain(blk)
     heap: list[tuple[float, int, dict[int, Iv]]] = []
@@ -297,9 +310,17 @@ def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> P
             "was proven: integer arithmetic has "
             "no worst-case error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
         )
-    band, seen_at = band_width(blk, op, float(e_cum * scale))
     cell_max = max(math.ceil(c.b) - math.floor(c.a) for c in cells)
-    err = Fraction(band) / scale + cell_max
+    limit = w.limits(True)[1] // (4 * cell_max + 2)
+    if limit < 1:
+        raise refuse(f"output {op.name!r}: a cell of its axis is too wide for the wide type")
+    # (1) the cell meets the band of E; (2) the interpolated point is in the band of E plus
+    # how far F leaves its chord over one cell (slope * width^2 / 4), up to its rounding
+    chord = max(c.slope * (c.b - c.a) ** 2 / 4 for c in cells)
+    rounding = Fraction(3, 2) + Fraction(10 * cell_max, limit)
+    options = [(e_cum * scale, cell_max * scale), ((e_cum + chord) * scale, rounding * scale)]
+    band, seen_at = band_width(blk, op, [(float(e), float(add)) for e, add in options])
+    err = Fraction(band) / scale
     if err > USEFUL * (xhi - xlo):
         where = ", ".join(f"{blk.plan.inputs[s].name}={x:g}" for s, x in sorted(seen_at.items()))
         raise refuse(
@@ -326,7 +347,7 @@ def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> P
     _found(blk, cells, c_stmts, v)
     with blk.b.if_(v["area"].gt(Int(0))):
         # a positive area: the cell found has 0 < num <= 2 den
-        _position(blk, v, q, cell_max, area.hi)
+        _position(blk, v, q, limit, area.hi)
         with blk.b.if_(q.lt(Int(math.floor(xlo)))):
             blk.b.set(q, Int(math.floor(xlo)))
         with blk.b.elif_(q.gt(Int(math.ceil(xhi)))):
@@ -340,15 +361,13 @@ def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> P
     return Port(op.name, scale, offset, slo, shi, bound, comment=f"{float(op.low):g}..{float(op.high):g}")
 
 
-def _position(blk: FixedBlock, v: dict[str, Var], q: Var, cell_max: int, area_hi: int) -> None:
-    """``q := xa + xw * num / (2 den)`` rounded, limited to the cell.  ``0 < num <= 2 den``;
-    the fraction is first brought to ``den < 2 limit`` by halvings (of both: only the position
-    inside the cell moves, which the bound does not count on) so that the product fits."""
+def _position(blk: FixedBlock, v: dict[str, Var], q: Var, limit: int, area_hi: int) -> None:
+    """``q := xa + xw * num / (2 den)`` rounded, limited to the cell.  ``0 < num <= 2 den + 1``;
+    the fraction is first brought to ``limit <= den < 2 limit`` (when above) by halvings of
+    both, each moving it by at most ``3 / (2 limit)``, so that ``xw * num + den`` fits
+    (``limit = wide max / (4 * widest cell + 2)``)."""
     w, b = blk.w, blk.b
     wide_max = w.limits(True)[1]
-    limit = wide_max // (4 * cell_max + 2)
-    if limit < 1:
-        raise refuse("a cell of the output axis is too wide for the wide type")
     steps = []
     k = 1
     while limit << k < max(area_hi, 1):
