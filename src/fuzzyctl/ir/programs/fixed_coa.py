@@ -257,6 +257,50 @@ def _found(
             b.set(v["den"], v["cum"] - v["prev"])
 
 
+def _bound(
+    blk: FixedBlock,
+    op: OutputPlan,
+    cells: list[Cell],
+    area: FX,
+    xi: tuple[Fraction, ...],
+    axis: tuple[Fraction, Fraction, Fraction],
+) -> tuple[Fraction, int]:
+    """The stated bound in stored units (module docstring), and the limit of the fraction's
+    halvings; refuses where the area can vanish or the bound would not be useful."""
+    scale, xlo, xhi = axis
+    w = blk.w
+    # the band: every C_i within e of F at its end, the comparison C_i >= A - C_i exact
+    e_cum = area.err * 3 / 2
+    lower, witness, witness_total = lower_area(blk, op, xi)
+    if Fraction(lower) <= 2 * e_cum:
+        where = ", ".join(f"{blk.plan.inputs[s].name}={x:g}" for s, x in sorted(witness.items()))
+        raise CodegenError(
+            f"output {op.name!r}: the accumulated set's area comes down to "
+            f"{witness_total * float(scale):.3g} (at {where}) and no lower bound above its rounding error "
+            "was proven: integer arithmetic has "
+            "no worst-case error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
+        )
+    cell_max = max(math.ceil(c.b) - math.floor(c.a) for c in cells)
+    limit = w.limits(True)[1] // (4 * cell_max + 2)
+    if limit < 1:
+        raise refuse(f"output {op.name!r}: a cell of its axis is too wide for the wide type")
+    # (1) the cell meets the band of E; (2) the interpolated point is in the band of E plus
+    # how far F leaves its chord over one cell (slope * width^2 / 4), up to its rounding
+    chord = max(c.slope * (c.b - c.a) ** 2 / 4 for c in cells)
+    rounding = Fraction(3, 2) + Fraction(10 * cell_max, limit)
+    options = [(e_cum * scale, cell_max * scale), ((e_cum + chord) * scale, rounding * scale)]
+    band, seen_at = band_width(blk, op, [(float(e), float(add)) for e, add in options])
+    err = Fraction(band) / scale
+    if err > USEFUL * (xhi - xlo):
+        where = ", ".join(f"{blk.plan.inputs[s].name}={x:g}" for s, x in sorted(seen_at.items()))
+        raise refuse(
+            f"output {op.name!r}: METHOD COA: the bisector can move by up to {float(err * scale):.3g} "
+            f"({float(100 * err / (xhi - xlo)):.3g} % of the range; near {where}) for a rounding of the "
+            "areas, where the accumulated set has a gap or little area: no useful error bound"
+        )
+    return err, limit
+
+
 def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     """The CoA of ``op`` in the integer block, and its port with the stated bound."""
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
@@ -299,35 +343,7 @@ def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> P
     v["found"] = blk.declare(f"FOUND_{n}", "narrow")
     for var, ex in a_stmts:
         blk.b.set(var, ex)  # type: ignore[arg-type]
-    # the band: every C_i within e of F at its end, the comparison C_i >= A - C_i exact
-    e_cum = area.err * 3 / 2
-    lower, witness, witness_total = lower_area(blk, op, xi)
-    if Fraction(lower) <= 2 * e_cum:
-        where = ", ".join(f"{blk.plan.inputs[s].name}={x:g}" for s, x in sorted(witness.items()))
-        raise CodegenError(
-            f"output {op.name!r}: the accumulated set's area comes down to "
-            f"{witness_total * float(scale):.3g} (at {where}) and no lower bound above its rounding error "
-            "was proven: integer arithmetic has "
-            "no worst-case error bound (use --arith float, or write rules that cover the inputs' whole RANGE)"
-        )
-    cell_max = max(math.ceil(c.b) - math.floor(c.a) for c in cells)
-    limit = w.limits(True)[1] // (4 * cell_max + 2)
-    if limit < 1:
-        raise refuse(f"output {op.name!r}: a cell of its axis is too wide for the wide type")
-    # (1) the cell meets the band of E; (2) the interpolated point is in the band of E plus
-    # how far F leaves its chord over one cell (slope * width^2 / 4), up to its rounding
-    chord = max(c.slope * (c.b - c.a) ** 2 / 4 for c in cells)
-    rounding = Fraction(3, 2) + Fraction(10 * cell_max, limit)
-    options = [(e_cum * scale, cell_max * scale), ((e_cum + chord) * scale, rounding * scale)]
-    band, seen_at = band_width(blk, op, [(float(e), float(add)) for e, add in options])
-    err = Fraction(band) / scale
-    if err > USEFUL * (xhi - xlo):
-        where = ", ".join(f"{blk.plan.inputs[s].name}={x:g}" for s, x in sorted(seen_at.items()))
-        raise refuse(
-            f"output {op.name!r}: METHOD COA: the bisector can move by up to {float(err * scale):.3g} "
-            f"({float(100 * err / (xhi - xlo)):.3g} % of the range; near {where}) for a rounding of the "
-            "areas, where the accumulated set has a gap or little area: no useful error bound"
-        )
+    err, limit = _bound(blk, op, cells, area, xi, (scale, xlo, xhi))
     slo, shi = math.floor(xlo), math.ceil(xhi)
     dflt = 0 if nan else round((default - offset) / scale)
     slo, shi = min(slo, dflt), max(shi, dflt)

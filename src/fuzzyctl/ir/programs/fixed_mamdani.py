@@ -431,10 +431,6 @@ def _lower_area(
 def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
 
-    if METHODS[op.method].bisects:
-        from fuzzyctl.ir.programs.fixed_coa import coa_output
-
-        return coa_output(blk, op, rules, info)
     w = blk.w
     assert op.grid is not None and op.low is not None and op.high is not None
     nan = op.default is not None and not math.isfinite(op.default)
