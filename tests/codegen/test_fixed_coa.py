@@ -219,6 +219,14 @@ def test_json_and_int_output(capsys: pytest.CaptureFixture[str], tmp_path: Path)
     assert "REAL" not in re.sub(r"\(\*.*?\*\)", "", st, flags=re.S)
 
 
+@pytest.mark.parametrize("dialect", ["codesys", "twincat", "scl", "iec", "openplc"])
+def test_every_dialect_renders_the_coa_block_in_integers(dialect: str) -> None:
+    for arith, wide in (("int16", "DINT"), ("int32", "LINT")):
+        st = generate_st(fuzzyctl.load(SMOOTH), arith=arith, dialect=dialect)
+        body = re.sub(r"\(\*.*?\*\)|//[^\n]*", "", st, flags=re.S)
+        assert "REAL" not in body and f": {wide};" in body and "FOUND_" in body
+
+
 @pytest.mark.extra("plcopen")
 @pytest.mark.parametrize("arith", ["int16", "int32"])
 def test_plcopen_of_a_coa_block_is_valid(arith: str) -> None:
