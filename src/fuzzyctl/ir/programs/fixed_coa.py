@@ -20,15 +20,22 @@ below a generation-time limit by at most ``log2`` of the wide type's width halvi
 six ``IF`` s, no loop), then limited to the cell.  No square root is taken: under MIN
 activation the set is not linear on a cell (a clipped line bends where it meets its level,
 at a point known only at run time), so the quadratic of a linear density would not be the
-exact solution either, and the bound below does not rely on the interpolation.
+exact solution either; the chord of ``F`` over a cell is what the second proof below uses.
 
 *Bound.*  Let ``e`` bound the error of every computed ``C_i`` (the tracked error of the
 total, :mod:`fuzzyctl.ir.builders.fixed_arith`: partial sums carry less) and
 ``E = 3 e / 2``.  The cell found satisfies ``F(a_i) < A/2 + E`` and ``F(b_i) >= A/2 - E``, so
 it meets the *band* ``{x : |F(x) - A/2| <= E}``, an interval (``F`` is continuous and
 non-decreasing) that holds the exact CoA.  The result lies in ``[floor(a_i), ceil(b_i)]``,
-hence ``|x - CoA| <= W + max_i (ceil(b_i) - floor(a_i))`` with ``W`` the band's largest width
-over every input.  ``W`` is bounded by branch and bound on boxes of the input domain
+hence ``|x - CoA| <= W(E) + max_i (ceil(b_i) - floor(a_i))`` with ``W(E)`` the band's width.
+Second proof: the interpolated point ``x_lin`` solves ``G(x) = A_computed / 2`` for ``G`` the
+chord of the computed ``C_(i-1), C_i`` over the cell, within ``e`` of the chord of ``F``, which
+is within ``s h^2 / 4`` of ``F`` (``s`` a bound of the set's slope on the cell, ``h`` its
+width: ``F' = mu`` varies by at most ``s h`` there); so ``x_lin`` lies in the band of
+``E + max s h^2 / 4`` and ``|x - CoA| <= W(E + s h^2 / 4) + 3/2 + 10 h_max / limit`` (the
+ends ``floor(a_i)``, ``ceil(b_i)``: 1; the last division: 1/2; each of the halvings moves the
+fraction by ``3 / (2 limit)``).  Per box of inputs the smaller of the two is taken.  The
+widths are bounded by branch and bound on boxes of the input domain
 (:func:`band_width`): on a box each set's level lies in an interval
 (:func:`fuzzyctl.ir.builders.fixed_bound.rule_intervals`), the accumulated set is monotone in
 the levels, so ``F_lo <= F <= F_hi`` and ``A_lo <= A <= A_hi`` (the exact piecewise-linear
