@@ -114,7 +114,10 @@ END_FUNCTION_BLOCK
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        (MAMDANI.replace("COG", "COA"), r"output 'y': Mamdani METHOD COA is not computed.*--arith float"),
+        (
+            MAMDANI.replace("COG", "COA").replace("(1, 0) (2, 1) (3, 0)", "(8, 0) (9, 1) (10, 0)"),
+            r"output 'y': METHOD COA: the bisector can move by up to .*gap.*--arith float",
+        ),
         (GAP, r"output 'y': the rules' total weight comes down to 0 \(at x=.*no worst-case error bound"),
         (MAMDANI.replace("(0, 1) (1, 0)", "GAUSS 0 1"), r"term 'a' of input 'x': a gauss"),
     ],

@@ -116,6 +116,8 @@ def add(w: Width, a: FX, b: FX, what: str = "a sum") -> FX:
     lo, hi = a.lo + b.lo, a.hi + b.hi
     a, b, wide = _pair(w, a, b, lo, hi)
     _check(w, lo, hi, wide, what)
+    if isinstance(a.ex, Int) and isinstance(b.ex, Int):  # folded, as in mul
+        return FX(Int(lo), lo, hi, a.scale, a.err + b.err, wide)
     return FX(a.ex + b.ex, lo, hi, a.scale, a.err + b.err, wide)
 
 
@@ -124,6 +126,8 @@ def sub(w: Width, a: FX, b: FX, what: str = "a difference") -> FX:
     lo, hi = a.lo - b.hi, a.hi - b.lo
     a, b, wide = _pair(w, a, b, lo, hi)
     _check(w, lo, hi, wide, what)
+    if isinstance(a.ex, Int) and isinstance(b.ex, Int):  # folded, as in mul
+        return FX(Int(lo), lo, hi, a.scale, a.err + b.err, wide)
     return FX(a.ex - b.ex, lo, hi, a.scale, a.err + b.err, wide)
 
 
@@ -135,6 +139,9 @@ def mul(w: Width, a: FX, b: FX, what: str = "a product") -> FX:
     # |ab - a'b'| <= |a| eb + |b'| ea with |a| <= |a'| + ea
     err = (a.magnitude + a.err) * b.err + b.magnitude * a.err
     a, b = widen(a), widen(b)
+    if isinstance(a.ex, Int) and isinstance(b.ex, Int):
+        # folded here: a product of two literals would be computed in C's int and overflow
+        return FX(Int(lo), lo, hi, a.scale * b.scale, err, True)
     return FX(a.ex * b.ex, lo, hi, a.scale * b.scale, err, True)
 
 

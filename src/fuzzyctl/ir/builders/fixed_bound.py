@@ -25,7 +25,7 @@ from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, Plan
 from fuzzyctl.engine.semantics.shapes import pwl_value
 from fuzzyctl.kinds import norms
 
-__all__ = ["Group", "WeightBounds", "weight_bounds"]
+__all__ = ["Group", "WeightBounds", "input_cells", "rule_intervals", "weight_bounds"]
 
 Iv = tuple[float, float]
 Points = tuple[tuple[float, float], ...]
@@ -90,7 +90,8 @@ def _cond(c: CondPlan, deg: Callable[[int, int], Iv]) -> Iv:
     return 1.0, 1.0
 
 
-def _total(plan: Plan, groups: Sequence[Group], box: dict[int, Iv], weights: Sequence[float]) -> Iv:
+def _degrees(plan: Plan, box: dict[int, Iv]) -> Callable[[int, int], Iv]:
+    """The interval of each input term's degree over ``box`` (cached)."""
     slots = [fi.slot for fi in plan.fuzzy_inputs]
     cache: dict[tuple[int, int], Iv] = {}
 
@@ -103,6 +104,22 @@ def _total(plan: Plan, groups: Sequence[Group], box: dict[int, Iv], weights: Seq
             cache[key] = _hull(pts, a, b)
         return cache[key]
 
+    return deg
+
+
+def rule_intervals(plan: Plan, box: dict[int, Iv], weights: Sequence[float]) -> list[Iv]:
+    """A rigorous interval of each rule's weighted degree over ``box`` (input slot ->
+    interval)."""
+    deg = _degrees(plan, box)
+    out = []
+    for ri, rule in enumerate(plan.rules):
+        r = _cond(rule.condition, deg)
+        out.append((r[0] * weights[ri], r[1] * weights[ri]))
+    return out
+
+
+def _total(plan: Plan, groups: Sequence[Group], box: dict[int, Iv], weights: Sequence[float]) -> Iv:
+    deg = _degrees(plan, box)
     rules: dict[int, Iv] = {}
     lo = hi = 0.0
     for accu, items in groups:
@@ -129,6 +146,19 @@ def _cuts(plan: Plan, slot: int, a: float, b: float) -> list[float]:
     return sorted(xs)
 
 
+def input_cells(plan: Plan, domain: dict[int, Iv], budget: int) -> list[dict[int, Iv]]:
+    """The boxes of ``domain`` between the input terms' breakpoints, where every degree is
+    linear (an input whose cells would pass ``budget`` boxes stays whole)."""
+    boxes: list[dict[int, Iv]] = [{}]
+    for s in sorted(domain):
+        cuts = _cuts(plan, s, *domain[s])
+        pieces = list(itertools.pairwise(cuts)) or [(cuts[0], cuts[0])]
+        if len(boxes) * len(pieces) > budget:
+            pieces = [domain[s]]
+        boxes = [{**bx, s: p} for bx in boxes for p in pieces]
+    return boxes
+
+
 def weight_bounds(
     plan: Plan,
     groups: Sequence[Group],
@@ -141,14 +171,7 @@ def weight_bounds(
     block can be given); ``weights[r]`` is rule ``r``'s constant weight.  The search stops
     when the lower bound reaches ``enough`` times the smallest total seen."""
     slots = sorted(domain)
-    # start from the cells between breakpoints, where every degree is linear
-    boxes: list[dict[int, Iv]] = [{}]
-    for s in slots:
-        cuts = _cuts(plan, s, *domain[s])
-        pieces = list(itertools.pairwise(cuts)) or [(cuts[0], cuts[0])]
-        if len(boxes) * len(pieces) > budget:
-            pieces = [domain[s]]
-        boxes = [{**bx, s: p} for bx in boxes for p in pieces]
+    boxes = input_cells(plan, domain, budget)
     heap: list[tuple[float, int, dict[int, Iv]]] = []
     high = 0.0
     best, witness = float("inf"), {s: domain[s][0] for s in slots}

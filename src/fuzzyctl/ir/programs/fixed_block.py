@@ -33,6 +33,7 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
+from fuzzyctl.ir.cost import stmts
 from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
@@ -539,5 +540,8 @@ def build_fixed(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
             f"{p.error_bound:.3g} (from each step's rounding, for every stored input)"
         )
+    # every branch counted (the CoA cell search takes one of its IFs per cell, the others cost
+    # their test): what a PLC's cycle must hold
+    header.append("cost per cycle, worst case: " + stmts(outer.root, False).summary())
     prog = FixedProgram(name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header)
     return prog

@@ -47,7 +47,18 @@ from fuzzyctl.kinds.methods import METHODS
 if TYPE_CHECKING:
     from fuzzyctl.ir.programs.fixed_block import FixedBlock, Port
 
-__all__ = ["check_mamdani", "mamdani_output"]
+__all__ = [
+    "Pieces",
+    "accumulate",
+    "activated_sets",
+    "check_mamdani",
+    "combine",
+    "crossings",
+    "lines_on",
+    "lower_area",
+    "mamdani_output",
+    "refuse",
+]
 
 #: the accumulations computed, and how the activated sets combine under each: their upper
 #: envelope (cut where two lines cross) or their sum
@@ -76,8 +87,8 @@ def check_mamdani(op: OutputPlan, weight_before_activation: bool) -> None:
             f"{name}: Mamdani METHOD {op.method} is not computed (only COG is): a maximum jumps from one "
             "set to another where their heights tie, so rounding has no worst-case error bound"
         )
-    if not method.integrating or method.bisects:
-        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (only COG is)")
+    if not method.integrating:
+        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (COG and COA are)")
     if not op.exact or op.grid is None:
         raise _refuse(f"{name}: terms that are not piecewise linear with constant points are not computed")
     if op.accu not in _COMBINE:
@@ -514,3 +525,14 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
 
     bound = round_up(err * scale)
     return Port(op.name, scale, offset, slo, shi, bound, comment=f"{float(op.low):g}..{float(op.high):g}")
+
+
+# the steps shared with the other Mamdani methods (fixed_coa: the bisector)
+refuse = _refuse
+combine = _combine
+activated_sets = _sets
+lines_on = _lines
+crossings = _cuts
+Pieces = _Pieces
+accumulate = _accumulate
+lower_area = _lower_area

@@ -260,9 +260,11 @@ def _output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port
 
 
 def emit_outputs(blk: FixedBlock, rules: list[FX], info: Var) -> list[Port]:
+    from fuzzyctl.ir.programs.fixed_coa import coa_output
     from fuzzyctl.ir.programs.fixed_mamdani import mamdani_output
 
-    return [
-        mamdani_output(blk, op, rules, info) if op.kind == "mamdani" else _output(blk, op, rules, info)
-        for op in blk.plan.outputs
-    ]
+    def mamdani(op: OutputPlan) -> Port:
+        bisects = METHODS[op.method].bisects
+        return (coa_output if bisects else mamdani_output)(blk, op, rules, info)
+
+    return [mamdani(op) if op.kind == "mamdani" else _output(blk, op, rules, info) for op in blk.plan.outputs]
