@@ -58,6 +58,9 @@ class Port:
     high: int
     error_bound: float = 0.0  # outputs: worst case against the exact engine, in the output's unit
     comment: str = ""
+    #: LM, RM, MoM: the bound where no other set's height is within ``tie_margin`` (degrees)
+    error_bound_away: float | None = None
+    tie_margin: float | None = None
 
     def formula(self) -> str:
         return f"stored * {float(self.scale)!r} + {float(self.offset)!r}"
@@ -72,6 +75,9 @@ class Port:
         }
         if output:
             d["error_bound"] = self.error_bound
+            if self.error_bound_away is not None:
+                d["error_bound_away_from_ties"] = self.error_bound_away
+                d["tie_margin"] = self.tie_margin
         return d
 
 
@@ -539,5 +545,11 @@ def build_fixed(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
             f"{p.error_bound:.3g} (from each step's rounding, for every stored input)"
         )
+        if p.error_bound_away is not None:
+            header.append(
+                f"output {p.name}: {p.error_bound_away:.3g} away from ties (one set alone at the top, every "
+                f"other set's height and the top's own jump levels more than {p.tie_margin:.3g} below or "
+                "away from it); the worst case includes the jump of the maximum where heights tie"
+            )
     prog = FixedProgram(name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header)
     return prog
