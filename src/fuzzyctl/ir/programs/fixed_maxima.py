@@ -62,7 +62,7 @@ from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
-from fuzzyctl.ir.nodes import Ex, Int, Var
+from fuzzyctl.ir.nodes import Call, Ex, Int, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
 
@@ -357,6 +357,66 @@ def _extreme(blk: FixedBlock, name: str, cands: list[tuple[Ex, FX]], left: bool)
     return FX(v, lo, hi, Fraction(1), max(p.err for _c, p in cands), False)
 
 
+def _mean(blk: FixedBlock, in_group: list[Ex], lp: list[FX], rp: list[FX], lm: FX, rm: FX) -> FX:
+    """MoM: ``(L + R) / 2`` of a single top set; of a group of several, the centroid of the
+    union of their intervals (each one less what the intervals starting before it cover:
+    ``[max(L_k, R_before), R_k]``, exact on the integer ends), or ``(LM + RM) / 2`` when the
+    union has no length (lone points), limited to ``[LM, RM]``."""
+    w = blk.w
+    half = fa.narrow(w, fa.rdiv(w, fa.add(w, lm, rm), 2), "the mean of maxima")
+    v = blk.declare(f"MOM_{len(blk.decls)}", "narrow", comment="mean of maxima")
+    blk.b.set(v, half.ex)
+    if len(lp) == 1:
+        return FX(v, half.lo, half.hi, Fraction(1), half.err, False)
+    lo, hi = min(p.lo for p in lp + rp), max(p.hi for p in lp + rp)
+    c = (lo + hi) // 2
+    reach = max(c - lo, hi - c)
+    wide_hi = w.limits(True)[1]
+    if reach * reach > wide_hi or 2 * (hi - lo) * len(lp) > wide_hi:
+        raise _refuse("an output's mean of maxima: the union's moment does not fit the wide type")
+    n = len(blk.decls)
+    count = blk.declare(f"NG_{n}", "narrow", comment="sets in the top group")
+    length = blk.declare(f"LEN_{n}", "wide", comment="length of the union of their level sets")
+    # the union's pieces are disjoint: their moment about c, sum of (R-c)^2 - (s-c)^2, stays
+    # within reach^2 in magnitude whatever the partial sum
+    moment = blk.declare(f"MOM2_{n}", "wide", comment=f"twice its moment about {c}")
+    start = blk.declare(f"RB_{n}", "narrow", comment="the part of a level set left uncovered starts here")
+    blk.b.set(count, Int(0))
+    for g in in_group:
+        with blk.b.if_(g):
+            blk.b.set(count, count + Int(1))
+    with blk.b.if_(count.gt(Int(1))):
+        blk.b.set(length, Int(0))
+        blk.b.set(moment, Int(0))
+        for k, (gk, lk, rk) in enumerate(zip(in_group, lp, rp, strict=True)):
+            with blk.b.if_(gk):
+                blk.b.set(start, lk.ex)
+                for j, (gj, lj, rj) in enumerate(zip(in_group, lp, rp, strict=True)):
+                    if j == k:
+                        continue
+                    before = lj.ex.le(lk.ex) if j < k else lj.ex.lt(lk.ex)
+                    with blk.b.if_(gj.and_(before).and_(rj.ex.gt(start))):
+                        blk.b.set(start, rj.ex)
+                with blk.b.if_(rk.ex.gt(start)):
+                    r_w, s_w = Call("WIDEN", (rk.ex,)), Call("WIDEN", (start,))
+                    blk.b.set(length, length + (r_w - s_w))
+                    blk.b.set(moment, moment + (r_w - s_w) * (r_w + s_w - Int(2 * c)))
+        with blk.b.if_(length.gt(Int(0))):
+            q = blk.declare(f"Q_{n}", "wide")
+            with blk.b.if_(moment.ge(Int(0))):
+                blk.b.set(q, (moment + length) / (Int(2) * length))
+            with blk.b.else_():
+                blk.b.set(q, -((length - moment) / (Int(2) * length)))
+            blk.b.set(q, q + Int(c))
+            lm_w, rm_w = Call("WIDEN", (lm.ex,)), Call("WIDEN", (rm.ex,))
+            with blk.b.if_(q.lt(lm_w)):
+                blk.b.set(q, lm_w)
+            with blk.b.if_(q.gt(rm_w)):
+                blk.b.set(q, rm_w)
+            blk.b.set(v, Call("NARROW", (q,)))
+    return FX(v, min(half.lo, lm.lo), max(half.hi, rm.hi), Fraction(1), half.err, False)
+
+
 @dataclass(frozen=True)
 class _Bounds:
     worst: Fraction  # stored units
@@ -377,7 +437,11 @@ def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX,
     margin = Fraction(delta, D) + 2 * e
     # the top group's lowest height: every set in it reaches it
     hs = blk.temp(replace(top, err=Fraction(0)), "the top group's lowest height")
-    in_group = [h.ex.ge(top.ex - Int(delta)) for h in heights]
+    in_group: list[Ex] = []
+    for h in heights:
+        g = blk.declare(f"G_{len(blk.decls)}", "bool", comment="the set is in the top group")
+        blk.b.set(g, h.ex.ge(top.ex - Int(delta)))
+        in_group.append(g)
     if len(sets) > 1:
         for h, cond in zip(heights, in_group, strict=True):
             with blk.b.if_(cond.and_(h.ex.lt(hs.ex))):
@@ -393,7 +457,8 @@ def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX,
         rights = _extreme(blk, f"RM_{len(blk.decls)}", list(zip(in_group, rp, strict=True)), False)
     if lefts is not None and rights is not None:
         away = max((a.err + b.err) / 2 for a, b in zip(lp, rp, strict=True)) + Fraction(1, 2)
-        res = fa.narrow(w, fa.rdiv(w, fa.add(w, lefts, rights), 2), "the mean of maxima")
+        res = _mean(blk, in_group, lp, rp, lefts, rights)
+        res = replace(res, err=away)
         spans = [p.span() for s in sets for p in (s.left, s.right)]
     else:
         res = lefts if lefts is not None else rights
