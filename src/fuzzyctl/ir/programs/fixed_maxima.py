@@ -69,7 +69,7 @@ from fuzzyctl.kinds.methods import METHODS
 if TYPE_CHECKING:
     from fuzzyctl.ir.programs.fixed_block import FixedBlock, Port
 
-__all__ = ["Profile", "check_maxima", "maxima_output", "profiles", "term_edges"]
+__all__ = ["Profile", "away_from_ties", "check_maxima", "maxima_output", "profiles", "term_edges"]
 
 #: one band of a profile: for levels ``h`` in ``(h0, h1]`` the position is
 #: ``x0 + (h - h0) (x1 - x0) / (h1 - h0)`` (stored output units)
@@ -437,11 +437,8 @@ def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX,
     margin = Fraction(delta, D) + 2 * e
     # the top group's lowest height: every set in it reaches it
     hs = blk.temp(replace(top, err=Fraction(0)), "the top group's lowest height")
-    in_group: list[Ex] = []
-    for h in heights:
-        g = blk.declare(f"G_{len(blk.decls)}", "bool", comment="the set is in the top group")
-        blk.b.set(g, h.ex.ge(top.ex - Int(delta)))
-        in_group.append(g)
+    # (conditions, not BOOL temporaries: an initialised VAR_TEMP is refused by some compilers)
+    in_group = [h.ex.ge(top.ex - Int(delta)) for h in heights]
     if len(sets) > 1:
         for h, cond in zip(heights, in_group, strict=True):
             with blk.b.if_(cond.and_(h.ex.lt(hs.ex))):
@@ -520,3 +517,34 @@ def maxima_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -
         error_bound_away=round_up(away * scale),
         tie_margin=round_up(bounds.margin),
     )
+
+
+def away_from_ties(op: OutputPlan, degrees: list[float], margin: float) -> bool:
+    """Whether the exact rule ``degrees`` (weights applied) put output ``op`` away from ties by
+    ``margin``: one set alone at the top, every other set, zero and the top set's jump levels
+    more than ``margin`` from its height (the condition of ``error_bound_away_from_ties``)."""
+    from fuzzyctl.ir.programs.fixed_outputs import constant
+
+    assert op.grid is not None
+    xs = tuple(Fraction(x) for x in op.grid.xs)
+    heights: dict[object, tuple[float, list[float]]] = {}
+    for c in op.contributions:
+        w = constant(c.weight)
+        if c.term is None or w == 0.0:
+            continue
+        left, right = profiles(term_edges(op, c.term, xs))
+        peak = float(left.peak)
+        a = degrees[c.rule] * w
+        is_min = c.act in CLIP_BRANCH
+        h = min(a, w * peak) if is_min else a * peak
+        jumps = [float(j) * w for j in left.jumps + right.jumps] if is_min else []
+        key = (c.term, c.act, w) if norms.is_max(op.accu or "MAX") else id(c)
+        if key not in heights or heights[key][0] < h:
+            heights[key] = (h, jumps)
+    ranked = sorted(heights.values(), key=lambda v: -v[0])
+    if not ranked or ranked[0][0] <= margin:
+        return False
+    top, jumps = ranked[0]
+    if len(ranked) > 1 and ranked[1][0] >= top - margin:
+        return False
+    return all(abs(top - j) > margin for j in jumps)
