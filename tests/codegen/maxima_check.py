@@ -11,7 +11,6 @@ from typing import Any
 
 import numpy as np
 
-import fuzzyctl
 from fuzzyctl.codegen.api import lower_block
 from fuzzyctl.engine.reference.interp import Interpreter
 from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
@@ -101,9 +100,7 @@ class Heights:
             return False
         if len(ranked) > 1 and ranked[1][1] >= top - margin:
             return False
-        if act in CLIP_BRANCH and any(abs(top - w * j) <= margin for j in self.jumps[term]):
-            return False
-        return True
+        return not (act in CLIP_BRANCH and any(abs(top - w * j) <= margin for j in self.jumps[term]))
 
     def brute(self, values: list[float], method: str) -> float:
         """LM / RM / MoM of the accumulated set (MAX) sampled on the fine grid."""

@@ -66,7 +66,10 @@ def _check(doc: fuzzyctl.model.Document, arith: str, rows: int, seed: int = 0) -
 def test_examples_within_both_stated_bounds(name: str, method: str, arith: str) -> None:
     doc = _example(name, method)
     observed, observed_away, share = _check(doc, arith, rows=4000)
-    print(f"\n{name} {method} {arith}: observed {observed:.3g}, away from ties {observed_away:.3g} ({share:.0%})")
+    print(
+        f"\n{name} {method} {arith}: observed {observed:.3g}, away from ties {observed_away:.3g} "
+        f"({share:.0%})"
+    )
     assert share > 0.5  # most inputs are away from ties: the second check is not vacuous
 
 
@@ -109,7 +112,10 @@ def test_the_engine_agrees_with_a_brute_force_maximum(method: str) -> None:
         names = [i.name for i in h.plan.inputs]
         checked = 0
         for _ in range(150):
-            row = [rng.uniform(*ctl.input_ranges[n]) if hasattr(ctl, "input_ranges") else rng.uniform(-5, 5) for n in names]
+            row = [
+                rng.uniform(*ctl.input_ranges[n]) if hasattr(ctl, "input_ranges") else rng.uniform(-5, 5)
+                for n in names
+            ]
             v = h.slots(names, np.array([row]))[0]
             if not h.away(v, 1e-3):
                 continue
@@ -162,7 +168,9 @@ END_FUNCTION_BLOCK
     [
         (TWO.replace("AND : MIN;", "AND : MIN; ACCU : SUM;"), r"output 'y': ACCU SUM of overlapping sets"),
         (
-            TWO.replace("LM", "MoM").replace("(1, 0) (2, 1) (3, 0)", "(1, 0) (1.5, 1) (2, 0) (2.5, 1) (3, 0)"),
+            TWO.replace("LM", "MoM").replace(
+                "(1, 0) (2, 1) (3, 0)", "(1, 0) (1.5, 1) (2, 0) (2.5, 1) (3, 0)"
+            ),
             r"output 'y': term 'hi' has two separate humps",
         ),
     ],
@@ -191,7 +199,10 @@ def test_json_header_and_int_output(capsys: pytest.CaptureFixture[str], tmp_path
     path.write_text(with_method(mamdani_variant((EXAMPLES / "crane.fcl").read_text()), "MoM"))
     got = {}
     for choice in ("unit", "scaled"):
-        assert main(["codegen", str(path), "--arith", "int16", "--int-output", choice, "--json", "--lang", "st"]) == 0
+        assert (
+            main(["codegen", str(path), "--arith", "int16", "--int-output", choice, "--json", "--lang", "st"])
+            == 0
+        )
         (port,) = json.loads(capsys.readouterr().out)["blocks"][0]["outputs"]
         got[choice] = port
     assert got["unit"]["scale"] == 1.0 and got["scaled"]["scale"] < 1.0
@@ -211,7 +222,11 @@ def test_c_test_bench_passes_and_fails_on_a_wrong_block(arith: str, tmp_path: Pa
     text = with_method(mamdani_variant((EXAMPLES / "crane.fcl").read_text()), "LM")
     for label, block_text, want in (
         ("good", text, "PASS FAIL_COUNT=0"),
-        ("wrong", re.sub(r"\(-?[\d.]+, 1\)", lambda m: m.group(0).replace(", 1)", ", 0.6)"), text, count=1), "FAIL"),
+        (
+            "wrong",
+            re.sub(r"\(-?[\d.]+, 1\)", lambda m: m.group(0).replace(", 1)", ", 0.6)"), text, count=1),
+            "FAIL",
+        ),
     ):
         where = tmp_path / label
         where.mkdir()
@@ -236,13 +251,17 @@ def test_plcopen_is_valid(method: str) -> None:
 
     schema = etree.XMLSchema(etree.parse(str(shared_path("tools", "plcopen", "tc6_xml_v201.xsd"))))
     for arith in ("int16", "int32"):
-        root = etree.fromstring(generate_plcopen(_example("figure7.fcl", method), arith=arith, dialect="iec").encode())
+        root = etree.fromstring(
+            generate_plcopen(_example("figure7.fcl", method), arith=arith, dialect="iec").encode()
+        )
         assert schema.validate(root), schema.error_log
 
 
 @pytest.mark.extra("matiec")
 @pytest.mark.parametrize("arith", ["int16", "int32"])
-def test_matiec_runs_the_blocks_within_their_bound_and_the_st_bench_passes(arith: str, tmp_path: Path) -> None:
+def test_matiec_runs_the_blocks_within_their_bound_and_the_st_bench_passes(
+    arith: str, tmp_path: Path
+) -> None:
     """The ``--dialect iec`` ST of the LM / RM / MoM variants through matiec and gcc: within
     the stated worst case everywhere and the away-from-ties bound away from ties; the ST
     test bench of one of them passes."""
@@ -276,18 +295,25 @@ def test_matiec_runs_the_blocks_within_their_bound_and_the_st_bench_passes(arith
         hi = np.array([p["stored_range"][1] for p in rep["inputs"]])
         stored = rng.integers(lo, hi + 1, size=(600, len(lo)))
         got, _info = M.run_block(exe, k, stored.astype(np.float64))
-        values = stored * np.array([p["scale"] for p in rep["inputs"]]) + np.array([p["offset"] for p in rep["inputs"]])
+        values = stored * np.array([p["scale"] for p in rep["inputs"]]) + np.array(
+            [p["offset"] for p in rep["inputs"]]
+        )
         (port,) = rep["outputs"]
         exact = np.asarray(
-            fuzzyctl.compile(doc).evaluate_batch({p["name"]: values[:, i] for i, p in enumerate(rep["inputs"])})[
-                port["name"]
-            ]
+            fuzzyctl.compile(doc).evaluate_batch(
+                {p["name"]: values[:, i] for i, p in enumerate(rep["inputs"])}
+            )[port["name"]]
         )
         err = np.abs(got[:, 0] * port["scale"] + port["offset"] - exact)
         assert err.max() <= port["error_bound"], (rep["block"], err.max())
         h = Heights(doc)
-        away = np.array([h.away(v, port["tie_margin"]) for v in h.slots([p["name"] for p in rep["inputs"]], values)])
-        assert away.any() and err[away].max() <= port["error_bound_away_from_ties"], (rep["block"], err[away].max())
+        away = np.array(
+            [h.away(v, port["tie_margin"]) for v in h.slots([p["name"] for p in rep["inputs"]], values)]
+        )
+        assert away.any() and err[away].max() <= port["error_bound_away_from_ties"], (
+            rep["block"],
+            err[away].max(),
+        )
     where = tmp_path / "bench"
     where.mkdir()
     M.iec2c(matiec, bench, where)

@@ -11,8 +11,8 @@ from typing import Any
 from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
-from fuzzyctl.ir.cost import Cost, stmts
 from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.cost import Cost, stmts
 from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
 from fuzzyctl.ir.render.fixed import fixed_st_parts, render_fixed_c, render_fixed_st
 from fuzzyctl.ir.render.st import STParts

@@ -88,10 +88,14 @@ def choose_fixed(gen: FixedGenerated, n: int, seed: int = 0) -> FixedBench:
         )
     tol = [math.floor(p.error_bound / float(p.scale) + 0.5) for p in prog.outputs]
     per_vector = _per_vector(gen, [run(row)[1] for row, _why in picked], tol)
-    return FixedBench(gen, [r for r, _w in picked], [w for _r, w in picked], expected, tol, covered, per_vector)
+    return FixedBench(
+        gen, [r for r, _w in picked], [w for _r, w in picked], expected, tol, covered, per_vector
+    )
 
 
-def _per_vector(gen: FixedGenerated, degrees: list[list[float]], tol: list[int]) -> list[list[int] | None] | None:
+def _per_vector(
+    gen: FixedGenerated, degrees: list[list[float]], tol: list[int]
+) -> list[list[int] | None] | None:
     """The tighter tolerance of LM / RM / MoM outputs at the vectors away from ties."""
     from fuzzyctl.ir.programs.fixed_maxima import away_from_ties
 

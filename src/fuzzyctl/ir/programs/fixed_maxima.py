@@ -52,6 +52,7 @@ positions at generation time."""
 from __future__ import annotations
 
 import contextlib
+import itertools
 import math
 from dataclasses import dataclass, replace
 from fractions import Fraction
@@ -100,7 +101,9 @@ class Profile:
 
     def lip(self) -> Fraction:
         """The largest run / rise of its bands (positions per unit of level)."""
-        return max((abs(x1 - x0) / (h1 - h0) for h0, h1, x0, x1 in self.bands if h1 > h0), default=Fraction(0))
+        return max(
+            (abs(x1 - x0) / (h1 - h0) for h0, h1, x0, x1 in self.bands if h1 > h0), default=Fraction(0)
+        )
 
     def span(self) -> tuple[Fraction, Fraction]:
         xs = [x for b in self.bands for x in b[2:]]
@@ -172,7 +175,7 @@ def _one_hump(edges: list[Edge]) -> bool:
     """Every level set is one interval: the degrees never rise again after falling."""
     ys = [y for _a, _b, ya, yb in edges for y in (ya, yb)]
     fell = False
-    for a, b in zip(ys, ys[1:], strict=False):
+    for a, b in itertools.pairwise(ys):
         if b < a:
             fell = True
         elif b > a and fell:
@@ -323,11 +326,11 @@ def _position(blk: FixedBlock, prof: Profile, hs: FX, is_min: bool, extra: Fract
             plan.append((None, band[3], cur, hs.hi))
     v = blk.declare(f"P_{len(blk.decls)}", "narrow", comment="where a level set starts")
     err = Fraction(0)
-    for k, (c, what, lo, hi) in enumerate(plan):
-        if c is None:
+    for k, (cut, what, lo, hi) in enumerate(plan):
+        if cut is None:
             ctx = blk.b.else_() if k else contextlib.nullcontext()
         else:
-            ctx = blk.b.if_(hs.ex.le(Int(c))) if k == 0 else blk.b.elif_(hs.ex.le(Int(c)))
+            ctx = blk.b.if_(hs.ex.le(Int(cut))) if k == 0 else blk.b.elif_(hs.ex.le(Int(cut)))
         with ctx:
             if isinstance(what, Fraction):
                 val = fa.const(w, what, Fraction(1))
@@ -426,7 +429,7 @@ class _Bounds:
 
 def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX, _Bounds]:
     """Emit the heights, the top group and the result; ``(H', result, bounds)``."""
-    w, D = blk.w, blk.D
+    D = blk.D
     side = METHODS[op.method].maximum
     heights = [_height(blk, s) for s in sets]
     e = max(h.err for h in heights)
@@ -458,8 +461,9 @@ def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX,
         res = replace(res, err=away)
         spans = [p.span() for s in sets for p in (s.left, s.right)]
     else:
-        res = lefts if lefts is not None else rights
-        assert res is not None
+        one = lefts if lefts is not None else rights
+        assert one is not None
+        res = one
         ps = lp if lefts is not None else rp
         away = max(p.err for p in ps)
         spans = [(s.left if lefts is not None else s.right).span() for s in sets]
@@ -492,7 +496,7 @@ def maxima_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -
     dflt = 0 if nan else round((default - offset) / scale)
     worst = bounds.worst
     if not nan:  # nothing may fire in integers where the exact top is a rounding above 0
-        worst = max(worst, max(abs(dflt - slo), abs(shi - dflt)))
+        worst = max(worst, Fraction(max(abs(dflt - slo), abs(shi - dflt))))
     slo, shi = min(slo, dflt), max(shi, dflt)
     if not w.fits(slo, shi, False):
         raise _refuse(f"output {op.name!r}: may overflow its type")
