@@ -42,6 +42,7 @@ from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
 from fuzzyctl.ir.builders.fixed_bound import Group, weight_bounds
 from fuzzyctl.ir.nodes import Int, Var
+from fuzzyctl.ir.programs.fixed_maxima import check_maxima, maxima_output
 from fuzzyctl.kinds.methods import METHODS
 
 if TYPE_CHECKING:
@@ -72,8 +73,6 @@ def check_mamdani(op: OutputPlan, weight_before_activation: bool) -> None:
     name = f"output {op.name!r}"
     method = METHODS[op.method]
     if method.maximum is not None:
-        from fuzzyctl.ir.programs.fixed_maxima import check_maxima
-
         check_maxima(op, weight_before_activation)
     elif not method.integrating or method.bisects:
         raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (only COG is)")
@@ -420,8 +419,6 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
 
     if METHODS[op.method].maximum is not None:
-        from fuzzyctl.ir.programs.fixed_maxima import maxima_output
-
         return maxima_output(blk, op, rules, info)
     w = blk.w
     assert op.grid is not None and op.low is not None and op.high is not None
