@@ -173,6 +173,12 @@ END_FUNCTION_BLOCK
             ),
             r"output 'y': term 'hi' has two separate humps",
         ),
+        (
+            TWO.replace("(0, 1) (1, 0)", "(0, 1) (0.4, 0)")
+            .replace("(0, 0) (1, 1)", "(0.6, 0) (1, 1)")
+            .replace("METHOD : LM;", "METHOD : LM; DEFAULT := NaN;"),
+            r"output 'y': its DEFAULT is NaN and no rule may fire",
+        ),
     ],
 )
 def test_what_is_not_computed_is_refused_naming_it(text: str, message: str) -> None:

@@ -63,6 +63,7 @@ from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
+from fuzzyctl.ir.builders.fixed_bound import Group, weight_bounds
 from fuzzyctl.ir.nodes import Call, Ex, Int, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds.methods import METHODS
@@ -472,6 +473,28 @@ def _compute(blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> tuple[FX, FX,
     return top, res, _Bounds(Fraction(hi - lo), away, margin)
 
 
+def _always_fires(blk: FixedBlock, op: OutputPlan, e: Fraction) -> None:
+    """With a NaN default (no rule fired) there is no number to bound the error by: the top
+    height must be proven above its rounding ``e`` over every input (a set ``min(w a, w p)``
+    or ``w a p`` holds at least ``w a p``; the box search of the rules' degrees)."""
+    from fuzzyctl.ir.programs.fixed_outputs import constant, input_domain
+
+    items = []
+    for c in op.contributions:
+        w = constant(c.weight)
+        if c.term is not None and w > 0:
+            items.append((c.rule, w * max((y for _x, y in op.terms[c.term].pwl or ()), default=0.0)))
+    groups: list[Group] = [(op.accu or "MAX", tuple(items))]
+    weights = [constant(r.weight) for r in blk.plan.rules]
+    found = weight_bounds(blk.plan, groups, weights, input_domain(blk), budget=2000, enough=0.75)
+    if not Fraction(found.low) > e:
+        where = ", ".join(f"{blk.plan.inputs[k].name}={v:g}" for k, v in sorted(found.witness.items()))
+        raise _refuse(
+            f"output {op.name!r}: its DEFAULT is NaN and no rule may fire (the top comes down to "
+            f"{found.witness_total:.3g} at {where}): no worst-case error bound"
+        )
+
+
 def maxima_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     """The LM, RM or MoM of Mamdani output ``op`` (terms and rules checked)."""
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
@@ -492,6 +515,8 @@ def maxima_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -
     if not sets:
         raise _refuse(f"output {op.name!r}: concluded by no rule with a nonzero term, it has no integer form")
     top, res, bounds = _compute(blk, op, sets)
+    if nan:
+        _always_fires(blk, op, top.err)
     slo, shi = math.floor(xlo), math.ceil(xhi)
     dflt = 0 if nan else round((default - offset) / scale)
     worst = bounds.worst
