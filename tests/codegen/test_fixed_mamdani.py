@@ -85,7 +85,6 @@ END_FUNCTION_BLOCK
 @pytest.mark.parametrize(
     ("text", "message"),
     [
-        (MAMDANI.replace("COG", "LM"), r"output 'y': Mamdani METHOD LM is not computed.*heights tie"),
         (MAMDANI.replace("AND : MIN;", "AND : MIN; ACCU : BSUM;"), r"output 'y': ACCU BSUM is not computed"),
         (
             MAMDANI.replace("AND : MIN;", "AND : MIN; ACT : PROD;"),

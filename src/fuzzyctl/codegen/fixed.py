@@ -12,6 +12,7 @@ from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.cost import Cost, stmts
 from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
 from fuzzyctl.ir.render.fixed import fixed_st_parts, render_fixed_c, render_fixed_st
 from fuzzyctl.ir.render.st import STParts
@@ -19,7 +20,7 @@ from fuzzyctl.kinds import arith as arith_kinds
 from fuzzyctl.kinds import targets
 from fuzzyctl.model import Document, FunctionBlock
 
-__all__ = ["FixedGenerated", "build_fixed_block", "generate_c_fixed", "generate_st_fixed"]
+__all__ = ["FixedGenerated", "build_fixed_block", "fixed_cost", "generate_c_fixed", "generate_st_fixed"]
 
 
 @dataclass
@@ -42,7 +43,13 @@ class FixedGenerated:
             "notes": list(self.notes),
             "inputs": [p.to_dict(type_name, False) for p in prog.inputs],
             "outputs": [p.to_dict(type_name, True) for p in prog.outputs],
+            "cost": fixed_cost(prog).to_dict(),
         }
+
+
+def fixed_cost(prog: FixedProgram) -> Cost:
+    """The usual and worst cost of one cycle of the integer block (:mod:`fuzzyctl.ir.cost`)."""
+    return Cost(stmts(prog.body, True), stmts(prog.body, False))
 
 
 def input_ranges(model: Document | FunctionBlock | Plan, plan: Plan) -> dict[str, tuple[float, float]]:
@@ -85,6 +92,7 @@ def build_fixed_block(
             f"  {r.comment()}" for r in renames
         ]
     prog.header[1:1] = notes
+    prog.header += fixed_cost(prog).header()
     return FixedGenerated(prog, plan, target, renames, notes)
 
 

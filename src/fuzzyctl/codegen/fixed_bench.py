@@ -34,6 +34,9 @@ class FixedBench:
     expected: list[list[int]]  # stored outputs (rounded)
     tolerance: list[int]  # per output, in stored units
     covered_rules: int
+    #: per output with a bound away from ties (LM, RM, MoM), per vector: that bound where the
+    #: vector is away from ties, else ``tolerance`` (None: ``tolerance`` for every vector)
+    per_vector: list[list[int] | None] | None = None
 
 
 def _value(p: Port, stored: int) -> float:
@@ -49,7 +52,7 @@ def choose_fixed(gen: FixedGenerated, n: int, seed: int = 0) -> FixedBench:
     interp = Interpreter(plan)
     rng = random.Random(seed)
 
-    def run(row: list[int]) -> tuple[list[float], list[float]]:
+    def run(row: list[int]) -> tuple[list[float], list[float]]:  # outputs, rule degrees
         values = [0.0] * len(plan.inputs)
         for p, v in zip(ports, row, strict=True):
             values[slot[p.name]] = _value(p, v)
@@ -84,7 +87,27 @@ def choose_fixed(gen: FixedGenerated, n: int, seed: int = 0) -> FixedBench:
             [round((y - float(p.offset)) / float(p.scale)) for y, p in zip(outs, prog.outputs, strict=True)]
         )
     tol = [math.floor(p.error_bound / float(p.scale) + 0.5) for p in prog.outputs]
-    return FixedBench(gen, [r for r, _w in picked], [w for _r, w in picked], expected, tol, covered)
+    per_vector = _per_vector(gen, [run(row)[1] for row, _why in picked], tol)
+    return FixedBench(
+        gen, [r for r, _w in picked], [w for _r, w in picked], expected, tol, covered, per_vector
+    )
+
+
+def _per_vector(
+    gen: FixedGenerated, degrees: list[list[float]], tol: list[int]
+) -> list[list[int] | None] | None:
+    """The tighter tolerance of LM / RM / MoM outputs at the vectors away from ties."""
+    from fuzzyctl.ir.programs.fixed_maxima import away_from_ties
+
+    ops = {o.name: o for o in gen.plan.outputs}
+    out: list[list[int] | None] = []
+    for p, t in zip(gen.program.outputs, tol, strict=True):
+        if p.error_bound_away is None or p.tie_margin is None:
+            out.append(None)
+            continue
+        near = math.floor(p.error_bound_away / float(p.scale) + 0.5)
+        out.append([near if away_from_ties(ops[p.name], d, p.tie_margin) else t for d in degrees])
+    return out if any(v is not None for v in out) else None
 
 
 def _header(bench: FixedBench) -> list[str]:
@@ -98,10 +121,17 @@ def _header(bench: FixedBench) -> list[str]:
         "PASS is TRUE once every vector matched; FAIL_COUNT counts the vectors that did not; "
         "FIRST_FAIL is the number (1-based) of the first of them, 0 if none",
     ]
-    for p, t in zip(prog.outputs, bench.tolerance, strict=True):
+    per = bench.per_vector or [None] * len(prog.outputs)
+    for p, t, vec in zip(prog.outputs, bench.tolerance, per, strict=True):
         lines.append(
             f"output {p.name}: tolerance {t} stored units (the stated error bound {p.error_bound:.3g})"
         )
+        if vec is not None:
+            near = sum(v < t for v in vec)
+            lines.append(
+                f"output {p.name}: {min(vec)} stored units at the {near} vectors away from ties (the stated "
+                f"bound there {p.error_bound_away:.3g}); array TB_T{prog.outputs.index(p)}"
+            )
     return lines
 
 
@@ -117,8 +147,8 @@ def render_fixed_st_bench(bench: FixedBench, dialect: str = "codesys") -> str:
     out = [record.comment(line) for line in _header(bench)]
     out += [record.comment(why, lead=f"vector {r + 1}: ") for r, why in enumerate(bench.why)]
 
-    def array(var: str, values: list[int]) -> str:
-        return f"    {var} : ARRAY[0..{n - 1}] OF {narrow} := [{', '.join(str(v) for v in values)}];"
+    def array(var: str, values: list[int], kind: str = narrow) -> str:
+        return f"    {var} : ARRAY[0..{n - 1}] OF {kind} := [{', '.join(str(v) for v in values)}];"
 
     out += [f"PROGRAM {name}", "VAR_OUTPUT", "    PASS : BOOL := FALSE;", "    FAIL_COUNT : INT := 0;"]
     out += ["    FIRST_FAIL : INT := 0;", "    DONE : BOOL := FALSE;", "END_VAR", "VAR", f"    TB_FB : {fb};"]
@@ -126,13 +156,18 @@ def render_fixed_st_bench(bench: FixedBench, dialect: str = "codesys") -> str:
         out.append(array(f"TB_X{i}", [row[i] for row in bench.rows]))
     for c, _p in enumerate(prog.outputs):
         out.append(array(f"TB_Y{c}", [e[c] for e in bench.expected]))
+    per = bench.per_vector or [None] * len(prog.outputs)
+    for c, vec in enumerate(per):
+        if vec is not None:
+            out.append(array(f"TB_T{c}", vec, wide))  # a worst case may pass the narrow type
     out += ["    TB_K : INT := 0;", "    TB_BAD : BOOL;", f"    TB_D : {wide};", "END_VAR"]
     args = ", ".join(f"{p.name} := TB_X{i}[TB_K]" for i, p in enumerate(prog.inputs))
     out += ["IF NOT DONE THEN", f"    TB_FB({args});", "    TB_BAD := TB_FB.INFO <> 0;"]
     conv = f"{narrow}_TO_{wide}"
     for c, p in enumerate(prog.outputs):
         out.append(f"    TB_D := {conv}(TB_FB.{p.name}) - {conv}(TB_Y{c}[TB_K]);")
-        out += [f"    IF TB_D > {bench.tolerance[c]} OR TB_D < -{bench.tolerance[c]} THEN"]
+        t = f"TB_T{c}[TB_K]" if per[c] is not None else str(bench.tolerance[c])
+        out += [f"    IF TB_D > {t} OR TB_D < -{t} THEN"]
         out += ["        TB_BAD := TRUE;", "    END_IF;"]
     out += st_bench_tail(n)
     return "\n".join(out) + "\n"
@@ -154,10 +189,16 @@ def render_fixed_c_bench(bench: FixedBench) -> str:
     for c, _p in enumerate(prog.outputs):
         vals = ", ".join(str(e[c]) for e in bench.expected)
         lines.append(f"static const {narrow} {name}_TB_Y{c}[{n}] = {{{vals}}};")
+    per = bench.per_vector or [None] * len(prog.outputs)
+    for c, vec in enumerate(per):
+        if vec is not None:
+            vals = ", ".join(str(v) for v in vec)
+            lines.append(f"static const long long {name}_TB_T{c}[{n}] = {{{vals}}};")
     body = [f"fb.{p.name} = {name}_TB_X{i}[k];" for i, p in enumerate(prog.inputs)]
     body.append(f"bad = {name}_step(&fb) != 0;")
     for c, p in enumerate(prog.outputs):
         body.append(f"d = (long long)fb.{p.name} - (long long){name}_TB_Y{c}[k];")
-        body.append(f"if (d > {bench.tolerance[c]} || d < -{bench.tolerance[c]}) bad = 1;")
+        t = f"{name}_TB_T{c}[k]" if per[c] is not None else str(bench.tolerance[c])
+        body.append(f"if (d > {t} || d < -{t}) bad = 1;")
     lines += c_bench_driver(name, n, "long long", body)
     return "\n".join(lines) + "\n"

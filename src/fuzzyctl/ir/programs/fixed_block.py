@@ -33,7 +33,6 @@ from fuzzyctl.engine.plan import (
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
-from fuzzyctl.ir.cost import stmts
 from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
@@ -59,6 +58,9 @@ class Port:
     high: int
     error_bound: float = 0.0  # outputs: worst case against the exact engine, in the output's unit
     comment: str = ""
+    #: LM, RM, MoM: the bound where no other set's height is within ``tie_margin`` (degrees)
+    error_bound_away: float | None = None
+    tie_margin: float | None = None
 
     def formula(self) -> str:
         return f"stored * {float(self.scale)!r} + {float(self.offset)!r}"
@@ -73,6 +75,9 @@ class Port:
         }
         if output:
             d["error_bound"] = self.error_bound
+            if self.error_bound_away is not None:
+                d["error_bound_away_from_ties"] = self.error_bound_away
+                d["tie_margin"] = self.tie_margin
         return d
 
 
@@ -540,8 +545,11 @@ def build_fixed(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
             f"{p.error_bound:.3g} (from each step's rounding, for every stored input)"
         )
-    # every branch counted (the CoA cell search takes one of its IFs per cell, the others cost
-    # their test): what a PLC's cycle must hold
-    header.append("cost per cycle, worst case: " + stmts(outer.root, False).summary())
+        if p.error_bound_away is not None:
+            header.append(
+                f"output {p.name}: {p.error_bound_away:.3g} away from ties (one set alone at the top, every "
+                f"other set's height and the top's own jump levels more than {p.tie_margin:.3g} below or "
+                "away from it); the worst case includes the jump of the maximum where heights tie"
+            )
     prog = FixedProgram(name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header)
     return prog

@@ -42,6 +42,7 @@ from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
 from fuzzyctl.ir.builders.fixed_bound import Group, weight_bounds
 from fuzzyctl.ir.nodes import Int, Var
+from fuzzyctl.ir.programs.fixed_maxima import check_maxima, maxima_output
 from fuzzyctl.kinds.methods import METHODS
 
 if TYPE_CHECKING:
@@ -83,12 +84,9 @@ def check_mamdani(op: OutputPlan, weight_before_activation: bool) -> None:
     name = f"output {op.name!r}"
     method = METHODS[op.method]
     if method.maximum is not None:
-        raise _refuse(
-            f"{name}: Mamdani METHOD {op.method} is not computed (only COG is): a maximum jumps from one "
-            "set to another where their heights tie, so rounding has no worst-case error bound"
-        )
-    if not method.integrating:
-        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (COG and COA are)")
+        check_maxima(op, weight_before_activation)
+    elif not method.integrating:
+        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (COG, COA, LM, RM and MoM are)")
     if not op.exact or op.grid is None:
         raise _refuse(f"{name}: terms that are not piecewise linear with constant points are not computed")
     if op.accu not in _COMBINE:
@@ -431,6 +429,8 @@ def _lower_area(
 def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     from fuzzyctl.ir.programs.fixed_block import Port, output_scale
 
+    if METHODS[op.method].maximum is not None:
+        return maxima_output(blk, op, rules, info)
     w = blk.w
     assert op.grid is not None and op.low is not None and op.high is not None
     nan = op.default is not None and not math.isfinite(op.default)
