@@ -149,11 +149,6 @@ def test_a_wide_gap_is_refused_naming_it() -> None:
             gen(fuzzyctl.load(text), arith="int32")
 
 
-def test_the_other_maximum_methods_stay_refused() -> None:
-    with pytest.raises(CodegenError, match=r"Mamdani METHOD LM is not computed"):
-        generate_c(fuzzyctl.load(SMOOTH.replace("COA", "LM")), arith="int16")
-
-
 # --------------------------------------------------------------------------- mutants
 
 
