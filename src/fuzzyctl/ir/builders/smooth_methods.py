@@ -48,25 +48,60 @@ SAME_TOP = 1e-12  # peaks and plateaus this close to the height reach it
 
 def smooth_method(
     g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], cal: Q.Calibration, rtol: float
-) -> tuple[Var, Var]:
-    """(value, fired) of ``op`` by its method from its activated ``sets``; ``rtol`` is the
-    plan's quadrature tolerance (the CoA's half-area tolerance derives from it)."""
+) -> tuple[Var, Var, Var]:
+    """(value, fired, capped) of ``op`` by its method from its activated ``sets``; ``rtol`` is
+    the plan's quadrature tolerance (the CoA's half-area tolerance derives from it).
+    ``capped`` is TRUE when a cap on the work was reached: a panel accepted short of the
+    quadrature's tolerance, or (LM, RM, MoM) a smooth peak within 1e-6 of the top left
+    unsearched beyond :data:`PEAKS` (the PLC block's INFO 16#04)."""
     entry = METHODS[op.method]
     if entry.integrating and not entry.bisects:
-        value, fired, _capped = Q.smooth_cog(g, op, sets, cal)
-        return value, fired
+        return Q.smooth_cog(g, op, sets, cal)
     pts, n = Q.smooth_pieces(g, op, sets, cal)
+    capped = g.let(False, "QCAPPED", "BOOL")
     if entry.bisects:
-        return _bisector(g, op, sets, pts, n, rtol)
-    assert entry.maximum is not None
-    return _maxima(g, op, sets, pts, n, entry.maximum)
+        value, fired = _bisector(g, op, sets, pts, n, rtol, capped)
+    else:
+        assert entry.maximum is not None
+        value, fired = _maxima(g, op, sets, pts, n, entry.maximum, capped)
+    return value, fired, capped
+
+
+def method_bound(op: OutputPlan, rtol: float) -> str:
+    """The error the generated CoA, LM, RM or MoM of a smooth ``op`` aims at, as text for the
+    header (checked against the reference interpreter by tests/codegen/test_smooth_plc.py)."""
+    entry = METHODS[op.method]
+    caps = (
+        f"unless INFO = 16#04: more than {Q.QCAP} panels of 15 points per evaluation (or "
+        f"{Q.STACK - 2} nested halvings of one piece) were needed"
+    )
+    if entry.bisects:
+        tol = max(COA_TOL, 10.0 * rtol)
+        return (
+            f"panels as the CoG's (Kronrod and Gauss agree to {Q.QTOL:.0e} x width; "
+            f"{Q.QTOL_REAL:.0e} in a REAL build), the half-area point taken where the area from "
+            f"either side reaches half to {tol:.0e} x area (a panel within it answers its end), "
+            f"then bisection to the last bit ({HALVINGS} steps at most) on a 15-point Kronrod "
+            f"estimate, so |CoA error| <= ({tol:.0e} x area + the panels' error) / (the set's "
+            f"height at the bisector); {caps}"
+        )
+    return (
+        f"nodes of the panels as the CoG's (17 per panel), values within {PLATEAU_TOL:.0e} "
+        f"relative of the top count as the top (a plateau, its edges by bisection to the last "
+        f"bit, {HALVINGS} steps at most); a node within {PEAK_NEAR:.0e} of the top with both "
+        f"neighbours lower is a smooth peak found by golden-section search ({GOLDEN} steps at "
+        f"most, {PEAKS} peaks at most), and peaks within {SAME_TOP:.0e} of the height reach it: "
+        f"a plateau's edges are exact to the last bit, a smooth peak only to the stretch where "
+        f"the set is flat in floating point (about (1e-12)^(1/k) of the term's width for a "
+        f"maximum of order k); {caps}, or more than {PEAKS} peaks near the top were found"
+    )
 
 
 # --------------------------------------------------------------------------- CoA
 
 
 def _bisector(
-    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, rtol: float
+    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, rtol: float, capped: Var
 ) -> tuple[Var, Var]:
     b = g.b
     accu = op.accu or "MAX"
@@ -98,7 +133,7 @@ def _bisector(
                             b.set(var, val)
                 b.set(cum, cum + k)
 
-            Q.panels(g, op, sets, accu, pts, n, g.let(False, "QCAPPED", "BOOL"), visit, bad=bad)
+            Q.panels(g, op, sets, accu, pts, n, capped, visit, bad=bad)
             b.set(half, 0.5 * total)
             b.set(tol, max(COA_TOL, 10.0 * rtol) * total)
             b.set(cum, 0.0)
@@ -160,7 +195,7 @@ def _solve(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], a: Var, d: Var, targ
     tgt = g.let(target, "STG")
     it = g.let(0, "SIT", "INT")
     go = g.let(True, "SGO", "BOOL")
-    with b.while_(go):
+    with b.while_(go, bound=HALVINGS + 1):
         mid = g.let(0.5 * (lo + hi), "SMID")
         with b.if_(mid.eq(lo).or_(mid.eq(hi)).or_(it.ge(HALVINGS))):
             b.set(go, False)
@@ -176,14 +211,16 @@ def _solve(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], a: Var, d: Var, targ
 # --------------------------------------------------------------------------- LM, RM, MoM
 
 
-def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, which: str) -> tuple[Var, Var]:
+def _maxima(
+    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, which: str, capped: Var
+) -> tuple[Var, Var]:
     b = g.b
     accu = op.accu or "MAX"
     area = g.let(0.0, "QA")
     top = g.let(0.0, "TOP")  # a set below 0 (a function term) has no maximum that fires
     bad = g.let(False, "QBAD", "BOOL") if Q.has_function_terms(op, sets) else None
     count, last = g.let(0, "NACC", "DINT"), g.let(0, "LACC", "DINT")
-    w = _Window(g, op, sets, top)
+    w = _Window(g, op, sets, top, capped)
     xs = Q.gk_nodes(g, ends=True)
     # two visits of the same panels (one copy of the set's code): the area, the top value and
     # the number of panels, then the nodes in increasing x through the window
@@ -206,7 +243,6 @@ def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, w
                     with b.for_(k, 0, Q.NODES_WITH_ENDS - 1) as kv:
                         b.set(top, g.max_(top, ys[kv], "TOP"))
 
-            capped = g.let(False, "QCAPPED", "BOOL")
             Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True, bad=bad)
     value = g.let(0.0, "Y")
     fired = g.let(area.gt(0.0).and_(top.gt(0.0)), "FIRED", "BOOL")
@@ -228,8 +264,8 @@ class _Window:
     judged when the next one arrives, or the end.  Nodes are queued per panel and judged in
     one loop, so that the searches below are written once."""
 
-    def __init__(self, g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], top: Var) -> None:
-        self.g, self.op, self.sets, self.top = g, op, sets, top
+    def __init__(self, g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], top: Var, capped: Var) -> None:
+        self.g, self.op, self.sets, self.top, self.capped = g, op, sets, top, capped
         let = g.let
         self.qx = g.array("WQX", "REAL", Q.NODES_WITH_ENDS)
         self.qy = g.array("WQY", "REAL", Q.NODES_WITH_ENDS)
@@ -260,7 +296,7 @@ class _Window:
         """Judge the queued nodes (and, when ``end``, the last node: no right neighbour)."""
         g, b = self.g, self.g.b
         i = g.counter("WQ")
-        with b.for_(i, 0, self.qn) as iv:  # one more than queued: the end
+        with b.for_(i, 0, self.qn, bound=Q.NODES_WITH_ENDS + 1) as iv:  # one more than queued: the end
             more = g.let(iv.lt(self.qn), "WMORE", "BOOL")
             with b.if_(more.or_(end)):
                 xr, yr = g.let(self.xb, "WXR"), g.let(-1.0, "WYR")  # the end: no right node
@@ -290,15 +326,17 @@ class _Window:
         thr = g.let(top * (1.0 - PLATEAU_TOL), "WTHR")
         level = g.min_(yb, thr, "WLV")
         peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(not_(has_left).or_(ya.lt(level))).and_(yr.lt(level))
-        with b.if_(peak):
+        # beyond PEAKS peaks none is searched (it would not be kept): the work stays bounded
+        with b.if_(peak.and_(self.npk.lt(PEAKS))):
             lo = g.let(xb, "GLO")
             with b.if_(has_left):
                 b.set(lo, xa)
             px, pv = self._golden(lo, xr, xb, yb)
-            with b.if_(self.npk.lt(PEAKS)):
-                b.set(self.kx[self.npk], px)
-                b.set(self.kv[self.npk], pv)
-                b.set(self.npk, self.npk + 1)
+            b.set(self.kx[self.npk], px)
+            b.set(self.kv[self.npk], pv)
+            b.set(self.npk, self.npk + 1)
+        with b.elif_(peak):
+            b.set(self.capped, True)
         # runs at the top
         with b.if_(yb.ge(thr)):
             with b.if_(self.run.eq(0)):
@@ -327,7 +365,7 @@ class _Window:
         go = g.let(True, "GGO", "BOOL")
         at = g.array("GP", "REAL", 2)
         val = g.array("GF", "REAL", 2)
-        with b.while_(go):
+        with b.while_(go, bound=GOLDEN + 1):
             scale = g.max_(g.max_(1.0, g.call("ABS", lo), "GS"), g.call("ABS", hi), "GS")
             with b.if_((hi - lo).le(1e-15 * scale).or_(it.ge(GOLDEN))):
                 b.set(go, False)
@@ -369,7 +407,7 @@ class _Window:
                 b.set(i, self.rx)
                 b.set(search, self.rhas)
             it = g.let(0, "EIT", "INT")
-            with b.while_(search):
+            with b.while_(search, bound=HALVINGS + 1):
                 mid = g.let(0.5 * (o + i), "EM")
                 with b.if_(mid.eq(o).or_(mid.eq(i)).or_(it.ge(HALVINGS))):
                     b.set(search, False)
@@ -388,12 +426,12 @@ class _Window:
         g, b = self.g, self.g.b
         sup = g.let(self.top, "SUP")
         j = g.counter("PJ")
-        with b.for_(j, 0, self.npk - 1) as jv:
+        with b.for_(j, 0, self.npk - 1, bound=PEAKS) as jv:
             b.set(sup, g.max_(sup, self.kv[jv], "SUP"))
         cut = g.let(sup * (1.0 - SAME_TOP), "SCUT")
         np_, lo, hi, tot = g.let(0, "NP", "INT"), g.let(0.0, "PLO"), g.let(0.0, "PHI"), g.let(0.0, "PSUM")
         j = g.counter("PJ")
-        with b.for_(j, 0, self.npk - 1) as jv, b.if_(self.kv[jv].ge(cut)):
+        with b.for_(j, 0, self.npk - 1, bound=PEAKS) as jv, b.if_(self.kv[jv].ge(cut)):
             x = self.kx[jv]
             with b.if_(np_.eq(0)):
                 b.set(lo, x)
