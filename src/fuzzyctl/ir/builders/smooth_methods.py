@@ -67,34 +67,40 @@ def smooth_method(
     return value, fired, capped
 
 
-def method_bound(op: OutputPlan, rtol: float) -> str:
-    """The error the generated CoA, LM, RM or MoM of a smooth ``op`` aims at, as text for the
-    header (checked against the reference interpreter by tests/codegen/test_smooth_plc.py)."""
+def method_bound(op: OutputPlan, rtol: float) -> list[str]:
+    """The error the generated CoA, LM, RM or MoM of a smooth ``op`` aims at, as header lines
+    (each within a comment's length; checked against the reference interpreter by
+    tests/codegen/test_smooth_plc.py)."""
     entry = METHODS[op.method]
+    panels = (
+        f"panels accepted when Kronrod and Gauss agree to {Q.QTOL:.0e} x width ({Q.QTOL_REAL:.0e} "
+        f"in a REAL build)"
+    )
     caps = (
         f"unless INFO = 16#04: more than {Q.QCAP} panels of 15 points per evaluation (or "
         f"{Q.STACK - 2} nested halvings of one piece) were needed"
     )
     if entry.bisects:
         tol = max(COA_TOL, 10.0 * rtol)
-        return (
-            f"panels as the CoG's (Kronrod and Gauss agree to {Q.QTOL:.0e} x width; "
-            f"{Q.QTOL_REAL:.0e} in a REAL build), the half-area point taken where the area from "
-            f"either side reaches half to {tol:.0e} x area (a panel within it answers its end), "
-            f"then bisection to the last bit ({HALVINGS} steps at most) on a 15-point Kronrod "
-            f"estimate, so |CoA error| <= ({tol:.0e} x area + the panels' error) / (the set's "
-            f"height at the bisector); {caps}"
-        )
-    return (
-        f"nodes of the panels as the CoG's (17 per panel), values within {PLATEAU_TOL:.0e} "
-        f"relative of the top count as the top (a plateau, its edges by bisection to the last "
-        f"bit, {HALVINGS} steps at most); a node within {PEAK_NEAR:.0e} of the top with both "
-        f"neighbours lower is a smooth peak found by golden-section search ({GOLDEN} steps at "
-        f"most, {PEAKS} peaks at most), and peaks within {SAME_TOP:.0e} of the height reach it: "
-        f"a plateau's edges are exact to the last bit, a smooth peak only to the stretch where "
-        f"the set is flat in floating point (about (1e-12)^(1/k) of the term's width for a "
-        f"maximum of order k); {caps}, or more than {PEAKS} peaks near the top were found"
-    )
+        return [
+            panels,
+            f"the bisector is in the panel where the area from either side reaches half to "
+            f"{tol:.0e} x area (a panel within it answers its end), then found by bisection to the "
+            f"last bit ({HALVINGS} steps at most) on a 15-point Kronrod estimate: |CoA error| <= "
+            f"({tol:.0e} x area + the panels' error) / (the set's height at the bisector)",
+            caps,
+        ]
+    return [
+        f"{panels}; their 17 nodes (ends included) are searched for the maximum",
+        f"values within {PLATEAU_TOL:.0e} relative of the top count as the top: a plateau's "
+        f"edges are found by bisection to the last bit ({HALVINGS} steps at most), exact",
+        f"a node within {PEAK_NEAR:.0e} of the top with both neighbours lower is a smooth peak "
+        f"found by golden-section search ({GOLDEN} steps at most, {PEAKS} peaks at most), peaks "
+        f"within {SAME_TOP:.0e} of the height reach it: a smooth peak is placed only within the "
+        f"stretch where the set is that close to its top (about (1e-12)^(1/k) of the term's "
+        f"width for a maximum of order k)",
+        f"{caps}, or more than {PEAKS} peaks near the top were found",
+    ]
 
 
 # --------------------------------------------------------------------------- CoA

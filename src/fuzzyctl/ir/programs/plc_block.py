@@ -354,14 +354,13 @@ class _Builder(RuleBuilder):
         cal = Q.calibrate(op)
         rtol = self.plan.options.quad_rtol
         entry = METHODS[op.method]
+        head = f"output {op.name}: smooth set"
+        where = f"on {len(cal.cuts) - 1} intervals, split at located kinks"
         if entry.integrating and not entry.bisects:
-            what, bound = "CoG by adaptive Gauss-Kronrod 7/15", Q.cog_bound()
+            self.notes.append(f"{head}, CoG by adaptive Gauss-Kronrod 7/15 {where}: {Q.cog_bound()}")
         else:
-            what, bound = f"{op.method} on the panels of adaptive Gauss-Kronrod 7/15", method_bound(op, rtol)
-        self.notes.append(
-            f"output {op.name}: smooth set, {what} on {len(cal.cuts) - 1} intervals, split at "
-            f"located kinks: {bound}"
-        )
+            self.notes.append(f"{head}, {op.method} on the panels of adaptive Gauss-Kronrod 7/15 {where}")
+            self.notes += [f"output {op.name}: {line}" for line in method_bound(op, rtol)]
         value, fired, capped = smooth_method(self.g, op, sets, cal, rtol)
         self.capped[op.name] = capped
         return value, fired
