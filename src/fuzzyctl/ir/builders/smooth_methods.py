@@ -316,7 +316,8 @@ class _Window:
                     b.set(self.ya, self.yb)
                     b.set(self.xb, xr)
                     b.set(self.yb, yr)
-                    b.set(self.seen, g.min_(self.seen + 1, 2, "WN"))
+                    with b.if_(self.seen.lt(2)):  # (an INT: no REAL temporary of min_)
+                        b.set(self.seen, self.seen + 1)
         b.set(self.qn, 0)
 
     def _judge(self, xr: Var, yr: Var, more: Var) -> None:
