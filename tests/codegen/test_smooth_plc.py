@@ -18,6 +18,7 @@ activation and accumulation, Gaussian and bell terms) and on a fixed one:
 
 from __future__ import annotations
 
+import ctypes
 import dataclasses
 import re
 import warnings
@@ -198,3 +199,46 @@ def test_plcopen_of_every_method_is_valid(method: str) -> None:
     xml = generate_plcopen(doc)
     root = valid(xml)
     assert "smooth set" in xml and root is not None
+
+
+# --------------------------------------------------------------------------- the peak cap
+
+PEAKED = """FUNCTION_BLOCK peaks
+VAR_INPUT x : REAL; END_VAR
+VAR_OUTPUT y : REAL; END_VAR
+FUZZIFY x TERM a := (0, 1) (10, 1); END_FUZZIFY
+DEFUZZIFY y {terms} RANGE := (0 .. 19); METHOD : {method}; DEFAULT := -1; END_DEFUZZIFY
+RULEBLOCK r AND : MIN; ACT : PROD; ACCU : MAX;
+{rules}
+END_RULEBLOCK END_FUNCTION_BLOCK"""
+
+
+@pytest.mark.parametrize("count", [16, 18])
+def test_more_smooth_peaks_than_searched_set_info_04(count: int, tmp_path: Path) -> None:
+    """``count`` equal Gaussian peaks at 1, 2, ...: up to 16 are searched (INFO 0, LM and RM
+    the outer peaks as the reference says); beyond, the block flags INFO 16#04 (its RM then
+    misses the last peaks: that is what the flag says)."""
+    terms = " ".join(f"TERM t{k} := gauss {k} 0.2;" for k in range(1, count + 1))
+    rules = "\n".join(f"RULE {k} : IF x IS a THEN y IS t{k};" for k in range(1, count + 1))
+    plans = []
+    for method in ("LM", "RM"):
+        fb = fuzzyctl.load(PEAKED.format(terms=terms, rules=rules, method=method)).blocks[0]
+        plan = fuzzyctl.compile(fb, backend="interpreted").plan
+        plans.append(dataclasses.replace(plan, name=f"peaks_{method.lower()}_{count}"))
+    lib = build_library(plans, tmp_path)
+    data = np.array([[5.0]])
+    for plan in plans:
+        want = float(S.reference(plan, data, "scalar")[0, 0])
+        size = getattr(lib, f"{plan.name}_size")
+        size.restype = ctypes.c_size_t
+        inst = ctypes.create_string_buffer(int(size()))
+        getattr(lib, f"{plan.name}_init")(inst)
+        out = np.empty(1)
+        fn = getattr(lib, f"{plan.name}_batch")  # returns the last row's INFO
+        fn.argtypes = [ctypes.c_void_p, ctypes.c_size_t, ctypes.c_void_p, ctypes.c_void_p]
+        fn.restype = ctypes.c_ubyte
+        info = fn(inst, 1, data.ctypes.data, out.ctypes.data)
+        if count <= 16 or plan.outputs[0].method == "LM":
+            assert abs(float(out[0]) - want) <= 1e-6, (plan.name, out[0], want)
+        assert info == (0x04 if count > 16 else 0x00), (plan.name, info)
+    assert abs(want - count) <= 1e-6  # RM: the last peak
