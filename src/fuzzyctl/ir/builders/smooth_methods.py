@@ -2,7 +2,8 @@
 IR twins of :func:`fuzzyctl.engine.reference.quadrature.bisector` and
 :func:`~fuzzyctl.engine.reference.quadrature.maxima`, on the pieces and panels of
 :mod:`fuzzyctl.ir.builders.quadrature` (the smooth CoG's), so that the native evaluator runs
-every method in C.
+every method in C and the PLC block (ir/programs/plc_block.py) in ST, C and PLCopen, with
+bounded work per cycle (every search has a step limit; the caps set ``capped``, INFO 16#04).
 
 * CoA: the panels are integrated once for the total area, then visited again (the same
   panels in the same order: the acceptance test is deterministic) to find the panel where
@@ -15,7 +16,8 @@ every method in C.
   where a drastic sum reaches 1 lies between two pieces too narrow to integrate); the
   second walks those nodes in increasing x with a window of three: a node with both
   neighbours lower and within 1e-6 of the top is a smooth peak refined by golden-section
-  search (at most :data:`PEAKS` of them are kept), a run of nodes at the top (to :data:`PLATEAU_TOL`) is a
+  search (at most :data:`PEAKS` of them are searched and kept: more set ``capped``), a run
+  of nodes at the top (to :data:`PLATEAU_TOL`) is a
   plateau whose edges are found by bisection.  The maximum is the plateaus when the top is
   reached on one (MoM: their centroid), else the peaks within 1e-12 of the height (MoM:
   their mean).
@@ -39,7 +41,7 @@ from fuzzyctl.ir.nodes import Ex, Var, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds.methods import METHODS
 
-PEAKS = 16  # smooth peaks within 1e-6 of the top kept at most (more: the first ones)
+PEAKS = 16  # smooth peaks within 1e-6 of the top searched at most (more: the first ones, capped)
 GOLDEN = 80  # golden-section steps at most (the reference's)
 HALVINGS = 100  # bisection steps at most (the reference's; they stop at the last bit)
 PEAK_NEAR = 1e-6  # a node this close below the top may hide a higher smooth peak
