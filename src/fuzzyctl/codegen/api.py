@@ -71,7 +71,7 @@ def build(plan: Plan, target: Target, default: float | str | None = None) -> Gen
         extra.append("renamed for the target (model name -> generated name):")
         extra += [f"  {r.comment()}" for r in renames]
     prog.header[1:1] = extra
-    quad = [line for line in prog.header if "Gauss-Kronrod" in line]
+    quad = [line for line in prog.header if line.startswith("output ")]  # smooth outputs' notes
     return Generated(prog, plan, renames, notes + quad)
 
 

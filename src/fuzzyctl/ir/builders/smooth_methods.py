@@ -2,7 +2,8 @@
 IR twins of :func:`fuzzyctl.engine.reference.quadrature.bisector` and
 :func:`~fuzzyctl.engine.reference.quadrature.maxima`, on the pieces and panels of
 :mod:`fuzzyctl.ir.builders.quadrature` (the smooth CoG's), so that the native evaluator runs
-every method in C.
+every method in C and the PLC block (ir/programs/plc_block.py) in ST, C and PLCopen, with
+bounded work per cycle (every search has a step limit; the caps set ``capped``, INFO 16#04).
 
 * CoA: the panels are integrated once for the total area, then visited again (the same
   panels in the same order: the acceptance test is deterministic) to find the panel where
@@ -15,7 +16,8 @@ every method in C.
   where a drastic sum reaches 1 lies between two pieces too narrow to integrate); the
   second walks those nodes in increasing x with a window of three: a node with both
   neighbours lower and within 1e-6 of the top is a smooth peak refined by golden-section
-  search (at most :data:`PEAKS` of them are kept), a run of nodes at the top (to :data:`PLATEAU_TOL`) is a
+  search (at most :data:`PEAKS` of them are searched and kept: more set ``capped``), a run
+  of nodes at the top (to :data:`PLATEAU_TOL`) is a
   plateau whose edges are found by bisection.  The maximum is the plateaus when the top is
   reached on one (MoM: their centroid), else the peaks within 1e-12 of the height (MoM:
   their mean).
@@ -39,7 +41,7 @@ from fuzzyctl.ir.nodes import Ex, Var, not_
 from fuzzyctl.ir.state import Gen
 from fuzzyctl.kinds.methods import METHODS
 
-PEAKS = 16  # smooth peaks within 1e-6 of the top kept at most (more: the first ones)
+PEAKS = 16  # smooth peaks within 1e-6 of the top searched at most (more: the first ones, capped)
 GOLDEN = 80  # golden-section steps at most (the reference's)
 HALVINGS = 100  # bisection steps at most (the reference's; they stop at the last bit)
 PEAK_NEAR = 1e-6  # a node this close below the top may hide a higher smooth peak
@@ -48,25 +50,66 @@ SAME_TOP = 1e-12  # peaks and plateaus this close to the height reach it
 
 def smooth_method(
     g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], cal: Q.Calibration, rtol: float
-) -> tuple[Var, Var]:
-    """(value, fired) of ``op`` by its method from its activated ``sets``; ``rtol`` is the
-    plan's quadrature tolerance (the CoA's half-area tolerance derives from it)."""
+) -> tuple[Var, Var, Var]:
+    """(value, fired, capped) of ``op`` by its method from its activated ``sets``; ``rtol`` is
+    the plan's quadrature tolerance (the CoA's half-area tolerance derives from it).
+    ``capped`` is TRUE when a cap on the work was reached: a panel accepted short of the
+    quadrature's tolerance, or (LM, RM, MoM) a smooth peak within 1e-6 of the top left
+    unsearched beyond :data:`PEAKS` (the PLC block's INFO 16#04)."""
     entry = METHODS[op.method]
     if entry.integrating and not entry.bisects:
-        value, fired, _capped = Q.smooth_cog(g, op, sets, cal)
-        return value, fired
+        return Q.smooth_cog(g, op, sets, cal)
     pts, n = Q.smooth_pieces(g, op, sets, cal)
+    capped = g.let(False, "QCAPPED", "BOOL")
     if entry.bisects:
-        return _bisector(g, op, sets, pts, n, rtol)
-    assert entry.maximum is not None
-    return _maxima(g, op, sets, pts, n, entry.maximum)
+        value, fired = _bisector(g, op, sets, pts, n, rtol, capped)
+    else:
+        assert entry.maximum is not None
+        value, fired = _maxima(g, op, sets, pts, n, entry.maximum, capped)
+    return value, fired, capped
+
+
+def method_bound(op: OutputPlan, rtol: float) -> list[str]:
+    """The error the generated CoA, LM, RM or MoM of a smooth ``op`` aims at, as header lines
+    (each within a comment's length; checked against the reference interpreter by
+    tests/codegen/test_smooth_plc.py)."""
+    entry = METHODS[op.method]
+    panels = (
+        f"panels accepted when Kronrod and Gauss agree to {Q.QTOL:.0e} x width ({Q.QTOL_REAL:.0e} "
+        f"in a REAL build)"
+    )
+    caps = (
+        f"unless INFO = 16#04: more than {Q.QCAP} panels of 15 points per evaluation (or "
+        f"{Q.STACK - 2} nested halvings of one piece) were needed"
+    )
+    if entry.bisects:
+        tol = max(COA_TOL, 10.0 * rtol)
+        return [
+            panels,
+            f"the bisector is in the panel where the area from either side reaches half to "
+            f"{tol:.0e} x area (a panel within it answers its end), then found by bisection to the "
+            f"last bit ({HALVINGS} steps at most) on a 15-point Kronrod estimate: |CoA error| <= "
+            f"({tol:.0e} x area + the panels' error) / (the set's height at the bisector)",
+            caps,
+        ]
+    return [
+        f"{panels}; their 17 nodes (ends included) are searched for the maximum",
+        f"values within {PLATEAU_TOL:.0e} relative of the top count as the top: a plateau's "
+        f"edges are found by bisection to the last bit ({HALVINGS} steps at most), exact",
+        f"a node within {PEAK_NEAR:.0e} of the top with both neighbours lower is a smooth peak "
+        f"found by golden-section search ({GOLDEN} steps at most, {PEAKS} peaks at most), peaks "
+        f"within {SAME_TOP:.0e} of the height reach it: a smooth peak is placed only within the "
+        f"stretch where the set is that close to its top (about (1e-12)^(1/k) of the term's "
+        f"width for a maximum of order k)",
+        f"{caps}, or more than {PEAKS} peaks near the top were found",
+    ]
 
 
 # --------------------------------------------------------------------------- CoA
 
 
 def _bisector(
-    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, rtol: float
+    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, rtol: float, capped: Var
 ) -> tuple[Var, Var]:
     b = g.b
     accu = op.accu or "MAX"
@@ -98,7 +141,7 @@ def _bisector(
                             b.set(var, val)
                 b.set(cum, cum + k)
 
-            Q.panels(g, op, sets, accu, pts, n, g.let(False, "QCAPPED", "BOOL"), visit, bad=bad)
+            Q.panels(g, op, sets, accu, pts, n, capped, visit, bad=bad)
             b.set(half, 0.5 * total)
             b.set(tol, max(COA_TOL, 10.0 * rtol) * total)
             b.set(cum, 0.0)
@@ -160,7 +203,7 @@ def _solve(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], a: Var, d: Var, targ
     tgt = g.let(target, "STG")
     it = g.let(0, "SIT", "INT")
     go = g.let(True, "SGO", "BOOL")
-    with b.while_(go):
+    with b.while_(go, bound=HALVINGS + 1):
         mid = g.let(0.5 * (lo + hi), "SMID")
         with b.if_(mid.eq(lo).or_(mid.eq(hi)).or_(it.ge(HALVINGS))):
             b.set(go, False)
@@ -176,14 +219,16 @@ def _solve(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], a: Var, d: Var, targ
 # --------------------------------------------------------------------------- LM, RM, MoM
 
 
-def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, which: str) -> tuple[Var, Var]:
+def _maxima(
+    g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, which: str, capped: Var
+) -> tuple[Var, Var]:
     b = g.b
     accu = op.accu or "MAX"
     area = g.let(0.0, "QA")
     top = g.let(0.0, "TOP")  # a set below 0 (a function term) has no maximum that fires
     bad = g.let(False, "QBAD", "BOOL") if Q.has_function_terms(op, sets) else None
     count, last = g.let(0, "NACC", "DINT"), g.let(0, "LACC", "DINT")
-    w = _Window(g, op, sets, top)
+    w = _Window(g, op, sets, top, capped)
     xs = Q.gk_nodes(g, ends=True)
     # two visits of the same panels (one copy of the set's code): the area, the top value and
     # the number of panels, then the nodes in increasing x through the window
@@ -206,7 +251,6 @@ def _maxima(g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], pts: Var, n: Var, w
                     with b.for_(k, 0, Q.NODES_WITH_ENDS - 1) as kv:
                         b.set(top, g.max_(top, ys[kv], "TOP"))
 
-            capped = g.let(False, "QCAPPED", "BOOL")
             Q.panels(g, op, sets, accu, pts, n, capped, visit, keep_nodes=True, bad=bad)
     value = g.let(0.0, "Y")
     fired = g.let(area.gt(0.0).and_(top.gt(0.0)), "FIRED", "BOOL")
@@ -228,8 +272,8 @@ class _Window:
     judged when the next one arrives, or the end.  Nodes are queued per panel and judged in
     one loop, so that the searches below are written once."""
 
-    def __init__(self, g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], top: Var) -> None:
-        self.g, self.op, self.sets, self.top = g, op, sets, top
+    def __init__(self, g: Gen, op: OutputPlan, sets: list[Q.SmoothSet], top: Var, capped: Var) -> None:
+        self.g, self.op, self.sets, self.top, self.capped = g, op, sets, top, capped
         let = g.let
         self.qx = g.array("WQX", "REAL", Q.NODES_WITH_ENDS)
         self.qy = g.array("WQY", "REAL", Q.NODES_WITH_ENDS)
@@ -260,7 +304,7 @@ class _Window:
         """Judge the queued nodes (and, when ``end``, the last node: no right neighbour)."""
         g, b = self.g, self.g.b
         i = g.counter("WQ")
-        with b.for_(i, 0, self.qn) as iv:  # one more than queued: the end
+        with b.for_(i, 0, self.qn, bound=Q.NODES_WITH_ENDS + 1) as iv:  # one more than queued: the end
             more = g.let(iv.lt(self.qn), "WMORE", "BOOL")
             with b.if_(more.or_(end)):
                 xr, yr = g.let(self.xb, "WXR"), g.let(-1.0, "WYR")  # the end: no right node
@@ -274,7 +318,8 @@ class _Window:
                     b.set(self.ya, self.yb)
                     b.set(self.xb, xr)
                     b.set(self.yb, yr)
-                    b.set(self.seen, g.min_(self.seen + 1, 2, "WN"))
+                    with b.if_(self.seen.lt(2)):  # (an INT: no REAL temporary of min_)
+                        b.set(self.seen, self.seen + 1)
         b.set(self.qn, 0)
 
     def _judge(self, xr: Var, yr: Var, more: Var) -> None:
@@ -290,15 +335,17 @@ class _Window:
         thr = g.let(top * (1.0 - PLATEAU_TOL), "WTHR")
         level = g.min_(yb, thr, "WLV")
         peak = yb.ge(top * (1.0 - PEAK_NEAR)).and_(not_(has_left).or_(ya.lt(level))).and_(yr.lt(level))
-        with b.if_(peak):
+        # beyond PEAKS peaks none is searched (it would not be kept): the work stays bounded
+        with b.if_(peak.and_(self.npk.lt(PEAKS))):
             lo = g.let(xb, "GLO")
             with b.if_(has_left):
                 b.set(lo, xa)
             px, pv = self._golden(lo, xr, xb, yb)
-            with b.if_(self.npk.lt(PEAKS)):
-                b.set(self.kx[self.npk], px)
-                b.set(self.kv[self.npk], pv)
-                b.set(self.npk, self.npk + 1)
+            b.set(self.kx[self.npk], px)
+            b.set(self.kv[self.npk], pv)
+            b.set(self.npk, self.npk + 1)
+        with b.elif_(peak):
+            b.set(self.capped, True)
         # runs at the top
         with b.if_(yb.ge(thr)):
             with b.if_(self.run.eq(0)):
@@ -327,7 +374,7 @@ class _Window:
         go = g.let(True, "GGO", "BOOL")
         at = g.array("GP", "REAL", 2)
         val = g.array("GF", "REAL", 2)
-        with b.while_(go):
+        with b.while_(go, bound=GOLDEN + 1):
             scale = g.max_(g.max_(1.0, g.call("ABS", lo), "GS"), g.call("ABS", hi), "GS")
             with b.if_((hi - lo).le(1e-15 * scale).or_(it.ge(GOLDEN))):
                 b.set(go, False)
@@ -369,7 +416,7 @@ class _Window:
                 b.set(i, self.rx)
                 b.set(search, self.rhas)
             it = g.let(0, "EIT", "INT")
-            with b.while_(search):
+            with b.while_(search, bound=HALVINGS + 1):
                 mid = g.let(0.5 * (o + i), "EM")
                 with b.if_(mid.eq(o).or_(mid.eq(i)).or_(it.ge(HALVINGS))):
                     b.set(search, False)
@@ -388,12 +435,12 @@ class _Window:
         g, b = self.g, self.g.b
         sup = g.let(self.top, "SUP")
         j = g.counter("PJ")
-        with b.for_(j, 0, self.npk - 1) as jv:
+        with b.for_(j, 0, self.npk - 1, bound=PEAKS) as jv:
             b.set(sup, g.max_(sup, self.kv[jv], "SUP"))
         cut = g.let(sup * (1.0 - SAME_TOP), "SCUT")
         np_, lo, hi, tot = g.let(0, "NP", "INT"), g.let(0.0, "PLO"), g.let(0.0, "PHI"), g.let(0.0, "PSUM")
         j = g.counter("PJ")
-        with b.for_(j, 0, self.npk - 1) as jv, b.if_(self.kv[jv].ge(cut)):
+        with b.for_(j, 0, self.npk - 1, bound=PEAKS) as jv, b.if_(self.kv[jv].ge(cut)):
             x = self.kx[jv]
             with b.if_(np_.eq(0)):
                 b.set(lo, x)

@@ -126,7 +126,8 @@ class NativeBuilder(FastBuilder):
                 raise self.g.refuse(f"term {op.name}.{t.name}", "a smooth output term given by variables")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         # every method: CoG as the PLC block integrates it, CoA/LM/RM/MoM on the same panels
-        return smooth_method(self.g, op, sets, Q.calibrate(op), self.plan.options.quad_rtol)
+        value, fired, _capped = smooth_method(self.g, op, sets, Q.calibrate(op), self.plan.options.quad_rtol)
+        return value, fired
 
     def exact_output(self, op: OutputPlan, groups: list[Group]) -> tuple[Ex, Ex]:
         """A piecewise-linear output by any exact method: the PLC block's defuzzification

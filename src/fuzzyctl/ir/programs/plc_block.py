@@ -27,6 +27,7 @@ from fuzzyctl.ir.builders import quadrature as Q
 from fuzzyctl.ir.builders import terms as T
 from fuzzyctl.ir.builders.mamdani import ExactOutput, Group, exact_outputs, term_points
 from fuzzyctl.ir.builders.rules import Contrib, Params, RuleBuilder, literal, single_use
+from fuzzyctl.ir.builders.smooth_methods import method_bound, smooth_method
 from fuzzyctl.ir.cost import cost
 from fuzzyctl.ir.nodes import Ex, Index, Int, Num, Program, Var, ex, not_
 from fuzzyctl.ir.programs.guard import check_known_fields
@@ -38,7 +39,7 @@ from fuzzyctl.kinds.methods import METHODS
 INFO_OK = 0x00
 INFO_DISABLED = 0x01  # ENABLE = FALSE: outputs keep their values
 INFO_DEFAULT = 0x02  # no rule fired for at least one output: DEFAULT or the previous value
-INFO_QUADRATURE = 0x04  # a smooth output's CoG reached its iteration cap short of its tolerance
+INFO_QUADRATURE = 0x04  # a smooth output's quadrature (or peak search) reached its cap
 INFO_DEGREE_RANGE = 0x31  # an input used as a degree (or WITH weight) is outside [0, 1]
 
 
@@ -168,12 +169,6 @@ class _Builder(RuleBuilder):
         check_known_fields(g, self.plan)
         for op in self.plan.outputs:
             if op.kind == "mamdani" and not op.exact:
-                if not METHODS[op.method].centroid:
-                    raise g.refuse(
-                        f"output {op.name}: METHOD : {op.method} of a smooth set",
-                        "only the centre of gravity of smooth sets is integrated by the generated "
-                        "code; use METHOD : COG, or piecewise-linear terms",
-                    )
                 for t in op.terms:
                     if not Q.constant_term(t) or t.kind == "function":
                         raise g.refuse(
@@ -349,18 +344,24 @@ class _Builder(RuleBuilder):
         return self.ts(op, contribs, values)
 
     def _smooth(self, op: OutputPlan, contribs: list[Contrib]) -> tuple[Ex, Ex]:
-        """CoG of a smooth set by quadrature to a tolerance fixed now (codegen.quadrature)."""
+        """A smooth set by its method (CoG, CoA, LM, RM, MoM) on quadrature panels to a
+        tolerance fixed now (ir/builders/quadrature.py, smooth_methods.py: the native
+        evaluator's IR)."""
         from fuzzyctl.ir.programs.evaluator import merge
 
         groups = merge(self.g, contribs, op.accu or "MAX")
         sets = [Q.SmoothSet(gr.term, gr.a, gr.w, gr.act) for gr in groups]
         cal = Q.calibrate(op)
-        bound = Q.cog_bound()
-        self.notes.append(
-            f"output {op.name}: smooth set, CoG by adaptive Gauss-Kronrod 7/15 on "
-            f"{len(cal.cuts) - 1} intervals, split at located kinks: {bound}"
-        )
-        value, fired, capped = Q.smooth_cog(self.g, op, sets, cal)
+        rtol = self.plan.options.quad_rtol
+        entry = METHODS[op.method]
+        head = f"output {op.name}: smooth set"
+        where = f"on {len(cal.cuts) - 1} intervals, split at located kinks"
+        if entry.integrating and not entry.bisects:
+            self.notes.append(f"{head}, CoG by adaptive Gauss-Kronrod 7/15 {where}: {Q.cog_bound()}")
+        else:
+            self.notes.append(f"{head}, {op.method} on the panels of adaptive Gauss-Kronrod 7/15 {where}")
+            self.notes += [f"output {op.name}: {line}" for line in method_bound(op, rtol)]
+        value, fired, capped = smooth_method(self.g, op, sets, cal, rtol)
         self.capped[op.name] = capped
         return value, fired
 
@@ -428,7 +429,7 @@ def _info_comment() -> str:
     return (
         f"16#{INFO_OK:02X} ok, 16#{INFO_DISABLED:02X} ENABLE is FALSE (outputs unchanged), "
         f"16#{INFO_DEFAULT:02X} no rule fired for an output (DEFAULT or previous value), "
-        f"16#{INFO_QUADRATURE:02X} a smooth output's CoG hit its iteration cap (may miss its stated bound), "
+        f"16#{INFO_QUADRATURE:02X} a smooth output's quadrature hit its cap (may miss its stated bound), "
         f"16#{INFO_DEGREE_RANGE:02X} a degree input is outside 0..1 (outputs unchanged)"
     )
 

@@ -67,6 +67,8 @@ def libm_functions(prog: Program) -> list[str]:
 class _C(Printer):
     """C99 statements; block fields as ``fb->x``, constant tables as ``NAME_x``."""
 
+    GROUP_AND_IN_OR = True
+
     def __init__(self, prog: Program, single: bool, target: targets.Target = C) -> None:
         super().__init__(target, real=f"{prog.name}_real", single=single)
         self.prog = prog

@@ -79,6 +79,9 @@ class Printer(StmtVisitor):
     END_WHILE: str | None = "}"
     #: The statement an empty block holds (Python ``pass``, ST ``;``); None: nothing.
     EMPTY: str | None = None
+    #: An AND operand of an OR in parentheses although it binds tighter (gcc -Wall's
+    #: -Wparentheses warns on ``a && b || c``, and -Werror makes that an error).
+    GROUP_AND_IN_OR = False
 
     def __init__(self, caps: Target, real: str = "", single: bool = False, comments: bool = True) -> None:
         self.caps = caps
@@ -150,6 +153,8 @@ class Printer(StmtVisitor):
             return op.format(left, rhs)
         s = f"{left} {op} {rhs}"
         if self.caps.parenthesise_all or p < parent or (right and p == parent):
+            return f"({s})"
+        if self.GROUP_AND_IN_OR and e.op == "AND" and parent == PRECEDENCE["OR"]:
             return f"({s})"
         return s
 
