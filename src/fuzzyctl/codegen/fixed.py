@@ -13,6 +13,8 @@ from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders.fixed_smooth import parse_term_tolerance
+from fuzzyctl.ir.cost import cost
+from fuzzyctl.ir.nodes import Program
 from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
 from fuzzyctl.ir.render.fixed import fixed_st_parts, render_fixed_c, render_fixed_st
 from fuzzyctl.ir.render.st import STParts
@@ -44,6 +46,7 @@ class FixedGenerated:
             "inputs": [p.to_dict(type_name, False) for p in prog.inputs],
             "outputs": [p.to_dict(type_name, True) for p in prog.outputs],
             "approximated_terms": list(prog.approximations),
+            "cost": cost(Program(prog.name, [], prog.body)).to_dict(),
         }
 
 

@@ -35,7 +35,8 @@ from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
 from fuzzyctl.ir.builders.fixed_smooth import SmoothTerm, approximate, default_tolerance
-from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
+from fuzzyctl.ir.cost import cost
+from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Program, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.arith import INT_OUTPUTS, Arith
@@ -643,6 +644,9 @@ def build_fixed(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
             f"{p.error_bound:.3g} (from each step's rounding, for every stored input)"
         )
+    # what one cycle costs: a smooth term's bisection counts its deepest path only
+    spent = cost(Program(name, [], outer.root)).worst
+    header.append(f"cost per cycle, worst case (conversions WIDEN/NARROW counted as calls): {spent.summary()}")
     prog = FixedProgram(
         name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header, approximations
     )
