@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 from fractions import Fraction
 
 import numpy as np
@@ -207,3 +208,78 @@ def test_plcopen_of_a_smooth_block_is_valid(arith: str) -> None:
     assert schema.validate(root), schema.error_log
     st = generate_st(doc, arith=arith, dialect="iec")
     assert "DEG_0_1" in st and b"DEG_0_1" in etree.tostring(root)
+
+
+#: matiec and gcc take minutes on the thousands of chords of the default int32 tolerance
+MATIEC_TOL = {"term_tolerance": 1e-4}
+
+
+def _smooth_systems(arith: str) -> list[tuple[str, fuzzyctl.model.Document, dict]]:
+    docs = [("tipper", fuzzyctl.load(EXAMPLES / "tipper.fis"))]
+    docs += [(f"smooth {s}", fuzzyctl.load(smooth_fcl(s))) for s in range(4)]
+    out = []
+    for label, doc in docs:
+        report: list = []
+        try:
+            generate_st(doc, arith=arith, dialect="iec", report=report, **MATIEC_TOL)
+        except CodegenError:
+            continue
+        out.append((label, doc, report[0].to_dict()))
+    return out
+
+
+@pytest.mark.extra("matiec")
+@pytest.mark.parametrize("arith", ["int16", "int32"])
+def test_matiec_runs_the_smooth_blocks_within_their_bound(arith: str, tmp_path: Path) -> None:
+    from tests.codegen import matiec as M
+
+    matiec = M.build()
+    systems = _smooth_systems(arith)
+    assert len(systems) >= 4
+    text = "\n".join(generate_st(doc, arith=arith, dialect="iec", **MATIEC_TOL) for _l, doc, _r in systems)
+    M.iec2c(matiec, text, tmp_path)
+    blocks = [
+        M.Block(r["block"], tuple(p["name"] for p in r["inputs"]), tuple(p["name"] for p in r["outputs"]))
+        for _l, _d, r in systems
+    ]
+    exe = M.compile_c(matiec, tmp_path, M.driver(blocks, {"int16": "IEC_INT", "int32": "IEC_DINT"}[arith]))
+    for k, (label, doc, rep) in enumerate(systems):
+        rng = np.random.default_rng(k)
+        lo = np.array([p["stored_range"][0] for p in rep["inputs"]])
+        hi = np.array([p["stored_range"][1] for p in rep["inputs"]])
+        stored = np.vstack([rng.integers(lo, hi + 1, size=(1000, len(lo))), lo, hi])
+        got, _flags = M.run_block(exe, k, stored.astype(np.float64))
+        values = stored * np.array([p["scale"] for p in rep["inputs"]]) + np.array(
+            [p["offset"] for p in rep["inputs"]]
+        )
+        batch = fuzzyctl.compile(doc, out_of_range="ignore").evaluate_batch(
+            {p["name"]: values[:, i] for i, p in enumerate(rep["inputs"])}
+        )
+        for j, p in enumerate(rep["outputs"]):
+            err = float(np.max(np.abs(got[:, j] * p["scale"] + p["offset"] - np.asarray(batch[p["name"]]))))
+            assert err <= p["error_bound"], (label, p["name"], err, p["error_bound"])
+
+
+@pytest.mark.extra("matiec")
+@pytest.mark.parametrize("arith", ["int16", "int32"])
+def test_the_smooth_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(arith: str, tmp_path: Path) -> None:
+    import subprocess
+
+    from tests.codegen import matiec as M
+
+    matiec = M.build()
+    tipper = (EXAMPLES / "tipper.fis").read_text()
+    good = generate_st(fuzzyctl.load(EXAMPLES / "tipper.fis"), arith=arith, dialect="iec", testbench=60, **MATIEC_TOL)
+    # the bench of the right block around a block whose Gaussian is a little wider
+    moved = tmp_path / "moved.fis"
+    moved.write_text(tipper.replace("'good':'gaussmf',[1.5 5]", "'good':'gaussmf',[1.8 5]"))
+    assert moved.read_text() != tipper
+    wrong_block = generate_st(fuzzyctl.load(moved), arith=arith, dialect="iec", **MATIEC_TOL)
+    bench = good[good.index("(* test bench") :]
+    for label, text, want in (("good", good, "1 0"), ("wrong", wrong_block + "\n" + bench, "0 ")):
+        where = tmp_path / label
+        where.mkdir()
+        M.iec2c(matiec, text, where)
+        exe = M.compile_c(matiec, where, M.bench_driver(["TB_tipper"]))
+        out = subprocess.run([str(exe), "0"], capture_output=True, text=True, timeout=120).stdout
+        assert out.startswith(want), (label, out)
