@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import json
 import math
-from pathlib import Path
 from fractions import Fraction
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -125,7 +125,9 @@ def test_the_tipper_within_its_stated_bound(arith: str) -> None:
     assert (observed > 0).all()
     terms = out.report["approximated_terms"]
     assert [t["term"] for t in terms] == ["poor", "good", "excellent"]
-    assert all(t["deviation"] <= t["tolerance"] == fs.default_tolerance(arith_kinds.get(arith)) for t in terms)
+    assert all(
+        t["deviation"] <= t["tolerance"] == fs.default_tolerance(arith_kinds.get(arith)) for t in terms
+    )
     assert bound[0] <= (0.05 if arith == "int16" else 0.001) * 30  # within 5 % / 0.1 % of the tip's range
 
 
@@ -134,7 +136,7 @@ def test_a_moved_breakpoint_degree_breaks_the_stated_bound(monkeypatch: pytest.M
     the proof's deviation kept; the stated bound no longer holds."""
     real = fixed_block.approximate
 
-    def moved(*args, **kw):  # noqa: ANN002, ANN003, ANN202
+    def moved(*args, **kw):
         a = real(*args, **kw)
         degs = list(a.degrees)
         k = len(degs) // 3
@@ -262,14 +264,18 @@ def test_matiec_runs_the_smooth_blocks_within_their_bound(arith: str, tmp_path: 
 
 @pytest.mark.extra("matiec")
 @pytest.mark.parametrize("arith", ["int16", "int32"])
-def test_the_smooth_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(arith: str, tmp_path: Path) -> None:
+def test_the_smooth_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
+    arith: str, tmp_path: Path
+) -> None:
     import subprocess
 
     from tests.codegen import matiec as M
 
     matiec = M.build()
     tipper = (EXAMPLES / "tipper.fis").read_text()
-    good = generate_st(fuzzyctl.load(EXAMPLES / "tipper.fis"), arith=arith, dialect="iec", testbench=60, **MATIEC_TOL)
+    good = generate_st(
+        fuzzyctl.load(EXAMPLES / "tipper.fis"), arith=arith, dialect="iec", testbench=60, **MATIEC_TOL
+    )
     # the bench of the right block around a block whose Gaussian is a little wider
     moved = tmp_path / "moved.fis"
     moved.write_text(tipper.replace("'good':'gaussmf',[1.5 5]", "'good':'gaussmf',[1.8 5]"))

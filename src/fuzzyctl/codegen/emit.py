@@ -164,7 +164,9 @@ def _check_term_tolerance(value: str | float, integer: bool) -> None:
     from fuzzyctl.ir.builders.fixed_smooth import parse_term_tolerance
 
     if not integer:
-        raise OptionError("--term-tolerance applies to --arith int16 and int32 (without --lookup)", "--term-tolerance")
+        raise OptionError(
+            "--term-tolerance applies to --arith int16 and int32 (without --lookup)", "--term-tolerance"
+        )
     try:
         parse_term_tolerance(value)
     except CodegenError as exc:

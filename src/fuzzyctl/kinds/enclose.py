@@ -143,16 +143,16 @@ class _Eval:
             env[name] = self.ex(node, env)
         return self.ex(f.body, env)
 
-    def ex(self, e: ast.expr, env: dict[str, Enclosure]) -> Enclosure:  # noqa: PLR0911
+    def ex(self, e: ast.expr, env: dict[str, Enclosure]) -> Enclosure:
         n = self.n
         if isinstance(e, ast.Constant):
-            return _point(float(e.value), n)
+            return _point(float(e.value), n)  # type: ignore[arg-type]
         if isinstance(e, ast.Name):
             if e.id in env:
                 return env[e.id]
             if e.id == "pi":
                 z = np.zeros(n)
-                return Enclosure(np.full(n, _down(np.float64(math.pi))), np.full(n, _up(np.float64(math.pi))), z, z)
+                return Enclosure(_down(np.full(n, math.pi)), _up(np.full(n, math.pi)), z, z)
             return _iv(np.full(n, -_INF), np.full(n, _INF), np.full(n, -_INF), np.full(n, _INF))
         if isinstance(e, ast.NamedExpr):
             v = self.ex(e.value, env)
@@ -207,7 +207,7 @@ class _Eval:
         zero = (a.lo == 0) & (a.hi == 0) & ((b.lo > 0) | (b.hi < 0))
         return Enclosure(np.where(zero, 0.0, out.lo), np.where(zero, 0.0, out.hi), out.dlo, out.dhi)
 
-    def call(self, name: str, args: list[Enclosure]) -> Enclosure:  # noqa: PLR0911
+    def call(self, name: str, args: list[Enclosure]) -> Enclosure:
         a = args[0]
         with np.errstate(all="ignore"):
             if name == "exp":
@@ -262,7 +262,9 @@ class _Eval:
         ok = (a.lo >= 0) & (b.dlo == 0) & (b.dhi == 0)
 
         def corners(e_lo: Arr, e_hi: Arr) -> tuple[Arr, Arr]:
-            ps = np.stack([np.power(a.lo, e_lo), np.power(a.lo, e_hi), np.power(a.hi, e_lo), np.power(a.hi, e_hi)])
+            ps = np.stack(
+                [np.power(a.lo, e_lo), np.power(a.lo, e_hi), np.power(a.hi, e_lo), np.power(a.hi, e_hi)]
+            )
             return _clean(_down(np.min(ps, axis=0), 4), _up(np.max(ps, axis=0), 4))
 
         lo, hi = corners(b.lo, b.hi)
@@ -304,12 +306,15 @@ class _Eval:
 def _narrowed(test: ast.expr, env: dict[str, Enclosure], holds: bool) -> dict[str, Enclosure]:
     """``env`` with a name compared to a constant narrowed to the values where ``test``
     is ``holds`` (a branch is only taken there: its enclosure may assume it)."""
-    if not (isinstance(test, ast.Compare) and len(test.ops) == 1 and isinstance(test.comparators[0], ast.Constant)):
+    if not (
+        isinstance(test, ast.Compare) and len(test.ops) == 1 and isinstance(test.comparators[0], ast.Constant)
+    ):
         return dict(env)
     left = test.left.target if isinstance(test.left, ast.NamedExpr) else test.left
     if not isinstance(left, ast.Name) or left.id not in env:
         return dict(env)
-    v, c, op = env[left.id], float(test.comparators[0].value), test.ops[0]
+    v, op = env[left.id], test.ops[0]
+    c = float(test.comparators[0].value)  # type: ignore[arg-type]
     lo, hi = v.lo, v.hi
     upper = isinstance(op, ast.Lt | ast.LtE) if holds else isinstance(op, ast.Gt | ast.GtE)
     lower = isinstance(op, ast.Gt | ast.GtE) if holds else isinstance(op, ast.Lt | ast.LtE)

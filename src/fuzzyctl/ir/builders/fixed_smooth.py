@@ -173,12 +173,14 @@ def _greedy(ks: _Ints, ys: _Arr, target: float) -> list[int]:
 
 def _bounds(g: _Grid, ka: _Arr, ya: _Arr, kb: _Arr, yb: _Arr, k0: _Arr, k1: _Arr) -> _Arr:
     """A proven bound of ``|f - chord|`` on the stored values of each ``[k0, k1]``."""
-    shape = registry.get(g.term.kind)
+    shape = registry.SHAPES[g.term.kind]
     n = len(k0)
     kc = (k0 + k1) / 2
     x0, x1 = g.bounds(k0, k1)
     xc0, xc1 = g.bounds(kc, kc)
-    e = enclose(shape.parsed(), registry.HELPERS, np.concatenate([x0, xc0]), np.concatenate([x1, xc1]), g.params)
+    e = enclose(
+        shape.parsed(), registry.HELPERS, np.concatenate([x0, xc0]), np.concatenate([x1, xc1]), g.params
+    )
     h = g.h  # a height in [0, 1] scales values and derivatives (one more rounding each)
     lo, hi = np.nextafter(e.lo * h, -math.inf), np.nextafter(e.hi * h, math.inf)
     dlo, dhi = np.nextafter(e.dlo * h, -math.inf), np.nextafter(e.dhi * h, math.inf)

@@ -124,7 +124,9 @@ def _check_cond(c: CondPlan, plan: Plan, rule: str) -> None:
         term = fi.terms[c.term]
         if term.pwl is None and smooth_term(term):
             if not 0.0 <= float(term.height) <= 1.0:  # type: ignore[arg-type]
-                raise _refuse(f"term {term.name!r} of input {fi.name!r}: a height outside 0..1 is not computed")
+                raise _refuse(
+                    f"term {term.name!r} of input {fi.name!r}: a height outside 0..1 is not computed"
+                )
         elif term.pwl is None:
             raise _refuse(
                 f"term {term.name!r} of input {fi.name!r}: a {term.kind} term (not piecewise linear with "
@@ -234,10 +236,12 @@ def _input_port(plan: Plan, slot: int, arith: Arith, rng: tuple[float, float] | 
             if fi.slot == slot
             for t in fi.terms
             if t.pwl is None and smooth_term(t)
-            for x in registry.get(t.kind).span.of([float(p) for p in t.params])  # type: ignore[arg-type]
+            for x in registry.SHAPES[t.kind].span.of([float(p) for p in t.params])  # type: ignore[arg-type]
         ]
         if not all(math.isfinite(x) for x in xs):
-            raise _refuse(f"input {name!r}: without RANGE a smooth term's universe is unbounded: give a RANGE")
+            raise _refuse(
+                f"input {name!r}: without RANGE a smooth term's universe is unbounded: give a RANGE"
+            )
         if not xs:
             raise _refuse(f"input {name!r}: without RANGE or piecewise-linear terms it has no scaling")
         rng = (min(xs), max(xs))
@@ -636,8 +640,9 @@ def build_fixed(
         header.append(f"input {p.name}: value = {p.formula()} (range {p.comment})")
     for a in approximations:
         header.append(
-            f"input {a['input']} IS {a['term']} ({a['kind']}): {a['chords']} chords, proven to deviate at most "
-            f"{a['deviation']:.3g} degrees from the term (tolerance {a['tolerance']:g}), counted in the errors"
+            f"input {a['input']} IS {a['term']} ({a['kind']}): {a['chords']} chords, proven to deviate "
+            f"at most {a['deviation']:.3g} degrees from the term (tolerance {a['tolerance']:g}), "
+            "counted in the errors"
         )
     for p in outputs:
         header.append(
@@ -646,7 +651,9 @@ def build_fixed(
         )
     # what one cycle costs: a smooth term's bisection counts its deepest path only
     spent = cost(Program(name, [], outer.root)).worst
-    header.append(f"cost per cycle, worst case (conversions WIDEN/NARROW counted as calls): {spent.summary()}")
+    header.append(
+        f"cost per cycle, worst case (conversions WIDEN/NARROW counted as calls): {spent.summary()}"
+    )
     prog = FixedProgram(
         name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header, approximations
     )
