@@ -109,7 +109,7 @@ def codegen(
             "--term-tolerance",
             help="--arith int16/int32: how far (in degrees) the chords computing a smooth input term "
             "(Gaussian, bell, sigmoid, ...) may deviate from it; proven, and counted in each output's error "
-            "bound (default 1e-3 in int16, 1e-5 in int32).",
+            "bound (default 2.5e-4 in int16, 1e-5 in int32).",
             show_default=False,
         ),
     ] = None,

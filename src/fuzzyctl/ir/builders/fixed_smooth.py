@@ -62,10 +62,12 @@ class SmoothTerm(TermPlan):
 
 
 def default_tolerance(arith: Arith) -> float:
-    """The deviation allowed by default: about 16 units of an int16 degree (2**-14), so that
-    a Gaussian takes about 30 chords; 1e-5 in int32 (a few hundred chords a Gaussian: the
-    degree's own rounding there, 2**-30, is out of reach at any affordable size)."""
-    return 1e-3 if arith.bits <= 16 else 1e-5
+    """The deviation allowed by default.  int16: 2.5e-4, four units of the stored degree
+    (2**-14), so the chords add about as much to an output's bound as the block's own
+    roundings do (a Gaussian takes about 55 chords, 6 comparisons).  int32: 1e-5; the
+    degree's own unit there (2**-30) is out of reach at any affordable size (a Gaussian
+    takes about 300-560 chords, 9-10 comparisons), so the chords set the int32 bound."""
+    return 2.5e-4 if arith.bits <= 16 else 1e-5
 
 
 def parse_term_tolerance(value: object) -> float | None:
