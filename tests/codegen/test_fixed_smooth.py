@@ -109,6 +109,15 @@ def test_a_bad_term_tolerance_names_the_option(value: str, capsys: pytest.Captur
     assert code not in (0, 3) and "--term-tolerance" in err and "Traceback" not in err
 
 
+def test_a_tolerance_too_fine_for_the_chords_is_refused_naming_the_term(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    code = main(["codegen", "--arith", "int32", "--term-tolerance", "1e-9", str(EXAMPLES / "tipper.fis")])
+    err = capsys.readouterr().err
+    assert code not in (0, 3) and "Traceback" not in err
+    assert "term 'poor' of input 'service'" in err and "--term-tolerance" in err and "--arith float" in err
+
+
 def test_term_tolerance_applies_to_integer_arithmetic_only(capsys: pytest.CaptureFixture[str]) -> None:
     code = main(["codegen", "--term-tolerance", "1e-4", str(EXAMPLES / "tipper.fis")])
     assert code not in (0, 3) and "--arith int16 and int32" in capsys.readouterr().err
