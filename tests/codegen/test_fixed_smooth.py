@@ -10,6 +10,7 @@ breaks the bound, so the check is not vacuous."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 from fractions import Fraction
@@ -151,9 +152,7 @@ def test_a_moved_breakpoint_degree_breaks_the_stated_bound(monkeypatch: pytest.M
         k = len(degs) // 3
         degs[k] = degs[k] + 0.02 if degs[k] < 0.9 else degs[k] - 0.02
         pwl = tuple((x, y) for (x, _y), y in zip(a.pwl or (), degs, strict=True))
-        return fs.SmoothTerm(
-            a.name, a.kind, a.params, a.height, a.expr, pwl, a.knots, tuple(degs), a.deviation, a.tolerance
-        )
+        return dataclasses.replace(a, pwl=pwl, degrees=tuple(degs))
 
     monkeypatch.setattr(fixed_block, "approximate", moved)
     out = run_c(fuzzyctl.load(EXAMPLES / "tipper.fis"), "int32", rows=20_000, seed=3)

@@ -59,6 +59,7 @@ class SmoothTerm(TermPlan):
     degrees: tuple[float, ...] = ()
     deviation: float = 0.0
     tolerance: float = 0.0
+    xs: tuple[float, ...] = ()  # the breakpoints in the input's unit (``pwl``'s x)
 
 
 def default_tolerance(arith: Arith) -> float:
@@ -304,14 +305,14 @@ def approximate(
         degrees=tuple(degs),
         deviation=dev,
         tolerance=tol,
+        xs=tuple(x for x, _y in pwl),
     )
 
 
 def hull(term: SmoothTerm, a: float, b: float) -> tuple[float, float]:
     """An interval holding the term's exact degree for every input in ``[a, b]``: the chords'
     hull there widened by the proven deviation (and a margin for this float arithmetic)."""
-    xs = [x for x, _y in term.pwl or ()]
-    ys = term.degrees
+    xs, ys = term.xs, term.degrees
 
     def at(x: float) -> float:
         i = bisect.bisect_right(xs, x)
