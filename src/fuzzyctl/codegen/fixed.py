@@ -46,7 +46,7 @@ class FixedGenerated:
             "inputs": [p.to_dict(type_name, False) for p in prog.inputs],
             "outputs": [p.to_dict(type_name, True) for p in prog.outputs],
             "approximated_terms": list(prog.approximations),
-            "cost": cost(Program(prog.name, [], prog.body)).to_dict(),
+            "cost": (prog.cost or cost(Program(prog.name, [], prog.body))).to_dict(),
         }
 
 

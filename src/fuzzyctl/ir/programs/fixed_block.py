@@ -35,7 +35,7 @@ from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
 from fuzzyctl.ir.builders.fixed_smooth import SmoothTerm, approximate, default_tolerance
-from fuzzyctl.ir.cost import cost
+from fuzzyctl.ir.cost import Cost, cost
 from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Program, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
@@ -101,6 +101,7 @@ class FixedProgram:
     #: the smooth input terms computed as chords: input, term, kind, chords, proven
     #: deviation and tolerance (degrees)
     approximations: list[dict[str, object]] = field(default_factory=list)
+    cost: Cost | None = None  # one cycle's (fuzzyctl.ir.cost)
 
 
 def _refuse(what: str) -> CodegenError:
@@ -650,11 +651,11 @@ def build_fixed(
             f"{p.error_bound:.3g} (from each step's rounding, for every stored input)"
         )
     # what one cycle costs: a smooth term's bisection counts its deepest path only
-    spent = cost(Program(name, [], outer.root)).worst
+    spent = cost(Program(name, [], outer.root))
     header.append(
-        f"cost per cycle, worst case (conversions WIDEN/NARROW counted as calls): {spent.summary()}"
+        f"cost per cycle, worst case (conversions WIDEN/NARROW counted as calls): {spent.worst.summary()}"
     )
     prog = FixedProgram(
-        name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header, approximations
+        name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header, approximations, spent
     )
     return prog
