@@ -297,3 +297,31 @@ def test_the_smooth_st_test_bench_passes_on_matiec_and_fails_on_a_wrong_block(
         exe = M.compile_c(matiec, where, M.bench_driver(["TB_tipper"]))
         out = subprocess.run([str(exe), "0"], capture_output=True, text=True, timeout=120).stdout
         assert out.startswith(want), (label, out)
+
+
+@pytest.mark.parametrize("arith", ["int16", "int32"])
+def test_the_c_test_bench_passes_and_fails_on_a_wrong_block(arith: str, tmp_path: Path) -> None:
+    """gcc with the strict flags: the tipper's bench passes; around a block whose Gaussian is
+    wider (the bench's expected values kept) it fails."""
+    import shutil
+    import subprocess
+
+    from tests.codegen.fixed_check import STRICT
+
+    tipper = (EXAMPLES / "tipper.fis").read_text()
+    moved = tmp_path / "moved.fis"
+    moved.write_text(tipper.replace("'good':'gaussmf',[1.5 5]", "'good':'gaussmf',[1.8 5]"))
+    good = generate_c(fuzzyctl.load(EXAMPLES / "tipper.fis"), arith=arith, testbench=60)
+    bad = dict(good, **{k: v for k, v in generate_c(fuzzyctl.load(moved), arith=arith).items()})
+    cc = shutil.which("cc")
+    assert cc
+    for label, files, want in (("good", good, "PASS"), ("bad", bad, "FAIL")):
+        where = tmp_path / label
+        where.mkdir()
+        for name, text in files.items():
+            (where / name).write_text(text)
+        sources = [str(where / n) for n in files if n.endswith(".c")]
+        exe = where / "tb"
+        subprocess.run([cc, *STRICT, "-DFUZZYCTL_TESTBENCH_MAIN", *sources, "-o", str(exe)], check=True)
+        out = subprocess.run([str(exe)], capture_output=True, text=True).stdout
+        assert out.startswith(want), (label, out)
