@@ -128,3 +128,47 @@ def mamdani_variant(text: str, half_width: float = 50.0, low: float = -150.0, hi
     text = re.sub(r"TERM (\w+) := (-?[\d.]+);", triangle, text)
     text = re.sub(r"METHOD\s*:\s*CoGS;", f"METHOD : CoG; RANGE := ({low!r} .. {high!r});", text, flags=re.I)
     return re.sub(r"FUNCTION_BLOCK (\w+)", r"FUNCTION_BLOCK \1_m", text, count=1)
+
+
+def smooth_fcl(seed: int) -> str:
+    """A random system as :func:`random_fcl` draws it, each input term replaced by a smooth
+    one at the same peak: a sigmoid at the range's ends, a Gaussian or a generalised bell
+    (drawn) between, each as wide as the gap to its neighbours."""
+    rng = np.random.default_rng(20_000 + seed)
+    text = random_fcl(seed).replace("FUNCTION_BLOCK rnd", f"FUNCTION_BLOCK rnds{seed}")
+    out: list[str] = []
+    peaks: list[float] = []
+    for line in text.splitlines():
+        m = re.match(r"\s*TERM (t\d+) := (\(.*\));", line)
+        if m:
+            pts = [tuple(float(v) for v in p.split(",")) for p in re.findall(r"\(([^)]*)\)", m.group(2))]
+            peaks.append(next(x for x, y in pts if y == 1.0))
+            out.append(f"@{m.group(1)}")
+            continue
+        if line.startswith("END_FUZZIFY"):
+            out = _smooth_terms(out, peaks, rng)
+            peaks = []
+        out.append(line)
+    return "\n".join(out) + "\n"
+
+
+def _smooth_terms(lines: list[str], peaks: list[float], rng: np.random.Generator) -> list[str]:
+    n = len(peaks)
+    res = []
+    for line in lines:
+        if not line.startswith("@"):
+            res.append(line)
+            continue
+        k = int(line[2:])
+        c = peaks[k]
+        gap = max(peaks[k + 1] - c if k + 1 < n else 0.0, c - peaks[k - 1] if k > 0 else 0.0)
+        if k == 0 or k == n - 1:  # a shoulder: a sigmoid half way to the neighbour
+            other = peaks[1] if k == 0 else peaks[-2]
+            slope = (8.0 if k == n - 1 else -8.0) / abs(other - c)
+            shape = f"SIGM {round(slope, 6)!r} {round((c + other) / 2, 6)!r}"
+        elif rng.random() < 0.5:
+            shape = f"GAUSS {c!r} {round(gap * float(rng.uniform(0.4, 0.7)), 6)!r}"
+        else:
+            shape = f"GBELL {round(gap * 0.6, 6)!r} {round(float(rng.uniform(1.0, 3.0)), 3)!r} {c!r}"
+        res.append(f"    TERM t{k} := {shape};")
+    return res

@@ -103,6 +103,16 @@ def codegen(
             show_default=False,
         ),
     ] = None,
+    term_tolerance: Annotated[
+        str | None,
+        typer.Option(
+            "--term-tolerance",
+            help="--arith int16/int32: how far (in degrees) the chords computing a smooth input term "
+            "(Gaussian, bell, sigmoid, ...) may deviate from it; proven, and counted in each output's error "
+            "bound (default 2.5e-4 in int16, 1e-5 in int32).",
+            show_default=False,
+        ),
+    ] = None,
     lookup: Annotated[
         bool,
         typer.Option(
@@ -204,6 +214,7 @@ def codegen(
             max_bytes=max_bytes,
             int_output=None if int_output is None else int_output.value,
             samples=samples,
+            term_tolerance=term_tolerance,
         )
     if as_json and emitted.reports:
         typer.echo(json.dumps(emitted.to_dict(), indent=2))

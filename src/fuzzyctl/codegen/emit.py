@@ -99,6 +99,7 @@ def check_options(
     tolerance: str | float | None = None,
     max_bytes: int | None = None,
     int_output: str | None = None,
+    term_tolerance: str | float | None = None,
 ) -> None:
     """Refuse options that do not apply to ``lang`` before anything is read
     (:class:`OptionError` names the option); what applies is the target's record."""
@@ -134,6 +135,8 @@ def check_options(
             raise OptionError(
                 f"--int-output {int_output!r}: choose {' or '.join(arith_kinds.INT_OUTPUTS)}", "--int-output"
             )
+    if term_tolerance is not None:
+        _check_term_tolerance(term_tolerance, arith_kinds.get(arith).integer and not lookup)
     refusal = targets.dialect(dialect).refused_by.get(caps.name) if dialect is not None else None
     if refusal is not None:
         raise OptionError(f"{refusal}: use --lang st --dialect {dialect}", "--dialect")
@@ -154,6 +157,20 @@ def _check_lookup(lookup: bool, tolerance: str | float | None, max_bytes: int | 
         parse_tolerance(tolerance)
     if max_bytes is not None and max_bytes < 16:
         raise OptionError(f"--max-bytes {max_bytes}: give at least 16 bytes", "--max-bytes")
+
+
+def _check_term_tolerance(value: str | float, integer: bool) -> None:
+    from fuzzyctl.escape import CodegenError
+    from fuzzyctl.ir.builders.fixed_smooth import parse_term_tolerance
+
+    if not integer:
+        raise OptionError(
+            "--term-tolerance applies to --arith int16 and int32 (without --lookup)", "--term-tolerance"
+        )
+    try:
+        parse_term_tolerance(value)
+    except CodegenError as exc:
+        raise OptionError(str(exc), "--term-tolerance") from None
 
 
 def _check_fmu_options(lang: str, fmi: int | None, other: bool) -> None:
@@ -192,6 +209,7 @@ def emit(
     max_bytes: int | None = None,
     int_output: str | None = None,
     samples: int | None = None,
+    term_tolerance: str | float | None = None,
 ) -> Emitted:
     """Generate ``lang`` for ``model`` (a document, or a file read as ``format``; the options
         are checked first) and write it: ``st`` and ``plcopen`` to the file
@@ -217,6 +235,7 @@ def emit(
         tolerance=tolerance,
         max_bytes=max_bytes,
         int_output=int_output,
+        term_tolerance=term_tolerance,
     )
     check_samples(samples)
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
@@ -251,6 +270,8 @@ def emit(
         kwargs["int_output"] = int_output
     if samples is not None:  # the type-2 generators: codegen/type2.py
         kwargs["samples"] = samples
+    if term_tolerance is not None:  # smooth input terms in the integer generators
+        kwargs["term_tolerance"] = term_tolerance
     if caps.report:
         kwargs["report"] = emitted.blocks
     result = generator_of(caps)(document, **kwargs)

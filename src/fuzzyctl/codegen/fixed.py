@@ -12,6 +12,7 @@ from fuzzyctl.codegen.defaults import apply_default, parse_default
 from fuzzyctl.codegen.rename import Rename, rename_plan
 from fuzzyctl.engine.plan import Plan
 from fuzzyctl.escape import CodegenError
+from fuzzyctl.ir.builders.fixed_smooth import parse_term_tolerance
 from fuzzyctl.ir.cost import Cost, stmts
 from fuzzyctl.ir.programs.fixed_block import FixedProgram, build_fixed
 from fuzzyctl.ir.render.fixed import fixed_st_parts, render_fixed_c, render_fixed_st
@@ -43,13 +44,14 @@ class FixedGenerated:
             "notes": list(self.notes),
             "inputs": [p.to_dict(type_name, False) for p in prog.inputs],
             "outputs": [p.to_dict(type_name, True) for p in prog.outputs],
+            "approximated_terms": list(prog.approximations),
             "cost": fixed_cost(prog).to_dict(),
         }
 
 
 def fixed_cost(prog: FixedProgram) -> Cost:
     """The usual and worst cost of one cycle of the integer block (:mod:`fuzzyctl.ir.cost`)."""
-    return Cost(stmts(prog.body, True), stmts(prog.body, False))
+    return prog.cost or Cost(stmts(prog.body, True), stmts(prog.body, False))
 
 
 def input_ranges(model: Document | FunctionBlock | Plan, plan: Plan) -> dict[str, tuple[float, float]]:
@@ -79,6 +81,7 @@ def build_fixed_block(
     default: float | str | None = None,
     int_output: str = "scaled",
     ranges: dict[str, tuple[float, float]] | None = None,
+    term_tolerance: float | None = None,
 ) -> FixedGenerated:
     if default == "hold":
         raise CodegenError("--default hold is not generated in integer arithmetic: give a number")
@@ -86,7 +89,7 @@ def build_fixed_block(
     plan, renames = rename_plan(plan, target)
     renamed = {r.original: r.name for r in renames if r.kind == "input"}
     ranges = {renamed.get(k, k): v for k, v in (ranges or {}).items()}
-    prog = build_fixed(plan, arith_kinds.get(arith), int_output, ranges)
+    prog = build_fixed(plan, arith_kinds.get(arith), int_output, ranges, term_tolerance)
     if renames:
         prog.header[1:1] = ["renamed for the target (model name -> generated name):"] + [
             f"  {r.comment()}" for r in renames
@@ -113,9 +116,10 @@ def generate_st_fixed(
     from ``options``)."""
     options = dict(options)
     int_output = options.pop("int_output", int_output)
+    tol = parse_term_tolerance(options.pop("term_tolerance", None))
     parts = []
     for plan in _plans(model, block, options):
-        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
+        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan), tol)
         if report is not None:
             report.append(gen)
         parts.append(render_fixed_st(gen.program, dialect))
@@ -138,10 +142,11 @@ def fixed_st_blocks(
     """The integer blocks :func:`generate_st_fixed` prints, as parts (for PLCopen XML)."""
     options = dict(options)
     int_output = options.pop("int_output", int_output)
+    tol = parse_term_tolerance(options.pop("term_tolerance", None))
     default = options.pop("default", None)
     out = []
     for plan in _plans(model, block, options):
-        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan))
+        gen = build_fixed_block(plan, "st", arith, default, int_output, input_ranges(model, plan), tol)
         out.append(fixed_st_parts(gen.program, dialect))
     return out
 
@@ -160,9 +165,10 @@ def generate_c_fixed(
     """The integer blocks as C files (``NAME.h``, ``NAME.c``, ``NAME_testbench.c``)."""
     options = dict(options)
     int_output = options.pop("int_output", int_output)
+    tol = parse_term_tolerance(options.pop("term_tolerance", None))
     files: dict[str, str] = {}
     for plan in _plans(model, block, options):
-        gen = build_fixed_block(plan, "c", arith, default, int_output, input_ranges(model, plan))
+        gen = build_fixed_block(plan, "c", arith, default, int_output, input_ranges(model, plan), tol)
         if report is not None:
             report.append(gen)
         header, source = render_fixed_c(gen.program)

@@ -23,6 +23,8 @@ from dataclasses import dataclass
 from fuzzyctl.engine.lowering.grid import left_limit, right_limit
 from fuzzyctl.engine.plan import CAnd, CNot, CondPlan, COr, CTerm, CTrue, Plan
 from fuzzyctl.engine.semantics.shapes import pwl_value
+from fuzzyctl.ir.builders.fixed_smooth import SmoothTerm
+from fuzzyctl.ir.builders.fixed_smooth import hull as smooth_hull
 from fuzzyctl.kinds import norms
 
 __all__ = ["Group", "WeightBounds", "input_cells", "rule_intervals", "weight_bounds"]
@@ -98,10 +100,13 @@ def _degrees(plan: Plan, box: dict[int, Iv]) -> Callable[[int, int], Iv]:
     def deg(var: int, term: int) -> Iv:
         key = (var, term)
         if key not in cache:
-            pts = plan.fuzzy_inputs[var].terms[term].pwl
-            assert pts is not None
+            t = plan.fuzzy_inputs[var].terms[term]
             a, b = box[slots[var]]
-            cache[key] = _hull(pts, a, b)
+            if isinstance(t, SmoothTerm):  # chords standing for a smooth term: their deviation too
+                cache[key] = smooth_hull(t, a, b)
+            else:
+                assert t.pwl is not None
+                cache[key] = _hull(t.pwl, a, b)
         return cache[key]
 
     return deg
@@ -142,7 +147,8 @@ def _cuts(plan: Plan, slot: int, a: float, b: float) -> list[float]:
     for fi in plan.fuzzy_inputs:
         if fi.slot == slot:
             for t in fi.terms:
-                xs.update(x for x, _y in t.pwl or () if a < x < b)
+                if not isinstance(t, SmoothTerm):  # (its many chords bend little: no cells)
+                    xs.update(x for x, _y in t.pwl or () if a < x < b)
     return sorted(xs)
 
 

@@ -29,11 +29,14 @@ from fuzzyctl.engine.plan import (
     OutputPlan,
     Plan,
     Slot,
+    TermPlan,
 )
 from fuzzyctl.escape import CodegenError
 from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX, Width
-from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Stmt, Var
+from fuzzyctl.ir.builders.fixed_smooth import SmoothTerm, approximate, default_tolerance
+from fuzzyctl.ir.cost import Cost, cost
+from fuzzyctl.ir.nodes import Assign, Bin, Bool, Builder, Ex, Int, Program, Stmt, Var
 from fuzzyctl.kinds import norms
 from fuzzyctl.kinds import shapes as registry
 from fuzzyctl.kinds.arith import INT_OUTPUTS, Arith
@@ -101,6 +104,10 @@ class FixedProgram:
     decls: list[FixedDecl]
     body: list[Stmt]
     header: list[str] = field(default_factory=list)
+    #: the smooth input terms computed as chords: input, term, kind, chords, proven
+    #: deviation and tolerance (degrees)
+    approximations: list[dict[str, object]] = field(default_factory=list)
+    cost: Cost | None = None  # one cycle's (fuzzyctl.ir.cost)
 
 
 def _refuse(what: str) -> CodegenError:
@@ -111,13 +118,23 @@ def _refuse(what: str) -> CodegenError:
 # --------------------------------------------------------------------------- what is computed
 
 
+def smooth_term(term: TermPlan) -> bool:
+    """A term computed as chords with a proven deviation (:mod:`fuzzyctl.ir.builders.fixed_smooth`)."""
+    return registry.flag(term.kind, "smooth") and term.constant
+
+
 def _check_cond(c: CondPlan, plan: Plan, rule: str) -> None:
     if isinstance(c, CTerm):
         fi = plan.fuzzy_inputs[c.var]
         if c.hedges:
             raise _refuse(f"rule {rule}: hedges ({' '.join(c.hedges)}) are not computed")
-        if fi.terms[c.term].pwl is None:
-            term = fi.terms[c.term]
+        term = fi.terms[c.term]
+        if term.pwl is None and smooth_term(term):
+            if not 0.0 <= float(term.height) <= 1.0:  # type: ignore[arg-type]
+                raise _refuse(
+                    f"term {term.name!r} of input {fi.name!r}: a height outside 0..1 is not computed"
+                )
+        elif term.pwl is None:
             raise _refuse(
                 f"term {term.name!r} of input {fi.name!r}: a {term.kind} term (not piecewise linear with "
                 "constant points) is not computed"
@@ -219,6 +236,19 @@ def _input_port(plan: Plan, slot: int, arith: Arith, rng: tuple[float, float] | 
     name = plan.inputs[slot].name
     if rng is None:
         xs = [x for fi in plan.fuzzy_inputs if fi.slot == slot for t in fi.terms for x, _y in t.pwl or ()]
+        # a smooth term: its universe without RANGE (the registry's span)
+        xs += [
+            x
+            for fi in plan.fuzzy_inputs
+            if fi.slot == slot
+            for t in fi.terms
+            if t.pwl is None and smooth_term(t)
+            for x in registry.SHAPES[t.kind].span.of([float(p) for p in t.params])  # type: ignore[arg-type]
+        ]
+        if not all(math.isfinite(x) for x in xs):
+            raise _refuse(
+                f"input {name!r}: without RANGE a smooth term's universe is unbounded: give a RANGE"
+            )
         if not xs:
             raise _refuse(f"input {name!r}: without RANGE or piecewise-linear terms it has no scaling")
         rng = (min(xs), max(xs))
@@ -351,9 +381,78 @@ class FixedBlock:
                 continue
         raise _refuse("term: a membership slope does not fit the wide type")
 
+    def approximate_smooth(self, tolerance: float | None) -> list[dict[str, object]]:
+        """Every smooth term a rule reads replaced by its chords (``tolerance`` in degrees;
+        None: the arithmetic's default, loosened when a term needs too many chords)."""
+        import dataclasses
+
+        tol = default_tolerance(self.arith) if tolerance is None else tolerance
+        fis = list(self.plan.fuzzy_inputs)
+        report: list[dict[str, object]] = []
+        for var, term in self.plan.terms_read():
+            fi = fis[var]
+            t = fi.terms[term]
+            if t.pwl is not None or not smooth_term(t):
+                continue
+            p = self.inputs[fi.slot]
+            where = f"term {t.name!r} of input {fi.name!r}"
+            a = approximate(t, where, p.scale, p.offset, p.low, p.high, tol, tolerance is None)
+            terms = list(fi.terms)
+            terms[term] = a
+            fis[var] = dataclasses.replace(fi, terms=tuple(terms))
+            report.append(
+                {
+                    "input": fi.name,
+                    "term": t.name,
+                    "kind": t.kind,
+                    "chords": max(len(a.knots) - 1, 1),
+                    "deviation": a.deviation,
+                    "tolerance": a.tolerance,
+                }
+            )
+        self.plan = dataclasses.replace(self.plan, fuzzy_inputs=tuple(fis))
+        return report
+
+    def smooth_membership(self, var: int, term: int, t: SmoothTerm) -> FX:
+        """The chords of a smooth term, found by bisection over the breakpoints (as many
+        comparisons as the tree is deep), with the proven deviation added to the error."""
+        fi = self.plan.fuzzy_inputs[var]
+        xv = Var(f"X_{fi.slot}")
+        ks, ys = t.knots, t.degrees
+        n = len(ks) - 1
+        leaves = [
+            self.linear_piece(
+                ks[j], ks[j + 1] - (j < n - 1), Fraction(ks[j]), ys[j], Fraction(ks[j + 1]), ys[j + 1], xv
+            )
+            for j in range(n)
+        ] or [self.degree_const(ys[0])]
+        v = self.declare(f"DEG_{var}_{term}", "narrow", comment=f"{fi.name} IS {t.name} ({n} chords)")
+
+        def tree(lo: int, hi: int) -> None:
+            if hi - lo <= 1:
+                self.b.set(v, fa.narrow(self.w, leaves[lo], "a degree").ex)
+                return
+            mid = (lo + hi) // 2
+            with self.b.if_(xv.lt(Int(ks[mid]))):
+                tree(lo, mid)
+            with self.b.else_():
+                tree(mid, hi)
+
+        tree(0, len(leaves))
+        lo, hi = min(x.lo for x in leaves), max(x.hi for x in leaves)
+        if lo < 0 or hi > self.D:
+            with self.b.if_(v.lt(Int(0))):
+                self.b.set(v, Int(0))
+            with self.b.elif_(v.gt(Int(self.D))):
+                self.b.set(v, Int(self.D))
+        err = max(x.err for x in leaves) + Fraction(t.deviation)
+        return FX(v, max(lo, 0), min(hi, self.D), self.dscale, err, False)
+
     def membership(self, var: int, term: int) -> FX:
         fi = self.plan.fuzzy_inputs[var]
         t = fi.terms[term]
+        if isinstance(t, SmoothTerm):
+            return self.smooth_membership(var, term, t)
         pts = t.pwl
         assert pts is not None
         port, xv = self.inputs[fi.slot], Var(f"X_{fi.slot}")
@@ -498,10 +597,15 @@ class FixedBlock:
 
 
 def build_fixed(
-    plan: Plan, arith: Arith, int_output: str = "scaled", ranges: dict[str, tuple[float, float]] | None = None
+    plan: Plan,
+    arith: Arith,
+    int_output: str = "scaled",
+    ranges: dict[str, tuple[float, float]] | None = None,
+    term_tolerance: float | None = None,
 ) -> FixedProgram:
     """The integer block of ``plan`` (raises :class:`CodegenError` naming what it cannot compute
-    or prove)."""
+    or prove).  Smooth input terms are computed as chords within ``term_tolerance`` degrees
+    (None: the arithmetic's default, see :mod:`fuzzyctl.ir.builders.fixed_smooth`)."""
     from fuzzyctl.ir.programs.fixed_outputs import emit_outputs
 
     if plan.options.emulate is not None:
@@ -511,6 +615,7 @@ def build_fixed(
     check_supported(plan)
     name = plan.name or "fuzzy"
     blk = FixedBlock(plan, arith, name, int_output, ranges or {})
+    approximations = blk.approximate_smooth(term_tolerance)
     for p in blk.inputs.values():
         blk.declare(
             p.name,
@@ -540,6 +645,12 @@ def build_fixed(
     ]
     for p in blk.inputs.values():
         header.append(f"input {p.name}: value = {p.formula()} (range {p.comment})")
+    for a in approximations:
+        header.append(
+            f"input {a['input']} IS {a['term']} ({a['kind']}): {a['chords']} chords, proven to deviate "
+            f"at most {a['deviation']:.3g} degrees from the term (tolerance {a['tolerance']:g}), "
+            "counted in the errors"
+        )
     for p in outputs:
         header.append(
             f"output {p.name}: value = {p.formula()}; worst-case error against the exact engine "
@@ -551,5 +662,10 @@ def build_fixed(
                 f"other set's height and the top's own jump levels more than {p.tie_margin:.3g} below or "
                 "away from it); the worst case includes the jump of the maximum where heights tie"
             )
-    prog = FixedProgram(name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header)
+    # what one cycle costs (a smooth term's bisection counts its deepest path only); the
+    # generator prints it in the header
+    spent = cost(Program(name, [], outer.root))
+    prog = FixedProgram(
+        name, arith, list(blk.inputs.values()), outputs, blk.decls, outer.root, header, approximations, spent
+    )
     return prog
