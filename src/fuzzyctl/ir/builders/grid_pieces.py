@@ -43,6 +43,37 @@ from fuzzyctl.kinds import norms
 LINEAR_ACCUS = frozenset(name for name, e in norms.ACCUMULATIONS.items() if e.idempotent or e.additive)
 
 
+#: Above this size (:func:`unrolled_size`) the straight-line form takes longer to compile and
+#: runs slower than the run-time grid's loops (:mod:`fuzzyctl.ir.builders.mamdani`), which its
+#: callers then take: a 3-input, 50-rule LM system with weighted conclusions (size 50,280)
+#: came to 28 MB of C and 150 s of ``cc -O3``; one of size 1,581 to 0.7 MB, 2.5 s and 2,063
+#: ns/row against the loops' 0.4 s and 378 ns/row.
+UNROLL_LIMIT = 1_000
+
+
+def unrolled_size(grid: GridPlan, sets: list[Set], accu: str) -> int:
+    """The size of the straight-line code :func:`pieces` writes, counted as :func:`_interval`
+    makes it: per interval, the compare-exchanges of its candidate points' insertion network
+    plus candidates times sets (the degree at each point)."""
+    total = 0
+    for j in range(len(grid.xs) - 1):
+        lines = [(grid.left[s.term][j], grid.right[s.term][j], s) for s in sets if s.term in grid.active[j]]
+        cands = sum(1 for left, right, s in lines if s.is_min and left != right)
+        if norms.is_max(accu):
+            flat = [[left == right for _p in range(2 if s.is_min else 1)] for left, right, s in lines]
+            for i in range(len(lines)):
+                for k in range(i + 1, len(lines)):
+                    # a MIN set's second part (its clip) is flat; two flat parts never cross
+                    cands += sum(
+                        1
+                        for pi, fi in enumerate(flat[i])
+                        for pk, fk in enumerate(flat[k])
+                        if not ((fi or pi == 1) and (fk or pk == 1))
+                    )
+        total += cands * (cands - 1) // 2 + cands * len(lines)
+    return total
+
+
 @dataclass(frozen=True)
 class Set:
     """One activated set: ``w * min(a, term)`` (``is_min``) or ``w * a * term``."""

@@ -135,7 +135,7 @@ class NativeBuilder(FastBuilder):
         the PLC block has no run-time form of is refused there, :func:`M.exact_outputs`)."""
         assert op.low is not None and op.high is not None
         accu = op.accu or "MAX"
-        if op.grid is not None and GP.applies(accu):
+        if op.grid is not None and GP.applies(accu) and not self._too_long(op, op.grid, groups, accu):
             return self._unrolled(op, op.grid, groups, accu)
         lit = Literals(self.g, "", "")
         points = [M.term_points(self, t, lit, lit, f"term {op.name}.{t.name}") for t in op.terms]
@@ -150,6 +150,16 @@ class NativeBuilder(FastBuilder):
         )
         value, fired = M.exact_outputs(self.g, [spec], None if op.grid is None else [op.grid])
         return value[0], fired[0]
+
+    @staticmethod
+    def _too_long(op: OutputPlan, grid: GridPlan, groups: list[Group], accu: str) -> bool:
+        """Straight-line code past :data:`GP.UNROLL_LIMIT`, for a method the run-time grid's
+        loops compute (same pieces, same results; they compile in seconds)."""
+        entry = METHODS[op.method]
+        if not (entry.integrating or entry.maximum is not None):
+            return False
+        sets = [GP.Set(gr.term, gr.a, gr.w, norms.is_min(gr.act)) for gr in groups]
+        return GP.unrolled_size(grid, sets, accu) > GP.UNROLL_LIMIT
 
     def _unrolled(self, op: OutputPlan, grid: GridPlan, groups: list[Group], accu: str) -> tuple[Ex, Ex]:
         """CoA, LM, RM, MoM on the constant grid as straight-line code: the pieces
