@@ -76,6 +76,7 @@ from fuzzyctl.ir.programs.fixed_mamdani import (
     crossings,
     lines_on,
     lower_area,
+    output_axis,
     refuse,
 )
 
@@ -310,19 +311,12 @@ def _bound(
 
 def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
     """The CoA of ``op`` in the integer block, and its port with the stated bound."""
-    from fuzzyctl.ir.programs.fixed_block import Port, output_scale
+    from fuzzyctl.ir.programs.fixed_block import Port
     from fuzzyctl.ir.programs.fixed_outputs import round_up
 
     w = blk.w
     assert op.grid is not None and op.low is not None and op.high is not None
-    nan = op.default is not None and not math.isfinite(op.default)
-    default = Fraction(0.0 if op.default is None or nan else op.default)
-    lo, hi = Fraction(op.low), Fraction(op.high)
-    if not nan:
-        lo, hi = min(lo, default), max(hi, default)
-    scale, offset = output_scale(lo, hi, blk.arith, blk.int_output, False)
-    xi = tuple((Fraction(x) - offset) / scale for x in op.grid.xs)
-    xlo, xhi = (Fraction(op.low) - offset) / scale, (Fraction(op.high) - offset) / scale
+    nan, default, scale, offset, xi, xlo, xhi = output_axis(blk, op)
     blk.b.comment(f"output {op.name}: centre of area (bisector) of the accumulated set (ACCU {op.accu})")
     sets = activated_sets(blk, op, rules)
     if not sets:

@@ -33,7 +33,7 @@ import itertools
 import math
 from dataclasses import dataclass, replace
 from fractions import Fraction
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 from fuzzyctl.engine.plan import OutputPlan
 from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
@@ -426,12 +426,24 @@ def _lower_area(
     return bounds.low, bounds.witness, bounds.witness_total
 
 
-def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
-    from fuzzyctl.ir.programs.fixed_block import Port, output_scale
+class OutputAxis(NamedTuple):
+    """A Mamdani output's stored units: NaN DEFAULT or not, the DEFAULT (0 for NaN), the
+    scaling (``value = stored * scale + offset``, from RANGE and DEFAULT), the grid and the
+    range in stored units."""
 
-    if METHODS[op.method].maximum is not None:
-        return maxima_output(blk, op, rules, info)
-    w = blk.w
+    nan: bool
+    default: Fraction
+    scale: Fraction
+    offset: Fraction
+    xi: tuple[Fraction, ...]
+    xlo: Fraction
+    xhi: Fraction
+
+
+def output_axis(blk: FixedBlock, op: OutputPlan) -> OutputAxis:
+    """The stored units of ``op`` (CoG, CoA and the maxima scale alike)."""
+    from fuzzyctl.ir.programs.fixed_block import output_scale
+
     assert op.grid is not None and op.low is not None and op.high is not None
     nan = op.default is not None and not math.isfinite(op.default)
     default = Fraction(0.0 if op.default is None or nan else op.default)
@@ -441,6 +453,17 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
     scale, offset = output_scale(lo, hi, blk.arith, blk.int_output, False)
     xi = tuple((Fraction(x) - offset) / scale for x in op.grid.xs)
     xlo, xhi = (Fraction(op.low) - offset) / scale, (Fraction(op.high) - offset) / scale
+    return OutputAxis(nan, default, scale, offset, xi, xlo, xhi)
+
+
+def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> Port:
+    from fuzzyctl.ir.programs.fixed_block import Port
+
+    if METHODS[op.method].maximum is not None:
+        return maxima_output(blk, op, rules, info)
+    w = blk.w
+    assert op.grid is not None and op.low is not None and op.high is not None
+    nan, default, scale, offset, xi, xlo, xhi = output_axis(blk, op)
     centre = round((xlo + xhi) / 2)
     blk.b.comment(f"output {op.name}: centre of gravity of the accumulated set (ACCU {op.accu})")
     sets = _sets(blk, op, rules)
