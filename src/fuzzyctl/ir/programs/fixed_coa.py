@@ -63,7 +63,6 @@ from fuzzyctl.engine.plan import OutputPlan
 from fuzzyctl.engine.reference.pwl import grid_pieces
 from fuzzyctl.engine.semantics.operators import CLIP_BRANCH
 from fuzzyctl.escape import CodegenError
-from fuzzyctl.ir.builders import fixed_arith as fa
 from fuzzyctl.ir.builders.fixed_arith import FX
 from fuzzyctl.ir.builders.fixed_bound import input_cells, rule_intervals
 from fuzzyctl.ir.nodes import Int, Var
@@ -78,6 +77,8 @@ from fuzzyctl.ir.programs.fixed_mamdani import (
     lower_area,
     output_axis,
     refuse,
+    store_default,
+    store_in_range,
 )
 
 if TYPE_CHECKING:
@@ -365,15 +366,9 @@ def coa_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) -> P
     with blk.b.if_(v["area"].gt(Int(0))):
         # a positive area: the cell found has 0 < num <= 2 den
         _position(blk, v, q, limit, area.hi)
-        with blk.b.if_(q.lt(Int(math.floor(xlo)))):
-            blk.b.set(q, Int(math.floor(xlo)))
-        with blk.b.elif_(q.gt(Int(math.ceil(xhi)))):
-            blk.b.set(q, Int(math.ceil(xhi)))
-        blk.b.set(out, fa.narrow(w, FX(q, slo, shi, Fraction(1), Fraction(0), True), "the output").ex)
+        store_in_range(blk, q, out, (xlo, xhi), (slo, shi))
     with blk.b.else_():
-        blk.b.set(info, Int(2))
-        if not op.no_change:
-            blk.b.set(out, Int(dflt))
+        store_default(blk, op, out, info, dflt)
     bound = round_up(err * scale)
     return Port(op.name, scale, offset, slo, shi, bound, comment=f"{float(op.low):g}..{float(op.high):g}")
 

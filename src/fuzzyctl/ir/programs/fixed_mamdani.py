@@ -426,6 +426,27 @@ def _lower_area(
     return bounds.low, bounds.witness, bounds.witness_total
 
 
+def store_in_range(
+    blk: FixedBlock, q: Var, out: Var, stored: tuple[Fraction, Fraction], limits: tuple[int, int]
+) -> None:
+    """``out := q`` limited to the output's range in stored units (the exact value lies in it:
+    limiting only brings the result closer), narrowed to the output's type (``limits``)."""
+    xlo, xhi = stored
+    with blk.b.if_(q.lt(Int(math.floor(xlo)))):
+        blk.b.set(q, Int(math.floor(xlo)))
+    with blk.b.elif_(q.gt(Int(math.ceil(xhi)))):
+        blk.b.set(q, Int(math.ceil(xhi)))
+    fx = FX(q, limits[0], limits[1], Fraction(1), Fraction(0), True)
+    blk.b.set(out, fa.narrow(blk.w, fx, "the output").ex)
+
+
+def store_default(blk: FixedBlock, op: OutputPlan, out: Var, info: Var, default: int) -> None:
+    """No rule fired: INFO 2, and the DEFAULT unless the output keeps its value (NC)."""
+    blk.b.set(info, Int(2))
+    if not op.no_change:
+        blk.b.set(out, Int(default))
+
+
 class OutputAxis(NamedTuple):
     """A Mamdani output's stored units: NaN DEFAULT or not, the DEFAULT (0 for NaN), the
     scaling (``value = stored * scale + offset``, from RANGE and DEFAULT), the grid and the
@@ -534,16 +555,9 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
         with blk.b.else_():
             blk.b.set(q, -((den / Int(2) - num) / den))
         blk.b.set(q, q + Int(centre))
-        # the exact centre lies in the range: limiting to it only brings the result closer
-        with blk.b.if_(q.lt(Int(math.floor(xlo)))):
-            blk.b.set(q, Int(math.floor(xlo)))
-        with blk.b.elif_(q.gt(Int(math.ceil(xhi)))):
-            blk.b.set(q, Int(math.ceil(xhi)))
-        blk.b.set(out, fa.narrow(w, FX(q, slo, shi, Fraction(1), Fraction(0), True), "the output").ex)
+        store_in_range(blk, q, out, (xlo, xhi), (slo, shi))
     with blk.b.else_():
-        blk.b.set(info, Int(2))
-        if not op.no_change:
-            blk.b.set(out, Int(dflt))
+        store_default(blk, op, out, info, dflt)
     from fuzzyctl.ir.programs.fixed_outputs import round_up
 
     bound = round_up(err * scale)
