@@ -71,11 +71,14 @@ from fuzzyctl.ir.programs.fixed_mamdani import (
     Pieces,
     accumulate,
     activated_sets,
+    check_clip_work,
+    clip_work,
     combine,
     crossings,
     lines_on,
     lower_area,
     output_axis,
+    piece_ends,
     refuse,
     store_default,
     store_in_range,
@@ -133,18 +136,14 @@ def _cells(
                 (j, lines, ta + (tb - ta) * Fraction(i, k), ta + (tb - ta) * Fraction(i + 1, k))
                 for i in range(k)
             ]
-        work = sum(2 * len(lines) - 1 for _j, lines, _a, _b in plan)
+        work = clip_work(plan)
         if work <= MAX_CLIPS or n <= 1:
             break
         n //= 2
-    if work > MAX_CLIPS:
-        raise refuse(
-            f"output {op.name!r}: {len(plan)} cells need {work} clipped-set integrals per cycle "
-            f"(more than {MAX_CLIPS})"
-        )
+    check_clip_work(op.name, f"{len(plan)} cells", plan)
     out = []
     for j, lines, ta, tb in plan:
-        a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
+        a, b = piece_ends(xi, j, ta, tb)
         # each set's line (MIN: clipped, PROD: scaled by its level) has at most its slope
         slopes = []
         for k, y0, y1 in lines:

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import itertools
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from fractions import Fraction
 from typing import TYPE_CHECKING, NamedTuple
@@ -315,15 +316,10 @@ class _Pieces:
             todo += [(j, lines, ta, tb) for ta, tb in itertools.pairwise(ts)]
         # the work grows with the pieces times the sets over each (distinct weights make distinct
         # sets): past a limit the block would be too long for a PLC cycle and for its compiler
-        work = sum(2 * len(lines) - 1 for _j, lines, _a, _b in todo)
-        if work > MAX_CLIPS:
-            raise _refuse(
-                f"output {self.op.name!r}: {len(self.sets)} activated sets over {len(todo)} pieces need "
-                f"{work} clipped-set integrals per cycle (more than {MAX_CLIPS})"
-            )
+        check_clip_work(self.op.name, f"{len(self.sets)} activated sets over {len(todo)} pieces", todo)
         out = []
         for j, lines, ta, tb in todo:
-            a, b = xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
+            a, b = piece_ends(xi, j, ta, tb)
             out.append(_Piece(a, b, self.piece(lines, ta, tb)))
         return out
 
@@ -424,6 +420,28 @@ def _lower_area(
         enough=0.75,
     )
     return bounds.low, bounds.witness, bounds.witness_total
+
+
+def clip_work(todo: Sequence[tuple[int, Sequence[object], Fraction, Fraction]]) -> int:
+    """Clipped-set integrals per cycle of pieces ``(interval, lines, ta, tb)``: a MAX
+    envelope of ``m`` lines takes ``2 m - 1``."""
+    return sum(2 * len(lines) - 1 for _j, lines, _a, _b in todo)
+
+
+def check_clip_work(
+    name: str, what: str, todo: Sequence[tuple[int, Sequence[object], Fraction, Fraction]]
+) -> None:
+    """Refuse an output whose pieces need more than :data:`MAX_CLIPS` integrals per cycle."""
+    work = clip_work(todo)
+    if work > MAX_CLIPS:
+        raise _refuse(
+            f"output {name!r}: {what} need {work} clipped-set integrals per cycle (more than {MAX_CLIPS})"
+        )
+
+
+def piece_ends(xi: tuple[Fraction, ...], j: int, ta: Fraction, tb: Fraction) -> tuple[Fraction, Fraction]:
+    """The stored abscissae of the fractions ``ta`` and ``tb`` of grid interval ``j``."""
+    return xi[j] + (xi[j + 1] - xi[j]) * ta, xi[j] + (xi[j + 1] - xi[j]) * tb
 
 
 def store_in_range(
