@@ -26,6 +26,7 @@ from enum import StrEnum
 from functools import cached_property
 from typing import TypeAlias
 
+from fuzzyctl.diagnostics import FuzzyctlError
 from fuzzyctl.kinds import methods as method_kinds
 from fuzzyctl.kinds.shapes import SHAPES as SHAPE_REGISTRY
 from fuzzyctl.kinds.shapes import Shape
@@ -565,6 +566,14 @@ class FunctionBlock:
         return any(t.lower is not None for v in blocks for t in v.terms)
 
 
+class UnknownBlock(FuzzyctlError, KeyError):
+    """A function block name the document does not have (a ``KeyError`` for lookups, and a
+    :class:`~fuzzyctl.diagnostics.FuzzyctlError` so the CLI reports it as bad input)."""
+
+    def __str__(self) -> str:  # KeyError would quote the message
+        return str(self.args[0]) if self.args else "no such function block"
+
+
 @dataclass(frozen=True)
 class Document:
     """A parsed file: one or more function blocks (IEC allows several per file)."""
@@ -586,7 +595,7 @@ class Document:
             if b.name == name:
                 return b
         known = ", ".join(repr(b.name) for b in self.blocks)
-        raise KeyError(f"no function block {name!r} (this file has {known})")
+        raise UnknownBlock(f"no function block {name!r} (this file has {known})")
 
 
 # --------------------------------------------------------------------------- keyword sets

@@ -68,8 +68,14 @@ def _controller(
     with usage_errors():
         check_samples(samples)  # before the file is read
     doc = fuzzyctl.load(file, strict=strict, format=fmt, compat=compat)
-    with usage_errors():
-        check_samples(samples, doc.block(block))
+    if samples is not None:
+        chosen: Any
+        try:
+            chosen = doc.block(block)
+        except KeyError:  # an unknown --block: compile() below says so
+            chosen = doc
+        with usage_errors():
+            check_samples(samples, chosen)
     extra: dict[str, Any] = {} if samples is None else {"samples": samples}
     ctl = fuzzyctl.compile(doc, block=block, compat=compat, strict=strict, **extra)
     from fuzzyctl.diagnostics import render_all

@@ -241,7 +241,12 @@ def emit(
     document = model if isinstance(model, Document) else fuzzyctl.load(model, strict=strict, format=format)
     caps = targets.cli_target(lang)
     refuse_type2(document, "codegen", caps.type2)  # (any block: --block errors come later)
-    check_samples(samples, document if block is None else document.block(block))
+    if samples is not None:
+        try:
+            chosen_block = document if block is None else document.block(block)
+        except KeyError:  # an unknown --block is reported below, by the generators
+            chosen_block = document
+        check_samples(samples, chosen_block)
     if "fmi" in caps.cli_options:
         return _fmu(document, output, fmi or 3, block, strict, default, force, binary, hint)
     emitted = Emitted(lang)
