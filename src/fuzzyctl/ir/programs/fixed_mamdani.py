@@ -71,12 +71,12 @@ MAX_CLIPS = 600
 _ACT = ("MIN", "PROD")
 
 
-def _combine(op: OutputPlan) -> str:
+def combine(op: OutputPlan) -> str:
     """How ``op``'s activated sets combine (its accumulation was checked to be computed)."""
     return _COMBINE[op.accu or "MAX"]
 
 
-def _refuse(what: str) -> CodegenError:
+def refuse(what: str) -> CodegenError:
     return CodegenError(f"{what} in integer arithmetic (use --arith float)")
 
 
@@ -87,21 +87,21 @@ def check_mamdani(op: OutputPlan, weight_before_activation: bool) -> None:
     if method.maximum is not None:
         check_maxima(op, weight_before_activation)
     elif not method.integrating:
-        raise _refuse(f"{name}: Mamdani METHOD {op.method} is not computed (COG, COA, LM, RM and MoM are)")
+        raise refuse(f"{name}: Mamdani METHOD {op.method} is not computed (COG, COA, LM, RM and MoM are)")
     if not op.exact or op.grid is None:
-        raise _refuse(f"{name}: terms that are not piecewise linear with constant points are not computed")
+        raise refuse(f"{name}: terms that are not piecewise linear with constant points are not computed")
     if op.accu not in _COMBINE:
-        raise _refuse(f"{name}: ACCU {op.accu} is not computed on fuzzy sets (MAX and SUM are)")
+        raise refuse(f"{name}: ACCU {op.accu} is not computed on fuzzy sets (MAX and SUM are)")
     for c in op.contributions:
         if c.term is None:
-            raise _refuse(f"{name}: a bare degree conclusion is not computed")
+            raise refuse(f"{name}: a bare degree conclusion is not computed")
         if c.act not in _ACT:
-            raise _refuse(f"{name}: ACT {c.act} is not computed (MIN and PROD are)")
+            raise refuse(f"{name}: ACT {c.act} is not computed (MIN and PROD are)")
     if weight_before_activation:
-        raise _refuse(f"{name}: weights applied before activation are not computed")
+        raise refuse(f"{name}: weights applied before activation are not computed")
     for t in op.terms:
         if t.pwl is None or any(not 0.0 <= y <= 1.0 for _x, y in t.pwl):
-            raise _refuse(f"{name}: term {t.name!r} with degrees outside 0..1 is not computed")
+            raise refuse(f"{name}: term {t.name!r} with degrees outside 0..1 is not computed")
 
 
 @dataclass(frozen=True)
@@ -114,7 +114,7 @@ class _Set:
     is_min: bool
 
 
-def _sets(blk: FixedBlock, op: OutputPlan, rules: list[FX]) -> list[_Set]:
+def activated_sets(blk: FixedBlock, op: OutputPlan, rules: list[FX]) -> list[_Set]:
     """The activated sets; under MAX, contributions of one term, activation and weight share
     one set whose level is their largest degree (``w min(a, T)`` grows with ``a``)."""
     from fuzzyctl.ir.programs.fixed_outputs import constant
@@ -123,7 +123,7 @@ def _sets(blk: FixedBlock, op: OutputPlan, rules: list[FX]) -> list[_Set]:
     for k, c in enumerate(op.contributions):
         if constant(c.weight) == 0.0:
             continue
-        key: object = (c.term, c.act, constant(c.weight)) if _combine(op) == "envelope" else k
+        key: object = (c.term, c.act, constant(c.weight)) if combine(op) == "envelope" else k
         keyed.setdefault(key, []).append(k)
     out = []
     for ks in keyed.values():
@@ -174,7 +174,7 @@ def _tau(blk: FixedBlock, x: FX, span: Fraction) -> FX:
             return blk.limited(fa.rdiv(w, prod, 1 << s), 0, blk.D)
         except CodegenError:
             continue
-    raise _refuse("a clipped output line: its slope does not fit the wide type")
+    raise refuse("a clipped output line: its slope does not fit the wide type")
 
 
 def _clip(blk: FixedBlock, level: FX, y0: Fraction, y1: Fraction) -> tuple[FX, FX]:
@@ -231,7 +231,7 @@ class _Piece:
     parts: list[tuple[FX, FX]]
 
 
-def _lines(op: OutputPlan, sets: list[_Set], j: int) -> list[tuple[int, Fraction, Fraction]]:
+def lines_on(op: OutputPlan, sets: list[_Set], j: int) -> list[tuple[int, Fraction, Fraction]]:
     """``(set, value at the left end, at the right end)`` of the sets nonzero on interval ``j``."""
     assert op.grid is not None
     g = op.grid
@@ -244,7 +244,7 @@ def _lines(op: OutputPlan, sets: list[_Set], j: int) -> list[tuple[int, Fraction
     return out
 
 
-def _cuts(lines: list[tuple[int, Fraction, Fraction]]) -> list[Fraction]:
+def crossings(lines: list[tuple[int, Fraction, Fraction]]) -> list[Fraction]:
     """0, 1 and the points (as fractions of the interval) where two lines cross."""
     ts = {Fraction(0), Fraction(1)}
     for i, (_k, a0, a1) in enumerate(lines):
@@ -255,7 +255,7 @@ def _cuts(lines: list[tuple[int, Fraction, Fraction]]) -> list[Fraction]:
     return sorted(ts)
 
 
-class _Pieces:
+class Pieces:
     def __init__(self, blk: FixedBlock, op: OutputPlan, sets: list[_Set]) -> None:
         self.blk, self.op, self.sets = blk, op, sets
         self.prefix: dict[frozenset[int], FX] = {}
@@ -275,14 +275,14 @@ class _Pieces:
         """Area and moment on the part ``[ta, tb]`` of an interval where no two lines cross."""
         blk, w = self.blk, self.blk.w
         ends = [(k, y0 + (y1 - y0) * ta, y0 + (y1 - y0) * tb) for k, y0, y1 in lines]
-        if _combine(self.op) == "sum" or len(ends) == 1:
+        if combine(self.op) == "sum" or len(ends) == 1:
             out = []
             for k, y0, y1 in ends:
                 s = self.sets[k]
                 out.append(_clip(blk, s.level, y0, y1) if s.is_min else _scaled(blk, s.level, y0, y1))
             return out
         if not all(self.sets[k].is_min for k, _a, _b in ends):
-            raise _refuse(
+            raise refuse(
                 f"output {self.op.name!r}: PROD activation of sets that overlap under ACCU MAX "
                 "is not computed"
             )
@@ -309,10 +309,10 @@ class _Pieces:
         for j in range(len(xi) - 1):
             if xi[j + 1] <= xi[j]:
                 continue
-            lines = _lines(self.op, self.sets, j)
+            lines = lines_on(self.op, self.sets, j)
             if not lines:
                 continue
-            ts = _cuts(lines) if _combine(self.op) == "envelope" else [Fraction(0), Fraction(1)]
+            ts = crossings(lines) if combine(self.op) == "envelope" else [Fraction(0), Fraction(1)]
             todo += [(j, lines, ta, tb) for ta, tb in itertools.pairwise(ts)]
         # the work grows with the pieces times the sets over each (distinct weights make distinct
         # sets): past a limit the block would be too long for a PLC cycle and for its compiler
@@ -340,14 +340,14 @@ def _scaled(blk: FixedBlock, level: FX, y0: Fraction, y1: Fraction) -> tuple[FX,
             except CodegenError:
                 continue
         else:
-            raise _refuse(f"output: a PROD-activated set's integral does not fit ({float(c):g})")
+            raise refuse(f"output: a PROD-activated set's integral does not fit ({float(c):g})")
     return out[0], out[1]
 
 
 # --------------------------------------------------------------------------- sums and quotient
 
 
-def _accumulate(
+def accumulate(
     blk: FixedBlock, name: str, terms: list[list[tuple[FX, Fraction]]], what: str
 ) -> tuple[FX, list[tuple[Var, object]]]:
     """``name := sum over pieces of sum x * c`` (``x`` degrees, ``c`` constants), the constants
@@ -375,14 +375,14 @@ def _accumulate(
                 stmts.append((var, acc.ex))
                 acc = fa.var(name, acc)
             if acc is None:
-                raise _refuse(f"{what}: the output has no set")
+                raise refuse(f"{what}: the output has no set")
             return acc, stmts
         except CodegenError:
             continue
-    raise _refuse(f"{what} does not fit the wide type")
+    raise refuse(f"{what} does not fit the wide type")
 
 
-def _lower_area(
+def lower_area(
     blk: FixedBlock, op: OutputPlan, xi: tuple[Fraction, ...]
 ) -> tuple[float, dict[int, float], float]:
     """A lower bound of the exact area (in stored output units times degree) over every
@@ -434,7 +434,7 @@ def check_clip_work(
     """Refuse an output whose pieces need more than :data:`MAX_CLIPS` integrals per cycle."""
     work = clip_work(todo)
     if work > MAX_CLIPS:
-        raise _refuse(
+        raise refuse(
             f"output {name!r}: {what} need {work} clipped-set integrals per cycle (more than {MAX_CLIPS})"
         )
 
@@ -505,21 +505,21 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
     nan, default, scale, offset, xi, xlo, xhi = output_axis(blk, op)
     centre = round((xlo + xhi) / 2)
     blk.b.comment(f"output {op.name}: centre of gravity of the accumulated set (ACCU {op.accu})")
-    sets = _sets(blk, op, rules)
+    sets = activated_sets(blk, op, rules)
     if not sets:
-        raise _refuse(f"output {op.name!r}: concluded by no rule, it has no integer form")
-    pieces = _Pieces(blk, op, sets).all(xi)
+        raise refuse(f"output {op.name!r}: concluded by no rule, it has no integer form")
+    pieces = Pieces(blk, op, sets).all(xi)
     if not pieces:
-        raise _refuse(f"output {op.name!r}: its sets are empty on its range")
-    low_area, witness, witness_total = _lower_area(blk, op, xi)
+        raise refuse(f"output {op.name!r}: its sets are empty on its range")
+    low_area, witness, witness_total = lower_area(blk, op, xi)
     n = len(blk.decls)
-    area, a_stmts = _accumulate(
+    area, a_stmts = accumulate(
         blk,
         f"AREA_{n}",
         [[(a, p.b - p.a) for a, _m in p.parts] for p in pieces],
         f"output {op.name!r}: the area",
     )
-    moment, m_stmts = _accumulate(
+    moment, m_stmts = accumulate(
         blk,
         f"MOMENT_{n}",
         [
@@ -559,9 +559,9 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
     dflt = 0 if nan else round((default - offset) / scale)
     slo, shi = min(slo, dflt), max(shi, dflt)
     if not w.fits(slo, shi, False):
-        raise _refuse(f"output {op.name!r}: may overflow its type")
+        raise refuse(f"output {op.name!r}: may overflow its type")
     if not w.fits(moment.lo - area.hi, moment.hi + area.hi, True):
-        raise _refuse(f"output {op.name!r}: the rounded quotient does not fit the wide type")
+        raise refuse(f"output {op.name!r}: the rounded quotient does not fit the wide type")
     out = blk.declare(
         op.name, "narrow", "output", comment=f"value = stored * {float(scale)!r} + {float(offset)!r}"
     )
@@ -580,14 +580,3 @@ def mamdani_output(blk: FixedBlock, op: OutputPlan, rules: list[FX], info: Var) 
 
     bound = round_up(err * scale)
     return Port(op.name, scale, offset, slo, shi, bound, comment=f"{float(op.low):g}..{float(op.high):g}")
-
-
-# the steps shared with the other Mamdani methods (fixed_coa: the bisector)
-refuse = _refuse
-combine = _combine
-activated_sets = _sets
-lines_on = _lines
-crossings = _cuts
-Pieces = _Pieces
-accumulate = _accumulate
-lower_area = _lower_area
