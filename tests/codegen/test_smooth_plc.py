@@ -153,6 +153,7 @@ def test_st_lreal_every_method_on_a_fixed_smooth_system(method: str) -> None:
         check(fb, plan, data, got, want, 1e-9)
 
 
+@pytest.mark.extra("matiec")
 @pytest.mark.parametrize("real", ["LREAL", "REAL"])
 def test_matiec_every_method_of_smooth_sets(real: str, tmp_path: Path) -> None:
     """matiec-compiled ST against the reference: LREAL as the C, REAL within 1e-4 of the range
@@ -193,6 +194,7 @@ def test_c_bench_passes_and_fails_on_a_wrong_expected_value(method: str, off: fl
     assert _run_bench(tampered, tmp_path / "bad") == "FAIL FAIL_COUNT=1 FIRST_FAIL=3 rc=1"
 
 
+@pytest.mark.extra("plcopen")
 @pytest.mark.parametrize("method", METHODS_SWEPT)
 def test_plcopen_of_every_method_is_valid(method: str) -> None:
     doc = fuzzyctl.load(CLIPPED.replace("METHOD : COG", f"METHOD : {method}"))
